@@ -1,0 +1,71 @@
+"""Exception types raised by pneumorph.
+
+Every error a user can cause derives from :class:`PneumorphError`, so a caller can catch
+them all at once; each subclass also derives from the built-in exception that describes
+it best (``ValueError``, ``KeyError``), so generic handlers keep working.
+"""
+
+from __future__ import annotations
+
+
+class PneumorphError(Exception):
+    """Base class of all errors raised on purpose by pneumorph."""
+
+
+class UnknownMaterialError(PneumorphError, KeyError):
+    """A material name that is not in the library.
+
+    Parameters
+    ----------
+    name : str
+        The name that was asked for.
+    known : sequence of str
+        The names the library holds; listed in the message.
+    """
+
+    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return f"unknown material {self.name!r}; known materials: {', '.join(self.known)}"
+
+
+class UnknownModelError(PneumorphError, KeyError):
+    """A constitutive model name that pneumorph does not implement."""
+
+    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return f"unknown model {self.name!r}; known models: {', '.join(self.known)}"
+
+
+class DataFormatError(PneumorphError, ValueError):
+    """Test data that cannot be read: wrong columns, NaN, non-monotonic stretch, ...
+
+    The message names the file, the row (1-based, as a text editor shows it) and what was
+    expected.
+    """
+
+    def __init__(self, message: str, path: str | None = None, row: int | None = None) -> None:
+        self.path = path
+        self.row = row
+        where = ""
+        if path is not None:
+            where = f"{path}"
+            if row is not None:
+                where += f", row {row}"
+            where += ": "
+        super().__init__(where + message)
+
+
+class MaterialDataError(PneumorphError, ValueError):
+    """A material definition (library or user TOML) that is incomplete or inconsistent."""
+
+
+class FitError(PneumorphError, RuntimeError):
+    """A model fit that could not be carried out (too few points, optimiser failure)."""
