@@ -69,3 +69,27 @@ class MaterialDataError(PneumorphError, ValueError):
 
 class FitError(PneumorphError, RuntimeError):
     """A model fit that could not be carried out (too few points, optimiser failure)."""
+
+
+class PressureRangeError(PneumorphError, ValueError):
+    """A pressure outside the range in which a pressure-dependent law was calibrated.
+
+    Parameters
+    ----------
+    pressure : float
+        The pressure asked for, in MPa.
+    lower, upper : float
+        The calibrated range, in MPa.
+    what : str
+        What the range belongs to (named in the message).
+    """
+
+    def __init__(self, pressure: float, lower: float, upper: float, what: str = "law") -> None:
+        self.pressure = pressure
+        self.lower = lower
+        self.upper = upper
+        super().__init__(
+            f"pressure {pressure * 1e3:.6g} kPa is outside the calibrated range "
+            f"{lower * 1e3:.6g}-{upper * 1e3:.6g} kPa of the {what}; "
+            "recalibrate the law for this range instead of extrapolating"
+        )
