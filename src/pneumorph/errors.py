@@ -93,3 +93,33 @@ class PressureRangeError(PneumorphError, ValueError):
             f"{lower * 1e3:.6g}-{upper * 1e3:.6g} kPa of the {what}; "
             "recalibrate the law for this range instead of extrapolating"
         )
+
+
+class SimulationFailed(PneumorphError, RuntimeError):
+    """A finite-element solve that did not converge.
+
+    Parameters
+    ----------
+    reached : float
+        The last converged load factor (0 = unloaded, 1 = the full load).
+    cause : str
+        Why it stopped (e.g. Newton did not converge after the allowed cut-backs).
+    design : str, optional
+        The orientation vector of the design, as a string of digits.
+    pressure : float, optional
+        The full pressure of the ramp, in MPa; the message then names the pressure reached.
+    """
+
+    def __init__(
+        self, reached: float, cause: str, design: str | None = None, pressure: float | None = None
+    ) -> None:
+        self.reached = reached
+        self.cause = cause
+        self.design = design
+        self.pressure = pressure
+        what = f"design {design}: " if design else ""
+        if pressure is not None:
+            where = f"converged up to {reached * pressure * 1e3:.4g} kPa of {pressure * 1e3:.4g} kPa"
+        else:
+            where = f"converged up to load factor {reached:.4g}"
+        super().__init__(f"{what}simulation failed, {where}: {cause}")
