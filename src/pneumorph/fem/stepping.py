@@ -1,0 +1,224 @@
+"""Quasi-static load stepping on FElupe with reported levels, cut-back and a predictor.
+
+A ramp from load factor 0 to 1 is reported at ``increments`` equally spaced levels (the
+dissertation's "method 2", section 4.3: one solve gives the response at ten pressures).
+Between two reported levels the solver takes ``substeps`` Newton solves; a substep that
+fails is halved (cut-back) without changing the reported levels. Each substep starts from
+the linear extrapolation of the last two converged states, which keeps the very soft
+bending mode of a long actuator from costing hundreds of Newton iterations.
+
+Everything a load factor changes (cavity pressure, a pressure-dependent filler modulus)
+is set by one callable ``apply(t)``, so the stepping knows nothing about the model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.errors import SimulationFailed
+
+
+@dataclass(frozen=True)
+class StepSettings:
+    """Settings of a load ramp.
+
+    Parameters
+    ----------
+    increments : int
+        Number of reported, equally spaced load levels (the last one is the full load).
+    substeps : int
+        Substeps per reported increment before any cut-back.
+    max_cutbacks : int
+        How many times a failed substep may be halved before the solve is abandoned.
+    max_iterations : int
+        Newton iterations allowed per substep.
+    tolerance : float
+        Convergence tolerance of FElupe's Newton method on the residual norm.
+    predictor : bool
+        Start each substep from the linear extrapolation of the last two converged states.
+
+    Examples
+    --------
+    >>> StepSettings(increments=10, substeps=2).levels()[:3]
+    array([0.1, 0.2, 0.3])
+    """
+
+    increments: int = 10
+    substeps: int = 2
+    max_cutbacks: int = 6
+    max_iterations: int = 16
+    tolerance: float = 1e-8
+    predictor: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("increments", "substeps", "max_iterations"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
+        if self.max_cutbacks < 0:
+            raise ValueError(f"max_cutbacks must be >= 0, got {self.max_cutbacks}")
+        if not self.tolerance > 0:
+            raise ValueError(f"tolerance must be positive, got {self.tolerance}")
+
+    def levels(self) -> NDArray[np.float64]:
+        """The reported load factors ``1/n, 2/n, ..., 1``."""
+        return np.arange(1, self.increments + 1) / self.increments
+
+
+@dataclass
+class RampStatistics:
+    """What a ramp cost: Newton iterations and substeps, cut-backs."""
+
+    newton_iterations: int = 0
+    substeps: int = 0
+    cutbacks: int = 0
+    reached: float = 0.0
+    history: list[tuple[float, int]] = field(default_factory=list)
+
+
+def _min_jacobian(fields: Any) -> float:
+    """Smallest det F over all quadrature points of the displacement field."""
+    import felupe as fem
+
+    F = fields[0].extract(grad=True, sym=False, add_identity=True)
+    return float(np.min(fem.math.det(F)))
+
+
+def _solve_substep(
+    items: Sequence[Any],
+    fields: Any,
+    dof1: NDArray[np.int64],
+    dof0: NDArray[np.int64],
+    settings: StepSettings,
+) -> tuple[int, str | None]:
+    """One Newton solve; returns (iterations, cause of failure or None)."""
+    import felupe as fem
+
+    try:
+        res = fem.newtonraphson(
+            items=list(items),
+            x0=fields,
+            dof1=dof1,
+            dof0=dof0,
+            tol=settings.tolerance,
+            maxiter=settings.max_iterations,
+            verbose=0,
+        )
+    except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError) as exc:
+        return settings.max_iterations, f"{type(exc).__name__}: {exc}"
+    iterations = int(res.iterations)
+    if not res.success:
+        return iterations, "Newton iterations did not reach the tolerance"
+    if not all(np.all(np.isfinite(f.values)) for f in fields.fields):
+        return iterations, "the solution is not finite"
+    jmin = _min_jacobian(fields)
+    if not jmin > 0.0:
+        return iterations, f"an element inverted (det F = {jmin:.3g})"
+    return iterations, None
+
+
+def _values(fields: Any) -> list[NDArray[np.float64]]:
+    return [f.values.copy() for f in fields.fields]
+
+
+def _restore(fields: Any, values: Sequence[NDArray[np.float64]]) -> None:
+    for f, v in zip(fields.fields, values):
+        f.values[:] = v
+
+
+def ramp(
+    items: Sequence[Any],
+    fields: Any,
+    apply: Callable[[float], None],
+    dof1: NDArray[np.int64],
+    dof0: NDArray[np.int64],
+    settings: StepSettings = StepSettings(),
+    on_level: Callable[[int, float], None] | None = None,
+    monitor: Callable[[], float] | None = None,
+) -> RampStatistics:
+    """Ramp a FElupe model from load factor 0 to 1.
+
+    Parameters
+    ----------
+    items : sequence
+        FElupe items (solid bodies, pressure bodies) whose sum is the residual.
+    fields : felupe.FieldContainer
+        The unknowns; updated in place, ending in the converged state at factor 1.
+    apply : callable
+        ``apply(t)`` sets every load and load-dependent property for factor ``t``.
+    dof1, dof0 : ndarray
+        Active and prescribed degrees of freedom (prescribed values are held fixed).
+    settings : StepSettings
+        Increments, substeps, cut-back and Newton settings.
+    on_level : callable, optional
+        ``on_level(k, t)`` is called after reported level ``k`` (0-based) has converged,
+        with the fields in that state: read the results there.
+    monitor : callable, optional
+        ``monitor()`` returns a scalar of the current state that cannot decrease along a
+        stable, rising pressure ramp - the cavity volume, the work-conjugate of the
+        pressure. A substep that converges to a state with a smaller value has jumped to
+        another (non-physical or unstable) branch and is cut back like a failed one.
+
+    Returns
+    -------
+    RampStatistics
+
+    Raises
+    ------
+    SimulationFailed
+        If a substep still fails after ``max_cutbacks`` halvings; ``reached`` is the last
+        converged load factor and the fields hold that state.
+    """
+    stats = RampStatistics()
+    prev: list[NDArray[np.float64]] | None = None
+    t_prev = 0.0
+    current = _values(fields)
+    t_now = 0.0
+    apply(0.0)
+    watched = monitor() if monitor is not None else 0.0
+    for k, level in enumerate(settings.levels()):
+        dt = 1.0 / (settings.increments * settings.substeps)
+        cutbacks_here = 0
+        while t_now < level - 1e-12:
+            t_try = min(t_now + dt, level)
+            if settings.predictor and prev is not None and t_now > t_prev:
+                s = (t_try - t_now) / (t_now - t_prev)
+                _restore(fields, [c + s * (c - p) for c, p in zip(current, prev)])
+            apply(t_try)
+            iterations, cause = _solve_substep(items, fields, dof1, dof0, settings)
+            stats.newton_iterations += iterations
+            value = watched
+            if cause is None and monitor is not None:
+                value = monitor()
+                if value < watched:
+                    cause = f"the monitored quantity fell from {watched:.6g} to {value:.6g}"
+            if cause is None:
+                watched = value
+                prev, t_prev = current, t_now
+                current, t_now = _values(fields), t_try
+                stats.substeps += 1
+                stats.history.append((t_now, iterations))
+                cutbacks_here = 0
+                # grow back towards the nominal substep after a successful cut-back
+                dt = min(2 * dt, 1.0 / (settings.increments * settings.substeps))
+                continue
+            _restore(fields, current)
+            apply(t_now)
+            cutbacks_here += 1
+            stats.cutbacks += 1
+            if cutbacks_here > settings.max_cutbacks:
+                stats.reached = t_now
+                raise SimulationFailed(
+                    reached=t_now,
+                    cause=f"no convergence at load factor {t_try:.4g} after "
+                    f"{settings.max_cutbacks} cut-backs ({cause})",
+                )
+            dt /= 2.0
+        stats.reached = t_now
+        if on_level is not None:
+            on_level(k, level)
+    return stats
