@@ -123,3 +123,18 @@ class SimulationFailed(PneumorphError, RuntimeError):
         else:
             where = f"converged up to load factor {reached:.4g}"
         super().__init__(f"{what}simulation failed, {where}: {cause}")
+
+
+class UnknownDatasetError(PneumorphError, KeyError):
+    """A name that is neither a readable data file nor a bundled test-data set."""
+
+    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return (
+            f"no data file or bundled data set named {self.name!r}; "
+            f"bundled data sets: {', '.join(self.known) or 'none'}"
+        )

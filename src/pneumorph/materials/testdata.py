@@ -1,0 +1,566 @@
+"""Reading stress-stretch test data of rubber-like materials.
+
+A :class:`TestCurve` is one homogeneous test (uniaxial tension and/or compression,
+equibiaxial tension or planar tension, i.e. pure shear) as stretch against *nominal*
+stress in MPa; a :class:`TestData` holds the curves of one material, any number per mode.
+
+:func:`read_curve` reads the usual text layouts:
+
+- delimiter comma, semicolon, tab or whitespace, detected from the first line (with a
+  semicolon, tab or whitespace delimiter a decimal comma is accepted);
+- an optional header row; column roles are read from it where it names them
+  (``stretch``/``lambda``, ``strain``, ``stress``, ``true``, ``%``, a unit in brackets),
+  else given with ``columns``, e.g. ``("stress", "stretch")`` for files with stress first;
+- the x column as stretch, engineering strain or true (logarithmic) strain, as a fraction
+  or in percent;
+- the stress as nominal (engineering) or true (Cauchy) stress in MPa, kPa, Pa, N/mm^2,
+  kgf/cm^2 or psi. True stress is turned into nominal stress with incompressibility: in
+  all three modes the loaded direction has ``sigma = P * lambda`` (uniaxial ``F = diag(l,
+  l^-1/2, l^-1/2)``, equibiaxial ``diag(l, l, l^-2)``, planar ``diag(l, 1, l^-1)``, all
+  with ``J = 1``), so ``P = sigma / lambda``;
+- the format of the Soft Robotics Materials Database (Marechal et al. 2021): a
+  ``PARAMETER;INFO;URL`` block of metadata, a blank line, the header
+  ``Time (s);True Strain;True Stress (MPa);Engineering Strain;Engineering Stress (MPa)``.
+  It is recognised automatically; the metadata are kept and the engineering columns used.
+
+Curves must be monotonic in stretch. ``truncate`` keeps part of a curve that is not:
+``"loading"`` keeps the rows up to the largest stretch (drops an unloading branch),
+``"peak-stress"`` keeps the rows up to the largest stress (drops what follows failure).
+Pull-to-failure tests of the database are truncated at the peak stress by default: the
+rows after it record the specimen tearing, not the material law.
+
+Examples
+--------
+>>> data = load_dataset("treloar1944")
+>>> data.modes
+('uniaxial', 'equibiaxial', 'planar')
+>>> c = data.curve("uniaxial")
+>>> len(c.stretch), float(c.stretch[-1]), round(float(c.stress[-1]), 4)
+(25, 7.6, 6.3176)
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from types import MappingProxyType
+from typing import ClassVar
+
+import numpy as np
+
+from pneumorph.errors import DataFormatError, UnknownDatasetError
+from pneumorph.materials.hyperelastic import MODES, FloatArray
+
+#: Stress units understood by the readers and their factor to MPa.
+STRESS_UNITS: Mapping[str, float] = MappingProxyType(
+    {
+        "mpa": 1.0,
+        "n/mm^2": 1.0,
+        "n/mm2": 1.0,
+        "kpa": 1e-3,
+        "pa": 1e-6,
+        "kgf/cm^2": 0.0980665,
+        "kgf/cm2": 0.0980665,
+        "kg/cm^2": 0.0980665,
+        "psi": 0.00689475729,
+    }
+)
+#: Column roles for ``columns=``; ``"skip"`` ignores a column.
+COLUMN_ROLES = ("stretch", "strain", "true-strain", "stress", "skip")
+TRUNCATE = ("none", "loading", "peak-stress")
+_SORO_MARK = "parameter;info"
+_MODE_WORDS = {
+    "uniaxial": ("ut", "uc", "uni", "uniaxial", "tension", "tensile", "compression"),
+    "equibiaxial": ("et", "eb", "bt", "equibiaxial", "biaxial", "equibi"),
+    "planar": ("ps", "pt", "planar", "pureshear", "shear"),
+}
+
+
+@dataclass(frozen=True, eq=False)
+class TestCurve:
+    """One homogeneous test: stretch against nominal stress.
+
+    Attributes
+    ----------
+    mode : {"uniaxial", "equibiaxial", "planar"}
+        Loading mode; uniaxial curves may include compression (``stretch < 1``).
+    stretch : ndarray
+        Stretch in the loaded direction, strictly increasing (read-only).
+    stress : ndarray
+        Nominal (engineering, first Piola-Kirchhoff) stress in MPa (read-only).
+    source : str or None
+        File the curve was read from.
+    description : str
+        Free text (material, test).
+    metadata : mapping of str to str
+        Metadata found in the file (the database's ``PARAMETER;INFO`` block).
+    notes : tuple of str
+        What was done to the numbers: unit scaling, conversions, truncation.
+    """
+
+    __test__: ClassVar[bool] = False  # not a pytest test class
+
+    mode: str
+    stretch: FloatArray
+    stress: FloatArray
+    source: str | None = None
+    description: str = ""
+    metadata: Mapping[str, str] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ValueError(f"unknown loading mode {self.mode!r}; expected one of {MODES}")
+        lam = np.array(self.stretch, dtype=float)
+        p = np.array(self.stress, dtype=float)
+        if lam.ndim != 1 or lam.shape != p.shape:
+            raise ValueError("stretch and stress must be 1-D arrays of the same length")
+        lam.setflags(write=False)
+        p.setflags(write=False)
+        object.__setattr__(self, "stretch", lam)
+        object.__setattr__(self, "stress", p)
+        object.__setattr__(self, "metadata", MappingProxyType(dict(self.metadata)))
+        object.__setattr__(self, "notes", tuple(self.notes))
+
+    def __len__(self) -> int:
+        return int(self.stretch.size)
+
+
+@dataclass(frozen=True, eq=False)
+class TestData:
+    """The test curves of one material, any number per mode.
+
+    Attributes
+    ----------
+    curves : tuple of TestCurve
+    name : str
+        A short name (file stem or dataset name) for tables and figures.
+    """
+
+    __test__: ClassVar[bool] = False
+
+    curves: tuple[TestCurve, ...]
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "curves", tuple(self.curves))
+        if not self.curves:
+            raise ValueError("TestData needs at least one curve")
+
+    @property
+    def modes(self) -> tuple[str, ...]:
+        """Modes present, in the order uniaxial, equibiaxial, planar."""
+        return tuple(m for m in MODES if any(c.mode == m for c in self.curves))
+
+    @property
+    def sources(self) -> tuple[str, ...]:
+        """Files the curves came from."""
+        return tuple(c.source for c in self.curves if c.source)
+
+    def curve(self, mode: str) -> TestCurve:
+        """All points of ``mode`` as one curve, sorted by stretch."""
+        parts = [c for c in self.curves if c.mode == mode]
+        if not parts:
+            raise KeyError(f"no {mode} data in {self.name or 'this data'}; modes: {self.modes}")
+        if len(parts) == 1:
+            return parts[0]
+        lam = np.concatenate([c.stretch for c in parts])
+        p = np.concatenate([c.stress for c in parts])
+        order = np.argsort(lam, kind="stable")
+        return TestCurve(
+            mode, lam[order], p[order], source=", ".join(c.source or "?" for c in parts),
+            description="; ".join(c.description for c in parts if c.description),
+            notes=tuple(n for c in parts for n in c.notes),
+        )
+
+    def restrict(self, min_stretch: float | None = None, max_stretch: float | None = None) -> TestData:
+        """Only the points with ``min_stretch <= stretch <= max_stretch``.
+
+        Examples
+        --------
+        >>> len(load_dataset("treloar1944").restrict(max_stretch=3.0).curve("uniaxial"))
+        9
+        """
+        lo = -math.inf if min_stretch is None else min_stretch
+        hi = math.inf if max_stretch is None else max_stretch
+        out = []
+        for c in self.curves:
+            keep = (c.stretch >= lo) & (c.stretch <= hi)
+            if keep.any():
+                note = f"restricted to stretch {lo:g}-{hi:g} ({int(keep.sum())} of {len(c)} points)"
+                out.append(TestCurve(c.mode, c.stretch[keep], c.stress[keep], c.source,
+                                     c.description, c.metadata, c.notes + (note,)))
+        if not out:
+            raise DataFormatError(f"no data point has a stretch between {lo:g} and {hi:g}",
+                                  path=self.name or None)
+        return TestData(tuple(out), self.name)
+
+
+def guess_mode(path: str | Path) -> str | None:
+    """Loading mode named in a file's name or folder (``Treloar_ut.dat``, ``PS/...``).
+
+    Examples
+    --------
+    >>> guess_mode("Treloar_et.dat"), guess_mode("data/PS/stress_stretch.txt"), guess_mode("x.csv")
+    ('equibiaxial', 'planar', None)
+    """
+    p = Path(path)
+    words = re.split(r"[^a-z0-9]+", f"{p.parent.name} {p.stem}".lower().replace("pure shear", "pureshear"))
+    found = {mode for mode, names in _MODE_WORDS.items() for w in words if w in names}
+    return found.pop() if len(found) == 1 else None
+
+
+def _stress_unit_factor(unit: str, path: str) -> float:
+    key = unit.strip().lower().replace(" ", "")
+    if key not in STRESS_UNITS:
+        raise DataFormatError(f"unknown stress unit {unit!r}; expected one of "
+                              "MPa, N/mm^2, kPa, Pa, kgf/cm^2, psi", path=path)
+    return STRESS_UNITS[key]
+
+
+def _split(line: str, delimiter: str | None) -> list[str]:
+    cells = line.split() if delimiter is None else [c.strip() for c in line.split(delimiter)]
+    while cells and cells[-1] == "":
+        cells.pop()
+    return cells
+
+
+def _number(cell: str, delimiter: str | None) -> float:
+    if delimiter != "," and "," in cell and "." not in cell:
+        cell = cell.replace(",", ".")  # decimal comma
+    return float(cell)
+
+
+def _is_numeric_row(cells: list[str], delimiter: str | None) -> bool:
+    try:
+        for c in cells:
+            _number(c, delimiter)
+    except ValueError:
+        return False
+    return True
+
+
+def _roles_from_header(header: list[str]) -> tuple[list[str], dict[str, str]] | None:
+    """Column roles, and what the header says of units and kinds; None if it cannot tell."""
+    kinds = []
+    for h in header:
+        t = h.lower()
+        if "stress" in t:
+            kinds.append(("stress", "true" if re.search(r"true|cauchy", t) else "nominal"))
+        elif "stretch" in t or "lambda" in t:
+            kinds.append(("stretch", ""))
+        elif "strain" in t:
+            kinds.append(("true-strain" if re.search(r"true|log|hencky", t) else "strain", ""))
+        else:
+            kinds.append(("skip", ""))
+    stress = [i for i, k in enumerate(kinds) if k[0] == "stress"]
+    xs = [i for i, k in enumerate(kinds) if k[0] in ("stretch", "strain", "true-strain")]
+    if not stress or not xs:
+        return None
+    # prefer nominal stress and stretch > engineering strain > true strain
+    s = min(stress, key=lambda i: kinds[i][1] != "nominal")
+    x = min(xs, key=lambda i: ("stretch", "strain", "true-strain").index(kinds[i][0]))
+    roles = ["skip"] * len(header)
+    roles[s], roles[x] = "stress", kinds[x][0]
+    info = {"stress_kind": kinds[s][1]}
+    unit = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]", header[s])
+    if unit and unit.group(1).lower().replace(" ", "") in STRESS_UNITS:
+        info["stress_unit"] = unit.group(1)
+    if "%" in header[x] or "percent" in header[x].lower():
+        info["strain_unit"] = "percent"
+    return roles, info
+
+
+def read_curve(
+    path: str | Path,
+    mode: str | None = None,
+    *,
+    columns: Sequence[str] | str | None = None,
+    strain_unit: str | None = None,
+    stress_kind: str | None = None,
+    stress_unit: str | None = None,
+    delimiter: str | None = None,
+    truncate: str | None = None,
+    description: str | None = None,
+) -> TestCurve:
+    """Read one stress-stretch curve from a text file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    mode : {"uniaxial", "equibiaxial", "planar"}, optional
+        Loading mode; by default taken from the file name (:func:`guess_mode`), else uniaxial.
+    columns : sequence of str or str, optional
+        Role of each column, from ``stretch``, ``strain`` (engineering), ``true-strain``,
+        ``stress`` and ``skip`` (e.g. ``"stress,stretch"``). By default read from the header
+        or, for two columns without a header, ``stretch, stress``.
+    strain_unit : {"fraction", "percent"}, optional
+        Unit of a strain column (default: percent if the header says ``%``, else fraction).
+    stress_kind : {"nominal", "true"}, optional
+        Default: what the header says, else nominal. True stress becomes ``sigma / lambda``.
+    stress_unit : str, optional
+        One of :data:`STRESS_UNITS` (default: the header's unit, else MPa).
+    delimiter : str, optional
+        ``","``, ``";"``, ``"\\t"`` or ``" "`` (any whitespace); detected by default.
+    truncate : {"none", "loading", "peak-stress"}, optional
+        Keep only the rows up to the largest stretch (``loading``) or the largest stress
+        (``peak-stress``). Default: ``peak-stress`` for pull-to-failure files of the
+        materials database, ``none`` otherwise (a non-monotonic curve is then an error).
+    description : str, optional
+        Defaults to the material named in the metadata, else the file name.
+
+    Returns
+    -------
+    TestCurve
+        Sorted by increasing stretch.
+
+    Raises
+    ------
+    DataFormatError
+        With the file, the 1-based row and what was expected.
+    """
+    path = Path(path)
+    src = str(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig", errors="replace")
+    except OSError as exc:
+        raise DataFormatError(f"cannot read the file ({exc.strerror or exc})", path=src) from None
+    lines = list(enumerate(text.splitlines(), start=1))
+    metadata: dict[str, str] = {}
+    body = [(n, s) for n, s in lines if s.strip() and not s.lstrip().startswith("#")]
+    if body and body[0][1].strip().lower().startswith(_SORO_MARK):
+        body, metadata = _soro_metadata(body, src)
+    if not body:
+        raise DataFormatError("no data rows found", path=src)
+    if delimiter in (" ", "whitespace"):
+        delimiter = None
+    elif delimiter is None:
+        first = body[0][1]
+        delimiter = next((d for d in (";", ",", "\t") if d in first), None)
+
+    header: list[str] | None = None
+    header_row = body[0][0]
+    if not _is_numeric_row(_split(body[0][1], delimiter), delimiter):
+        header = _split(body[0][1], delimiter)
+        body = body[1:]
+    info: dict[str, str] = {}
+    if columns is None:
+        if header is not None and (found := _roles_from_header(header)) is not None:
+            roles, info = found
+        elif header is not None:
+            raise DataFormatError(
+                f"cannot tell the stretch and stress columns from the header {header}; "
+                "name them with columns=, e.g. 'stretch,stress'", path=src, row=header_row)
+        else:
+            roles = ["stretch", "stress"]
+    else:
+        roles = [c.strip().lower() for c in (columns.split(",") if isinstance(columns, str) else columns)]
+    bad = [r for r in roles if r not in COLUMN_ROLES]
+    if bad or sum(r == "stress" for r in roles) != 1 or sum(r in ("stretch", "strain", "true-strain") for r in roles) != 1:
+        raise DataFormatError(
+            f"columns {roles} must name one of stretch/strain/true-strain, one stress and "
+            f"otherwise 'skip' (roles: {', '.join(COLUMN_ROLES)})", path=src)
+    ncol = len(roles)
+    if header is not None and len(header) != ncol:
+        raise DataFormatError(f"the header has {len(header)} columns but columns= names {ncol}",
+                              path=src, row=header_row)
+
+    rows = []
+    for n, line in body:
+        cells = _split(line, delimiter)
+        if len(cells) != ncol:
+            raise DataFormatError(f"expected {ncol} columns, found {len(cells)}: {line.strip()!r}",
+                                  path=src, row=n)
+        values = []
+        for k, cell in enumerate(cells, start=1):
+            if roles[k - 1] == "skip":
+                values.append(0.0)
+                continue
+            try:
+                v = _number(cell, delimiter)
+            except ValueError:
+                raise DataFormatError(f"column {k}: expected a number, found {cell!r}",
+                                      path=src, row=n) from None
+            if not math.isfinite(v):
+                raise DataFormatError(f"column {k}: expected a finite number, found {cell!r}",
+                                      path=src, row=n)
+            values.append(v)
+        rows.append(values)
+    if len(rows) < 2:
+        raise DataFormatError(f"expected at least 2 data rows, found {len(rows)}", path=src)
+    table = np.array(rows)
+    rownum = np.array([n for n, _ in body])
+    xrole = next(r for r in roles if r in ("stretch", "strain", "true-strain"))
+    x = table[:, roles.index(xrole)]
+    y = table[:, roles.index("stress")]
+    notes: list[str] = []
+
+    strain_unit = strain_unit or info.get("strain_unit", "fraction")
+    if strain_unit not in ("fraction", "percent"):
+        raise DataFormatError(f"strain_unit must be 'fraction' or 'percent', got {strain_unit!r}", path=src)
+    scale = 0.01 if strain_unit == "percent" and xrole != "stretch" else 1.0
+    lam = {"stretch": x, "strain": 1.0 + scale * x, "true-strain": np.exp(scale * x)}[xrole]
+    if xrole != "stretch":
+        notes.append(f"stretch = {'1 + e' if xrole == 'strain' else 'exp(eps)'}"
+                     f" from {xrole} in {strain_unit}")
+    bad_rows = np.flatnonzero(lam <= 0)
+    if bad_rows.size:
+        i = int(bad_rows[0])
+        raise DataFormatError(
+            f"stretch must be positive, found {lam[i]:.6g} (column {roles.index(xrole) + 1}"
+            f" read as {xrole}; is the column order right? see columns=)", path=src, row=int(rownum[i]))
+    unit = stress_unit or info.get("stress_unit", "MPa")
+    factor = _stress_unit_factor(unit, src)
+    p = y * factor
+    if factor != 1.0:
+        notes.append(f"stress converted from {unit} to MPa (x {factor:g})")
+    kind = stress_kind or info.get("stress_kind") or "nominal"
+    if kind not in ("nominal", "true"):
+        raise DataFormatError(f"stress_kind must be 'nominal' or 'true', got {kind!r}", path=src)
+    if kind == "true":
+        p = p / lam
+        notes.append("true stress converted to nominal with incompressibility: P = sigma / lambda")
+
+    if truncate is None:
+        failure = "pull-to-failure" in metadata.get("Type of test", "").lower()
+        truncate = "peak-stress" if failure else "none"
+    if truncate not in TRUNCATE:
+        raise DataFormatError(f"truncate must be one of {TRUNCATE}, got {truncate!r}", path=src)
+    if truncate != "none":
+        end = int(np.argmax(lam if truncate == "loading" else p)) + 1
+        if end < lam.size:
+            notes.append(f"truncated at the {'largest stretch' if truncate == 'loading' else 'peak stress'}"
+                         f" (row {rownum[end - 1]}); {lam.size - end} later rows dropped")
+        lam, p, rownum = lam[:end], p[:end], rownum[:end]
+    d = np.diff(lam)
+    direction = 1.0 if d.size and d[0] > 0 else -1.0
+    wrong = np.flatnonzero(d * direction <= 0)
+    if wrong.size:
+        i = int(wrong[0]) + 1
+        raise DataFormatError(
+            f"stretch {lam[i]:.6g} does not {'increase' if direction > 0 else 'decrease'} from the "
+            f"previous row ({lam[i - 1]:.6g}); expected a monotonic loading curve (for a test that "
+            "unloads or fails use truncate='loading' or 'peak-stress')", path=src, row=int(rownum[i]))
+    if direction < 0:
+        lam, p = lam[::-1], p[::-1]
+    if mode is None:
+        mode = guess_mode(path) or "uniaxial"
+    if mode not in MODES:
+        raise DataFormatError(f"unknown loading mode {mode!r}; expected one of {', '.join(MODES)}", path=src)
+    desc = description or metadata.get("Material") or path.stem
+    return TestCurve(mode, lam, p, source=src, description=desc, metadata=metadata, notes=tuple(notes))
+
+
+def _soro_metadata(body: list[tuple[int, str]], src: str) -> tuple[list[tuple[int, str]], dict[str, str]]:
+    """Split the database's ``PARAMETER;INFO;URL`` block from the table."""
+    meta: dict[str, str] = {}
+    for k, (n, line) in enumerate(body[1:], start=1):
+        cells = _split(line, ";")
+        if not cells:  # a line of empty cells ends the block
+            continue
+        if "stress" in line.lower() and "strain" in line.lower():
+            return body[k:], meta
+        meta[cells[0]] = cells[1] if len(cells) > 1 else ""
+        if len(cells) > 2 and cells[2]:
+            meta[f"{cells[0]} URL"] = cells[2]
+    raise DataFormatError("metadata block found but no header row with strain and stress",
+                          path=src, row=body[-1][0])
+
+
+# --------------------------------------------------------------------------- datasets
+
+
+@dataclass(frozen=True)
+class DatasetInfo:
+    """A bundled data set: its name, what it is, its licence and where it comes from."""
+
+    name: str
+    description: str
+    licence: str
+    citation: str
+    origin: str
+
+
+def _dataset_root() -> Path:
+    return Path(str(resources.files("pneumorph.materials") / "data" / "datasets"))
+
+
+def _manifest(name: str) -> tuple[Path, dict]:
+    folder = _dataset_root() / name
+    with open(folder / "dataset.toml", "rb") as fh:
+        return folder, tomllib.load(fh)
+
+
+def list_datasets() -> tuple[DatasetInfo, ...]:
+    """The bundled data sets.
+
+    Examples
+    --------
+    >>> [d.name for d in list_datasets()]
+    ['treloar1944']
+    """
+    out = []
+    for folder in sorted(_dataset_root().iterdir()):
+        if (folder / "dataset.toml").is_file():
+            _, m = _manifest(folder.name)
+            out.append(DatasetInfo(folder.name, m["description"], m["licence"], m["citation"], m["origin"]))
+    return tuple(out)
+
+
+def load_dataset(name: str) -> TestData:
+    """Load a bundled data set by name (see :func:`list_datasets`).
+
+    Raises
+    ------
+    UnknownDatasetError
+        If there is no such data set.
+    """
+    known = [d.name for d in list_datasets()]
+    if name not in known:
+        raise UnknownDatasetError(name, known)
+    folder, m = _manifest(name)
+    curves = []
+    for c in m["curve"]:
+        opts = {k: v for k, v in c.items() if k not in ("file", "mode")}
+        curves.append(read_curve(folder / c["file"], c["mode"], description=m["description"], **opts))
+    return TestData(tuple(curves), name)
+
+
+def read_test_data(sources: Iterable[str | Path], mode: str | None = None, **options: object) -> TestData:
+    """Read files and/or bundled data sets into one :class:`TestData`.
+
+    Parameters
+    ----------
+    sources : iterable of str or Path
+        Data files (read with :func:`read_curve`) or names of bundled data sets.
+    mode : str, optional
+        Loading mode of every file; by default guessed from each file name, else uniaxial.
+    **options
+        Passed to :func:`read_curve` for the files.
+
+    Examples
+    --------
+    >>> read_test_data(["treloar1944"]).name
+    'treloar1944'
+    """
+    curves: list[TestCurve] = []
+    names = []
+    for s in sources:
+        p = Path(s)
+        if p.is_file():
+            curves.append(read_curve(p, mode, **options))  # type: ignore[arg-type]
+            names.append(p.stem)
+        elif str(s) in {d.name for d in list_datasets()}:
+            curves.extend(load_dataset(str(s)).curves)
+            names.append(str(s))
+        else:
+            raise UnknownDatasetError(str(s), [d.name for d in list_datasets()])
+    if not curves:
+        raise DataFormatError("no data file or data set given")
+    return TestData(tuple(curves), " + ".join(dict.fromkeys(names)))
