@@ -16,3 +16,7 @@ from pneumorph.cli.library import list_materials, show_material  # noqa: E402
 materials.add_command(list_materials)
 materials.add_command(show_material)
 materials.add_command(characterise)
+
+from pneumorph.cli.fit import fit  # noqa: E402
+
+materials.add_command(fit)
