@@ -227,3 +227,19 @@ def test_plot_fits(tmp_path: Path) -> None:
     plot_fits(data, results, tmp_path / "fits.svg")
     svg = (tmp_path / "fits.svg").read_text()
     assert f"pneumorph {__version__}" in svg and "Treloar_ps.dat" in svg
+
+
+@pytest.mark.parametrize("material", ["Ecoflex 00-30", "Dragon Skin 30"])
+def test_stable_constraint(reference_dir: Path, material: str) -> None:
+    """Unconstrained Ogden fits of these curves are Drucker-unstable; the constrained ones are not."""
+    curve = read_curve(reference_dir / SORO / f"{material}.csv")
+    free = fit("ogden-3", curve)
+    assert not free.stability.is_stable
+    r = fit("ogden-3", curve, stable=True)
+    assert r.stable_constrained and r.stability.is_stable
+    assert all(m * a >= 0 for m, a in zip(r.model.mu, r.model.alpha))
+    assert 0.998 < r.r2["uniaxial"] <= free.r2["uniaxial"]
+    y = fit("yeoh", curve, stable=True)
+    assert all(c >= 0 for c in y.model.c) and y.stability.is_stable
+    assert y.r2["uniaxial"] <= fit("yeoh", curve).r2["uniaxial"]
+    print(f"\n{material} stable: ogden-3 R^2 {r.r2['uniaxial']:.6f}, yeoh R^2 {y.r2['uniaxial']:.6f}")

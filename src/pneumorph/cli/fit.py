@@ -34,6 +34,9 @@ from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE, list_datasets, 
 @click.option("--max-stretch", type=float, help="Fit only points with at most this stretch.")
 @click.option("--weighting", type=click.Choice(WEIGHTINGS), default="absolute", show_default=True,
               help="Residuals: plain stress, relative to the stress, or per-mode normalised.")
+@click.option("--stable", is_flag=True,
+              help="Constrain parameter signs so that the model is Drucker-stable everywhere "
+                   "(Ogden mu_n alpha_n >= 0; invariant models coefficients >= 0).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Ogden starts.")
 @click.option("--starts", type=click.IntRange(min=1), default=8, show_default=True,
               help="Number of Ogden starts.")
@@ -44,7 +47,7 @@ from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE, list_datasets, 
 def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, columns: str | None,
         strain_unit: str | None, stress_kind: str | None, stress_unit: str | None,
         delimiter: str | None, truncate: str | None, min_stretch: float | None,
-        max_stretch: float | None, weighting: str, seed: int, starts: int,
+        max_stretch: float | None, weighting: str, stable: bool, seed: int, starts: int,
         plot_path: str | None, as_json: bool, markdown: bool) -> None:
     """Fit hyperelastic models to test DATA (files and/or bundled data sets).
 
@@ -64,7 +67,7 @@ def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, column
     test = read_test_data(data, mode, **options)
     if min_stretch is not None or max_stretch is not None:
         test = test.restrict(min_stretch, max_stretch)
-    table = compare(models, test, weighting=weighting, seed=seed, starts=starts)
+    table = compare(models, test, weighting=weighting, seed=seed, starts=starts, stable=stable)
     if plot_path:
         from pneumorph.plot.fits import plot_fits  # matplotlib only when asked
 

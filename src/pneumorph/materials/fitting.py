@@ -61,7 +61,7 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, lsq_linear
 
 from pneumorph.errors import FitError, UnknownModelError
 from pneumorph.materials.hyperelastic import (
@@ -165,6 +165,8 @@ class FitResult:
     weighting : str
     data_name : str
     sources : tuple of str
+    stable_constrained : bool
+        Whether the parameter signs were constrained for stability (``fit(stable=True)``).
     """
 
     model_name: str
@@ -183,6 +185,7 @@ class FitResult:
     weighting: str
     data_name: str = ""
     sources: tuple[str, ...] = ()
+    stable_constrained: bool = False
 
     def predict(self, mode: str, stretch: Any) -> FloatArray:
         """Nominal stress of the fitted model, MPa."""
@@ -206,6 +209,7 @@ class FitResult:
             "starts": self.starts,
             "seed": self.seed,
             "weighting": self.weighting,
+            "stable_constrained": self.stable_constrained,
             "data": self.data_name,
             "sources": list(self.sources),
         }
@@ -213,7 +217,8 @@ class FitResult:
     def summary(self) -> str:
         """Human-readable report: parameters, mu0, R^2 per mode, stability."""
         lines = [f"{self.model_name} fitted to {self.data_name or 'data'} "
-                 f"({self.weighting} residuals, {self.starts} start{'s' if self.starts > 1 else ''})"]
+                 f"({self.weighting} residuals, {self.starts} start{'s' if self.starts > 1 else ''}"
+                 f"{', signs constrained for stability' if self.stable_constrained else ''})"]
         for mode, n in self.n_points.items():
             lo, hi = self.stretch_range[mode]
             lines.append(f"  {mode}: {n} points, stretch {lo:.4g}-{hi:.4g}")
@@ -276,12 +281,14 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
     return np.concatenate(w)
 
 
-def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap):  # type: ignore[no-untyped-def]
+def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):  # type: ignore[no-untyped-def]
     """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
 
     The exponents are parametrised as ``alpha_1`` and the gaps ``alpha_(k+1) - alpha_k >=
     gap``: two terms with (nearly) equal exponents degenerate into huge moduli of opposite
-    sign that cancel, a solution with no meaning as material parameters.
+    sign that cancel, a solution with no meaning as material parameters. With ``stable``
+    every term keeps ``mu_n alpha_n >= 0`` (such pairs cannot cancel, so the final polish
+    works on the exponents directly, each keeping its sign).
     """
     yw = y * w
     tri = np.tril(np.ones((n, n)))
@@ -291,37 +298,53 @@ def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap):  # type: ignore[
 
     def mu_for(alpha: FloatArray) -> FloatArray:
         a, _ = _ogden_columns(curves, alpha)
-        return np.linalg.lstsq(a * w[:, None], yw, rcond=None)[0]
+        if not stable:
+            return np.linalg.lstsq(a * w[:, None], yw, rcond=None)[0]
+        pos = alpha > 0
+        return lsq_linear(a * w[:, None], yw, bounds=(np.where(pos, 0.0, -np.inf), np.where(pos, np.inf, 0.0)),
+                          method="bvls").x
 
     def projected(x: FloatArray) -> FloatArray:
-        a, _ = _ogden_columns(curves, alphas(x))
-        aw = a * w[:, None]
-        return aw @ np.linalg.lstsq(aw, yw, rcond=None)[0] - yw
+        alpha = alphas(x)
+        a, _ = _ogden_columns(curves, alpha)
+        return (a @ mu_for(alpha) - y) * w
 
     def full(p: FloatArray) -> FloatArray:
-        a, _ = _ogden_columns(curves, alphas(p[n:]))
+        a, _ = _ogden_columns(curves, p[n:] if stable else alphas(p[n:]))
         return (a @ p[:n] - y) * w
 
     def full_jac(p: FloatArray) -> FloatArray:
-        a, da = _ogden_columns(curves, alphas(p[n:]))
-        return np.hstack([a, (da * p[:n]) @ tri]) * w[:, None]
+        a, da = _ogden_columns(curves, p[n:] if stable else alphas(p[n:]))
+        return np.hstack([a, (da * p[:n]) @ (np.eye(n) if stable else tri)]) * w[:, None]
 
     lo = [-alpha_bound] + [gap] * (n - 1)
     hi = [alpha_bound] * n
-    best = None
+    best, best_alpha = None, None
     for _ in range(starts):
         a0 = np.sort(rng.uniform(-10.0, 10.0, n))
         x0 = np.clip(np.concatenate([a0[:1], np.diff(a0)]), lo, hi)
         with np.errstate(all="ignore"):
             vp = least_squares(projected, x0, bounds=(lo, hi), max_nfev=200)
-            p0 = np.concatenate([mu_for(alphas(vp.x)), vp.x])
-            res = least_squares(full, p0, jac=full_jac, bounds=([-np.inf] * n + lo, [np.inf] * n + hi),
-                                x_scale="jac", max_nfev=300)
+            alpha = alphas(vp.x)
+            mu = mu_for(alpha)
+            if stable:
+                big = max(alpha_bound, float(np.abs(alpha).max()))
+                pos = alpha > 0
+                blo = np.concatenate([np.where(pos, 0.0, -np.inf), np.where(pos, 1e-3, -big)])
+                bhi = np.concatenate([np.where(pos, np.inf, 0.0), np.where(pos, big, -1e-3)])
+                p0 = np.clip(np.concatenate([mu, alpha]), blo, bhi)
+            else:
+                blo = np.array([-np.inf] * n + lo)
+                bhi = np.array([np.inf] * n + hi)
+                p0 = np.concatenate([mu, vp.x])
+            res = least_squares(full, p0, jac=full_jac, bounds=(blo, bhi), x_scale="jac", max_nfev=300)
         if np.all(np.isfinite(res.x)) and (best is None or res.cost < best.cost):
             best = res
+            best_alpha = res.x[n:] if stable else alphas(res.x[n:])
     if best is None:
         raise FitError("the Ogden fit failed from every start (non-finite parameters)")
-    return np.concatenate([best.x[:n], alphas(best.x[n:])])
+    order = np.argsort(best_alpha)
+    return np.concatenate([best.x[:n][order], best_alpha[order]])
 
 
 def fit(
@@ -335,6 +358,7 @@ def fit(
     seed: int | np.random.Generator | None = 0,
     alpha_bound: float = 30.0,
     min_alpha_gap: float = 0.5,
+    stable: bool = False,
     stability_range: tuple[float, float] | None = None,
 ) -> FitResult:
     """Fit a hyperelastic model to test data by least squares on the nominal stress.
@@ -360,6 +384,12 @@ def fit(
         between consecutive exponents.
     min_alpha_gap : float
         Smallest gap between consecutive Ogden exponents (see the module notes).
+    stable : bool
+        Constrain the signs of the parameters to values that make the model Drucker-stable
+        at every stretch: Ogden ``mu_n alpha_n >= 0`` for every term, the invariant models
+        all coefficients ``>= 0`` (for neo-Hooke, Mooney-Rivlin-2 and Yeoh this is
+        sufficient; for Mooney-Rivlin-3 the ``C11`` term can still be unstable, see
+        ``FitResult.stability``). Default False: unconstrained, as in the dissertation.
     stability_range : (float, float), optional
         Stretch range of the Drucker check; default ``(min(0.5, smallest stretch),
         max(1.5, largest stretch))``.
@@ -405,7 +435,7 @@ def fit(
         if starts < 1:
             raise ValueError(f"starts must be at least 1, got {starts}")
         rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-        p = _fit_ogden(curves, y, w, spec.terms, starts, rng, alpha_bound, min_alpha_gap)
+        p = _fit_ogden(curves, y, w, spec.terms, starts, rng, alpha_bound, min_alpha_gap, stable)
         nstarts = starts
     else:
         a = _linear_columns(spec, curves)
@@ -414,8 +444,11 @@ def fit(
         if rank < npar:
             raise FitError(f"the data cannot determine the {npar} parameters of {spec.name} "
                            f"(rank {rank}); add points over a wider stretch range or another mode")
-        res = least_squares(lambda q: aw @ q - y * w, p0, jac=lambda q: aw, method="lm")
-        p, nstarts, used_seed = res.x, 1, None
+        if stable:  # bounded linear least squares: convex, so still the unique optimum
+            p = lsq_linear(aw, y * w, bounds=(0.0, np.inf), method="bvls").x
+        else:
+            p = least_squares(lambda q: aw @ q - y * w, p0, jac=lambda q: aw, method="lm").x
+        nstarts, used_seed = 1, None
     model = spec.build(p)
     pred = [model.nominal_stress(c.mode, c.stretch) for c in curves]
     lo = min(float(c.stretch.min()) for c in curves)
@@ -441,6 +474,7 @@ def fit(
         weighting=weighting,
         data_name=data.name,
         sources=data.sources,
+        stable_constrained=stable,
     )
 
 
