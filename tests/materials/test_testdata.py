@@ -120,6 +120,15 @@ def test_header_percent_kpa_comma(tmp_path: Path) -> None:
     assert any("kPa" in n for n in c.notes)
 
 
+def test_header_units_with_explicit_columns(tmp_path: Path) -> None:
+    f = tmp_path / "reversed.csv"
+    f.write_text("Stress [kPa],Strain [%]\n0,0\n12,20\n")
+    c = read_curve(f, columns="stress,strain")
+    np.testing.assert_allclose(c.stretch, [1.0, 1.2])
+    np.testing.assert_allclose(c.stress, [0.0, 0.012])
+    assert read_curve(f, columns="stress,strain", stress_unit="MPa").stress[1] == 12.0
+
+
 def test_semicolon_decimal_comma_and_whitespace(tmp_path: Path) -> None:
     f = tmp_path / "a.txt"
     f.write_text("Strain;Stress (MPa);Stretch\n0,0;0,0;1,0\n0,5;0,12;1,5\n")

@@ -245,8 +245,21 @@ def _is_numeric_row(cells: list[str], delimiter: str | None) -> bool:
     return True
 
 
-def _roles_from_header(header: list[str]) -> tuple[list[str], dict[str, str]] | None:
-    """Column roles, and what the header says of units and kinds; None if it cannot tell."""
+def _header_info(header: list[str], roles: list[str]) -> dict[str, str]:
+    """What the header cells of the stress and x columns say of kind and unit."""
+    s = roles.index("stress")
+    x = next(i for i, r in enumerate(roles) if r in ("stretch", "strain", "true-strain"))
+    info = {"stress_kind": "true" if re.search(r"true|cauchy", header[s].lower()) else "nominal"}
+    unit = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]", header[s])
+    if unit and unit.group(1).lower().replace(" ", "") in STRESS_UNITS:
+        info["stress_unit"] = unit.group(1)
+    if "%" in header[x] or "percent" in header[x].lower():
+        info["strain_unit"] = "percent"
+    return info
+
+
+def _roles_from_header(header: list[str]) -> list[str] | None:
+    """Column roles named by a header row; None if it cannot tell."""
     kinds = []
     for h in header:
         t = h.lower()
@@ -267,13 +280,7 @@ def _roles_from_header(header: list[str]) -> tuple[list[str], dict[str, str]] | 
     x = min(xs, key=lambda i: ("stretch", "strain", "true-strain").index(kinds[i][0]))
     roles = ["skip"] * len(header)
     roles[s], roles[x] = "stress", kinds[x][0]
-    info = {"stress_kind": kinds[s][1]}
-    unit = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]", header[s])
-    if unit and unit.group(1).lower().replace(" ", "") in STRESS_UNITS:
-        info["stress_unit"] = unit.group(1)
-    if "%" in header[x] or "percent" in header[x].lower():
-        info["strain_unit"] = "percent"
-    return roles, info
+    return roles
 
 
 def read_curve(
@@ -352,7 +359,7 @@ def read_curve(
     info: dict[str, str] = {}
     if columns is None:
         if header is not None and (found := _roles_from_header(header)) is not None:
-            roles, info = found
+            roles = found
         elif header is not None:
             raise DataFormatError(
                 f"cannot tell the stretch and stress columns from the header {header}; "
@@ -370,6 +377,8 @@ def read_curve(
     if header is not None and len(header) != ncol:
         raise DataFormatError(f"the header has {len(header)} columns but columns= names {ncol}",
                               path=src, row=header_row)
+    if header is not None:
+        info = _header_info(header, roles)
 
     rows = []
     for n, line in body:
