@@ -61,9 +61,9 @@ def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, column
         resolve_model(name)
     if delimiter == "\\t":
         delimiter = "\t"
-    options = {k: v for k, v in dict(columns=columns, strain_unit=strain_unit, stress_kind=stress_kind,
-                                     stress_unit=stress_unit, delimiter=delimiter,
-                                     truncate=truncate).items() if v is not None}
+    given = {"columns": columns, "strain_unit": strain_unit, "stress_kind": stress_kind,
+             "stress_unit": stress_unit, "delimiter": delimiter, "truncate": truncate}
+    options = {k: v for k, v in given.items() if v is not None}
     test = read_test_data(data, mode, **options)
     if min_stretch is not None or max_stretch is not None:
         test = test.restrict(min_stretch, max_stretch)

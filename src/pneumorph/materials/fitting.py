@@ -216,9 +216,10 @@ class FitResult:
 
     def summary(self) -> str:
         """Human-readable report: parameters, mu0, R^2 per mode, stability."""
-        lines = [f"{self.model_name} fitted to {self.data_name or 'data'} "
-                 f"({self.weighting} residuals, {self.starts} start{'s' if self.starts > 1 else ''}"
-                 f"{', signs constrained for stability' if self.stable_constrained else ''})"]
+        head = (f"{self.model_name} fitted to {self.data_name or 'data'} "
+                f"({self.weighting} residuals, {self.starts} start{'s' if self.starts > 1 else ''}"
+                f"{', signs constrained for stability' if self.stable_constrained else ''})")
+        lines = [head]
         for mode, n in self.n_points.items():
             lo, hi = self.stretch_range[mode]
             lines.append(f"  {mode}: {n} points, stretch {lo:.4g}-{hi:.4g}")
