@@ -19,9 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pneumorph.materials.datasets import load_dataset
 from pneumorph.materials.fitting import compare, r_squared
 from pneumorph.materials.hyperelastic import Ogden
-from pneumorph.materials.testdata import TestData, load_dataset, read_curve
+from pneumorph.materials.testdata import TestData, read_curve
 from pneumorph.plot import plot_fits
 
 MODELS = ("neo-hooke", "mooney-rivlin-2", "mooney-rivlin-3", "yeoh", "ogden-3")

@@ -7,9 +7,10 @@ import json
 import click
 
 from pneumorph import __version__
+from pneumorph.materials.datasets import list_datasets, read_test_data
 from pneumorph.materials.fitting import MODEL_NAMES, WEIGHTINGS, compare, resolve_model
 from pneumorph.materials.hyperelastic import MODES
-from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE, list_datasets, read_test_data
+from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE
 
 
 @click.command("fit")

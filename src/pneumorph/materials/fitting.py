@@ -45,7 +45,7 @@ residuals on top of that.
 
 Examples
 --------
->>> from pneumorph.materials.testdata import load_dataset
+>>> from pneumorph.materials.datasets import load_dataset
 >>> r = fit("yeoh", load_dataset("treloar1944"))
 >>> {m: round(v, 3) for m, v in r.r2.items()}
 {'uniaxial': 0.995, 'equibiaxial': 0.945, 'planar': 0.998}
@@ -61,7 +61,6 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares, lsq_linear
 
 from pneumorph.errors import FitError, UnknownModelError
 from pneumorph.materials.hyperelastic import (
@@ -283,6 +282,8 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
 
 
 def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):  # type: ignore[no-untyped-def]
+    from scipy.optimize import least_squares, lsq_linear  # deferred: keeps the CLI start fast
+
     """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
 
     The exponents are parametrised as ``alpha_1`` and the gaps ``alpha_(k+1) - alpha_k >=
@@ -415,6 +416,8 @@ def fit(
     >>> round(r.parameters["C10"], 6), round(r.r2["uniaxial"], 6)
     (0.2, 1.0)
     """
+    from scipy.optimize import least_squares, lsq_linear  # deferred: keeps the CLI start fast
+
     spec = resolve_model(model_name)
     if isinstance(data, TestCurve):
         data = TestData((data,), data.description)
@@ -541,7 +544,7 @@ def compare(model_names: Sequence[str], data: TestData | TestCurve, **options: A
 
     Examples
     --------
-    >>> from pneumorph.materials.testdata import load_dataset
+    >>> from pneumorph.materials.datasets import load_dataset
     >>> t = compare(["neo-hooke", "mooney-rivlin-2"], load_dataset("treloar1944"))
     >>> print(t.to_markdown().splitlines()[0])
     | model | R^2 uniaxial | R^2 equibiaxial | R^2 planar | R^2 overall | mu0 [MPa] | Drucker-stable |

@@ -2,7 +2,7 @@
 
 Examples
 --------
->>> from pneumorph.materials.testdata import load_dataset
+>>> from pneumorph.materials.datasets import load_dataset
 >>> from pneumorph.materials.fitting import fit
 >>> data = load_dataset("treloar1944")
 >>> fig = plot_fits(data, [fit("yeoh", data)])
