@@ -31,7 +31,7 @@ SORO = "reference-data/marechal2021_SoRo-Materials-DB/Tensile-Tests-Data"
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    repo = Path(__file__).resolve().parents[1]
+    repo = Path(__file__).resolve().parents[2]
     ap.add_argument("--shared", type=Path, default=repo.parent / "shared")
     ap.add_argument("--figures", type=Path, default=repo / "docs" / "figures")
     args = ap.parse_args()
