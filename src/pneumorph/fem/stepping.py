@@ -13,6 +13,7 @@ is set by one callable ``apply(t)``, so the stepping knows nothing about the mod
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -95,19 +96,26 @@ def _solve_substep(
     dof0: NDArray[np.int64],
     settings: StepSettings,
 ) -> tuple[int, str | None]:
-    """One Newton solve; returns (iterations, cause of failure or None)."""
+    """One Newton solve; returns (iterations, cause of failure or None).
+
+    A trial that fails is cut back, so the numerical warnings of its divergence (singular
+    matrix, powers of negative volume ratios) are expected and not shown.
+    """
     import felupe as fem
+    from scipy.sparse.linalg import MatrixRankWarning
 
     try:
-        res = fem.newtonraphson(
-            items=list(items),
-            x0=fields,
-            dof1=dof1,
-            dof0=dof0,
-            tol=settings.tolerance,
-            maxiter=settings.max_iterations,
-            verbose=0,
-        )
+        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            warnings.simplefilter("ignore", MatrixRankWarning)
+            res = fem.newtonraphson(
+                items=list(items),
+                x0=fields,
+                dof1=dof1,
+                dof0=dof0,
+                tol=settings.tolerance,
+                maxiter=settings.max_iterations,
+                verbose=0,
+            )
     except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError) as exc:
         return settings.max_iterations, f"{type(exc).__name__}: {exc}"
     iterations = int(res.iterations)
