@@ -138,3 +138,11 @@ class UnknownDatasetError(PneumorphError, KeyError):
             f"no data file or bundled data set named {self.name!r}; "
             f"bundled data sets: {', '.join(self.known) or 'none'}"
         )
+
+
+class OrientationError(PneumorphError, ValueError):
+    """An orientation vector that is not a string of 0/1 digits of the expected length."""
+
+
+class GeometryError(PneumorphError, ValueError):
+    """A unit or actuator geometry that cannot be built (non-positive sizes, no cavity, ...)."""

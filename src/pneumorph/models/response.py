@@ -1,0 +1,204 @@
+"""The response of one actuator design to a pressure ramp, and the model interface.
+
+Coordinates: ``x`` along the actuator's long axis (the base at ``x = 0``), ``y`` in the
+bending plane (positive towards the side a unit of orientation 0 bends to), ``z`` across
+the width (3D only). Lengths in mm, pressures in MPa (kPa only at the edges).
+
+A model of any fidelity (2D reduced-order, 3D, a surrogate) turns an orientation vector
+into a :class:`Response`; the design search sees nothing else.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Response:
+    """Unit centres, tip and curl of one design at every reported pressure.
+
+    Attributes
+    ----------
+    orientation : str
+        The design, base first (``"0101..."``).
+    pressures : ndarray, shape (k,)
+        The reported pressures (MPa), increasing; e.g. 4.5, 9, ..., 45 kPa.
+    centres : ndarray, shape (k, n, 2)
+        Current (x, y) of every unit centre - the mean of the unit's four tracked nodes at
+        the cavity's vertices (Fig 4.4) - at every reported pressure; NaN after a failure.
+    reference_centres : ndarray, shape (n, 2)
+        The unit centres of the undeformed actuator.
+    tip : ndarray, shape (k, 2)
+        Current (x, y) of the tip (centre of the free end face).
+    reference_tip : ndarray, shape (2,)
+        The undeformed tip.
+    curl : ndarray, shape (k,)
+        Rotation of the free end face in degrees, counter-clockwise positive, unwrapped
+        (it can exceed 360).
+    converged : bool
+        True if the whole ramp converged.
+    reached : float
+        The highest pressure that converged (MPa); equals ``pressures[-1]`` if converged.
+    failure : str or None
+        Why the ramp stopped, if it did.
+    metadata : dict
+        Provenance: model fidelity and fingerprint, solver statistics, wall time, versions.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> r = Response.empty("01", np.array([0.0225, 0.045]), np.array([[5.0, 0.0], [15.0, 0.0]]),
+    ...                    np.array([20.0, 0.0]))
+    >>> r.n_units, r.n_levels, bool(np.isnan(r.centres).all())
+    (2, 2, True)
+    """
+
+    orientation: str
+    pressures: FloatArray
+    centres: FloatArray
+    reference_centres: FloatArray
+    tip: FloatArray
+    reference_tip: FloatArray
+    curl: FloatArray
+    converged: bool = True
+    reached: float = float("nan")
+    failure: str | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        k, n = len(self.pressures), len(self.orientation)
+        shapes = {
+            "centres": (self.centres.shape, (k, n, 2)),
+            "reference_centres": (self.reference_centres.shape, (n, 2)),
+            "tip": (self.tip.shape, (k, 2)),
+            "reference_tip": (self.reference_tip.shape, (2,)),
+            "curl": (self.curl.shape, (k,)),
+        }
+        for name, (got, want) in shapes.items():
+            if tuple(got) != want:
+                raise ValueError(f"Response.{name} has shape {tuple(got)}, expected {want}")
+
+    @classmethod
+    def empty(
+        cls,
+        orientation: str,
+        pressures: FloatArray,
+        reference_centres: FloatArray,
+        reference_tip: FloatArray,
+        **kwargs: Any,
+    ) -> Response:
+        """A response with every level still unknown (NaN), to be filled level by level."""
+        k, n = len(pressures), len(orientation)
+        return cls(
+            orientation=orientation,
+            pressures=np.asarray(pressures, dtype=float),
+            centres=np.full((k, n, 2), np.nan),
+            reference_centres=np.asarray(reference_centres, dtype=float),
+            tip=np.full((k, 2), np.nan),
+            reference_tip=np.asarray(reference_tip, dtype=float),
+            curl=np.full(k, np.nan),
+            **kwargs,
+        )
+
+    @property
+    def n_units(self) -> int:
+        return len(self.orientation)
+
+    @property
+    def n_levels(self) -> int:
+        return len(self.pressures)
+
+    @property
+    def displacements(self) -> FloatArray:
+        """Unit-centre displacements ``centres - reference_centres``, shape (k, n, 2)."""
+        return self.centres - self.reference_centres[None]
+
+    def centreline(self, level: int) -> FloatArray:
+        """The polyline base -> unit centres -> tip at a reported level, shape (n + 2, 2)."""
+        base = np.array([[0.0, self.reference_centres[0, 1]]])
+        return np.concatenate([base, self.centres[level], self.tip[level][None]])
+
+    def level_of(self, pressure: float) -> int:
+        """Index of the reported level at ``pressure`` (MPa), within 1e-9 MPa.
+
+        Raises
+        ------
+        KeyError
+            If ``pressure`` is not a reported level.
+        """
+        hits = np.flatnonzero(np.isclose(self.pressures, pressure, rtol=0.0, atol=1e-9))
+        if not hits.size:
+            levels = ", ".join(f"{p * 1e3:g}" for p in self.pressures)
+            raise KeyError(f"{pressure * 1e3:g} kPa is not a reported level ({levels} kPa)")
+        return int(hits[0])
+
+    # -- persistence ------------------------------------------------------------------
+    _ARRAYS = ("pressures", "centres", "reference_centres", "tip", "reference_tip", "curl")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (pressures in MPa, lengths in mm, NaN as null)."""
+
+        def clean(a: FloatArray) -> Any:
+            return np.where(np.isnan(a), None, a).tolist()
+
+        out: dict[str, Any] = {"orientation": self.orientation}
+        out.update({name: clean(getattr(self, name)) for name in self._ARRAYS})
+        out.update(converged=self.converged, reached=self.reached, failure=self.failure)
+        out["metadata"] = self.metadata
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Response:
+        arrays = {
+            name: np.array(data[name], dtype=float) for name in cls._ARRAYS
+        }  # None -> nan via dtype float
+        return cls(
+            orientation=data["orientation"],
+            converged=bool(data["converged"]),
+            reached=float(data["reached"]),
+            failure=data.get("failure"),
+            metadata=dict(data.get("metadata", {})),
+            **arrays,
+        )
+
+    def save(self, path: str | Path) -> tuple[Path, Path]:
+        """Write ``<path>.npz`` (arrays) and ``<path>.json`` (everything, readable)."""
+        base = Path(path)
+        base.parent.mkdir(parents=True, exist_ok=True)
+        npz, js = base.with_suffix(".npz"), base.with_suffix(".json")
+        np.savez(npz, **{name: getattr(self, name) for name in self._ARRAYS})
+        js.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
+        return npz, js
+
+    @classmethod
+    def load(cls, path: str | Path) -> Response:
+        """Read a response written by :meth:`save` (from its JSON file)."""
+        return cls.from_dict(json.loads(Path(path).with_suffix(".json").read_text(encoding="utf-8")))
+
+
+@runtime_checkable
+class ActuatorModel(Protocol):
+    """What the design search needs from a model of any fidelity.
+
+    ``evaluate`` raises :class:`pneumorph.errors.SimulationFailed` when the ramp cannot be
+    completed; evaluators record that as a failed design. ``fingerprint`` changes whenever
+    anything that changes results changes (unit, materials, filler law, mesh, solver
+    settings, pressure ramp), and keys the evaluation cache.
+    """
+
+    fidelity: str
+    n_units: int
+
+    def fingerprint(self) -> str: ...
+
+    def pressures(self) -> FloatArray: ...
+
+    def evaluate(self, orientation: str) -> Response: ...
