@@ -146,3 +146,46 @@ class OrientationError(PneumorphError, ValueError):
 
 class GeometryError(PneumorphError, ValueError):
     """A unit or actuator geometry that cannot be built (non-positive sizes, no cavity, ...)."""
+
+
+class CrimpError(PneumorphError, ValueError):
+    """A crimp or composite coupon that cannot exist (non-positive amplitude, wavelength
+    longer than the coupon, crimp deeper than the matrix, ...)."""
+
+
+class TargetExpressionError(PneumorphError, ValueError):
+    """A target expression that is not allowed: unknown names, attribute access, huge powers, ...
+
+    The message quotes the offending part and its column (1-based).
+    """
+
+
+class UnknownObjectiveError(PneumorphError, KeyError):
+    """An objective name that is neither a tip goal nor a target preset."""
+
+    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return (
+            f"unknown objective {self.name!r}; known objectives: {', '.join(self.known)}, "
+            "or a profile 'y = f(x)' / 'r = f(theta)'"
+        )
+
+
+class SearchConfigError(PneumorphError, ValueError):
+    """Design-search settings that cannot work (population below 2, no units, ...)."""
+
+
+class EvaluationError(PneumorphError, RuntimeError):
+    """A model that raised something other than SimulationFailed while evaluating a design."""
+
+
+class SchedulerUnreachableError(PneumorphError, ConnectionError):
+    """A Dask scheduler address that could not be reached within the timeout."""
+
+
+class RunFolderError(PneumorphError, ValueError):
+    """A run folder that holds a different run (other settings or another model)."""

@@ -95,6 +95,7 @@ def _solve_substep(
     dof1: NDArray[np.int64],
     dof0: NDArray[np.int64],
     settings: StepSettings,
+    solver: Callable[[Any, Any], NDArray[np.float64]],
 ) -> tuple[int, str | None]:
     """One Newton solve; returns (iterations, cause of failure or None).
 
@@ -114,10 +115,14 @@ def _solve_substep(
                 dof0=dof0,
                 tol=settings.tolerance,
                 maxiter=settings.max_iterations,
+                solver=solver,
                 verbose=0,
             )
-    except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError) as exc:
+    except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
         return settings.max_iterations, f"{type(exc).__name__}: {exc}"
+    # FElupe iterates on copies of the unknowns and re-links the items' fields to them:
+    # point the caller's container (and so every field linked to it) at the result.
+    fields.link(res.x)
     iterations = int(res.iterations)
     if not res.success:
         return iterations, "Newton iterations did not reach the tolerance"
@@ -147,6 +152,7 @@ def ramp(
     settings: StepSettings = StepSettings(),
     on_level: Callable[[int, float], None] | None = None,
     monitor: Callable[[], float] | None = None,
+    solver: Callable[[Any, Any], NDArray[np.float64]] | None = None,
 ) -> RampStatistics:
     """Ramp a FElupe model from load factor 0 to 1.
 
@@ -170,6 +176,9 @@ def ramp(
         stable, rising pressure ramp - the cavity volume, the work-conjugate of the
         pressure. A substep that converges to a state with a smaller value has jumped to
         another (non-physical or unstable) branch and is cut back like a failed one.
+    solver : callable, optional
+        ``solver(A, b)`` for the linear systems (default:
+        :func:`pneumorph.fem.linear.default_solver`).
 
     Returns
     -------
@@ -181,6 +190,9 @@ def ramp(
         If a substep still fails after ``max_cutbacks`` halvings; ``reached`` is the last
         converged load factor and the fields hold that state.
     """
+    from pneumorph.fem.linear import default_solver
+
+    solver = solver or default_solver()
     stats = RampStatistics()
     prev: list[NDArray[np.float64]] | None = None
     t_prev = 0.0
@@ -197,7 +209,7 @@ def ramp(
                 s = (t_try - t_now) / (t_now - t_prev)
                 _restore(fields, [c + s * (c - p) for c, p in zip(current, prev)])
             apply(t_try)
-            iterations, cause = _solve_substep(items, fields, dof1, dof0, settings)
+            iterations, cause = _solve_substep(items, fields, dof1, dof0, settings, solver)
             stats.newton_iterations += iterations
             value = watched
             if cause is None and monitor is not None:

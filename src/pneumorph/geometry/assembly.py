@@ -1,0 +1,232 @@
+"""Assemble an actuator mesh from a unit and an orientation vector.
+
+One structured grid whose lines fall on every interface of every unit in either
+orientation; each cell is labelled (body, stiff layer, cavity, slit) from its unit's
+section, mirrored for orientation 1; cavity cells become the filler of the 2D
+reduced-order model (section 5.2) and are removed in 3D; slit cells are removed. The
+linear grid is then made quadratic (quad8 in 2D, hex20 in 3D) so that all materials share
+one set of points.
+
+The result is plain data (:class:`ActuatorMesh`): the model builders turn it into FElupe
+regions and fields.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.errors import GeometryError
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.unit import UnitSpec
+
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+FloatArray = NDArray[np.float64]
+
+BODY, LAYER, CAVITY, SLIT = 0, 1, 2, 3
+
+
+@dataclass(frozen=True)
+class ActuatorMesh:
+    """A meshed actuator: points, cells per region, and the nodes the results are read at.
+
+    Attributes
+    ----------
+    points : ndarray, shape (p, dim)
+        Coordinates (mm): x along the actuator, y across its height, z across its width.
+    cells : ndarray, shape (c, 8) or (c, 20)
+        Quadratic cells (``quad8`` in 2D, ``hexahedron20`` in 3D) in FElupe's ordering.
+    cell_type : str
+    regions : dict of str to ndarray
+        Cell indices of ``"body"``, ``"layer"`` and, in 2D, ``"filler"`` (the cavities).
+    cavity_points : ndarray of bool, shape (p,)
+        Points on the cavity walls (and, in 2D, inside the filler).
+    tracked : ndarray, shape (n, 4)
+        Per unit, the points at the cavity's four vertices (Fig 4.4; mid-width in 3D).
+    end_points : ndarray
+        Points of the free end face in the section plane, ordered by height.
+    base_points : ndarray of bool, shape (p,)
+        Points of the clamped base face (x = 0).
+    orientation : str
+    spec : UnitSpec
+    """
+
+    points: FloatArray
+    cells: IntArray
+    cell_type: str
+    regions: dict[str, IntArray]
+    cavity_points: BoolArray
+    tracked: IntArray
+    end_points: IntArray
+    base_points: BoolArray
+    orientation: str
+    spec: UnitSpec
+
+    @property
+    def dim(self) -> int:
+        return int(self.points.shape[1])
+
+    @property
+    def n_units(self) -> int:
+        return len(self.orientation)
+
+    @property
+    def length(self) -> float:
+        return self.n_units * self.spec.pitch + self.spec.end_cap
+
+    def unit_centres(self, displacement: FloatArray | None = None) -> FloatArray:
+        """Mean (x, y) of each unit's four tracked points, shape (n, 2)."""
+        x = self.points if displacement is None else self.points + displacement
+        return x[self.tracked][..., :2].mean(axis=1)
+
+    def submesh(self, region: str) -> tuple[FloatArray, IntArray]:
+        """Points (all of them, shared) and the cells of one region."""
+        return self.points, self.cells[self.regions[region]]
+
+
+def grid_lines(breaks: list[float], size: float) -> FloatArray:
+    """Coordinates through every break, no gap wider than ``size``.
+
+    Breaks closer than 1e-6 mm are merged.
+
+    Examples
+    --------
+    >>> grid_lines([0.0, 1.5, 4.5], 1.5).tolist()
+    [0.0, 1.5, 3.0, 4.5]
+    """
+    b = np.unique(np.round(np.asarray(breaks, dtype=float), 6))
+    out = [b[0]]
+    for lo, hi in zip(b[:-1], b[1:]):
+        n = max(1, int(np.ceil((hi - lo) / size - 1e-9)))
+        out.extend(np.linspace(lo, hi, n + 1)[1:])
+    return np.asarray(out)
+
+
+def _section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
+    """Local x breaks of one unit and y breaks of both orientations."""
+    x0, x1, y0, y1 = spec.cavity
+    xb = [0.0, x0, x1, x1 + spec.end_wall, spec.pitch]
+    yb = [0.0, y0, y1, spec.height - spec.layer, spec.height]
+    if spec.slit is not None:
+        yb.append(spec.slit_depth)
+    yb += [spec.height - y for y in yb]
+    return xb, yb
+
+
+def _label(spec: UnitSpec, orientation: str, centres: FloatArray) -> IntArray:
+    """Label of each linear cell from its centroid: BODY, LAYER, CAVITY or SLIT."""
+    n, P, H = len(orientation), spec.pitch, spec.height
+    unit = np.clip(np.floor(centres[:, 0] / P).astype(int), 0, n - 1)
+    lx = centres[:, 0] - unit * P
+    cap = centres[:, 0] > n * P  # the end cap: solid, body or layer by height
+    flipped = np.array([c == "1" for c in orientation])[unit]
+    ly = np.where(flipped, H - centres[:, 1], centres[:, 1])
+    x0, x1, y0, y1 = spec.cavity
+    cavity = (lx > x0) & (lx < x1) & (ly > y0) & (ly < y1) & ~cap
+    if centres.shape[1] == 3:
+        z = centres[:, 2]
+        cavity &= (z > spec.side_wall) & (z < spec.width - spec.side_wall)
+    label = np.where(ly > H - spec.layer, LAYER, BODY)
+    label = np.where(cavity, CAVITY, label)
+    if spec.slit is not None:
+        sx0, _, _, sy1 = spec.slit
+        label = np.where((lx > sx0) & (ly < sy1) & ~cap, SLIT, label)
+    return label
+
+
+def assemble(spec: UnitSpec, orientation: str, dim: int = 2) -> ActuatorMesh:
+    """Mesh an actuator of ``len(orientation)`` units.
+
+    Parameters
+    ----------
+    spec : UnitSpec
+        The articulating unit.
+    orientation : str
+        The design, base first: one digit per unit, 1 = turned 180 degrees.
+    dim : {2, 3}
+        2 = plane-strain longitudinal section with filled cavities; 3 = solid with empty
+        cavities.
+
+    Returns
+    -------
+    ActuatorMesh
+
+    Examples
+    --------
+    >>> m = assemble(UnitSpec(), "01", dim=2)
+    >>> m.cell_type, m.tracked.shape, sorted(m.regions)
+    ('quad8', (2, 4), ['body', 'filler', 'layer'])
+    >>> np.round(m.unit_centres(), 3).tolist()
+    [[5.25, 7.5], [15.75, 10.5]]
+    """
+    import felupe as fem
+
+    if dim not in (2, 3):
+        raise GeometryError(f"dim must be 2 or 3, got {dim!r}")
+    orientation = parse_orientation(orientation)
+    n, P, H, W = len(orientation), spec.pitch, spec.height, spec.width
+    h = spec.element_size
+    xb_local, yb = _section_breaks(spec)
+    xs = grid_lines([i * P + x for i in range(n) for x in xb_local] + [n * P + spec.end_cap], h)
+    ys = grid_lines(yb, h)
+    if dim == 3:
+        zs = grid_lines([0.0, spec.side_wall, W / 2, W - spec.side_wall, W], h)
+        grid = fem.Grid(xs, ys, zs)
+    else:
+        grid = fem.Grid(xs, ys)
+    label = _label(spec, orientation, grid.points[grid.cells].mean(axis=1))
+    keep = label != SLIT if dim == 2 else (label == BODY) | (label == LAYER)
+    cells, label = grid.cells[keep], label[keep]
+    used = np.unique(cells)
+    renumber = np.full(len(grid.points), -1)
+    renumber[used] = np.arange(len(used))
+    linear = fem.Mesh(grid.points[used], renumber[cells], grid.cell_type)
+    mesh = linear.add_midpoints_edges()
+    points = np.asarray(mesh.points, dtype=float)
+    regions = {"body": np.flatnonzero(label == BODY), "layer": np.flatnonzero(label == LAYER)}
+    if dim == 2:
+        regions["filler"] = np.flatnonzero(label == CAVITY)
+
+    tol = 1e-6
+    x0, x1, y0, y1 = spec.cavity
+    cavity_points = np.zeros(len(points), dtype=bool)
+    tracked = np.zeros((n, 4), dtype=np.int64)
+    for i, o in enumerate(orientation):
+        cy0, cy1 = (y0, y1) if o == "0" else (H - y1, H - y0)
+        inside = (
+            (points[:, 0] > i * P + x0 - tol)
+            & (points[:, 0] < i * P + x1 + tol)
+            & (points[:, 1] > cy0 - tol)
+            & (points[:, 1] < cy1 + tol)
+        )
+        if dim == 3:
+            inside &= (points[:, 2] > spec.side_wall - tol) & (points[:, 2] < W - spec.side_wall + tol)
+        cavity_points |= inside
+        corners = [(i * P + x0, cy0), (i * P + x1, cy0), (i * P + x1, cy1), (i * P + x0, cy1)]
+        for k, (cx, cy) in enumerate(corners):
+            d = (points[:, 0] - cx) ** 2 + (points[:, 1] - cy) ** 2
+            if dim == 3:
+                d = d + (points[:, 2] - W / 2) ** 2
+            tracked[i, k] = int(np.argmin(d))
+            if d[tracked[i, k]] > tol**2:  # pragma: no cover - the grid has these lines
+                raise GeometryError(f"no mesh point at cavity vertex {k} of unit {i}")
+    on_end = np.isclose(points[:, 0], n * P + spec.end_cap)
+    if dim == 3:
+        on_end &= np.isclose(points[:, 2], W / 2)
+    end_points = np.flatnonzero(on_end)
+    end_points = end_points[np.argsort(points[end_points, 1])]
+    return ActuatorMesh(
+        points=points,
+        cells=np.asarray(mesh.cells, dtype=np.int64),
+        cell_type=mesh.cell_type,
+        regions=regions,
+        cavity_points=cavity_points,
+        tracked=tracked,
+        end_points=end_points,
+        base_points=np.isclose(points[:, 0], 0.0),
+        orientation=orientation,
+        spec=spec,
+    )

@@ -1,0 +1,210 @@
+"""The articulating unit (section 4.2): dimensions, materials and mesh size.
+
+The unit's longitudinal section in its own frame (orientation 0), x along the actuator,
+y across its height, the soft face at y = 0 and the stiff layer on top::
+
+    y = height  +--------------------------------------------+
+                |  stiff layer (layer_material), `layer` thick |
+                +--------------------------------------------+
+                | wall  (body material)                       |
+                |   +---------------------------+  +---+      |
+                |   |          cavity           |  |   |      |
+                |   +---------------------------+  |   |      |
+                | bottom wall (`wall`)             |slit|     |
+    y = 0       +--------------------------------  +---+  ---+
+                x = 0   end_wall             cavity   end_wall  slit   x = pitch
+
+Along x a unit is ``end_wall | cavity | end_wall | slit``: adjacent units share nothing but
+material, so two cavities are ``2 end_wall`` (+ the slit) apart. The optional slit is a gap
+of ``slit_width`` cut from the soft face to ``slit_depth`` at the end of the unit, so the
+inflating end walls can push each other apart (as in Pneu-nets) instead of only bulging the
+soft wall. In 3D the cavity stops ``side_wall`` short of both sides; the slit goes through
+the whole width. Orientation 1 is the unit turned 180 degrees about the long axis: its
+section is mirrored, y -> height - y.
+
+Examples
+--------
+>>> u = UnitSpec()
+>>> u.height, u.cavity_length
+(18.0, 7.5)
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+from typing import Any
+
+from pneumorph.errors import GeometryError
+
+_LENGTHS = (
+    "pitch",
+    "width",
+    "wall",
+    "side_wall",
+    "end_wall",
+    "layer",
+    "cavity_height",
+    "slit_width",
+    "slit_depth",
+    "end_cap",
+    "element_size",
+)
+
+
+@dataclass(frozen=True)
+class UnitSpec:
+    """Dimensions (mm), materials and element size of one articulating unit.
+
+    Parameters
+    ----------
+    pitch : float
+        Length of one unit along the actuator (10.5 mm: 15 units = 157.5 mm).
+    width : float
+        Width across the actuator (3D only).
+    wall : float
+        Thickness of the soft (bottom) wall and of the wall between cavity and layer.
+    side_wall : float
+        Thickness of the side walls (3D only).
+    end_wall : float
+        Thickness of each end wall of the cavity.
+    layer : float
+        Thickness of the stiff layer that gives the preferential bending direction.
+    cavity_height : float
+        Height of the cavity.
+    slit_width, slit_depth : float
+        The gap cut from the soft face at the end of the unit (0 = no slit).
+    end_cap : float
+        Extra material closing the free end of the last unit (mm). The interior walls
+        between cavities are ``2 end_wall`` thick; the free end wall is only ``end_wall``
+        plus this cap, and balloons first if it is thin.
+    body_material, layer_material : str
+        Library names of the body and the stiff layer.
+    element_size : float
+        Target edge length of the quadratic elements.
+    name : str
+        A label for reports.
+
+    Raises
+    ------
+    GeometryError
+        Non-positive dimensions, walls that leave no cavity, a slit that cuts the unit in two.
+    """
+
+    pitch: float = 10.5
+    width: float = 15.0
+    wall: float = 1.5
+    side_wall: float = 1.5
+    end_wall: float = 1.5
+    layer: float = 3.0
+    cavity_height: float = 12.0
+    slit_width: float = 0.0
+    slit_depth: float = 0.0
+    end_cap: float = 0.0
+    body_material: str = "mold_star_15"
+    layer_material: str = "smooth_sil_950"
+    element_size: float = 1.5
+    name: str = "unit"
+
+    def __post_init__(self) -> None:
+        for key in _LENGTHS:
+            value = getattr(self, key)
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise GeometryError(f"unit {key} must be a finite number of mm, got {value!r}")
+        for key in ("pitch", "width", "wall", "side_wall", "end_wall", "layer", "cavity_height", "element_size"):
+            if getattr(self, key) <= 0:
+                raise GeometryError(f"unit {key} must be positive, got {getattr(self, key)} mm")
+        for key in ("slit_width", "slit_depth", "end_cap"):
+            if getattr(self, key) < 0:
+                raise GeometryError(f"unit {key} must be >= 0, got {getattr(self, key)} mm")
+        if self.cavity_length <= 0:
+            raise GeometryError(
+                f"the walls leave no cavity: pitch {self.pitch} mm - 2 x end wall {self.end_wall} mm "
+                f"- slit {self.slit_width} mm = {self.cavity_length:g} mm"
+            )
+        if 2 * self.side_wall >= self.width:
+            raise GeometryError(
+                f"the side walls leave no cavity: 2 x {self.side_wall} mm >= width {self.width} mm"
+            )
+        if (self.slit_width > 0) != (self.slit_depth > 0):
+            raise GeometryError(
+                f"a slit needs both a width and a depth, got width {self.slit_width} mm and "
+                f"depth {self.slit_depth} mm"
+            )
+        if self.slit_depth >= self.height - self.layer:
+            raise GeometryError(
+                f"slit depth {self.slit_depth} mm reaches the stiff layer (at {self.height - self.layer} mm): "
+                "the units would only be joined by the layer; make it shallower"
+            )
+
+    @property
+    def height(self) -> float:
+        """Total height: bottom wall + cavity + top wall + stiff layer."""
+        return self.wall + self.cavity_height + self.wall + self.layer
+
+    @property
+    def cavity_length(self) -> float:
+        """Length of the cavity along the actuator."""
+        return self.pitch - 2 * self.end_wall - self.slit_width
+
+    @property
+    def cavity(self) -> tuple[float, float, float, float]:
+        """The cavity ``(x0, x1, y0, y1)`` in the unit's own frame (orientation 0)."""
+        x0 = self.end_wall
+        return (x0, x0 + self.cavity_length, self.wall, self.wall + self.cavity_height)
+
+    @property
+    def slit(self) -> tuple[float, float, float, float] | None:
+        """The slit ``(x0, x1, y0, y1)`` in the unit's own frame, or None."""
+        if self.slit_width == 0:
+            return None
+        return (self.pitch - self.slit_width, self.pitch, 0.0, self.slit_depth)
+
+    def to_dict(self) -> dict[str, Any]:
+        """All parameters, for TOML files and provenance."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], source: str = "unit definition") -> UnitSpec:
+        """Build from a mapping (e.g. the ``[unit]`` table of a TOML file).
+
+        Raises
+        ------
+        GeometryError
+            Unknown keys (the message lists the known ones) or invalid values.
+        """
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise GeometryError(
+                f"{source}: unknown unit parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}"
+            )
+        try:
+            return cls(**data)
+        except TypeError as exc:  # pragma: no cover - guarded by the key check
+            raise GeometryError(f"{source}: {exc}") from None
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> UnitSpec:
+        """Read a unit from a TOML file with a ``[unit]`` table (lengths in mm).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> p = pathlib.Path(tempfile.mkdtemp()) / "u.toml"
+        >>> _ = p.write_text("[unit]\\npitch = 12.0\\nslit_width = 1.0\\nslit_depth = 8.0\\n")
+        >>> UnitSpec.from_toml(p).cavity_length
+        8.0
+        """
+        p = Path(path)
+        try:
+            data = tomllib.loads(p.read_text(encoding="utf-8"))
+        except OSError as exc:
+            raise GeometryError(f"{p}: cannot read the unit file ({exc.strerror})") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise GeometryError(f"{p}: not valid TOML: {exc}") from None
+        if "unit" not in data or not isinstance(data["unit"], dict):
+            raise GeometryError(f"{p}: expected a [unit] table with the unit's dimensions in mm")
+        return cls.from_dict(data["unit"], source=str(p))

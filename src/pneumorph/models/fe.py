@@ -1,0 +1,324 @@
+"""Finite-element actuator models on FElupe: the 2D reduced-order and the 3D model.
+
+Both take a unit, an orientation vector and a pressure ramp and return a
+:class:`~pneumorph.models.response.Response`. The 2D model (chapter 5) is a plane-strain
+longitudinal section whose cavities hold a linear filler whose modulus follows the
+calibrated law E(P) at every substep of the ramp (section 5.3, natively - no temperature
+trick); the 3D model has empty cavities. Silicones use the dissertation's compressible
+Ogden model (Eq 2.12, Tables A.4, A.5) through the hand-coded kernel
+:class:`pneumorph.fem.OgdenCompressible`; the base face is clamped and a follower pressure
+acts on the cavity walls.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pneumorph import __version__
+from pneumorph.errors import SimulationFailed
+from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume, ramp
+from pneumorph.geometry.assembly import ActuatorMesh, assemble
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.materials import get, get_filler
+from pneumorph.materials.filler import FillerLaw
+from pneumorph.models.response import FloatArray, Response
+
+#: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
+MODEL_REVISION = 1
+
+
+@dataclass(frozen=True)
+class RampSpec:
+    """The pressure ramp and how it is solved.
+
+    Parameters
+    ----------
+    pressure : float
+        Final pressure in MPa (0.045 = 45 kPa).
+    steps : StepSettings
+        Reported increments (10 by default: 4.5, 9, ..., 45 kPa), substeps, cut-back.
+    """
+
+    pressure: float = 0.045
+    steps: StepSettings = field(default_factory=lambda: StepSettings(increments=10, substeps=2))
+
+    def __post_init__(self) -> None:
+        if not (self.pressure > 0 and np.isfinite(self.pressure)):
+            raise ValueError(f"the pressure must be positive, got {self.pressure * 1e3:g} kPa")
+
+    def pressures(self) -> FloatArray:
+        return self.pressure * self.steps.levels()
+
+
+def _end_face_angle(x: FloatArray) -> float:
+    """Angle (rad) of the end face, from its lowest to its highest point, against +y."""
+    d = x[-1] - x[0]
+    return float(np.arctan2(-d[0], d[1]))
+
+
+class FEModel:
+    """Common machinery of the 2D and 3D models (build once per design, solve the ramp)."""
+
+    fidelity = "fe"
+    dim = 2
+
+    def __init__(
+        self,
+        n_units: int,
+        unit: UnitSpec | None = None,
+        ramp_spec: RampSpec | None = None,
+        filler: FillerLaw | None = None,
+    ) -> None:
+        if int(n_units) < 1:
+            raise ValueError(f"an actuator needs at least 1 unit, got {n_units}")
+        self.n_units = int(n_units)
+        self.unit = unit or UnitSpec()
+        self.ramp = ramp_spec or RampSpec()
+        self.filler = filler
+        self.body = get(self.unit.body_material)
+        self.layer = get(self.unit.layer_material)
+
+    # -- identity -----------------------------------------------------------------------
+    def describe(self) -> dict[str, Any]:
+        """Everything that determines the results (hashed into the fingerprint)."""
+        out = {
+            "fidelity": self.fidelity,
+            "revision": MODEL_REVISION,
+            "n_units": self.n_units,
+            "unit": self.unit.to_dict(),
+            "materials": {"body": self.body.to_dict(), "layer": self.layer.to_dict()},
+            "pressure_mpa": self.ramp.pressure,
+            "steps": asdict(self.ramp.steps),
+        }
+        if self.filler is not None:
+            out["filler"] = self.filler.to_dict()
+        return out
+
+    def fingerprint(self) -> str:
+        text = json.dumps(self.describe(), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def pressures(self) -> FloatArray:
+        return self.ramp.pressures()
+
+    # -- building -------------------------------------------------------------------------
+    def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
+        """(Region class, boundary region class, field class) for this dimension."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _silicone_umat(self, material: Any) -> OgdenCompressible:
+        return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value)
+
+    def _extra_bodies(self, mesh: ActuatorMesh, field: Any) -> tuple[list[Any], Any]:
+        """Further items (the 2D filler) and a callback ``set_pressure(p)`` for them."""
+        return [], lambda p: None
+
+    def build(self, orientation: str) -> dict[str, Any]:
+        """FElupe objects for one design (mesh, fields, bodies, boundary conditions)."""
+        import felupe as fem
+
+        mesh = assemble(self.unit, orientation, self.dim)
+        Region, BoundaryRegion, Field = self._regions(mesh)
+        fmesh = fem.Mesh(mesh.points, mesh.cells, mesh.cell_type)
+        field = fem.FieldContainer([Field(Region(fmesh), dim=self.dim)])
+        bodies = []
+        for name, material in (("body", self.body), ("layer", self.layer)):
+            sub = fem.Mesh(mesh.points, mesh.cells[mesh.regions[name]], mesh.cell_type)
+            sub_field = fem.FieldContainer([Field(Region(sub), dim=self.dim)])
+            sub_field.link(field)
+            bodies.append(fem.SolidBody(self._silicone_umat(material), sub_field))
+        extra, set_extra = self._extra_bodies(mesh, field)
+        silicone = np.concatenate([mesh.regions["body"], mesh.regions["layer"]])
+        walls_mesh = fem.Mesh(mesh.points, mesh.cells[silicone], mesh.cell_type)
+        kwargs = {"ensure_3d": True} if self.dim == 2 else {}
+        walls = BoundaryRegion(walls_mesh, mask=mesh.cavity_points, **kwargs)
+        wall_field = fem.FieldContainer([Field(walls, dim=self.dim)])
+        wall_field.link(field)
+        pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
+        base = fem.Boundary(field[0], mask=mesh.base_points)
+        dof0, dof1 = fem.dof.partition(field, {"base": base})
+        return {
+            "mesh": mesh,
+            "field": field,
+            "items": [*bodies, *extra, pressure],
+            "pressure": pressure,
+            "set_extra": set_extra,
+            "wall_field": wall_field,
+            "dof0": dof0,
+            "dof1": dof1,
+        }
+
+    # -- solving --------------------------------------------------------------------------
+    def evaluate(self, orientation: str, on_level: Any = None) -> Response:
+        """Solve the pressure ramp of one design.
+
+        Parameters
+        ----------
+        orientation : str
+            The design, one digit per unit (``"0101..."``).
+        on_level : callable, optional
+            ``on_level(k, pressure_mpa)`` after each reported level (progress).
+
+        Raises
+        ------
+        SimulationFailed
+            If the ramp cannot be completed; ``reached`` and ``pressure`` name how far it got.
+        """
+        design = parse_orientation(orientation, self.n_units)
+        t0 = time.perf_counter()
+        model = self.build(design)
+        mesh: ActuatorMesh = model["mesh"]
+        field = model["field"]
+        pressures = self.pressures()
+        x_end0 = mesh.points[mesh.end_points][:, :2]
+        response = Response.empty(
+            design,
+            pressures,
+            mesh.unit_centres(),
+            x_end0.mean(axis=0),
+            metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()},
+        )
+        angle0 = _end_face_angle(x_end0)
+        angles: list[float] = []
+
+        def apply(t: float) -> None:
+            p = t * self.ramp.pressure
+            model["pressure"].update(p)
+            model["set_extra"](p)
+
+        def record(k: int, t: float) -> None:
+            u = field[0].values[:, : 2]
+            response.centres[k] = mesh.unit_centres(field[0].values[:, : self.dim])
+            x_end = x_end0 + u[mesh.end_points]
+            response.tip[k] = x_end.mean(axis=0)
+            angles.append(_end_face_angle(x_end) - angle0)
+            response.curl[: len(angles)] = np.degrees(np.unwrap(angles))
+            if on_level is not None:
+                on_level(k, pressures[k])
+
+        try:
+            stats = ramp(
+                model["items"],
+                field,
+                apply,
+                model["dof1"],
+                model["dof0"],
+                self.ramp.steps,
+                on_level=record,
+                monitor=lambda: cavity_volume(model["wall_field"]),
+            )
+        except SimulationFailed as exc:
+            raise SimulationFailed(
+                reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure
+            ) from None
+        meta = dict(response.metadata)
+        meta.update(
+            newton_iterations=stats.newton_iterations,
+            substeps=stats.substeps,
+            cutbacks=stats.cutbacks,
+            wall_time_s=time.perf_counter() - t0,
+            dofs=int(field[0].values.size),
+            pneumorph=__version__,
+        )
+        return Response(
+            orientation=design,
+            pressures=response.pressures,
+            centres=response.centres,
+            reference_centres=response.reference_centres,
+            tip=response.tip,
+            reference_tip=response.reference_tip,
+            curl=response.curl,
+            converged=True,
+            reached=float(pressures[-1]),
+            metadata=meta,
+        )
+
+
+class Reduced2D(FEModel):
+    """The 2D plane-strain reduced-order model with a pressure-dependent filler (chapter 5).
+
+    Parameters
+    ----------
+    n_units : int
+        Number of units.
+    unit : UnitSpec, optional
+        The articulating unit (default: :class:`UnitSpec` defaults).
+    ramp_spec : RampSpec, optional
+        Pressure ramp (default 45 kPa in 10 reported increments).
+    filler : FillerLaw, optional
+        The filler law E(P) (default: Eq 5.2). The ramp must lie inside its calibrated
+        range, else :class:`pneumorph.errors.PressureRangeError` is raised at once.
+
+    Examples
+    --------
+    >>> m = Reduced2D(2, ramp_spec=RampSpec(pressure=0.01))   # 10 kPa in 10 increments
+    >>> r = m.evaluate("00")
+    >>> r.converged, r.n_levels, bool(r.curl[-1] > 0)
+    (True, 10, True)
+    """
+
+    fidelity = "2d"
+    dim = 2
+
+    def __init__(
+        self,
+        n_units: int,
+        unit: UnitSpec | None = None,
+        ramp_spec: RampSpec | None = None,
+        filler: FillerLaw | None = None,
+    ) -> None:
+        super().__init__(n_units, unit, ramp_spec, filler or get_filler())
+        assert self.filler is not None
+        # PressureRangeError outside the calibrated range, naming the ramp's top pressure
+        self.filler.modulus(self.ramp.pressure)
+
+    def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
+        import felupe as fem
+
+        return fem.RegionQuadraticQuad, fem.RegionQuadraticQuadBoundary, fem.FieldPlaneStrain
+
+    def _extra_bodies(self, mesh: ActuatorMesh, field: Any) -> tuple[list[Any], Any]:
+        import felupe as fem
+
+        law = self.filler
+        assert law is not None
+        nu = law.poisson_ratio
+        umat = fem.NeoHookeCompressible(mu=1.0, lmbda=1.0)
+        sub = fem.Mesh(mesh.points, mesh.cells[mesh.regions["filler"]], mesh.cell_type)
+        sub_field = fem.FieldContainer([fem.FieldPlaneStrain(fem.RegionQuadraticQuad(sub), dim=2)])
+        sub_field.link(field)
+
+        def set_pressure(p: float) -> None:
+            # linear-elastic filler at large strain: compressible neo-Hooke with the Lame
+            # constants of E(P) and nu (small-strain limit = Hooke's law)
+            e = float(law.modulus(p))
+            umat.mu = e / (2 * (1 + nu))
+            umat.lmbda = e * nu / ((1 + nu) * (1 - 2 * nu))
+
+        set_pressure(0.0)
+        return [fem.SolidBody(umat, sub_field)], set_pressure
+
+
+class Full3D(FEModel):
+    """The 3D model: quadratic hexahedra, empty cavities, the same ramp (chapter 4).
+
+    Parameters are those of :class:`Reduced2D` without the filler.
+    """
+
+    fidelity = "3d"
+    dim = 3
+
+    def __init__(self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None) -> None:
+        super().__init__(n_units, unit, ramp_spec, None)
+
+    def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
+        import felupe as fem
+
+        return fem.RegionQuadraticHexahedron, fem.RegionQuadraticHexahedronBoundary, fem.Field

@@ -1,0 +1,100 @@
+"""Finite-element actuator models: symmetry, path independence, errors, provenance.
+
+Small actuators and low pressures keep these fast; the physics checked does not depend on
+the unit's cavity design.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.errors import OrientationError, PressureRangeError, SimulationFailed
+from pneumorph.fem import StepSettings
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.materials import get_filler
+from pneumorph.materials.filler import FillerLaw
+from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
+
+LOW = RampSpec(pressure=0.01, steps=StepSettings(increments=2, substeps=2))
+
+
+@pytest.fixture(scope="module")
+def pair_2d():
+    model = Reduced2D(2, ramp_spec=LOW)
+    return model.evaluate("01"), model.evaluate("10")
+
+
+def test_2d_inverting_every_unit_mirrors_the_shape(pair_2d) -> None:
+    a, b = pair_2d
+    H = UnitSpec().height
+    assert a.converged and b.converged
+    np.testing.assert_allclose(a.centres[..., 0], b.centres[..., 0], atol=1e-7)
+    np.testing.assert_allclose(a.centres[..., 1], H - b.centres[..., 1], atol=1e-7)
+    np.testing.assert_allclose(a.curl, -b.curl, atol=1e-6)
+    np.testing.assert_allclose(a.tip[:, 1], H - b.tip[:, 1], atol=1e-7)
+
+
+def test_2d_aligned_units_bend_towards_the_stiff_layer() -> None:
+    r = Reduced2D(2, ramp_spec=LOW).evaluate("00")
+    assert np.all(np.diff(r.curl) > 0) and r.curl[0] > 0
+    assert np.all(r.tip[:, 1] > r.reference_tip[1])
+
+
+def test_filler_path_independence() -> None:
+    """Hyperelastic equilibrium depends only on the current load and moduli (Fig 5.7).
+
+    A filler that follows E(P) and one held at E(p_max) reach the same shape at p_max
+    but not at the intermediate levels, where the constant filler is softer.
+    """
+    eq52 = get_filler()
+    e_end = float(eq52.modulus(LOW.pressure))
+    constant = FillerLaw(
+        name="constant", display_name="E(p_max)", coefficients=(e_end,),
+        pressure_range=eq52.pressure_range, poisson_ratio=eq52.poisson_ratio,
+    )
+    varying = Reduced2D(2, ramp_spec=LOW).evaluate("00")
+    fixed = Reduced2D(2, ramp_spec=LOW, filler=constant).evaluate("00")
+    np.testing.assert_allclose(fixed.centres[-1], varying.centres[-1], atol=1e-6)
+    assert abs(fixed.curl[0]) > abs(varying.curl[0]) * 1.01
+
+
+def test_pressure_outside_the_filler_range_is_refused() -> None:
+    with pytest.raises(PressureRangeError, match="60 kPa is outside the calibrated range 0-45 kPa"):
+        Reduced2D(3, ramp_spec=RampSpec(pressure=0.06))
+    with pytest.raises(ValueError, match="must be positive"):
+        RampSpec(pressure=-0.01)
+
+
+def test_orientation_of_the_wrong_length_is_refused() -> None:
+    with pytest.raises(OrientationError, match="has 3 units, expected 2"):
+        Reduced2D(2, ramp_spec=LOW).evaluate("010")
+    with pytest.raises(ValueError, match="at least 1 unit"):
+        Reduced2D(0)
+
+
+def test_failed_solve_names_the_design_and_the_pressure_reached() -> None:
+    starved = RampSpec(pressure=0.01, steps=StepSettings(increments=2, substeps=1, max_iterations=1, max_cutbacks=1))
+    with pytest.raises(SimulationFailed, match=r"design 01: simulation failed, converged up to 0 kPa of 10 kPa") as info:
+        Reduced2D(2, ramp_spec=starved).evaluate("01")
+    assert info.value.design == "01" and info.value.reached == 0.0
+
+
+def test_fingerprint_follows_everything_that_changes_results(pair_2d) -> None:
+    base = Reduced2D(2, ramp_spec=LOW)
+    assert base.fingerprint() == Reduced2D(2, ramp_spec=LOW).fingerprint()
+    assert base.fingerprint() != Reduced2D(3, ramp_spec=LOW).fingerprint()
+    assert base.fingerprint() != Reduced2D(2, unit=UnitSpec(wall=1.4), ramp_spec=LOW).fingerprint()
+    assert base.fingerprint() != Reduced2D(2, ramp_spec=RampSpec(pressure=0.02)).fingerprint()
+    assert pair_2d[0].metadata["fingerprint"] == base.fingerprint()
+    assert pair_2d[0].metadata["newton_iterations"] > 0
+
+
+def test_3d_single_unit_mirror() -> None:
+    ramp = RampSpec(pressure=0.005, steps=StepSettings(increments=1, substeps=1))
+    model = Full3D(1, ramp_spec=ramp)
+    a, b = model.evaluate("0"), model.evaluate("1")
+    H = UnitSpec().height
+    assert a.curl[-1] > 0
+    np.testing.assert_allclose(a.centres[..., 1], H - b.centres[..., 1], atol=1e-7)
+    np.testing.assert_allclose(a.curl, -b.curl, atol=1e-6)
