@@ -1,0 +1,65 @@
+"""Design search: objectives, fitness (Eq 4.1), genetic algorithm, exhaustive search, runs.
+
+The functions a front end calls:
+
+- :func:`make_objective` - an objective from text (``"sin"``, ``"max-y"``, ``"y = ..."``).
+- :func:`score` - a response's fitness at every pressure level and its best level.
+- :func:`run_ga` / :func:`run_exhaustive` - the searches, through any evaluator.
+- :func:`run_design` - a whole run into a folder (resumable), from a :class:`DesignConfig`.
+- :func:`population_study` - the population-size study of section 6.1.
+
+Examples
+--------
+>>> from pneumorph.design import make_objective
+>>> make_objective("sin", amplitude=15).label
+'sin: y = A*sin(2*pi*1*x/L), A = 15 mm'
+"""
+
+from pneumorph.design.config import DesignConfig
+from pneumorph.design.exhaustive import (
+    ExhaustiveResult,
+    mirror_response,
+    run_exhaustive,
+)
+from pneumorph.design.fitness import Score, score
+from pneumorph.design.ga import GAConfig, GAResult, GenerationStats, run_ga
+from pneumorph.design.run import RunResult, run_design
+from pneumorph.design.scoring import Candidate
+from pneumorph.design.study import StudyResult, plot_study, population_study
+from pneumorph.design.targets import (
+    PRESETS,
+    TIP_GOALS,
+    Objective,
+    ProfileTarget,
+    TipGoal,
+    make_objective,
+    profile_target,
+    tip_goal,
+)
+
+__all__ = [
+    "PRESETS",
+    "TIP_GOALS",
+    "Candidate",
+    "DesignConfig",
+    "ExhaustiveResult",
+    "GAConfig",
+    "GAResult",
+    "GenerationStats",
+    "Objective",
+    "ProfileTarget",
+    "RunResult",
+    "Score",
+    "StudyResult",
+    "TipGoal",
+    "make_objective",
+    "mirror_response",
+    "plot_study",
+    "population_study",
+    "profile_target",
+    "run_design",
+    "run_exhaustive",
+    "run_ga",
+    "score",
+    "tip_goal",
+]

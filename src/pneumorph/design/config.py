@@ -1,0 +1,179 @@
+"""Settings of a design run and their TOML form (read with :mod:`tomllib`, written here).
+
+A config file::
+
+    [design]
+    objective = "sin"        # a tip goal, a preset (sin, cos) or "y = ..." / "r = ..."
+    amplitude = 10.0         # mm
+    periods = 1.0
+    units = 15
+    search = "ga"            # or "exhaustive"
+    seed = 0
+
+    [ga]
+    population = 100
+    generations = 15
+
+    [execution]
+    executor = "serial"      # serial | processes | dask
+    cache = "evaluations.sqlite"
+
+    [model]                  # handed to the model factory unchanged
+    fidelity = "2d"
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+from pneumorph.design.ga import GAConfig
+from pneumorph.design.targets import Objective, make_objective
+from pneumorph.errors import SearchConfigError
+from pneumorph.execution.evaluators import EXECUTORS
+
+SEARCHES = ("ga", "exhaustive")
+
+
+@dataclass(frozen=True)
+class DesignConfig:
+    """Everything that defines a design run (the model's own settings go in ``model``).
+
+    Examples
+    --------
+    >>> c = DesignConfig(objective="cos", amplitude=20.0, units=8)
+    >>> DesignConfig.from_dict(c.to_dict()) == c
+    True
+    >>> DesignConfig(units=0)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: the actuator needs at least 1 unit, got 0
+    """
+
+    objective: str = "sin"
+    amplitude: float = 10.0
+    periods: float = 1.0
+    point: tuple[float, float] | None = None
+    anchored: bool = True
+    units: int = 15
+    search: str = "ga"
+    seed: int = 0
+    ga: GAConfig = field(default_factory=GAConfig)
+    executor: str = "serial"
+    workers: int | None = None
+    scheduler: str | None = None
+    cache: str | None = None
+    model: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if int(self.units) != self.units or self.units < 1:
+            raise SearchConfigError(f"the actuator needs at least 1 unit, got {self.units}")
+        if self.search not in SEARCHES:
+            raise SearchConfigError(f"unknown search {self.search!r}; choose one of {', '.join(SEARCHES)}")
+        if self.executor not in EXECUTORS:
+            raise SearchConfigError(f"unknown executor {self.executor!r}; choose one of {', '.join(EXECUTORS)}")
+        for name in ("amplitude", "periods"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        if self.ga.seed != self.seed:
+            object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
+        if self.point is not None:
+            object.__setattr__(self, "point", tuple(float(v) for v in self.point))
+        self.make_objective()  # fail early on a bad objective
+
+    def make_objective(self) -> Objective:
+        """The objective these settings describe."""
+        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored)
+
+    # -- plain-data form --------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """Nested tables ``design``, ``ga``, ``execution``, ``model`` (None values left out)."""
+        design = {
+            k: getattr(self, k)
+            for k in ("objective", "amplitude", "periods", "point", "anchored", "units", "search", "seed")
+        }
+        ga = {k: v for k, v in asdict(self.ga).items() if k != "seed"}
+        execution = {k: getattr(self, k) for k in ("executor", "workers", "scheduler", "cache")}
+
+        def clean(d: dict[str, Any]) -> dict[str, Any]:
+            return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items() if v is not None}
+
+        return {"design": clean(design), "ga": clean(ga), "execution": clean(execution), "model": dict(self.model)}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> DesignConfig:
+        """Settings from nested tables (unknown keys are an error, naming the key)."""
+        known_design = {f.name for f in fields(cls)} - {"ga", "model", "executor", "workers", "scheduler", "cache"}
+        known_ga = {f.name for f in fields(GAConfig)} - {"seed"}
+        known_exec = {"executor", "workers", "scheduler", "cache"}
+        tables = {"design": known_design, "ga": known_ga, "execution": known_exec}
+        for table in set(data) - {*tables, "model", "provenance"}:
+            raise SearchConfigError(f"unknown table [{table}] in the design config; known: design, ga, execution, model")
+        kwargs: dict[str, Any] = {}
+        for table, known in tables.items():
+            for key in set(data.get(table, {})) - known:
+                raise SearchConfigError(f"unknown key {key!r} in [{table}]; known keys: {', '.join(sorted(known))}")
+        kwargs.update(data.get("design", {}))
+        kwargs.update(data.get("execution", {}))
+        if "point" in kwargs:
+            kwargs["point"] = tuple(kwargs["point"])
+        ga = GAConfig(**{**data.get("ga", {}), "seed": kwargs.get("seed", 0)})
+        return cls(ga=ga, model=dict(data.get("model", {})), **kwargs)
+
+    @classmethod
+    def read(cls, path: str | Path) -> DesignConfig:
+        """Settings from a TOML file (a run folder's ``config.toml`` works too)."""
+        try:
+            data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        except tomllib.TOMLDecodeError as exc:
+            raise SearchConfigError(f"{path}: not valid TOML: {exc}") from None
+        return cls.from_dict(data)
+
+
+# -- a small TOML writer (tables of scalars, lists and one level of sub-tables) -----------
+def _value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v, ensure_ascii=False)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def to_toml(tables: dict[str, dict[str, Any]]) -> str:
+    """TOML text of ``{table: {key: value or {key: value}}}``.
+
+    >>> print(to_toml({"design": {"units": 8, "point": [1.0, 2.0]}, "provenance": {"deps": {"numpy": "2.0"}}}))
+    [design]
+    units = 8
+    point = [1.0, 2.0]
+    <BLANKLINE>
+    [provenance]
+    <BLANKLINE>
+    [provenance.deps]
+    numpy = "2.0"
+    <BLANKLINE>
+    """
+    lines: list[str] = []
+    for name, table in tables.items():
+        lines.append(f"[{name}]")
+        subtables = {k: v for k, v in table.items() if isinstance(v, dict)}
+        lines += [f"{k} = {_value(v)}" for k, v in table.items() if k not in subtables and v is not None]
+        lines.append("")
+        for sub, content in subtables.items():
+            lines.append(f"[{name}.{sub}]")
+            lines += [f"{k} = {_value(v)}" for k, v in content.items() if v is not None]
+            lines.append("")
+    return "\n".join(lines)

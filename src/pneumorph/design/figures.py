@@ -1,0 +1,100 @@
+"""Figures of a design run: the best profile against the target (Figs 6.6-6.11), convergence."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from pneumorph.design.ga import GenerationStats
+from pneumorph.design.scoring import Candidate
+from pneumorph.design.targets import Objective, ProfileTarget
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def profile_points(candidate: Candidate) -> np.ndarray:
+    """Base, unit centres and tip at the best level, heights above their undeformed positions."""
+    r, k = candidate.response, candidate.level
+    assert r is not None and k is not None
+    centres = np.column_stack([r.centres[k, :, 0], r.centres[k, :, 1] - r.reference_centres[:, 1]])
+    tip = np.array([r.tip[k, 0], r.tip[k, 1] - r.reference_tip[1]])
+    return np.vstack([[0.0, 0.0], centres, tip])
+
+
+def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, unit: str = "mm") -> Path:
+    """The best design's profile at its best pressure beside the target (or the tip goal).
+
+    Parameters
+    ----------
+    candidate : Candidate
+        A converged design with its response and best level.
+    objective : ProfileTarget or TipGoal
+    path : str or Path
+        Output file (PNG or SVG by its suffix).
+
+    Returns
+    -------
+    Path
+    """
+    plt = _pyplot()
+    r = candidate.response
+    pts = profile_points(candidate)
+    length = float(r.reference_tip[0])
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.axhline(0.0, color="0.8", lw=0.8, ls="--", label="undeformed axis")
+    if isinstance(objective, ProfileTarget):
+        if objective.coordinates == "cartesian":
+            xs = np.linspace(0.0, max(length, float(np.nanmax(pts[:, 0]))), 300)
+            ax.plot(xs, objective.curve(xs, length), color="C1", lw=2, label=f"target {objective.label}")
+        else:
+            th = np.unwrap(np.arctan2(pts[1:-1, 1], pts[1:-1, 0]))
+            ts = np.linspace(min(th.min(), 0.0), max(th.max(), 0.0), 300)
+            rs = objective.curve(ts, length)
+            ax.plot(rs * np.cos(ts), rs * np.sin(ts), color="C1", lw=2, label=f"target {objective.label}")
+        what = f"error {candidate.value:.3g} {unit}"
+    else:
+        if objective.point is not None:
+            ax.plot(*objective.point, "x", color="C1", ms=10, mew=2, label="point to reach")
+        what = f"{objective.label}: {candidate.value:.4g} {objective.unit}"
+    ax.plot(pts[:, 0], pts[:, 1], "-", color="C0", lw=1.5, label="actuator centreline")
+    ax.plot(pts[1:-1, 0], pts[1:-1, 1], "o", color="C0", ms=4, label="unit centres")
+    ax.plot(*pts[-1], "s", color="C3", ms=6, label="tip")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x along the actuator (mm)")
+    ax.set_ylabel("y (mm)")
+    pressure = candidate.pressure * 1e3 if candidate.pressure is not None else float("nan")
+    ax.set_title(f"{candidate.design} at {pressure:.4g} kPa - {what}", fontsize=9)
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+    path = Path(path)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return path
+
+
+def plot_convergence(history: Sequence[GenerationStats], path: str | Path, unit: str = "mm") -> Path:
+    """Best and mean fitness of the population over the generations."""
+    plt = _pyplot()
+    gens = [h.generation for h in history]
+    fig, ax = plt.subplots(figsize=(5.6, 3.6))
+    ax.plot(gens, [h.best for h in history], "o-", label="best")
+    ax.plot(gens, [h.mean for h in history], "s--", label="mean")
+    ax.set_xlabel("generation")
+    ax.set_ylabel(f"fitness ({unit})")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    path = Path(path)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return path

@@ -1,0 +1,179 @@
+"""Fitness of a response against an objective, at every reported pressure (Eq 4.1).
+
+Reading of the dissertation (section 4.5.4). Eq 4.1 is evaluated at each of the ten
+solution increments, with ``Y`` the *displacements* of the tracked unit centres (the mean
+of the four nodes at the cavity's vertices) and of the desired profile:
+
+.. math:: F_k = \\sqrt{\\sum_i (Y^{desired}(x_{k,i}) - Y_{k,i})^2}
+
+Here ``Y_{k,i} = y_{k,i} - y^{ref}_i`` is the height of centre ``i`` at level ``k`` above
+its own undeformed position - the displacement the dissertation reads from its punch file,
+i.e. the height above the undeformed axis - and the target is evaluated at the centre's
+*current* position along the actuator, ``x_{k,i}`` (undeformed x plus the x displacement),
+so that an actuator that shortens as it bends is compared where its units are. The lowest
+``F_k`` over the levels selects the reported pressure (method 2 of section 4.3). Ties go to
+the lower pressure.
+
+Polar targets ``r = f(theta)`` use the same datum: centre ``i`` sits at
+``(x_{k,i}, Y_{k,i})`` relative to the base, with radius ``r`` and angle ``theta``
+(unwrapped along the actuator so a curl past 180 degrees keeps counting), and the error is
+the root of the summed squared radial differences.
+
+Tip goals (Table 6.1) use the tip in the same frame: ``X`` = the tip's x, ``Y`` = its
+height above the undeformed tip, the distance to the base ``sqrt(X^2 + Y^2)`` and the curl
+in degrees (counter-clockwise positive).
+
+A failed response (not converged, or every level NaN) scores the worst value
+(``+inf`` when minimising, ``-inf`` when maximising); a single NaN level scores the worst
+value at that level only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.design.targets import Objective, ProfileTarget, Sense
+from pneumorph.models.response import Response
+
+FloatArray = NDArray[np.float64]
+
+
+def worst(sense: Sense) -> float:
+    """The worst possible fitness for an objective's sense.
+
+    >>> worst("min"), worst("max")
+    (inf, -inf)
+    """
+    return float("inf") if sense == "min" else float("-inf")
+
+
+def is_better(a: float, b: float, sense: Sense) -> bool:
+    """True if fitness ``a`` is strictly better than ``b``."""
+    return a < b if sense == "min" else a > b
+
+
+@dataclass(frozen=True)
+class Score:
+    """The fitness of one design at every reported level, and its best level.
+
+    Attributes
+    ----------
+    values : ndarray, shape (k,)
+        Objective value per level (mm or degrees); worst where the level is NaN.
+    level : int or None
+        Index of the best level; None for a failed design.
+    value : float
+        The objective value at the best level; the worst value for a failed design.
+    pressure : float or None
+        The pressure of the best level (MPa).
+    failed : bool
+        True if the design did not give a usable response.
+    """
+
+    values: FloatArray
+    level: int | None
+    value: float
+    pressure: float | None
+    failed: bool = False
+
+
+def _datum_centres(r: Response) -> tuple[FloatArray, FloatArray]:
+    """Current x of the centres and their height above their undeformed position, (k, n)."""
+    return r.centres[..., 0], r.centres[..., 1] - r.reference_centres[None, :, 1]
+
+
+def profile_errors(response: Response, target: ProfileTarget) -> FloatArray:
+    """Eq 4.1 at every reported level, shape (k,); NaN where a level is missing.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pneumorph.design.targets import profile_target
+    >>> ref = np.array([[5.0, 0.0], [15.0, 0.0]])
+    >>> r = Response.empty("00", np.array([0.01]), ref, np.array([20.0, 0.0]))
+    >>> r.centres[0] = [[5.0, 1.0], [15.0, 2.0]]; r.tip[0] = [20.0, 2.0]; r.curl[0] = 0.0
+    >>> profile_errors(r, profile_target("y = 0.1*x")).round(6).tolist()  # sqrt(0.5^2 + 0.5^2)
+    [0.707107]
+    """
+    length = float(response.reference_tip[0])
+    x, y = _datum_centres(response)
+    if target.coordinates == "cartesian":
+        want, got = target.curve(x, length), y
+    else:
+        theta = np.unwrap(np.arctan2(y, x), axis=-1)
+        want, got = target.curve(theta, length), np.hypot(x, y)
+    with np.errstate(invalid="ignore"):
+        return np.sqrt(np.sum((want - got) ** 2, axis=-1))
+
+
+def tip_values(response: Response, name: str, point: tuple[float, float] | None = None) -> FloatArray:
+    """The quantity a tip goal optimises, at every reported level, shape (k,)."""
+    x = response.tip[:, 0]
+    y = response.tip[:, 1] - response.reference_tip[1]
+    if name in ("max-x", "min-x"):
+        return x.copy()
+    if name in ("max-y", "min-y"):
+        return y
+    if name == "min-distance":
+        return np.hypot(x, y)
+    if name == "max-curl":
+        return response.curl.copy()
+    if name == "reach" and point is not None:
+        return np.hypot(x - point[0], y - point[1])
+    raise ValueError(f"no tip quantity for goal {name!r}")
+
+
+def objective_values(response: Response, objective: Objective) -> FloatArray:
+    """Raw objective value at every level (NaN where the level is missing)."""
+    if isinstance(objective, ProfileTarget):
+        return profile_errors(response, objective)
+    return tip_values(response, objective.name, objective.point)
+
+
+def failed_score(objective: Objective, n_levels: int) -> Score:
+    """The score of a design that could not be evaluated."""
+    bad = worst(objective.sense)
+    return Score(np.full(n_levels, bad), None, bad, None, failed=True)
+
+
+def score(response: Response | None, objective: Objective, n_levels: int | None = None) -> Score:
+    """Fitness of a response at every level and its best level.
+
+    Parameters
+    ----------
+    response : Response or None
+        None (or a non-converged response) for a failed solve.
+    objective : ProfileTarget or TipGoal
+    n_levels : int, optional
+        Number of levels of a failed design's score (default: the response's, else 0).
+
+    Returns
+    -------
+    Score
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pneumorph.design.targets import tip_goal
+    >>> ref = np.array([[5.0, 0.0]])
+    >>> r = Response.empty("0", np.array([0.02, 0.04]), ref, np.array([10.0, 0.0]))
+    >>> r.centres[:] = ref; r.tip[:] = [[9.0, 3.0], [7.0, 5.0]]; r.curl[:] = [20.0, 45.0]
+    >>> s = score(r, tip_goal("max-y"))
+    >>> s.level, s.value, s.pressure
+    (1, 5.0, 0.04)
+    >>> score(None, tip_goal("max-y"), n_levels=2).value
+    -inf
+    """
+    if response is None or not response.converged:
+        k = n_levels if n_levels is not None else (response.n_levels if response is not None else 0)
+        return failed_score(objective, k)
+    values = objective_values(response, objective)
+    bad = worst(objective.sense)
+    values = np.where(np.isfinite(values), values, bad)
+    if not np.isfinite(values).any():
+        return Score(values, None, bad, None, failed=True)
+    level = int(np.argmin(values) if objective.sense == "min" else np.argmax(values))
+    return Score(values, level, float(values[level]), float(response.pressures[level]))

@@ -1,0 +1,339 @@
+"""Genetic algorithm over orientation vectors: DEAP's ``eaSimple`` (section 4.5).
+
+This is the only module that touches DEAP's global ``creator``. The generational loop
+follows ``deap.algorithms.eaSimple`` step for step (tournament selection, ``varAnd`` with
+two-point crossover and bit-flip mutation, evaluation of the individuals whose fitness was
+invalidated, generational replacement) with one difference: DEAP's operators draw from the
+global :mod:`random` module, which other code (a Dask scheduler thread, a plotting library)
+may also draw from, so here the same operators draw from a private ``random.Random(seed)``.
+With ``elitism = 0`` a run reproduces ``eaSimple`` exactly when ``eaSimple`` is given a
+global ``random`` seeded with the same seed (tested).
+
+A whole generation is evaluated as one batch through an evaluator, so the solves can run
+in parallel; designs seen before in the run are not sent again.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from deap import base, creator, tools
+
+from pneumorph.design.fitness import Score
+from pneumorph.design.scoring import Candidate, ScoreBook
+from pneumorph.design.targets import Objective, Sense
+from pneumorph.errors import SearchConfigError
+from pneumorph.execution.evaluators import Evaluator
+from pneumorph.models.response import ActuatorModel
+
+_FITNESS = {"min": "PneumorphFitnessMin", "max": "PneumorphFitnessMax"}
+_INDIVIDUAL = {"min": "PneumorphIndividualMin", "max": "PneumorphIndividualMax"}
+for _sense, _weight in (("min", -1.0), ("max", 1.0)):
+    if not hasattr(creator, _FITNESS[_sense]):
+        creator.create(_FITNESS[_sense], base.Fitness, weights=(_weight,))
+    if not hasattr(creator, _INDIVIDUAL[_sense]):
+        creator.create(_INDIVIDUAL[_sense], list, fitness=getattr(creator, _FITNESS[_sense]))
+
+
+@dataclass(frozen=True)
+class GAConfig:
+    """Settings of the genetic algorithm.
+
+    Defaults: population 100 and 15 generations (section 6.1); the dissertation does not
+    give the operator probabilities, so ``cxpb``, ``mutpb``, ``indpb`` and ``tournsize``
+    are DEAP's example values for ``eaSimple`` on bit strings.
+
+    Attributes
+    ----------
+    population, generations : int
+    cxpb, mutpb : float
+        Probability that a pair is crossed over / an individual is mutated.
+    indpb : float
+        Probability that a mutated individual's unit flips.
+    tournsize : int
+        Individuals per selection tournament.
+    elitism : int
+        Best distinct individuals carried into the next generation (0 = plain eaSimple).
+    hall_of_fame : int
+        Number of distinct best designs kept.
+    seed : int
+        Seed of the private random generator.
+    budget : int or None
+        Most distinct designs evaluated in the run (solved or taken from the cache). The run
+        stops before a generation that would exceed it, so all finished generations are
+        plain eaSimple generations and a resumed run stops at the same place.
+
+    Examples
+    --------
+    >>> GAConfig(population=1)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: the population must hold at least 2 individuals, got 1
+    """
+
+    population: int = 100
+    generations: int = 15
+    cxpb: float = 0.5
+    mutpb: float = 0.2
+    indpb: float = 0.05
+    tournsize: int = 3
+    elitism: int = 0
+    hall_of_fame: int = 10
+    seed: int = 0
+    budget: int | None = None
+
+    def __post_init__(self) -> None:
+        if int(self.population) != self.population or self.population < 2:
+            raise SearchConfigError(f"the population must hold at least 2 individuals, got {self.population}")
+        if int(self.generations) != self.generations or self.generations < 0:
+            raise SearchConfigError(f"the number of generations must be 0 or more, got {self.generations}")
+        for name in ("cxpb", "mutpb", "indpb"):
+            value = getattr(self, name)
+            if not 0.0 <= value <= 1.0:
+                raise SearchConfigError(f"{name} is a probability between 0 and 1, got {value}")
+        if self.tournsize < 1:
+            raise SearchConfigError(f"the tournament size must be at least 1, got {self.tournsize}")
+        if not 0 <= self.elitism < self.population:
+            raise SearchConfigError(
+                f"elitism must be between 0 and population - 1 = {self.population - 1}, got {self.elitism}"
+            )
+        if self.budget is not None and self.budget < self.population:
+            raise SearchConfigError(
+                f"a budget of {self.budget} designs does not cover the initial population of {self.population}"
+            )
+        if self.hall_of_fame < 1:
+            raise SearchConfigError(f"the hall of fame must keep at least 1 design, got {self.hall_of_fame}")
+
+
+@dataclass(frozen=True)
+class GenerationStats:
+    """Statistics of one generation's population (finite fitness values only).
+
+    ``evaluations`` = individuals whose fitness was computed (eaSimple's ``nevals``), of
+    which ``cache_hits`` were known (earlier in the run or from the evaluation cache) and
+    ``solves`` were new model solves; ``failures`` = individuals with a failed solve.
+    """
+
+    generation: int
+    best: float
+    mean: float
+    worst: float
+    std: float
+    evaluations: int
+    cache_hits: int
+    solves: int
+    failures: int
+    wall_time: float
+    best_design: str
+
+    def as_row(self) -> dict[str, object]:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class GAResult:
+    """What a GA run found.
+
+    Attributes
+    ----------
+    config : GAConfig
+    sense : {"min", "max"}
+    history : tuple of GenerationStats
+        Generation 0 (the initial population) to the last.
+    hall_of_fame : tuple of Candidate
+        The best distinct designs, best first.
+    population : tuple of str
+        The final population.
+    stopped : str
+        ``"generations"`` or ``"budget"``: why the run ended.
+    solves : int
+        New model solves in this run (cache hits excluded).
+    scores : dict
+        Every design evaluated in the run and its score.
+    """
+
+    config: GAConfig
+    sense: Sense
+    history: tuple[GenerationStats, ...]
+    hall_of_fame: tuple[Candidate, ...]
+    population: tuple[str, ...]
+    solves: int
+    scores: dict[str, Score] = field(repr=False)
+    stopped: str = "generations"
+
+    @property
+    def best(self) -> Candidate:
+        return self.hall_of_fame[0]
+
+
+# -- operators with a private generator (same algorithms as deap.tools) -----------------
+def cx_two_point(ind1: list[int], ind2: list[int], rng: random.Random) -> tuple[list[int], list[int]]:
+    """Two-point crossover in place, as ``deap.tools.cxTwoPoint``."""
+    size = min(len(ind1), len(ind2))
+    if size < 2:
+        return ind1, ind2
+    c1 = rng.randint(1, size)
+    c2 = rng.randint(1, size - 1)
+    if c2 >= c1:
+        c2 += 1
+    else:
+        c1, c2 = c2, c1
+    ind1[c1:c2], ind2[c1:c2] = ind2[c1:c2], ind1[c1:c2]
+    return ind1, ind2
+
+
+def mut_flip_bit(individual: list[int], indpb: float, rng: random.Random) -> tuple[list[int]]:
+    """Flip each unit with probability ``indpb``, as ``deap.tools.mutFlipBit``."""
+    for i in range(len(individual)):
+        if rng.random() < indpb:
+            individual[i] = type(individual[i])(not individual[i])
+    return (individual,)
+
+
+def sel_tournament(individuals: Sequence, k: int, tournsize: int, rng: random.Random) -> list:
+    """``k`` tournaments of ``tournsize`` random picks, as ``deap.tools.selTournament``."""
+    return [max((rng.choice(individuals) for _ in range(tournsize)), key=lambda ind: ind.fitness) for _ in range(k)]
+
+
+def var_and(population: Sequence, toolbox: base.Toolbox, cxpb: float, mutpb: float, rng: random.Random) -> list:
+    """Crossover then mutation on clones, as ``deap.algorithms.varAnd``."""
+    offspring = [toolbox.clone(ind) for ind in population]
+    for i in range(1, len(offspring), 2):
+        if rng.random() < cxpb:
+            offspring[i - 1], offspring[i] = toolbox.mate(offspring[i - 1], offspring[i])
+            del offspring[i - 1].fitness.values, offspring[i].fitness.values
+    for i in range(len(offspring)):
+        if rng.random() < mutpb:
+            (offspring[i],) = toolbox.mutate(offspring[i])
+            del offspring[i].fitness.values
+    return offspring
+
+
+def make_toolbox(n_units: int, sense: Sense, config: GAConfig, rng: random.Random) -> base.Toolbox:
+    """A DEAP toolbox whose random operators all draw from ``rng``."""
+    toolbox = base.Toolbox()
+    toolbox.register("attr_bool", rng.randint, 0, 1)
+    toolbox.register("individual", tools.initRepeat, getattr(creator, _INDIVIDUAL[sense]), toolbox.attr_bool, n_units)
+    toolbox.register("population", tools.initRepeat, list, toolbox.individual)
+    toolbox.register("mate", cx_two_point, rng=rng)
+    toolbox.register("mutate", mut_flip_bit, indpb=config.indpb, rng=rng)
+    toolbox.register("select", sel_tournament, tournsize=config.tournsize, rng=rng)
+    return toolbox
+
+
+def _design(ind: Sequence[int]) -> str:
+    return "".join(str(int(b)) for b in ind)
+
+
+def _stats(gen: int, population: Sequence, book: ScoreBook, counts: tuple[int, int, int], wall: float) -> GenerationStats:
+    values = np.array([ind.fitness.values[0] for ind in population], dtype=float)
+    finite = values[np.isfinite(values)]
+    best_ind = max(population, key=lambda ind: ind.fitness)
+    if finite.size:
+        best, worst_ = (finite.min(), finite.max()) if book.sense == "min" else (finite.max(), finite.min())
+        mean, std = float(finite.mean()), float(finite.std())
+    else:
+        best = worst_ = mean = std = math.nan
+    return GenerationStats(
+        gen, float(best), mean, float(worst_), std, *counts, int(values.size - finite.size), wall, _design(best_ind)
+    )
+
+
+def _evaluate(population: Sequence, book: ScoreBook) -> tuple[int, int, int]:
+    invalid = [ind for ind in population if not ind.fitness.valid]
+    before = book.solves
+    scores = book.score_many([_design(ind) for ind in invalid])
+    for ind, s in zip(invalid, scores, strict=True):
+        ind.fitness.values = (s.value,)
+    solves = book.solves - before
+    return len(invalid), len(invalid) - solves, solves
+
+
+def run_ga(
+    model: ActuatorModel,
+    objective: Objective,
+    config: GAConfig = GAConfig(),
+    evaluator: Evaluator | None = None,
+    on_generation: Callable[[GenerationStats], None] | None = None,
+) -> GAResult:
+    """Search the orientation vectors of ``model`` for the best fitness with eaSimple.
+
+    Parameters
+    ----------
+    model : ActuatorModel
+        Gives ``n_units`` and evaluates designs.
+    objective : ProfileTarget or TipGoal
+        What to minimise or maximise.
+    config : GAConfig
+    evaluator : Evaluator, optional
+        How designs are solved (serial by default); wrap it in a
+        :class:`~pneumorph.execution.CachedEvaluator` to persist the solves.
+    on_generation : callable, optional
+        Called with each generation's :class:`GenerationStats` as soon as it is known.
+
+    Returns
+    -------
+    GAResult
+
+    Raises
+    ------
+    SearchConfigError
+        A model with fewer than 1 unit.
+    """
+    book = ScoreBook(model, objective, evaluator)
+    rng = random.Random(config.seed)
+    toolbox = make_toolbox(model.n_units, objective.sense, config, rng)
+    history: list[GenerationStats] = []
+
+    start = time.perf_counter()
+    population = toolbox.population(n=config.population)
+    counts = _evaluate(population, book)
+    history.append(_stats(0, population, book, counts, time.perf_counter() - start))
+    if on_generation:
+        on_generation(history[-1])
+    stopped = "generations"
+    for gen in range(1, config.generations + 1):
+        start = time.perf_counter()
+        offspring = var_and(toolbox.select(population, len(population)), toolbox, config.cxpb, config.mutpb, rng)
+        if config.budget is not None:
+            new = {_design(ind) for ind in offspring if not ind.fitness.valid} - book.scores.keys()
+            if len(book.scores) + len(new) > config.budget:
+                stopped = "budget"
+                break
+        counts = _evaluate(offspring, book)
+        if config.elitism:
+            _keep_elites(population, offspring, config.elitism, toolbox)
+        population[:] = offspring
+        history.append(_stats(gen, population, book, counts, time.perf_counter() - start))
+        if on_generation:
+            on_generation(history[-1])
+    return GAResult(
+        config,
+        objective.sense,
+        tuple(history),
+        book.hall_of_fame(config.hall_of_fame),
+        tuple(_design(ind) for ind in population),
+        book.solves,
+        dict(book.scores),
+        stopped,
+    )
+
+
+def _keep_elites(population: list, offspring: list, k: int, toolbox: base.Toolbox) -> None:
+    """Replace the ``k`` worst offspring by the ``k`` best distinct parents (no random draws)."""
+    elites, seen = [], set()
+    for ind in sorted(population, key=lambda ind: ind.fitness, reverse=True):
+        if _design(ind) not in seen:
+            seen.add(_design(ind))
+            elites.append(toolbox.clone(ind))
+        if len(elites) == k:
+            break
+    worst_first = sorted(range(len(offspring)), key=lambda i: offspring[i].fitness)
+    for i, elite in zip(worst_first, elites):
+        if elite.fitness > offspring[i].fitness:
+            offspring[i] = elite

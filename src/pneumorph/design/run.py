@@ -1,0 +1,316 @@
+"""A design run in a folder: settings with provenance, logs, hall of fame, report, figures.
+
+Folder contents:
+
+- ``config.toml`` - the settings (:class:`~pneumorph.design.config.DesignConfig`) and a
+  ``[provenance]`` table: pneumorph version, date, seed, model fidelity and fingerprint,
+  pressures, Python and dependency versions.
+- ``generations.csv`` - one row per generation, written as the run goes (GA).
+- ``ranking.csv`` - every design and its fitness (exhaustive search).
+- ``hall_of_fame.json`` - the best distinct designs.
+- ``report.md`` - the winning design, its pressure (kPa) and error, the settings.
+- ``profile.png`` - the winner at its pressure against the target (Figs 6.6-6.11);
+  ``convergence.png`` - best and mean fitness per generation.
+- whatever the model's optional hook ``write_deformed(response, level, folder) -> list[Path]``
+  writes (the deformed shape, VTK of the winner).
+
+Running the same settings into the same folder again resumes: the GA replays with the same
+seed and the evaluation cache answers every design solved before. Ctrl-C stops the run
+after the files written so far are flushed; :attr:`RunResult.status` is then
+``"interrupted"``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import platform
+import time
+import tomllib
+from dataclasses import dataclass, field, replace
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from pneumorph.design.config import DesignConfig, to_toml
+from pneumorph.design.exhaustive import run_exhaustive
+from pneumorph.design.figures import plot_convergence, plot_profile
+from pneumorph.design.ga import GenerationStats, run_ga
+from pneumorph.design.scoring import Candidate
+from pneumorph.design.targets import Objective, ProfileTarget
+from pneumorph.errors import RunFolderError, SearchConfigError
+from pneumorph.execution.cache import (
+    CachedEvaluator,
+    EvaluationCache,
+    default_cache_path,
+)
+from pneumorph.execution.evaluators import Evaluator, make_evaluator
+from pneumorph.models.response import ActuatorModel
+
+DEPENDENCIES = ("numpy", "scipy", "felupe", "tensortrax", "deap", "matplotlib", "distributed")
+_COMPARED = ("design", "ga", "model")
+
+
+def _version(name: str) -> str | None:
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return None
+
+
+def provenance(config: DesignConfig, model: ActuatorModel) -> dict[str, Any]:
+    """Where a run comes from: versions, date, seed, model identity."""
+    return {
+        "pneumorph": _version("pneumorph") or "unknown",
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "seed": config.seed,
+        "model_fidelity": str(getattr(model, "fidelity", "unknown")),
+        "model_fingerprint": model.fingerprint(),
+        "model_units": int(model.n_units),
+        "pressures_kPa": [round(float(p) * 1e3, 9) for p in model.pressures()],
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "dependencies": {name: v for name in DEPENDENCIES if (v := _version(name)) is not None},
+    }
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What a run produced.
+
+    Attributes
+    ----------
+    status : {"finished", "interrupted"}
+    folder : Path
+    objective : ProfileTarget or TipGoal
+    hall_of_fame : tuple of Candidate
+        Best first; empty if the run was interrupted before its end.
+    history : tuple of GenerationStats
+        GA generations (empty for an exhaustive search).
+    solves, cache_hits : int
+        New model solves and designs answered by the evaluation cache in this run.
+    wall_time : float
+    files : tuple of Path
+    """
+
+    status: str
+    folder: Path
+    objective: Objective
+    hall_of_fame: tuple[Candidate, ...]
+    history: tuple[GenerationStats, ...]
+    solves: int
+    cache_hits: int
+    wall_time: float
+    files: tuple[Path, ...] = field(default=())
+
+    @property
+    def best(self) -> Candidate | None:
+        return self.hall_of_fame[0] if self.hall_of_fame else None
+
+
+def _check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrite: bool) -> bool:
+    """True if ``folder`` holds the same run (resume); an error if it holds another one."""
+    path = folder / "config.toml"
+    if not path.exists() or overwrite:
+        return False
+    old = tomllib.loads(path.read_text(encoding="utf-8"))
+    new = config.to_dict()
+    for table in _COMPARED:
+        if old.get(table, {}) != new.get(table, {}):
+            raise RunFolderError(
+                f"{folder} holds a run with other [{table}] settings ({old.get(table)} instead of "
+                f"{new.get(table)}); choose another output folder or overwrite it"
+            )
+    old_fp = old.get("provenance", {}).get("model_fingerprint")
+    if old_fp not in (None, fingerprint):
+        raise RunFolderError(
+            f"{folder} holds a run of another model (fingerprint {old_fp}, now {fingerprint}); "
+            "choose another output folder or overwrite it"
+        )
+    return True
+
+
+class _GenerationLog:
+    """``generations.csv``, one flushed row per generation."""
+
+    FIELDS = tuple(GenerationStats.__dataclass_fields__)
+
+    def __init__(self, path: Path) -> None:
+        self.file = path.open("w", newline="", encoding="utf-8")
+        self.writer = csv.DictWriter(self.file, fieldnames=self.FIELDS)
+        self.writer.writeheader()
+        self.file.flush()
+        self.rows: list[GenerationStats] = []
+
+    def __call__(self, stats: GenerationStats) -> None:
+        self.rows.append(stats)
+        self.writer.writerow(stats.as_row())
+        self.file.flush()
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def run_design(
+    config: DesignConfig,
+    model: ActuatorModel,
+    folder: str | Path,
+    evaluator: Evaluator | None = None,
+    cache: EvaluationCache | None = None,
+    on_generation: Any = None,
+    on_progress: Any = None,
+    overwrite: bool = False,
+) -> RunResult:
+    """Run a design search and write its folder.
+
+    Parameters
+    ----------
+    config : DesignConfig
+    model : ActuatorModel
+        Built for ``config`` (its ``n_units`` must equal ``config.units``).
+    folder : str or Path
+        The run folder; created if missing; resumed if it holds the same run.
+    evaluator : Evaluator, optional
+        By default made from ``config.executor`` (and closed at the end).
+    cache : EvaluationCache, optional
+        By default opened at ``config.cache`` or :func:`default_cache_path`.
+    on_generation, on_progress : callable, optional
+        Progress callbacks: a GA generation's stats; exhaustive (done, total).
+    overwrite : bool
+        Start afresh in a folder that holds another run.
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    SearchConfigError
+        The model's number of units differs from the config's.
+    RunFolderError
+        The folder holds another run and ``overwrite`` is not set.
+    """
+    folder = Path(folder)
+    if int(model.n_units) != config.units:
+        raise SearchConfigError(f"the model has {model.n_units} units but the config asks for {config.units}")
+    objective = config.make_objective()
+    fingerprint = model.fingerprint()
+    resumed = _check_folder(folder, config, fingerprint, overwrite)
+    folder.mkdir(parents=True, exist_ok=True)
+    prov = provenance(config, model)
+    prov["resumed"] = resumed
+    (folder / "config.toml").write_text(to_toml({**config.to_dict(), "provenance": prov}), encoding="utf-8")
+
+    own_evaluator = evaluator is None
+    inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
+    own_cache = cache is None
+    cache = cache or EvaluationCache(config.cache or default_cache_path())
+    cached = CachedEvaluator(inner, cache)
+    start = time.perf_counter()
+    log = _GenerationLog(folder / "generations.csv") if config.search == "ga" else None
+
+    def on_gen(stats: GenerationStats) -> None:
+        log(stats)  # type: ignore[misc]
+        if on_generation:
+            on_generation(stats)
+
+    status, hof, history, ranking = "finished", (), (), None
+    try:
+        if config.search == "ga":
+            ga = run_ga(model, objective, config.ga, cached, on_gen)
+            hof, history = ga.hall_of_fame, ga.history
+        else:
+            ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame, on_progress=on_progress)
+            hof, ranking = ex.hall_of_fame, [(d, ex.scores[d]) for d in ex.ranking]
+    except KeyboardInterrupt:
+        status = "interrupted"
+        history = tuple(log.rows) if log else ()
+    finally:
+        if log:
+            log.close()
+        if own_evaluator:
+            inner.close()
+        if own_cache:
+            cache.close()
+    result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
+                       time.perf_counter() - start)
+    files = _write_outputs(result, config, model, ranking)
+    return replace(result, files=tuple(files))
+
+
+def _write_outputs(result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any) -> list[Path]:
+    folder, files = result.folder, []
+    if result.history:
+        files.append(folder / "generations.csv")
+    if ranking is not None:
+        path = folder / "ranking.csv"
+        with path.open("w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["rank", "design", "value", "level", "pressure_kPa", "failed"])
+            for i, (d, s) in enumerate(ranking, 1):
+                p = "" if s.pressure is None else round(s.pressure * 1e3, 9)
+                w.writerow([i, d, s.value, "" if s.level is None else s.level, p, s.failed])
+        files.append(path)
+    if result.hall_of_fame:
+        path = folder / "hall_of_fame.json"
+        entries = [{"rank": i, **c.to_dict()} for i, c in enumerate(result.hall_of_fame, 1)]
+        doc = {"objective": result.objective.label, "sense": result.objective.sense,
+               "unit": result.objective.unit, "designs": entries}
+        path.write_text(json.dumps(doc, indent=1), encoding="utf-8")
+        files.append(path)
+    best = result.best
+    if best is not None and best.response is not None and best.level is not None:
+        files.append(plot_profile(best, result.objective, folder / "profile.png"))
+        hook = getattr(model, "write_deformed", None)
+        if callable(hook):
+            files.extend(Path(p) for p in hook(best.response, best.level, folder / "winner"))
+    if result.history:
+        files.append(plot_convergence(result.history, folder / "convergence.png", result.objective.unit))
+    path = folder / "report.md"
+    path.write_text(report_text(result, config, model, [f.name for f in files]), encoding="utf-8")
+    files.append(path)
+    return files
+
+
+def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[str]) -> str:
+    """The markdown report of a run."""
+    o = result.objective
+    lines = [f"# Design run: {o.label}", ""]
+    if result.status == "interrupted":
+        lines += ["**Interrupted.** Run the same command again to resume; solved designs are cached.", ""]
+    search = (
+        f"genetic algorithm (population {config.ga.population}, {config.ga.generations} generations, "
+        f"seed {config.seed})" if config.search == "ga" else "exhaustive search"
+    )
+    lines += [
+        f"- objective: {o.label} ({'minimised' if o.sense == 'min' else 'maximised'})",
+        f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",
+        f"- search: {search}",
+        (f"- new solves: {result.solves}, answered by the cache: {result.cache_hits}, "
+        f"wall time {result.wall_time:.1f} s"),
+        "",
+    ]
+    best = result.best
+    if best is not None:
+        what = "error (Eq 4.1)" if isinstance(o, ProfileTarget) else "value"
+        pressure = "-" if best.pressure is None else f"{best.pressure * 1e3:.4g} kPa"
+        lines += [
+            "## Winner",
+            "",
+            f"- design (base first): `{best.design}`",
+            f"- pressure: {pressure}",
+            f"- {what}: {best.value:.6g} {o.unit}",
+            "",
+            "## Hall of fame",
+            "",
+            f"| rank | design | {o.unit} | pressure (kPa) |",
+            "|---:|---|---:|---:|",
+        ]
+        for i, c in enumerate(result.hall_of_fame, 1):
+            p = "failed" if c.pressure is None else f"{c.pressure * 1e3:.4g}"
+            lines.append(f"| {i} | `{c.design}` | {c.value:.6g} | {p} |")
+        lines.append("")
+    if files:
+        lines += ["## Files", "", *[f"- [{f}]({f})" for f in files], ""]
+    return "\n".join(lines)

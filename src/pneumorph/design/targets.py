@@ -1,0 +1,258 @@
+"""Design objectives: target profiles (section 6.3) and tip goals (Table 6.1).
+
+An objective says *what* is wanted; :mod:`pneumorph.design.fitness` measures a
+:class:`~pneumorph.models.Response` against it.
+
+- :class:`ProfileTarget` - a curve the inflated actuator should follow, ``y = f(x)``
+  (Cartesian) or ``r = f(theta)`` (polar), given as a safe math expression in the variables
+  ``x`` (or ``theta``), ``L`` (the undeformed actuator length, mm) and ``A`` (an amplitude,
+  mm); always minimised (it is an error in mm, Eq 4.1).
+- :class:`TipGoal` - a single goal for the tip: ``max-x``, ``min-x``, ``max-y``, ``min-y``,
+  ``min-distance`` (tip to base, Table 6.1's "minimum radius of curvature"), ``max-curl``
+  and ``reach`` (a given tip point).
+
+Presets (section 6.3): ``sin`` is ``A*sin(2*pi*m*x/L)`` and ``cos`` is
+``A*(cos(2*pi*m*x/L) - 1)``, ``m`` periods over the actuator length (one by default).
+The dissertation does not print its cos formula; the actuator's base is clamped at
+``y = 0``, so the preset is shifted to pass through the base (``anchored=False`` gives the
+plain ``A*cos(...)``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pneumorph.design.expressions import Expression, parse_expression
+from pneumorph.errors import (
+    SearchConfigError,
+    TargetExpressionError,
+    UnknownObjectiveError,
+)
+
+Sense = Literal["min", "max"]
+
+_CARTESIAN = ("x", "L", "A")
+_POLAR = ("theta", "L", "A")
+_HINTS_CARTESIAN = {
+    "theta": " - theta is the variable of polar targets; write 'r = f(theta)' for one",
+    "y": " - the expression is the right-hand side of y = f(x)",
+}
+_HINTS_POLAR = {
+    "x": " - x is the variable of Cartesian targets; write 'y = f(x)' for one",
+    "r": " - the expression is the right-hand side of r = f(theta)",
+}
+
+
+@dataclass(frozen=True)
+class ProfileTarget:
+    """A target curve for the unit centres, matched by Eq 4.1 (minimised).
+
+    Attributes
+    ----------
+    expression : Expression
+        The checked right-hand side.
+    coordinates : {"cartesian", "polar"}
+        ``y = f(x)`` or ``r = f(theta)`` (theta in radians from the x axis, about the base).
+    amplitude : float
+        The value of ``A`` (mm).
+    length : float or None
+        The value of ``L`` (mm); None takes the undeformed length of the actuator.
+    name : str
+        A short label ("sin", "cos" or the expression).
+
+    Examples
+    --------
+    >>> t = profile_target("sin", amplitude=10.0)
+    >>> t.curve([0.0, 25.0, 50.0], length=100.0).round(6).tolist()
+    [0.0, 10.0, 0.0]
+    >>> profile_target("y = 0.1*x").curve([10.0], length=100.0).tolist()
+    [1.0]
+    """
+
+    expression: Expression
+    coordinates: Literal["cartesian", "polar"] = "cartesian"
+    amplitude: float = 10.0
+    length: float | None = None
+    name: str = ""
+    sense: Sense = field(default="min", init=False)
+    unit: str = field(default="mm", init=False)
+
+    def curve(self, s: ArrayLike, length: float) -> NDArray[np.float64]:
+        """The target at ``s`` (x in mm, or theta in rad) for an actuator of ``length`` mm."""
+        L = self.length if self.length is not None else length
+        var = "x" if self.coordinates == "cartesian" else "theta"
+        return self.expression(**{var: np.asarray(s, dtype=float)}, L=L, A=self.amplitude)
+
+    @property
+    def label(self) -> str:
+        lhs = "y" if self.coordinates == "cartesian" else "r"
+        text = f"{lhs} = {self.expression.text}"
+        if "A" in self.expression.used:
+            text += f", A = {self.amplitude:g} mm"
+        return text if not self.name or self.name == self.expression.text else f"{self.name}: {text}"
+
+
+@dataclass(frozen=True)
+class TipGoal:
+    """A goal for the tip position or rotation (Table 6.1).
+
+    Attributes
+    ----------
+    name : str
+        One of :data:`TIP_GOALS`.
+    sense : {"min", "max"}
+        Whether the value is minimised or maximised.
+    point : tuple of float or None
+        The tip point to reach (mm, relative to the base), for ``reach`` only.
+
+    Examples
+    --------
+    >>> tip_goal("max-y").sense, tip_goal("Min distance").name
+    ('max', 'min-distance')
+    """
+
+    name: str
+    sense: Sense
+    point: tuple[float, float] | None = None
+
+    @property
+    def unit(self) -> str:
+        return "deg" if self.name == "max-curl" else "mm"
+
+    @property
+    def label(self) -> str:
+        if self.name == "reach" and self.point is not None:
+            return f"reach the tip point ({self.point[0]:g}, {self.point[1]:g}) mm"
+        return TIP_GOALS[self.name][1]
+
+
+Objective = ProfileTarget | TipGoal
+
+TIP_GOALS: dict[str, tuple[Sense, str]] = {
+    "max-x": ("max", "maximum horizontal tip position (max X)"),
+    "min-x": ("min", "minimum horizontal tip position (min X)"),
+    "max-y": ("max", "maximum vertical tip position (max Y)"),
+    "min-y": ("min", "minimum vertical tip position (min Y)"),
+    "min-distance": ("min", "minimum distance of the tip to the base"),
+    "max-curl": ("max", "maximum curl of the tip (counter-clockwise, degrees)"),
+    "reach": ("min", "distance of the tip to a given point"),
+}
+_ALIASES = {"min-radius": "min-distance", "min-dist": "min-distance", "curl": "max-curl"}
+PRESETS = ("sin", "cos")
+
+
+def _normalise(name: str) -> str:
+    return re.sub(r"[\s_]+", "-", name.strip().lower())
+
+
+def tip_goal(name: str, point: tuple[float, float] | None = None) -> TipGoal:
+    """The tip goal called ``name`` (case, spaces and underscores do not matter).
+
+    Raises
+    ------
+    UnknownObjectiveError
+        For a name that is not a tip goal.
+    SearchConfigError
+        ``reach`` without a point, or a point for another goal.
+    """
+    key = _ALIASES.get(_normalise(name), _normalise(name))
+    if key not in TIP_GOALS:
+        raise UnknownObjectiveError(name, [*TIP_GOALS, *PRESETS])
+    if key == "reach":
+        if point is None or len(point) != 2 or not np.all(np.isfinite(point)):
+            raise SearchConfigError("the objective 'reach' needs a tip point (x, y) in mm, e.g. (60, 40)")
+        point = (float(point[0]), float(point[1]))
+    elif point is not None:
+        raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {key!r}")
+    return TipGoal(key, TIP_GOALS[key][0], point)
+
+
+def profile_target(
+    spec: str,
+    amplitude: float = 10.0,
+    periods: float = 1.0,
+    length: float | None = None,
+    anchored: bool = True,
+) -> ProfileTarget:
+    """A target profile from a preset name or an expression.
+
+    Parameters
+    ----------
+    spec : str
+        ``"sin"``, ``"cos"``, ``"y = <expression in x>"``, ``"r = <expression in theta>"``
+        or a bare expression (polar if it uses ``theta``).
+    amplitude : float
+        ``A`` in mm (presets: the amplitude).
+    periods : float
+        Presets: the number of periods over the actuator length.
+    length : float, optional
+        ``L`` in mm; by default the undeformed length of the actuator evaluated.
+    anchored : bool
+        The cos preset: shift it by ``-A`` so that it starts at the base (default).
+
+    Raises
+    ------
+    TargetExpressionError
+        An expression outside the whitelist, or non-positive periods.
+    """
+    if not np.isfinite(amplitude):
+        raise TargetExpressionError(f"the amplitude must be a finite number of mm, got {amplitude!r}")
+    key = _normalise(spec)
+    if key in PRESETS:
+        if not (np.isfinite(periods) and periods > 0):
+            raise TargetExpressionError(f"the number of periods must be positive, got {periods!r}")
+        arg = f"2*pi*{periods:.17g}*x/L"
+        text = f"A*sin({arg})" if key == "sin" else (f"A*(cos({arg}) - 1)" if anchored else f"A*cos({arg})")
+        return ProfileTarget(parse_expression(text, _CARTESIAN), "cartesian", amplitude, length, key)
+    lhs, _, rhs = spec.partition("=")
+    if rhs:
+        side = lhs.strip().lower()
+        if side not in ("y", "r"):
+            raise TargetExpressionError(
+                f"the left-hand side of {spec!r} must be y (for y = f(x)) or r (for r = f(theta)), got {lhs.strip()!r}"
+            )
+        polar = side == "r"
+    else:
+        rhs = spec
+        polar = re.search(r"\btheta\b", spec) is not None
+    variables, hints = (_POLAR, _HINTS_POLAR) if polar else (_CARTESIAN, _HINTS_CARTESIAN)
+    expr = parse_expression(rhs, variables, hints)
+    return ProfileTarget(expr, "polar" if polar else "cartesian", amplitude, length, expr.text)
+
+
+def make_objective(
+    spec: str,
+    amplitude: float = 10.0,
+    periods: float = 1.0,
+    point: tuple[float, float] | None = None,
+    anchored: bool = True,
+) -> Objective:
+    """Any objective from its text: a tip goal, a preset or a profile expression.
+
+    Examples
+    --------
+    >>> make_objective("max_x").label
+    'maximum horizontal tip position (max X)'
+    >>> make_objective("cos", amplitude=20).label
+    'cos: y = A*(cos(2*pi*1*x/L) - 1), A = 20 mm'
+    >>> make_objective("max-z")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y, min-y, min-distance, max-curl, reach, sin, cos, or a profile 'y = f(x)' / 'r = f(theta)'
+    """
+    key = _ALIASES.get(_normalise(spec), _normalise(spec))
+    if key in TIP_GOALS:
+        return tip_goal(key, point)
+    if point is not None:
+        raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {spec!r}")
+    if key in PRESETS or "=" in spec:
+        return profile_target(spec, amplitude, periods, anchored=anchored)
+    words = re.fullmatch(r"[A-Za-z_][\w\- ]*", spec.strip())
+    if words and spec.strip() not in (*_CARTESIAN, *_POLAR, "pi", "e"):
+        raise UnknownObjectiveError(spec, [*TIP_GOALS, *PRESETS])
+    return profile_target(spec, amplitude, periods, anchored=anchored)

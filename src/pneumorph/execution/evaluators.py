@@ -1,0 +1,275 @@
+"""Evaluators: one interface, three ways to solve a batch of designs.
+
+- :class:`SerialEvaluator` - one after the other in this process.
+- :class:`ProcessPoolEvaluator` - a pool of local processes (all cores by default); each
+  worker receives the model once and keeps it; BLAS/OpenMP threads are set to 1 in the
+  workers so that processes, not threads, share the cores.
+- :class:`DaskEvaluator` - a Dask ``distributed`` cluster: a scheduler address (many
+  machines) or a ``LocalCluster`` on this machine; the model is sent to every worker once.
+
+Every evaluator has ``iter_evaluate(model, designs)``, yielding ``(index, Outcome)`` as
+solves finish (so a cache can store each at once), and ``evaluate_many(model, designs)``,
+the outcomes in the order of the designs. A :class:`~pneumorph.errors.SimulationFailed`
+becomes a failed :class:`~pneumorph.execution.outcome.Outcome`; any other exception from
+the model stops the batch as :class:`~pneumorph.errors.EvaluationError`.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import time
+from collections.abc import Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from typing import Any, Protocol, runtime_checkable
+
+from pneumorph.errors import SchedulerUnreachableError, SearchConfigError
+from pneumorph.execution.outcome import Outcome, solve
+from pneumorph.models.response import ActuatorModel
+
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
+@runtime_checkable
+class Evaluator(Protocol):
+    """Solves designs of a model; see the module docstring."""
+
+    def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]: ...
+
+    def evaluate_many(self, model: ActuatorModel, designs: Iterable[str]) -> list[Outcome]: ...
+
+    def close(self) -> None: ...
+
+
+class _Base:
+    def evaluate_many(self, model: ActuatorModel, designs: Iterable[str]) -> list[Outcome]:
+        """Outcomes of ``designs``, in their order."""
+        designs = list(designs)
+        out: list[Outcome | None] = [None] * len(designs)
+        for i, outcome in self.iter_evaluate(model, designs):  # type: ignore[attr-defined]
+            out[i] = outcome
+        return out  # type: ignore[return-value]
+
+    def close(self) -> None:
+        """Release workers (nothing to do for the serial evaluator)."""
+
+    def __enter__(self) -> Any:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class SerialEvaluator(_Base):
+    """Solve the designs one after another in this process.
+
+    Examples
+    --------
+    >>> SerialEvaluator().evaluate_many(object(), [])
+    []
+    """
+
+    def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
+        for i, design in enumerate(designs):
+            yield i, solve(model, design)
+
+
+# -- process pool ------------------------------------------------------------------------
+_WORKER_MODEL: Any = None
+
+
+def _init_worker(model: ActuatorModel) -> None:
+    global _WORKER_MODEL
+    for name in THREAD_VARIABLES:
+        os.environ[name] = "1"
+    _WORKER_MODEL = model
+
+
+def _solve_in_worker(design: str) -> Outcome:
+    return solve(_WORKER_MODEL, design)
+
+
+class ProcessPoolEvaluator(_Base):
+    """Solve designs in a pool of local processes.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Number of processes; all cores by default.
+
+    The pool starts on first use (processes are spawned, so they import fresh with one
+    BLAS/OpenMP thread each) and is kept while the model's fingerprint stays the same.
+    """
+
+    def __init__(self, workers: int | None = None) -> None:
+        if workers is not None and workers < 1:
+            raise SearchConfigError(f"the number of worker processes must be at least 1, got {workers}")
+        self.workers = workers or os.cpu_count() or 1
+        self._pool: ProcessPoolExecutor | None = None
+        self._fingerprint: str | None = None
+
+    def _ensure_pool(self, model: ActuatorModel) -> ProcessPoolExecutor:
+        fp = model.fingerprint()
+        if self._pool is not None and fp == self._fingerprint:
+            return self._pool
+        self.close()
+        saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
+        os.environ.update({name: "1" for name in THREAD_VARIABLES})  # inherited by spawned workers
+        try:
+            self._pool = ProcessPoolExecutor(
+                max_workers=self.workers,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_init_worker,
+                initargs=(model,),
+            )
+            # start the workers now, while the environment says one thread
+            for f in [self._pool.submit(os.getpid) for _ in range(self.workers)]:
+                f.result()
+        finally:
+            for name, value in saved.items():
+                if value is None:
+                    os.environ.pop(name, None)
+                else:
+                    os.environ[name] = value
+        self._fingerprint = fp
+        return self._pool
+
+    def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
+        designs = list(designs)
+        if not designs:
+            return
+        pool = self._ensure_pool(model)
+        futures: dict[Future, int] = {pool.submit(_solve_in_worker, d): i for i, d in enumerate(designs)}
+        pending = set(futures)
+        try:
+            while pending:
+                done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for f in sorted(done, key=futures.__getitem__):
+                    yield futures[f], f.result()
+        finally:
+            for f in pending:
+                f.cancel()
+
+    def close(self) -> None:
+        """Shut the pool down (cancelling queued solves)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+            self._fingerprint = None
+
+
+# -- dask --------------------------------------------------------------------------------
+def _solve_on_dask_worker(model: ActuatorModel, design: str) -> Outcome:
+    for name in THREAD_VARIABLES:
+        os.environ.setdefault(name, "1")
+    return solve(model, design)
+
+
+class DaskEvaluator(_Base):
+    """Solve designs on a Dask ``distributed`` cluster.
+
+    Parameters
+    ----------
+    address : str, optional
+        A scheduler address (``"tcp://host:8786"``); None starts a ``LocalCluster``.
+    workers : int, optional
+        LocalCluster only: number of workers (all cores by default).
+    processes : bool
+        LocalCluster only: workers in processes (True) or threads of this process.
+    timeout : float
+        Seconds to wait for the scheduler before giving up.
+
+    Raises
+    ------
+    SearchConfigError
+        If ``distributed`` is not installed.
+    SchedulerUnreachableError
+        If the scheduler does not answer within ``timeout`` seconds.
+    """
+
+    def __init__(
+        self, address: str | None = None, workers: int | None = None, processes: bool = True, timeout: float = 5.0
+    ) -> None:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:  # pragma: no cover - depends on the installation
+            raise SearchConfigError(
+                "the dask executor needs the 'distributed' package: pip install 'pneumorph[dask]'"
+            ) from None
+        self.address = address
+        self._cluster = None
+        if address is None:
+            n = workers or os.cpu_count() or 1
+            self._cluster = LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=None
+            )
+            self.client = Client(self._cluster, timeout=timeout)
+        else:
+            start = time.perf_counter()
+            try:
+                self.client = Client(address, timeout=timeout)
+            except (OSError, TimeoutError) as exc:
+                waited = time.perf_counter() - start
+                raise SchedulerUnreachableError(
+                    f"no Dask scheduler answered at {address!r} within {waited:.1f} s ({exc}); "
+                    "check the address and that 'dask scheduler' runs there, or use --executor processes"
+                ) from None
+        self._model_future: Any = None
+        self._fingerprint: str | None = None
+
+    def _model_on_workers(self, model: ActuatorModel) -> Any:
+        fp = model.fingerprint()
+        if self._model_future is None or fp != self._fingerprint:
+            self._model_future = self.client.scatter(model, broadcast=True, hash=False)
+            self._fingerprint = fp
+        return self._model_future
+
+    def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
+        from distributed import as_completed
+
+        designs = list(designs)
+        if not designs:
+            return
+        remote = self._model_on_workers(model)
+        futures = [
+self.client.submit(_solve_on_dask_worker, remote, d, pure=False) for d in designs
+        ]
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for f in as_completed(futures):
+                yield index[f.key], f.result()
+        finally:
+            self.client.cancel([f for f in futures if not f.done()])
+
+    def close(self) -> None:
+        """Close the client (and the LocalCluster this evaluator started)."""
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+            self._cluster = None
+
+
+EXECUTORS = ("serial", "processes", "dask")
+
+
+def make_evaluator(
+    kind: str = "serial", workers: int | None = None, scheduler: str | None = None, timeout: float = 5.0
+) -> SerialEvaluator | ProcessPoolEvaluator | DaskEvaluator:
+    """An evaluator by name: ``serial``, ``processes`` or ``dask``.
+
+    Examples
+    --------
+    >>> type(make_evaluator("serial")).__name__
+    'SerialEvaluator'
+    >>> make_evaluator("gpu")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: unknown executor 'gpu'; choose one of serial, processes, dask
+    """
+    if kind == "serial":
+        return SerialEvaluator()
+    if kind == "processes":
+        return ProcessPoolEvaluator(workers)
+    if kind == "dask":
+        return DaskEvaluator(scheduler, workers=workers, timeout=timeout)
+    raise SearchConfigError(f"unknown executor {kind!r}; choose one of {', '.join(EXECUTORS)}")
