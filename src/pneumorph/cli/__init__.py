@@ -24,6 +24,10 @@ def cli() -> None:
 
 cli.add_command(materials)
 
+from pneumorph.cli.simulate import simulate  # noqa: E402
+
+cli.add_command(simulate)
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code (errors print one clear line)."""

@@ -35,6 +35,25 @@ MODEL_REVISION = 1
 
 
 @dataclass(frozen=True)
+class Solution:
+    """A solved design with its full fields, for figures and VTK files.
+
+    Attributes
+    ----------
+    response : Response
+        What the search sees.
+    mesh : ActuatorMesh
+        The meshed actuator.
+    displacements : ndarray, shape (k, p, dim)
+        Nodal displacements at every reported level (NaN after a failure).
+    """
+
+    response: Response
+    mesh: ActuatorMesh
+    displacements: FloatArray
+
+
+@dataclass(frozen=True)
 class RampSpec:
     """The pressure ramp and how it is solved.
 
@@ -157,7 +176,14 @@ class FEModel:
 
     # -- solving --------------------------------------------------------------------------
     def evaluate(self, orientation: str, on_level: Any = None) -> Response:
-        """Solve the pressure ramp of one design.
+        """Solve the pressure ramp of one design and return its :class:`Response`.
+
+        See :meth:`solve` for the parameters and errors.
+        """
+        return self.solve(orientation, on_level).response
+
+    def solve(self, orientation: str, on_level: Any = None) -> Solution:
+        """Solve the pressure ramp of one design, keeping the displacement fields.
 
         Parameters
         ----------
@@ -187,6 +213,7 @@ class FEModel:
         )
         angle0 = _end_face_angle(x_end0)
         angles: list[float] = []
+        displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
 
         def apply(t: float) -> None:
             p = t * self.ramp.pressure
@@ -195,7 +222,8 @@ class FEModel:
 
         def record(k: int, t: float) -> None:
             u = field[0].values[:, : 2]
-            response.centres[k] = mesh.unit_centres(field[0].values[:, : self.dim])
+            displacements[k] = field[0].values[:, : self.dim]
+            response.centres[k] = mesh.unit_centres(displacements[k])
             x_end = x_end0 + u[mesh.end_points]
             response.tip[k] = x_end.mean(axis=0)
             angles.append(_end_face_angle(x_end) - angle0)
@@ -227,7 +255,7 @@ class FEModel:
             dofs=int(field[0].values.size),
             pneumorph=__version__,
         )
-        return Response(
+        final = Response(
             orientation=design,
             pressures=response.pressures,
             centres=response.centres,
@@ -239,6 +267,7 @@ class FEModel:
             reached=float(pressures[-1]),
             metadata=meta,
         )
+        return Solution(final, mesh, displacements)
 
 
 class Reduced2D(FEModel):

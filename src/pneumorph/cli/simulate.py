@@ -1,0 +1,84 @@
+"""``pneumorph simulate``: solve the pressure ramp of one design."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+import click
+
+
+@click.command("simulate")
+@click.option("--orientation", "-o", required=True, metavar="DIGITS",
+              help="The design, base first: one digit per unit, 1 = unit turned 180 degrees (e.g. 010011).")
+@click.option("--pressure", type=float, default=45.0, show_default=True, help="Final pressure in kPa.")
+@click.option("--increments", type=int, default=10, show_default=True, help="Reported pressure levels.")
+@click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="2d", show_default=True,
+              help="2D reduced-order (plane strain with filler) or 3D model.")
+@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
+              help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
+@click.option("--out", type=click.Path(file_okay=False), help="Folder for response (NPZ+JSON), VTK and PNG files.")
+@click.option("--json", "as_json", is_flag=True, help="Print tip, curl and unit centres of every level as JSON.")
+def simulate(
+    orientation: str,
+    pressure: float,
+    increments: int,
+    fidelity: str,
+    unit_file: str | None,
+    out: str | None,
+    as_json: bool,
+) -> None:
+    """Inflate one actuator design and report its shape at every pressure level."""
+    from pathlib import Path
+
+    from pneumorph.fem import StepSettings
+    from pneumorph.geometry import parse_orientation
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.io import provenance, write_vtk_series
+    from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
+
+    design = parse_orientation(orientation)
+    unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
+    ramp = RampSpec(pressure=pressure / 1e3, steps=StepSettings(increments=increments, substeps=2))
+    model = Reduced2D(len(design), unit, ramp) if fidelity == "2d" else Full3D(len(design), unit, ramp)
+    t0 = time.perf_counter()
+
+    def progress(k: int, p: float) -> None:
+        click.echo(f"  level {k + 1:2d}/{increments}: {p * 1e3:7.3f} kPa converged  [{time.perf_counter() - t0:6.1f} s]",
+                   err=True)
+
+    click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa)", err=True)
+    solution = model.solve(design, on_level=progress)
+    resp = solution.response
+    meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
+    if out:
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        resp.save(folder / "response")
+        write_vtk_series(solution, folder / "vtk", meta=meta)
+        from pneumorph.plot.shape import plot_shape
+
+        plot_shape(solution, folder / "shape.png", levels=sorted({resp.n_levels // 2 - 1, resp.n_levels - 1}))
+        (folder / "provenance.json").write_text(json.dumps(meta, indent=1, default=str), encoding="utf-8")
+    if as_json:
+        levels = [
+            {
+                "pressure_kpa": float(p * 1e3),
+                "tip_mm": resp.tip[k].tolist(),
+                "curl_deg": float(resp.curl[k]),
+                "unit_centres_mm": resp.centres[k].tolist(),
+            }
+            for k, p in enumerate(resp.pressures)
+        ]
+        click.echo(json.dumps({"orientation": design, "model": fidelity, "converged": resp.converged,
+                               "levels": levels, "metadata": resp.metadata}, indent=1))
+    else:
+        click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} {'curl [deg]':>11}")
+        for k, p in enumerate(resp.pressures):
+            click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {resp.curl[k]:11.2f}")
+        m = resp.metadata
+        click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
+                   f"{m['wall_time_s']:.2f} s")
+        if out:
+            click.echo(f"written to {out}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")

@@ -1,0 +1,72 @@
+"""ParaView files of a solved actuator: one VTU per reported pressure and a PVD series."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+_REGION_IDS = {"body": 0, "layer": 1, "filler": 2}
+
+
+def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator", meta: dict | None = None) -> Path:
+    """Write ``<stem>_<k>.vtu`` for every converged level and ``<stem>.pvd`` to open them all.
+
+    Each VTU holds the undeformed points with the point data ``displacement`` (use
+    ParaView's *Warp By Vector*) and the cell data ``region`` (0 body, 1 stiff layer,
+    2 filler). The PVD's time value is the pressure in kPa.
+
+    Parameters
+    ----------
+    solution : pneumorph.models.fe.Solution
+        A solved design.
+    folder : str or Path
+        Output folder (created).
+    stem : str
+        File name stem.
+    meta : dict, optional
+        Provenance, written as a JSON comment into the PVD file.
+
+    Returns
+    -------
+    Path
+        The PVD file.
+    """
+    import meshio
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    mesh = solution.mesh
+    points = np.zeros((len(mesh.points), 3))
+    points[:, : mesh.dim] = mesh.points
+    region = np.empty(len(mesh.cells), dtype=np.int32)
+    for name, idx in mesh.regions.items():
+        region[idx] = _REGION_IDS[name]
+    pressures = solution.response.pressures
+    entries = []
+    for k, u in enumerate(solution.displacements):
+        if np.isnan(u).any():
+            break
+        disp = np.zeros_like(points)
+        disp[:, : mesh.dim] = u
+        name = f"{stem}_{k:02d}.vtu"
+        meshio.write(
+            out / name,
+            meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data={"displacement": disp},
+                        cell_data={"region": [region]}),
+        )
+        entries.append(f'    <DataSet timestep="{pressures[k] * 1e3:.6g}" file={quoteattr(name)}/>')
+    comment = json.dumps(meta or {}, default=str).replace("--", "- -")
+    pvd = out / f"{stem}.pvd"
+    pvd.write_text(
+        '<?xml version="1.0"?>\n'
+        f"<!-- pneumorph: time = pressure in kPa; {comment} -->\n"
+        '<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+        + "\n".join(entries)
+        + "\n  </Collection>\n</VTKFile>\n",
+        encoding="utf-8",
+    )
+    return pvd

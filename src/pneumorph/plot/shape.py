@@ -1,0 +1,112 @@
+"""Figures of a solved actuator: the deformed shape coloured by material."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import PolyCollection
+from matplotlib.figure import Figure
+
+from pneumorph import __version__
+
+COLOURS = {"body": "#4daf4a", "layer": "#377eb8", "filler": "#d9d9d9"}
+LABELS = {"body": "body", "layer": "stiff layer", "filler": "filler (2D model)"}
+
+# quad8 outline through the mid-side nodes; corner faces of a hexahedron
+_QUAD8_OUTLINE = [0, 4, 1, 5, 2, 6, 3, 7]
+_HEX_FACES = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+
+
+def _section(ax: Any, solution: Any, level: int | None, outline: bool) -> None:
+    mesh = solution.mesh
+    x = mesh.points if level is None else mesh.points + solution.displacements[level]
+    for name, idx in mesh.regions.items():
+        polys = x[mesh.cells[idx]][:, _QUAD8_OUTLINE]
+        ax.add_collection(PolyCollection(polys, facecolor=COLOURS[name], edgecolor="k", lw=0.15, label=LABELS[name]))
+    if outline and level is not None:
+        ref = mesh.points[mesh.cells][:, _QUAD8_OUTLINE]
+        ax.add_collection(PolyCollection(ref, facecolor="none", edgecolor="0.6", lw=0.2))
+    c = mesh.unit_centres(None if level is None else solution.displacements[level])
+    ax.plot(c[:, 0], c[:, 1], "k.-", ms=3, lw=0.8, label="unit centres")
+
+
+def _surface(ax: Any, solution: Any, level: int | None) -> None:
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    mesh = solution.mesh
+    x = mesh.points if level is None else mesh.points + solution.displacements[level]
+    x = x[:, [0, 2, 1]]  # drawn as (x, z, y): the height y points up
+    corners = mesh.cells[:, :8]
+    faces = corners[:, _HEX_FACES].reshape(-1, 4)  # (6 c, 4)
+    owner = np.repeat(np.arange(len(corners)), 6)
+    key = np.sort(faces, axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    outer = first[counts == 1]
+    region_of = np.empty(len(mesh.cells), dtype=object)
+    for name, idx in mesh.regions.items():
+        region_of[idx] = name
+    colours = [COLOURS[region_of[owner[f]]] for f in outer]
+    ax.add_collection3d(Poly3DCollection(x[faces[outer]], facecolors=colours, edgecolor="k", linewidths=0.05))
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    span = (hi - lo).max() / 2
+    mid = (hi + lo) / 2
+    ax.set(xlim=(mid[0] - span, mid[0] + span), ylim=(mid[1] - span, mid[1] + span), zlim=(mid[2] - span, mid[2] + span))
+    ax.view_init(elev=20, azim=-60)
+
+
+def plot_shape(
+    solution: Any,
+    path: str | Path | None = None,
+    levels: Sequence[int] | None = None,
+    title: str | None = None,
+) -> Figure:
+    """The deformed actuator at some reported levels, coloured by material.
+
+    2D models show the section with the undeformed mesh in grey; 3D models show the
+    outer surface (x along the actuator, y up, z across).
+
+    Parameters
+    ----------
+    solution : pneumorph.models.fe.Solution
+        A solved design.
+    path : str or Path, optional
+        Write the figure there (PNG, SVG or PDF by the extension).
+    levels : sequence of int, optional
+        Reported levels to draw (default: the last converged one).
+    title : str, optional
+        Figure title (default: the design and the model).
+    """
+    resp = solution.response
+    done = [k for k in range(resp.n_levels) if not np.isnan(solution.displacements[k]).any()]
+    levels = list(levels) if levels is not None else done[-1:]
+    dim = solution.mesh.dim
+    fig = Figure(figsize=(5.5 * max(1, len(levels)), 5.0), layout="constrained")
+    FigureCanvasAgg(fig)
+    for i, k in enumerate(levels):
+        if dim == 2:
+            ax = fig.add_subplot(1, len(levels), i + 1)
+            _section(ax, solution, k, outline=True)
+            ax.set_aspect("equal")
+            ax.autoscale_view()
+            ax.set_xlabel("x [mm]")
+            ax.set_ylabel("y [mm]")
+            ax.grid(alpha=0.3)
+            if i == 0:
+                ax.legend(loc="best", fontsize=7)
+        else:
+            ax = fig.add_subplot(1, len(levels), i + 1, projection="3d")
+            _surface(ax, solution, k)
+            ax.set_xlabel("x [mm]")
+            ax.set_ylabel("z [mm]")
+            ax.set_zlabel("y [mm]")
+        ax.set_title(f"{resp.pressures[k] * 1e3:.4g} kPa, curl {resp.curl[k]:.1f} deg", fontsize=9)
+    fig.suptitle(title or f"design {resp.orientation} ({resp.metadata.get('fidelity', '')} model)")
+    fig.text(0.01, 0.005, f"pneumorph {__version__} | {resp.metadata.get('fingerprint', '')}", fontsize=6, color="0.4")
+    if path is not None:
+        fig.savefig(path, dpi=150, metadata={"Software": f"pneumorph {__version__}",
+                                             "Description": f"design {resp.orientation}"})
+    return fig
