@@ -79,7 +79,12 @@ def test_exhaustive_with_symmetry_equals_brute_force(name: str, model, evaluator
 
 def test_symmetry_halves_the_solves(model: ToyModel) -> None:
     obj = objective("sin")
-    half = run_exhaustive(model, obj, CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:")))
+    progress = []
+    half = run_exhaustive(
+        model, obj, CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:")), batch_size=32,
+        on_progress=lambda done, total: progress.append((done, total)),
+    )
+    assert progress[-1] == (256, 256) and len(progress) == 4  # 128 designs solved in batches of 32
     full = run_exhaustive(model, obj, CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:")), symmetry=False)
     assert (half.solves, full.solves) == (129, 256)  # 128 + one mirror solved to verify the symmetry
     assert half.ranking == full.ranking

@@ -161,6 +161,7 @@ def run_design(
     on_generation: Any = None,
     on_progress: Any = None,
     overwrite: bool = False,
+    figures: bool = True,
 ) -> RunResult:
     """Run a design search and write its folder.
 
@@ -179,6 +180,8 @@ def run_design(
         Progress callbacks: a GA generation's stats; exhaustive (done, total).
     overwrite : bool
         Start afresh in a folder that holds another run.
+    figures : bool
+        Draw the figures (and call the model's ``write_deformed`` hook).
 
     Returns
     -------
@@ -235,11 +238,13 @@ def run_design(
             cache.close()
     result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
                        time.perf_counter() - start)
-    files = _write_outputs(result, config, model, ranking)
+    files = _write_outputs(result, config, model, ranking, figures)
     return replace(result, files=tuple(files))
 
 
-def _write_outputs(result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any) -> list[Path]:
+def _write_outputs(
+    result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any, figures: bool
+) -> list[Path]:
     folder, files = result.folder, []
     if result.history:
         files.append(folder / "generations.csv")
@@ -260,12 +265,12 @@ def _write_outputs(result: RunResult, config: DesignConfig, model: ActuatorModel
         path.write_text(json.dumps(doc, indent=1), encoding="utf-8")
         files.append(path)
     best = result.best
-    if best is not None and best.response is not None and best.level is not None:
+    if figures and best is not None and best.response is not None and best.level is not None:
         files.append(plot_profile(best, result.objective, folder / "profile.png"))
         hook = getattr(model, "write_deformed", None)
         if callable(hook):
             files.extend(Path(p) for p in hook(best.response, best.level, folder / "winner"))
-    if result.history:
+    if figures and result.history:
         files.append(plot_convergence(result.history, folder / "convergence.png", result.objective.unit))
     path = folder / "report.md"
     path.write_text(report_text(result, config, model, [f.name for f in files]), encoding="utf-8")

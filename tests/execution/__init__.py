@@ -1,0 +1,1 @@
+"""Tests of the evaluators and the evaluation cache."""
