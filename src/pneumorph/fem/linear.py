@@ -22,15 +22,46 @@ def superlu(A: Any, b: Any) -> np.ndarray:
     return spsolve(A.tocsc(), b, permc_spec="MMD_AT_PLUS_A")
 
 
-def pardiso(A: Any, b: Any) -> np.ndarray:
-    """MKL PARDISO through pypardiso (general, non-symmetric: follower pressure)."""
-    import pypardiso
+class Pardiso:
+    """MKL PARDISO (general, non-symmetric: follower pressure) that reuses its analysis.
 
-    return pypardiso.spsolve(A.tocsr(), np.asarray(b))
+    The fill-reducing ordering and symbolic factorisation (PARDISO phase 11) depend only
+    on the sparsity pattern, which stays the same through a whole pressure ramp; they are
+    computed once and every later system with the same pattern only factorises and solves
+    (phase 23). Use one instance per ramp.
+    """
+
+    def __init__(self) -> None:
+        from pypardiso import PyPardisoSolver
+
+        self._solver = PyPardisoSolver(mtype=11)
+        self._pattern: tuple[np.ndarray, np.ndarray] | None = None
+        self.analyses = 0
+
+    def __call__(self, A: Any, b: Any) -> np.ndarray:
+        A = A.tocsr()
+        A.sort_indices()
+        b = np.asarray(b, dtype=float)
+        s = self._solver
+        s._check_A(A)
+        b2 = s._check_b(A, b)
+        same = (
+            self._pattern is not None
+            and np.array_equal(self._pattern[0], A.indptr)
+            and np.array_equal(self._pattern[1], A.indices)
+        )
+        if same:
+            s.set_phase(23)
+        else:
+            s.set_phase(13)
+            self._pattern = (A.indptr.copy(), A.indices.copy())
+            self.analyses += 1
+        x = s._call_pardiso(A, b2)
+        return x.reshape(b.shape)
 
 
 def default_solver() -> Callable[[Any, Any], np.ndarray]:
-    """PARDISO if ``pypardiso`` imports, else SuperLU.
+    """A new PARDISO solver (reusing its analysis) if ``pypardiso`` imports, else SuperLU.
 
     Examples
     --------
@@ -40,7 +71,6 @@ def default_solver() -> Callable[[Any, Any], np.ndarray]:
     [0.090909, 0.636364]
     """
     try:
-        import pypardiso  # noqa: F401
+        return Pardiso()
     except ImportError:
         return partial(superlu)
-    return pardiso

@@ -1,0 +1,56 @@
+"""Wall time of one actuator evaluation (the cost of one design in the search).
+
+Solves a 15-unit design (random, seeded) with the 2D reduced-order or the 3D model, 10
+reported increments to the final pressure, and reports the median wall time over the
+repeats, Newton iterations and cut-backs. Run on one core as a search worker would:
+
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/evaluate.py --model 2d --repeat 5
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/evaluate.py --model 3d --repeat 1
+
+Issue bars: 2D <= 2 s median (goal 0.25 s); 3D <= 120 s (goal 30 s); the dissertation
+needed 45 s and 590 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import statistics
+import time
+
+import numpy as np
+
+from pneumorph.fem import StepSettings
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", choices=["2d", "3d"], default="2d")
+    parser.add_argument("--units", type=int, default=15)
+    parser.add_argument("--pressure", type=float, default=45.0, help="kPa")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--unit", help="unit TOML file (default: the built-in unit)")
+    parser.add_argument("--design", help="orientation digits (default: random, seed 0)")
+    args = parser.parse_args()
+    unit = UnitSpec.from_toml(args.unit) if args.unit else UnitSpec()
+    ramp = RampSpec(pressure=args.pressure / 1e3, steps=StepSettings(increments=10, substeps=2))
+    model = (Reduced2D if args.model == "2d" else Full3D)(args.units, unit, ramp)
+    design = args.design or "".join(map(str, np.random.default_rng(0).integers(0, 2, args.units)))
+    print(f"{args.model} model, design {design}, {args.pressure:g} kPa; {platform.machine()}, "
+          f"Python {platform.python_version()}")
+    model.evaluate(design[::-1])  # warm-up: imports, MKL, caches (another design)
+    times = []
+    for i in range(args.repeat):
+        t0 = time.perf_counter()
+        r = model.evaluate(design)
+        times.append(time.perf_counter() - t0)
+        m = r.metadata
+        print(f"  run {i + 1}: {times[-1]:.3f} s, {m['newton_iterations']} Newton iterations, "
+              f"{m['substeps']} substeps, {m['cutbacks']} cut-backs, {m['dofs']} dofs, curl {r.curl[-1]:.1f} deg")
+    print(f"median {statistics.median(times):.3f} s over {len(times)} runs")
+
+
+if __name__ == "__main__":
+    main()
