@@ -300,6 +300,8 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
     if best is not None:
         what = "error (Eq 4.1)" if isinstance(o, ProfileTarget) else "value"
         pressure = "-" if best.pressure is None else f"{best.pressure * 1e3:.4g} kPa"
+        if best.failure is not None:
+            lines += [f"**No design converged.** The best entry failed: {best.failure}", ""]
         lines += [
             "## Winner",
             "",
