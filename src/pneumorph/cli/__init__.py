@@ -24,8 +24,14 @@ def cli() -> None:
 
 cli.add_command(materials)
 
+from pneumorph.cli.composite import composite  # noqa: E402
+
+cli.add_command(composite)
+
+from pneumorph.cli.design import design  # noqa: E402
 from pneumorph.cli.simulate import simulate  # noqa: E402
 
+cli.add_command(design)
 cli.add_command(simulate)
 
 

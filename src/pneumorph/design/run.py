@@ -273,7 +273,8 @@ def _write_outputs(
     if figures and result.history:
         files.append(plot_convergence(result.history, folder / "convergence.png", result.objective.unit))
     path = folder / "report.md"
-    path.write_text(report_text(result, config, model, [f.name for f in files]), encoding="utf-8")
+    names = [f.relative_to(folder).as_posix() if f.is_relative_to(folder) else f.name for f in files]
+    path.write_text(report_text(result, config, model, names), encoding="utf-8")
     files.append(path)
     return files
 

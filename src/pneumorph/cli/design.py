@@ -1,0 +1,122 @@
+"""``pneumorph design``: the main job - the actuator whose inflated shape best meets a goal."""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+
+import click
+
+_TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
+
+
+def _kpa(pressure: float | None) -> float:
+    return float("nan") if pressure is None else pressure * 1e3
+
+
+def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
+    slug = re.sub(r"[^a-z0-9]+", "-", objective.lower()).strip("-")[:40] or "target"
+    return f"runs/{slug}-{units}u-{search}-seed{seed}"
+
+
+@click.command("design")
+@click.argument("config_file", required=False, type=click.Path(exists=True, dir_okay=False))
+@click.option("--target", metavar="TARGET",
+              help="Profile to match: 'sin', 'cos', 'y = <expr in x, L, A>' or 'r = <expr in theta>'. "
+                   "Default (no config file): sin, amplitude 10 mm, one period.")
+@click.option("--objective", type=click.Choice(_TIP_GOALS), help="A tip goal instead of a profile (Table 6.1).")
+@click.option("--amplitude", type=float, help="Amplitude A of the sin/cos target, mm (default 10).")
+@click.option("--periods", type=float, help="Periods of the sin/cos target over the actuator (default 1).")
+@click.option("--point", type=float, nargs=2, metavar="X Y", help="Tip point (mm) for --objective reach.")
+@click.option("--units", type=int, help="Number of articulating units (default 15).")
+@click.option("--pop", "population", type=int, help="GA population (default 100).")
+@click.option("--gen", "generations", type=int, help="GA generations (default 15).")
+@click.option("--seed", type=int, help="Random seed (default 0): the same seed gives the same run.")
+@click.option("--search", type=click.Choice(["ga", "exhaustive"]), help="Genetic algorithm or all 2^n designs.")
+@click.option("--executor", type=click.Choice(["serial", "processes", "dask"]),
+              help="Where designs are solved (default processes: all cores).")
+@click.option("--workers", type=int, help="Processes or Dask workers (default: all cores).")
+@click.option("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://host:8786); default a local cluster.")
+@click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), help="Model fidelity (default 2d).")
+@click.option("--pressure", type=float, help="Maximum pressure, kPa (default 45).")
+@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False), help="Unit TOML file.")
+@click.option("--cache", metavar="FILE", help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
+@click.option("--out", metavar="DIR", help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
+@click.option("--overwrite", is_flag=True, help="Start afresh in a folder that holds another run.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
+           periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
+           generations: int | None, seed: int | None, search: str | None, executor: str | None,
+           workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
+           unit_file: str | None, cache: str | None, out: str | None, overwrite: bool, as_json: bool) -> None:
+    """Design the actuator whose inflated shape best matches a target or tip goal.
+
+    Without options: a 15-unit actuator for the target "sin, amplitude 10 mm, one period"
+    with the 2D reduced-order model, a GA of 100 x 15 (section 6.1), all cores. Running the
+    same command again resumes: solved designs come from the evaluation cache.
+    """
+    from dataclasses import replace
+
+    from pneumorph.design import DesignConfig, run_design
+    from pneumorph.errors import SearchConfigError
+    from pneumorph.models.factory import make_model
+
+    if target and objective:
+        raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
+    config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
+    changes: dict = {}
+    for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
+                       ("point", point), ("units", units), ("search", search), ("seed", seed),
+                       ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
+        if value is not None:
+            changes[key] = value
+    ga_changes = {k: v for k, v in (("population", population), ("generations", generations)) if v is not None}
+    model_settings = dict(config.model)
+    for key, value in (("fidelity", fidelity), ("pressure_kpa", pressure), ("unit_file", unit_file)):
+        if value is not None:
+            model_settings[key] = value
+    if unit_file:
+        model_settings.pop("unit", None)
+    config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
+    config = DesignConfig.from_dict(config.to_dict())  # validate the combination
+    folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
+    model = make_model(config.units, config.model)
+
+    label = config.make_objective().label
+    click.echo(f"designing {config.units} units for {label} ({model.fidelity} model, {config.search}, "
+               f"executor {config.executor}) -> {folder}", err=True)
+
+    def on_generation(stats) -> None:  # type: ignore[no-untyped-def]
+        total = config.ga.generations
+        done = stats.generation
+        bar = "#" * int(20 * done / max(total, 1))
+        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: best {stats.best:.4g}  mean {stats.mean:.4g}  "
+                   f"solves {stats.solves}  cache hits {stats.cache_hits}  {stats.wall_time:.1f} s", err=True)
+
+    def on_progress(done: int, total: int) -> None:
+        bar = "#" * int(20 * done / max(total, 1))
+        click.echo(f"  [{bar:<20}] {done}/{total} designs", err=True)
+
+    result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
+                        overwrite=overwrite)
+    best = result.best
+    if as_json:
+        click.echo(json.dumps({
+            "status": result.status,
+            "folder": str(result.folder),
+            "objective": label,
+            "best": None if best is None else {
+                "design": best.design, "pressure_kpa": _kpa(best.pressure), "fitness": best.value,
+            },
+            "hall_of_fame": [{"design": c.design, "pressure_kpa": _kpa(c.pressure), "fitness": c.value,
+                              "failure": c.failure} for c in result.hall_of_fame],
+            "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
+        }, indent=1))
+    elif best is not None:
+        click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: fitness {best.value:.4g} "
+                   f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
+        click.echo(f"report: {result.folder / 'report.md'}")
+    if result.status == "interrupted":
+        click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
+        sys.exit(130)

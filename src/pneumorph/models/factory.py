@@ -1,0 +1,54 @@
+"""Build a model from plain settings (a design config's ``[model]`` table, CLI options)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from pneumorph.errors import SearchConfigError
+from pneumorph.fem import StepSettings
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
+
+MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file")
+
+
+def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel:
+    """A 2D or 3D FE model of ``units`` units from plain settings.
+
+    Parameters
+    ----------
+    units : int
+        Number of articulating units.
+    settings : mapping, optional
+        ``fidelity`` ("2d" default, or "3d"), ``pressure_kpa`` (45), ``increments`` (10),
+        ``substeps`` (2), and the unit: ``unit`` (a table of UnitSpec parameters) or
+        ``unit_file`` (a TOML file with a ``[unit]`` table).
+
+    Examples
+    --------
+    >>> m = make_model(4, {"pressure_kpa": 30, "unit": {"slit_width": 1.0, "slit_depth": 9.0}})
+    >>> m.fidelity, m.n_units, round(m.ramp.pressure, 6), m.unit.slit_width
+    ('2d', 4, 0.03, 1.0)
+    """
+    s = dict(settings or {})
+    unknown = sorted(set(s) - set(MODEL_KEYS))
+    if unknown:
+        raise SearchConfigError(f"unknown model setting(s) {', '.join(unknown)}; known: {', '.join(MODEL_KEYS)}")
+    if "unit" in s and "unit_file" in s:
+        raise SearchConfigError("give the unit either inline ([model.unit]) or as unit_file, not both")
+    if "unit_file" in s:
+        unit = UnitSpec.from_toml(Path(s["unit_file"]))
+    else:
+        unit = UnitSpec.from_dict(dict(s.get("unit", {})), source="[model.unit]")
+    ramp = RampSpec(
+        pressure=float(s.get("pressure_kpa", 45.0)) / 1e3,
+        steps=StepSettings(increments=int(s.get("increments", 10)), substeps=int(s.get("substeps", 2))),
+    )
+    fidelity = s.get("fidelity", "2d")
+    if fidelity == "2d":
+        return Reduced2D(units, unit, ramp)
+    if fidelity == "3d":
+        return Full3D(units, unit, ramp)
+    raise SearchConfigError(f"unknown model fidelity {fidelity!r}; choose 2d or 3d")
