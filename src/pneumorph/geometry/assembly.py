@@ -52,6 +52,8 @@ class ActuatorMesh:
         Points of the clamped base face (x = 0).
     orientation : str
     spec : UnitSpec
+    symmetry_points : ndarray of bool, shape (p,)
+        3D half models: points on the mid-plane z = width / 2, where u_z = 0.
     """
 
     points: FloatArray
@@ -64,6 +66,7 @@ class ActuatorMesh:
     base_points: BoolArray
     orientation: str
     spec: UnitSpec
+    symmetry_points: BoolArray | None = None
 
     @property
     def dim(self) -> int:
@@ -137,7 +140,7 @@ def _label(spec: UnitSpec, orientation: str, centres: FloatArray) -> IntArray:
     return label
 
 
-def assemble(spec: UnitSpec, orientation: str, dim: int = 2) -> ActuatorMesh:
+def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False) -> ActuatorMesh:
     """Mesh an actuator of ``len(orientation)`` units.
 
     Parameters
@@ -149,6 +152,10 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2) -> ActuatorMesh:
     dim : {2, 3}
         2 = plane-strain longitudinal section with filled cavities; 3 = solid with empty
         cavities.
+    half : bool
+        3D only: mesh the half 0 <= z <= width / 2; the model then holds u_z = 0 on the
+        mid-plane (``symmetry_points``). The actuator is symmetric across its width, so this
+        gives the same solution with half the unknowns.
 
     Returns
     -------
@@ -173,7 +180,8 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2) -> ActuatorMesh:
     xs = grid_lines([i * P + x for i in range(n) for x in xb_local] + [n * P + spec.end_cap], h)
     ys = grid_lines(yb, h)
     if dim == 3:
-        zs = grid_lines([0.0, spec.side_wall, W / 2, W - spec.side_wall, W], h)
+        zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+        zs = grid_lines(zb, h)
         grid = fem.Grid(xs, ys, zs)
     else:
         grid = fem.Grid(xs, ys)
@@ -229,4 +237,5 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2) -> ActuatorMesh:
         base_points=np.isclose(points[:, 0], 0.0),
         orientation=orientation,
         spec=spec,
+        symmetry_points=np.isclose(points[:, 2], W / 2) if (dim == 3 and half) else None,
     )

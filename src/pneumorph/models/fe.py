@@ -87,6 +87,7 @@ class FEModel:
 
     fidelity = "fe"
     dim = 2
+    half = False
 
     def __init__(
         self,
@@ -143,7 +144,7 @@ class FEModel:
         """FElupe objects for one design (mesh, fields, bodies, boundary conditions)."""
         import felupe as fem
 
-        mesh = assemble(self.unit, orientation, self.dim)
+        mesh = assemble(self.unit, orientation, self.dim, half=self.half)
         Region, BoundaryRegion, Field = self._regions(mesh)
         fmesh = fem.Mesh(mesh.points, mesh.cells, mesh.cell_type)
         field = fem.FieldContainer([Field(Region(fmesh), dim=self.dim)])
@@ -161,8 +162,10 @@ class FEModel:
         wall_field = fem.FieldContainer([Field(walls, dim=self.dim)])
         wall_field.link(field)
         pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
-        base = fem.Boundary(field[0], mask=mesh.base_points)
-        dof0, dof1 = fem.dof.partition(field, {"base": base})
+        bounds = {"base": fem.Boundary(field[0], mask=mesh.base_points)}
+        if mesh.symmetry_points is not None:
+            bounds["symmetry"] = fem.Boundary(field[0], mask=mesh.symmetry_points, skip=(1, 1, 0))
+        dof0, dof1 = fem.dof.partition(field, bounds)
         return {
             "mesh": mesh,
             "field": field,
@@ -358,14 +361,24 @@ class Reduced2D(FEModel):
 class Full3D(FEModel):
     """The 3D model: quadratic hexahedra, empty cavities, the same ramp (chapter 4).
 
-    Parameters are those of :class:`Reduced2D` without the filler.
+    Parameters are those of :class:`Reduced2D` without the filler, and
+
+    half : bool
+        Model half the width with u_z = 0 on the mid-plane (default): the same solution
+        as the full model for this symmetric actuator, with half the unknowns.
     """
 
     fidelity = "3d"
     dim = 3
 
-    def __init__(self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None) -> None:
+    def __init__(
+        self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True
+    ) -> None:
         super().__init__(n_units, unit, ramp_spec, None)
+        self.half = bool(half)
+
+    def describe(self) -> dict[str, Any]:
+        return {**super().describe(), "half_model": self.half}
 
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem
