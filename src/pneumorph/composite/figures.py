@@ -43,30 +43,39 @@ def plot_load_strain(results: Sequence[CouponResult], path: str | Path | None = 
     >>> from pneumorph.composite.coupon import CouponSpec, simulate_coupon
     >>> r = simulate_coupon(CouponSpec.from_ratio(0.3, length=20.0, per_flute=1, rows=1), levels=14)
     >>> len(plot_load_strain([r]).axes)
-    2
+    4
     """
-    fig = Figure(figsize=(10, 4.2), layout="constrained")
+    fig = Figure(figsize=(10, 7.0), layout="constrained")
     FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 2, sharey=True)
-    for ax, kind, title in zip(axes, ("surface", "engineering"), ("Averaged surface strain", "Engineering strain")):
-        for i, r in enumerate(results):
-            colour = f"C{i}"
-            eps = r.strain(kind)  # type: ignore[arg-type]
-            t = r.transition(kind)  # type: ignore[arg-type]
-            ax.plot(100 * eps, r.force, "-", color=colour, lw=1.4,
-                    label=f"{_label(r)}: transition {100 * t.transition_strain:.1f} %")
-            xs = np.array([0.0, t.transition_strain])
-            ax.plot(100 * xs, t.primary.slope * xs + t.primary.intercept, ":", color=colour, lw=0.9)
-            xs2 = np.array([t.transition_strain, eps[-1]])
-            ax.plot(100 * xs2, t.secondary.slope * xs2 + t.secondary.intercept, "--", color=colour, lw=0.9)
-            ax.plot(100 * t.transition_strain, t.transition_stress, "o", color=colour, ms=4)
-        ax.set_xlabel(f"{title} (%)")
-        ax.set_title(title)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="upper left")
-    axes[0].set_ylabel("Force (N per mm of width)")
+    grid = fig.subplots(2, 2, sharex="col")
+    knee = 0.0
+    for row, zoom in ((grid[0], False), (grid[1], True)):
+        for ax, kind, title in zip(row, ("surface", "engineering"), ("Averaged surface strain", "Engineering strain")):
+            for i, r in enumerate(results):
+                colour = f"C{i}"
+                eps = r.strain(kind)  # type: ignore[arg-type]
+                t = r.transition(kind)  # type: ignore[arg-type]
+                knee = max(knee, float(np.interp(t.transition_strain, eps, r.force)))
+                ax.plot(100 * eps, r.force, "-", color=colour, lw=1.4,
+                        label=f"{_label(r)}: transition {100 * t.transition_strain:.1f} %")
+                xs = np.array([0.0, t.transition_strain])
+                ax.plot(100 * xs, t.primary.slope * xs + t.primary.intercept, ":", color=colour, lw=0.9)
+                xs2 = np.array([t.transition_strain, eps[-1]])
+                ax.plot(100 * xs2, t.secondary.slope * xs2 + t.secondary.intercept, "--", color=colour, lw=0.9)
+                ax.plot(100 * t.transition_strain, t.transition_stress, "o", color=colour, ms=4)
+            ax.grid(alpha=0.3)
+            if zoom:
+                ax.set_xlabel(f"{title} (%)")
+            else:
+                ax.set_title(title)
+                ax.legend(fontsize=8, loc="upper left")
     top = max(float(np.max(r.force)) for r in results)
-    axes[0].set_ylim(-0.02 * top, 1.02 * top)
+    grid[0, 0].set_ylim(-0.02 * top, 1.02 * top)
+    grid[0, 1].set_ylim(-0.02 * top, 1.02 * top)
+    grid[1, 0].set_ylim(0.0, 3.0 * knee)
+    grid[1, 1].set_ylim(0.0, 3.0 * knee)
+    grid[0, 0].set_ylabel("Force (N per mm of width)")
+    grid[1, 0].set_ylabel("Force, primary branch (N per mm)")
     specs = results[0].spec
     _caption(fig, f"plane strain, L0 {specs.crimp.length:g} mm, T {specs.thickness:g} mm, "
                   f"A {specs.crimp.amplitude:g} mm, {specs.matrix} + {specs.paper}; two-line fits dotted/dashed")
@@ -195,7 +204,7 @@ def plot_transitions(rows: Sequence[dict[str, Any]], path: str | Path | None = N
     ax = fig.subplots()
     cr = np.array([r["crimp_ratio"] for r in rows])
     first = rows[0]
-    grid = np.linspace(0.05, max(0.4, cr.max() + 0.05), 200)
+    grid = np.linspace(0.1, max(0.4, cr.max() + 0.05), 200)
     amp, length = first.get("amplitude", 1.5), first.get("length", 176.25)
     ax.plot(grid, [100 * Crimp.from_ratio(c, amp, length).transition_strain for c in grid], "-", color="C0",
             lw=1.0, label=f"Eqs 3.1-3.4 (L0 = {length:g} mm)")
