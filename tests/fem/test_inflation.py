@@ -134,3 +134,34 @@ def test_pressure_control_stops_at_the_limit_point_of_a_thin_sphere() -> None:
     reached_pressure = info.value.reached * 0.07 * MU
     assert 0.060 * MU <= reached_pressure <= 0.0636 * MU * 1.002
     assert "cut-backs" in str(info.value)
+
+
+def test_enforced_displacement_ramp_matches_the_closed_form() -> None:
+    """Displacement control: a nearly incompressible neo-Hookean bar stretched to l = 2.
+
+    The nominal stress from the reaction force equals mu (l - l^-2) within the
+    compressibility error mu/K = 2e-4.
+    """
+    mesh = fem.Cube(n=3)
+    region = fem.RegionHexahedron(mesh)
+    field = fem.FieldContainer([fem.Field(region, dim=3)])
+    x = mesh.points
+    bounds = {
+        "x0": fem.Boundary(field[0], fx=0.0, skip=(0, 1, 1)),
+        "y0": fem.Boundary(field[0], fy=0.0, skip=(1, 0, 1)),
+        "z0": fem.Boundary(field[0], fz=0.0, skip=(1, 1, 0)),
+        "x1": fem.Boundary(field[0], fx=1.0, skip=(0, 1, 1)),
+    }
+    dof0, dof1 = fem.dof.partition(field, bounds)
+    solid = fem.SolidBodyNearlyIncompressible(fem.NeoHooke(mu=MU), field, bulk=K)
+    right = np.isclose(x[:, 0], 1.0)
+    stretch = 2.0
+
+    def apply(t: float) -> None:
+        field[0].values[right, 0] = t * (stretch - 1.0)
+
+    stats = ramp([solid], field, apply, dof1, dof0, StepSettings(increments=4, substeps=1))
+    assert np.allclose(field[0].values[right, 0], stretch - 1.0)
+    force = solid.assemble.vector(field).toarray().reshape(-1, 3)[right, 0].sum()
+    assert force == pytest.approx(MU * (stretch - stretch**-2), rel=1e-3)
+    assert stats.reached == 1.0

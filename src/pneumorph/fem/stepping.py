@@ -105,6 +105,8 @@ def _solve_substep(
     import felupe as fem
     from scipy.sparse.linalg import MatrixRankWarning
 
+    # prescribed values as ``apply`` left them in the fields (enforced displacements)
+    ext0 = np.concatenate([f.values.ravel() for f in fields.fields])[dof0]
     try:
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             warnings.simplefilter("ignore", MatrixRankWarning)
@@ -113,6 +115,7 @@ def _solve_substep(
                 x0=fields,
                 dof1=dof1,
                 dof0=dof0,
+                ext0=ext0,
                 tol=settings.tolerance,
                 maxiter=settings.max_iterations,
                 solver=solver,
@@ -163,7 +166,8 @@ def ramp(
     fields : felupe.FieldContainer
         The unknowns; updated in place, ending in the converged state at factor 1.
     apply : callable
-        ``apply(t)`` sets every load and load-dependent property for factor ``t``.
+        ``apply(t)`` sets every load and load-dependent property for factor ``t``; an
+        enforced displacement is set by writing it into the prescribed values of ``fields``.
     dof1, dof0 : ndarray
         Active and prescribed degrees of freedom (prescribed values are held fixed).
     settings : StepSettings
