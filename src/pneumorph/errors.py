@@ -12,7 +12,29 @@ class PneumorphError(Exception):
     """Base class of all errors raised on purpose by pneumorph."""
 
 
-class UnknownMaterialError(PneumorphError, KeyError):
+class UnknownNameError(PneumorphError, KeyError):
+    """A name that is not among the known ones; ``known`` lists them for the message.
+
+    Parameters
+    ----------
+    name : str
+        The name that was asked for.
+    known : sequence of str
+        The names that exist.
+    """
+
+    what = "name"
+
+    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return f"unknown {self.what} {self.name!r}; known {self.what}s: {', '.join(self.known)}"
+
+
+class UnknownMaterialError(UnknownNameError):
     """A material name that is not in the library.
 
     Parameters
@@ -23,25 +45,13 @@ class UnknownMaterialError(PneumorphError, KeyError):
         The names the library holds; listed in the message.
     """
 
-    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
-        self.name = name
-        self.known = tuple(known)
-        super().__init__(name)
-
-    def __str__(self) -> str:
-        return f"unknown material {self.name!r}; known materials: {', '.join(self.known)}"
+    what = "material"
 
 
-class UnknownModelError(PneumorphError, KeyError):
+class UnknownModelError(UnknownNameError):
     """A constitutive model name that pneumorph does not implement."""
 
-    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
-        self.name = name
-        self.known = tuple(known)
-        super().__init__(name)
-
-    def __str__(self) -> str:
-        return f"unknown model {self.name!r}; known models: {', '.join(self.known)}"
+    what = "model"
 
 
 class DataFormatError(PneumorphError, ValueError):
@@ -125,13 +135,8 @@ class SimulationFailed(PneumorphError, RuntimeError):
         super().__init__(f"{what}simulation failed, {where}: {cause}")
 
 
-class UnknownDatasetError(PneumorphError, KeyError):
+class UnknownDatasetError(UnknownNameError):
     """A name that is neither a readable data file nor a bundled test-data set."""
-
-    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
-        self.name = name
-        self.known = tuple(known)
-        super().__init__(name)
 
     def __str__(self) -> str:
         return (
@@ -160,13 +165,8 @@ class TargetExpressionError(PneumorphError, ValueError):
     """
 
 
-class UnknownObjectiveError(PneumorphError, KeyError):
+class UnknownObjectiveError(UnknownNameError):
     """An objective name that is neither a tip goal nor a target preset."""
-
-    def __init__(self, name: str, known: list[str] | tuple[str, ...]) -> None:
-        self.name = name
-        self.known = tuple(known)
-        super().__init__(name)
 
     def __str__(self) -> str:
         return (
