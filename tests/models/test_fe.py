@@ -108,3 +108,19 @@ def test_3d_half_model_equals_the_full_model() -> None:
     assert half.metadata["dofs"] < 0.6 * full.metadata["dofs"]
     np.testing.assert_allclose(half.centres, full.centres, atol=1e-7)
     np.testing.assert_allclose(half.curl, full.curl, atol=1e-6)
+
+
+def test_2d_tip_displacement_converges_with_the_mesh() -> None:
+    """Element sizes 1.5, 0.75, 0.375 mm on a 2-unit actuator at 15 kPa.
+
+    The tip displacement changes less with each halving (measured: 0.0146 then 0.0073 mm
+    of 2.13 mm) and the default 1.5 mm mesh lies within 3 % of the finest.
+    """
+    ramp = RampSpec(pressure=0.015, steps=StepSettings(increments=3, substeps=1))
+    tips = []
+    for h in (1.5, 0.75, 0.375):
+        r = Reduced2D(2, unit=UnitSpec(element_size=h), ramp_spec=ramp).evaluate("00")
+        tips.append(float(np.hypot(*(r.tip[-1] - r.reference_tip))))
+    d1, d2 = abs(tips[1] - tips[0]), abs(tips[2] - tips[1])
+    assert d2 < 0.7 * d1
+    assert abs(tips[0] - tips[2]) < 0.03 * tips[2]
