@@ -41,3 +41,15 @@ def test_design_rejects_bad_input(extra: list[str], message: str, tmp_path: Path
     code = main(["design", *TINY, "--out", str(tmp_path / "r"), "--cache", str(tmp_path / "c.sqlite"), *extra])
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+def test_population_study_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    args = ["study", "--units", "2", "--pressure", "10", "--populations", "2,4", "--seeds", "2", "--gen", "2",
+            "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "st"), "--json"]
+    assert main(args) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    assert [r["population"] for r in rows] == [2, 4]
+    for r in rows:
+        assert r["lowest"] <= r["mean"] <= r["largest"] and len(r["best"]) == 2
+    assert (tmp_path / "st" / "study.png").is_file()
+    assert main(["study", "--populations", "2,x", "--out", str(tmp_path / "s2")]) == 2

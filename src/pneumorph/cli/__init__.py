@@ -30,9 +30,11 @@ cli.add_command(composite)
 
 from pneumorph.cli.design import design  # noqa: E402
 from pneumorph.cli.simulate import simulate  # noqa: E402
+from pneumorph.cli.study import study  # noqa: E402
 
 cli.add_command(design)
 cli.add_command(simulate)
+cli.add_command(study)
 
 
 def main(argv: list[str] | None = None) -> int:

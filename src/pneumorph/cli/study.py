@@ -1,0 +1,88 @@
+"""``pneumorph study``: the GA population-size study of section 6.1 (Fig 6.1)."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+
+@click.command("study")
+@click.argument("config_file", required=False, type=click.Path(exists=True, dir_okay=False))
+@click.option("--populations", default="20,40,60,80", show_default=True, metavar="LIST",
+              help="Population sizes, comma-separated.")
+@click.option("--seeds", type=int, default=5, show_default=True, help="Runs (seeds 0..N-1) per population size.")
+@click.option("--gen", "generations", type=int, default=25, show_default=True, help="Generations per run.")
+@click.option("--units", type=int, help="Number of units (default: the config's, else 15).")
+@click.option("--target", help="Profile target (default: the config's, else sin, amplitude 10 mm).")
+@click.option("--pressure", type=float, help="Maximum pressure, kPa (default 45).")
+@click.option("--executor", type=click.Choice(["serial", "processes", "dask"]), default="processes", show_default=True)
+@click.option("--cache", metavar="FILE", help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--out", default="runs/population-study", show_default=True, metavar="DIR",
+              help="Folder for study.json and study.png.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
+def study(config_file: str | None, populations: str, seeds: int, generations: int, units: int | None,
+          target: str | None, pressure: float | None, executor: str, cache: str | None, out: str,
+          as_json: bool) -> None:
+    """Best fitness against GA population size over several seeds (lowest, largest, mean).
+
+    Every design is solved once for the whole study: all runs share the evaluation cache.
+    """
+    from dataclasses import replace
+    from pathlib import Path
+
+    from pneumorph.design import DesignConfig, plot_study, population_study
+    from pneumorph.errors import SearchConfigError
+    from pneumorph.execution import (
+        CachedEvaluator,
+        EvaluationCache,
+        default_cache_path,
+        make_evaluator,
+    )
+    from pneumorph.io import provenance
+    from pneumorph.models.factory import make_model
+
+    try:
+        pops = tuple(int(p) for p in populations.split(","))
+    except ValueError:
+        raise SearchConfigError(f"--populations takes whole numbers separated by commas, got {populations!r}") from None
+    config = DesignConfig.read(config_file) if config_file else DesignConfig()
+    changes = {k: v for k, v in (("units", units), ("objective", target)) if v is not None}
+    model_settings = dict(config.model)
+    if pressure is not None:
+        model_settings["pressure_kpa"] = pressure
+    config = replace(config, model=model_settings, **changes)
+    config = DesignConfig.from_dict(config.to_dict())
+    model = make_model(config.units, config.model)
+    objective = config.make_objective()
+    evaluator = CachedEvaluator(make_evaluator(executor), EvaluationCache(cache or default_cache_path()))
+    click.echo(f"population study: {objective.label}, populations {pops}, {seeds} seeds, "
+               f"{generations} generations, {config.units} units", err=True)
+
+    def on_run(pop: int, seed: int, result) -> None:  # type: ignore[no-untyped-def]
+        best = result.best
+        click.echo(f"  population {pop:3d}, seed {seed}: best {best.value:.4g} ({best.design})", err=True)
+
+    try:
+        result = population_study(model, objective, pops, tuple(range(seeds)), generations,
+                                  base=replace(config.ga, seed=0), evaluator=evaluator, on_run=on_run)
+    finally:
+        close = getattr(evaluator, "close", None)
+        if callable(close):
+            close()
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    summary = {
+        "objective": result.objective, "unit": result.unit, "generations": result.generations,
+        "rows": [row.as_dict() for row in result.rows],
+        "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint(), config=config.to_dict()),
+    }
+    (folder / "study.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
+    plot_study(result, folder / "study.png")
+    if as_json:
+        click.echo(json.dumps({k: v for k, v in summary.items() if k != "provenance"}, indent=1))
+    else:
+        click.echo(f"{'population':>10} {'lowest':>10} {'largest':>10} {'mean':>10}   [{result.unit}]")
+        for row in result.rows:
+            click.echo(f"{row.population:>10} {row.lowest:>10.4g} {row.largest:>10.4g} {row.mean:>10.4g}")
+        click.echo(f"written to {folder}/ (study.json, study.png)")
