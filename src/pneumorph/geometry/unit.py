@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import GeometryError
+from pneumorph.materials.filler import FillerLaw
 
 _LENGTHS = (
     "pitch",
@@ -86,6 +87,15 @@ class UnitSpec:
         Target edge length of the quadratic elements.
     name : str
         A label for reports.
+    filler_coefficients : tuple of float
+        The unit's calibrated filler law of the 2D model, ``E(P) = sum_k c_k P^k`` (MPa, P
+        in MPa; ``pneumorph calibrate`` writes it). Empty: the dissertation's Eq 5.2.
+    filler_range_kpa : (float, float)
+        The pressure range the law was calibrated over.
+    filler_poisson_ratio : float
+        Poisson's ratio of the filler.
+    filler_source : str
+        Where the law comes from (provenance of the calibration).
 
     Raises
     ------
@@ -107,8 +117,16 @@ class UnitSpec:
     layer_material: str = "smooth_sil_950"
     element_size: float = 1.5
     name: str = "unit"
+    filler_coefficients: tuple[float, ...] = ()
+    filler_range_kpa: tuple[float, float] = (0.0, 45.0)
+    filler_poisson_ratio: float = 0.3
+    filler_source: str = ""
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "filler_coefficients", tuple(float(c) for c in self.filler_coefficients))
+        object.__setattr__(self, "filler_range_kpa", tuple(float(c) for c in self.filler_range_kpa))
+        if self.filler_coefficients:
+            self.filler_law()  # validates: positive modulus over the range, Poisson's ratio
         for key in _LENGTHS:
             value = getattr(self, key)
             if not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -162,9 +180,32 @@ class UnitSpec:
             return None
         return (self.pitch - self.slit_width, self.pitch, 0.0, self.slit_depth)
 
+    def filler_law(self) -> FillerLaw | None:
+        """The unit's calibrated filler law, or None (then the 2D model uses Eq 5.2).
+
+        Raises
+        ------
+        MaterialDataError
+            A law that is not positive over its range, or a bad Poisson's ratio.
+        """
+        if not self.filler_coefficients:
+            return None
+        lo, hi = self.filler_range_kpa
+        return FillerLaw(
+            name=f"{self.name}_filler",
+            display_name=f"filler of {self.name}",
+            coefficients=self.filler_coefficients,
+            pressure_range=(lo / 1e3, hi / 1e3),
+            poisson_ratio=self.filler_poisson_ratio,
+            source=self.filler_source or f"calibrated for unit {self.name!r}",
+        )
+
     def to_dict(self) -> dict[str, Any]:
         """All parameters, for TOML files and provenance."""
-        return asdict(self)
+        out = asdict(self)
+        out["filler_coefficients"] = list(self.filler_coefficients)
+        out["filler_range_kpa"] = list(self.filler_range_kpa)
+        return out
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], source: str = "unit definition") -> UnitSpec:

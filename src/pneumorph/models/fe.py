@@ -305,8 +305,9 @@ class Reduced2D(FEModel):
     ramp_spec : RampSpec, optional
         Pressure ramp (default 45 kPa in 10 reported increments).
     filler : FillerLaw, optional
-        The filler law E(P) (default: Eq 5.2). The ramp must lie inside its calibrated
-        range, else :class:`pneumorph.errors.PressureRangeError` is raised at once.
+        The filler law E(P) (default: the unit's calibrated law, else Eq 5.2). The ramp
+        must lie inside its calibrated range, else
+        :class:`pneumorph.errors.PressureRangeError` is raised at once.
 
     Examples
     --------
@@ -326,7 +327,8 @@ class Reduced2D(FEModel):
         ramp_spec: RampSpec | None = None,
         filler: FillerLaw | None = None,
     ) -> None:
-        super().__init__(n_units, unit, ramp_spec, filler or get_filler())
+        unit = unit or UnitSpec()
+        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler())
         assert self.filler is not None
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
         self.filler.modulus(self.ramp.pressure)
