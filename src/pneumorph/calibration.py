@@ -1,0 +1,274 @@
+"""Calibrate the 2D model's filler law E(P) against the 3D model (chapter 5).
+
+For each pressure level and each of several independent runs, a random design is solved
+in 3D, and the filler modulus E that makes the 2D model reproduce it best is found with a
+SciPy optimiser from a random starting point, minimising Eq 5.1:
+
+    Gamma(E) = sum over units [(X2 - X3)^2 + (Y2 - Y3)^2]
+
+over the unit-centre displacements at that pressure. The 2D solve for a trial E uses a
+constant filler of modulus E up to the level's pressure: a hyperelastic equilibrium does not
+depend on the loading path, so this is the 2D state at that pressure with E(P) = E. Linear
+and quadratic laws E(P) are then fitted to all (P, E) points by least squares with their
+R^2 (Fig 5.3); a law that fits badly or is not positive over the range is reported with a
+warning and not silently used.
+
+3D responses are cached (:class:`pneumorph.execution.EvaluationCache`), so recalibrating
+repeats no 3D solve.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from pneumorph.errors import MaterialDataError, SimulationFailed
+from pneumorph.fem import StepSettings
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.materials.filler import FillerLaw
+from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
+from pneumorph.models.response import Response
+
+#: R^2 below which a fitted law is reported as a poor fit.
+R2_WARNING = 0.9
+
+
+class CalibrationWarning(UserWarning):
+    """A fitted filler law that fits badly or is not positive over its range."""
+
+
+@dataclass(frozen=True)
+class FillerPoint:
+    """The best constant filler modulus for one design at one pressure."""
+
+    run: int
+    pressure: float  # MPa
+    design: str
+    modulus: float  # MPa
+    gamma: float  # Eq 5.1 at the optimum, mm^2
+    start: float  # the optimiser's random starting modulus, MPa
+    evaluations: int
+
+
+@dataclass(frozen=True)
+class LawFit:
+    """A polynomial law E(P) fitted to the calibration points."""
+
+    degree: int
+    coefficients: tuple[float, ...]  # c_0, c_1, ... (MPa, P in MPa)
+    r_squared: float
+    minimum: tuple[float, float]  # (pressure, modulus) over the range
+    problems: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """The points of every run, both fitted laws and the chosen one."""
+
+    points: tuple[FillerPoint, ...]
+    linear: LawFit
+    quadratic: LawFit
+    chosen: LawFit | None
+    pressure_range: tuple[float, float]
+    poisson_ratio: float
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def law(self) -> FillerLaw:
+        """The chosen law as a :class:`FillerLaw` (raises if no law was acceptable)."""
+        if self.chosen is None:
+            raise MaterialDataError(
+                "no acceptable filler law: " + "; ".join(self.linear.problems + self.quadratic.problems)
+            )
+        return FillerLaw(
+            name="calibrated_filler",
+            display_name="calibrated filler",
+            coefficients=self.chosen.coefficients,
+            pressure_range=self.pressure_range,
+            poisson_ratio=self.poisson_ratio,
+            source="pneumorph calibrate (Eq 5.1 against the 3D model)",
+        )
+
+    def unit_with_law(self, unit: UnitSpec) -> UnitSpec:
+        """``unit`` carrying the chosen law, with provenance."""
+        law = self.law()
+        src = (f"pneumorph calibrate: {len(self.points)} points, degree {self.chosen.degree}, "  # type: ignore[union-attr]
+               f"R^2 {self.chosen.r_squared:.4f}")  # type: ignore[union-attr]
+        return replace(
+            unit,
+            filler_coefficients=law.coefficients,
+            filler_range_kpa=(self.pressure_range[0] * 1e3, self.pressure_range[1] * 1e3),
+            filler_poisson_ratio=self.poisson_ratio,
+            filler_source=src,
+        )
+
+
+def unit_centre_displacements(response: Response, level: int) -> np.ndarray:
+    """(n, 2) displacements of the unit centres at a reported level."""
+    return response.centres[level] - response.reference_centres
+
+
+def gamma(d2: np.ndarray, d3: np.ndarray) -> float:
+    """Eq 5.1: summed squared differences of the unit-centre displacements (mm^2).
+
+    Examples
+    --------
+    >>> gamma(np.array([[1.0, 0.0], [0.0, 2.0]]), np.array([[0.0, 0.0], [0.0, 0.0]]))
+    5.0
+    """
+    return float(np.sum((np.asarray(d2) - np.asarray(d3)) ** 2))
+
+
+def fit_law(pressures: Sequence[float], moduli: Sequence[float], degree: int,
+            pressure_range: tuple[float, float]) -> LawFit:
+    """Least-squares polynomial E(P) of a degree, with R^2 (Eqs A.1-A.3) and checks.
+
+    Examples
+    --------
+    >>> f = fit_law([0.005, 0.01, 0.02], [0.05, 0.04, 0.02], 1, (0.0, 0.02))
+    >>> [round(c, 6) for c in f.coefficients], round(f.r_squared, 6)
+    ([0.06, -2.0], 1.0)
+    """
+    p = np.asarray(pressures, dtype=float)
+    e = np.asarray(moduli, dtype=float)
+    if len(np.unique(p)) <= degree + 1:
+        nan = float("nan")
+        return LawFit(degree, (), nan, (nan, nan),
+                      (f"degree {degree}: {len(np.unique(p))} pressure levels cannot test a law with "
+                       f"{degree + 1} coefficients",))
+    coeffs = np.polynomial.polynomial.polyfit(p, e, degree)
+    pred = np.polynomial.polynomial.polyval(p, coeffs)
+    ssto = float(np.sum((e - e.mean()) ** 2))
+    r2 = 1.0 - float(np.sum((e - pred) ** 2)) / ssto if ssto > 0 else 1.0
+    grid = np.linspace(*pressure_range, 201)
+    values = np.polynomial.polynomial.polyval(grid, coeffs)
+    i = int(np.argmin(values))
+    problems = []
+    if r2 < R2_WARNING:
+        problems.append(f"degree {degree}: R^2 = {r2:.4f} is below {R2_WARNING}")
+    if values[i] <= 0:
+        problems.append(f"degree {degree}: modulus {values[i]:.4g} MPa at {grid[i] * 1e3:.4g} kPa is not positive")
+    return LawFit(degree, tuple(float(c) for c in coeffs), r2, (float(grid[i]), float(values[i])), tuple(problems))
+
+
+def best_filler_modulus(
+    design: str,
+    level: int,
+    reference: Response,
+    make_2d: Callable[[float, float], Reduced2D],
+    start: float,
+    bounds: tuple[float, float] = (1e-4, 1.0),
+) -> FillerPoint:
+    """The constant filler modulus minimising Eq 5.1 for one design at one reported level.
+
+    Brent's method on log10(E), its first bracket at ``start`` (relative tolerance about
+    0.5 % in E); trial moduli outside ``bounds`` are clipped and penalised. A 2D solve that
+    fails for a trial modulus scores as a very large Gamma, so the search moves away from it.
+    """
+    from scipy.optimize import minimize_scalar
+
+    pressure = float(reference.pressures[level])
+    target = unit_centre_displacements(reference, level)
+    counter = {"n": 0}
+
+    lo, hi = np.log10(bounds[0]), np.log10(bounds[1])
+
+    def objective(x: float) -> float:
+        clipped = min(max(float(x), lo), hi)
+        penalty = 1e6 * (float(x) - clipped) ** 2
+        counter["n"] += 1
+        model = make_2d(10.0**clipped, pressure)
+        try:
+            r = model.evaluate(design)
+        except SimulationFailed:
+            return 1e12 + penalty
+        return gamma(unit_centre_displacements(r, -1), target) + penalty
+
+    x0 = float(np.log10(start))
+    res = minimize_scalar(objective, bracket=(x0, x0 + 0.2), method="brent", options={"xtol": 2e-3, "maxiter": 50})
+    x = min(max(float(res.x), lo), hi)
+    return FillerPoint(run=-1, pressure=pressure, design=design, modulus=float(10.0**x),
+                       gamma=float(objective(x)), start=float(start), evaluations=counter["n"])
+
+
+def calibrate(
+    unit: UnitSpec,
+    n_units: int,
+    pressures_kpa: Sequence[float] = (5, 10, 15, 20, 25, 30, 35, 40, 45),
+    runs: int = 3,
+    seed: int = 0,
+    bounds: tuple[float, float] = (1e-4, 1.0),
+    steps: StepSettings | None = None,
+    solve_3d: Callable[[Full3D, str], Response] | None = None,
+    on_point: Callable[[FillerPoint], None] | None = None,
+) -> Calibration:
+    """Calibrate the unit's filler law (chapter 5, Fig 5.3).
+
+    Parameters
+    ----------
+    unit : UnitSpec
+        The articulating unit.
+    n_units : int
+        Actuator length used for calibration (15 in the dissertation).
+    pressures_kpa : sequence of float
+        Pressure levels (5-45 kPa in 5 kPa steps by default).
+    runs : int
+        Independent runs; each picks a new random design and starting point per level.
+    seed : int
+        Seed of the designs and starting points.
+    bounds : (float, float)
+        Search range of the filler modulus (MPa).
+    steps : StepSettings, optional
+        Ramp of the 3D and 2D solves; levels are placed so that each calibration pressure
+        is a reported level of the 3D ramp.
+    solve_3d : callable, optional
+        ``solve_3d(model, design) -> Response``; pass a cached solver to reuse 3D results.
+    on_point : callable, optional
+        Progress: called with each :class:`FillerPoint`.
+
+    Returns
+    -------
+    Calibration
+    """
+    rng = np.random.default_rng(seed)
+    levels = np.asarray(pressures_kpa, dtype=float) / 1e3
+    p_max = float(levels.max())
+    increments = int(round(p_max / np.gcd.reduce(np.round(levels * 1e4).astype(int)) * 1e4))
+    steps = steps or StepSettings(increments=increments, substeps=2)
+    if steps.increments != increments:
+        steps = replace(steps, increments=increments)
+    model3d = Full3D(n_units, unit, RampSpec(pressure=p_max, steps=steps))
+    solve_3d = solve_3d or (lambda model, design: model.evaluate(design))
+    nu = unit.filler_poisson_ratio
+
+    def make_2d(e: float, pressure: float) -> Reduced2D:
+        law = FillerLaw("trial", "trial", (e,), (0.0, pressure), nu)
+        n = max(1, int(round(pressure / p_max * steps.increments)))
+        return Reduced2D(n_units, unit, RampSpec(pressure=pressure, steps=replace(steps, increments=n)), law)
+
+    points = []
+    for run in range(runs):
+        for p in levels:
+            design = "".join(map(str, rng.integers(0, 2, n_units)))
+            start = float(10.0 ** rng.uniform(np.log10(bounds[0]) + 0.5, np.log10(bounds[1]) - 0.5))
+            reference = solve_3d(model3d, design)
+            level = reference.level_of(p)
+            point = replace(best_filler_modulus(design, level, reference, make_2d, start, bounds), run=run)
+            points.append(point)
+            if on_point is not None:
+                on_point(point)
+    prange = (0.0, p_max)
+    ps = [pt.pressure for pt in points]
+    es = [pt.modulus for pt in points]
+    linear = fit_law(ps, es, 1, prange)
+    quadratic = fit_law(ps, es, 2, prange)
+    chosen = next((f for f in (quadratic, linear) if not f.problems), None)
+    for f in (linear, quadratic):
+        for problem in f.problems:
+            warnings.warn(f"filler law {problem}", CalibrationWarning, stacklevel=2)
+    return Calibration(tuple(points), linear, quadratic, chosen, prange, nu,
+                       metadata={"n_units": n_units, "runs": runs, "seed": seed,
+                                 "fingerprint_3d": model3d.fingerprint()})

@@ -1,0 +1,48 @@
+"""Filler-law calibration: recovers known laws; bad laws are reported, not used."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from pneumorph.calibration import CalibrationWarning, calibrate, fit_law
+from pneumorph.fem import StepSettings
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.materials.filler import FillerLaw
+from pneumorph.models.fe import Reduced2D
+
+TRUE = (0.05, -1.0)  # E(P) = 0.05 - 1.0 P (MPa, P in MPa)
+
+
+def truth(model, design):  # noqa: ANN001, ANN201 - stands in for the 3D solve
+    """A 2D model whose filler follows a known law: the calibration must find that law."""
+    law = FillerLaw("true", "true", TRUE, (0.0, model.ramp.pressure), 0.3)
+    return Reduced2D(model.n_units, model.unit, model.ramp, law).evaluate(design)
+
+
+def test_calibration_recovers_a_known_law() -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationWarning)
+        cal = calibrate(UnitSpec(), 2, pressures_kpa=(4, 8, 12), runs=1, seed=3,
+                        steps=StepSettings(increments=3, substeps=1), solve_3d=truth)
+    for point in cal.points:
+        expected = TRUE[0] + TRUE[1] * point.pressure
+        assert point.modulus == pytest.approx(expected, rel=0.01)
+    assert cal.chosen is cal.linear
+    np.testing.assert_allclose(cal.linear.coefficients, TRUE, rtol=0.03)
+    assert cal.linear.r_squared > 0.999
+    unit = cal.unit_with_law(UnitSpec())
+    assert unit.filler_law().modulus(0.008) == pytest.approx(0.042, rel=0.01)
+    assert "pneumorph calibrate" in unit.filler_source
+
+
+def test_bad_laws_are_flagged() -> None:
+    p = [0.005, 0.01, 0.02, 0.03, 0.04]
+    noisy = fit_law(p, [0.05, 0.01, 0.06, 0.0, 0.05], 1, (0.0, 0.045))
+    assert noisy.problems and "R^2" in noisy.problems[0]
+    negative = fit_law(p, [0.05, 0.04, 0.02, 0.0, -0.02], 1, (0.0, 0.045))
+    assert any("not positive" in x for x in negative.problems)
+    too_few = fit_law([0.01, 0.02], [0.04, 0.03], 2, (0.0, 0.02))
+    assert "cannot test" in too_few.problems[0]
