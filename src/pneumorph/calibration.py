@@ -272,3 +272,80 @@ def calibrate(
     return Calibration(tuple(points), linear, quadratic, chosen, prange, nu,
                        metadata={"n_units": n_units, "runs": runs, "seed": seed,
                                  "fingerprint_3d": model3d.fingerprint()})
+
+
+@dataclass(frozen=True)
+class Validation:
+    """2D against 3D on held-out designs: distances between matching unit centres (mm)."""
+
+    designs: tuple[str, ...]
+    pressures: np.ndarray  # (k,) MPa
+    mean: np.ndarray  # (k,) mean over designs and units
+    max: np.ndarray  # (k,)
+    per_design_mean: np.ndarray  # (d, k)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"designs": list(self.designs), "pressures_kpa": (self.pressures * 1e3).tolist(),
+                "mean_mm": self.mean.tolist(), "max_mm": self.max.tolist(),
+                "per_design_mean_mm": self.per_design_mean.tolist()}
+
+
+def validate(
+    unit: UnitSpec,
+    n_units: int,
+    designs: Sequence[str],
+    ramp: RampSpec,
+    solve_3d: Callable[[Full3D, str], Response] | None = None,
+) -> Validation:
+    """Distances between matching unit centres, 2D (the unit's law) against 3D, per level."""
+    model2d = Reduced2D(n_units, unit, ramp)
+    model3d = Full3D(n_units, unit, ramp)
+    solve_3d = solve_3d or (lambda model, design: model.evaluate(design))
+    per = []
+    for design in designs:
+        r2 = model2d.evaluate(design)
+        r3 = solve_3d(model3d, design)
+        per.append(np.linalg.norm(r2.centres - r3.centres, axis=-1))  # (k, n)
+    d = np.stack(per)  # (designs, k, n)
+    return Validation(tuple(designs), model2d.pressures(), d.mean(axis=(0, 2)), d.max(axis=(0, 2)),
+                      d.mean(axis=2))
+
+
+def cached_3d_solver(cache: Any) -> Callable[[Full3D, str], Response]:
+    """A ``solve_3d`` that answers from an :class:`~pneumorph.execution.EvaluationCache`."""
+    from pneumorph.execution.outcome import solve
+
+    def solve_3d(model: Full3D, design: str) -> Response:
+        key = model.fingerprint()
+        hit = cache.get(key, design)
+        outcome = hit if hit is not None else solve(model, design)
+        if hit is None:
+            cache.put(key, outcome)
+        if outcome.response is None:
+            raise SimulationFailed(reached=0.0, cause=f"3D reference failed: {outcome.failure}", design=design)
+        return outcome.response
+
+    return solve_3d
+
+
+def plot_calibration(cal: Calibration, path: Any) -> Any:
+    """Fig 5.3: the best modulus per pressure for each run, and both fitted laws."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.0, 4.2), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for run in sorted({p.run for p in cal.points}):
+        pts = [p for p in cal.points if p.run == run]
+        ax.plot([p.pressure * 1e3 for p in pts], [p.modulus for p in pts], "o", label=f"run {run + 1}")
+    grid = np.linspace(*cal.pressure_range, 100)
+    for fit, style in ((cal.linear, "--"), (cal.quadratic, "-")):
+        if fit.coefficients:
+            ax.plot(grid * 1e3, np.polynomial.polynomial.polyval(grid, fit.coefficients), style,
+                    label=f"degree {fit.degree}, R$^2$ = {fit.r_squared:.4f}")
+    ax.set(xlabel="pressure [kPa]", ylabel="filler modulus E [MPa]", title="Filler law calibration (Eq 5.1)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=150)
+    return path

@@ -1,0 +1,89 @@
+"""``pneumorph calibrate``: the 2D model's filler law for a unit, against the 3D model."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+
+@click.command("calibrate")
+@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
+              help="Unit TOML file (default: the built-in unit).")
+@click.option("--units", "n_units", type=int, default=15, show_default=True, help="Actuator length in units.")
+@click.option("--pressures", default="5,10,15,20,25,30,35,40,45", show_default=True, metavar="LIST",
+              help="Calibration pressures, kPa, comma-separated.")
+@click.option("--runs", type=int, default=3, show_default=True, help="Independent runs (new random designs).")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--validate", "n_validate", type=int, default=10, show_default=True,
+              help="Held-out random designs for the 2D-against-3D check.")
+@click.option("--cache", metavar="FILE", help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--out", default="runs/calibration", show_default=True, metavar="DIR")
+@click.option("--json", "as_json", is_flag=True)
+def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, seed: int, n_validate: int,
+              cache: str | None, out: str, as_json: bool) -> None:
+    """Fit the filler law E(P) of the 2D model to the 3D model (chapter 5) and check it.
+
+    Writes calibration.json, calibration.png (Fig 5.3) and unit.toml: the unit with the
+    chosen law and its provenance, ready for --unit of the other commands.
+    """
+    from pathlib import Path
+
+    import numpy as np
+
+    from pneumorph import calibration as cal_mod
+    from pneumorph.design.config import to_toml
+    from pneumorph.errors import SearchConfigError
+    from pneumorph.execution import EvaluationCache, default_cache_path
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.io import provenance
+    from pneumorph.models.fe import RampSpec
+
+    try:
+        levels = tuple(float(p) for p in pressures.split(","))
+    except ValueError:
+        raise SearchConfigError(f"--pressures takes numbers (kPa) separated by commas, got {pressures!r}") from None
+    unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
+    store = EvaluationCache(cache or default_cache_path())
+    solve_3d = cal_mod.cached_3d_solver(store)
+
+    def on_point(p) -> None:  # type: ignore[no-untyped-def]
+        click.echo(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
+                   f"(Eq 5.1 = {p.gamma:.4g} mm^2, {p.evaluations} 2D solves)", err=True)
+
+    result = cal_mod.calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point)
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    cal_mod.plot_calibration(result, folder / "calibration.png")
+    summary = {
+        "points": [p.__dict__ for p in result.points],
+        "linear": result.linear.__dict__, "quadratic": result.quadratic.__dict__,
+        "chosen_degree": None if result.chosen is None else result.chosen.degree,
+        "provenance": provenance(unit=unit.to_dict(), calibration=result.metadata),
+    }
+    if result.chosen is not None:
+        calibrated = result.unit_with_law(unit)
+        (folder / "unit.toml").write_text(to_toml({"unit": calibrated.to_dict()}), encoding="utf-8")
+        if n_validate > 0:
+            rng = np.random.default_rng(seed + 10_000)
+            designs = ["".join(map(str, rng.integers(0, 2, n_units))) for _ in range(n_validate)]
+            p_max = max(levels) / 1e3
+            check = cal_mod.validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
+            summary["validation"] = check.to_dict()
+    (folder / "calibration.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
+    store.close()
+    if as_json:
+        click.echo(json.dumps({k: v for k, v in summary.items() if k != "provenance"}, indent=1, default=str))
+        return
+    for fit in (result.linear, result.quadratic):
+        coeffs = ", ".join(f"{c:.5g}" for c in fit.coefficients)
+        click.echo(f"degree {fit.degree}: coefficients [{coeffs}] (MPa, P in MPa), R^2 = {fit.r_squared:.4f}"
+                   + (f"  PROBLEMS: {'; '.join(fit.problems)}" if fit.problems else ""))
+    if result.chosen is None:
+        click.echo("no acceptable law: nothing written to unit.toml", err=True)
+    if "validation" in summary:
+        v = summary["validation"]
+        for p, m, x in zip(v["pressures_kpa"], v["mean_mm"], v["max_mm"]):
+            click.echo(f"  {p:5.1f} kPa: 2D-3D unit-centre distance mean {m:.3f} mm, max {x:.3f} mm")
+    written = "calibration.json, calibration.png" + (", unit.toml" if result.chosen is not None else "")
+    click.echo(f"written to {folder}/ ({written})")
