@@ -192,7 +192,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
     renumber = np.full(len(grid.points), -1)
     renumber[used] = np.arange(len(used))
     linear = fem.Mesh(grid.points[used], renumber[cells], grid.cell_type)
-    mesh = linear.add_midpoints_edges()
+    mesh = linear.add_midpoints_edges() if spec.element_order == 2 else linear
     points = np.asarray(mesh.points, dtype=float)
     regions = {"body": np.flatnonzero(label == BODY), "layer": np.flatnonzero(label == LAYER)}
     if dim == 2:

@@ -84,7 +84,10 @@ class UnitSpec:
     body_material, layer_material : str
         Library names of the body and the stiff layer.
     element_size : float
-        Target edge length of the quadratic elements.
+        Target edge length of the elements.
+    element_order : {1, 2}
+        2: quadratic elements (quad8 / hex20, the default); 1: linear (quad4 / hex8), for
+        mesh studies such as Table 4.1.
     name : str
         A label for reports.
     filler_coefficients : tuple of float
@@ -116,6 +119,7 @@ class UnitSpec:
     body_material: str = "mold_star_15"
     layer_material: str = "smooth_sil_950"
     element_size: float = 1.5
+    element_order: int = 2
     name: str = "unit"
     filler_coefficients: tuple[float, ...] = ()
     filler_range_kpa: tuple[float, float] = (0.0, 45.0)
@@ -127,6 +131,8 @@ class UnitSpec:
         object.__setattr__(self, "filler_range_kpa", tuple(float(c) for c in self.filler_range_kpa))
         if self.filler_coefficients:
             self.filler_law()  # validates: positive modulus over the range, Poisson's ratio
+        if self.element_order not in (1, 2):
+            raise GeometryError(f"element_order must be 1 (linear) or 2 (quadratic), got {self.element_order!r}")
         for key in _LENGTHS:
             value = getattr(self, key)
             if not isinstance(value, (int, float)) or not math.isfinite(value):

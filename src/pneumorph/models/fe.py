@@ -336,6 +336,8 @@ class Reduced2D(FEModel):
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem
 
+        if mesh.cell_type == "quad":
+            return fem.RegionQuad, fem.RegionQuadBoundary, fem.FieldPlaneStrain
         return fem.RegionQuadraticQuad, fem.RegionQuadraticQuadBoundary, fem.FieldPlaneStrain
 
     def _extra_bodies(self, mesh: ActuatorMesh, field: Any) -> tuple[list[Any], Any]:
@@ -346,7 +348,8 @@ class Reduced2D(FEModel):
         nu = law.poisson_ratio
         umat = fem.NeoHookeCompressible(mu=1.0, lmbda=1.0)
         sub = fem.Mesh(mesh.points, mesh.cells[mesh.regions["filler"]], mesh.cell_type)
-        sub_field = fem.FieldContainer([fem.FieldPlaneStrain(fem.RegionQuadraticQuad(sub), dim=2)])
+        Region = self._regions(mesh)[0]
+        sub_field = fem.FieldContainer([fem.FieldPlaneStrain(Region(sub), dim=2)])
         sub_field.link(field)
 
         def set_pressure(p: float) -> None:
@@ -385,4 +388,6 @@ class Full3D(FEModel):
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem
 
+        if mesh.cell_type == "hexahedron":
+            return fem.RegionHexahedron, fem.RegionHexahedronBoundary, fem.Field
         return fem.RegionQuadraticHexahedron, fem.RegionQuadraticHexahedronBoundary, fem.Field

@@ -25,10 +25,11 @@ def _section(ax: Any, solution: Any, level: int | None, outline: bool) -> None:
     mesh = solution.mesh
     x = mesh.points if level is None else mesh.points + solution.displacements[level]
     for name, idx in mesh.regions.items():
-        polys = x[mesh.cells[idx]][:, _QUAD8_OUTLINE]
+        order = _QUAD8_OUTLINE if mesh.cells.shape[1] == 8 else [0, 1, 2, 3]
+        polys = x[mesh.cells[idx]][:, order]
         ax.add_collection(PolyCollection(polys, facecolor=COLOURS[name], edgecolor="k", lw=0.15, label=LABELS[name]))
     if outline and level is not None:
-        ref = mesh.points[mesh.cells][:, _QUAD8_OUTLINE]
+        ref = mesh.points[mesh.cells][:, order]
         ax.add_collection(PolyCollection(ref, facecolor="none", edgecolor="0.6", lw=0.2))
     c = mesh.unit_centres(None if level is None else solution.displacements[level])
     ax.plot(c[:, 0], c[:, 1], "k.-", ms=3, lw=0.8, label="unit centres")
