@@ -38,6 +38,10 @@ cli.add_command(design)
 cli.add_command(simulate)
 cli.add_command(study)
 
+from pneumorph.cli.bimodal import bimodal  # noqa: E402
+
+cli.add_command(bimodal)
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code (errors print one clear line)."""

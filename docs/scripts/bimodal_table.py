@@ -1,0 +1,98 @@
+"""Regenerate the bimodal-actuator table and figures of docs/bimodal.md.
+
+Runs the 3D model for the three crimp ratios, each with the library's assumed bulk modulus
+of the composite and with a nearly incompressible composite (nu = 0.495), one process, one
+run after the other; every run's result is kept as JSON in ``--out`` and reused when the
+script is started again (delete the file to re-run it). Figures go to docs/figures/.
+
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/bimodal_table.py [--voids 15]
+        [--element-size 2.5] [--pmax 60] [--end-cap 0] [--out /tmp/bimodal-runs] [--only 0.2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from pneumorph.bimodal.figures import plot_outlines, plot_tip_paths
+from pneumorph.bimodal.geometry import BimodalSpec
+from pneumorph.bimodal.model import BimodalModel, BimodalResult, bilinear_material
+from pneumorph.bimodal.switch import find_switch
+from pneumorph.cli.bimodal import bulk_from_poisson
+from pneumorph.materials import get
+
+DOCS = Path(__file__).resolve().parents[1]
+VARIANTS = {"nu0495": 0.495, "library": None}
+
+
+def load(path: Path) -> BimodalResult:
+    d = json.loads(path.read_text())
+    p = np.asarray(d["pressures_kpa"], float) / 1e3
+    tip = np.column_stack([d["tip_ux_mm"], d["tip_uy_mm"]]).reshape(-1, 2)
+    return BimodalResult(d["crimp_ratio"], p, tip, np.asarray(d["outline"]), d["pmax_kpa"] / 1e3, d["completed"],
+                         d["cause"], find_switch(p, tip[:, 1]), d["metadata"])
+
+
+def run(cr: float, nu: float | None, args: argparse.Namespace, path: Path) -> BimodalResult:
+    if path.exists():
+        return load(path)
+    bulk = None if nu is None else bulk_from_poisson(get(bilinear_material(cr)).shear_modulus, nu)
+    spec = BimodalSpec(voids=args.voids, element_size=args.element_size, end_cap=args.end_cap)
+    model = BimodalModel(spec, crimp_ratio=cr, pmax=args.pmax / 1e3, bilinear_bulk=bulk)
+    t0 = time.perf_counter()
+    print(f"CR {cr} nu {nu}: ", end="", flush=True)
+    r = model.solve(on_level=lambda k, p, v: print(f"{1e3 * p:g}:{v:+.2f} ", end="", flush=True))
+    print(f"({time.perf_counter() - t0:.0f} s)", flush=True)
+    d = r.to_dict()
+    d["outline"] = np.round(r.outline, 4).tolist()
+    path.write_text(json.dumps(d))
+    return r
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--voids", type=int, default=15)
+    ap.add_argument("--element-size", type=float, default=2.5)
+    ap.add_argument("--pmax", type=float, default=60.0)
+    ap.add_argument("--end-cap", type=float, default=0.0)
+    ap.add_argument("--out", type=Path, default=Path("/tmp/bimodal-runs"))
+    ap.add_argument("--only", type=float, nargs="*", default=None, help="crimp ratios to run")
+    ap.add_argument("--tag", default="", help="suffix of the figure names (e.g. for reduced models)")
+    args = ap.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    ratios = args.only or [0.2, 0.25, 0.3]
+    stem = f"v{args.voids}-h{args.element_size:g}-p{args.pmax:g}-cap{args.end_cap:g}"
+    rows = []
+    for cr in ratios:
+        runs = []
+        for key, nu in VARIANTS.items():
+            r = run(cr, nu, args, args.out / f"{stem}-cr{cr:g}-{key}.json")
+            label = "nu = 0.495" if nu is not None else "library K"
+            runs.append((label, r))
+            s = r.switch
+            m = r.metadata
+            rows.append(
+                f"| {cr:g} | {label} ({m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa) "
+                f"| {1e3 * r.pressures[-1] if len(r.pressures) else 0:g} | "
+                f"{'-' if s.turning is None else f'{1e3 * s.turning:g} ({s.peak:+.2f} mm)'} | "
+                f"{'none' if s.switch is None else f'{1e3 * s.switch:.1f}'} | "
+                f"{r.tip[:, 1].max():+.2f} / {r.tip[:, 1].min():+.2f} | {m['dofs']:,} | {m['wall_time_s']:.0f} |"
+            )
+        tag = f"cr{cr:g}".replace(".", "_") + args.tag
+        plot_tip_paths(runs, title=f"Bimodal actuator, CR {cr:g} ({args.voids} voids)",
+                       path=DOCS / "figures" / f"bimodal-{tag}.png")
+        best = max(runs, key=lambda lr: len(lr[1].pressures))[1]
+        plot_outlines(best, title=f"Mid-plane outline, CR {cr:g} ({args.voids} voids)",
+                      path=DOCS / "figures" / f"bimodal-{tag}-shape.png")
+    print("| CR | composite bulk modulus | last converged (kPa) | tip turns back at (kPa) | switch (kPa) "
+          "| max / min u_y (mm) | dofs | time (s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    print("\n".join(rows))
+
+
+if __name__ == "__main__":
+    main()

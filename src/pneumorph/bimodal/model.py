@@ -1,0 +1,292 @@
+"""3D finite-element model of the bimodal actuator and its pressure ramp (section 3.3.3).
+
+Quadratic hexahedra (``hexahedron20``) on the layered grid of
+:func:`pneumorph.bimodal.geometry.mesh_actuator`, half the width with u_z = 0 on the
+mid-plane, one displacement field shared by one :class:`felupe.SolidBody` per layer, each
+with the compressible Ogden model of Eq 2.12 (:class:`pneumorph.fem.OgdenCompressible`):
+Mold Star 15 body and seal, Smooth-Sil 950 strip (Table A.4), and the bilinear composite
+modelled as a homogeneous material with the Table B.1 Ogden parameters of its crimp ratio,
+as the dissertation does (section 3.2.7). A follower pressure acts on every void wall;
+the base face is clamped. The ramp rises in equal steps (5 kPa: the increments of the
+physical test, section 3.3.2) and is solved by :func:`pneumorph.fem.ramp` (cut-back,
+predictor, cavity-volume monitor); a ramp that stops converging ends the response there,
+as the physical test ended at rupture.
+
+The tip is the mid-point of the end face's chord on the mid-plane (between its bottom and
+top corners); its displacement is ``(u_x, u_y)``, u_y > 0 towards the Smooth-Sil strip (the
+first bending mode, composite on the outside).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pneumorph import __version__
+from pneumorph.bimodal.geometry import BILINEAR, BODY, LABELS, SEAL, STRIP, BimodalMesh, BimodalSpec, mesh_actuator
+from pneumorph.bimodal.switch import Switch, find_switch
+from pneumorph.errors import SimulationFailed, UnknownMaterialError
+from pneumorph.materials import get
+
+FloatArray = np.ndarray
+
+#: Table B.1 crimp ratios and their library entries.
+CRIMP_MATERIALS = {0.2: "bilinear_0_2", 0.25: "bilinear_0_25", 0.3: "bilinear_0_3"}
+
+
+def bilinear_material(crimp_ratio: float) -> str:
+    """Library name of the Table B.1 composite of a crimp ratio.
+
+    Raises
+    ------
+    UnknownMaterialError
+        For a crimp ratio other than 0.2, 0.25 and 0.3 (Table B.1 has no others).
+
+    Examples
+    --------
+    >>> bilinear_material(0.25)
+    'bilinear_0_25'
+    """
+    for cr, name in CRIMP_MATERIALS.items():
+        if abs(float(crimp_ratio) - cr) < 1e-9:
+            return name
+    raise UnknownMaterialError(f"bilinear composite of crimp ratio {crimp_ratio:g} (Table B.1)",
+                               [f"crimp ratio {c:g}" for c in CRIMP_MATERIALS])
+
+
+@dataclass(frozen=True)
+class BimodalResult:
+    """Tip response of one pressure ramp.
+
+    Attributes
+    ----------
+    crimp_ratio : float or None
+    pressures : ndarray
+        Converged reported pressures (MPa), from the first step on.
+    tip : ndarray, shape (k, 2)
+        Tip displacement (u_x, u_y) in mm at those pressures.
+    outline : ndarray, shape (k + 1, m, 2)
+        Current (x, y) of the mid-plane outline (bottom edge, end face, top edge reversed)
+        at zero pressure and at every converged pressure, for shape figures.
+    pmax : float
+        The ramp's top pressure (MPa).
+    completed : bool
+        True if the whole ramp converged.
+    cause : str
+        Why the ramp ended early ("" if it completed).
+    switch : Switch
+        Where the tip turns back and where it crosses to the other side.
+    metadata : dict
+        Model description, degrees of freedom, Newton iterations, cut-backs, wall time.
+    """
+
+    crimp_ratio: float | None
+    pressures: FloatArray
+    tip: FloatArray
+    outline: FloatArray
+    pmax: float
+    completed: bool
+    cause: str
+    switch: Switch
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (pressures in kPa, lengths in mm)."""
+        return {
+            "crimp_ratio": self.crimp_ratio,
+            "pmax_kpa": 1e3 * self.pmax,
+            "completed": self.completed,
+            "cause": self.cause,
+            "pressures_kpa": np.round(1e3 * self.pressures, 6).tolist(),
+            "tip_ux_mm": np.round(self.tip[:, 0], 4).tolist(),
+            "tip_uy_mm": np.round(self.tip[:, 1], 4).tolist(),
+            "switch": self.switch.to_dict(),
+            "metadata": self.metadata,
+        }
+
+
+class BimodalModel:
+    """The bimodal actuator's 3D FE model.
+
+    Parameters
+    ----------
+    spec : BimodalSpec, optional
+        Geometry and element size (default: the dissertation's actuator, 1.5 mm elements).
+    crimp_ratio : float
+        0.2, 0.25 or 0.3: selects the Table B.1 composite.
+    pmax : float
+        Top pressure of the ramp (MPa).
+    step : float
+        Pressure step (MPa); 0.005 = the 5 kPa of the physical test.
+    materials : dict, optional
+        Override library names per layer (``"bilinear"``, ``"seal"``, ``"body"``, ``"strip"``).
+    bilinear_bulk : float, optional
+        Bulk modulus of the composite (MPa) instead of the library's assumed value.
+    substeps, max_cutbacks : int
+        Newton solves per step and halvings allowed (see :class:`pneumorph.fem.StepSettings`).
+    half : bool
+        Half model across the width (u_z = 0 on the mid-plane), the default.
+
+    Examples
+    --------
+    >>> m = BimodalModel(BimodalSpec(voids=1, element_size=5.0), pmax=0.005)
+    >>> r = m.solve()
+    >>> r.completed, r.pressures.tolist(), bool(r.tip[0, 1] > 0)
+    (True, [0.005], True)
+    """
+
+    def __init__(
+        self,
+        spec: BimodalSpec | None = None,
+        crimp_ratio: float | None = 0.3,
+        pmax: float = 0.1,
+        step: float = 0.005,
+        materials: dict[str, str] | None = None,
+        bilinear_bulk: float | None = None,
+        substeps: int = 1,
+        max_cutbacks: int = 4,
+        half: bool = True,
+    ) -> None:
+        if not (pmax > 0 and np.isfinite(pmax)) or not (step > 0 and np.isfinite(step)):
+            raise ValueError(f"pmax and step must be positive, got {pmax * 1e3:g} and {step * 1e3:g} kPa")
+        self.spec = spec or BimodalSpec()
+        self.crimp_ratio = crimp_ratio
+        names = {"bilinear": None, "seal": "mold_star_15", "body": "mold_star_15", "strip": "smooth_sil_950"}
+        if crimp_ratio is not None:
+            names["bilinear"] = bilinear_material(crimp_ratio)
+        unknown = set(materials or {}) - set(names)
+        if unknown:
+            raise ValueError(f"unknown layer(s) {sorted(unknown)}; layers: {sorted(names)}")
+        names.update(materials or {})
+        if names["bilinear"] is None:
+            raise ValueError("give a crimp ratio or a bilinear material")
+        self.names = names
+        self.materials = {k: get(v) for k, v in names.items()}
+        self.bilinear_bulk = bilinear_bulk
+        self.increments = max(1, int(round(pmax / step)))
+        self.step = float(step)
+        self.pmax = self.increments * self.step
+        self.substeps = int(substeps)
+        self.max_cutbacks = int(max_cutbacks)
+        self.half = bool(half)
+
+    def bulk(self, layer: str) -> float:
+        """Bulk modulus (MPa) used for a layer."""
+        if layer == "bilinear" and self.bilinear_bulk is not None:
+            return float(self.bilinear_bulk)
+        return float(self.materials[layer].bulk_modulus.value)
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "spec": self.spec.to_dict(),
+            "crimp_ratio": self.crimp_ratio,
+            "materials": dict(self.names),
+            "bulk_moduli_kpa": {k: 1e3 * self.bulk(k) for k in self.names},
+            "pmax_kpa": 1e3 * self.pmax,
+            "step_kpa": 1e3 * self.step,
+            "substeps": self.substeps,
+            "half_model": self.half,
+            "element": "hexahedron20",
+        }
+
+    def build(self) -> dict[str, Any]:
+        """FElupe objects: mesh, global field, layer bodies, void pressure, boundaries."""
+        import felupe as fem
+
+        from pneumorph.fem import OgdenCompressible
+
+        mesh: BimodalMesh = mesh_actuator(self.spec, half=self.half)
+        Region, Boundary = fem.RegionQuadraticHexahedron, fem.RegionQuadraticHexahedronBoundary
+        fmesh = fem.Mesh(mesh.points, mesh.cells, mesh.cell_type)
+        field_ = fem.FieldContainer([fem.Field(Region(fmesh), dim=3)])
+        bodies = []
+        for code in (BILINEAR, SEAL, BODY, STRIP):
+            name = LABELS[code]
+            m = self.materials[name].model
+            umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name))
+            sub = fem.Mesh(mesh.points, mesh.cells[mesh.label == code], mesh.cell_type)
+            sub_field = fem.FieldContainer([fem.Field(Region(sub), dim=3)])
+            sub_field.link(field_)
+            bodies.append(fem.SolidBody(umat, sub_field))
+        walls = Boundary(fmesh, mask=mesh.void_points)
+        wall_field = fem.FieldContainer([fem.Field(walls, dim=3)])
+        wall_field.link(field_)
+        pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
+        bounds = {"base": fem.Boundary(field_[0], mask=mesh.base_points)}
+        if mesh.symmetry_points is not None:
+            bounds["symmetry"] = fem.Boundary(field_[0], mask=mesh.symmetry_points, skip=(1, 1, 0))
+        dof0, dof1 = fem.dof.partition(field_, bounds)
+        return {"mesh": mesh, "field": field_, "items": [*bodies, pressure], "pressure": pressure,
+                "wall_field": wall_field, "dof0": dof0, "dof1": dof1}
+
+    def solve(self, on_level: Any = None) -> BimodalResult:
+        """Ramp the pressure; stop at the top pressure or where the solve stops converging.
+
+        Parameters
+        ----------
+        on_level : callable, optional
+            ``on_level(k, pressure_mpa, tip_uy_mm)`` after each converged step (progress).
+        """
+        from pneumorph.fem import StepSettings, cavity_volume, ramp
+
+        t0 = time.perf_counter()
+        model = self.build()
+        mesh: BimodalMesh = model["mesh"]
+        field_ = model["field"]
+        outline_ids = _outline(mesh)
+        x0 = mesh.points[outline_ids][:, :2]
+        pressures: list[float] = []
+        tips: list[FloatArray] = []
+        outlines = [x0]
+        settings = StepSettings(increments=self.increments, substeps=self.substeps, max_cutbacks=self.max_cutbacks)
+
+        def apply(t: float) -> None:
+            model["pressure"].update(t * self.pmax)
+
+        def record(k: int, t: float) -> None:
+            u = field_[0].values
+            pressures.append(t * self.pmax)
+            tips.append(u[mesh.tip, :2].mean(axis=0))
+            outlines.append(x0 + u[outline_ids, :2])
+            if on_level is not None:
+                on_level(k, pressures[-1], float(tips[-1][1]))
+
+        cause, stats = "", None
+        try:
+            stats = ramp(model["items"], field_, apply, model["dof1"], model["dof0"], settings,
+                         on_level=record, monitor=lambda: cavity_volume(model["wall_field"]))
+        except SimulationFailed as exc:
+            cause = f"stopped after {1e3 * (pressures[-1] if pressures else 0.0):g} kPa: {exc.cause}"
+        p = np.asarray(pressures, dtype=float)
+        tip = np.asarray(tips, dtype=float).reshape(-1, 2)
+        meta = {
+            "model": self.describe(),
+            "dofs": int(field_[0].values.size),
+            "cells": int(len(mesh.cells)),
+            "wall_time_s": round(time.perf_counter() - t0, 2),
+            "pneumorph": __version__,
+        }
+        if stats is not None:
+            meta.update(newton_iterations=stats.newton_iterations, substeps=stats.substeps, cutbacks=stats.cutbacks)
+        return BimodalResult(
+            crimp_ratio=self.crimp_ratio, pressures=p, tip=tip, outline=np.asarray(outlines), pmax=self.pmax,
+            completed=not cause, cause=cause, switch=find_switch(p, tip[:, 1]), metadata=meta,
+        )
+
+
+def _outline(mesh: BimodalMesh) -> np.ndarray:
+    """Mid-plane outline points: bottom edge (base to tip), end face (up), top edge (back)."""
+    pts, s = mesh.points, mesh.spec
+    mid = np.isclose(pts[:, 2], s.width / 2)
+    bottom = np.flatnonzero(mid & np.isclose(pts[:, 1], 0.0))
+    top = np.flatnonzero(mid & np.isclose(pts[:, 1], s.height))
+    bottom = bottom[np.argsort(pts[bottom, 0])]
+    top = top[np.argsort(-pts[top, 0])]
+    end = mesh.section_points[1:-1]
+    return np.concatenate([bottom, end, top])
+
+
+__all__ = ["CRIMP_MATERIALS", "BimodalModel", "BimodalResult", "bilinear_material"]

@@ -1,0 +1,39 @@
+"""``pneumorph bimodal`` on a one-void actuator."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from pneumorph.cli import main
+from pneumorph.cli.bimodal import bulk_from_poisson
+
+
+def test_json_run(tmp_path, capsys) -> None:
+    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--json",
+                 "--out", str(tmp_path)])
+    assert code == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["pressures_kpa"] == [5.0] and d["completed"]
+    assert d["metadata"]["model"]["materials"]["bilinear"] == "bilinear_0_3"
+    assert {p.split("/")[-1] for p in d["files"]} == {"bimodal-cr0_3.json", "bimodal-cr0_3-tip.png",
+                                                      "bimodal-cr0_3-shape.png"}
+
+
+def test_text_run_with_poisson(capsys) -> None:
+    code = main(["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "-q",
+                 "--bilinear-nu", "0.45"])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "switch pressure" in out and "none below 5 kPa" in out
+
+
+def test_bad_crimp_ratio(capsys) -> None:
+    assert main(["bimodal", "-c", "0.35"]) == 2
+    assert "0.35" in capsys.readouterr().err
+
+
+def test_bulk_from_poisson() -> None:
+    # K = 2 mu (1 + nu) / (3 (1 - 2 nu)); nu = 0.25 gives K = 5/3 mu
+    assert bulk_from_poisson(3.0, 0.25) == pytest.approx(5.0)

@@ -1,0 +1,82 @@
+"""Layered geometry of the bimodal actuator (section 3.3): dimensions, labels, volumes."""
+
+from __future__ import annotations
+
+import pytest
+
+from pneumorph.bimodal.geometry import ASSUMED, BimodalSpec, cell_volumes, mesh_actuator
+from pneumorph.errors import GeometryError
+
+
+def test_defaults_are_the_dissertations_actuator() -> None:
+    s = BimodalSpec()
+    # section 3.3.1: 157.5 x 15 x 17.5 mm Mold Star body, 15 voids; 3.3.2: 1 mm seal; 5 mm composite
+    assert (s.length, s.width, s.body_height, s.voids, s.seal, s.bilinear) == (157.5, 15.0, 17.5, 15, 1.0, 5.0)
+    assert s.height == pytest.approx(5.0 + 1.0 + 17.5 + 2.0)
+    # the void runs from the seal (y = 6) to the top wall (y = 6 + 17.5 - 1.5)
+    assert s.void == (1.5, 9.0, 6.0, 22.0)
+    assert s.void_volume == pytest.approx(7.5 * 16.0 * 12.0)
+    for key in ("top_wall", "end_wall", "side_wall", "strip", "tip_point", "end_cap"):
+        assert key in ASSUMED
+
+
+@pytest.mark.parametrize("half", [False, True])
+def test_layer_volumes(half: bool) -> None:
+    s = BimodalSpec(voids=2, element_size=3.0)
+    w = s.width / (2 if half else 1)
+    v = cell_volumes(mesh_actuator(s, half=half))
+    L = s.length
+    assert v["bilinear"] == pytest.approx(L * 5.0 * w)
+    assert v["seal"] == pytest.approx(L * 1.0 * w)
+    assert v["strip"] == pytest.approx(L * 2.0 * w)
+    assert v["body"] == pytest.approx(L * 17.5 * w - 2 * s.void_volume * w / s.width)
+
+
+def test_pressurised_walls_enclose_the_voids() -> None:
+    """The void-wall boundary encloses exactly the voids (half model: half of them)."""
+    import felupe as fem
+
+    from pneumorph.fem import cavity_volume
+
+    s = BimodalSpec(voids=2, element_size=3.0)
+    for half, factor in ((True, 0.5), (False, 1.0)):
+        m = mesh_actuator(s, half=half)
+        mesh = fem.Mesh(m.points, m.cells, m.cell_type)
+        walls = fem.RegionQuadraticHexahedronBoundary(mesh, mask=m.void_points)
+        field = fem.FieldContainer([fem.Field(walls, dim=3)])
+        # the divergence theorem about the origin: the mid-plane z = 7.5 adds x.n = 7.5 dA
+        # on the cut (half model) - shift the origin onto it instead
+        if half:
+            mesh_shift = fem.Mesh(m.points - [0, 0, s.width / 2], m.cells, m.cell_type)
+            walls = fem.RegionQuadraticHexahedronBoundary(mesh_shift, mask=m.void_points)
+            field = fem.FieldContainer([fem.Field(walls, dim=3)])
+        assert cavity_volume(field) == pytest.approx(factor * 2 * s.void_volume, rel=1e-9)
+
+
+def test_end_cap_closes_the_last_void() -> None:
+    s = BimodalSpec(voids=1, element_size=3.0, end_cap=3.0)
+    assert s.length == 13.5
+    v = cell_volumes(mesh_actuator(s, half=False))
+    assert v["body"] == pytest.approx(13.5 * 17.5 * 15.0 - s.void_volume)
+
+
+def test_tip_corners_on_the_end_face() -> None:
+    s = BimodalSpec(voids=2, element_size=3.0)
+    m = mesh_actuator(s)
+    assert m.points[m.tip].tolist() == [[s.length, 0.0, 7.5], [s.length, s.height, 7.5]]
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"voids": 0}, "at least one void"),
+        ({"end_wall": 5.25}, "end walls leave no void"),
+        ({"side_wall": 7.5}, "side walls"),
+        ({"top_wall": 17.5}, "top wall"),
+        ({"bilinear": 0.0}, "bilinear must be a positive"),
+        ({"end_cap": -1.0}, "end_cap"),
+    ],
+)
+def test_impossible_geometry_is_rejected(kwargs: dict, words: str) -> None:
+    with pytest.raises(GeometryError, match=words):
+        BimodalSpec(**kwargs)

@@ -1,0 +1,68 @@
+"""Physics of the bimodal actuator's 3D model on tiny meshes (three voids, coarse cells)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.bimodal.geometry import BimodalSpec
+from pneumorph.bimodal.model import BimodalModel, bilinear_material
+from pneumorph.errors import UnknownMaterialError
+from pneumorph.materials import drucker_stability, get
+
+TINY = BimodalSpec(voids=3, element_size=5.0)
+
+
+def test_first_mode_bends_towards_the_stiff_strip() -> None:
+    """Section 3.3.1: at low pressure the composite is soft and on the outside (u_y > 0)."""
+    r = BimodalModel(TINY, crimp_ratio=0.3, pmax=0.005).solve()
+    assert r.completed and r.pressures.tolist() == [0.005]
+    assert r.tip[0, 1] > 0.0
+    # a stiff layer in place of the composite bends it the other way
+    stiff = BimodalModel(TINY, crimp_ratio=0.3, pmax=0.005, materials={"bilinear": "smooth_sil_950"}).solve()
+    assert stiff.tip[0, 1] < 0.0
+
+
+def test_mirror_image_of_a_symmetric_stack() -> None:
+    """Same thicknesses above and below the voids and the materials swapped: the tip moves
+    to the mirror-image position (u_x equal, u_y opposite)."""
+    spec = BimodalSpec(voids=3, element_size=5.0, bilinear=2.0, strip=2.0, seal=1.5, top_wall=1.5)
+    up = BimodalModel(spec, crimp_ratio=None, pmax=0.005,
+                      materials={"bilinear": "mold_star_15", "strip": "smooth_sil_950"}).solve()
+    down = BimodalModel(spec, crimp_ratio=None, pmax=0.005,
+                        materials={"bilinear": "smooth_sil_950", "strip": "mold_star_15"}).solve()
+    assert abs(up.tip[0, 1]) > 0.01
+    assert down.tip[0, 0] == pytest.approx(up.tip[0, 0], rel=1e-6)
+    assert down.tip[0, 1] == pytest.approx(-up.tip[0, 1], rel=1e-6)
+
+
+def test_half_model_equals_full_model() -> None:
+    spec = BimodalSpec(voids=1, element_size=5.0)
+    half = BimodalModel(spec, pmax=0.005, half=True).solve()
+    full = BimodalModel(spec, pmax=0.005, half=False).solve()
+    assert half.metadata["dofs"] < full.metadata["dofs"]
+    np.testing.assert_allclose(half.tip, full.tip, rtol=1e-6, atol=1e-9)
+
+
+def test_bulk_modulus_override() -> None:
+    m = BimodalModel(TINY, crimp_ratio=0.2, bilinear_bulk=5.0)
+    assert m.bulk("bilinear") == 5.0
+    assert m.bulk("body") == get("mold_star_15").bulk_modulus.value
+    assert BimodalModel(TINY, crimp_ratio=0.2).bulk("bilinear") == get("bilinear_0_2").bulk_modulus.value
+
+
+def test_only_table_b1_crimp_ratios() -> None:
+    assert bilinear_material(0.3) == "bilinear_0_3"
+    with pytest.raises(UnknownMaterialError, match="0.35"):
+        bilinear_material(0.35)
+
+
+def test_table_b1_stability() -> None:
+    """Drucker stability of the Table B.1 fits over stretches 0.3-3: CR 0.2 is not stable
+    (in uniaxial compression and equibiaxial tension just beyond l = 1), CR 0.25 and 0.3 are."""
+    r = {cr: drucker_stability(get(bilinear_material(cr)).model, (0.3, 3.0), 541) for cr in (0.2, 0.25, 0.3)}
+    assert not r[0.2].is_stable
+    lam = r[0.2].stretch
+    bad = lam[~r[0.2].stable["uniaxial"]]
+    assert 0.85 < bad.min() and bad.max() < 0.96
+    assert r[0.25].is_stable and r[0.3].is_stable
