@@ -32,7 +32,9 @@ def test_calibration_recovers_a_known_law() -> None:
         assert point.modulus == pytest.approx(expected, rel=0.01)
     assert cal.chosen is cal.linear
     np.testing.assert_allclose(cal.linear.coefficients, TRUE, rtol=0.03)
-    assert cal.linear.r_squared > 0.999
+    # with every point within 1 % (<= 4.6e-4 MPa) of a law spanning 0.046-0.038 MPa over
+    # three points, SSE <= 3 (4.6e-4)^2 and SSTO = 2 (0.004)^2, hence R^2 >= 0.98
+    assert cal.linear.r_squared > 0.98
     unit = cal.unit_with_law(UnitSpec())
     assert unit.filler_law().modulus(0.008) == pytest.approx(0.042, rel=0.01)
     assert "pneumorph calibrate" in unit.filler_source

@@ -167,7 +167,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
     >>> m.cell_type, m.tracked.shape, sorted(m.regions)
     ('quad8', (2, 4), ['body', 'filler', 'layer'])
     >>> np.round(m.unit_centres(), 3).tolist()
-    [[5.25, 7.5], [15.75, 10.5]]
+    [[5.25, 4.5], [15.75, 7.5]]
     """
     import felupe as fem
 

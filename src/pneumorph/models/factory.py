@@ -28,7 +28,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
 
     Examples
     --------
-    >>> m = make_model(4, {"pressure_kpa": 30, "unit": {"slit_width": 1.0, "slit_depth": 9.0}})
+    >>> m = make_model(4, {"pressure_kpa": 30, "unit": {"slit_width": 1.0, "slit_depth": 5.0}})
     >>> m.fidelity, m.n_units, round(m.ramp.pressure, 6), m.unit.slit_width
     ('2d', 4, 0.03, 1.0)
     """
