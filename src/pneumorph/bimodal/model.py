@@ -125,8 +125,10 @@ class BimodalModel:
         Override library names per layer (``"bilinear"``, ``"seal"``, ``"body"``, ``"strip"``).
     bilinear_bulk : float, optional
         Bulk modulus of the composite (MPa) instead of the library's assumed value.
-    substeps, max_cutbacks : int
-        Newton solves per step and halvings allowed (see :class:`pneumorph.fem.StepSettings`).
+    substeps, max_cutbacks, max_iterations : int
+        Newton solves per step, halvings allowed and Newton iterations per trial (see
+        :class:`pneumorph.fem.StepSettings`). Near the pressure at which a wall balloons
+        (a limit point) every trial that fails costs ``max_iterations`` tangent solves.
     half : bool
         Half model across the width (u_z = 0 on the mid-plane), the default.
 
@@ -148,6 +150,7 @@ class BimodalModel:
         bilinear_bulk: float | None = None,
         substeps: int = 1,
         max_cutbacks: int = 4,
+        max_iterations: int = 12,
         half: bool = True,
     ) -> None:
         if not (pmax > 0 and np.isfinite(pmax)) or not (step > 0 and np.isfinite(step)):
@@ -171,6 +174,7 @@ class BimodalModel:
         self.pmax = self.increments * self.step
         self.substeps = int(substeps)
         self.max_cutbacks = int(max_cutbacks)
+        self.max_iterations = int(max_iterations)
         self.half = bool(half)
 
     def bulk(self, layer: str) -> float:
@@ -188,6 +192,8 @@ class BimodalModel:
             "pmax_kpa": 1e3 * self.pmax,
             "step_kpa": 1e3 * self.step,
             "substeps": self.substeps,
+            "max_cutbacks": self.max_cutbacks,
+            "max_iterations": self.max_iterations,
             "half_model": self.half,
             "element": "hexahedron20",
         }
@@ -241,7 +247,8 @@ class BimodalModel:
         pressures: list[float] = []
         tips: list[FloatArray] = []
         outlines = [x0]
-        settings = StepSettings(increments=self.increments, substeps=self.substeps, max_cutbacks=self.max_cutbacks)
+        settings = StepSettings(increments=self.increments, substeps=self.substeps, max_cutbacks=self.max_cutbacks,
+                                max_iterations=self.max_iterations)
 
         def apply(t: float) -> None:
             model["pressure"].update(t * self.pmax)
