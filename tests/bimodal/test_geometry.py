@@ -80,3 +80,9 @@ def test_tip_corners_on_the_end_face() -> None:
 def test_impossible_geometry_is_rejected(kwargs: dict, words: str) -> None:
     with pytest.raises(GeometryError, match=words):
         BimodalSpec(**kwargs)
+
+
+def test_station_one_void_short_of_the_tip() -> None:
+    s = BimodalSpec(voids=3, element_size=3.0)
+    m = mesh_actuator(s)
+    assert m.points[m.station].tolist() == [[21.0, 0.0, 7.5], [21.0, s.height, 7.5]]

@@ -215,6 +215,10 @@ class BimodalMesh:
         their mid-point.
     section_points : ndarray
         Points of the mid-plane (z = width / 2) outline of the end face, ordered by height.
+    station : ndarray, shape (2,)
+        Bottom and top points of the mid-plane at the centre of the last wall between two
+        voids, x = (voids - 1) pitch (the base section for a single void): a second tracked
+        point, one void short of the tip, away from the free end wall.
     spec : BimodalSpec
     """
 
@@ -228,6 +232,7 @@ class BimodalMesh:
     tip: IntArray
     section_points: IntArray
     spec: BimodalSpec
+    station: IntArray | None = None
 
     def cells_of(self, name: str) -> IntArray:
         """Cells of one layer (``"bilinear"``, ``"seal"``, ``"body"``, ``"strip"``)."""
@@ -306,6 +311,9 @@ def mesh_actuator(spec: BimodalSpec, half: bool = True, quadratic: bool = True) 
     section = np.flatnonzero(end & mid)
     section = section[np.argsort(points[section, 1])]
     tip = section[[0, -1]]
+    xs_ = (spec.voids - 1) * P
+    st = np.flatnonzero(np.isclose(points[:, 0], xs_) & mid)
+    st = st[np.argsort(points[st, 1])][[0, -1]]
     return BimodalMesh(
         points=points,
         cells=np.asarray(mesh.cells, dtype=np.int64),
@@ -317,6 +325,7 @@ def mesh_actuator(spec: BimodalSpec, half: bool = True, quadratic: bool = True) 
         tip=tip,
         section_points=section,
         spec=spec,
+        station=st,
     )
 
 

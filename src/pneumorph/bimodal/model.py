@@ -79,6 +79,11 @@ class BimodalResult:
         Why the ramp ended early ("" if it completed).
     switch : Switch
         Where the tip turns back and where it crosses to the other side.
+    station : ndarray, shape (k, 2)
+        Displacement of the mid-point of the section one void short of the tip
+        (:attr:`BimodalMesh.station`), which the bulging free end wall does not move.
+    station_switch : Switch
+        The same for the station's transverse displacement.
     metadata : dict
         Model description, degrees of freedom, Newton iterations, cut-backs, wall time.
     """
@@ -92,6 +97,8 @@ class BimodalResult:
     cause: str
     switch: Switch
     metadata: dict[str, Any] = field(default_factory=dict)
+    station: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+    station_switch: Switch = field(default_factory=lambda: Switch(0, None, None, None))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (pressures in kPa, lengths in mm)."""
@@ -104,6 +111,9 @@ class BimodalResult:
             "tip_ux_mm": np.round(self.tip[:, 0], 4).tolist(),
             "tip_uy_mm": np.round(self.tip[:, 1], 4).tolist(),
             "switch": self.switch.to_dict(),
+            "station_ux_mm": np.round(self.station[:, 0], 4).tolist(),
+            "station_uy_mm": np.round(self.station[:, 1], 4).tolist(),
+            "station_switch": self.station_switch.to_dict(),
             "metadata": self.metadata,
         }
 
@@ -246,6 +256,7 @@ class BimodalModel:
         x0 = mesh.points[outline_ids][:, :2]
         pressures: list[float] = []
         tips: list[FloatArray] = []
+        stations: list[FloatArray] = []
         outlines = [x0]
         settings = StepSettings(increments=self.increments, substeps=self.substeps, max_cutbacks=self.max_cutbacks,
                                 max_iterations=self.max_iterations)
@@ -257,6 +268,7 @@ class BimodalModel:
             u = field_[0].values
             pressures.append(t * self.pmax)
             tips.append(u[mesh.tip, :2].mean(axis=0))
+            stations.append(u[mesh.station, :2].mean(axis=0))
             outlines.append(x0 + u[outline_ids, :2])
             if on_level is not None:
                 on_level(k, pressures[-1], float(tips[-1][1]))
@@ -269,6 +281,7 @@ class BimodalModel:
             cause = f"stopped after {1e3 * (pressures[-1] if pressures else 0.0):g} kPa: {exc.cause}"
         p = np.asarray(pressures, dtype=float)
         tip = np.asarray(tips, dtype=float).reshape(-1, 2)
+        station = np.asarray(stations, dtype=float).reshape(-1, 2)
         meta = {
             "model": self.describe(),
             "dofs": int(field_[0].values.size),
@@ -281,6 +294,7 @@ class BimodalModel:
         return BimodalResult(
             crimp_ratio=self.crimp_ratio, pressures=p, tip=tip, outline=np.asarray(outlines), pmax=self.pmax,
             completed=not cause, cause=cause, switch=find_switch(p, tip[:, 1]), metadata=meta,
+            station=station, station_switch=find_switch(p, station[:, 1]),
         )
 
 
