@@ -241,7 +241,7 @@ class BimodalMesh:
 
 
 def _label(spec: BimodalSpec, centres: FloatArray) -> IntArray:
-    y0, y1, y2, y3, _ = spec.interfaces
+    y0, y1, _, y3, _ = spec.interfaces
     x, y, z = centres[:, 0], centres[:, 1], centres[:, 2]
     lx = x - np.clip(np.floor(x / spec.pitch), 0, spec.voids - 1) * spec.pitch
     label = np.select([y < y0, y < y1, y < y3], [BILINEAR, SEAL, BODY], STRIP)

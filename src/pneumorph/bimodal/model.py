@@ -26,7 +26,16 @@ from typing import Any
 import numpy as np
 
 from pneumorph import __version__
-from pneumorph.bimodal.geometry import BILINEAR, BODY, LABELS, SEAL, STRIP, BimodalMesh, BimodalSpec, mesh_actuator
+from pneumorph.bimodal.geometry import (
+    BILINEAR,
+    BODY,
+    LABELS,
+    SEAL,
+    STRIP,
+    BimodalMesh,
+    BimodalSpec,
+    mesh_actuator,
+)
 from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SimulationFailed, UnknownMaterialError
 from pneumorph.materials import get
@@ -179,7 +188,7 @@ class BimodalModel:
         self.names = names
         self.materials = {k: get(v) for k, v in names.items()}
         self.bilinear_bulk = bilinear_bulk
-        self.increments = max(1, int(round(pmax / step)))
+        self.increments = max(1, round(pmax / step))
         self.step = float(step)
         self.pmax = self.increments * self.step
         self.substeps = int(substeps)
@@ -285,7 +294,7 @@ class BimodalModel:
         meta = {
             "model": self.describe(),
             "dofs": int(field_[0].values.size),
-            "cells": int(len(mesh.cells)),
+            "cells": len(mesh.cells),
             "wall_time_s": round(time.perf_counter() - t0, 2),
             "pneumorph": __version__,
         }

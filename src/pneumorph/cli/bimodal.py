@@ -37,13 +37,20 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
 @click.option("--bilinear-nu", type=float, default=None,
               help="Small-strain Poisson's ratio of the composite, sets its bulk modulus "
                    "[default: the library's assumed bulk modulus].")
+@click.option("--max-cutbacks", type=int, default=2, show_default=True,
+              help="Halvings of a step that does not converge before the ramp ends there.")
+@click.option("--max-iterations", type=int, default=10, show_default=True, help="Newton iterations per trial.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
 def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
-            bilinear_nu: float | None, out: Path | None, as_json: bool, quiet: bool) -> None:
-    """3D FE of the bimodal actuator: tip displacement in pressure steps, switch pressure."""
+            bilinear_nu: float | None, max_cutbacks: int, max_iterations: int, out: Path | None, as_json: bool,
+            quiet: bool) -> None:
+    """3D FE of the bimodal actuator: tip displacement in pressure steps, switch pressure.
+
+    The ramp ends at --pmax or at the last pressure that converges (where a wall balloons).
+    """
     from pneumorph.bimodal.geometry import BimodalSpec
     from pneumorph.bimodal.model import BimodalModel, bilinear_material
     from pneumorph.errors import GeometryError
@@ -56,7 +63,8 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     if bilinear_nu is not None:
         bulk = bulk_from_poisson(get(bilinear_material(cr)).shear_modulus, bilinear_nu)
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
-    model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk)
+    model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
+                         max_cutbacks=max_cutbacks, max_iterations=max_iterations)
 
     def progress(k: int, p: float, v: float) -> None:
         if not quiet and not as_json:
