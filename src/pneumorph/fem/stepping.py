@@ -156,6 +156,7 @@ def ramp(
     on_level: Callable[[int, float], None] | None = None,
     monitor: Callable[[], float] | None = None,
     solver: Callable[[Any, Any], NDArray[np.float64]] | None = None,
+    on_substep: Callable[[float], None] | None = None,
 ) -> RampStatistics:
     """Ramp a FElupe model from load factor 0 to 1.
 
@@ -183,6 +184,9 @@ def ramp(
     solver : callable, optional
         ``solver(A, b)`` for the linear systems (default:
         :func:`pneumorph.fem.linear.default_solver`).
+    on_substep : callable, optional
+        ``on_substep(t)`` after every converged substep (before ``on_level``), e.g. to
+        follow a rotation continuously.
 
     Returns
     -------
@@ -226,6 +230,8 @@ def ramp(
                 current, t_now = _values(fields), t_try
                 stats.substeps += 1
                 stats.history.append((t_now, iterations))
+                if on_substep is not None:
+                    on_substep(t_now)
                 cutbacks_here = 0
                 # grow back towards the nominal substep after a successful cut-back
                 dt = min(2 * dt, 1.0 / (settings.increments * settings.substeps))

@@ -215,7 +215,7 @@ class FEModel:
             metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()},
         )
         angle0 = _end_face_angle(x_end0)
-        angles: list[float] = []
+        turned = {"total": 0.0, "last": angle0}  # end-face rotation, followed substep by substep
         displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
 
         def apply(t: float) -> None:
@@ -223,14 +223,17 @@ class FEModel:
             model["pressure"].update(p)
             model["set_extra"](p)
 
+        def follow(t: float) -> None:
+            angle = _end_face_angle(x_end0 + field[0].values[:, :2][mesh.end_points])
+            step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
+            turned["total"] += step
+            turned["last"] = angle
+
         def record(k: int, t: float) -> None:
-            u = field[0].values[:, : 2]
             displacements[k] = field[0].values[:, : self.dim]
             response.centres[k] = mesh.unit_centres(displacements[k])
-            x_end = x_end0 + u[mesh.end_points]
-            response.tip[k] = x_end.mean(axis=0)
-            angles.append(_end_face_angle(x_end) - angle0)
-            response.curl[: len(angles)] = np.degrees(np.unwrap(angles))
+            response.tip[k] = (x_end0 + displacements[k][mesh.end_points][:, :2]).mean(axis=0)
+            response.curl[k] = np.degrees(turned["total"])
             if on_level is not None:
                 on_level(k, pressures[k])
 
@@ -244,6 +247,7 @@ class FEModel:
                 self.ramp.steps,
                 on_level=record,
                 monitor=lambda: cavity_volume(model["wall_field"]),
+                on_substep=follow,
             )
         except SimulationFailed as exc:
             raise SimulationFailed(
