@@ -222,6 +222,7 @@ class BimodalModel:
         import felupe as fem
 
         from pneumorph.fem import OgdenCompressible
+        from pneumorph.fem.parts import clamped_dofs, linked_solid
 
         mesh: BimodalMesh = mesh_actuator(self.spec, half=self.half)
         Region, Boundary = fem.RegionQuadraticHexahedron, fem.RegionQuadraticHexahedronBoundary
@@ -232,18 +233,13 @@ class BimodalModel:
             name = LABELS[code]
             m = self.materials[name].model
             umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name))
-            sub = fem.Mesh(mesh.points, mesh.cells[mesh.label == code], mesh.cell_type)
-            sub_field = fem.FieldContainer([fem.Field(Region(sub), dim=3)])
-            sub_field.link(field_)
-            bodies.append(fem.SolidBody(umat, sub_field))
+            bodies.append(linked_solid(umat, mesh.points, mesh.cells[mesh.label == code], mesh.cell_type,
+                                       Region, fem.Field, 3, field_))
         walls = Boundary(fmesh, mask=mesh.void_points)
         wall_field = fem.FieldContainer([fem.Field(walls, dim=3)])
         wall_field.link(field_)
         pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
-        bounds = {"base": fem.Boundary(field_[0], mask=mesh.base_points)}
-        if mesh.symmetry_points is not None:
-            bounds["symmetry"] = fem.Boundary(field_[0], mask=mesh.symmetry_points, skip=(1, 1, 0))
-        dof0, dof1 = fem.dof.partition(field_, bounds)
+        dof0, dof1 = clamped_dofs(field_, mesh.base_points, mesh.symmetry_points)
         return {"mesh": mesh, "field": field_, "items": [*bodies, pressure], "pressure": pressure,
                 "wall_field": wall_field, "dof0": dof0, "dof1": dof1}
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import json
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -23,6 +23,7 @@ import numpy as np
 from pneumorph import __version__
 from pneumorph.errors import SimulationFailed
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume, ramp
+from pneumorph.fem.parts import clamped_dofs, linked_solid
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
@@ -150,10 +151,8 @@ class FEModel:
         field = fem.FieldContainer([Field(Region(fmesh), dim=self.dim)])
         bodies = []
         for name, material in (("body", self.body), ("layer", self.layer)):
-            sub = fem.Mesh(mesh.points, mesh.cells[mesh.regions[name]], mesh.cell_type)
-            sub_field = fem.FieldContainer([Field(Region(sub), dim=self.dim)])
-            sub_field.link(field)
-            bodies.append(fem.SolidBody(self._silicone_umat(material), sub_field))
+            bodies.append(linked_solid(self._silicone_umat(material), mesh.points, mesh.cells[mesh.regions[name]],
+                                       mesh.cell_type, Region, Field, self.dim, field))
         extra, set_extra = self._extra_bodies(mesh, field)
         silicone = np.concatenate([mesh.regions["body"], mesh.regions["layer"]])
         walls_mesh = fem.Mesh(mesh.points, mesh.cells[silicone], mesh.cell_type)
@@ -162,10 +161,7 @@ class FEModel:
         wall_field = fem.FieldContainer([Field(walls, dim=self.dim)])
         wall_field.link(field)
         pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
-        bounds = {"base": fem.Boundary(field[0], mask=mesh.base_points)}
-        if mesh.symmetry_points is not None:
-            bounds["symmetry"] = fem.Boundary(field[0], mask=mesh.symmetry_points, skip=(1, 1, 0))
-        dof0, dof1 = fem.dof.partition(field, bounds)
+        dof0, dof1 = clamped_dofs(field, mesh.base_points, mesh.symmetry_points)
         return {
             "mesh": mesh,
             "field": field,
@@ -262,18 +258,7 @@ class FEModel:
             dofs=int(field[0].values.size),
             pneumorph=__version__,
         )
-        final = Response(
-            orientation=design,
-            pressures=response.pressures,
-            centres=response.centres,
-            reference_centres=response.reference_centres,
-            tip=response.tip,
-            reference_tip=response.reference_tip,
-            curl=response.curl,
-            converged=True,
-            reached=float(pressures[-1]),
-            metadata=meta,
-        )
+        final = replace(response, converged=True, reached=float(pressures[-1]), metadata=meta)
         return Solution(final, mesh, displacements)
 
 
@@ -351,10 +336,8 @@ class Reduced2D(FEModel):
         assert law is not None
         nu = law.poisson_ratio
         umat = fem.NeoHookeCompressible(mu=1.0, lmbda=1.0)
-        sub = fem.Mesh(mesh.points, mesh.cells[mesh.regions["filler"]], mesh.cell_type)
-        Region = self._regions(mesh)[0]
-        sub_field = fem.FieldContainer([fem.FieldPlaneStrain(Region(sub), dim=2)])
-        sub_field.link(field)
+        body = linked_solid(umat, mesh.points, mesh.cells[mesh.regions["filler"]], mesh.cell_type,
+                            self._regions(mesh)[0], fem.FieldPlaneStrain, 2, field)
 
         def set_pressure(p: float) -> None:
             # linear-elastic filler at large strain: compressible neo-Hooke with the Lame
@@ -364,7 +347,7 @@ class Reduced2D(FEModel):
             umat.lmbda = e * nu / ((1 + nu) * (1 - 2 * nu))
 
         set_pressure(0.0)
-        return [fem.SolidBody(umat, sub_field)], set_pressure
+        return [body], set_pressure
 
 
 class Full3D(FEModel):
