@@ -21,6 +21,15 @@ def _pyplot():
     return plt
 
 
+def save_figure(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+    """Lay out, write (PNG/SVG by extension, 150 dpi) and close a pyplot figure."""
+    path = Path(path)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    _pyplot().close(fig)
+    return path
+
+
 def profile_points(candidate: Candidate) -> np.ndarray:
     """Base, unit centres and tip at the best level, heights above their undeformed positions."""
     r, k = candidate.response, candidate.level
@@ -75,11 +84,7 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     ax.set_title(f"{candidate.design} at {pressure:.4g} kPa - {what}", fontsize=9)
     ax.legend(fontsize=7, loc="best")
     ax.grid(alpha=0.3)
-    path = Path(path)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_convergence(history: Sequence[GenerationStats], path: str | Path, unit: str = "mm") -> Path:
@@ -93,8 +98,4 @@ def plot_convergence(history: Sequence[GenerationStats], path: str | Path, unit:
     ax.set_ylabel(f"fitness ({unit})")
     ax.legend()
     ax.grid(alpha=0.3)
-    path = Path(path)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

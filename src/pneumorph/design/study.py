@@ -147,11 +147,9 @@ def population_study(
 
 def plot_study(result: StudyResult, path: str | Path) -> Path:
     """Lowest, largest and mean best fitness against the population size (Fig 6.1)."""
-    import matplotlib
+    from pneumorph.design.figures import _pyplot, save_figure
 
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
+    plt = _pyplot()
     pops = [r.population for r in result.rows]
     fig, ax = plt.subplots(figsize=(5.6, 3.8))
     ax.plot(pops, [r.lowest for r in result.rows], "v-", label="Lowest")
@@ -163,8 +161,4 @@ def plot_study(result: StudyResult, path: str | Path) -> Path:
     ax.set_xticks(pops)
     ax.legend()
     ax.grid(alpha=0.3)
-    path = Path(path)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
