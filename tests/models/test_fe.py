@@ -124,3 +124,31 @@ def test_2d_tip_displacement_converges_with_the_mesh() -> None:
     d1, d2 = abs(tips[1] - tips[0]), abs(tips[2] - tips[1])
     assert d2 < 0.7 * d1
     assert abs(tips[0] - tips[2]) < 0.03 * tips[2]
+
+
+@pytest.mark.parametrize("pressure", [0.01, 0.045])
+def test_2d_fast_backend_gives_felupes_results(pressure: float) -> None:
+    """The vectorised assembly and its Newton method against FElupe's, 3 units.
+
+    Both stop at FElupe's criterion ||r1|| / (1e-3 + ||r0||) < 1e-8; the equilibrium
+    error this leaves is a relative force imbalance of 1e-8, so shapes may differ by
+    about 1e-8 of the displacements (tens of mm): 1e-6 mm and 1e-5 degrees allow that
+    with margin and would catch any difference in the equations.
+    """
+    design = "".join(map(str, np.random.default_rng(7).integers(0, 2, 3)))
+    ramp = RampSpec(pressure=pressure)
+    fast = Reduced2D(3, ramp_spec=ramp).evaluate(design)
+    slow = Reduced2D(3, ramp_spec=ramp, backend="felupe").evaluate(design)
+    assert fast.metadata["backend"] == "fast" and slow.metadata["backend"] == "felupe"
+    assert fast.metadata["fingerprint"] == slow.metadata["fingerprint"]
+    assert abs(fast.curl[-1]) > 1.0  # a real bending
+    np.testing.assert_allclose(fast.centres, slow.centres, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(fast.tip, slow.tip, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(fast.curl, slow.curl, rtol=0, atol=1e-5)
+
+
+def test_unknown_backend_is_refused() -> None:
+    with pytest.raises(ValueError, match="backend must be one of fast, felupe, got 'jax'"):
+        Reduced2D(2, backend="jax")
+    with pytest.raises(ValueError, match="backend must be one of felupe"):
+        Full3D(1, backend="fast")

@@ -108,7 +108,7 @@ class OgdenCompressible:
     def gradient(self, x: list, **kwargs: object) -> list:
         """First Piola-Kirchhoff stress ``P = F S`` and (no) state variables."""
         F, statevars = x[0], x[-1]
-        c, N, J, lba, m, S, h = self._principal(F)
+        _, N, _, _, _, S, _ = self._principal(F)
         S_mat = np.einsum("...Ia,...a,...Ja->IJ...", N, S, N)
         P = np.einsum("iI...,IJ...->iJ...", F, S_mat)
         return [P, statevars]

@@ -157,6 +157,7 @@ def ramp(
     monitor: Callable[[], float] | None = None,
     solver: Callable[[Any, Any], NDArray[np.float64]] | None = None,
     on_substep: Callable[[float], None] | None = None,
+    substep: Callable[[Any, StepSettings], tuple[int, str | None]] | None = None,
 ) -> RampStatistics:
     """Ramp a FElupe model from load factor 0 to 1.
 
@@ -187,6 +188,10 @@ def ramp(
     on_substep : callable, optional
         ``on_substep(t)`` after every converged substep (before ``on_level``), e.g. to
         follow a rotation continuously.
+    substep : callable, optional
+        ``substep(fields, settings)`` solves one substep in place of FElupe's Newton
+        method and returns ``(iterations, cause of failure or None)``, e.g. a
+        :class:`pneumorph.fem.fastnewton.FastSubstep` (``solver`` is then not used).
 
     Returns
     -------
@@ -200,7 +205,8 @@ def ramp(
     """
     from pneumorph.fem.linear import default_solver
 
-    solver = solver or default_solver()
+    if substep is None:
+        solver = solver or default_solver()
     stats = RampStatistics()
     prev: list[NDArray[np.float64]] | None = None
     t_prev = 0.0
@@ -217,7 +223,10 @@ def ramp(
                 s = (t_try - t_now) / (t_now - t_prev)
                 _restore(fields, [c + s * (c - p) for c, p in zip(current, prev)])
             apply(t_try)
-            iterations, cause = _solve_substep(items, fields, dof1, dof0, settings, solver)
+            if substep is not None:
+                iterations, cause = substep(fields, settings)
+            else:
+                iterations, cause = _solve_substep(items, fields, dof1, dof0, settings, solver)
             stats.newton_iterations += iterations
             value = watched
             if cause is None and monitor is not None:

@@ -23,6 +23,8 @@ import numpy as np
 from pneumorph import __version__
 from pneumorph.errors import SimulationFailed
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume, ramp
+from pneumorph.fem.fastassembly import PlaneStrainSystem
+from pneumorph.fem.fastnewton import FastSubstep
 from pneumorph.fem.parts import clamped_dofs, linked_solid
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.orientation import parse_orientation
@@ -89,6 +91,7 @@ class FEModel:
     fidelity = "fe"
     dim = 2
     half = False
+    backends: tuple[str, ...] = ("felupe",)
 
     def __init__(
         self,
@@ -96,7 +99,12 @@ class FEModel:
         unit: UnitSpec | None = None,
         ramp_spec: RampSpec | None = None,
         filler: FillerLaw | None = None,
+        backend: str | None = None,
     ) -> None:
+        backend = backend or self.backends[0]
+        if backend not in self.backends:
+            raise ValueError(f"backend must be one of {', '.join(self.backends)}, got {backend!r}")
+        self.backend = backend
         if int(n_units) < 1:
             raise ValueError(f"an actuator needs at least 1 unit, got {n_units}")
         self.n_units = int(n_units)
@@ -233,6 +241,11 @@ class FEModel:
             if on_level is not None:
                 on_level(k, pressures[k])
 
+        substep, monitor = None, lambda: cavity_volume(model["wall_field"])
+        if self.backend == "fast":
+            system = PlaneStrainSystem(model["items"], field, model["dof1"], model["dof0"])
+            substep = FastSubstep(system)
+            monitor = lambda: system.cavity_volume(field[0].values.ravel())
         try:
             stats = ramp(
                 model["items"],
@@ -242,8 +255,9 @@ class FEModel:
                 model["dof0"],
                 self.ramp.steps,
                 on_level=record,
-                monitor=lambda: cavity_volume(model["wall_field"]),
+                monitor=monitor,
                 on_substep=follow,
+                substep=substep,
             )
         except SimulationFailed as exc:
             raise SimulationFailed(
@@ -256,6 +270,7 @@ class FEModel:
             cutbacks=stats.cutbacks,
             wall_time_s=time.perf_counter() - t0,
             dofs=int(field[0].values.size),
+            backend=self.backend,
             pneumorph=__version__,
         )
         final = replace(response, converged=True, reached=float(pressures[-1]), metadata=meta)
@@ -297,6 +312,11 @@ class Reduced2D(FEModel):
         The filler law E(P) (default: the unit's calibrated law, else Eq 5.2). The ramp
         must lie inside its calibrated range, else
         :class:`pneumorph.errors.PressureRangeError` is raised at once.
+    backend : {"fast", "felupe"}
+        ``"fast"`` (default): the vectorised assembly of
+        :class:`pneumorph.fem.fastassembly.PlaneStrainSystem` and its Newton method;
+        ``"felupe"``: FElupe's assembly and ``newtonraphson``. Both solve the same
+        equations to the same tolerance (the fingerprint does not depend on it).
 
     Examples
     --------
@@ -308,6 +328,7 @@ class Reduced2D(FEModel):
 
     fidelity = "2d"
     dim = 2
+    backends = ("fast", "felupe")
 
     def __init__(
         self,
@@ -315,9 +336,10 @@ class Reduced2D(FEModel):
         unit: UnitSpec | None = None,
         ramp_spec: RampSpec | None = None,
         filler: FillerLaw | None = None,
+        backend: str | None = None,
     ) -> None:
         unit = unit or UnitSpec()
-        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler())
+        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend)
         assert self.filler is not None
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
         self.filler.modulus(self.ramp.pressure)
@@ -364,13 +386,17 @@ class Full3D(FEModel):
     dim = 3
 
     def __init__(
-        self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True
+        self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
+        backend: str | None = None,
     ) -> None:
-        super().__init__(n_units, unit, ramp_spec, None)
+        super().__init__(n_units, unit, ramp_spec, None, backend)
         self.half = bool(half)
 
     def describe(self) -> dict[str, Any]:
-        return {**super().describe(), "half_model": self.half}
+        out = {**super().describe(), "half_model": self.half}
+        # the 3D model has no filler: a unit's filler law must not change its fingerprint
+        out["unit"] = {k: v for k, v in out["unit"].items() if not k.startswith("filler_")}
+        return out
 
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem
