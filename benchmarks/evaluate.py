@@ -20,7 +20,6 @@ import time
 
 import numpy as np
 
-from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 
@@ -33,12 +32,15 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--unit", help="unit TOML file (default: the built-in unit)")
     parser.add_argument("--design", help="orientation digits (default: random, seed 0)")
+    parser.add_argument("--backend", help="assembly and Newton method (default: the model's, 2D: fast)")
     args = parser.parse_args()
     unit = UnitSpec.from_toml(args.unit) if args.unit else UnitSpec()
-    ramp = RampSpec(pressure=args.pressure / 1e3, steps=StepSettings(increments=10, substeps=2))
-    model = (Reduced2D if args.model == "2d" else Full3D)(args.units, unit, ramp)
+    cls = Reduced2D if args.model == "2d" else Full3D
+    # the model's default ramp (2D: one substep per level, 3D: two), 10 reported levels
+    ramp = RampSpec(pressure=args.pressure / 1e3, steps=cls.default_steps)
+    model = cls(args.units, unit, ramp, backend=args.backend)
     design = args.design or "".join(map(str, np.random.default_rng(0).integers(0, 2, args.units)))
-    print(f"{args.model} model, design {design}, {args.pressure:g} kPa; {platform.machine()}, "
+    print(f"{args.model} model ({model.backend}), design {design}, {args.pressure:g} kPa; {platform.machine()}, "
           f"Python {platform.python_version()}")
     model.evaluate(design[::-1])  # warm-up: imports, MKL, caches (another design)
     times = []

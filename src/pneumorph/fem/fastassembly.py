@@ -44,7 +44,8 @@ class _Group:
     cells: IntArray  # (c, n) point indices
     g: FloatArray  # (c, q, n, 2) dN_a/dX_J
     g_res: FloatArray  # (c, n, 2q): g[c, q, a, J] as [c, a, (q, J)]
-    g_mat: FloatArray  # (c, 2q, n): g[c, q, b, L] as [c, (q, L), b]
+    gT: FloatArray  # (cq, 2, n): g[c, q, b, L] as [(c, q), L, b]
+    B: FloatArray  # (c, 2n, 4q): d_ii' g[c, q, a, J] as [c, (a, i), (q, i', J)]
     dV: FloatArray  # (c, q)
     kernel: Kernel | None  # None for a pressurised boundary
 
@@ -69,7 +70,10 @@ def _group(cells: IntArray, region: Any, kernel: Kernel | None) -> _Group:
         cells=np.asarray(cells, dtype=np.int64),
         g=g,
         g_res=np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 2 * q)),
-        g_mat=np.ascontiguousarray(g.transpose(0, 1, 3, 2).reshape(c, 2 * q, n)),
+        gT=np.ascontiguousarray(g.transpose(0, 1, 3, 2).reshape(c * q, 2, n)),
+        B=np.ascontiguousarray(
+            np.einsum("cqaJ,ij->caiqjJ", g, np.eye(2)).reshape(c, 2 * n, 4 * q)
+        ),
         dV=np.ascontiguousarray(region.dV.T),
         kernel=kernel,
     )
@@ -191,13 +195,13 @@ class PlaneStrainSystem:
             c, q = grp.dV.shape
             F = _gradients(grp.g, grp.cells, U)
             assert grp.kernel is not None
-            P, A, J = grp.kernel(F.reshape(-1, 2, 2))
+            P, A, J = grp.kernel(np.ascontiguousarray(F.transpose(2, 3, 0, 1)).reshape(2, 2, c * q))
             jmin = min(jmin, float(J.min()))
             dV = grp.dV.reshape(-1)
-            PdV = (P * dV[:, None, None]).reshape(c, q, 2, 2)
-            # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[c, q, i, J] dV
-            vectors.append(np.matmul(grp.g_res, PdV.transpose(0, 1, 3, 2).reshape(c, 2 * q, 2)).ravel())
-            self._cache.append(A * dV[:, None, None, None, None])
+            PdV = (P * dV).reshape(2, 2, c, q)
+            # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV
+            vectors.append(np.matmul(grp.g_res, PdV.transpose(2, 3, 1, 0).reshape(c, 2 * q, 2)).ravel())
+            self._cache.append(A * dV)
         for item, grp, h, ndA in self.pressures:
             p = float(item.results.pressure)
             F = _gradients(grp.g, grp.cells, U)
@@ -221,11 +225,11 @@ class PlaneStrainSystem:
         blocks = []
         for grp, AdV in zip(self.groups, self._cache):
             c, q, n, _ = grp.g.shape
-            # T[cq, a, (i, k, L)] = sum_J g[cq, a, J] A[cq, i, J, k, L] dV
-            At = AdV.transpose(0, 2, 1, 3, 4).reshape(c * q, 2, 8)
-            T = np.matmul(grp.g.reshape(c * q, n, 2), At).reshape(c, q, n, 2, 2, 2)
-            T = T.transpose(0, 2, 3, 4, 1, 5).reshape(c, n * 4, 2 * q)  # [c, (a, i, k), (q, L)]
-            blocks.append(np.matmul(T, grp.g_mat).ravel())  # [c, a, i, k, b]
+            # D[cq, (i, J, k), b] = sum_L A[i, J, k, L, cq] dV g[cq, b, L]
+            At = np.ascontiguousarray(AdV.reshape(16, c * q).T).reshape(c * q, 8, 2)
+            D = np.matmul(At, grp.gT).reshape(c, 4 * q, 2 * n)  # [c, (q, i, J), (k, b)]
+            # K[c, (a, i), (k, b)] = sum_(q, J) g[c, q, a, J] D[c, (q, i, J), (k, b)]
+            blocks.append(np.matmul(grp.B, D).ravel())
         for item, grp, h, ndA in self.pressures:
             p = float(item.results.pressure)
             # t[f, q, b] = N_1 dN_b/dX_2 - N_2 dN_b/dX_1 (with dA); M[f, a, b] = p sum_q h_a t_b

@@ -23,6 +23,19 @@ from pneumorph.fem.fastassembly import PlaneStrainSystem
 FloatArray = NDArray[np.float64]
 
 
+def pattern_solver(indptr: NDArray[np.int32], indices: NDArray[np.int32]) -> Callable[[Any, Any], FloatArray]:
+    """``solve(data, b)`` for matrices on one CSR pattern: PARDISO if available, else SuperLU."""
+    from pneumorph.fem.linear import PardisoPattern, superlu
+
+    try:
+        return PardisoPattern(indptr, indices)
+    except ImportError:
+        import scipy.sparse as sp
+
+        n = len(indptr) - 1
+        return lambda data, b: superlu(sp.csr_matrix((data, indices, indptr), shape=(n, n)), b)
+
+
 def residual_norm(r: FloatArray, dof1: NDArray[np.int64], dof0: NDArray[np.int64]) -> float:
     """FElupe's relative residual norm ``||r1|| / (1e-3 + ||r0||)``."""
     return float(np.linalg.norm(r[dof1]) / (1e-3 + np.linalg.norm(r[dof0])))
@@ -40,31 +53,28 @@ class FastSubstep:
     system : PlaneStrainSystem
         The assembled model.
     solver : callable, optional
-        ``solver(A, b)`` for the active block (default:
-        :func:`pneumorph.fem.linear.default_solver`).
+        ``solver(data, b)`` for the active block given by its CSR values on the
+        system's pattern (default: :func:`pattern_solver`).
     """
 
     def __init__(self, system: PlaneStrainSystem, solver: Callable[[Any, Any], FloatArray] | None = None) -> None:
-        from pneumorph.fem.linear import default_solver
-
         self.system = system
-        self.solver = solver or default_solver()
+        self.solver = solver or pattern_solver(system.indptr, system.indices)
 
     def __call__(self, fields: Any, settings: Any) -> tuple[int, str | None]:
-        import scipy.sparse as sp
-
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
         values = fields[0].values
         u = values.ravel().copy()
-        n1 = dof1.size
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
             r, jmin = system.residual(u)
+            if not (jmin > 0.0 and np.all(np.isfinite(r))):
+                # an over-reaching predictor: the ramp cuts the substep back at no Newton cost
+                return 0, f"the predicted start is not admissible (det F = {jmin:.3g})"
             for iteration in range(1, settings.max_iterations + 1):
-                K = sp.csr_matrix((system.tangent_data(), system.indices, system.indptr), shape=(n1, n1))
                 try:
-                    dx = self.solver(K, -r[dof1])
+                    dx = self.solver(system.tangent_data(), -r[dof1])
                 except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
                     return iteration, f"{type(exc).__name__}: {exc}"
                 if not np.all(np.isfinite(dx)):

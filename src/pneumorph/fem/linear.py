@@ -80,3 +80,76 @@ def default_solver() -> Callable[[Any, Any], np.ndarray]:
         return Pardiso()
     except ImportError:
         return partial(superlu)
+
+
+class PardisoPattern:
+    """MKL PARDISO for a sequence of matrices with one fixed CSR pattern.
+
+    The ordering and symbolic analysis are done at the first call, each later call only
+    factorises and solves. It has its own PARDISO handle (released when the object is
+    collected), uses the minimum-degree ordering and no scaling or weighted matching,
+    which on the 2D actuator tangents factorise about twice as fast as the defaults.
+
+    Parameters
+    ----------
+    indptr, indices : ndarray
+        The CSR pattern (sorted column indices), 0-based.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> solve = PardisoPattern(np.array([0, 2, 4]), np.array([0, 1, 0, 1]))
+    >>> np.round(solve(np.array([4.0, 1.0, 1.0, 3.0]), np.array([1.0, 2.0])), 6).tolist()
+    [0.090909, 0.636364]
+    """
+
+    def __init__(self, indptr: np.ndarray, indices: np.ndarray) -> None:
+        import ctypes
+
+        Pardiso()  # loads MKL once per thread
+        self._lib = Pardiso._local.solver
+        self._ctypes = ctypes
+        self.n = len(indptr) - 1
+        self.ia = np.ascontiguousarray(indptr, dtype=np.int32) + 1
+        self.ja = np.ascontiguousarray(indices, dtype=np.int32) + 1
+        self.pt = np.zeros(64, dtype=np.int64)
+        self.iparm = np.zeros(64, dtype=np.int32)
+        self.iparm[0] = 1  # user values: minimum degree (iparm[1] = 0), no scaling/matching
+        self.iparm[9] = 13  # pivot perturbation 1e-13 (the non-symmetric default)
+        self.analysed = False
+        self.factorisations = 0
+
+    def _call(self, phase: int, data: np.ndarray, b: np.ndarray) -> np.ndarray:
+        ct = self._ctypes
+        x = np.zeros_like(b)
+        error = ct.c_int32(0)
+        i32 = ct.POINTER(ct.c_int32)
+        f64 = ct.POINTER(ct.c_double)
+        self._lib._mkl_pardiso(
+            self.pt.ctypes.data_as(ct.POINTER(ct.c_int64)), ct.byref(ct.c_int32(1)), ct.byref(ct.c_int32(1)),
+            ct.byref(ct.c_int32(11)), ct.byref(ct.c_int32(phase)), ct.byref(ct.c_int32(self.n)),
+            data.ctypes.data_as(f64), self.ia.ctypes.data_as(i32), self.ja.ctypes.data_as(i32),
+            np.zeros(0, dtype=np.int32).ctypes.data_as(i32), ct.byref(ct.c_int32(1)),
+            self.iparm.ctypes.data_as(i32), ct.byref(ct.c_int32(0)), b.ctypes.data_as(f64),
+            x.ctypes.data_as(f64), ct.byref(error),
+        )
+        if error.value != 0:
+            raise ArithmeticError(f"PARDISO failed with error {error.value} in phase {phase}")
+        return x
+
+    def __call__(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` for the matrix with CSR values ``data`` on the pattern."""
+        data = np.ascontiguousarray(data, dtype=float)
+        b = np.ascontiguousarray(b, dtype=float)
+        if not self.analysed:
+            self._call(11, data, b)
+            self.analysed = True
+        self.factorisations += 1
+        return self._call(23, data, b)
+
+    def __del__(self) -> None:
+        if getattr(self, "analysed", False):
+            import contextlib
+
+            with contextlib.suppress(Exception):  # nothing to release at interpreter shutdown
+                self._call(-1, np.zeros(0), np.zeros(0))

@@ -137,6 +137,21 @@ def _solve_substep(
     return iterations, None
 
 
+def _extrapolate(
+    states: Sequence[tuple[float, list[NDArray[np.float64]]]], t: float
+) -> list[NDArray[np.float64]]:
+    """Lagrange extrapolation of the field values of converged states to factor ``t``."""
+    times = [s[0] for s in states]
+    weights = []
+    for j, tj in enumerate(times):
+        w = 1.0
+        for m, tm in enumerate(times):
+            if m != j:
+                w *= (t - tm) / (tj - tm)
+        weights.append(w)
+    return [sum(w * s[1][i] for w, s in zip(weights, states)) for i in range(len(states[0][1]))]
+
+
 def _values(fields: Any) -> list[NDArray[np.float64]]:
     return [f.values.copy() for f in fields.fields]
 
@@ -158,6 +173,7 @@ def ramp(
     solver: Callable[[Any, Any], NDArray[np.float64]] | None = None,
     on_substep: Callable[[float], None] | None = None,
     substep: Callable[[Any, StepSettings], tuple[int, str | None]] | None = None,
+    predictor_order: int = 1,
 ) -> RampStatistics:
     """Ramp a FElupe model from load factor 0 to 1.
 
@@ -192,6 +208,9 @@ def ramp(
         ``substep(fields, settings)`` solves one substep in place of FElupe's Newton
         method and returns ``(iterations, cause of failure or None)``, e.g. a
         :class:`pneumorph.fem.fastnewton.FastSubstep` (``solver`` is then not used).
+    predictor_order : int
+        Degree of the polynomial through the last converged states that predicts the
+        start of a substep (1: linear, 2: quadratic once three states are known).
 
     Returns
     -------
@@ -208,9 +227,8 @@ def ramp(
     if substep is None:
         solver = solver or default_solver()
     stats = RampStatistics()
-    prev: list[NDArray[np.float64]] | None = None
-    t_prev = 0.0
     current = _values(fields)
+    history: list[tuple[float, list[NDArray[np.float64]]]] = [(0.0, current)]  # converged states
     t_now = 0.0
     apply(0.0)
     watched = monitor() if monitor is not None else 0.0
@@ -219,9 +237,8 @@ def ramp(
         cutbacks_here = 0
         while t_now < level - 1e-12:
             t_try = min(t_now + dt, level)
-            if settings.predictor and prev is not None and t_now > t_prev:
-                s = (t_try - t_now) / (t_now - t_prev)
-                _restore(fields, [c + s * (c - p) for c, p in zip(current, prev)])
+            if settings.predictor and len(history) > 1:
+                _restore(fields, _extrapolate(history[-1 - predictor_order:], t_try))
             apply(t_try)
             if substep is not None:
                 iterations, cause = substep(fields, settings)
@@ -235,8 +252,8 @@ def ramp(
                     cause = f"the monitored quantity fell from {watched:.6g} to {value:.6g}"
             if cause is None:
                 watched = value
-                prev, t_prev = current, t_now
                 current, t_now = _values(fields), t_try
+                history = [*history[-2:], (t_now, current)]
                 stats.substeps += 1
                 stats.history.append((t_now, iterations))
                 if on_substep is not None:

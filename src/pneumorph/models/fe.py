@@ -92,6 +92,10 @@ class FEModel:
     dim = 2
     half = False
     backends: tuple[str, ...] = ("felupe",)
+    #: degree of the predictor's extrapolation through the last converged states
+    predictor_order = 1
+    #: the ramp when none is given
+    default_steps = StepSettings(increments=10, substeps=2)
 
     def __init__(
         self,
@@ -109,7 +113,7 @@ class FEModel:
             raise ValueError(f"an actuator needs at least 1 unit, got {n_units}")
         self.n_units = int(n_units)
         self.unit = unit or UnitSpec()
-        self.ramp = ramp_spec or RampSpec()
+        self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
         self.filler = filler
         self.body = get(self.unit.body_material)
         self.layer = get(self.unit.layer_material)
@@ -258,6 +262,7 @@ class FEModel:
                 monitor=monitor,
                 on_substep=follow,
                 substep=substep,
+                predictor_order=self.predictor_order,
             )
         except SimulationFailed as exc:
             raise SimulationFailed(
@@ -307,7 +312,8 @@ class Reduced2D(FEModel):
     unit : UnitSpec, optional
         The articulating unit (default: :class:`UnitSpec` defaults).
     ramp_spec : RampSpec, optional
-        Pressure ramp (default 45 kPa in 10 reported increments).
+        Pressure ramp (default 45 kPa in 10 reported increments, one substep each before
+        any cut-back).
     filler : FillerLaw, optional
         The filler law E(P) (default: the unit's calibrated law, else Eq 5.2). The ramp
         must lie inside its calibrated range, else
@@ -329,6 +335,11 @@ class Reduced2D(FEModel):
     fidelity = "2d"
     dim = 2
     backends = ("fast", "felupe")
+    # one substep per reported level, started from the quadratic extrapolation of the
+    # last three states: 114 Newton iterations for the 15-unit benchmark design at 45 kPa
+    # where two substeps from the linear one took 168 (same results within the tolerance)
+    predictor_order = 2
+    default_steps = StepSettings(increments=10, substeps=1)
 
     def __init__(
         self,
