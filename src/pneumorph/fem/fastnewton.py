@@ -6,7 +6,10 @@ residual of the active dofs over ``1e-3`` plus the norm of the reaction forces,
     ||r[dof1]|| / (1e-3 + ||r[dof0]||) < tol,
 
 checked after every update, so a converged state satisfies the same equilibrium as one
-of ``felupe.newtonraphson``. Prescribed values stay as the ramp set them.
+of ``felupe.newtonraphson``. Prescribed values stay as the ramp set them. Unlike FElupe's
+method it gives up early - on a non-admissible start (a predictor that inverted an
+element), a non-finite residual or a residual 1e3 times the reaction forces - and leaves
+the cut-back to the ramp.
 """
 
 from __future__ import annotations
@@ -21,6 +24,12 @@ from numpy.typing import NDArray
 from pneumorph.fem.fastassembly import PlaneStrainSystem
 
 FloatArray = NDArray[np.float64]
+
+
+#: A relative residual norm (residual over reaction forces) beyond which a substep is
+#: abandoned at once: converging substeps of the 2D actuator stay below ~10, diverging
+#: ones pass 1e4 on their way to inverted elements.
+DIVERGED = 1e3
 
 
 def pattern_solver(indptr: NDArray[np.int32], indices: NDArray[np.int32]) -> Callable[[Any, Any], FloatArray]:
@@ -84,6 +93,8 @@ class FastSubstep:
                 fnorm = residual_norm(r, dof1, dof0)
                 if not np.isfinite(fnorm):
                     return iteration, "the residual is not finite"
+                if fnorm > DIVERGED:
+                    return iteration, f"diverging (residual norm {fnorm:.3g})"
                 if fnorm < settings.tolerance:
                     values[:] = u.reshape(values.shape)
                     if not jmin > 0.0:
