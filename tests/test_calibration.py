@@ -16,7 +16,7 @@ from pneumorph.models.fe import Reduced2D
 TRUE = (0.05, -1.0)  # E(P) = 0.05 - 1.0 P (MPa, P in MPa)
 
 
-def truth(model, design):  # noqa: ANN001, ANN201 - stands in for the 3D solve
+def truth(model, design):
     """A 2D model whose filler follows a known law: the calibration must find that law."""
     law = FillerLaw("true", "true", TRUE, (0.0, model.ramp.pressure), 0.3)
     return Reduced2D(model.n_units, model.unit, model.ramp, law).evaluate(design)
@@ -48,3 +48,14 @@ def test_bad_laws_are_flagged() -> None:
     assert any("not positive" in x for x in negative.problems)
     too_few = fit_law([0.01, 0.02], [0.04, 0.03], 2, (0.0, 0.02))
     assert "cannot test" in too_few.problems[0]
+
+
+def test_holdout_designs_are_distinct_and_held_out() -> None:
+    from pneumorph.calibration import calibration_designs, holdout_designs
+    from pneumorph.errors import SearchConfigError
+
+    cal = calibration_designs(3, 3, seed=1)
+    held = holdout_designs(3, 8 - len(set(cal)), seed=1, exclude=cal)
+    assert sorted(set(cal) | set(held)) == sorted(f"{i:03b}" for i in range(8))  # the whole space, no overlap
+    with pytest.raises(SearchConfigError, match="only 0 designs"):
+        holdout_designs(1, 1, exclude=["0", "1"])

@@ -1,8 +1,9 @@
 """Calibrate the 2D model's filler law E(P) against the 3D model (chapter 5).
 
-For each pressure level and each of several independent runs, a random design is solved
-in 3D, and the filler modulus E that makes the 2D model reproduce it best is found with a
-SciPy optimiser from a random starting point, minimising Eq 5.1:
+Each of several independent runs solves one random design in 3D; one 3D ramp reports every
+calibration pressure (the dissertation's "method 2", section 4.3). At each pressure level the
+filler modulus E that makes the 2D model reproduce that 3D state best is found with a SciPy
+optimiser from a random starting point, minimising Eq 5.1:
 
     Gamma(E) = sum over units [(X2 - X3)^2 + (Y2 - Y3)^2]
 
@@ -26,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.errors import MaterialDataError, SimulationFailed
+from pneumorph.errors import MaterialDataError, SearchConfigError, SimulationFailed
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials.filler import FillerLaw
@@ -137,8 +138,8 @@ def fit_law(pressures: Sequence[float], moduli: Sequence[float], degree: int,
     if len(np.unique(p)) <= degree + 1:
         nan = float("nan")
         return LawFit(degree, (), nan, (nan, nan),
-                      (f"degree {degree}: {len(np.unique(p))} pressure levels cannot test a law with "
-                       f"{degree + 1} coefficients",))
+                      ((f"degree {degree}: {len(np.unique(p))} pressure levels cannot test a law with "
+                       f"{degree + 1} coefficients"),))
     coeffs = np.polynomial.polynomial.polyfit(p, e, degree)
     pred = np.polynomial.polynomial.polyval(p, coeffs)
     ssto = float(np.sum((e - e.mean()) ** 2))
@@ -194,6 +195,71 @@ def best_filler_modulus(
                        gamma=float(objective(x)), start=float(start), evaluations=counter["n"])
 
 
+def _random_designs(n_units: int, count: int, seed: int) -> list[str]:
+    rng = np.random.default_rng(seed)
+    return ["".join(map(str, rng.integers(0, 2, n_units))) for _ in range(count)]
+
+
+def calibration_designs(n_units: int, runs: int, seed: int = 0) -> list[str]:
+    """The random design of each calibration run (one 3D solve each).
+
+    Examples
+    --------
+    >>> calibration_designs(6, 2, seed=0)
+    ['011100', '110010']
+    """
+    return _random_designs(n_units, runs, seed + 1)
+
+
+def holdout_designs(n_units: int, count: int, seed: int = 0, exclude: Sequence[str] = ()) -> list[str]:
+    """Distinct random designs for validation, none of them in ``exclude``.
+
+    Pass the calibration designs as ``exclude`` so that the validation is held out.
+
+    Raises
+    ------
+    SearchConfigError
+        If the design space has fewer than ``count`` designs outside ``exclude``.
+
+    Examples
+    --------
+    >>> held = holdout_designs(15, 10, exclude=calibration_designs(15, 3))
+    >>> len(held), len(set(held)), len(held[0])
+    (10, 10, 15)
+    """
+    excluded = set(exclude)
+    free = 2**n_units - len(excluded)
+    if count > free:
+        raise SearchConfigError(f"{n_units} units have only {free} designs outside the {len(excluded)} excluded ones; "
+                         f"{count} held-out designs were asked for")
+    rng = np.random.default_rng(seed + 10_000)
+    out: list[str] = []
+    while len(out) < count:
+        d = "".join(map(str, rng.integers(0, 2, n_units)))
+        if d not in excluded and d not in out:
+            out.append(d)
+    return out
+
+
+def reference_model(unit: UnitSpec, n_units: int, pressures_kpa: Sequence[float],
+                    steps: StepSettings | None = None) -> Full3D:
+    """The 3D model of a calibration: its ramp reports every calibration pressure.
+
+    Examples
+    --------
+    >>> m = reference_model(UnitSpec(), 15, (5, 10, 15, 20, 25, 30, 35, 40, 45))
+    >>> m.ramp.steps.increments, round(m.ramp.pressure * 1e3, 6)
+    (9, 45.0)
+    """
+    levels = np.asarray(pressures_kpa, dtype=float) / 1e3
+    p_max = float(levels.max())
+    increments = round(p_max / np.gcd.reduce(np.round(levels * 1e4).astype(int)) * 1e4)
+    steps = steps or StepSettings(increments=increments, substeps=2)
+    if steps.increments != increments:
+        steps = replace(steps, increments=increments)
+    return Full3D(n_units, unit, RampSpec(pressure=p_max, steps=steps))
+
+
 def calibrate(
     unit: UnitSpec,
     n_units: int,
@@ -216,7 +282,8 @@ def calibrate(
     pressures_kpa : sequence of float
         Pressure levels (5-45 kPa in 5 kPa steps by default).
     runs : int
-        Independent runs; each picks a new random design and starting point per level.
+        Independent runs; each solves one random design in 3D (all levels from one ramp)
+        and starts the optimiser from a new random modulus at every level.
     seed : int
         Seed of the designs and starting points.
     bounds : (float, float)
@@ -236,25 +303,21 @@ def calibrate(
     rng = np.random.default_rng(seed)
     levels = np.asarray(pressures_kpa, dtype=float) / 1e3
     p_max = float(levels.max())
-    increments = int(round(p_max / np.gcd.reduce(np.round(levels * 1e4).astype(int)) * 1e4))
-    steps = steps or StepSettings(increments=increments, substeps=2)
-    if steps.increments != increments:
-        steps = replace(steps, increments=increments)
-    model3d = Full3D(n_units, unit, RampSpec(pressure=p_max, steps=steps))
+    model3d = reference_model(unit, n_units, pressures_kpa, steps)
+    steps = model3d.ramp.steps
     solve_3d = solve_3d or (lambda model, design: model.evaluate(design))
     nu = unit.filler_poisson_ratio
 
     def make_2d(e: float, pressure: float) -> Reduced2D:
         law = FillerLaw("trial", "trial", (e,), (0.0, pressure), nu)
-        n = max(1, int(round(pressure / p_max * steps.increments)))
+        n = max(1, round(pressure / p_max * steps.increments))
         return Reduced2D(n_units, unit, RampSpec(pressure=pressure, steps=replace(steps, increments=n)), law)
 
     points = []
-    for run in range(runs):
+    for run, design in enumerate(calibration_designs(n_units, runs, seed)):
+        reference = solve_3d(model3d, design)
         for p in levels:
-            design = "".join(map(str, rng.integers(0, 2, n_units)))
             start = float(10.0 ** rng.uniform(np.log10(bounds[0]) + 0.5, np.log10(bounds[1]) - 0.5))
-            reference = solve_3d(model3d, design)
             level = reference.level_of(p)
             point = replace(best_filler_modulus(design, level, reference, make_2d, start, bounds), run=run)
             points.append(point)

@@ -19,17 +19,17 @@ import click
               help="Held-out random designs for the 2D-against-3D check.")
 @click.option("--cache", metavar="FILE", help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", default="runs/calibration", show_default=True, metavar="DIR")
+@click.option("--references-only", is_flag=True,
+              help="Only solve (and cache) the 3D references of the calibration and validation designs.")
 @click.option("--json", "as_json", is_flag=True)
 def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, seed: int, n_validate: int,
-              cache: str | None, out: str, as_json: bool) -> None:
+              cache: str | None, out: str, references_only: bool, as_json: bool) -> None:
     """Fit the filler law E(P) of the 2D model to the 3D model (chapter 5) and check it.
 
     Writes calibration.json, calibration.png (Fig 5.3) and unit.toml: the unit with the
     chosen law and its provenance, ready for --unit of the other commands.
     """
     from pathlib import Path
-
-    import numpy as np
 
     from pneumorph import calibration as cal_mod
     from pneumorph.design.config import to_toml
@@ -46,6 +46,11 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     store = EvaluationCache(cache or default_cache_path())
     solve_3d = cal_mod.cached_3d_solver(store)
+
+    if references_only:
+        _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d)
+        store.close()
+        return
 
     def on_point(p) -> None:  # type: ignore[no-untyped-def]
         click.echo(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
@@ -65,8 +70,7 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
         calibrated = result.unit_with_law(unit)
         (folder / "unit.toml").write_text(to_toml({"unit": calibrated.to_dict()}), encoding="utf-8")
         if n_validate > 0:
-            rng = np.random.default_rng(seed + 10_000)
-            designs = ["".join(map(str, rng.integers(0, 2, n_units))) for _ in range(n_validate)]
+            designs = cal_mod.holdout_designs(n_units, n_validate, seed, cal_mod.calibration_designs(n_units, runs, seed))
             p_max = max(levels) / 1e3
             check = cal_mod.validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
             summary["validation"] = check.to_dict()
@@ -87,3 +91,27 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
             click.echo(f"  {p:5.1f} kPa: 2D-3D unit-centre distance mean {m:.3f} mm, max {x:.3f} mm")
     written = "calibration.json, calibration.png" + (", unit.toml" if result.chosen is not None else "")
     click.echo(f"written to {folder}/ ({written})")
+
+
+def _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d) -> None:  # type: ignore[no-untyped-def]
+    """Solve the 3D references into the cache, one by one, with their wall time."""
+    import time
+
+    from pneumorph import calibration as cal_mod
+    from pneumorph.models.fe import Full3D, RampSpec
+
+    jobs = [(cal_mod.reference_model(unit, n_units, levels), d)
+            for d in cal_mod.calibration_designs(n_units, runs, seed)]
+    holdout = Full3D(n_units, unit, RampSpec(pressure=max(levels) / 1e3))
+    held = cal_mod.holdout_designs(n_units, n_validate, seed, [d for _, d in jobs])
+    jobs += [(holdout, d) for d in held]
+    for i, (model, design) in enumerate(jobs, 1):
+        t0 = time.perf_counter()
+        kind = "calibration" if i <= runs else "validation"
+        try:
+            r = solve_3d(model, design)
+            msg = f"curl {r.curl[-1]:.1f} deg"
+        except Exception as exc:  # noqa: BLE001 - a failed reference is reported, the others go on
+            msg = f"FAILED: {exc}"
+        click.echo(f"  3D reference {i}/{len(jobs)} ({kind}) {design}: {msg}, "
+                   f"{time.perf_counter() - t0:.0f} s", err=True)
