@@ -29,14 +29,26 @@ def test_references_only_fills_the_cache_that_calibration_then_reuses(
     from pneumorph.execution import EvaluationCache
 
     cache = tmp_path / "c.sqlite"
-    common = ["--units", "1", "--pressures", "5,10", "--runs", "1", "--cache", str(cache)]
-    assert main(["calibrate", *common, "--validate", "1", "--references-only"]) == 0
+    common = ["--units", "1", "--pressures", "4,8,12", "--runs", "1", "--validate", "1", "--cache", str(cache)]
+    assert main(["calibrate", *common, "--references-only"]) == 0
     log = capsys.readouterr().err
     assert "3D reference 1/2 (calibration)" in log and "3D reference 2/2 (validation)" in log
     with EvaluationCache(cache) as store:
         assert store.count() == 2  # one calibration design, one held-out design
-    # the calibration finds its 3D reference in the cache: no new entry, no 3D solve
-    with pytest.warns(UserWarning, match="cannot test"):
-        assert main(["calibrate", *common, "--validate", "0", "--out", str(tmp_path / "cal")]) == 0
+    # calibration and validation find their 3D references in the cache: no new 3D solve
+    out = tmp_path / "cal"
+    with pytest.warns(UserWarning, match="cannot test"):  # three levels cannot test a quadratic
+        assert main(["calibrate", *common, "--out", str(out), "--json"]) == 0
     with EvaluationCache(cache) as store:
         assert store.count() == 2
+    data = json.loads(capsys.readouterr().out)
+    assert data["chosen_degree"] == 1
+    (calibrated,) = {p["design"] for p in data["points"]}
+    assert data["validation"]["designs"] == [{"0": "1", "1": "0"}[calibrated]]  # held out: the mirror
+    # the mirror design deforms as the mirror image in 2D and 3D, so its 2D-3D distance at
+    # 12 kPa is the calibration's residual there, sqrt(Eq 5.1), through the fitted law
+    # (R^2 = 1 - 2e-7, so the law's E(12 kPa) is the calibrated point's)
+    top = next(p for p in data["points"] if round(p["pressure"] * 1e3) == 12)
+    assert data["validation"]["max_mm"][-1] == pytest.approx(top["gamma"] ** 0.5, rel=1e-3)
+    for name in ("calibration.png", "profiles.png", "filler_paths.png", "unit.toml"):
+        assert (out / name).is_file()

@@ -74,6 +74,8 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
             p_max = max(levels) / 1e3
             check = cal_mod.validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
             summary["validation"] = check.to_dict()
+            summary["figures"] = _validation_figures(result, calibrated, n_units, designs[0], p_max, solve_3d,
+                                                     folder)
     (folder / "calibration.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
     store.close()
     if as_json:
@@ -115,3 +117,32 @@ def _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d) -
             msg = f"FAILED: {exc}"
         click.echo(f"  3D reference {i}/{len(jobs)} ({kind}) {design}: {msg}, "
                    f"{time.perf_counter() - t0:.0f} s", err=True)
+
+
+def _validation_figures(result, unit, n_units, design, p_max, solve_3d, folder):  # type: ignore[no-untyped-def]
+    """Fig 5.4 (each run's law, the chosen law, 3D) and Fig 5.7 (constant filler against E(P))."""
+    from dataclasses import replace
+
+    from pneumorph import calibration as cal_mod
+    from pneumorph.models.fe import Full3D, RampSpec
+    from pneumorph.plot import calibration as figs
+
+    ramp = RampSpec(pressure=p_max)
+    reference = solve_3d(Full3D(n_units, unit, ramp), design)
+    law = result.law()
+    laws = {}
+    for run in sorted({p.run for p in result.points}):
+        pts = [p for p in result.points if p.run == run]
+        fit = cal_mod.fit_law([p.pressure for p in pts], [p.modulus for p in pts], result.chosen.degree,
+                              result.pressure_range)
+        if fit.coefficients and not fit.problems:  # a run's law that is not positive cannot be solved
+            laws[f"run {run + 1} law"] = replace(law, coefficients=fit.coefficients)
+    laws["fitted law"] = law
+    profiles = figs.plot_law_profiles(figs.law_responses(unit, n_units, design, ramp, laws), reference,
+                                      folder / "profiles.png")
+    choices = {"E(P)": law,
+               "constant E(0)": figs.constant_law(law, 0.0, "constant E(0)"),
+               f"constant E({p_max * 1e3:g} kPa)": figs.constant_law(law, p_max, "constant E(p_max)")}
+    paths = figs.plot_filler_paths(figs.law_responses(unit, n_units, design, ramp, choices), reference,
+                                   folder / "filler_paths.png")
+    return [str(profiles), str(paths)]
