@@ -53,7 +53,7 @@ def test_filler_path_independence() -> None:
         name="constant", display_name="E(p_max)", coefficients=(e_end,),
         pressure_range=eq52.pressure_range, poisson_ratio=eq52.poisson_ratio,
     )
-    varying = Reduced2D(2, ramp_spec=LOW).evaluate("00")
+    varying = Reduced2D(2, ramp_spec=LOW, filler=eq52).evaluate("00")
     fixed = Reduced2D(2, ramp_spec=LOW, filler=constant).evaluate("00")
     np.testing.assert_allclose(fixed.centres[-1], varying.centres[-1], atol=1e-6)
     assert abs(fixed.curl[0]) > abs(varying.curl[0]) * 1.01
@@ -150,5 +150,37 @@ def test_2d_fast_backend_gives_felupes_results(pressure: float) -> None:
 def test_unknown_backend_is_refused() -> None:
     with pytest.raises(ValueError, match="backend must be one of fast, felupe, got 'jax'"):
         Reduced2D(2, backend="jax")
-    with pytest.raises(ValueError, match="backend must be one of felupe"):
-        Full3D(1, backend="fast")
+    with pytest.raises(ValueError, match="backend must be one of fast, felupe, got 'jax'"):
+        Full3D(1, backend="jax")
+
+
+@pytest.mark.parametrize("pressure", [0.015, 0.045])
+def test_3d_fast_backend_gives_felupes_results(pressure: float) -> None:
+    """The fast 3D path (symmetric assembly, kept tangents) against FElupe's Newton method.
+
+    One unit, hex20 at 3 mm, the default ramp. Both stop at ||r1|| / (1e-3 + ||r0||) <
+    1e-8, which leaves shapes free to differ by about 1e-8 of the displacements (mm):
+    1e-6 mm and 1e-5 degrees allow that with margin and would catch any difference in
+    the equations.
+    """
+    unit = UnitSpec(element_size=3.0)
+    ramp = RampSpec(pressure=pressure, steps=Full3D.default_steps)
+    fast = Full3D(1, unit=unit, ramp_spec=ramp).evaluate("0")
+    slow = Full3D(1, unit=unit, ramp_spec=ramp, backend="felupe").evaluate("0")
+    assert fast.metadata["backend"] == "fast" and slow.metadata["backend"] == "felupe"
+    assert fast.metadata["fingerprint"] == slow.metadata["fingerprint"]
+    assert fast.metadata["factorisations"] < slow.metadata["factorisations"]
+    assert abs(fast.curl[-1]) > 2.0  # a real bending
+    np.testing.assert_allclose(fast.centres, slow.centres, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(fast.tip, slow.tip, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(fast.curl, slow.curl, rtol=0, atol=1e-5)
+
+
+def test_3d_fingerprint_holds_the_result_determining_ramp_settings_only() -> None:
+    base = Full3D(2)
+    solved_otherwise = RampSpec(steps=StepSettings(increments=10, substeps=3, max_cutbacks=2, max_iterations=9))
+    assert Full3D(2, ramp_spec=solved_otherwise, backend="felupe").fingerprint() == base.fingerprint()
+    assert base.describe()["steps"] == {"increments": 10, "tolerance": 1e-8}
+    assert Full3D(2, ramp_spec=RampSpec(steps=StepSettings(increments=5))).fingerprint() != base.fingerprint()
+    assert Full3D(2, ramp_spec=RampSpec(steps=StepSettings(tolerance=1e-6))).fingerprint() != base.fingerprint()
+    assert Full3D(2, ramp_spec=RampSpec(pressure=0.03)).fingerprint() != base.fingerprint()

@@ -1,4 +1,5 @@
-"""Newton's method on a :class:`~pneumorph.fem.fastassembly.PlaneStrainSystem`.
+"""Newton's method on a fast system (:class:`~pneumorph.fem.fastassembly.PlaneStrainSystem`,
+:class:`~pneumorph.fem.fastassembly3d.SolidSystem3D`).
 
 The convergence test is FElupe's (``felupe.tools._newton.check``): the norm of the
 residual of the active dofs over ``1e-3`` plus the norm of the reaction forces,
@@ -21,7 +22,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.fem.fastassembly import PlaneStrainSystem
 
 FloatArray = NDArray[np.float64]
 
@@ -32,17 +32,20 @@ FloatArray = NDArray[np.float64]
 DIVERGED = 1e3
 
 
-def pattern_solver(indptr: NDArray[np.int32], indices: NDArray[np.int32]) -> Callable[[Any, Any], FloatArray]:
-    """``solve(data, b)`` for matrices on one CSR pattern: PARDISO if available, else SuperLU."""
-    from pneumorph.fem.linear import PardisoPattern, superlu
+def pattern_solver(
+    indptr: NDArray[np.int32], indices: NDArray[np.int32], symmetric: bool = False, ordering: int = 0
+) -> Any:
+    """A solver for matrices on one CSR pattern: PARDISO if available, else SuperLU.
+
+    It is called as ``solve(data, b)`` or as ``factorize(data)`` then ``solve(b)``. With
+    ``symmetric`` the pattern is the upper triangle of a symmetric matrix.
+    """
+    from pneumorph.fem.linear import PardisoPattern, SuperLUPattern
 
     try:
-        return PardisoPattern(indptr, indices)
+        return PardisoPattern(indptr, indices, symmetric=symmetric, ordering=ordering)
     except ImportError:
-        import scipy.sparse as sp
-
-        n = len(indptr) - 1
-        return lambda data, b: superlu(sp.csr_matrix((data, indices, indptr), shape=(n, n)), b)
+        return SuperLUPattern(indptr, indices, symmetric=symmetric)
 
 
 def residual_norm(r: FloatArray, dof1: NDArray[np.int64], dof0: NDArray[np.int64]) -> float:
@@ -57,20 +60,77 @@ class FastSubstep:
     (written back in place) and returns ``(iterations, cause of failure or None)``, like
     the FElupe path of the ramp.
 
+    With ``reuse`` it is a Newton method that keeps its factorised tangent while that
+    still converges well (a chord method with refresh): every substep starts with a
+    fresh tangent at its predicted state; an iteration whose residual norm falls by less
+    than the factor ``reuse`` has the tangent re-assembled and factorised at the state it
+    reached, and a step of a kept tangent that does not lower the residual at all is
+    taken back and redone with a fresh tangent. Near the solution a kept tangent
+    converges almost as fast as a fresh one, so where a factorisation costs many
+    residual evaluations (3D) this saves most of them; the converged states satisfy the
+    same criterion as Newton's.
+
     Parameters
     ----------
-    system : PlaneStrainSystem
-        The assembled model.
-    solver : callable, optional
-        ``solver(data, b)`` for the active block given by its CSR values on the
-        system's pattern (default: :func:`pattern_solver`).
+    system : PlaneStrainSystem or SolidSystem3D
+        The assembled model (its ``symmetric`` and ``ordering`` attributes choose the
+        default solver).
+    solver : object, optional
+        With ``factorize(data)`` and ``solve(b)`` for the active block given by its CSR
+        values on the system's pattern (default: :func:`pattern_solver`); a plain
+        callable ``solver(data, b)`` allows Newton's method only.
+    reuse : float, optional
+        Residual reduction factor per iteration below which a tangent is kept (None:
+        Newton's method, a fresh tangent at every iteration).
+
+    Attributes
+    ----------
+    factorisations : int
+        Tangents assembled and factorised so far.
     """
 
-    def __init__(self, system: PlaneStrainSystem, solver: Callable[[Any, Any], FloatArray] | None = None) -> None:
+    def __init__(
+        self, system: Any, solver: Any = None, reuse: float | None = None, depth: int = 0, fresh_start: bool = True
+    ) -> None:
         self.system = system
-        self.solver = solver or pattern_solver(system.indptr, system.indices)
+        self.solver = solver or pattern_solver(
+            system.indptr, system.indices, getattr(system, "symmetric", False), getattr(system, "ordering", 0)
+        )
+        if reuse is not None and not (0.0 < reuse < 1.0 and hasattr(self.solver, "factorize")):
+            raise ValueError(f"reuse must lie in (0, 1) with a solver that factorises once, got {reuse}")
+        self.reuse = reuse
+        self.depth = int(depth)
+        self.fresh_start = bool(fresh_start)
+        self.factorisations = 0
+        self._factorised = False
+        #: set to a list to record ``(residual norm, tangent fresh)`` after every iteration
+        self.trace: list[tuple[float, bool]] | None = None
+
+    def _factorize(self) -> None:
+        data = self.system.tangent_data()
+        if hasattr(self.solver, "factorize"):
+            self.solver.factorize(data)
+        else:
+            self._data = data
+        self._factorised = True
+        self.factorisations += 1
+
+    def _solve(self, b: FloatArray) -> FloatArray:
+        if hasattr(self.solver, "factorize"):
+            return np.asarray(self.solver.solve(b))
+        return np.asarray(self.solver(self._data, b))
 
     def __call__(self, fields: Any, settings: Any) -> tuple[int, str | None]:
+        if self.reuse is None:
+            return self._newton(fields, settings)
+        if self.fresh_start:
+            self._factorised = False
+        iterations, cause = self._chord(fields, settings)
+        if cause is not None:
+            self._factorised = False
+        return iterations, cause
+
+    def _newton(self, fields: Any, settings: Any) -> tuple[int, str | None]:
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
         values = fields[0].values
@@ -83,7 +143,8 @@ class FastSubstep:
                 return 0, f"the predicted start is not admissible (det F = {jmin:.3g})"
             for iteration in range(1, settings.max_iterations + 1):
                 try:
-                    dx = self.solver(system.tangent_data(), -r[dof1])
+                    self._factorize()
+                    dx = self._solve(-r[dof1])
                 except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
                     return iteration, f"{type(exc).__name__}: {exc}"
                 if not np.all(np.isfinite(dx)):
@@ -91,6 +152,8 @@ class FastSubstep:
                 u[dof1] += dx
                 r, jmin = system.residual(u)
                 fnorm = residual_norm(r, dof1, dof0)
+                if self.trace is not None:
+                    self.trace.append((fnorm, True))
                 if not np.isfinite(fnorm):
                     return iteration, "the residual is not finite"
                 if fnorm > DIVERGED:
@@ -100,5 +163,76 @@ class FastSubstep:
                     if not jmin > 0.0:
                         return iteration, f"an element inverted (det F = {jmin:.3g})"
                     return iteration, None
+        values[:] = u.reshape(values.shape)
+        return settings.max_iterations, "Newton iterations did not reach the tolerance"
+
+    def _chord(self, fields: Any, settings: Any) -> tuple[int, str | None]:
+        """Chord iterations with Anderson acceleration and refresh (see the class notes)."""
+        system = self.system
+        dof1, dof0 = system.dof1, system.dof0
+        values = fields[0].values
+        u = values.ravel().copy()
+        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            r, jmin = system.residual(u)
+            if not (jmin > 0.0 and np.all(np.isfinite(r))):
+                return 0, f"the predicted start is not admissible (det F = {jmin:.3g})"
+            fnorm = residual_norm(r, dof1, dof0)
+            if self.trace is not None:
+                self.trace.append((fnorm, False))
+            f: FloatArray | None = None  # chord step -K0^-1 r at u
+            dU: list[FloatArray] = []
+            dF: list[FloatArray] = []
+            fresh = False
+            for iteration in range(1, settings.max_iterations + 1):
+                try:
+                    if not self._factorised:
+                        self._factorize()  # at the state of the last residual, u
+                        fresh, f, dU, dF = True, None, [], []
+                    if f is None:
+                        f = -self._solve(r[dof1])
+                except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
+                    return iteration, f"{type(exc).__name__}: {exc}"
+                step = f
+                if dF:
+                    Fm = np.column_stack(dF)
+                    gamma = np.linalg.lstsq(Fm, f, rcond=None)[0]
+                    step = f - (np.column_stack(dU) + Fm) @ gamma
+                if not np.all(np.isfinite(step)):
+                    return iteration, "the linear solve gave a non-finite increment"
+                u_new = u.copy()
+                u_new[dof1] += step
+                r_new, jmin = system.residual(u_new)
+                fnorm_new = residual_norm(r_new, dof1, dof0)
+                if self.trace is not None:
+                    self.trace.append((fnorm_new, fresh))
+                if not fresh and not (fnorm_new < fnorm and jmin > 0.0):
+                    # a kept tangent that no longer helps: take the step back, refresh
+                    system.residual(u)  # the state the tangent is assembled at
+                    self._factorised = False
+                    continue
+                if not np.isfinite(fnorm_new):
+                    return iteration, "the residual is not finite"
+                if fnorm_new > DIVERGED:
+                    return iteration, f"diverging (residual norm {fnorm_new:.3g})"
+                if fnorm_new < settings.tolerance:
+                    values[:] = u_new.reshape(values.shape)
+                    if not jmin > 0.0:
+                        return iteration, f"an element inverted (det F = {jmin:.3g})"
+                    return iteration, None
+                if fnorm_new > self.reuse * fnorm:
+                    self._factorised = False  # refresh at u_new
+                    f = None
+                else:
+                    try:
+                        f_new = -self._solve(r_new[dof1])
+                    except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
+                        return iteration, f"{type(exc).__name__}: {exc}"
+                    if self.depth > 0:
+                        dU.append(step)
+                        dF.append(f_new - f)
+                        dU, dF = dU[-self.depth:], dF[-self.depth:]
+                    f = f_new
+                u, r, fnorm, fresh = u_new, r_new, fnorm_new, False
         values[:] = u.reshape(values.shape)
         return settings.max_iterations, "Newton iterations did not reach the tolerance"

@@ -140,3 +140,118 @@ def neo_hooke_plane_strain(F: FloatArray, mu: float, lmbda: float) -> tuple[Floa
         for j in range(2):
             A[i, j, i, j] += mu
     return P, A, J
+
+
+def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Eigenvalues ``(n, 3)`` and eigenvectors ``(n, 3, 3)`` (columns) of ``C = F^T F``.
+
+    The costliest step of :func:`ogden_3d`: pass it there as ``principal`` to reuse it.
+    """
+    return np.linalg.eigh(np.einsum("kIp,kJp->pIJ", F, F))
+
+
+def ogden_3d(
+    F: FloatArray,
+    mu: Sequence[float],
+    alpha: Sequence[float],
+    bulk: float,
+    tangent: bool = True,
+    principal: tuple[FloatArray, FloatArray] | None = None,
+) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+    """Stress and tangent of the compressible Ogden model (Eq 2.12), points last.
+
+    The numbers of :class:`pneumorph.fem.ogden.OgdenCompressible` (principal form,
+    divided differences exact at equal stretches) for deformation gradients stored as
+    ``(3, 3, n)``, so that every step runs elementwise over long rows; only the
+    eigenvectors of ``C`` come from a batched ``numpy.linalg.eigh``.
+
+    Parameters
+    ----------
+    F : ndarray, shape (3, 3, n)
+    mu, alpha : sequence of float
+        Ogden moduli (MPa, published Marc convention) and exponents.
+    bulk : float
+        Bulk modulus of ``9/2 K (J^(1/3) - 1)^2`` (MPa).
+    tangent : bool
+        Compute the tangent (else ``A`` is None: a residual costs about half).
+    principal : tuple of ndarray, optional
+        :func:`principal_3d` of the same ``F``, if already computed.
+
+    Returns
+    -------
+    P : ndarray, shape (3, 3, n)
+    A : ndarray, shape (3, 3, 3, 3, n), or None
+        ``dP_iJ / dF_kL``.
+    J : ndarray, shape (n,)
+        ``det F``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> P, A, J = ogden_3d(np.eye(3)[..., None], [0.1], [2.0], 10.0)
+    >>> float(abs(P).max()), round(float(A[0, 0, 0, 0, 0]), 12), round(float(A[0, 1, 0, 1, 0]), 12)
+    (0.0, 10.133333333333, 0.1)
+    """
+    mu_ = [float(v) for v in mu]
+    alpha_ = [float(v) for v in alpha]
+    terms = range(len(mu_))
+    n = F.shape[-1]
+    c_rows, N_rows = principal if principal is not None else principal_3d(F)
+    c = [np.ascontiguousarray(c_rows[:, a]) for a in range(3)]
+    Nv = np.ascontiguousarray(N_rows.transpose(2, 1, 0))  # Nv[a, J, p] = N_a,J
+    J = (
+        F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
+        - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+        + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0])
+    )
+    lnJ = np.log(J)
+    lnc = [np.log(ca) - lnJ / 1.5 for ca in c]  # ln of c_a J^(-2/3)
+    Jn = [np.exp((-a / 3.0) * lnJ) for a in alpha_]
+    lb = [[np.exp((0.5 * a) * lnc[b]) for b in range(3)] for a in alpha_]  # lb[n][b]
+    m = [(lb_n[0] + lb_n[1] + lb_n[2]) / 3.0 for lb_n in lb]
+    J13 = np.exp(lnJ / 3.0)
+    h = 3.0 * bulk * J13 * (J13 - 1.0)  # J U'(J)
+    S = [(sum(mu_[k] * (lb[k][a] - m[k]) for k in terms) + h) / c[a] for a in range(3)]
+    f = np.einsum("iJp,aJp->aip", F, Nv)  # f[a] = F N_a
+    G = [[np.empty(0)] * 3 for _ in range(3)]  # G[a][b] = f_a (x) N_b
+    for a in range(3):
+        G[a][a] = f[a][:, None] * Nv[a][None, :]
+    P = S[0] * G[0][0] + S[1] * G[1][1] + S[2] * G[2][2]
+    if not tangent:
+        return P, None, J
+    for a, b in ((0, 1), (0, 2), (1, 2), (1, 0), (2, 0), (2, 1)):
+        G[a][b] = f[a][:, None] * Nv[b][None, :]
+    dh = bulk * (2.0 * J13 * J13 - J13)
+    shared = [dh - sum(mu_[k] * alpha_[k] * (lb[k][b] - m[k]) for k in terms) / 3.0 for b in range(3)]
+    diag = [[np.empty(0)] * 3 for _ in range(3)]
+    for a in range(3):
+        own = sum(mu_[k] * alpha_[k] * lb[k][a] for k in terms)
+        for b in range(3):
+            dbeta = (shared[b] + own * ((a == b) - 1.0 / 3.0)) / (2.0 * c[b])
+            diag[a][b] = 2.0 * (dbeta - (a == b) * S[a]) / c[a]  # 2 dS_a / dc_b
+    common = sum(mu_[k] * m[k] for k in terms) - h
+    # A = sum_a G_aa (x) R_a + sum_(a<b) dd_ab Gs_ab (x) Gs_ab + d_ik S_JL, filled row by
+    # row (iJ) of the 9 x 9 matrix: broadcasting whole (3, 3, 3, 3, n) blocks is far slower
+    left, right = [], []
+    for a in range(3):
+        left.append(G[a][a])
+        right.append(diag[a][0] * G[0][0] + diag[a][1] * G[1][1] + diag[a][2] * G[2][2])
+    for a, b in ((0, 1), (0, 2), (1, 2)):
+        dd = common / (c[a] * c[b])
+        for k in terms:
+            dd = dd + mu_[k] * Jn[k] * _power_divided_difference(c[b], c[a], alpha_[k] / 2.0 - 1.0)
+        Gs = G[a][b] + G[b][a]
+        left.append(Gs)
+        right.append(dd * Gs)
+    S_mat = S[0] * Nv[0][:, None] * Nv[0][None, :]
+    for a in (1, 2):
+        S_mat += S[a] * Nv[a][:, None] * Nv[a][None, :]
+    A = np.empty((3, 3, 3, 3, n))
+    for i in range(3):
+        for j in range(3):
+            row = A[i, j]
+            np.multiply(left[0][i, j], right[0], out=row)
+            for L, R in zip(left[1:], right[1:]):
+                row += L[i, j] * R
+            row[i] += S_mat[j]
+    return P, A, J

@@ -8,6 +8,7 @@ is about twice as fast as SciPy's default ordering on these matrices.
 
 from __future__ import annotations
 
+import contextlib
 import threading
 from collections.abc import Callable
 from functools import partial
@@ -93,7 +94,15 @@ class PardisoPattern:
     Parameters
     ----------
     indptr, indices : ndarray
-        The CSR pattern (sorted column indices), 0-based.
+        The CSR pattern (sorted column indices), 0-based; of the upper triangle only for
+        a symmetric matrix.
+    symmetric : bool
+        Real symmetric indefinite matrix (``mtype=-2``, Bunch-Kaufman pivoting), stored
+        as its upper triangle: about half the work and memory of the general LU.
+    ordering : int
+        PARDISO's fill-reducing ordering ``iparm[1]``: 0 minimum degree (default; the
+        best on the 2D tangents), 2 METIS nested dissection (on the 3D tangents a
+        quarter less fill and factorisation time than minimum degree).
 
     Examples
     --------
@@ -103,7 +112,7 @@ class PardisoPattern:
     [0.090909, 0.636364]
     """
 
-    def __init__(self, indptr: np.ndarray, indices: np.ndarray) -> None:
+    def __init__(self, indptr: np.ndarray, indices: np.ndarray, symmetric: bool = False, ordering: int = 0) -> None:
         import ctypes
 
         Pardiso()  # loads MKL once per thread
@@ -114,8 +123,10 @@ class PardisoPattern:
         self.ja = np.ascontiguousarray(indices, dtype=np.int32) + 1
         self.pt = np.zeros(64, dtype=np.int64)
         self.iparm = np.zeros(64, dtype=np.int32)
-        self.iparm[0] = 1  # user values: minimum degree (iparm[1] = 0), no scaling/matching
-        self.iparm[9] = 13  # pivot perturbation 1e-13 (the non-symmetric default)
+        self.mtype = -2 if symmetric else 11
+        self.iparm[0] = 1  # user values: no scaling/matching
+        self.iparm[1] = int(ordering)
+        self.iparm[9] = 8 if symmetric else 13  # pivot perturbation 1e-8 / 1e-13 (MKL's defaults)
         self.analysed = False
         self.factorisations = 0
 
@@ -127,7 +138,7 @@ class PardisoPattern:
         f64 = ct.POINTER(ct.c_double)
         self._lib._mkl_pardiso(
             self.pt.ctypes.data_as(ct.POINTER(ct.c_int64)), ct.byref(ct.c_int32(1)), ct.byref(ct.c_int32(1)),
-            ct.byref(ct.c_int32(11)), ct.byref(ct.c_int32(phase)), ct.byref(ct.c_int32(self.n)),
+            ct.byref(ct.c_int32(self.mtype)), ct.byref(ct.c_int32(phase)), ct.byref(ct.c_int32(self.n)),
             data.ctypes.data_as(f64), self.ia.ctypes.data_as(i32), self.ja.ctypes.data_as(i32),
             np.zeros(0, dtype=np.int32).ctypes.data_as(i32), ct.byref(ct.c_int32(1)),
             self.iparm.ctypes.data_as(i32), ct.byref(ct.c_int32(0)), b.ctypes.data_as(f64),
@@ -139,17 +150,60 @@ class PardisoPattern:
 
     def __call__(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Solve ``A x = b`` for the matrix with CSR values ``data`` on the pattern."""
+        self.factorize(data)
+        return self.solve(b)
+
+    def factorize(self, data: np.ndarray) -> None:
+        """Factorise the matrix with CSR values ``data`` (kept for :meth:`solve`)."""
         data = np.ascontiguousarray(data, dtype=float)
-        b = np.ascontiguousarray(b, dtype=float)
+        b = np.zeros(self.n)
         if not self.analysed:
             self._call(11, data, b)
             self.analysed = True
+        self._call(22, data, b)
+        self._data = data
         self.factorisations += 1
-        return self._call(23, data, b)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Solve with the last factorisation."""
+        return self._call(33, self._data, np.ascontiguousarray(b, dtype=float))
 
     def __del__(self) -> None:
         if getattr(self, "analysed", False):
-            import contextlib
-
             with contextlib.suppress(Exception):  # nothing to release at interpreter shutdown
                 self._call(-1, np.zeros(0), np.zeros(0))
+
+
+class SuperLUPattern:
+    """SciPy's SuperLU with :class:`PardisoPattern`'s interface (where MKL is missing).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> solve = SuperLUPattern(np.array([0, 2, 3]), np.array([0, 1, 1]), symmetric=True)
+    >>> np.round(solve(np.array([4.0, 1.0, 3.0]), np.array([1.0, 2.0])), 6).tolist()
+    [0.090909, 0.636364]
+    """
+
+    def __init__(self, indptr: np.ndarray, indices: np.ndarray, symmetric: bool = False) -> None:
+        self.indptr, self.indices, self.symmetric = indptr, indices, symmetric
+        self.n = len(indptr) - 1
+        self.factorisations = 0
+        self._lu: Any = None
+
+    def factorize(self, data: np.ndarray) -> None:
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import splu
+
+        A = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+        if self.symmetric:
+            A = A + sp.triu(A, k=1).T
+        self._lu = splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        self.factorisations += 1
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return np.asarray(self._lu.solve(np.asarray(b, dtype=float)))
+
+    def __call__(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
+        self.factorize(data)
+        return self.solve(b)
