@@ -17,7 +17,7 @@ from felupe.tools._newton import fun_items, jac_items
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume
 from pneumorph.fem.fastassembly3d import SolidSystem3D
 from pneumorph.fem.fastnewton import FastSubstep
-from pneumorph.fem.kernels import ogden_3d
+from pneumorph.fem.kernels import ogden_3d, principal_3d
 from pneumorph.fem.linear import PardisoPattern, SuperLUPattern
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Full3D
@@ -44,6 +44,22 @@ def test_ogden_kernel_is_the_felupe_material() -> None:
     np.testing.assert_allclose(A, A3, rtol=0, atol=1e-12 * abs(A3).max())
     np.testing.assert_allclose(J, np.linalg.det(np.moveaxis(F, -1, 0)), rtol=1e-13)
     assert none is None and np.array_equal(P_only, P)
+
+
+def test_closed_form_eigen_decomposition_of_C() -> None:
+    """Closed form where the eigenvalues are apart, LAPACK where they (nearly) coincide."""
+    rng = np.random.default_rng(2)
+    F = np.eye(3)[..., None] + 0.3 * rng.standard_normal((3, 3, 500))
+    F[..., 0] = np.eye(3)
+    F[..., 1] = np.diag([1.2, 1.2, 0.9])
+    F[..., 2] = np.eye(3) + 1e-7 * rng.standard_normal((3, 3))  # gaps far below 1e-4
+    F[..., 3] = np.diag([1.0, 1.0 + 1e-3, 1.3])  # a gap of 2e-3 in the closed form
+    C = np.einsum("kIp,kJp->pIJ", F, F)
+    c, N = principal_3d(F)
+    c_ref = np.linalg.eigvalsh(C)
+    np.testing.assert_allclose(c, c_ref, rtol=0, atol=1e-13 * c_ref.max())
+    np.testing.assert_allclose(np.einsum("pia,pja->pij", N * c[:, None, :], N), C, rtol=0, atol=1e-13 * c_ref.max())
+    np.testing.assert_allclose(np.einsum("pia,pib->pab", N, N), np.broadcast_to(np.eye(3), C.shape), atol=1e-14)
 
 
 @pytest.fixture(scope="module")

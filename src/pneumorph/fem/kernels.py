@@ -142,12 +142,71 @@ def neo_hooke_plane_strain(F: FloatArray, mu: float, lmbda: float) -> tuple[Floa
     return P, A, J
 
 
+#: relative eigenvalue gap below which :func:`principal_3d` uses LAPACK instead of the
+#: closed form (whose eigenvectors lose accuracy as eps / gap)
+_GAP = 1e-4
+
+
 def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Eigenvalues ``(n, 3)`` and eigenvectors ``(n, 3, 3)`` (columns) of ``C = F^T F``.
 
-    The costliest step of :func:`ogden_3d`: pass it there as ``principal`` to reuse it.
+    The costliest step of :func:`ogden_3d` (pass it there as ``principal`` to reuse
+    it). Closed form where the eigenvalues are apart: the trigonometric solution of the
+    characteristic cubic, eigenvectors of the extreme eigenvalues as the largest cross
+    product of two rows of ``C - c I``, the middle one completing the right-handed
+    basis. Points with a relative gap below ``1e-4`` (the undeformed state, uniaxial
+    and equibiaxial states) go to LAPACK's ``eigh``, which is several times slower.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> c, N = principal_3d(np.diag([1.0, 1.2, 1.5])[..., None])
+    >>> np.round(c, 12).tolist(), np.round(abs(N[0]), 12).tolist()
+    ([[1.0, 1.44, 2.25]], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     """
-    return np.linalg.eigh(np.einsum("kIp,kJp->pIJ", F, F))
+    C11 = np.einsum("kp,kp->p", F[:, 0], F[:, 0])
+    C22 = np.einsum("kp,kp->p", F[:, 1], F[:, 1])
+    C33 = np.einsum("kp,kp->p", F[:, 2], F[:, 2])
+    C12 = np.einsum("kp,kp->p", F[:, 0], F[:, 1])
+    C13 = np.einsum("kp,kp->p", F[:, 0], F[:, 2])
+    C23 = np.einsum("kp,kp->p", F[:, 1], F[:, 2])
+    q = (C11 + C22 + C33) / 3.0
+    B11, B22, B33 = C11 - q, C22 - q, C33 - q
+    p2 = (B11 * B11 + B22 * B22 + B33 * B33 + 2.0 * (C12 * C12 + C13 * C13 + C23 * C23)) / 6.0
+    p = np.sqrt(p2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        detB = B11 * (B22 * B33 - C23 * C23) - C12 * (C12 * B33 - C23 * C13) + C13 * (C12 * C23 - B22 * C13)
+        r = np.clip(detB / (2.0 * p2 * p), -1.0, 1.0)
+    phi = np.arccos(r) / 3.0
+    hi = q + 2.0 * p * np.cos(phi)
+    lo = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
+    mid = 3.0 * q - hi - lo
+    c = np.stack([lo, mid, hi], axis=1)
+    rows = np.stack(
+        [np.stack([C11, C12, C13], axis=1), np.stack([C12, C22, C23], axis=1), np.stack([C13, C23, C33], axis=1)],
+        axis=1,
+    )  # (n, 3, 3)
+
+    def vector(lam: FloatArray) -> FloatArray:
+        M = rows.copy()
+        for i in range(3):
+            M[:, i, i] -= lam
+        cands = np.stack([np.cross(M[:, 0], M[:, 1]), np.cross(M[:, 0], M[:, 2]), np.cross(M[:, 1], M[:, 2])])
+        norms = np.einsum("kpi,kpi->kp", cands, cands)
+        best = np.argmax(norms, axis=0)
+        v = np.take_along_axis(cands, best[None, :, None], axis=0)[0]
+        return v / np.sqrt(np.take_along_axis(norms, best[None], axis=0)[0])[:, None]
+
+    v_lo = vector(lo)
+    v_hi = vector(hi)
+    v_hi -= np.einsum("pi,pi->p", v_hi, v_lo)[:, None] * v_lo
+    v_hi /= np.linalg.norm(v_hi, axis=1)[:, None]
+    v_mid = np.cross(v_hi, v_lo)
+    N = np.stack([v_lo, v_mid, v_hi], axis=2)
+    close = ~((np.minimum(mid - lo, hi - mid) > _GAP * q) & np.all(np.isfinite(N), axis=(1, 2)))
+    if np.any(close):
+        c[close], N[close] = np.linalg.eigh(rows[close])
+    return c, N
 
 
 def ogden_3d(
