@@ -44,6 +44,10 @@ def test_ogden_kernel_is_the_felupe_material() -> None:
     np.testing.assert_allclose(A, A3, rtol=0, atol=1e-12 * abs(A3).max())
     np.testing.assert_allclose(J, np.linalg.det(np.moveaxis(F, -1, 0)), rtol=1e-13)
     assert none is None and np.array_equal(P_only, P)
+    pairs = [(0, 0), (0, 2), (2, 1)]
+    _, blocks, _ = ogden_3d(F, MU, ALPHA, K, pairs=pairs)
+    for m, (i, k) in enumerate(pairs):
+        np.testing.assert_allclose(blocks[m], A[i, :, k], rtol=0, atol=1e-14 * abs(A3).max())
 
 
 def test_closed_form_eigen_decomposition_of_C() -> None:

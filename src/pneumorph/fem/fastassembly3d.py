@@ -66,7 +66,7 @@ def _kernel_of(umat: Any) -> Kernel:
     from pneumorph.fem.ogden import OgdenCompressible
 
     if isinstance(umat, OgdenCompressible):
-        return lambda F, tangent, principal: ogden_3d(F, umat.mu, umat.alpha, umat.bulk, tangent, principal)
+        return lambda F, tangent, principal: ogden_3d(F, umat.mu, umat.alpha, umat.bulk, tangent, principal, _UPPER)
     raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
 
@@ -268,14 +268,13 @@ class SolidSystem3D:
     def tangent_data(self) -> FloatArray:
         """CSR ``data`` of the upper triangle of ``K[dof1, dof1]`` (state of the last residual)."""
         data = np.zeros(self.nnz)
-        ik = np.array(_UPPER)
         for s, (Fp, principal) in zip(self.solids, self._state):
             c, q, n, _ = s.g.shape
             _, A, _ = s.kernel(Fp, True, principal)
             assert A is not None
             dV = s.dV.reshape(-1)
             # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
-            Ap = (A[ik[:, 0], :, ik[:, 1]] * dV).transpose(3, 1, 0, 2).reshape(c, q, 3, 6, 3)
+            Ap = (A * dV).transpose(3, 1, 0, 2).reshape(c, q, 3, 6, 3)
             blocks = np.empty((c, n, 6, n))
             for start in range(0, c, _CHUNK):
                 sl = slice(start, min(start + _CHUNK, c))

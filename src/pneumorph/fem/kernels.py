@@ -216,6 +216,7 @@ def ogden_3d(
     bulk: float,
     tangent: bool = True,
     principal: tuple[FloatArray, FloatArray] | None = None,
+    pairs: Sequence[tuple[int, int]] | None = None,
 ) -> tuple[FloatArray, FloatArray | None, FloatArray]:
     """Stress and tangent of the compressible Ogden model (Eq 2.12), points last.
 
@@ -235,6 +236,9 @@ def ogden_3d(
         Compute the tangent (else ``A`` is None: a residual costs about half).
     principal : tuple of ndarray, optional
         :func:`principal_3d` of the same ``F``, if already computed.
+    pairs : sequence of (int, int), optional
+        Return only the blocks ``A[i, :, k, :]`` of these component pairs, as an array
+        ``(len(pairs), 3, 3, n)`` (a symmetric tangent needs the pairs ``i <= k``).
 
     Returns
     -------
@@ -305,6 +309,17 @@ def ogden_3d(
     S_mat = S[0] * Nv[0][:, None] * Nv[0][None, :]
     for a in (1, 2):
         S_mat += S[a] * Nv[a][:, None] * Nv[a][None, :]
+    if pairs is not None:  # only the blocks A[i, :, k, :] asked for, as [pair, J, L]
+        Ab = np.empty((len(pairs), 3, 3, n))
+        for m, (i, k) in enumerate(pairs):
+            for j in range(3):
+                row = Ab[m, j]
+                np.multiply(left[0][i, j], right[0][k], out=row)
+                for L, R in zip(left[1:], right[1:]):
+                    row += L[i, j] * R[k]
+                if i == k:
+                    row += S_mat[j]
+        return P, Ab, J
     A = np.empty((3, 3, 3, 3, n))
     for i in range(3):
         for j in range(3):

@@ -253,7 +253,7 @@ def ramp(
             if cause is None:
                 watched = value
                 current, t_now = _values(fields), t_try
-                history = [*history[-2:], (t_now, current)]
+                history = [*history[-max(2, predictor_order):], (t_now, current)]
                 stats.substeps += 1
                 stats.history.append((t_now, iterations))
                 if on_substep is not None:
