@@ -59,11 +59,11 @@ def test_closed_form_eigen_decomposition_of_C() -> None:
     F[..., 2] = np.eye(3) + 1e-7 * rng.standard_normal((3, 3))  # gaps far below 1e-4
     F[..., 3] = np.diag([1.0, 1.0 + 1e-3, 1.3])  # a gap of 2e-3 in the closed form
     C = np.einsum("kIp,kJp->pIJ", F, F)
-    c, N = principal_3d(F)
+    c, N = principal_3d(F)  # (a, p), (a, J, p)
     c_ref = np.linalg.eigvalsh(C)
-    np.testing.assert_allclose(c, c_ref, rtol=0, atol=1e-13 * c_ref.max())
-    np.testing.assert_allclose(np.einsum("pia,pja->pij", N * c[:, None, :], N), C, rtol=0, atol=1e-13 * c_ref.max())
-    np.testing.assert_allclose(np.einsum("pia,pib->pab", N, N), np.broadcast_to(np.eye(3), C.shape), atol=1e-14)
+    np.testing.assert_allclose(c.T, c_ref, rtol=0, atol=1e-13 * c_ref.max())
+    np.testing.assert_allclose(np.einsum("aip,ap,ajp->pij", N, c, N), C, rtol=0, atol=1e-13 * c_ref.max())
+    np.testing.assert_allclose(np.einsum("aip,bip->pab", N, N), np.broadcast_to(np.eye(3), C.shape), atol=1e-14)
 
 
 @pytest.fixture(scope="module")

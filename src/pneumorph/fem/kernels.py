@@ -148,7 +148,7 @@ _GAP = 1e-4
 
 
 def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Eigenvalues ``(n, 3)`` and eigenvectors ``(n, 3, 3)`` (columns) of ``C = F^T F``.
+    """Eigenvalues ``c[a]`` ``(3, n)`` and eigenvectors ``N[a, J]`` ``(3, 3, n)`` of ``C = F^T F``.
 
     The costliest step of :func:`ogden_3d` (pass it there as ``principal`` to reuse
     it). Closed form where the eigenvalues are apart: the trigonometric solution of the
@@ -156,20 +156,21 @@ def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
     product of two rows of ``C - c I``, the middle one completing the right-handed
     basis. Points with a relative gap below ``1e-4`` (the undeformed state, uniaxial
     and equibiaxial states) go to LAPACK's ``eigh``, which is several times slower.
+    Eigenvalues ascend.
 
     Examples
     --------
     >>> import numpy as np
     >>> c, N = principal_3d(np.diag([1.0, 1.2, 1.5])[..., None])
-    >>> np.round(c, 12).tolist(), np.round(abs(N[0]), 12).tolist()
-    ([[1.0, 1.44, 2.25]], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> np.round(c[:, 0], 12).tolist(), np.round(abs(N[..., 0]), 12).tolist()
+    ([1.0, 1.44, 2.25], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     """
-    C11 = np.einsum("kp,kp->p", F[:, 0], F[:, 0])
-    C22 = np.einsum("kp,kp->p", F[:, 1], F[:, 1])
-    C33 = np.einsum("kp,kp->p", F[:, 2], F[:, 2])
-    C12 = np.einsum("kp,kp->p", F[:, 0], F[:, 1])
-    C13 = np.einsum("kp,kp->p", F[:, 0], F[:, 2])
-    C23 = np.einsum("kp,kp->p", F[:, 1], F[:, 2])
+    C11 = F[0, 0] * F[0, 0] + F[1, 0] * F[1, 0] + F[2, 0] * F[2, 0]
+    C22 = F[0, 1] * F[0, 1] + F[1, 1] * F[1, 1] + F[2, 1] * F[2, 1]
+    C33 = F[0, 2] * F[0, 2] + F[1, 2] * F[1, 2] + F[2, 2] * F[2, 2]
+    C12 = F[0, 0] * F[0, 1] + F[1, 0] * F[1, 1] + F[2, 0] * F[2, 1]
+    C13 = F[0, 0] * F[0, 2] + F[1, 0] * F[1, 2] + F[2, 0] * F[2, 2]
+    C23 = F[0, 1] * F[0, 2] + F[1, 1] * F[1, 2] + F[2, 1] * F[2, 2]
     q = (C11 + C22 + C33) / 3.0
     B11, B22, B33 = C11 - q, C22 - q, C33 - q
     p2 = (B11 * B11 + B22 * B22 + B33 * B33 + 2.0 * (C12 * C12 + C13 * C13 + C23 * C23)) / 6.0
@@ -181,31 +182,42 @@ def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
     hi = q + 2.0 * p * np.cos(phi)
     lo = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
     mid = 3.0 * q - hi - lo
-    c = np.stack([lo, mid, hi], axis=1)
-    rows = np.stack(
-        [np.stack([C11, C12, C13], axis=1), np.stack([C12, C22, C23], axis=1), np.stack([C13, C23, C33], axis=1)],
-        axis=1,
-    )  # (n, 3, 3)
 
-    def vector(lam: FloatArray) -> FloatArray:
-        M = rows.copy()
-        for i in range(3):
-            M[:, i, i] -= lam
-        cands = np.stack([np.cross(M[:, 0], M[:, 1]), np.cross(M[:, 0], M[:, 2]), np.cross(M[:, 1], M[:, 2])])
-        norms = np.einsum("kpi,kpi->kp", cands, cands)
-        best = np.argmax(norms, axis=0)
-        v = np.take_along_axis(cands, best[None, :, None], axis=0)[0]
-        return v / np.sqrt(np.take_along_axis(norms, best[None], axis=0)[0])[:, None]
+    def vector(lam: FloatArray) -> list[FloatArray]:
+        m11, m22, m33 = C11 - lam, C22 - lam, C33 - lam
+        cands = [  # cross products of the rows of C - lam I: (1, 2), (1, 3), (2, 3)
+            (C12 * C23 - C13 * m22, C13 * C12 - m11 * C23, m11 * m22 - C12 * C12),
+            (C12 * m33 - C13 * C23, C13 * C13 - m11 * m33, m11 * C23 - C12 * C13),
+            (m22 * m33 - C23 * C23, C23 * C13 - C12 * m33, C12 * C23 - m22 * C13),
+        ]
+        norms = [x * x + y * y + z * z for x, y, z in cands]
+        first = (norms[0] >= norms[1]) & (norms[0] >= norms[2])
+        second = ~first & (norms[1] >= norms[2])
+        v = [np.where(first, cands[0][j], np.where(second, cands[1][j], cands[2][j])) for j in range(3)]
+        scale = 1.0 / np.sqrt(np.where(first, norms[0], np.where(second, norms[1], norms[2])))
+        return [vj * scale for vj in v]
 
     v_lo = vector(lo)
     v_hi = vector(hi)
-    v_hi -= np.einsum("pi,pi->p", v_hi, v_lo)[:, None] * v_lo
-    v_hi /= np.linalg.norm(v_hi, axis=1)[:, None]
-    v_mid = np.cross(v_hi, v_lo)
-    N = np.stack([v_lo, v_mid, v_hi], axis=2)
-    close = ~((np.minimum(mid - lo, hi - mid) > _GAP * q) & np.all(np.isfinite(N), axis=(1, 2)))
+    dot = v_hi[0] * v_lo[0] + v_hi[1] * v_lo[1] + v_hi[2] * v_lo[2]
+    v_hi = [v_hi[j] - dot * v_lo[j] for j in range(3)]
+    scale = 1.0 / np.sqrt(v_hi[0] * v_hi[0] + v_hi[1] * v_hi[1] + v_hi[2] * v_hi[2])
+    v_hi = [vj * scale for vj in v_hi]
+    v_mid = [
+        v_hi[1] * v_lo[2] - v_hi[2] * v_lo[1],
+        v_hi[2] * v_lo[0] - v_hi[0] * v_lo[2],
+        v_hi[0] * v_lo[1] - v_hi[1] * v_lo[0],
+    ]
+    c = np.stack([lo, mid, hi])
+    N = np.array([v_lo, v_mid, v_hi])
+    close = ~((np.minimum(mid - lo, hi - mid) > _GAP * q) & np.all(np.isfinite(N), axis=(0, 1)))
     if np.any(close):
-        c[close], N[close] = np.linalg.eigh(rows[close])
+        Cc = np.stack(
+            [np.stack([C11, C12, C13]), np.stack([C12, C22, C23]), np.stack([C13, C23, C33])]
+        )[..., close]
+        cc, Nc = np.linalg.eigh(np.moveaxis(Cc, -1, 0))  # (m, 3), (m, J, a)
+        c[:, close] = cc.T
+        N[..., close] = Nc.transpose(2, 1, 0)
     return c, N
 
 
@@ -259,9 +271,8 @@ def ogden_3d(
     alpha_ = [float(v) for v in alpha]
     terms = range(len(mu_))
     n = F.shape[-1]
-    c_rows, N_rows = principal if principal is not None else principal_3d(F)
-    c = [np.ascontiguousarray(c_rows[:, a]) for a in range(3)]
-    Nv = np.ascontiguousarray(N_rows.transpose(2, 1, 0))  # Nv[a, J, p] = N_a,J
+    c_all, Nv = principal if principal is not None else principal_3d(F)  # Nv[a, J, p] = N_a,J
+    c = [c_all[0], c_all[1], c_all[2]]
     J = (
         F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
         - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
