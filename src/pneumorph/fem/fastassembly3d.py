@@ -212,14 +212,17 @@ class SolidSystem3D:
             owner.take = np.flatnonzero(valid)
             keys_all.append((lo * n1 + hi).ravel()[owner.take])
         keys = np.concatenate(keys_all)
+        if n1 * n1 < 2**32:
+            keys = keys.astype(np.uint32)  # sorts faster
         order = np.argsort(keys)
         sorted_keys = keys[order]
         first = np.empty(keys.size, dtype=bool)
         first[0] = True
         np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=first[1:])
+        starts = np.flatnonzero(first)
         position = np.empty(keys.size, dtype=np.int64)
-        position[order] = np.cumsum(first) - 1
-        unique = sorted_keys[first]
+        position[order] = np.repeat(np.arange(starts.size), np.diff(np.append(starts, keys.size)))
+        unique = sorted_keys[first].astype(np.int64)
         self.nnz = int(unique.size)
         rows_u = unique // n1
         self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows_u, minlength=n1))]).astype(np.int32)
