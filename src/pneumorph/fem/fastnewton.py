@@ -16,12 +16,10 @@ the cut-back to the ramp.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-
 
 FloatArray = NDArray[np.float64]
 
@@ -61,8 +59,8 @@ class FastSubstep:
     the FElupe path of the ramp.
 
     With ``reuse`` it is a Newton method that keeps its factorised tangent while that
-    still converges well (a chord method with refresh): every substep starts with a
-    fresh tangent at its predicted state; an iteration whose residual norm falls by less
+    still converges well (a chord method with refresh): every substep starts (by
+    default) with a fresh tangent at its predicted state; an iteration whose residual norm falls by less
     than the factor ``reuse`` has the tangent re-assembled and factorised at the state it
     reached, and a step of a kept tangent that does not lower the residual at all is
     taken back and redone with a fresh tangent. Near the solution a kept tangent
@@ -82,6 +80,14 @@ class FastSubstep:
     reuse : float, optional
         Residual reduction factor per iteration below which a tangent is kept (None:
         Newton's method, a fresh tangent at every iteration).
+    depth : int
+        With ``reuse``: Anderson acceleration of the chord steps over this many previous
+        steps (0: plain chord steps). Each step is the chord step minus the combination
+        of the previous step and chord-step differences that best cancels the current
+        chord step (least squares), which approximates the missing tangent update.
+    fresh_start : bool
+        With ``reuse``: assemble a fresh tangent at the start of every substep (default)
+        instead of carrying the last one over.
 
     Attributes
     ----------
