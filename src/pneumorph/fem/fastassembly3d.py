@@ -49,6 +49,7 @@ class _Solid:
     kernel: Kernel
     take: IntArray  # positions in the (c, a, (i, k), b) element blocks that are assembled
     scatter: IntArray  # their CSR positions
+    blocks: FloatArray | None = None  # buffer of the element blocks
 
 
 @dataclass
@@ -278,7 +279,9 @@ class SolidSystem3D:
             dV = s.dV.reshape(-1)
             # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
             Ap = (A * dV).transpose(3, 1, 0, 2).reshape(c, q, 3, 6, 3)
-            blocks = np.empty((c, n, 6, n))
+            if s.blocks is None:  # kept: allocating tens of MB per tangent costs page faults
+                s.blocks = np.empty((c, n, 6, n))
+            blocks = s.blocks
             for start in range(0, c, _CHUNK):
                 sl = slice(start, min(start + _CHUNK, c))
                 m = sl.stop - sl.start
