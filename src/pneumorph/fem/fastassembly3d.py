@@ -139,6 +139,8 @@ class SolidSystem3D:
     symmetric = True
     #: PARDISO ordering: METIS nested dissection suits the 3D pattern
     ordering = 2
+    #: a Newton method that keeps its tangents may factorise in single precision
+    single_precision = True
 
     def __init__(self, items: Sequence[Any], field: Any, dof1: IntArray, dof0: IntArray) -> None:
         import felupe as fem

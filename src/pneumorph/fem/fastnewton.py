@@ -31,17 +31,22 @@ DIVERGED = 1e3
 
 
 def pattern_solver(
-    indptr: NDArray[np.int32], indices: NDArray[np.int32], symmetric: bool = False, ordering: int = 0
+    indptr: NDArray[np.int32],
+    indices: NDArray[np.int32],
+    symmetric: bool = False,
+    ordering: int = 0,
+    single: bool = False,
 ) -> Any:
     """A solver for matrices on one CSR pattern: PARDISO if available, else SuperLU.
 
     It is called as ``solve(data, b)`` or as ``factorize(data)`` then ``solve(b)``. With
-    ``symmetric`` the pattern is the upper triangle of a symmetric matrix.
+    ``symmetric`` the pattern is the upper triangle of a symmetric matrix; ``single``
+    asks PARDISO for a single-precision factorisation.
     """
     from pneumorph.fem.linear import PardisoPattern, SuperLUPattern
 
     try:
-        return PardisoPattern(indptr, indices, symmetric=symmetric, ordering=ordering)
+        return PardisoPattern(indptr, indices, symmetric=symmetric, ordering=ordering, single=single)
     except ImportError:
         return SuperLUPattern(indptr, indices, symmetric=symmetric)
 
@@ -100,7 +105,11 @@ class FastSubstep:
     ) -> None:
         self.system = system
         self.solver = solver or pattern_solver(
-            system.indptr, system.indices, getattr(system, "symmetric", False), getattr(system, "ordering", 0)
+            system.indptr,
+            system.indices,
+            getattr(system, "symmetric", False),
+            getattr(system, "ordering", 0),
+            single=reuse is not None and getattr(system, "single_precision", False),
         )
         if reuse is not None and not (0.0 < reuse < 1.0 and hasattr(self.solver, "factorize")):
             raise ValueError(f"reuse must lie in (0, 1) with a solver that factorises once, got {reuse}")

@@ -401,9 +401,9 @@ class Full3D(FEModel):
         as the full model for this symmetric actuator, with half the unknowns.
     backend : {"fast", "felupe"}
         ``"fast"`` (default): :class:`pneumorph.fem.fastassembly3d.SolidSystem3D` (the
-        upper triangle of the symmetric tangent, PARDISO's symmetric indefinite solver)
-        and :class:`pneumorph.fem.fastnewton.FastSubstep` keeping its factorised tangent
-        while it converges well; ``"felupe"``: FElupe's assembly and ``newtonraphson``.
+        upper triangle of the symmetric tangent, PARDISO's symmetric indefinite solver in
+        single precision) and :class:`pneumorph.fem.fastnewton.FastSubstep` keeping its
+        factorised tangent while it converges well; ``"felupe"``: FElupe's assembly and ``newtonraphson``.
         Both stop at the same criterion.
 
     The fingerprint holds the result-determining ramp settings only - the reported
@@ -420,10 +420,12 @@ class Full3D(FEModel):
     # linear one took 62 (same results within the tolerance); 37 for the 15-unit one
     predictor_order = 2
     default_steps = StepSettings(increments=10, substeps=1, max_iterations=25)
-    # a tangent assembled and factorised costs about eight residuals: keep it while the
-    # residual norm at least halves per iteration (chord steps with Anderson acceleration).
-    # 15-unit benchmark design: 17 factorisations and 69 iterations where Newton's method
-    # took 37 of each; a threshold of 0.3 took 21 and 60, 0.7 took 15 and 74.
+    # a tangent assembled and factorised costs several residuals: keep it while the
+    # residual norm at least halves per iteration (chord steps with Anderson acceleration;
+    # the kept tangents are factorised in single precision, SolidSystem3D.single_precision).
+    # 15-unit benchmark design, double-precision factorisations: 17 factorisations and 69
+    # iterations where Newton's method took 37 of each; a threshold of 0.3 took 21 and 60,
+    # 0.7 took 15 and 74. Single precision: 15 and 74 at 0.5.
     tangent_reuse = 0.5
     anderson_depth = 6
 
