@@ -5,7 +5,10 @@ symmetry: 128 solves plus a symmetry check), takes the global optimum of a sin, 
 a tip objective, then runs the GA with a budget of 85 distinct designs (1/3 of the space)
 for five seeds each and counts how often it finds that optimum (issue bar: 4 of 5). The
 GA settings are those of the budget test in ``tests/design/test_search.py``, fixed before
-any objective was looked at.
+any objective was looked at. A GA run counts as a find when its best value equals the
+optimum within 1e-6 (relative): the solver tolerance, since the exhaustive search scores
+half of the designs from the mirror image's solve (mirror-equivalent designs of a
+symmetric objective, such as all-0 and all-1 for the tip-to-base distance, tie).
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/ga_vs_exhaustive.py [--cache F] [--json F]
 """
@@ -51,7 +54,9 @@ def main() -> None:
         for seed in range(args.seeds):
             ga = run_ga(model, obj, GAConfig(seed=seed, **BUDGET_GA), evaluator)
             looked.append(len(ga.scores))
-            found += ga.best.value == best.value
+            # the exhaustive search scores half the designs from their mirror image's solve, so
+            # the same design's value can differ from a direct solve within the solver tolerance
+            found += abs(ga.best.value - best.value) <= 1e-6 * max(1.0, abs(best.value))
         row = {"objective": label, "optimum": best.design, "value": best.value, "level": best.level,
                "exhaustive_wall_s": t_ex, "ga_found": found, "seeds": args.seeds, "ga_distinct_designs": looked}
         rows.append(row)
