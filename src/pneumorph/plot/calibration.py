@@ -28,6 +28,16 @@ def _figure(size: tuple[float, float]) -> Any:
     return fig
 
 
+def _finish(fig: Any, ax: Any, title: str, path: str | Path) -> Path:
+    """Title, grid and legend, then write the figure (150 dpi)."""
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    path = Path(path)
+    fig.savefig(path, dpi=150)
+    return path
+
+
 def centre_distances(r2: Response, r3: Response) -> np.ndarray:
     """(levels, units) distances between matching unit centres of two responses, mm."""
     return np.linalg.norm(r2.centres - r3.centres, axis=-1)
@@ -63,13 +73,8 @@ def plot_law_profiles(responses: Mapping[str, Response], reference: Response, pa
     ax.plot(c3[:, 0], c3[:, 1], "ks--", ms=4, lw=1.2, label="3D")
     ax.plot(reference.reference_centres[:, 0], reference.reference_centres[:, 1], ":", color="0.6",
             label="undeformed")
-    ax.set(xlabel="x [mm]", ylabel="y [mm]", aspect="equal",
-           title=f"Unit centres at {pressure:.1f} kPa, design {reference.orientation}")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    path = Path(path)
-    fig.savefig(path, dpi=150)
-    return path
+    ax.set(xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    return _finish(fig, ax, f"Unit centres at {pressure:.1f} kPa, design {reference.orientation}", path)
 
 
 def plot_filler_paths(responses: Mapping[str, Response], reference: Response, path: str | Path) -> Path:
@@ -91,13 +96,8 @@ def plot_filler_paths(responses: Mapping[str, Response], reference: Response, pa
         colour = f"C{i}"
         ax.plot(p, d.mean(axis=1), "o-", color=colour, label=f"{name}: mean")
         ax.plot(p, d.max(axis=1), "^:", color=colour, label=f"{name}: max")
-    ax.set(xlabel="pressure [kPa]", ylabel="2D-3D unit-centre distance [mm]",
-           title=f"Constant against pressure-dependent filler, design {reference.orientation}")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    path = Path(path)
-    fig.savefig(path, dpi=150)
-    return path
+    ax.set(xlabel="pressure [kPa]", ylabel="2D-3D unit-centre distance [mm]")
+    return _finish(fig, ax, f"Constant vs pressure-dependent filler, {reference.orientation}", path)
 
 
 def constant_law(law: FillerLaw, pressure: float, name: str) -> FillerLaw:
