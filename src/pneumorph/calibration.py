@@ -195,9 +195,8 @@ def best_filler_modulus(
                        gamma=float(objective(x)), start=float(start), evaluations=counter["n"])
 
 
-def _random_designs(n_units: int, count: int, seed: int) -> list[str]:
-    rng = np.random.default_rng(seed)
-    return ["".join(map(str, rng.integers(0, 2, n_units))) for _ in range(count)]
+def _random_design(rng: np.random.Generator, n_units: int) -> str:
+    return "".join(map(str, rng.integers(0, 2, n_units)))
 
 
 def calibration_designs(n_units: int, runs: int, seed: int = 0) -> list[str]:
@@ -208,7 +207,8 @@ def calibration_designs(n_units: int, runs: int, seed: int = 0) -> list[str]:
     >>> calibration_designs(6, 2, seed=0)
     ['011100', '110010']
     """
-    return _random_designs(n_units, runs, seed + 1)
+    rng = np.random.default_rng(seed + 1)
+    return [_random_design(rng, n_units) for _ in range(runs)]
 
 
 def holdout_designs(n_units: int, count: int, seed: int = 0, exclude: Sequence[str] = ()) -> list[str]:
@@ -235,7 +235,7 @@ def holdout_designs(n_units: int, count: int, seed: int = 0, exclude: Sequence[s
     rng = np.random.default_rng(seed + 10_000)
     out: list[str] = []
     while len(out) < count:
-        d = "".join(map(str, rng.integers(0, 2, n_units)))
+        d = _random_design(rng, n_units)
         if d not in excluded and d not in out:
             out.append(d)
     return out
@@ -302,9 +302,8 @@ def calibrate(
     """
     rng = np.random.default_rng(seed)
     levels = np.asarray(pressures_kpa, dtype=float) / 1e3
-    p_max = float(levels.max())
     model3d = reference_model(unit, n_units, pressures_kpa, steps)
-    steps = model3d.ramp.steps
+    steps, p_max = model3d.ramp.steps, model3d.ramp.pressure
     solve_3d = solve_3d or (lambda model, design: model.evaluate(design))
     nu = unit.filler_poisson_ratio
 

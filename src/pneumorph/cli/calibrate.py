@@ -137,12 +137,12 @@ def _validation_figures(result, unit, n_units, design, p_max, solve_3d, folder):
                               result.pressure_range)
         if fit.coefficients and not fit.problems:  # a run's law that is not positive cannot be solved
             laws[f"run {run + 1} law"] = replace(law, coefficients=fit.coefficients)
-    laws["fitted law"] = law
-    profiles = figs.plot_law_profiles(figs.law_responses(unit, n_units, design, ramp, laws), reference,
-                                      folder / "profiles.png")
-    choices = {"E(P)": law,
-               "constant E(0)": figs.constant_law(law, 0.0, "constant E(0)"),
-               f"constant E({p_max * 1e3:g} kPa)": figs.constant_law(law, p_max, "constant E(p_max)")}
-    paths = figs.plot_filler_paths(figs.law_responses(unit, n_units, design, ramp, choices), reference,
+    constants = {"constant E(0)": figs.constant_law(law, 0.0, "constant E(0)"),
+                 f"constant E({p_max * 1e3:g} kPa)": figs.constant_law(law, p_max, "constant E(p_max)")}
+    solved = figs.law_responses(unit, n_units, design, ramp, {"E(P)": law, **laws, **constants})
+    fitted = solved.pop("E(P)")  # solved once, drawn in both figures
+    runs = {name: solved[name] for name in laws}
+    profiles = figs.plot_law_profiles({**runs, "fitted law": fitted}, reference, folder / "profiles.png")
+    paths = figs.plot_filler_paths({"E(P)": fitted, **{name: solved[name] for name in constants}}, reference,
                                    folder / "filler_paths.png")
     return [str(profiles), str(paths)]

@@ -72,9 +72,6 @@ class UnitSpec:
     end_wall : float
         Thickness of each end wall of the cavity.
 
-    The defaults are the unit of the geometry study (``docs/unit-geometry.md``): 3 mm end
-    walls and a 6 mm high cavity make 15 aligned units curl about 300 degrees at 45 kPa in
-    3D, where the closed 1.5 mm-walled 7.5 x 12 mm cavity balloons instead of bending.
     layer : float
         Thickness of the stiff layer that gives the preferential bending direction.
     cavity_height : float
@@ -108,6 +105,12 @@ class UnitSpec:
     ------
     GeometryError
         Non-positive dimensions, walls that leave no cavity, a slit that cuts the unit in two.
+
+    Notes
+    -----
+    The defaults are the unit of the geometry study (``docs/unit-geometry.md``): 3 mm end
+    walls and a 6 mm high cavity make 15 aligned units curl about 300 degrees at 45 kPa in
+    3D, where the closed 1.5 mm-walled 7.5 x 12 mm cavity balloons instead of bending.
     """
 
     pitch: float = 10.5
