@@ -56,6 +56,31 @@ def residual_norm(r: FloatArray, dof1: NDArray[np.int64], dof0: NDArray[np.int64
     return float(np.linalg.norm(r[dof1]) / (1e-3 + np.linalg.norm(r[dof0])))
 
 
+def _inadmissible(r: FloatArray, jmin: float) -> str | None:
+    """Why a substep's starting state cannot be iterated from, or None.
+
+    An over-reaching predictor inverts elements; the ramp then cuts the substep back at no
+    Newton cost.
+    """
+    if jmin > 0.0 and np.all(np.isfinite(r)):
+        return None
+    return f"the predicted start is not admissible (det F = {jmin:.3g})"
+
+
+def _verdict(fnorm: float, jmin: float, u: FloatArray, values: FloatArray, tolerance: float) -> tuple[bool, str | None]:
+    """``(done, cause)`` after an iteration; on convergence ``u`` is written into ``values``."""
+    if not np.isfinite(fnorm):
+        return True, "the residual is not finite"
+    if fnorm > DIVERGED:
+        return True, f"diverging (residual norm {fnorm:.3g})"
+    if fnorm < tolerance:
+        values[:] = u.reshape(values.shape)
+        if not jmin > 0.0:
+            return True, f"an element inverted (det F = {jmin:.3g})"
+        return True, None
+    return False, None
+
+
 class FastSubstep:
     """Solve one substep of :func:`pneumorph.fem.stepping.ramp` on the fast system.
 
@@ -153,9 +178,8 @@ class FastSubstep:
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
             r, jmin = system.residual(u)
-            if not (jmin > 0.0 and np.all(np.isfinite(r))):
-                # an over-reaching predictor: the ramp cuts the substep back at no Newton cost
-                return 0, f"the predicted start is not admissible (det F = {jmin:.3g})"
+            if (cause := _inadmissible(r, jmin)) is not None:
+                return 0, cause
             for iteration in range(1, settings.max_iterations + 1):
                 try:
                     self._factorize()
@@ -169,15 +193,9 @@ class FastSubstep:
                 fnorm = residual_norm(r, dof1, dof0)
                 if self.trace is not None:
                     self.trace.append((fnorm, True))
-                if not np.isfinite(fnorm):
-                    return iteration, "the residual is not finite"
-                if fnorm > DIVERGED:
-                    return iteration, f"diverging (residual norm {fnorm:.3g})"
-                if fnorm < settings.tolerance:
-                    values[:] = u.reshape(values.shape)
-                    if not jmin > 0.0:
-                        return iteration, f"an element inverted (det F = {jmin:.3g})"
-                    return iteration, None
+                done, cause = _verdict(fnorm, jmin, u, values, settings.tolerance)
+                if done:
+                    return iteration, cause
         values[:] = u.reshape(values.shape)
         return settings.max_iterations, "Newton iterations did not reach the tolerance"
 
@@ -190,8 +208,8 @@ class FastSubstep:
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
             r, jmin = system.residual(u)
-            if not (jmin > 0.0 and np.all(np.isfinite(r))):
-                return 0, f"the predicted start is not admissible (det F = {jmin:.3g})"
+            if (cause := _inadmissible(r, jmin)) is not None:
+                return 0, cause
             fnorm = residual_norm(r, dof1, dof0)
             if self.trace is not None:
                 self.trace.append((fnorm, False))
@@ -226,15 +244,9 @@ class FastSubstep:
                     system.residual(u)  # the state the tangent is assembled at
                     self._factorised = False
                     continue
-                if not np.isfinite(fnorm_new):
-                    return iteration, "the residual is not finite"
-                if fnorm_new > DIVERGED:
-                    return iteration, f"diverging (residual norm {fnorm_new:.3g})"
-                if fnorm_new < settings.tolerance:
-                    values[:] = u_new.reshape(values.shape)
-                    if not jmin > 0.0:
-                        return iteration, f"an element inverted (det F = {jmin:.3g})"
-                    return iteration, None
+                done, cause = _verdict(fnorm_new, jmin, u_new, values, settings.tolerance)
+                if done:
+                    return iteration, cause
                 if fnorm_new > self.reuse * fnorm:
                     self._factorised = False  # refresh at u_new
                     f = None
