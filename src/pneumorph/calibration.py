@@ -10,9 +10,18 @@ optimiser from a random starting point, minimising Eq 5.1:
 over the unit-centre displacements at that pressure. The 2D solve for a trial E uses a
 constant filler of modulus E up to the level's pressure: a hyperelastic equilibrium does not
 depend on the loading path, so this is the 2D state at that pressure with E(P) = E. Linear
-and quadratic laws E(P) are then fitted to all (P, E) points by least squares with their
-R^2 (Fig 5.3); a law that fits badly or is not positive over the range is reported with a
-warning and not silently used.
+and quadratic laws E(P) are then fitted to all (P, E) points by weighted least squares with
+their R^2 (Fig 5.3); a law that fits badly or is not positive over the range is reported
+with a warning and not silently used.
+
+Weighting (:data:`WEIGHTINGS`). Near its optimum E*, Eq 5.1 grows like
+``Gamma* + kappa/2 (ln E - ln E*)^2``: what a law's miss costs in displacement is set by its
+*relative* error, scaled by the curvature ``kappa``, which rises steeply with pressure (the
+actuator softens). ``"relative"`` (the default) minimises the squared relative errors;
+``"sensitivity"`` also weights each point by its measured ``kappa`` (two more 2D solves per
+point), which minimises the summed Eq 5.1 over all points to second order; ``"uniform"`` is
+ordinary least squares on E, as in the dissertation. R^2 is reported in the fit's own
+weighting (the weighted-least-squares R^2) and, for comparison with Fig 5.3, unweighted.
 
 3D responses are cached (:class:`pneumorph.execution.EvaluationCache`), so recalibrating
 repeats no 3D solve.
@@ -36,6 +45,10 @@ from pneumorph.models.response import Response
 
 #: R^2 below which a fitted law is reported as a poor fit.
 R2_WARNING = 0.9
+#: How the calibration points are weighted in the fits of E(P) (see the module notes).
+WEIGHTINGS = ("relative", "sensitivity", "uniform")
+#: Step in ln E of the finite difference that measures the curvature of Eq 5.1.
+CURVATURE_STEP = 0.05
 
 
 class CalibrationWarning(UserWarning):
@@ -53,6 +66,7 @@ class FillerPoint:
     gamma: float  # Eq 5.1 at the optimum, mm^2
     start: float  # the optimiser's random starting modulus, MPa
     evaluations: int
+    curvature: float | None = None  # d^2 Gamma / d(ln E)^2 at the optimum, mm^2 (if measured)
 
 
 @dataclass(frozen=True)
@@ -61,9 +75,11 @@ class LawFit:
 
     degree: int
     coefficients: tuple[float, ...]  # c_0, c_1, ... (MPa, P in MPa)
-    r_squared: float
+    r_squared: float  # in the fit's own weighting
     minimum: tuple[float, float]  # (pressure, modulus) over the range
     problems: tuple[str, ...] = ()
+    weighting: str = "uniform"
+    r_squared_unweighted: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -96,8 +112,10 @@ class Calibration:
     def unit_with_law(self, unit: UnitSpec) -> UnitSpec:
         """``unit`` carrying the chosen law, with provenance."""
         law = self.law()
-        src = (f"pneumorph calibrate: {len(self.points)} points, degree {self.chosen.degree}, "  # type: ignore[union-attr]
-               f"R^2 {self.chosen.r_squared:.4f}")  # type: ignore[union-attr]
+        fit = self.chosen
+        assert fit is not None
+        src = (f"pneumorph calibrate: {len(self.points)} points, degree {fit.degree}, {fit.weighting} weighting, "
+               f"R^2 {fit.r_squared:.4f} (unweighted {fit.r_squared_unweighted:.4f})")
         return replace(
             unit,
             filler_coefficients=law.coefficients,
@@ -124,8 +142,23 @@ def gamma(d2: np.ndarray, d3: np.ndarray) -> float:
 
 
 def fit_law(pressures: Sequence[float], moduli: Sequence[float], degree: int,
-            pressure_range: tuple[float, float]) -> LawFit:
-    """Least-squares polynomial E(P) of a degree, with R^2 (Eqs A.1-A.3) and checks.
+            pressure_range: tuple[float, float], weights: Sequence[float] | None = None,
+            weighting: str = "uniform") -> LawFit:
+    """Weighted least-squares polynomial E(P) of a degree, with R^2 (Eqs A.1-A.3) and checks.
+
+    Parameters
+    ----------
+    pressures, moduli : sequence of float
+        The calibration points (MPa).
+    degree : int
+        Degree of the polynomial.
+    pressure_range : (float, float)
+        Range over which the law must stay positive (MPa).
+    weights : sequence of float, optional
+        Multiply the residuals ``E_i - E(P_i)`` (default: all 1). R^2 is computed with the
+        same weights, about the weighted mean; ``r_squared_unweighted`` without them.
+    weighting : str
+        Name of the weighting, recorded in the result.
 
     Examples
     --------
@@ -135,24 +168,60 @@ def fit_law(pressures: Sequence[float], moduli: Sequence[float], degree: int,
     """
     p = np.asarray(pressures, dtype=float)
     e = np.asarray(moduli, dtype=float)
-    if len(np.unique(p)) <= degree + 1:
+    w = np.ones_like(e) if weights is None else np.asarray(weights, dtype=float)
+    if w.shape != e.shape or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.any(w > 0):
+        raise ValueError(f"weights must be finite, non-negative, not all zero and one per point, got {w}")
+    if len(np.unique(p[w > 0])) <= degree + 1:
         nan = float("nan")
         return LawFit(degree, (), nan, (nan, nan),
-                      ((f"degree {degree}: {len(np.unique(p))} pressure levels cannot test a law with "
-                       f"{degree + 1} coefficients"),))
-    coeffs = np.polynomial.polynomial.polyfit(p, e, degree)
+                      ((f"degree {degree}: {len(np.unique(p[w > 0]))} pressure levels cannot test a law with "
+                       f"{degree + 1} coefficients"),), weighting)
+    coeffs = np.polynomial.polynomial.polyfit(p, e, degree, w=w)
     pred = np.polynomial.polynomial.polyval(p, coeffs)
-    ssto = float(np.sum((e - e.mean()) ** 2))
-    r2 = 1.0 - float(np.sum((e - pred) ** 2)) / ssto if ssto > 0 else 1.0
+
+    def r2_of(w2: np.ndarray) -> float:
+        mean = np.sum(w2 * e) / np.sum(w2)
+        ssto = float(np.sum(w2 * (e - mean) ** 2))
+        return 1.0 - float(np.sum(w2 * (e - pred) ** 2)) / ssto if ssto > 0 else 1.0
+
+    r2 = r2_of(w**2)
     grid = np.linspace(*pressure_range, 201)
     values = np.polynomial.polynomial.polyval(grid, coeffs)
     i = int(np.argmin(values))
     problems = []
     if r2 < R2_WARNING:
-        problems.append(f"degree {degree}: R^2 = {r2:.4f} is below {R2_WARNING}")
+        problems.append(f"degree {degree}: R^2 = {r2:.4f} ({weighting} weighting) is below {R2_WARNING}")
     if values[i] <= 0:
         problems.append(f"degree {degree}: modulus {values[i]:.4g} MPa at {grid[i] * 1e3:.4g} kPa is not positive")
-    return LawFit(degree, tuple(float(c) for c in coeffs), r2, (float(grid[i]), float(values[i])), tuple(problems))
+    return LawFit(degree, tuple(float(c) for c in coeffs), r2, (float(grid[i]), float(values[i])), tuple(problems),
+                  weighting, r2_of(np.ones_like(e)))
+
+
+def point_weights(points: Sequence[FillerPoint], weighting: str) -> np.ndarray:
+    """Weights of the calibration points' residuals in E for a weighting of :data:`WEIGHTINGS`.
+
+    ``"uniform"``: 1; ``"relative"``: 1/E; ``"sensitivity"``: sqrt(kappa)/E with kappa the
+    measured curvature of Eq 5.1 in ln E, so that the weighted squared residual is twice
+    the second-order rise of Eq 5.1 from missing the point.
+
+    Examples
+    --------
+    >>> pts = [FillerPoint(0, 0.01, "00", 0.04, 0.0, 0.04, 1, curvature=16.0)]
+    >>> point_weights(pts, "relative"), point_weights(pts, "sensitivity")
+    (array([25.]), array([100.]))
+    """
+    e = np.array([pt.modulus for pt in points], dtype=float)
+    if weighting == "uniform":
+        return np.ones_like(e)
+    if weighting == "relative":
+        return 1.0 / e
+    if weighting == "sensitivity":
+        kappa = np.array([np.nan if pt.curvature is None else pt.curvature for pt in points], dtype=float)
+        if np.any(np.isnan(kappa)):
+            raise ValueError("sensitivity weighting needs the curvature of every point (best_filler_modulus "
+                             "with curvature=True)")
+        return np.sqrt(np.maximum(kappa, 0.0)) / e
+    raise ValueError(f"weighting must be one of {', '.join(WEIGHTINGS)}, got {weighting!r}")
 
 
 def best_filler_modulus(
@@ -162,12 +231,15 @@ def best_filler_modulus(
     make_2d: Callable[[float, float], Reduced2D],
     start: float,
     bounds: tuple[float, float] = (1e-4, 1.0),
+    curvature: bool = False,
 ) -> FillerPoint:
     """The constant filler modulus minimising Eq 5.1 for one design at one reported level.
 
     Brent's method on log10(E), its first bracket at ``start`` (relative tolerance about
     0.5 % in E); trial moduli outside ``bounds`` are clipped and penalised. A 2D solve that
     fails for a trial modulus scores as a very large Gamma, so the search moves away from it.
+    With ``curvature``, two more 2D solves at ``E* exp(+-h)`` (h = :data:`CURVATURE_STEP`)
+    measure ``d^2 Gamma / d(ln E)^2`` at the optimum by a central difference.
     """
     from scipy.optimize import minimize_scalar
 
@@ -191,8 +263,13 @@ def best_filler_modulus(
     x0 = float(np.log10(start))
     res = minimize_scalar(objective, bracket=(x0, x0 + 0.2), method="brent", options={"xtol": 2e-3, "maxiter": 50})
     x = min(max(float(res.x), lo), hi)
+    best = float(objective(x))
+    kappa = None
+    if curvature:
+        dx = CURVATURE_STEP / np.log(10.0)
+        kappa = (objective(x + dx) - 2.0 * best + objective(x - dx)) / CURVATURE_STEP**2
     return FillerPoint(run=-1, pressure=pressure, design=design, modulus=float(10.0**x),
-                       gamma=float(objective(x)), start=float(start), evaluations=counter["n"])
+                       gamma=best, start=float(start), evaluations=counter["n"], curvature=kappa)
 
 
 def _random_design(rng: np.random.Generator, n_units: int) -> str:
@@ -270,6 +347,7 @@ def calibrate(
     steps: StepSettings | None = None,
     solve_3d: Callable[[Full3D, str], Response] | None = None,
     on_point: Callable[[FillerPoint], None] | None = None,
+    weighting: str = "relative",
 ) -> Calibration:
     """Calibrate the unit's filler law (chapter 5, Fig 5.3).
 
@@ -295,11 +373,16 @@ def calibrate(
         ``solve_3d(model, design) -> Response``; pass a cached solver to reuse 3D results.
     on_point : callable, optional
         Progress: called with each :class:`FillerPoint`.
+    weighting : {"relative", "sensitivity", "uniform"}
+        Weights of the points in the fits (module notes); ``"sensitivity"`` measures the
+        curvature of Eq 5.1 at every point (two more 2D solves each).
 
     Returns
     -------
     Calibration
     """
+    if weighting not in WEIGHTINGS:
+        raise SearchConfigError(f"weighting must be one of {', '.join(WEIGHTINGS)}, got {weighting!r}")
     rng = np.random.default_rng(seed)
     levels = np.asarray(pressures_kpa, dtype=float) / 1e3
     model3d = reference_model(unit, n_units, pressures_kpa, steps)
@@ -318,21 +401,23 @@ def calibrate(
         for p in levels:
             start = float(10.0 ** rng.uniform(np.log10(bounds[0]) + 0.5, np.log10(bounds[1]) - 0.5))
             level = reference.level_of(p)
-            point = replace(best_filler_modulus(design, level, reference, make_2d, start, bounds), run=run)
+            point = replace(best_filler_modulus(design, level, reference, make_2d, start, bounds,
+                                                curvature=weighting == "sensitivity"), run=run)
             points.append(point)
             if on_point is not None:
                 on_point(point)
     prange = (0.0, p_max)
     ps = [pt.pressure for pt in points]
     es = [pt.modulus for pt in points]
-    linear = fit_law(ps, es, 1, prange)
-    quadratic = fit_law(ps, es, 2, prange)
+    w = point_weights(points, weighting)
+    linear = fit_law(ps, es, 1, prange, w, weighting)
+    quadratic = fit_law(ps, es, 2, prange, w, weighting)
     chosen = next((f for f in (quadratic, linear) if not f.problems), None)
     for f in (linear, quadratic):
         for problem in f.problems:
             warnings.warn(f"filler law {problem}", CalibrationWarning, stacklevel=2)
     return Calibration(tuple(points), linear, quadratic, chosen, prange, nu,
-                       metadata={"n_units": n_units, "runs": runs, "seed": seed,
+                       metadata={"n_units": n_units, "runs": runs, "seed": seed, "weighting": weighting,
                                  "fingerprint_3d": model3d.fingerprint()})
 
 
@@ -405,7 +490,7 @@ def plot_calibration(cal: Calibration, path: Any) -> Any:
     for fit, style in ((cal.linear, "--"), (cal.quadratic, "-")):
         if fit.coefficients:
             ax.plot(grid * 1e3, np.polynomial.polynomial.polyval(grid, fit.coefficients), style,
-                    label=f"degree {fit.degree}, R$^2$ = {fit.r_squared:.4f}")
+                    label=f"degree {fit.degree}, {fit.weighting} weighting, R$^2$ = {fit.r_squared:.4f}")
     ax.set(xlabel="pressure [kPa]", ylabel="filler modulus E [MPa]", title="Filler law calibration (Eq 5.1)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

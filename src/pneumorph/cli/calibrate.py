@@ -21,9 +21,13 @@ import click
 @click.option("--out", default="runs/calibration", show_default=True, metavar="DIR")
 @click.option("--references-only", is_flag=True,
               help="Only solve (and cache) the 3D references of the calibration and validation designs.")
+@click.option("--weighting", type=click.Choice(["relative", "sensitivity", "uniform"]), default="relative",
+              show_default=True,
+              help="Weights of the points in the fits of E(P): relative error, relative error times the "
+                   "measured sensitivity of Eq 5.1 (two more 2D solves per point), or none.")
 @click.option("--json", "as_json", is_flag=True)
 def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, seed: int, n_validate: int,
-              cache: str | None, out: str, references_only: bool, as_json: bool) -> None:
+              cache: str | None, out: str, references_only: bool, weighting: str, as_json: bool) -> None:
     """Fit the filler law E(P) of the 2D model to the 3D model (chapter 5) and check it.
 
     Writes calibration.json, calibration.png (Fig 5.3) and unit.toml: the unit with the
@@ -56,7 +60,8 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
         click.echo(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
                    f"(Eq 5.1 = {p.gamma:.4g} mm^2, {p.evaluations} 2D solves)", err=True)
 
-    result = cal_mod.calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point)
+    result = cal_mod.calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point,
+                               weighting=weighting)
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     cal_mod.plot_calibration(result, folder / "calibration.png")
@@ -83,7 +88,8 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
         return
     for fit in (result.linear, result.quadratic):
         coeffs = ", ".join(f"{c:.5g}" for c in fit.coefficients)
-        click.echo(f"degree {fit.degree}: coefficients [{coeffs}] (MPa, P in MPa), R^2 = {fit.r_squared:.4f}"
+        click.echo(f"degree {fit.degree}: coefficients [{coeffs}] (MPa, P in MPa), R^2 = {fit.r_squared:.4f} "
+                   f"({fit.weighting} weighting; unweighted {fit.r_squared_unweighted:.4f})"
                    + (f"  PROBLEMS: {'; '.join(fit.problems)}" if fit.problems else ""))
     if result.chosen is None:
         click.echo("no acceptable law: nothing written to unit.toml", err=True)
@@ -134,7 +140,7 @@ def _validation_figures(result, unit, n_units, design, p_max, solve_3d, folder):
     for run in sorted({p.run for p in result.points}):
         pts = [p for p in result.points if p.run == run]
         fit = cal_mod.fit_law([p.pressure for p in pts], [p.modulus for p in pts], result.chosen.degree,
-                              result.pressure_range)
+                              result.pressure_range, cal_mod.point_weights(pts, result.chosen.weighting))
         if fit.coefficients and not fit.problems:  # a run's law that is not positive cannot be solved
             laws[f"run {run + 1} law"] = replace(law, coefficients=fit.coefficients)
     constants = {"constant E(0)": figs.constant_law(law, 0.0, "constant E(0)"),
