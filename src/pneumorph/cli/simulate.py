@@ -18,6 +18,9 @@ import click
               help="2D reduced-order (plane strain with filler) or 3D model.")
 @click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
               help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
+@click.option("--gravity", type=click.Choice(["none", "hanging", "horizontal"]), default="none", show_default=True,
+              help="Weight of the silicones, applied before the pressure: hanging from the clamped base "
+                   "(appendix A.2.2) or lying horizontal with gravity across the height.")
 @click.option("--out", type=click.Path(file_okay=False), help="Folder for response (NPZ+JSON), VTK and PNG files.")
 @click.option("--json", "as_json", is_flag=True, help="Print tip, curl and unit centres of every level as JSON.")
 def simulate(
@@ -26,6 +29,7 @@ def simulate(
     increments: int,
     fidelity: str,
     unit_file: str | None,
+    gravity: str,
     out: str | None,
     as_json: bool,
 ) -> None:
@@ -41,14 +45,16 @@ def simulate(
     design = parse_orientation(orientation)
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     ramp = RampSpec(pressure=pressure / 1e3, steps=StepSettings(increments=increments, substeps=2))
-    model = Reduced2D(len(design), unit, ramp) if fidelity == "2d" else Full3D(len(design), unit, ramp)
+    Model = Reduced2D if fidelity == "2d" else Full3D
+    model = Model(len(design), unit, ramp, gravity=gravity)
     t0 = time.perf_counter()
 
     def progress(k: int, p: float) -> None:
         click.echo(f"  level {k + 1:2d}/{increments}: {p * 1e3:7.3f} kPa converged  [{time.perf_counter() - t0:6.1f} s]",
                    err=True)
 
-    click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa)", err=True)
+    weight = "" if gravity == "none" else f", {gravity} under gravity"
+    click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa{weight})", err=True)
     solution = model.solve(design, on_level=progress)
     resp = solution.response
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.fem.bodyforce import DeadLoads
 from pneumorph.fem.kernels import neo_hooke_plane_strain, ogden_plane_strain
 
 FloatArray = NDArray[np.float64]
@@ -97,7 +98,7 @@ class PlaneStrainSystem:
         ``felupe.SolidBody`` items with :class:`~pneumorph.fem.ogden.OgdenCompressible`
         or ``felupe.NeoHookeCompressible`` materials on ``FieldPlaneStrain`` fields, and
         ``felupe.SolidBodyPressure`` items on boundary regions built with ``ensure_3d=True``
-        (all linked to one global field).
+        and ``felupe.SolidBodyForce`` dead loads (all linked to one global field).
     field : felupe.FieldContainer
         The global field (one ``FieldPlaneStrain``); only its size is read here.
     dof1, dof0 : ndarray
@@ -125,6 +126,7 @@ class PlaneStrainSystem:
         self.dof0 = np.asarray(dof0, dtype=np.int64)
         self.groups: list[_Group] = []
         self.pressures: list[tuple[Any, _Group, FloatArray, FloatArray]] = []
+        forces = []
         for item in items:
             sub = item.field[0]
             if not isinstance(sub, fem.FieldPlaneStrain):
@@ -138,8 +140,11 @@ class PlaneStrainSystem:
                 self.pressures.append((item, grp, h, ndA))
             elif isinstance(item, fem.SolidBody):
                 self.groups.append(_group(region.mesh.cells, region, _kernel_of(item.umat)))
+            elif isinstance(item, fem.SolidBodyForce):
+                forces.append(item)
             else:
                 raise TypeError(f"no fast assembly for {type(item).__name__}; use the FElupe backend")
+        self.dead = DeadLoads(forces, self.npoints, 2)
         self._build_pattern()
         self.points = np.asarray(field[0].region.mesh.points[:, :2], dtype=float)
         self._cache: list[tuple[FloatArray, ...]] = []
@@ -210,6 +215,8 @@ class PlaneStrainSystem:
             vectors.append((p * np.matmul(h.T[None], cofN)).ravel())
         weights = np.concatenate(vectors)
         r = np.bincount(self._edofs, weights=weights, minlength=self.ndof)
+        if self.dead:
+            r -= self.dead.vector()
         return r, jmin
 
     @staticmethod

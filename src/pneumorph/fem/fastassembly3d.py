@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.fem.bodyforce import DeadLoads
 from pneumorph.fem.kernels import ogden_3d, principal_3d
 
 FloatArray = NDArray[np.float64]
@@ -108,8 +109,9 @@ class SolidSystem3D:
     ----------
     items : sequence
         ``felupe.SolidBody`` items with :class:`~pneumorph.fem.ogden.OgdenCompressible`
-        materials and ``felupe.SolidBodyPressure`` items on boundary regions of closed
-        cavities (all on ``felupe.Field`` fields linked to one global field).
+        materials, ``felupe.SolidBodyPressure`` items on boundary regions of closed
+        cavities and ``felupe.SolidBodyForce`` dead loads (all on ``felupe.Field`` fields
+        linked to one global field).
     field : felupe.FieldContainer
         The global 3D field; only its size is read here.
     dof1, dof0 : ndarray
@@ -152,12 +154,16 @@ class SolidSystem3D:
         self.solids: list[_Solid] = []
         self.walls: list[_Walls] = []
         empty = np.zeros(0, dtype=np.int64)
+        forces = []
         for item in items:
             sub = item.field[0]
             if type(sub) is not fem.Field or sub.dim != 3:
                 raise TypeError(f"the fast 3D assembly needs 3D felupe.Field fields, got {type(sub).__name__}")
             region = sub.region
             cells = np.asarray(region.mesh.cells, dtype=np.int64)
+            if isinstance(item, fem.SolidBodyForce):
+                forces.append(item)
+                continue
             g = _gradients_of(region)
             if isinstance(item, fem.SolidBodyPressure):
                 h = np.ascontiguousarray(region.h[:, :, 0].T)
@@ -179,6 +185,7 @@ class SolidSystem3D:
                 )
             else:
                 raise TypeError(f"no fast assembly for {type(item).__name__}; use the FElupe backend")
+        self.dead = DeadLoads(forces, self.ndof // 3, 3)
         self._build_pattern()
         self._state: list[tuple[FloatArray, Any]] = []
         self._U = np.zeros((self.ndof // 3, 3))
@@ -269,6 +276,8 @@ class SolidSystem3D:
             F = _deformation(w.g, w.cells, U)
             cofN = _cof_normal(F, w.ndA)  # (f, q, 3)
             r += np.bincount(edofs, weights=(p * np.matmul(w.h.T[None], cofN)).ravel(), minlength=self.ndof)
+        if self.dead:
+            r -= self.dead.vector()
         return r, jmin
 
     def tangent_data(self) -> FloatArray:

@@ -10,8 +10,9 @@ from pneumorph.errors import SearchConfigError
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
+from pneumorph.models.gravity import gravity_vector
 
-MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file")
+MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity")
 
 
 def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel:
@@ -23,8 +24,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         Number of articulating units.
     settings : mapping, optional
         ``fidelity`` ("2d" default, or "3d"), ``pressure_kpa`` (45), ``increments`` (10),
-        ``substeps`` (2), and the unit: ``unit`` (a table of UnitSpec parameters) or
-        ``unit_file`` (a TOML file with a ``[unit]`` table).
+        ``substeps`` (2), ``gravity`` (none; ``"hanging"``, ``"horizontal"`` or a vector in
+        mm/s^2, :func:`pneumorph.models.gravity.gravity_vector`), and the unit: ``unit`` (a
+        table of UnitSpec parameters) or ``unit_file`` (a TOML file with a ``[unit]`` table).
 
     Examples
     --------
@@ -47,8 +49,14 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         steps=StepSettings(increments=int(s.get("increments", 10)), substeps=int(s.get("substeps", 2))),
     )
     fidelity = s.get("fidelity", "2d")
+    gravity = s.get("gravity")
+    if fidelity in ("2d", "3d"):
+        try:
+            gravity_vector(gravity, int(fidelity[0]))
+        except ValueError as exc:
+            raise SearchConfigError(f"[model] gravity: {exc}") from None
     if fidelity == "2d":
-        return Reduced2D(units, unit, ramp)
+        return Reduced2D(units, unit, ramp, gravity=gravity)
     if fidelity == "3d":
-        return Full3D(units, unit, ramp)
+        return Full3D(units, unit, ramp, gravity=gravity)
     raise SearchConfigError(f"unknown model fidelity {fidelity!r}; choose 2d or 3d")

@@ -7,7 +7,9 @@ calibrated law E(P) at every substep of the ramp (section 5.3, natively - no tem
 trick); the 3D model has empty cavities. Silicones use the dissertation's compressible
 Ogden model (Eq 2.12, Tables A.4, A.5) through the hand-coded kernel
 :class:`pneumorph.fem.OgdenCompressible`; the base face is clamped and a follower pressure
-acts on the cavity walls.
+acts on the cavity walls. Optionally gravity acts on the silicones (their densities; the
+2D filler stands in for air and has no mass): it is applied in full first, then the
+pressure is ramped (the hanging test of appendix A.2.2).
 """
 
 from __future__ import annotations
@@ -15,13 +17,14 @@ from __future__ import annotations
 import hashlib
 import json
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from pneumorph import __version__
-from pneumorph.errors import SimulationFailed
+from pneumorph.errors import MaterialDataError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume, ramp
 from pneumorph.fem.fastassembly import PlaneStrainSystem
 from pneumorph.fem.fastassembly3d import SolidSystem3D
@@ -32,6 +35,7 @@ from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get, get_filler
 from pneumorph.materials.filler import FillerLaw
+from pneumorph.models.gravity import gravity_vector
 from pneumorph.models.response import FloatArray, Response
 
 #: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
@@ -109,6 +113,7 @@ class FEModel:
         ramp_spec: RampSpec | None = None,
         filler: FillerLaw | None = None,
         backend: str | None = None,
+        gravity: str | Sequence[float] | None = None,
     ) -> None:
         backend = backend or self.backends[0]
         if backend not in self.backends:
@@ -122,6 +127,12 @@ class FEModel:
         self.filler = filler
         self.body = get(self.unit.body_material)
         self.layer = get(self.unit.layer_material)
+        self.gravity = gravity_vector(gravity, self.dim)
+        if self.gravity is not None:
+            for material in (self.body, self.layer):
+                if material.density is None:
+                    raise MaterialDataError(f"gravity needs the density of {material.name!r}, which has none; "
+                                            "add one to its material entry or run without gravity")
 
     # -- identity -----------------------------------------------------------------------
     def describe(self) -> dict[str, Any]:
@@ -137,6 +148,8 @@ class FEModel:
         }
         if self.filler is not None:
             out["filler"] = self.filler.to_dict()
+        if self.gravity is not None:  # absent without gravity: earlier fingerprints stay valid
+            out["gravity_mm_s2"] = list(self.gravity)
         return out
 
     def fingerprint(self) -> str:
@@ -178,11 +191,16 @@ class FEModel:
         wall_field = fem.FieldContainer([Field(walls, dim=self.dim)])
         wall_field.link(field)
         pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
+        forces = []
+        if self.gravity is not None:  # dead loads rho g on the silicones, switched on by the gravity stage
+            forces = [fem.SolidBodyForce(body.field, values=np.zeros(self.dim), scale=material.density.value)
+                      for body, material in zip(bodies, (self.body, self.layer))]
         dof0, dof1 = clamped_dofs(field, mesh.base_points, mesh.symmetry_points)
         return {
             "mesh": mesh,
             "field": field,
-            "items": [*bodies, *extra, pressure],
+            "items": [*bodies, *extra, pressure, *forces],
+            "forces": forces,
             "pressure": pressure,
             "set_extra": set_extra,
             "wall_field": wall_field,
@@ -256,6 +274,11 @@ class FEModel:
             system = System(model["items"], field, model["dof1"], model["dof0"])
             substep = FastSubstep(system, reuse=self.tangent_reuse, depth=self.anderson_depth)
             monitor = lambda: system.cavity_volume(field[0].values.ravel())
+        gravity_iterations = 0
+        if model["forces"]:
+            gravity_iterations = self._apply_gravity(model, substep, follow, design)
+            meta_tip = (x_end0 + field[0].values[mesh.end_points][:, :2]).mean(axis=0)
+            response.metadata.update(gravity_mm_s2=list(self.gravity or ()), gravity_tip=meta_tip.tolist())
         try:
             stats = ramp(
                 model["items"],
@@ -276,7 +299,7 @@ class FEModel:
             ) from None
         meta = dict(response.metadata)
         meta.update(
-            newton_iterations=stats.newton_iterations,
+            newton_iterations=stats.newton_iterations + gravity_iterations,
             factorisations=substep.factorisations if substep is not None else stats.newton_iterations,
             substeps=stats.substeps,
             cutbacks=stats.cutbacks,
@@ -287,6 +310,31 @@ class FEModel:
         )
         final = replace(response, converged=True, reached=float(pressures[-1]), metadata=meta)
         return Solution(final, mesh, displacements)
+
+    def _apply_gravity(self, model: dict[str, Any], substep: Any, follow: Any, design: str) -> int:
+        """Load the unpressurised actuator with its weight; returns the Newton iterations.
+
+        Gravity rises to its full value in :attr:`gravity_steps`; the pressure ramp then
+        starts from that state with gravity held.
+        """
+        g = np.asarray(self.gravity, dtype=float)
+
+        def apply(t: float) -> None:
+            for force in model["forces"]:
+                force.update(t * g)
+
+        try:
+            stats = ramp(model["items"], model["field"], apply, model["dof1"], model["dof0"], self.gravity_steps,
+                         on_substep=follow, substep=substep, predictor_order=self.predictor_order)
+        except SimulationFailed as exc:
+            raise SimulationFailed(reached=0.0, cause=f"under its own weight, before any pressure: {exc.cause}",
+                                   design=design, pressure=self.ramp.pressure) from None
+        return stats.newton_iterations
+
+    @property
+    def gravity_steps(self) -> StepSettings:
+        """The gravity stage: two substeps, the pressure ramp's Newton settings."""
+        return replace(self.ramp.steps, increments=1, substeps=2)
 
 
     def write_deformed(self, response: Response, level: int, folder: Any) -> list[Any]:
@@ -330,6 +378,12 @@ class Reduced2D(FEModel):
         :class:`pneumorph.fem.fastassembly.PlaneStrainSystem` and its Newton method;
         ``"felupe"``: FElupe's assembly and ``newtonraphson``. Both solve the same
         equations to the same tolerance (the fingerprint does not depend on it).
+    gravity : str or sequence of float, optional
+        Gravity on the silicones, applied in full before the pressure ramp: ``"hanging"``
+        (along the actuator, appendix A.2.2), ``"horizontal"`` (-y), or an acceleration
+        vector in mm/s^2 (:func:`pneumorph.models.gravity.gravity_vector`). Default none.
+        Responses then include the sag under gravity (displacements from the unloaded
+        mesh); the filler has no mass.
 
     Examples
     --------
@@ -355,9 +409,10 @@ class Reduced2D(FEModel):
         ramp_spec: RampSpec | None = None,
         filler: FillerLaw | None = None,
         backend: str | None = None,
+        gravity: str | Sequence[float] | None = None,
     ) -> None:
         unit = unit or UnitSpec()
-        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend)
+        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity)
         assert self.filler is not None
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
         self.filler.modulus(self.ramp.pressure)
@@ -405,6 +460,9 @@ class Full3D(FEModel):
         single precision) and :class:`pneumorph.fem.fastnewton.FastSubstep` keeping its
         factorised tangent while it converges well; ``"felupe"``: FElupe's assembly and ``newtonraphson``.
         Both stop at the same criterion.
+    gravity : str or sequence of float, optional
+        As for :class:`Reduced2D`; a half model needs gravity in its plane of symmetry
+        (no z component).
 
     The fingerprint holds the result-determining ramp settings only - the reported
     increments, the pressure and the tolerance - not how the ramp is solved (substeps,
@@ -431,10 +489,13 @@ class Full3D(FEModel):
 
     def __init__(
         self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
-        backend: str | None = None,
+        backend: str | None = None, gravity: str | Sequence[float] | None = None,
     ) -> None:
-        super().__init__(n_units, unit, ramp_spec, None, backend)
+        super().__init__(n_units, unit, ramp_spec, None, backend, gravity)
         self.half = bool(half)
+        if self.half and self.gravity is not None and self.gravity[2] != 0.0:
+            raise ValueError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
+                             "of the half model; use half=False")
 
     def describe(self) -> dict[str, Any]:
         out = {**super().describe(), "half_model": self.half}
