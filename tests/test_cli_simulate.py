@@ -39,3 +39,16 @@ def test_simulate_writes_every_output_and_json(tmp_path: Path, capsys: pytest.Ca
 def test_simulate_rejects_bad_input(args: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["simulate", *args]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_simulate_with_gravity_applies_the_weight_first(capsys: pytest.CaptureFixture[str]) -> None:
+    args = ["simulate", "-o", "01", "--pressure", "10", "--increments", "2", "--json"]
+    assert main(args) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert main([*args, "--gravity", "horizontal"]) == 0
+    lying = json.loads(capsys.readouterr().out)
+    assert lying["metadata"]["gravity_mm_s2"] == [0.0, -9806.65]
+    assert "gravity_mm_s2" not in plain["metadata"]
+    # the weight pulls the tip down (-y) at every level
+    for a, b in zip(lying["levels"], plain["levels"]):
+        assert a["tip_mm"][1] < b["tip_mm"][1]
