@@ -171,10 +171,11 @@ def fit_law(pressures: Sequence[float], moduli: Sequence[float], degree: int,
     w = np.ones_like(e) if weights is None else np.asarray(weights, dtype=float)
     if w.shape != e.shape or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.any(w > 0):
         raise ValueError(f"weights must be finite, non-negative, not all zero and one per point, got {w}")
-    if len(np.unique(p[w > 0])) <= degree + 1:
+    levels = len(np.unique(p[w > 0]))
+    if levels <= degree + 1:
         nan = float("nan")
         return LawFit(degree, (), nan, (nan, nan),
-                      ((f"degree {degree}: {len(np.unique(p[w > 0]))} pressure levels cannot test a law with "
+                      ((f"degree {degree}: {levels} pressure levels cannot test a law with "
                        f"{degree + 1} coefficients"),), weighting)
     coeffs = np.polynomial.polynomial.polyfit(p, e, degree, w=w)
     pred = np.polynomial.polynomial.polyval(p, coeffs)

@@ -159,11 +159,11 @@ class SolidSystem3D:
             sub = item.field[0]
             if type(sub) is not fem.Field or sub.dim != 3:
                 raise TypeError(f"the fast 3D assembly needs 3D felupe.Field fields, got {type(sub).__name__}")
-            region = sub.region
-            cells = np.asarray(region.mesh.cells, dtype=np.int64)
             if isinstance(item, fem.SolidBodyForce):
                 forces.append(item)
                 continue
+            region = sub.region
+            cells = np.asarray(region.mesh.cells, dtype=np.int64)
             g = _gradients_of(region)
             if isinstance(item, fem.SolidBodyPressure):
                 h = np.ascontiguousarray(region.h[:, :, 0].T)

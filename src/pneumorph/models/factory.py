@@ -49,14 +49,11 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         steps=StepSettings(increments=int(s.get("increments", 10)), substeps=int(s.get("substeps", 2))),
     )
     fidelity = s.get("fidelity", "2d")
-    gravity = s.get("gravity")
-    if fidelity in ("2d", "3d"):
-        try:
-            gravity_vector(gravity, int(fidelity[0]))
-        except ValueError as exc:
-            raise SearchConfigError(f"[model] gravity: {exc}") from None
-    if fidelity == "2d":
-        return Reduced2D(units, unit, ramp, gravity=gravity)
-    if fidelity == "3d":
-        return Full3D(units, unit, ramp, gravity=gravity)
-    raise SearchConfigError(f"unknown model fidelity {fidelity!r}; choose 2d or 3d")
+    Model: type[Reduced2D | Full3D] | None = {"2d": Reduced2D, "3d": Full3D}.get(fidelity)
+    if Model is None:
+        raise SearchConfigError(f"unknown model fidelity {fidelity!r}; choose 2d or 3d")
+    try:
+        gravity = gravity_vector(s.get("gravity"), Model.dim)
+    except ValueError as exc:
+        raise SearchConfigError(f"[model] gravity: {exc}") from None
+    return Model(units, unit, ramp, gravity=gravity)

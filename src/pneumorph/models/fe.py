@@ -260,10 +260,13 @@ class FEModel:
             turned["total"] += step
             turned["last"] = angle
 
+        def tip_of(u: FloatArray) -> FloatArray:
+            return (x_end0 + u[mesh.end_points][:, :2]).mean(axis=0)
+
         def record(k: int, t: float) -> None:
             displacements[k] = field[0].values[:, : self.dim]
             response.centres[k] = mesh.unit_centres(displacements[k])
-            response.tip[k] = (x_end0 + displacements[k][mesh.end_points][:, :2]).mean(axis=0)
+            response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
             if on_level is not None:
                 on_level(k, pressures[k])
@@ -275,10 +278,9 @@ class FEModel:
             substep = FastSubstep(system, reuse=self.tangent_reuse, depth=self.anderson_depth)
             monitor = lambda: system.cavity_volume(field[0].values.ravel())
         gravity_iterations = 0
-        if model["forces"]:
+        if self.gravity is not None:
             gravity_iterations = self._apply_gravity(model, substep, follow, design)
-            meta_tip = (x_end0 + field[0].values[mesh.end_points][:, :2]).mean(axis=0)
-            response.metadata.update(gravity_mm_s2=list(self.gravity or ()), gravity_tip=meta_tip.tolist())
+            response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(field[0].values).tolist())
         try:
             stats = ramp(
                 model["items"],
