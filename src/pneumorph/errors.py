@@ -189,3 +189,11 @@ class SchedulerUnreachableError(PneumorphError, ConnectionError):
 
 class RunFolderError(PneumorphError, ValueError):
     """A run folder that holds a different run (other settings or another model)."""
+
+
+class ChainTableError(PneumorphError, ValueError):
+    """A chain table that cannot serve: damaged, of another model, or too wide a window."""
+
+
+class LocalityError(SearchConfigError):
+    """The chain model cannot represent this model (gravity, or units that interact further)."""

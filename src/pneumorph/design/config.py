@@ -7,8 +7,10 @@ A config file::
     amplitude = 10.0         # mm
     periods = 1.0
     units = 15
-    search = "ga"            # or "exhaustive"
+    search = "certified"     # or "ga", "exhaustive"
     seed = 0
+    certify = false          # certified search: verify until no design can beat the winner
+    verify = 2               # designs verified by FE per batch (default: one per worker)
 
     [ga]
     population = 100
@@ -36,7 +38,7 @@ from pneumorph.design.targets import Objective, make_objective
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import EXECUTORS
 
-SEARCHES = ("ga", "exhaustive")
+SEARCHES = ("certified", "ga", "exhaustive")
 
 
 @dataclass(frozen=True)
@@ -60,8 +62,12 @@ class DesignConfig:
     point: tuple[float, float] | None = None
     anchored: bool = True
     units: int = 15
-    search: str = "ga"
+    search: str = "certified"
     seed: int = 0
+    certify: bool = False
+    verify: int | None = None
+    margin: float = 1.0
+    chain_table: str | None = None
     ga: GAConfig = field(default_factory=GAConfig)
     executor: str = "serial"
     workers: int | None = None
@@ -76,8 +82,13 @@ class DesignConfig:
             raise SearchConfigError(f"unknown search {self.search!r}; choose one of {', '.join(SEARCHES)}")
         if self.executor not in EXECUTORS:
             raise SearchConfigError(f"unknown executor {self.executor!r}; choose one of {', '.join(EXECUTORS)}")
-        for name in ("amplitude", "periods"):
+        for name in ("amplitude", "periods", "margin"):
             object.__setattr__(self, name, float(getattr(self, name)))
+        if self.verify is not None and (isinstance(self.verify, bool) or not isinstance(self.verify, int)
+                                        or self.verify < 1):
+            raise SearchConfigError(f"verify must be a whole number of designs >= 1, got {self.verify!r}")
+        if not (math.isfinite(self.margin) and self.margin > 0):
+            raise SearchConfigError(f"the bound's margin must be a positive number, got {self.margin!r}")
         if self.ga.seed != self.seed:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
@@ -93,7 +104,8 @@ class DesignConfig:
         """Nested tables ``design``, ``ga``, ``execution``, ``model`` (None values left out)."""
         design = {
             k: getattr(self, k)
-            for k in ("objective", "amplitude", "periods", "point", "anchored", "units", "search", "seed")
+            for k in ("objective", "amplitude", "periods", "point", "anchored", "units", "search", "seed",
+                      "certify", "verify", "margin", "chain_table")
         }
         ga = {k: v for k, v in asdict(self.ga).items() if k != "seed"}
         execution = {k: getattr(self, k) for k in ("executor", "workers", "scheduler", "cache")}

@@ -39,7 +39,8 @@ def profile_points(candidate: Candidate) -> np.ndarray:
     return np.vstack([[0.0, 0.0], centres, tip])
 
 
-def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, unit: str = "mm") -> Path:
+def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, unit: str = "mm",
+                 compare: Sequence[tuple[str, Candidate]] = ()) -> Path:
     """The best design's profile at its best pressure beside the target (or the tip goal).
 
     Parameters
@@ -49,6 +50,9 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     objective : ProfileTarget or TipGoal
     path : str or Path
         Output file (PNG or SVG by its suffix).
+    compare : sequence of (label, Candidate)
+        Further responses of the same design drawn dashed at the candidate's level (e.g.
+        the chain model's prediction beside its FE verification).
 
     Returns
     -------
@@ -74,6 +78,10 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
         if objective.point is not None:
             ax.plot(*objective.point, "x", color="C1", ms=10, mew=2, label="point to reach")
         what = f"{objective.label}: {candidate.value:.4g} {objective.unit}"
+    for i, (name, other) in enumerate(compare):
+        o = Candidate(other.design, other.value, candidate.level, candidate.pressure, None, other.response)
+        q = profile_points(o)
+        ax.plot(q[:, 0], q[:, 1], "--", marker=".", color=f"C{i + 4}", lw=1.2, label=f"{name}")
     ax.plot(pts[:, 0], pts[:, 1], "-", color="C0", lw=1.5, label="actuator centreline")
     ax.plot(pts[1:-1, 0], pts[1:-1, 1], "o", color="C0", ms=4, label="unit centres")
     ax.plot(*pts[-1], "s", color="C3", ms=6, label="tip")

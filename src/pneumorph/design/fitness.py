@@ -80,9 +80,22 @@ class Score:
     failed: bool = False
 
 
-def _datum_centres(r: Response) -> tuple[FloatArray, FloatArray]:
-    """Current x of the centres and their height above their undeformed position, (k, n)."""
-    return r.centres[..., 0], r.centres[..., 1] - r.reference_centres[None, :, 1]
+def profile_error_array(
+    centres: FloatArray, reference_centres: FloatArray, target: ProfileTarget, length: float
+) -> FloatArray:
+    """Eq 4.1 for stacked centres ``(..., n, 2)`` against their references ``(..., n, 2)``.
+
+    Returns the error over the last two axes, shape ``centres.shape[:-2]``.
+    """
+    x = centres[..., 0]
+    y = centres[..., 1] - reference_centres[..., 1]
+    if target.coordinates == "cartesian":
+        want, got = target.curve(x, length), y
+    else:
+        theta = np.unwrap(np.arctan2(y, x), axis=-1)
+        want, got = target.curve(theta, length), np.hypot(x, y)
+    with np.errstate(invalid="ignore"):
+        return np.sqrt(np.sum((want - got) ** 2, axis=-1))
 
 
 def profile_errors(response: Response, target: ProfileTarget) -> FloatArray:
@@ -98,21 +111,15 @@ def profile_errors(response: Response, target: ProfileTarget) -> FloatArray:
     >>> profile_errors(r, profile_target("y = 0.1*x")).round(6).tolist()  # sqrt(0.5^2 + 0.5^2)
     [0.707107]
     """
-    length = float(response.reference_tip[0])
-    x, y = _datum_centres(response)
-    if target.coordinates == "cartesian":
-        want, got = target.curve(x, length), y
-    else:
-        theta = np.unwrap(np.arctan2(y, x), axis=-1)
-        want, got = target.curve(theta, length), np.hypot(x, y)
-    with np.errstate(invalid="ignore"):
-        return np.sqrt(np.sum((want - got) ** 2, axis=-1))
+    return profile_error_array(response.centres, response.reference_centres[None], target,
+                               float(response.reference_tip[0]))
 
 
-def tip_values(response: Response, name: str, point: tuple[float, float] | None = None) -> FloatArray:
-    """The quantity a tip goal optimises, at every reported level, shape (k,)."""
-    x = response.tip[:, 0]
-    y = response.tip[:, 1] - response.reference_tip[1]
+def tip_value_array(tip: FloatArray, reference_tip: FloatArray, curl: FloatArray, name: str,
+                    point: tuple[float, float] | None = None) -> FloatArray:
+    """The quantity a tip goal optimises for stacked tips ``(..., 2)`` and curls ``(...)``."""
+    x = tip[..., 0]
+    y = tip[..., 1] - reference_tip[..., 1]
     if name in ("max-x", "min-x"):
         return x.copy()
     if name in ("max-y", "min-y"):
@@ -120,10 +127,15 @@ def tip_values(response: Response, name: str, point: tuple[float, float] | None 
     if name == "min-distance":
         return np.hypot(x, y)
     if name == "max-curl":
-        return response.curl.copy()
+        return np.array(curl, dtype=float, copy=True)
     if name == "reach" and point is not None:
         return np.hypot(x - point[0], y - point[1])
     raise ValueError(f"no tip quantity for goal {name!r}")
+
+
+def tip_values(response: Response, name: str, point: tuple[float, float] | None = None) -> FloatArray:
+    """The quantity a tip goal optimises, at every reported level, shape (k,)."""
+    return tip_value_array(response.tip, response.reference_tip, response.curl, name, point)
 
 
 def objective_values(response: Response, objective: Objective) -> FloatArray:

@@ -8,6 +8,10 @@ Folder contents:
 - ``generations.csv`` - one row per generation, written as the run goes (GA).
 - ``ranking.csv`` - every design and its fitness (exhaustive search).
 - ``hall_of_fame.json`` - the best distinct designs.
+- ``certificate.json`` - certified search: the FE-verified winner, the bound, the designs
+  verified, how much better at most an unverified design could be; ``top.csv`` - the best
+  designs by chain value with their FE and 2D values; ``chain-vs-fe.png`` - the winner's
+  shape from the chain against its FE verification.
 - ``report.md`` - the winning design, its pressure (kPa) and error, the settings.
 - ``profile.png`` - the winner at its pressure against the target (Figs 6.6-6.11);
   ``convergence.png`` - best and mean fitness per generation.
@@ -33,19 +37,24 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from pneumorph.design.certified import CertifiedResult, certified_search
 from pneumorph.design.config import DesignConfig, to_toml
 from pneumorph.design.exhaustive import run_exhaustive
 from pneumorph.design.figures import plot_convergence, plot_profile
+from pneumorph.design.fitness import score
 from pneumorph.design.ga import GenerationStats, run_ga
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
-from pneumorph.errors import RunFolderError, SearchConfigError
+from pneumorph.errors import PneumorphError, RunFolderError, SearchConfigError
 from pneumorph.execution.cache import (
     CachedEvaluator,
     EvaluationCache,
     default_cache_path,
 )
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
+from pneumorph.models.chain import ChainModel
+from pneumorph.models.chaintables import find_table, table_for
+from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
 
 DEPENDENCIES = ("numpy", "scipy", "felupe", "tensortrax", "deap", "matplotlib", "distributed")
@@ -103,9 +112,14 @@ class RunResult:
     cache_hits: int
     wall_time: float
     files: tuple[Path, ...] = field(default=())
+    certified: CertifiedResult | None = None
+    opinion_2d: dict[str, float] = field(default_factory=dict)
 
     @property
     def best(self) -> Candidate | None:
+        """The winner: the FE-verified one of a certified search, else the first of the hall of fame."""
+        if self.certified is not None:
+            return self.certified.winner
         return self.hall_of_fame[0] if self.hall_of_fame else None
 
 
@@ -162,6 +176,7 @@ def run_design(
     on_progress: Any = None,
     overwrite: bool = False,
     figures: bool = True,
+    on_message: Any = None,
 ) -> RunResult:
     """Run a design search and write its folder.
 
@@ -176,8 +191,9 @@ def run_design(
         By default made from ``config.executor`` (and closed at the end).
     cache : EvaluationCache, optional
         By default opened at ``config.cache`` or :func:`default_cache_path`.
-    on_generation, on_progress : callable, optional
-        Progress callbacks: a GA generation's stats; exhaustive (done, total).
+    on_generation, on_progress, on_message : callable, optional
+        Progress callbacks: a GA generation's stats; exhaustive (done, total); a line of
+        text from the certified search (table build, scoring, verification).
     overwrite : bool
         Start afresh in a folder that holds another run.
     figures : bool
@@ -200,6 +216,16 @@ def run_design(
     objective = config.make_objective()
     fingerprint = model.fingerprint()
     resumed = _check_folder(folder, config, fingerprint, overwrite)
+    say = on_message or (lambda text: None)
+    table_dir = None
+    if config.search == "certified":
+        if getattr(model, "gravity", None) is not None:
+            from pneumorph.errors import LocalityError
+
+            raise LocalityError("the certified search needs a free actuator (its chain model does not hold under "
+                                "gravity); search with --search ga or exhaustive")
+        if config.chain_table is not None:  # check a given table before anything is written
+            table_for(model, lambda n: make_model(n, config.model), path=config.chain_table)
     folder.mkdir(parents=True, exist_ok=True)
     prov = provenance(config, model)
     prov["resumed"] = resumed
@@ -209,6 +235,8 @@ def run_design(
     inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
     own_cache = cache is None
     cache = cache or EvaluationCache(config.cache or default_cache_path())
+    if cache.path != ":memory:":
+        table_dir = Path(cache.path).parent / "chain-tables"
     cached = CachedEvaluator(inner, cache)
     start = time.perf_counter()
     log = _GenerationLog(folder / "generations.csv") if config.search == "ga" else None
@@ -218,11 +246,24 @@ def run_design(
         if on_generation:
             on_generation(stats)
 
-    status, hof, history, ranking = "finished", (), (), None
+    status, hof, history, ranking, cert = "finished", (), (), None, None
     try:
         if config.search == "ga":
             ga = run_ga(model, objective, config.ga, cached, on_gen)
             hof, history = ga.hall_of_fame, ga.history
+        elif config.search == "certified":
+            table = table_for(model, lambda n: make_model(n, config.model), folder=table_dir,
+                              path=config.chain_table, evaluator=cached, on_progress=say)
+            chain = ChainModel(table, config.units)
+            verify = config.verify or int(getattr(inner, "workers", 1) or 1)
+            cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
+                                    hall_of_fame=config.ga.hall_of_fame, margin=config.margin, on_progress=say)
+            hof = cert.hall_of_fame
+            order = cert.scores.order()[:1000]
+            from pneumorph.models.chain import design_strings
+
+            names = design_strings(cert.scores.bits[order])
+            ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order)]
         else:
             ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame, on_progress=on_progress)
             hof, ranking = ex.hall_of_fame, [(d, ex.scores[d]) for d in ex.ranking]
@@ -236,11 +277,41 @@ def run_design(
             inner.close()
         if own_cache:
             cache.close()
+    opinion = _opinion_2d(config, model, objective, cert) if cert is not None else {}
     result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
-                       time.perf_counter() - start)
+                       time.perf_counter() - start, certified=cert, opinion_2d=opinion)
     files = _write_outputs(result, config, model, ranking, figures)
     return replace(result, files=tuple(files))
 
+
+
+def _chain_score(cert: CertifiedResult, i: int) -> Any:
+    """The chain's :class:`Score` of the ``i``-th scored design."""
+    from pneumorph.design.fitness import Score
+
+    sc = cert.scores
+    sign = 1.0 if cert.certificate["sense"] == "min" else -1.0
+    level = int(sc.level[i])
+    pressures = cert.winner.response.pressures if cert.winner.response is not None else None
+    p = None if pressures is None else float(pressures[level])
+    return Score(sc.per_level[i], level, sign * float(sc.cost[i]), p)
+
+
+def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective,
+                cert: CertifiedResult) -> dict[str, float]:
+    """The 2D reduced-order model's values of the listed designs (its shipped chain table), if it has one."""
+    if getattr(model, "fidelity", None) != "3d":
+        return {}
+    try:
+        model2d = make_model(config.units, {**config.model, "fidelity": "2d"})
+        table = find_table(model2d)
+    except PneumorphError:
+        return {}
+    if table is None:
+        return {}
+    chain = ChainModel(table, config.units)
+    designs = dict.fromkeys([cert.winner.design, *(c.design for c in cert.hall_of_fame)])
+    return {d: score(chain.evaluate(d), objective).value for d in designs}
 
 def _write_outputs(
     result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any, figures: bool
@@ -264,11 +335,18 @@ def _write_outputs(
                "unit": result.objective.unit, "designs": entries}
         path.write_text(json.dumps(doc, indent=1), encoding="utf-8")
         files.append(path)
+    cert = result.certified
+    if cert is not None:
+        files += _write_certificate(result, folder)
     best = result.best
     if figures and best is not None and best.response is not None and best.level is not None:
         files.append(plot_profile(best, result.objective, folder / "profile.png"))
+        if cert is not None and cert.winner.design in {c.design for c in cert.hall_of_fame}:
+            chain = next(c for c in cert.hall_of_fame if c.design == cert.winner.design)
+            files.append(plot_profile(best, result.objective, folder / "chain-vs-fe.png",
+                                      compare=[("chain model", chain)]))
         hook = getattr(model, "write_deformed", None)
-        if callable(hook):
+        if callable(hook) and cert is None:  # a certified run does not solve its winner a second time
             files.extend(Path(p) for p in hook(best.response, best.level, folder / "winner"))
     if figures and result.history:
         files.append(plot_convergence(result.history, folder / "convergence.png", result.objective.unit))
@@ -279,16 +357,59 @@ def _write_outputs(
     return files
 
 
+
+def _top_rows(result: RunResult) -> list[dict[str, Any]]:
+    """The listed designs by chain value with their FE and 2D values."""
+    cert = result.certified
+    assert cert is not None
+    rows = []
+    for i, c in enumerate(cert.hall_of_fame, 1):
+        fe = cert.verified.get(c.design)
+        rows.append({
+            "rank_chain": i, "design": c.design, "chain": c.value,
+            "chain_pressure_kPa": None if c.pressure is None else round(c.pressure * 1e3, 9),
+            "fe": None if fe is None or fe.failure else fe.value,
+            "fe_pressure_kPa": None if fe is None or fe.pressure is None else round(fe.pressure * 1e3, 9),
+            "chain_2d": result.opinion_2d.get(c.design),
+        })
+    return rows
+
+
+def _write_certificate(result: RunResult, folder: Path) -> list[Path]:
+    cert = result.certified
+    assert cert is not None
+    w = cert.winner
+    doc = {
+        "objective": result.objective.label, "sense": result.objective.sense, "unit": result.objective.unit,
+        "winner": {**w.to_dict(), "chain_value": next((c.value for c in cert.hall_of_fame if c.design == w.design),
+                                                      None), "chain_2d": result.opinion_2d.get(w.design)},
+        "certificate": cert.certificate,
+        "verified": {d: c.to_dict() for d, c in cert.verified.items()},
+        "top": _top_rows(result),
+    }
+    path = folder / "certificate.json"
+    path.write_text(json.dumps(doc, indent=1, default=float), encoding="utf-8")
+    top = folder / "top.csv"
+    rows = _top_rows(result)
+    with top.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return [path, top]
+
+
 def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[str]) -> str:
     """The markdown report of a run."""
     o = result.objective
     lines = [f"# Design run: {o.label}", ""]
     if result.status == "interrupted":
         lines += ["**Interrupted.** Run the same command again to resume; solved designs are cached.", ""]
-    search = (
-        f"genetic algorithm (population {config.ga.population}, {config.ga.generations} generations, "
-        f"seed {config.seed})" if config.search == "ga" else "exhaustive search"
-    )
+    search = {
+        "ga": f"genetic algorithm (population {config.ga.population}, {config.ga.generations} generations, "
+              f"seed {config.seed})",
+        "exhaustive": "exhaustive search",
+        "certified": "certified search (every design scored by the chain model, the best verified by FE)",
+    }[config.search]
     lines += [
         f"- objective: {o.label} ({'minimised' if o.sense == 'min' else 'maximised'})",
         f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",
@@ -318,6 +439,33 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
         for i, c in enumerate(result.hall_of_fame, 1):
             p = "failed" if c.pressure is None else f"{c.pressure * 1e3:.4g}"
             lines.append(f"| {i} | `{c.design}` | {c.value:.6g} | {p} |")
+        lines.append("")
+    cert = result.certified
+    if cert is not None:
+        c = cert.certificate
+        u = o.unit
+        verdict = ("**certified**: no unverified design can beat the winner" if c["certified"] else
+                   f"not certified: {c['could_beat']} unverified design(s) could beat the winner by up to "
+                   f"{c['gap']:.3g} {u}; run with --certify to verify them")
+        lines += [
+            "## Certificate",
+            "",
+            f"- designs scored by the chain model: {c['designs_scored']:,}"
+            + ("" if c["complete"] else " (branch-and-bound; every other design is worse by the chain)"),
+            f"- verified by FE ({getattr(model, 'fidelity', '?')}): {', '.join(f'`{d}`' for d in c['verified'])}",
+            f"- bound on the chain's objective error: {c['bound']:.3g} {u} (validated centre errors x {c['margin']:g})",
+            f"- {verdict}",
+            "",
+            f"| chain rank | design | chain ({u}) | FE ({u}) | 2D chain ({u}) | pressure (kPa) |",
+            "|---:|---|---:|---:|---:|---:|",
+        ]
+
+        def fmt(v: Any) -> str:
+            return "-" if v is None else f"{v:.4g}"
+
+        for row in _top_rows(result):
+            lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
+                         f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kPa'] or row['chain_pressure_kPa'])} |")
         lines.append("")
     if files:
         lines += ["## Files", "", *[f"- [{f}]({f})" for f in files], ""]

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import SearchConfigError
-from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
@@ -24,7 +24,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         Number of articulating units.
     settings : mapping, optional
         ``fidelity`` ("2d" default, or "3d"), ``pressure_kpa`` (45), ``increments`` (10),
-        ``substeps`` (2), ``gravity`` (none; ``"hanging"``, ``"horizontal"`` or a vector in
+        ``substeps`` (the model class's default: 1), ``gravity`` (none; ``"hanging"``, ``"horizontal"`` or a vector in
         mm/s^2, :func:`pneumorph.models.gravity.gravity_vector`), and the unit: ``unit`` (a
         table of UnitSpec parameters) or ``unit_file`` (a TOML file with a ``[unit]`` table).
 
@@ -44,14 +44,18 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         unit = UnitSpec.from_toml(Path(s["unit_file"]))
     else:
         unit = UnitSpec.from_dict(dict(s.get("unit", {})), source="[model.unit]")
-    ramp = RampSpec(
-        pressure=float(s.get("pressure_kpa", 45.0)) / 1e3,
-        steps=StepSettings(increments=int(s.get("increments", 10)), substeps=int(s.get("substeps", 2))),
-    )
     fidelity = s.get("fidelity", "2d")
     Model: type[Reduced2D | Full3D] | None = {"2d": Reduced2D, "3d": Full3D}.get(fidelity)
     if Model is None:
         raise SearchConfigError(f"unknown model fidelity {fidelity!r}; choose 2d or 3d")
+    # the model class's tuned ramp (one substep per level, its iteration limit) unless asked otherwise,
+    # so that API and CLI runs of the same design share their cache entries
+    defaults = Model.default_steps
+    ramp = RampSpec(
+        pressure=float(s.get("pressure_kpa", 45.0)) / 1e3,
+        steps=replace(defaults, increments=int(s.get("increments", defaults.increments)),
+                      substeps=int(s.get("substeps", defaults.substeps))),
+    )
     try:
         gravity = gravity_vector(s.get("gravity"), Model.dim)
     except ValueError as exc:

@@ -1,0 +1,71 @@
+"""``pneumorph chain``: build and inspect the chain tables of the certified search."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+
+@click.group("chain")
+def chain() -> None:
+    """Chain tables: per-window chord turns and lengths fitted to FE solves (docs/chain-model.md)."""
+
+
+@chain.command("build")
+@click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="3d", show_default=True,
+              help="The FE model the table is fitted to.")
+@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
+              help="Unit TOML file (default: the built-in unit).")
+@click.option("--pressure", type=float, help="Maximum pressure, kPa (default 45).")
+@click.option("--units", "n_units", type=int, default=15, show_default=True, help="Units of the training designs.")
+@click.option("--window", type=int, help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
+@click.option("--tolerance", type=float, default=0.2, show_default=True,
+              help="Worst held-out unit-centre error allowed at every level, mm.")
+@click.option("--heldout", type=int, default=10, show_default=True, help="Held-out random designs solved.")
+@click.option("--workers", type=int, help="Processes solving designs (default: all cores).")
+@click.option("--cache", metavar="FILE", help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--out", required=True, metavar="FILE", help="Table file to write (JSON).")
+@click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
+def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units: int, window: int | None,
+          tolerance: float, heldout: int, workers: int | None, cache: str | None, out: str, as_json: bool) -> None:
+    """Fit and validate the chain table of a unit and model (resumable through the cache).
+
+    The shipped tables of the built-in unit are regenerated with
+    `pneumorph chain build --model 3d --out src/pneumorph/models/data/chain-3d.json` (and 2d).
+    """
+    from pathlib import Path
+
+    from pneumorph.errors import ChainTableError
+    from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
+    from pneumorph.models.chain import build_table
+    from pneumorph.models.factory import make_model
+
+    settings: dict = {"fidelity": fidelity}
+    if unit_file:
+        settings["unit_file"] = unit_file
+    if pressure is not None:
+        settings["pressure_kpa"] = pressure
+    target = Path(out)
+    if target.is_dir() or not target.parent.exists() and target.parent != Path(""):
+        raise ChainTableError(f"--out {out}: give a file in an existing folder")
+    if heldout < 1:
+        raise ChainTableError(f"--heldout must be at least 1, got {heldout}")
+    if window is not None and (window < 1 or 2 * window + 1 > n_units):
+        raise ChainTableError(f"--window {window} needs 1 <= window and 2 window + 1 <= --units ({n_units})")
+    model = make_model(n_units, settings)
+    evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))
+    try:
+        table = build_table(model, evaluator, window=window, tolerance=tolerance, heldout=heldout,
+                            on_progress=lambda text: click.echo(text, err=True))
+    finally:
+        evaluator.close()
+    table.save(target)
+    v = table.validation
+    if as_json:
+        click.echo(json.dumps({"file": str(target), "window": table.window, "training": list(table.training),
+                               "validation": v}, indent=1))
+    else:
+        click.echo(f"{target}: window +-{table.window}, {len(table.training)} covering designs, "
+                   f"{len(v['designs'])} held-out: worst centre error {max(v['centre_worst_mm']):.4f} mm, "
+                   f"mean at {table.pressures[-1] * 1e3:g} kPa {v['centre_mean_mm'][-1]:.4f} mm")

@@ -1,0 +1,501 @@
+"""Certified search: every design scored by the chain model, the best verified by FE, with a bound.
+
+The chain model (:mod:`pneumorph.models.chain`) predicts the unit centres, tip and curl of
+any design within errors measured on held-out FE solves: at level ``k`` every centre
+within ``e_k``, the tip within ``t_k``, the curl within ``c_k``. From these follows a bound
+``beta_k`` on the objective (derivation in ``docs/chain-model.md``):
+
+- profile ``y = f(x)`` (Eq 4.1): a centre error ``(dx, dy)`` changes the term
+  ``f(x) - Y`` by at most ``|dy| + |f'| |dx| <= sqrt(1 + S^2) e_k`` with ``S`` the largest
+  slope of ``f``; over ``n`` centres ``beta_k = e_k sqrt(n (1 + S^2))``;
+- profile ``r = f(theta)``: radius within ``e_k``, angle within ``e_k / (r_i - e_k)``,
+  so ``beta_k = e_k sqrt(sum_i (1 + S_theta / (r_i - e_k))^2)`` (per design);
+- tip goals: ``t_k`` for positions and distances (1-Lipschitz), ``c_k`` for the curl.
+
+Since the objective is the best over the levels, a design's FE value lies within
+``max_k beta_k`` of its chain value, and it is at least as good as ``min_k (v_k - beta_k)``
+(minimising; the *optimistic* value). The search orders all designs by chain value,
+verifies the best with FE and reports how far at most any unverified design could beat the
+verified winner; with ``certify`` it verifies in chain order until none can.
+
+Up to :data:`MAX_ENUMERATE` units every design is scored (in chunks); above, a
+branch-and-bound over the chain (the partial sums of Eq 4.1 only grow; the tip can move at
+most the summed length of the chords not yet placed) returns every design whose chain value
+is within reach of the best, and a floor under all others.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.design.fitness import profile_error_array, tip_value_array
+from pneumorph.design.scoring import Candidate, ScoreBook
+from pneumorph.design.targets import Objective, ProfileTarget
+from pneumorph.errors import SearchConfigError
+from pneumorph.execution.evaluators import Evaluator
+from pneumorph.models.chain import ChainModel, design_strings, window_codes
+from pneumorph.models.response import ActuatorModel
+
+FloatArray = NDArray[np.float64]
+
+MAX_ENUMERATE = 20
+"""Longest actuator whose 2^n designs are all scored; longer ones go through branch-and-bound."""
+CHUNK = 8192
+"""Designs scored at once (memory: about 2 kB per design and level)."""
+MAX_NODES = 4_000_000
+"""Most open prefixes the branch-and-bound keeps at one depth."""
+
+
+# -- errors of the chain and the bound on the objective --------------------------------------
+def chain_errors(chain: ChainModel, margin: float = 1.0) -> dict[str, FloatArray]:
+    """The chain's validated worst errors per level: ``centre``, ``tip`` (mm), ``curl`` (deg).
+
+    The held-out errors of the table, times ``margin``, and for actuators longer than the
+    training designs times ``n / n_train`` (angle errors accumulate along the chain).
+    """
+    val = chain.table.validation
+    try:
+        errs = {k: np.asarray(val[src], dtype=float) for k, src in
+                (("centre", "centre_worst_mm"), ("tip", "tip_worst_mm"), ("curl", "curl_worst_deg"))}
+    except KeyError:
+        raise SearchConfigError("the chain table carries no validation; rebuild it with `pneumorph chain build`") \
+            from None
+    trained = int(chain.table.source.get("n_units", chain.n_units))
+    scale = margin * max(1.0, chain.n_units / max(trained, 1))
+    return {k: v * scale for k, v in errs.items()}
+
+
+def _max_slope(f: Callable[[FloatArray], FloatArray], lo: float, hi: float, samples: int = 20001) -> float:
+    """Largest |df/ds| on [lo, hi], from a fine grid (finite differences)."""
+    s = np.linspace(lo, hi, samples)
+    v = f(s)
+    with np.errstate(all="ignore"):
+        d = np.abs(np.diff(v) / np.diff(s))
+    if not np.isfinite(d).all():
+        return float("inf")
+    return float(d.max())
+
+
+def objective_bounds(chain: ChainModel, objective: Objective, centres: FloatArray, reference: FloatArray,
+                     errors: dict[str, FloatArray]) -> FloatArray:
+    """Bound ``beta`` on the objective error per design and level, shape (m, k)."""
+    m, k = centres.shape[:2]
+    n = chain.n_units
+    if not isinstance(objective, ProfileTarget):
+        e = errors["curl"] if objective.name == "max-curl" else errors["tip"]
+        return np.broadcast_to(e, (m, k))
+    e = errors["centre"]
+    length = float(chain.table.reference(np.zeros((1, n), dtype=np.uint8))[1][0])
+    reach = float(chain.table.length.max(axis=0).max()) * (n + 1) + float(e.max())
+    if objective.coordinates == "cartesian":
+        slope = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+        return np.broadcast_to(e * np.sqrt(n * (1.0 + slope**2)), (m, k))
+    slope = _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
+    x = centres[..., 0]
+    y = centres[..., 1] - reference[:, None, :, 1]
+    r = np.hypot(x, y) - e[None, :, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        term = np.where(r > 0, 1.0 + slope / r, np.inf)
+    return e[None, :] * np.sqrt((term**2).sum(axis=-1))
+
+
+# -- scoring every design -------------------------------------------------------------------
+@dataclass(frozen=True)
+class ChainScores:
+    """Chain values of a set of designs.
+
+    Attributes
+    ----------
+    bits : ndarray, shape (m, n)
+        The designs (0/1 per unit).
+    per_level : ndarray, shape (m, k)
+        The objective at every level (worst where a level is not finite).
+    cost : ndarray, shape (m,)
+        The best level's value as a cost (the value when minimising, its negative when
+        maximising).
+    level : ndarray, shape (m,)
+        The best level.
+    optimistic : ndarray, shape (m,)
+        The best cost the FE model can have given the bound (``min_k (cost_k - beta_k)``).
+    bound : ndarray, shape (m,)
+        ``max_k beta_k`` per design.
+    floor : float
+        The optimistic cost of every design *not* in the set (``inf`` when the set is all).
+    """
+
+    bits: NDArray[np.uint8]
+    per_level: FloatArray
+    cost: FloatArray
+    level: NDArray[np.int64]
+    optimistic: FloatArray
+    bound: FloatArray
+    floor: float = float("inf")
+
+    @property
+    def complete(self) -> bool:
+        return bool(np.isinf(self.floor))
+
+    def order(self) -> NDArray[np.int64]:
+        """Indices best first (ties: the smaller design)."""
+        return np.lexsort((self._as_int(), self.cost))
+
+    def _as_int(self) -> NDArray[np.int64]:
+        n = self.bits.shape[1]
+        return (self.bits.astype(np.int64) << np.arange(n - 1, -1, -1)).sum(axis=1)
+
+
+def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integer]) -> tuple[FloatArray, ...]:
+    """Objective per design and level (m, k), with the predicted centres and references."""
+    centres, tip, curl = chain.predict(bits)
+    ref_c, ref_t = chain.table.reference(bits)
+    if isinstance(objective, ProfileTarget):
+        values = profile_error_array(centres, ref_c[:, None], objective, float(ref_t[0]))
+    else:
+        values = tip_value_array(tip, ref_t, curl, objective.name, objective.point)
+    return values, centres, ref_c
+
+
+def _costs(values: FloatArray, beta: FloatArray, sense: str) -> tuple[FloatArray, ...]:
+    sign = 1.0 if sense == "min" else -1.0
+    c = np.where(np.isfinite(values), sign * values, np.inf)
+    level = np.argmin(c, axis=1)
+    cost = c[np.arange(len(c)), level]
+    optimistic = np.min(c - beta, axis=1)
+    bound = np.max(np.where(np.isfinite(beta), beta, np.inf), axis=1)
+    return cost, level, optimistic, bound
+
+
+def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.integer],
+                  errors: dict[str, FloatArray]) -> ChainScores:
+    """Chain scores of the given designs (chunked)."""
+    bits = np.asarray(bits, dtype=np.uint8)
+    parts: list[tuple[FloatArray, ...]] = []
+    for lo in range(0, max(len(bits), 1), CHUNK):
+        b = bits[lo : lo + CHUNK]
+        if not len(b):
+            break
+        values, centres, ref_c = level_values(chain, objective, b)
+        beta = objective_bounds(chain, objective, centres, ref_c, errors)
+        parts.append((values, *_costs(values, beta, objective.sense)))
+    values, cost, level, optimistic, bound = (np.concatenate([p[i] for p in parts]) for i in range(5))
+    return ChainScores(bits, values, cost, level, optimistic, bound)
+
+
+def all_bits(n: int) -> NDArray[np.uint8]:
+    """Every design of ``n`` units in binary order, shape (2^n, n)."""
+    return ((np.arange(2**n, dtype=np.int64)[:, None] >> np.arange(n - 1, -1, -1)) & 1).astype(np.uint8)
+
+
+# -- growing designs unit by unit: enumeration and branch-and-bound ---------------------------
+def _chord_codes(bits: NDArray[np.uint8], j: int, w: int, n: int) -> NDArray[np.int64]:
+    """Window codes of chord ``j`` of prefixes ``bits`` (which hold every unit it sees)."""
+    code = np.zeros(len(bits), dtype=np.int64)
+    for t in range(2 * w + 1):
+        u = j - w + t  # 1-based unit
+        sym = np.full(len(bits), 2 if u < 1 else 3, dtype=np.int64) if not 1 <= u <= n else bits[:, u - 1]
+        code += sym.astype(np.int64) * 4**t
+    return code
+
+
+def _prefix_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], remaining: int) -> FloatArray:
+    """A lower bound on the cost of every completion of each prefix, shape (m,)."""
+    table = chain.table
+    if isinstance(objective, ProfileTarget):
+        return np.sqrt(state["sum"].min(axis=1))
+    reach = remaining * table.length.max(axis=0)  # (k,): the remaining chords at their longest
+    p = state["point"]
+    x, y = p[..., 0], p[..., 1] - table.tip_ref[1]
+    name = objective.name
+    if name == "max-x":
+        c = -(x + reach)
+    elif name == "min-x":
+        c = x - reach
+    elif name == "max-y":
+        c = -(y + reach)
+    elif name == "min-y":
+        c = y - reach
+    elif name == "min-distance":
+        c = np.maximum(np.hypot(x, y) - reach, 0.0)
+    elif name == "reach":
+        q = objective.point
+        assert q is not None
+        c = np.maximum(np.hypot(x - q[0], y - q[1]) - reach, 0.0)
+    else:  # max-curl: the rest of the turns and the end turn at their largest
+        turns = np.degrees(remaining * table.turn.max(axis=0) + table.end.max(axis=0))
+        c = -(np.degrees(state["angle"]) + turns)
+    return c.min(axis=1)
+
+
+def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
+                 threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None) -> ChainScores:
+    """Chain scores of every design whose cost is below ``threshold`` (all designs for ``inf``).
+
+    Designs grow unit by unit, sharing their prefixes: a prefix of ``p`` units fixes the
+    chords whose windows it covers, hence the first centres and the partial sums of Eq 4.1
+    (which only grow), or the point where the remaining chords start (the tip can then move
+    at most their summed greatest length). Prefixes whose bound reaches ``threshold`` are
+    dropped (branch-and-bound); with no threshold this enumerates all ``2^n`` designs at
+    about two chord placements per design. With ``beam``, only the ``beam`` prefixes of
+    lowest bound are kept at every depth (a heuristic: no longer every design below the
+    threshold).
+
+    Raises
+    ------
+    SearchConfigError
+        More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose).
+    """
+    table = chain.table
+    n, w, k = chain.n_units, table.window, table.n_levels
+    profile = isinstance(objective, ProfileTarget)
+    polar = profile and objective.coordinates == "polar"
+    length = float(table.reference(np.zeros((1, n), dtype=np.uint8))[1][0])
+    e = errors["centre"]
+    slope = 0.0
+    if polar:
+        slope = _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
+    cy = np.asarray(table.centre_y)
+    bits = np.array([[0], [1]], dtype=np.uint8)
+    m = 2
+    st: dict[str, Any] = {"point": np.zeros((m, k, 2)), "angle": np.zeros((m, k)), "sum": np.zeros((m, k)),
+                          "bsum": np.zeros((m, k)), "theta": np.zeros((m, k))}
+    st["point"][..., 1] = cy[bits[:, 0]][:, None]
+    placed = 0
+    with np.errstate(all="ignore"):
+        for p in range(1, n + 1):
+            if p > 1:
+                bits = np.concatenate([np.repeat(bits, 2, axis=0),
+                                       np.tile(np.array([[0], [1]], dtype=np.uint8), (len(bits), 1))], axis=1)
+                st = {key: np.repeat(v, 2, axis=0) for key, v in st.items()}
+            upto = n + 1 if p == n else max(p - w + 1, 0)
+            for j in range(placed, upto):
+                rows = table._rows(_chord_codes(bits, j, w, n), table.codes, "chord")
+                st["angle"] = st["angle"] + table.turn[rows]
+                step = table.length[rows]
+                st["point"] = st["point"] + np.stack([step * np.cos(st["angle"]), step * np.sin(st["angle"])], -1)
+                if profile and j + 1 <= n:  # centre j + 1 is now known
+                    x = st["point"][..., 0]
+                    y = st["point"][..., 1] - cy[bits[:, j]][:, None]
+                    if not polar:
+                        st["sum"] = st["sum"] + (objective.curve(x, length) - y) ** 2
+                    else:
+                        raw = np.arctan2(y, x)
+                        th = raw if j == 0 else st["theta"] + (raw - st["theta"] + np.pi) % (2 * np.pi) - np.pi
+                        st["theta"] = th
+                        r = np.hypot(x, y)
+                        st["sum"] = st["sum"] + (objective.curve(th, length) - r) ** 2
+                        st["bsum"] = st["bsum"] + np.where(r > e, 1.0 + slope / (r - e), np.inf) ** 2
+            placed = max(placed, upto)
+            if p == n or (not np.isfinite(threshold) and beam is None):
+                continue
+            bound = _prefix_bound(chain, objective, st, n + 1 - placed)
+            keep = bound < threshold
+            if beam is not None and keep.sum() > beam:
+                keep = np.zeros(len(bits), dtype=bool)
+                keep[np.argpartition(bound, beam)[:beam]] = True
+            bits = bits[keep]
+            st = {key: v[keep] for key, v in st.items()}
+            if len(bits) > max_nodes:
+                raise SearchConfigError(f"branch-and-bound: {len(bits):,} open prefixes at unit {p} of {n}; "
+                                        "the bound is too loose for this target - use --search ga")
+        if profile:
+            values = np.sqrt(st["sum"])
+            if polar:
+                beta = e[None, :] * np.sqrt(st["bsum"])
+            else:
+                reach = float(table.length.max()) * (n + 1) + float(e.max())
+                s = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+                beta = np.broadcast_to(e * np.sqrt(n * (1.0 + s**2)), values.shape)
+        else:
+            erows = table._rows(_chord_codes(bits, n, w, n), table.end_codes, "end")
+            curl = np.degrees(st["angle"] + table.end[erows])
+            values = tip_value_array(st["point"], np.asarray(table.tip_ref), curl, objective.name, objective.point)
+            beta = np.broadcast_to(errors["curl"] if objective.name == "max-curl" else errors["tip"], values.shape)
+    cost, level, optimistic, bound = _costs(values, beta, objective.sense)
+    return ChainScores(bits, values, cost, level, optimistic, bound)
+
+
+def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
+                 max_enumerate: int = MAX_ENUMERATE) -> ChainScores:
+    """Chain scores of every design that can matter, with a floor under the rest.
+
+    Up to ``max_enumerate`` units: all ``2^n`` designs. Above: a beam search (the 4096
+    prefixes of lowest bound at every depth) gives a good cost ``c0``; branch-and-bound then returns every design of chain cost below
+    ``c0 + 2 beta`` (``beta`` the largest bound), the only ones whose FE value can beat a
+    design of chain cost ``c0``; all others are at least ``c0 + 2 beta`` by the chain, so
+    their optimistic value is at least ``c0 + beta``.
+    """
+    errors = chain_errors(chain, margin)
+    n = chain.n_units
+    if n <= max_enumerate:
+        return grow_designs(chain, objective, errors)
+    c0 = float(grow_designs(chain, objective, errors, beam=4096).cost.min())
+    probe = score_designs(chain, objective, np.zeros((1, n), dtype=np.uint8), errors)
+    beta = float(probe.bound.max()) if np.isfinite(probe.bound).all() else float(errors["centre"].max())
+    threshold = c0 + 2 * beta + 1e-9
+    scores = grow_designs(chain, objective, errors, threshold)
+    keep = scores.cost < threshold
+    return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
+                       scores.optimistic[keep], scores.bound[keep], floor=threshold - beta)
+
+
+# -- the search -------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CertifiedResult:
+    """A certified search's answer.
+
+    Attributes
+    ----------
+    winner : Candidate
+        The best FE-verified design (its FE value, level and response).
+    hall_of_fame : tuple of Candidate
+        The best designs by chain value (chain values and responses), best first.
+    verified : dict
+        FE candidates of every verified design.
+    certificate : dict
+        ``bound`` (largest objective bound), ``gap`` (how much better at most an unverified
+        design could be than the winner; 0 when certified), ``could_beat`` (unverified designs
+        whose optimistic value beats the winner), ``certified``, ``designs_scored``,
+        ``complete`` (all 2^n scored) and ``floor``.
+    scores : ChainScores
+    solves : int
+        New FE solves.
+    wall_time : float
+    """
+
+    winner: Candidate
+    hall_of_fame: tuple[Candidate, ...]
+    verified: dict[str, Candidate]
+    certificate: dict[str, Any]
+    scores: ChainScores = field(repr=False)
+    chain_winner: Candidate | None = None
+    solves: int = 0
+    wall_time: float = 0.0
+
+
+def _candidate(chain: ChainModel, objective: Objective, design: str) -> Candidate:
+    r = chain.evaluate(design)
+    from pneumorph.design.fitness import score
+
+    s = score(r, objective)
+    return Candidate(design, s.value, s.level, s.pressure, None, r)
+
+
+def certified_search(
+    fe_model: ActuatorModel,
+    chain: ChainModel,
+    objective: Objective,
+    evaluator: Evaluator | None = None,
+    verify: int = 1,
+    certify: bool = False,
+    hall_of_fame: int = 10,
+    margin: float = 1.0,
+    max_verify: int = 200,
+    on_progress: Callable[[str], None] | None = None,
+) -> CertifiedResult:
+    """Score every design with the chain, verify the best with FE, and bound the rest.
+
+    Parameters
+    ----------
+    fe_model : ActuatorModel
+        The model the chain was fitted to, with the same number of units.
+    chain : ChainModel
+    objective : ProfileTarget or TipGoal
+    evaluator : Evaluator, optional
+        Solves the FE verifications (serial by default; a cached one re-uses solves).
+    verify : int
+        Designs verified per batch (e.g. the number of workers).
+    certify : bool
+        Keep verifying, in chain order, until no unverified design can beat the winner.
+    hall_of_fame : int
+        Designs listed by chain value.
+    margin : float
+        Factor on the chain's validated errors in the bound.
+    max_verify : int
+        Stop certifying after this many FE solves (the gap then stays open).
+
+    Raises
+    ------
+    SearchConfigError
+        Mismatched models, ``verify < 1``, or no verified design converged.
+    """
+    start = time.perf_counter()
+    say = on_progress or (lambda text: None)
+    if int(fe_model.n_units) != chain.n_units:
+        raise SearchConfigError(f"the FE model has {fe_model.n_units} units, the chain model {chain.n_units}")
+    if verify < 1:
+        raise SearchConfigError(f"at least one design must be verified per batch, got {verify}")
+    if not (np.isfinite(margin) and margin > 0):
+        raise SearchConfigError(f"the bound's margin must be a positive number, got {margin!r}")
+    scores = chain_scores(chain, objective, margin)
+    order = scores.order()
+    designs = design_strings(scores.bits[order])
+    say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "
+        f"{time.perf_counter() - start:.2f} s; best {designs[0]}")
+    book = ScoreBook(fe_model, objective, evaluator)
+    sign = 1.0 if objective.sense == "min" else -1.0
+    optimistic = scores.optimistic[order]
+    position = 0
+    verified: list[str] = []
+
+    def winner_cost() -> float:
+        costs = [sign * book.scores[d].value for d in verified if not book.scores[d].failed]
+        return min(costs) if costs else float("inf")
+
+    while position < len(designs):
+        best = winner_cost()
+        if verified and not certify and np.isfinite(best):
+            break
+        if np.isfinite(best):
+            todo = [d for i, d in enumerate(designs[position:], position) if optimistic[i] < best][:verify]
+            if not todo:
+                break
+        else:
+            todo = designs[position : position + verify]
+        if len(verified) >= max_verify:
+            say(f"stopped after {len(verified)} FE verifications (max_verify)")
+            break
+        book.score_many(todo)
+        verified += todo
+        position = max(position, max(designs.index(d) for d in todo) + 1) if len(designs) < 70000 else \
+            position + len(todo)
+        say(f"verified {', '.join(todo)} by FE: " +
+            ", ".join(f"{book.scores[d].value:.4g}" for d in todo))
+    if not any(not book.scores[d].failed for d in verified):
+        raise SearchConfigError("no verified design converged in the FE model")
+    best_cost = winner_cost()
+    ver = set(verified)
+    rest = np.array([i for i, d in enumerate(designs) if d not in ver]) if len(designs) <= 70000 else \
+        np.arange(position, len(designs))
+    rest_opt = float(optimistic[rest].min()) if len(rest) else float("inf")
+    could_beat = int((optimistic[rest] < best_cost).sum()) if len(rest) else 0
+    beat_floor = scores.floor < best_cost
+    gap = max(0.0, best_cost - min(rest_opt, scores.floor))
+    winner = min((book.candidate(d) for d in verified if not book.scores[d].failed),
+                 key=lambda c: (sign * c.value, c.design))
+    hof = tuple(_candidate(chain, objective, d) for d in designs[:hall_of_fame])
+    certificate = {
+        "bound": float(np.max(scores.bound[order[: max(len(verified), 1)]])),
+        "bound_worst": float(np.max(scores.bound)),
+        "gap": gap,
+        "could_beat": could_beat,
+        "certified": could_beat == 0 and not beat_floor,
+        "verified": list(verified),
+        "designs_scored": int(len(designs)),
+        "complete": scores.complete,
+        "floor": None if scores.complete else sign * scores.floor,
+        "margin": margin,
+        "sense": objective.sense,
+    }
+    return CertifiedResult(winner, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
+                           chain_winner=hof[0] if hof else None, solves=book.solves,
+                           wall_time=time.perf_counter() - start)
+
+
+__all__ = ["CertifiedResult", "ChainScores", "grow_designs", "certified_search", "chain_errors",
+           "chain_scores", "objective_bounds", "score_designs"]

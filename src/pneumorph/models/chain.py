@@ -1,0 +1,770 @@
+"""The unit-chain model: an actuator's response from a table of per-window chord turns and lengths.
+
+Why it works. A free actuator (no gravity, no contact) carries only cavity pressure, which
+is self-equilibrated on every closed cavity, so a cut between two units carries no
+resultant force or moment; by Saint-Venant each unit deforms according to its own
+neighbourhood. Describe a response at every level by the polyline base -> unit centres ->
+tip (``n + 2`` points, ``n + 1`` chords):
+
+- the *turn* of chord ``j`` (its angle minus the angle of chord ``j - 1``; for ``j = 0`` the
+  angle of the first chord itself) and its *length*, for ``j = 0 .. n``;
+- the *end turn*: the curl of the end face minus the angle of the last chord.
+
+Element ``j`` (turn and length of chord ``j``, which starts at point ``j``: the base for
+``j = 0``, the centre of unit ``j`` otherwise) is keyed by its *window*, the orientations of
+the units ``j - w .. j + w`` (1-based), where positions before the first unit read as the
+base symbol ``B`` and positions after the last as the tip symbol ``T``. The end turn is keyed
+by the window of the last chord. A :class:`ChainTable` maps every window to its turn, length
+(and end turn) at every reported level; chaining the tabulated chords from the clamped base
+reproduces the unit centres, the tip and the curl of any design in microseconds.
+
+Mirror symmetry (every unit inverted mirrors the actuator) gives the window with 0 and 1
+exchanged the negated turns and the same lengths, so a training design teaches two
+windows at once and the covering set needs half as many FE solves.
+
+The table is fitted from FE solves of a *covering set* of designs in which every window
+occurs (:func:`covering_designs`), and validated on held-out random designs
+(:func:`build_table`): the window half-width grows until the worst unit-centre error of
+the held-out designs is within a tolerance at every level.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.errors import ChainTableError, LocalityError
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.models.response import FloatArray, Response
+
+IntArray = NDArray[np.int64]
+
+#: symbols of a window: the two orientations, the base and the tip
+BASE, TIP = 2, 3
+#: format of the table file (bumped when its layout changes)
+TABLE_FORMAT = 1
+#: a level's worst held-out centre error above this is refused (mm, default)
+DEFAULT_TOLERANCE = 0.2
+#: widest window tried by :func:`build_table`
+MAX_WINDOW = 3
+
+
+# -- windows ------------------------------------------------------------------------------
+def design_array(designs: Sequence[str] | str, n_units: int | None = None) -> NDArray[np.uint8]:
+    """Designs as a (m, n) array of 0/1 (one row per design).
+
+    >>> design_array(["010", "110"]).tolist()
+    [[0, 1, 0], [1, 1, 0]]
+    """
+    if isinstance(designs, str):
+        designs = [designs]
+    rows = [parse_orientation(d, n_units) for d in designs]
+    if not rows:
+        return np.zeros((0, n_units or 0), dtype=np.uint8)
+    n = len(rows[0])
+    if any(len(r) != n for r in rows):
+        raise ChainTableError("designs of different lengths cannot be scored together")
+    return (np.frombuffer("".join(rows).encode(), dtype=np.uint8) - ord("0")).reshape(len(rows), n)
+
+
+def design_strings(bits: NDArray[np.integer]) -> list[str]:
+    """The inverse of :func:`design_array`.
+
+    >>> design_strings(np.array([[0, 1, 1]]))
+    ['011']
+    """
+    bits = np.asarray(bits, dtype=np.uint8)
+    if bits.ndim == 1:
+        bits = bits[None]
+    text = (bits + ord("0")).astype(np.uint8).tobytes().decode()
+    n = bits.shape[1]
+    return [text[i * n : (i + 1) * n] for i in range(bits.shape[0])]
+
+
+def window_symbols(bits: NDArray[np.integer], window: int) -> NDArray[np.int64]:
+    """The windows of every element (chord) of every design, shape (m, n + 1, 2w + 1).
+
+    Element ``j`` sees the units ``j - w .. j + w`` (1-based); outside the actuator the
+    base symbol 2 and the tip symbol 3 stand in.
+
+    >>> window_symbols(np.array([[0, 1]]), 1)[0].tolist()
+    [[2, 2, 0], [2, 0, 1], [0, 1, 3]]
+    """
+    bits = np.asarray(bits, dtype=np.int64)
+    m, n = bits.shape
+    w = int(window)
+    padded = np.concatenate([np.full((m, w + 1), BASE), bits, np.full((m, w + 1), TIP)], axis=1)
+    # element j (0..n) sees padded columns j .. j + 2w (unit j - w sits at column j)
+    idx = np.arange(n + 1)[:, None] + np.arange(2 * w + 1)[None, :]
+    return padded[:, idx]
+
+
+def window_codes(bits: NDArray[np.integer], window: int) -> IntArray:
+    """Integer codes (base 4, first unit least significant) of every element's window, (m, n + 1)."""
+    sym = window_symbols(bits, window)
+    weights = 4 ** np.arange(sym.shape[-1], dtype=np.int64)
+    return sym @ weights
+
+
+def mirror_codes(codes: IntArray, window: int) -> IntArray:
+    """Codes of the mirrored windows (0 and 1 exchanged; base and tip kept)."""
+    codes = np.asarray(codes, dtype=np.int64)
+    out = np.zeros_like(codes)
+    for t in range(2 * window + 1):
+        s = (codes // 4**t) % 4
+        s = np.where(s < 2, 1 - s, s)
+        out += s * 4**t
+    return out
+
+
+def window_text(code: int, window: int) -> str:
+    """A window code as text, e.g. ``'BB01'``.
+
+    >>> window_text(int(window_codes(np.array([[0, 1]]), 1)[0, 0]), 1)
+    'BB0'
+    """
+    return "".join("01BT"[(int(code) // 4**t) % 4] for t in range(2 * window + 1))
+
+
+def possible_codes(n_units: int, window: int) -> IntArray:
+    """Every window code that occurs in some design of ``n_units`` units, sorted."""
+    n, w = int(n_units), int(window)
+    width = 2 * w + 1
+    found: set[int] = set()
+    for j in range(n + 1):
+        units = [j - w + t for t in range(width)]  # 1-based unit numbers
+        inside = [t for t, u in enumerate(units) if 1 <= u <= n]
+        fixed = sum((BASE if u < 1 else TIP) * 4**t for t, u in enumerate(units) if not 1 <= u <= n)
+        for k in range(2 ** len(inside)):
+            found.add(fixed + sum(((k >> i) & 1) * 4**t for i, t in enumerate(inside)))
+    return np.array(sorted(found), dtype=np.int64)
+
+
+def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -> list[str]:
+    """A small set of designs in which every window of ``n_units`` units occurs.
+
+    Greedy set cover: each pick is the design that shows the most windows not yet seen
+    (counting a window's mirror as seen when ``mirror``); ties go to the first design of a
+    seeded random pool, so the set is reproducible.
+
+    Parameters
+    ----------
+    n_units : int
+        Units of the training designs.
+    window : int
+        Half-width ``w`` of the windows.
+    mirror : bool
+        A design also teaches its mirror's windows (valid for a mirror-symmetric model).
+    seed : int
+        Seed of the candidate pool (all designs up to 16 units, else 20,000 random ones).
+
+    Examples
+    --------
+    >>> designs = covering_designs(6, 1)
+    >>> len(designs)
+    2
+    """
+    n, w = int(n_units), int(window)
+    if n < 1 or w < 0:
+        raise ChainTableError(f"a covering set needs at least 1 unit and a window >= 0, got {n} and {w}")
+    rng = np.random.default_rng(seed)
+    if n <= 16:
+        pool = ((np.arange(2**n)[:, None] >> np.arange(n)[None, ::-1]) & 1).astype(np.uint8)
+        pool = pool[rng.permutation(len(pool))]
+    else:
+        pool = rng.integers(0, 2, size=(20000, n), dtype=np.uint8)
+    codes = window_codes(pool, w)
+    canon = np.minimum(codes, mirror_codes(codes, w)) if mirror else codes
+    needed = np.unique(canon)
+    index = np.searchsorted(needed, canon)
+    seen = np.zeros(len(needed), dtype=bool)
+    chosen: list[int] = []
+    while not seen.all():
+        counts = _distinct_counts(index, ~seen[index], len(needed))
+        best = int(np.argmax(counts))
+        if counts[best] == 0:  # pragma: no cover - a random pool that misses a window
+            raise ChainTableError(f"no design of the pool shows the remaining windows of {n} units")
+        chosen.append(best)
+        seen[index[best]] = True
+    return design_strings(pool[chosen])
+
+
+def _distinct_counts(index: IntArray, new: NDArray[np.bool_], n_keys: int) -> IntArray:
+    """Per row, the number of distinct values of ``index`` where ``new`` is set."""
+    rows = np.repeat(np.arange(index.shape[0]), index.shape[1])
+    flat = rows * n_keys + index.ravel()
+    mask = new.ravel()
+    unique = np.unique(flat[mask])
+    return np.bincount(unique // n_keys, minlength=index.shape[0])
+
+
+# -- elements of a response -----------------------------------------------------------------
+def _wrap(a: FloatArray) -> FloatArray:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def response_elements(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Turns (rad) and lengths (mm) of the ``n + 1`` chords, and the end turn, per level.
+
+    Returns
+    -------
+    turn, length : ndarray, shape (k, n + 1)
+    end : ndarray, shape (k,)
+    """
+    k = response.n_levels
+    pts = np.stack([response.centreline(i) for i in range(k)])  # (k, n + 2, 2)
+    chords = np.diff(pts, axis=1)
+    angle = np.unwrap(np.arctan2(chords[..., 1], chords[..., 0]), axis=-1)
+    turn = np.diff(angle, axis=-1, prepend=0.0)
+    length = np.hypot(chords[..., 0], chords[..., 1])
+    end = _wrap(np.radians(response.curl) - angle[:, -1])
+    return turn, length, end
+
+
+# -- the table --------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ChainTable:
+    """Per-window turns, lengths and end turns of one unit and FE model, with provenance.
+
+    Attributes
+    ----------
+    window : int
+        Half-width ``w``.
+    pressures : ndarray, shape (k,)
+        The reported levels (MPa).
+    codes : ndarray, shape (K,)
+        Sorted window codes of the elements.
+    turn, length : ndarray, shape (K, k)
+        Mean turn (rad) and chord length (mm) of each window at each level.
+    end_codes : ndarray, shape (E,)
+        Sorted window codes of the last chord.
+    end : ndarray, shape (E, k)
+        Mean end turn (rad).
+    pitch : float
+        Distance between consecutive undeformed unit centres (mm).
+    centre_y : tuple of float
+        Undeformed height of a unit centre of orientation 0 and of orientation 1 (the
+        tracked cavity vertices sit off the mid-plane, so inverting a unit moves its centre).
+        The centreline starts at the base point ``(0, centre_y[first unit])``.
+    first_offset : float
+        Undeformed x of the first centre.
+    tip_ref : tuple of float
+        The undeformed tip: its x from the last undeformed centre, and its height.
+    source : dict
+        The FE model the table was fitted to: ``fidelity``, ``key`` (:func:`source_key`),
+        ``fingerprint`` and ``n_units`` of the training model, ``description``.
+    training : tuple of str
+        The covering designs solved.
+    validation : dict
+        Held-out designs and their mean / worst centre, tip and curl errors per level.
+    spread : float
+        The largest deviation of one training element from its window's mean (rad or mm):
+        how well a window determines its element.
+    """
+
+    window: int
+    pressures: FloatArray
+    codes: IntArray
+    turn: FloatArray
+    length: FloatArray
+    end_codes: IntArray
+    end: FloatArray
+    pitch: float
+    centre_y: tuple[float, float]
+    first_offset: float
+    tip_ref: tuple[float, float]
+    source: dict[str, Any]
+    training: tuple[str, ...]
+    validation: dict[str, Any] = field(default_factory=dict)
+    spread: float = 0.0
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_levels(self) -> int:
+        return len(self.pressures)
+
+    def fingerprint(self) -> str:
+        """Hash of everything that changes a prediction."""
+        h = hashlib.sha256()
+        h.update(json.dumps({"window": self.window, "source": self.source.get("key"),
+                             "pitch": self.pitch, "centre_y": list(self.centre_y),
+                             "first": self.first_offset, "tip": list(self.tip_ref)}, sort_keys=True).encode())
+        for a in (self.pressures, self.codes, self.turn, self.length, self.end_codes, self.end):
+            h.update(np.ascontiguousarray(a).tobytes())
+        return h.hexdigest()[:16]
+
+    # -- lookup and prediction ----------------------------------------------------------
+    def _rows(self, codes: IntArray, table: IntArray, what: str) -> IntArray:
+        idx = np.searchsorted(table, codes)
+        idx = np.clip(idx, 0, len(table) - 1)
+        missing = table[idx] != codes
+        if missing.any():
+            bad = window_text(int(np.asarray(codes)[missing].ravel()[0]), self.window)
+            raise ChainTableError(
+                f"the chain table has no entry for the {what} window {bad!r} (window +-{self.window}, trained on "
+                f"{self.source.get('n_units')} units); designs with fewer than {2 * self.window + 1} units or "
+                "a table of another model cannot be scored with it"
+            )
+        return idx
+
+    def check_units(self, n_units: int) -> None:
+        """Refuse a number of units whose windows the table cannot have seen."""
+        if int(n_units) < 1:
+            raise ChainTableError(f"an actuator needs at least 1 unit, got {n_units}")
+        trained = int(self.source.get("n_units", 0))
+        need = 2 * self.window + 1
+        if int(n_units) < need and int(n_units) != trained:
+            raise ChainTableError(
+                f"a chain table of window +-{self.window} needs at least {need} units (every window then holds "
+                f"at most one end); got {n_units}. Use the FE model for so short an actuator"
+            )
+
+    def reference(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray]:
+        """Undeformed unit centres (m, n, 2) and tip (2,) of designs (m, n)."""
+        bits = np.atleast_2d(np.asarray(bits))
+        m, n = bits.shape
+        x = self.first_offset + self.pitch * np.arange(n)
+        y = np.asarray(self.centre_y)[bits]
+        centres = np.stack([np.broadcast_to(x, (m, n)), y], axis=-1)
+        tip = np.array([x[-1] + self.tip_ref[0], self.tip_ref[1]])
+        return centres, tip
+
+    def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Centres (m, k, n, 2), tip (m, k, 2) and curl in degrees (m, k) of designs (m, n).
+
+        Examples
+        --------
+        See :class:`ChainModel`.
+        """
+        bits = np.atleast_2d(np.asarray(bits))
+        m, n = bits.shape
+        self.check_units(n)
+        codes = window_codes(bits, self.window)  # (m, n + 1)
+        rows = self._rows(codes, self.codes, "chord")
+        erows = self._rows(codes[:, -1], self.end_codes, "end")
+        angle = np.cumsum(self.turn[rows], axis=1)  # (m, n + 1, k)
+        length = self.length[rows]
+        steps = np.stack([length * np.cos(angle), length * np.sin(angle)], axis=-1)  # (m, n + 1, k, 2)
+        base = np.stack([np.zeros(m), np.asarray(self.centre_y)[bits[:, 0]]], axis=-1)  # (m, 2)
+        pts = np.cumsum(steps, axis=1) + base[:, None, None, :]
+        pts = pts.transpose(0, 2, 1, 3)  # (m, k, n + 1, 2)
+        centres, tip = pts[:, :, :-1], pts[:, :, -1]
+        curl = np.degrees(angle[:, -1, :] + self.end[erows])
+        return centres, tip, curl
+
+    # -- persistence ----------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form (arrays as lists; codes also as window text for readers)."""
+        return {
+            "format": TABLE_FORMAT,
+            "kind": "pneumorph chain table",
+            "window": self.window,
+            "pressures_mpa": self.pressures.tolist(),
+            "windows": [window_text(c, self.window) for c in self.codes],
+            "turn_rad": self.turn.tolist(),
+            "length_mm": self.length.tolist(),
+            "end_windows": [window_text(c, self.window) for c in self.end_codes],
+            "end_turn_rad": self.end.tolist(),
+            "pitch_mm": self.pitch,
+            "centre_y_mm": list(self.centre_y),
+            "first_offset_mm": self.first_offset,
+            "tip_ref_mm": list(self.tip_ref),
+            "source": self.source,
+            "training": list(self.training),
+            "validation": self.validation,
+            "spread": self.spread,
+            "metadata": self.metadata,
+            "fingerprint": self.fingerprint(),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], where: str = "chain table") -> ChainTable:
+        """Read :meth:`to_dict`'s form, checking its layout and its fingerprint."""
+        try:
+            if data.get("kind") != "pneumorph chain table" or data.get("format") != TABLE_FORMAT:
+                raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT}")
+            w = int(data["window"])
+
+            def codes_of(texts: list[str]) -> IntArray:
+                out = []
+                for t in texts:
+                    if len(t) != 2 * w + 1 or set(t) - set("01BT"):
+                        raise ChainTableError(f"{where}: bad window {t!r}")
+                    out.append(sum("01BT".index(ch) * 4**i for i, ch in enumerate(t)))
+                return np.array(out, dtype=np.int64)
+
+            table = cls(
+                window=w,
+                pressures=np.array(data["pressures_mpa"], dtype=float),
+                codes=codes_of(data["windows"]),
+                turn=np.array(data["turn_rad"], dtype=float),
+                length=np.array(data["length_mm"], dtype=float),
+                end_codes=codes_of(data["end_windows"]),
+                end=np.array(data["end_turn_rad"], dtype=float),
+                pitch=float(data["pitch_mm"]),
+                centre_y=(float(data["centre_y_mm"][0]), float(data["centre_y_mm"][1])),
+                first_offset=float(data["first_offset_mm"]),
+                tip_ref=(float(data["tip_ref_mm"][0]), float(data["tip_ref_mm"][1])),
+                source=dict(data["source"]),
+                training=tuple(data["training"]),
+                validation=dict(data.get("validation", {})),
+                spread=float(data.get("spread", 0.0)),
+                metadata=dict(data.get("metadata", {})),
+            )
+        except ChainTableError:
+            raise
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+            raise ChainTableError(f"{where}: damaged chain table ({type(exc).__name__}: {exc})") from None
+        k, K, E = table.n_levels, len(table.codes), len(table.end_codes)
+        shapes_ok = (table.turn.shape == (K, k) and table.length.shape == (K, k) and table.end.shape == (E, k))
+        if not shapes_ok or not (np.all(np.diff(table.codes) > 0) and np.all(np.diff(table.end_codes) > 0)):
+            raise ChainTableError(f"{where}: damaged chain table (array shapes or window order do not match)")
+        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures)):
+            raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
+        if data.get("fingerprint") != table.fingerprint():
+            raise ChainTableError(f"{where}: the chain table's contents do not match its fingerprint "
+                                  "(edited or damaged); rebuild it with `pneumorph chain build`")
+        return table
+
+    def save(self, path: str | Path) -> Path:
+        """Write the table as JSON (atomically: a temporary file renamed into place)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".part")
+        tmp.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
+        tmp.replace(path)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> ChainTable:
+        """Read a table written by :meth:`save`; :class:`ChainTableError` if it is not one."""
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise ChainTableError(f"{path}: no such chain table") from None
+        except (UnicodeDecodeError, json.JSONDecodeError, IsADirectoryError) as exc:
+            raise ChainTableError(f"{path}: not a chain table (unreadable JSON: {type(exc).__name__})") from None
+        if not isinstance(data, dict):
+            raise ChainTableError(f"{path}: not a chain table")
+        return cls.from_dict(data, where=str(path))
+
+
+# -- identity of the source model -------------------------------------------------------------
+def source_description(model: Any) -> dict[str, Any]:
+    """What a model's results depend on, except its number of units."""
+    describe = getattr(model, "describe", None)
+    desc = dict(describe()) if callable(describe) else {"fingerprint": model.fingerprint()}
+    desc.pop("n_units", None)
+    return desc
+
+
+def source_key(model: Any) -> str:
+    """Hash of :func:`source_description`: equal for the same unit, materials, ramp, fidelity."""
+    text = json.dumps(source_description(model), sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def check_source(table: ChainTable, model: Any) -> None:
+    """Refuse a table fitted to another model (unit, materials, ramp or fidelity)."""
+    key = source_key(model)
+    if table.source.get("key") != key:
+        theirs = table.source.get("fidelity", "?")
+        raise ChainTableError(
+            f"the chain table was fitted to another model ({theirs}, source {table.source.get('key')}) than the "
+            f"one asked for ({getattr(model, 'fidelity', '?')}, source {key}); rebuild it for this unit and model "
+            "with `pneumorph chain build`"
+        )
+
+
+# -- fitting --------------------------------------------------------------------------------
+def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True) -> ChainTable:
+    """Fit a table to converged training responses (all of the same length).
+
+    Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
+    mirrored occurrences with negated turns).
+
+    Raises
+    ------
+    ChainTableError
+        No responses, a failed one, mixed lengths or levels.
+    """
+    if not responses:
+        raise ChainTableError("a chain table needs at least one training response")
+    n = responses[0].n_units
+    pressures = responses[0].pressures
+    for r in responses:
+        if not r.converged or not np.isfinite(r.centres).all():
+            raise ChainTableError(f"training design {r.orientation} did not converge; the chain table needs "
+                                  "every training design solved to the last level")
+        if r.n_units != n or not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
+            raise ChainTableError("training responses of different lengths or pressure levels")
+    w = int(window)
+    all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
+    for r in responses:
+        turn, length, end = response_elements(r)
+        codes = window_codes(design_array(r.orientation), w)[0]
+        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w), -1.0)] if mirror else [])
+        for c, sign in variants:
+            all_codes.append(c)
+            all_turn.append(sign * turn.T)
+            all_len.append(length.T)
+            e_codes.append(c[-1:])
+            e_end.append(sign * end[None])
+    codes = np.concatenate(all_codes)
+    turn = np.concatenate(all_turn)
+    length = np.concatenate(all_len)
+    uniq, inv = np.unique(codes, return_inverse=True)
+    counts = np.bincount(inv)[:, None]
+    k = len(pressures)
+    mean_turn = np.zeros((len(uniq), k))
+    mean_len = np.zeros((len(uniq), k))
+    np.add.at(mean_turn, inv, turn)
+    np.add.at(mean_len, inv, length)
+    mean_turn /= counts
+    mean_len /= counts
+    spread = float(max(np.abs(turn - mean_turn[inv]).max(), np.abs(length - mean_len[inv]).max()))
+    ecodes = np.concatenate(e_codes)
+    end = np.concatenate(e_end)
+    euniq, einv = np.unique(ecodes, return_inverse=True)
+    mean_end = np.zeros((len(euniq), k))
+    np.add.at(mean_end, einv, end)
+    mean_end /= np.bincount(einv)[:, None]
+
+    ref = responses[0]
+    xs = ref.reference_centres[:, 0]
+    if n < 2:
+        raise ChainTableError("a chain table needs training designs of at least 2 units")
+    pitch = float(np.mean(np.diff(xs)))
+    tip_y = float(ref.reference_tip[1])
+    heights: dict[int, list[float]] = {0: [], 1: []}
+    for r in responses:
+        for o, y in zip(r.orientation, r.reference_centres[:, 1]):
+            heights[int(o)].append(float(y))
+            if mirror:
+                heights[1 - int(o)].append(2 * tip_y - float(y))
+    if not heights[0] or not heights[1] or max(np.ptp(heights[0]), np.ptp(heights[1])) > 1e-9:
+        raise ChainTableError("the training designs do not show both unit orientations at fixed heights")
+    centre_y = (heights[0][0], heights[1][0])
+    if not np.allclose(np.diff(xs), pitch, atol=1e-9):
+        raise ChainTableError("the training actuator's unit centres are not evenly spaced; a chain table "
+                              "needs identical units")
+    return ChainTable(
+        window=w,
+        pressures=np.asarray(pressures, dtype=float),
+        codes=uniq,
+        turn=mean_turn,
+        length=mean_len,
+        end_codes=euniq,
+        end=mean_end,
+        pitch=pitch,
+        centre_y=centre_y,
+        first_offset=float(xs[0]),
+        tip_ref=(float(ref.reference_tip[0] - xs[-1]), tip_y),
+        source=dict(source),
+        training=tuple(r.orientation for r in responses),
+        spread=spread,
+    )
+
+
+def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[str, Any]:
+    """Centre, tip and curl errors of the table's predictions against FE responses.
+
+    Returns a dict with per-level lists ``centre_mean_mm``, ``centre_worst_mm``,
+    ``tip_worst_mm``, ``curl_worst_deg``, ``norm_worst_mm`` (the worst root of the summed
+    squared centre errors of one design), and ``designs``.
+    """
+    k = table.n_levels
+    centre_err, tip_err, curl_err, norm_err = [], [], [], []
+    for r in responses:
+        c, t, cu = table.predict(design_array(r.orientation))
+        e = np.hypot(*(c[0] - r.centres).transpose(2, 0, 1))  # (k, n)
+        centre_err.append(e)
+        norm_err.append(np.sqrt((e**2).sum(axis=1)))
+        tip_err.append(np.hypot(*(t[0] - r.tip).T))
+        curl_err.append(np.abs(cu[0] - r.curl))
+    if not responses:
+        nan = [float("nan")] * k
+        return {"designs": [], "centre_mean_mm": nan, "centre_worst_mm": nan, "tip_worst_mm": nan,
+                "curl_worst_deg": nan, "norm_worst_mm": nan}
+    all_c = np.concatenate(centre_err, axis=1)
+    return {
+        "designs": [r.orientation for r in responses],
+        "centre_mean_mm": all_c.mean(axis=1).tolist(),
+        "centre_worst_mm": all_c.max(axis=1).tolist(),
+        "tip_worst_mm": np.max(tip_err, axis=0).tolist(),
+        "curl_worst_deg": np.max(curl_err, axis=0).tolist(),
+        "norm_worst_mm": np.max(norm_err, axis=0).tolist(),
+    }
+
+
+def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed: int = 1) -> list[str]:
+    """``count`` random designs of ``n_units`` units, none of them in ``exclude`` (seeded)."""
+    rng = np.random.default_rng(seed)
+    out: list[str] = []
+    taken = set(exclude)
+    limit = 2**n_units - len(taken)
+    while len(out) < min(count, limit):
+        d = design_strings(rng.integers(0, 2, size=(1, n_units), dtype=np.uint8))[0]
+        if d not in taken:
+            taken.add(d)
+            out.append(d)
+    return out
+
+
+def build_table(
+    model: Any,
+    evaluator: Any = None,
+    window: int | None = None,
+    tolerance: float = DEFAULT_TOLERANCE,
+    heldout: int = 10,
+    seed: int = 1,
+    max_window: int = MAX_WINDOW,
+    on_progress: Callable[[str], None] | None = None,
+) -> ChainTable:
+    """Fit and validate a chain table to an FE model by solving covering and held-out designs.
+
+    Parameters
+    ----------
+    model : ActuatorModel
+        The FE model of the training actuator (e.g. 15 units); it must be free (no gravity)
+        and mirror-symmetric.
+    evaluator : Evaluator, optional
+        How the designs are solved (serial by default); a
+        :class:`~pneumorph.execution.CachedEvaluator` makes the build resumable.
+    window : int, optional
+        A fixed half-width; by default 1, 2, ... up to ``max_window`` until the worst
+        held-out centre error is within ``tolerance`` at every level.
+    tolerance : float
+        Worst held-out unit-centre error allowed at any level (mm).
+    heldout : int
+        Random held-out designs (seeded by ``seed``) solved to validate the table.
+    on_progress : callable, optional
+        Called with a line of text after each stage.
+
+    Raises
+    ------
+    LocalityError
+        The model has gravity, or no window up to ``max_window`` meets the tolerance.
+    ChainTableError
+        A training design failed to converge.
+    """
+    from pneumorph.execution.evaluators import SerialEvaluator
+
+    if getattr(model, "gravity", None) is not None:
+        raise LocalityError("the chain model needs a free actuator: with gravity the weight makes moments along "
+                            "the chain, so a unit's response depends on the whole actuator; search with the FE "
+                            "model (--search ga or exhaustive)")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ChainTableError(f"the tolerance must be a positive number of mm, got {tolerance!r}")
+    evaluator = evaluator or SerialEvaluator()
+    n = int(model.n_units)
+    say = on_progress or (lambda text: None)
+    windows = [int(window)] if window is not None else list(range(1, max_window + 1))
+    if windows[0] < 1 or 2 * windows[-1] + 1 > n:
+        raise ChainTableError(f"a window of +-{windows[-1]} units needs training designs of at least "
+                              f"{2 * windows[-1] + 1} units; the model has {n}")
+    src = {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
+           "n_units": n, "description": source_description(model)}
+    solved: dict[str, Response] = {}
+
+    def solve(designs: list[str], what: str) -> list[Response]:
+        todo = [d for d in designs if d not in solved]
+        t0 = time.perf_counter()
+        done = 0
+        for i, outcome in evaluator.iter_evaluate(model, todo):
+            done += 1
+            if not outcome.ok:
+                raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
+                                      f"({outcome.failure}); the chain table needs every design solved")
+            solved[outcome.design] = outcome.response
+            say(f"  {what}: {done}/{len(todo)} solved ({'cached' if outcome.cached else 'solved'} "
+                f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
+        return [solved[d] for d in designs]
+
+    start = time.perf_counter()
+    best: ChainTable | None = None
+    for w in windows:
+        train = covering_designs(n, w)
+        say(f"window +-{w}: {len(train)} covering designs")
+        table = fit_table(solve(train, "covering"), w, src)
+        tests = heldout_designs(n, heldout, exclude=train, seed=seed)
+        val = prediction_errors(table, solve(tests, "held-out"))
+        val.update(tolerance_mm=tolerance, seed=seed)
+        worst = max(val["centre_worst_mm"])
+        say(f"window +-{w}: worst held-out centre error {worst:.4f} mm, mean at the last level "
+            f"{val['centre_mean_mm'][-1]:.4f} mm")
+        table = ChainTable(**{**table.__dict__, "validation": val,
+                              "metadata": {"solves": len(solved), "build_wall_s": time.perf_counter() - start}})
+        best = table
+        if worst <= tolerance:
+            return table
+    assert best is not None
+    raise LocalityError(
+        f"the chain model does not reproduce this model within {tolerance:g} mm: with window +-{best.window} "
+        f"the worst held-out unit-centre error is {max(best.validation['centre_worst_mm']):.3g} mm; the units "
+        "interact further than the window reaches, so search with the FE model (--search ga or exhaustive)"
+    )
+
+
+# -- the model -------------------------------------------------------------------------------
+class ChainModel:
+    """An :class:`~pneumorph.models.ActuatorModel` that chains a :class:`ChainTable`.
+
+    Parameters
+    ----------
+    table : ChainTable
+    n_units : int
+        Units of the actuator (any number from ``2 w + 1``; the table's windows do not
+        depend on the length).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pneumorph.models import Response
+    >>> ref = np.array([[5.0, 0.0], [15.0, 0.0], [25.0, 0.0]])
+    >>> r = Response.empty("010", np.array([0.045]), ref, np.array([30.0, 0.0]))
+    >>> r.centres[0] = ref; r.tip[0] = [30.0, 0.0]; r.curl[0] = 0.0
+    >>> table = fit_table([r], 1, {"fidelity": "toy", "key": "x", "n_units": 3})
+    >>> ChainModel(table, 3).evaluate("101").tip.round(9).tolist()
+    [[30.0, 0.0]]
+    """
+
+    def __init__(self, table: ChainTable, n_units: int) -> None:
+        table.check_units(n_units)
+        self.table = table
+        self.n_units = int(n_units)
+        self.fidelity = f"chain-{table.source.get('fidelity', '?')}"
+
+    def fingerprint(self) -> str:
+        return hashlib.sha256(f"{self.table.fingerprint()}-{self.n_units}".encode()).hexdigest()[:16]
+
+    def describe(self) -> dict[str, Any]:
+        return {"fidelity": self.fidelity, "n_units": self.n_units, "window": self.table.window,
+                "table": self.table.fingerprint(), "source": self.table.source.get("key")}
+
+    def pressures(self) -> FloatArray:
+        return self.table.pressures.copy()
+
+    def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Centres (m, k, n, 2), tip (m, k, 2), curl (m, k) of many designs at once."""
+        bits = np.atleast_2d(np.asarray(bits))
+        if bits.shape[1] != self.n_units:
+            raise ChainTableError(f"designs of {bits.shape[1]} units given to a chain model of {self.n_units}")
+        return self.table.predict(bits)
+
+    def evaluate(self, orientation: str) -> Response:
+        design = parse_orientation(orientation, self.n_units)
+        bits = design_array(design)
+        c, t, cu = self.predict(bits)
+        ref_c, ref_t = self.table.reference(bits)
+        return Response(design, self.pressures(), c[0], ref_c[0], t[0], ref_t, cu[0], converged=True, reached=float(self.table.pressures[-1]),
+                        metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()})
