@@ -9,7 +9,7 @@ import pytest
 
 from pneumorph.cli import main
 
-TINY = ["--units", "2", "--pop", "4", "--gen", "2", "--pressure", "10", "--executor", "serial"]
+TINY = ["--units", "2", "--search", "ga", "--pop", "4", "--gen", "2", "--pressure", "10", "--executor", "serial"]
 
 
 def test_tiny_design_run_writes_the_folder_and_resumes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

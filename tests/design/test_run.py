@@ -43,7 +43,8 @@ class DyingToy(ToyModel):
 
 def config(tmp_path: Path, **kw) -> DesignConfig:
     ga = GAConfig(population=16, generations=8, indpb=1 / 8, hall_of_fame=5)
-    return DesignConfig(**{"objective": "sin", "units": 8, "ga": ga, "cache": str(tmp_path / "cache.sqlite"), **kw})
+    return DesignConfig(**{"objective": "sin", "units": 8, "ga": ga, "cache": str(tmp_path / "cache.sqlite"),
+                           "search": "ga", **kw})
 
 
 def test_run_folder_contents(tmp_path: Path) -> None:

@@ -224,8 +224,12 @@ def run_design(
 
             raise LocalityError("the certified search needs a free actuator (its chain model does not hold under "
                                 "gravity); search with --search ga or exhaustive")
+        if config.units < 3:
+            raise SearchConfigError(f"the certified search needs at least 3 units (a window of +-1), got "
+                                    f"{config.units}; use --search exhaustive")
         if config.chain_table is not None:  # check a given table before anything is written
-            table_for(model, lambda n: make_model(n, config.model), path=config.chain_table)
+            table = table_for(model, _training(model), path=config.chain_table)
+            ChainModel(table, config.units)
     folder.mkdir(parents=True, exist_ok=True)
     prov = provenance(config, model)
     prov["resumed"] = resumed
@@ -252,7 +256,7 @@ def run_design(
             ga = run_ga(model, objective, config.ga, cached, on_gen)
             hof, history = ga.hall_of_fame, ga.history
         elif config.search == "certified":
-            table = table_for(model, lambda n: make_model(n, config.model), folder=table_dir,
+            table = table_for(model, _training(model), folder=table_dir,
                               path=config.chain_table, evaluator=cached, on_progress=say)
             chain = ChainModel(table, config.units)
             verify = config.verify or int(getattr(inner, "workers", 1) or 1)
@@ -283,6 +287,17 @@ def run_design(
     files = _write_outputs(result, config, model, ranking, figures)
     return replace(result, files=tuple(files))
 
+
+
+def _training(model: ActuatorModel) -> Any:
+    """``n -> the same model with n units`` (the training actuator of a new chain table)."""
+    with_units = getattr(model, "with_units", None)
+    if not callable(with_units):
+        def refuse(n: int) -> Any:
+            raise SearchConfigError(f"the {getattr(model, 'fidelity', '?')} model cannot be re-built with other "
+                                    "lengths to fit a chain table; give a table (chain_table) or another search")
+        return refuse
+    return with_units
 
 
 def _chain_score(cert: CertifiedResult, i: int) -> Any:

@@ -14,6 +14,7 @@ pressure is ramped (the hanging test of appendix A.2.2).
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import time
@@ -151,6 +152,18 @@ class FEModel:
         if self.gravity is not None:  # absent without gravity: earlier fingerprints stay valid
             out["gravity_mm_s2"] = list(self.gravity)
         return out
+
+    def with_units(self, n_units: int) -> FEModel:
+        """The same model (unit, materials, ramp, solver) for an actuator of ``n_units`` units.
+
+        >>> Reduced2D(15).with_units(4).n_units
+        4
+        """
+        if int(n_units) < 1:
+            raise ValueError(f"an actuator needs at least 1 unit, got {n_units}")
+        other = copy.copy(self)
+        other.n_units = int(n_units)
+        return other
 
     def fingerprint(self) -> str:
         text = json.dumps(self.describe(), sort_keys=True, default=str)

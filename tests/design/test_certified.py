@@ -1,0 +1,116 @@
+"""Certified search: equal to FE exhaustive search on the real 2D model, the bound, branch-and-bound."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.design import make_objective, run_exhaustive
+from pneumorph.design.certified import (
+    certified_search,
+    chain_errors,
+    chain_scores,
+    grow_designs,
+    objective_bounds,
+    score_designs,
+)
+from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
+from pneumorph.geometry.orientation import mirror
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.models.chain import ChainModel, ChainTable, build_table, design_strings
+from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.fe import RampSpec, Reduced2D
+
+N = 7
+
+
+@pytest.fixture(scope="module")
+def setup() -> tuple[Reduced2D, ChainModel, CachedEvaluator]:
+    """The real 2D model (coarse mesh, 25 kPa, 7 units), every design solved once, and its chain."""
+    model = Reduced2D(N, UnitSpec(element_size=3.0), RampSpec(pressure=0.025))
+    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
+    table = build_table(model, evaluator, heldout=8)
+    return model, ChainModel(table, N), evaluator
+
+
+OBJECTIVES = [
+    ("sin", {"amplitude": 5.0}),
+    ("cos", {"amplitude": 8.0}),
+    ("r = 20 + 15*theta", {}),
+    ("max-y", {}),
+    ("reach", {"point": (50.0, 30.0)}),
+]
+
+
+@pytest.mark.parametrize(("spec", "kw"), OBJECTIVES)
+def test_certified_search_equals_fe_exhaustive_search(setup, spec: str, kw: dict) -> None:
+    model, chain, evaluator = setup
+    objective = make_objective(spec, **kw)
+    truth = run_exhaustive(model, objective, evaluator)
+    result = certified_search(model, chain, objective, evaluator, verify=1, certify=True)
+    assert result.certificate["certified"] and result.certificate["gap"] == 0.0
+    assert result.certificate["designs_scored"] == 2**N
+    assert result.winner.value == pytest.approx(truth.best.value, abs=1e-6)
+    assert result.winner.design in {truth.best.design, mirror(truth.best.design)}
+    # far fewer FE solves than designs
+    assert len(result.certificate["verified"]) < 2**N / 4
+    # every verified design's FE value lies within the bound of its chain value
+    sign = 1.0 if objective.sense == "min" else -1.0
+    order = result.scores.order()
+    names = design_strings(result.scores.bits[order])
+    for design, fe in result.verified.items():
+        i = order[names.index(design)]
+        assert abs(sign * result.scores.cost[i] - fe.value) <= result.scores.bound[i] + 1e-9
+
+
+def test_without_certify_one_batch_is_verified_and_the_gap_is_reported(setup) -> None:
+    model, chain, evaluator = setup
+    objective = make_objective("sin", amplitude=5.0)
+    result = certified_search(model, chain, objective, evaluator, verify=1)
+    c = result.certificate
+    assert len(c["verified"]) == 1 and c["verified"][0] == result.hall_of_fame[0].design
+    assert c["certified"] == (c["could_beat"] == 0)
+    assert c["gap"] >= 0.0
+
+
+def test_the_cartesian_bound_is_the_closed_form() -> None:
+    # beta = e sqrt(n (1 + S^2)), S = 2 pi A / L the largest slope of the sin preset
+    table = ChainTable.load(shipped_path("2d"))
+    chain = ChainModel(table, 15)
+    objective = make_objective("sin", amplitude=10.0)
+    errors = chain_errors(chain)
+    bits = np.zeros((1, 15), dtype=np.uint8)
+    centres, _, _ = chain.predict(bits)
+    beta = objective_bounds(chain, objective, centres, chain.table.reference(bits)[0], errors)
+    length = float(table.reference(bits)[1][0])
+    slope = 2 * np.pi * 10.0 / length
+    assert np.allclose(beta[0], errors["centre"] * np.sqrt(15 * (1 + slope**2)), rtol=1e-6)
+    # a longer actuator than the training one widens the errors in proportion
+    assert np.allclose(chain_errors(ChainModel(table, 30))["centre"], 2 * errors["centre"])
+
+
+@pytest.mark.parametrize("spec", ["sin", "cos", "max-y", "max-curl", "r = 30 + 10*theta"])
+def test_growing_designs_unit_by_unit_equals_scoring_them_whole(spec: str) -> None:
+    chain = ChainModel(ChainTable.load(shipped_path("2d")), 10)
+    objective = make_objective(spec)
+    errors = chain_errors(chain)
+    grown = grow_designs(chain, objective, errors)
+    whole = score_designs(chain, objective, grown.bits, errors)
+    assert len(grown.bits) == 2**10
+    assert np.allclose(grown.cost, whole.cost, rtol=0, atol=1e-9)
+    assert np.allclose(grown.optimistic, whole.optimistic, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("spec", ["sin", "cos", "max-y", "min-distance"])
+def test_branch_and_bound_finds_every_design_that_matters(spec: str) -> None:
+    chain = ChainModel(ChainTable.load(shipped_path("2d")), 14)
+    objective = make_objective(spec, amplitude=10.0)
+    full = chain_scores(chain, objective)
+    bb = chain_scores(chain, objective, max_enumerate=10)
+    assert not bb.complete and full.complete
+    assert design_strings(bb.bits[bb.order()[:1]]) == design_strings(full.bits[full.order()[:1]])
+    # every design outside the branch-and-bound set is no better than its floor (optimistically)
+    found = set(design_strings(bb.bits))
+    outside = [i for i, d in enumerate(design_strings(full.bits)) if d not in found]
+    assert full.optimistic[outside].min() >= bb.floor - 1e-9
+    assert len(found) < 2**14 / 4
