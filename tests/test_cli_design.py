@@ -53,3 +53,55 @@ def test_population_study_command(tmp_path: Path, capsys: pytest.CaptureFixture[
         assert r["lowest"] <= r["mean"] <= r["largest"] and len(r["best"]) == 2
     assert (tmp_path / "st" / "study.png").is_file()
     assert main(["study", "--populations", "2,x", "--out", str(tmp_path / "s2")]) == 2
+
+
+def _certified(tmp_path: Path, *extra: str) -> list[str]:
+    return ["design", "--model", "2d", "--units", "6", "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"),
+            "--out", str(tmp_path / "run"), *extra]
+
+
+def test_certified_design_on_the_shipped_2d_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([*_certified(tmp_path, "--target", "cos", "--amplitude", "5", "--certify"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    cert = out["certificate"]
+    assert cert["certified"] and cert["designs_scored"] == 64 and cert["complete"]
+    assert out["best"]["design"] in cert["verified"] and out["solves"] == len(cert["verified"])
+    top = out["top"]
+    assert top[0]["fe"] is not None and abs(top[0]["fe"] - top[0]["chain"]) <= cert["bound"]
+    for name in ("certificate.json", "top.csv", "ranking.csv", "chain-vs-fe.png", "profile.png", "report.md"):
+        assert (tmp_path / "run" / name).is_file(), name
+    assert "## Certificate" in (tmp_path / "run" / "report.md").read_text()
+    saved = json.loads((tmp_path / "run" / "certificate.json").read_text())
+    assert saved["winner"]["design"] == out["best"]["design"]
+
+
+def test_certified_design_refuses_bad_tables_before_writing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from pneumorph.models.chaintables import shipped_path
+
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"kind": "pneumorph chain table", "format": 1, "window": 2')
+    assert main(_certified(tmp_path, "--chain-table", str(bad))) == 2
+    err = capsys.readouterr().err
+    assert "not a chain table" in err and "Traceback" not in err and len(err.strip().splitlines()) <= 2
+    assert not (tmp_path / "run").exists()
+    # the 3D table for the 2D model
+    assert main(_certified(tmp_path, "--chain-table", str(shipped_path("3d")))) == 2
+    assert "another model" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+    # too few units for the table's window
+    args = _certified(tmp_path, "--chain-table", str(shipped_path("2d")))
+    args[args.index("6")] = "4"
+    assert main(args) == 2
+    assert "needs at least 5 units" in capsys.readouterr().err
+
+
+def test_gravity_falls_back_to_the_genetic_algorithm(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    config = tmp_path / "g.toml"
+    config.write_text('[design]\nunits = 2\n[ga]\npopulation = 4\ngenerations = 1\n'
+                      '[execution]\nexecutor = "serial"\n[model]\npressure_kpa = 10\ngravity = "hanging"\n')
+    assert main(["design", str(config), "--cache", str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"),
+                 "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "falling back to the genetic algorithm" in captured.err
+    assert "certificate" not in json.loads(captured.out)
+    assert (tmp_path / "run" / "generations.csv").is_file()

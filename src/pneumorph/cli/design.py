@@ -90,6 +90,10 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if unit_file:
         model_settings.pop("unit", None)
     config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
+    if config.search == "certified" and config.model.get("gravity") is not None:
+        click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
+                   "falling back to the genetic algorithm", err=True)
+        config = replace(config, search="ga")
     if "fidelity" not in config.model:  # the certified search works on the 3D model by default
         config = replace(config, model={**config.model, "fidelity": "3d" if config.search == "certified" else "2d"})
     config = DesignConfig.from_dict(config.to_dict())  # validate the combination
