@@ -50,6 +50,9 @@ def main() -> None:
         entry = saved.setdefault(name, {})
         for fidelity in ("3d", "2d"):
             r = run(name, fidelity, args)
+            old = entry.get(f"certified_{fidelity}")
+            if r["solves"] == 0 and old and old["best"]["design"] == r["best"]["design"]:
+                r["wall_s"] = old["wall_s"]  # all from the cache: keep the wall time of the run that solved
             entry[f"certified_{fidelity}"] = r
             store.write_text(json.dumps(saved, indent=1), encoding="utf-8")
             c = r["certificate"]
@@ -91,7 +94,8 @@ def main() -> None:
               "version of this page: GA over the 2D model, mostly 24 x 8, the sin-10 run 100 x 15.", ""]
     for name in ORDER:
         if "certified_3d" in saved.get(name, {}):
-            lines += [f"![{name}](figures/examples/{name}-3d.png)", ""]
+            lines += [f"![{name}, 3D](figures/examples/{name}-3d.png)", f"![{name}, 2D](figures/examples/{name}-2d.png)",
+                      ""]
     (ROOT / "docs" / "examples.md").write_text("\n".join(lines), encoding="utf-8")
 
 

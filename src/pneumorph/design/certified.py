@@ -48,7 +48,7 @@ MAX_ENUMERATE = 20
 """Longest actuator whose 2^n designs are all scored; longer ones go through branch-and-bound."""
 CHUNK = 8192
 """Designs scored at once (memory: about 2 kB per design and level)."""
-MAX_NODES = 4_000_000
+MAX_NODES = 500_000
 """Most open prefixes the branch-and-bound keeps at one depth."""
 
 
@@ -203,32 +203,63 @@ def _chord_codes(bits: NDArray[np.uint8], j: int, w: int, n: int) -> NDArray[np.
     return code
 
 
+def _cos_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Least and greatest cosine over the angle intervals [lo, hi]."""
+    top = np.where(np.floor(hi / (2 * np.pi)) > np.floor(lo / (2 * np.pi) - 1e-15) - (lo % (2 * np.pi) == 0), 1.0,
+                   np.maximum(np.cos(lo), np.cos(hi)))
+    shifted_lo, shifted_hi = lo - np.pi, hi - np.pi
+    bottom = np.where(np.floor(shifted_hi / (2 * np.pi)) > np.floor(shifted_lo / (2 * np.pi) - 1e-15)
+                      - (shifted_lo % (2 * np.pi) == 0), -1.0, np.minimum(np.cos(lo), np.cos(hi)))
+    return bottom, top
+
+
+def _reach_box(table: Any, state: dict[str, Any], remaining: int) -> tuple[FloatArray, ...]:
+    """A box (per prefix and level) holding every tip its remaining chords can reach.
+
+    Chord ``i`` of the remaining ones turns by ``i`` tabulated turns at most, so its angle
+    lies in ``[a + i t_min, a + i t_max]``; its length in ``[L_min, L_max]``.
+    """
+    tmin, tmax = table.turn.min(axis=0), table.turn.max(axis=0)
+    lmin, lmax = table.length.min(axis=0), table.length.max(axis=0)
+    a = state["angle"]
+    x, y = state["point"][..., 0].copy(), state["point"][..., 1].copy()
+    xlo, xhi, ylo, yhi = x.copy(), x.copy(), y.copy(), y.copy()
+    for i in range(1, remaining + 1):
+        lo, hi = a + i * tmin, a + i * tmax
+        cmin, cmax = _cos_range(lo, hi)
+        smin, smax = _cos_range(lo - np.pi / 2, hi - np.pi / 2)
+        xhi += np.where(cmax >= 0, lmax * cmax, lmin * cmax)
+        xlo += np.where(cmin <= 0, lmax * cmin, lmin * cmin)
+        yhi += np.where(smax >= 0, lmax * smax, lmin * smax)
+        ylo += np.where(smin <= 0, lmax * smin, lmin * smin)
+    return xlo, xhi, ylo, yhi
+
+
 def _prefix_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], remaining: int) -> FloatArray:
     """A lower bound on the cost of every completion of each prefix, shape (m,)."""
     table = chain.table
     if isinstance(objective, ProfileTarget):
         return np.sqrt(state["sum"].min(axis=1))
-    reach = remaining * table.length.max(axis=0)  # (k,): the remaining chords at their longest
-    p = state["point"]
-    x, y = p[..., 0], p[..., 1] - table.tip_ref[1]
     name = objective.name
-    if name == "max-x":
-        c = -(x + reach)
-    elif name == "min-x":
-        c = x - reach
-    elif name == "max-y":
-        c = -(y + reach)
-    elif name == "min-y":
-        c = y - reach
-    elif name == "min-distance":
-        c = np.maximum(np.hypot(x, y) - reach, 0.0)
-    elif name == "reach":
-        q = objective.point
-        assert q is not None
-        c = np.maximum(np.hypot(x - q[0], y - q[1]) - reach, 0.0)
-    else:  # max-curl: the rest of the turns and the end turn at their largest
+    if name == "max-curl":  # the rest of the turns and the end turn at their largest
         turns = np.degrees(remaining * table.turn.max(axis=0) + table.end.max(axis=0))
-        c = -(np.degrees(state["angle"]) + turns)
+        return (-(np.degrees(state["angle"]) + turns)).min(axis=1)
+    xlo, xhi, ylo, yhi = _reach_box(table, state, remaining)
+    ylo, yhi = ylo - table.tip_ref[1], yhi - table.tip_ref[1]
+    if name == "max-x":
+        c = -xhi
+    elif name == "min-x":
+        c = xlo
+    elif name == "max-y":
+        c = -yhi
+    elif name == "min-y":
+        c = ylo
+    else:  # distance to the base or to a point: from the point to the box
+        q = (0.0, 0.0) if name == "min-distance" else objective.point
+        assert q is not None
+        dx = np.maximum(np.maximum(xlo - q[0], q[0] - xhi), 0.0)
+        dy = np.maximum(np.maximum(ylo - q[1], q[1] - yhi), 0.0)
+        c = np.hypot(dx, dy)
     return c.min(axis=1)
 
 
@@ -262,8 +293,11 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     cy = np.asarray(table.centre_y)
     bits = np.array([[0], [1]], dtype=np.uint8)
     m = 2
-    st: dict[str, Any] = {"point": np.zeros((m, k, 2)), "angle": np.zeros((m, k)), "sum": np.zeros((m, k)),
-                          "bsum": np.zeros((m, k)), "theta": np.zeros((m, k))}
+    st: dict[str, Any] = {"point": np.zeros((m, k, 2)), "angle": np.zeros((m, k))}
+    if profile:
+        st["sum"] = np.zeros((m, k))
+    if polar:
+        st.update(bsum=np.zeros((m, k)), theta=np.zeros((m, k)))
     st["point"][..., 1] = cy[bits[:, 0]][:, None]
     placed = 0
     with np.errstate(all="ignore"):

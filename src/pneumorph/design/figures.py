@@ -78,13 +78,15 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
         if objective.point is not None:
             ax.plot(*objective.point, "x", color="C1", ms=10, mew=2, label="point to reach")
         what = f"{objective.label}: {candidate.value:.4g} {objective.unit}"
+    fidelity = (r.metadata or {}).get("fidelity")
+    ax.plot(pts[:, 0], pts[:, 1], "-", color="C0", lw=1.5,
+            label="actuator centreline" + (f" ({fidelity} FE)" if compare and fidelity else ""))
+    ax.plot(pts[1:-1, 0], pts[1:-1, 1], "o", color="C0", ms=4, label="unit centres")
+    ax.plot(*pts[-1], "s", color="C3", ms=6, label="tip")
     for i, (name, other) in enumerate(compare):
         o = Candidate(other.design, other.value, candidate.level, candidate.pressure, None, other.response)
         q = profile_points(o)
-        ax.plot(q[:, 0], q[:, 1], "--", marker=".", color=f"C{i + 4}", lw=1.2, label=f"{name}")
-    ax.plot(pts[:, 0], pts[:, 1], "-", color="C0", lw=1.5, label="actuator centreline")
-    ax.plot(pts[1:-1, 0], pts[1:-1, 1], "o", color="C0", ms=4, label="unit centres")
-    ax.plot(*pts[-1], "s", color="C3", ms=6, label="tip")
+        ax.plot(q[:, 0], q[:, 1], ":", marker="x", ms=6, color=f"C{i + 4}", lw=1.2, zorder=5, label=name)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x along the actuator (mm)")
     ax.set_ylabel("y (mm)")
