@@ -105,3 +105,27 @@ def test_gravity_falls_back_to_the_genetic_algorithm(tmp_path: Path, capsys: pyt
     assert "falling back to the genetic algorithm" in captured.err
     assert "certificate" not in json.loads(captured.out)
     assert (tmp_path / "run" / "generations.csv").is_file()
+
+
+def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    unit = tmp_path / "coarse.toml"
+    unit.write_text("[unit]\nelement_size = 3.0\n")
+    cache = tmp_path / "cache" / "c.sqlite"
+    args = ["design", "--model", "2d", "--unit", str(unit), "--pressure", "20", "--units", "6", "--executor", "serial",
+            "--target", "cos", "--amplitude", "4", "--cache", str(cache), "--out", str(tmp_path / "run"), "--json"]
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    first = json.loads(captured.out)
+    assert "covering designs" in captured.err and "held-out" in captured.err  # progress of the build
+    tables = list((tmp_path / "cache" / "chain-tables").glob("chain-2d-*.json"))
+    assert len(tables) == 1
+    from pneumorph.models.chain import ChainTable
+
+    table = ChainTable.load(tables[0])
+    assert table.source["n_units"] == 15 and max(table.validation["centre_worst_mm"]) <= 0.2
+    # the solves of the build (15-unit designs) and the verification (6 units)
+    assert first["solves"] > len(table.training) + len(first["certificate"]["verified"])
+    assert main(args) == 0  # again: the table is found and every verification is cached
+    again = json.loads(capsys.readouterr().out)
+    assert again["solves"] == 0 and again["best"] == first["best"]

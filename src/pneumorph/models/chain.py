@@ -620,6 +620,17 @@ def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed:
     return out
 
 
+def _provenance(solves: int, start: float) -> dict[str, Any]:
+    import platform
+    from datetime import UTC, datetime
+
+    from pneumorph import __version__
+
+    return {"solves": solves, "build_wall_s": time.perf_counter() - start, "pneumorph": __version__,
+            "created": datetime.now(UTC).isoformat(timespec="seconds"), "python": platform.python_version(),
+            "numpy": np.__version__}
+
+
 def build_table(
     model: Any,
     evaluator: Any = None,
@@ -702,8 +713,7 @@ def build_table(
         worst = max(val["centre_worst_mm"])
         say(f"window +-{w}: worst held-out centre error {worst:.4f} mm, mean at the last level "
             f"{val['centre_mean_mm'][-1]:.4f} mm")
-        table = ChainTable(**{**table.__dict__, "validation": val,
-                              "metadata": {"solves": len(solved), "build_wall_s": time.perf_counter() - start}})
+        table = ChainTable(**{**table.__dict__, "validation": val, "metadata": _provenance(len(solved), start)})
         best = table
         if worst <= tolerance:
             return table
