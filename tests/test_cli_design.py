@@ -129,3 +129,25 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     assert main(args) == 0  # again: the table is found and every verification is cached
     again = json.loads(capsys.readouterr().out)
     assert again["solves"] == 0 and again["best"] == first["best"]
+
+
+def test_a_model_the_chain_cannot_represent_falls_back_to_the_ga(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    from pneumorph.errors import LocalityError
+    from pneumorph.models import chaintables
+
+    def no_locality(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise LocalityError("the chain model does not reproduce this model within 0.2 mm")
+
+    monkeypatch.setattr(chaintables, "build_table", no_locality)
+    unit = tmp_path / "coarse.toml"
+    unit.write_text("[unit]\nelement_size = 3.0\n")
+    args = ["design", "--unit", str(unit), "--pressure", "10", "--units", "3", "--pop", "4", "--gen", "1",
+            "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"), "--json"]
+    monkeypatch.chdir(tmp_path)
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    assert "falling back to the genetic algorithm" in captured.err
+    out = json.loads(captured.out)
+    assert "certificate" not in out and out["folder"].endswith("-ga-seed0")
+    assert not list((tmp_path / "runs").glob("*certified*"))  # the refused search left no folder

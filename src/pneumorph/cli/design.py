@@ -69,7 +69,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     from dataclasses import replace
 
     from pneumorph.design import DesignConfig, run_design
-    from pneumorph.errors import SearchConfigError
+    from pneumorph.errors import LocalityError, SearchConfigError
     from pneumorph.models.factory import make_model
 
     if target and objective:
@@ -90,6 +90,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if unit_file:
         model_settings.pop("unit", None)
     config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
+    fidelity_given = "fidelity" in config.model
     if config.search == "certified" and config.model.get("gravity") is not None:
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
                    "falling back to the genetic algorithm", err=True)
@@ -118,8 +119,19 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     def on_message(text: str) -> None:
         click.echo(f"  {text}", err=True)
 
-    result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
-                        overwrite=overwrite, on_message=on_message)
+    try:
+        result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
+                            overwrite=overwrite, on_message=on_message)
+    except LocalityError as exc:  # the chain cannot represent this model: nothing was written
+        if config.search != "certified":
+            raise
+        click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
+        settings = dict(config.model) if fidelity_given else {**config.model, "fidelity": "2d"}
+        config = replace(config, search="ga", model=settings)
+        model = make_model(config.units, config.model)
+        folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
+        result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
+                            overwrite=overwrite, on_message=on_message)
     best = result.best
     if as_json:
         click.echo(json.dumps({

@@ -230,10 +230,6 @@ def run_design(
         if config.chain_table is not None:  # check a given table before anything is written
             table = table_for(model, _training(model), path=config.chain_table)
             ChainModel(table, config.units)
-    folder.mkdir(parents=True, exist_ok=True)
-    prov = provenance(config, model)
-    prov["resumed"] = resumed
-    (folder / "config.toml").write_text(to_toml({**config.to_dict(), "provenance": prov}), encoding="utf-8")
 
     own_evaluator = evaluator is None
     inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
@@ -242,6 +238,26 @@ def run_design(
     if cache.path != ":memory:":
         table_dir = Path(cache.path).parent / "chain-tables"
     cached = CachedEvaluator(inner, cache)
+    chain = None
+    if config.search == "certified":
+        # the table (built on first use, through the cache) before the folder is claimed: a model the
+        # chain cannot represent leaves nothing behind
+        try:
+            table = table_for(model, _training(model), folder=table_dir, path=config.chain_table, evaluator=cached,
+                              on_progress=say)
+            chain = ChainModel(table, config.units)
+        except BaseException:
+            if own_evaluator:
+                inner.close()
+            if own_cache:
+                cache.close()
+            raise
+    folder.mkdir(parents=True, exist_ok=True)
+    prov = provenance(config, model)
+    prov["resumed"] = resumed
+    if chain is not None:
+        prov["chain_table"] = chain.table.fingerprint()
+    (folder / "config.toml").write_text(to_toml({**config.to_dict(), "provenance": prov}), encoding="utf-8")
     start = time.perf_counter()
     log = _GenerationLog(folder / "generations.csv") if config.search == "ga" else None
 
@@ -256,9 +272,7 @@ def run_design(
             ga = run_ga(model, objective, config.ga, cached, on_gen)
             hof, history = ga.hall_of_fame, ga.history
         elif config.search == "certified":
-            table = table_for(model, _training(model), folder=table_dir,
-                              path=config.chain_table, evaluator=cached, on_progress=say)
-            chain = ChainModel(table, config.units)
+            assert chain is not None
             verify = config.verify or int(getattr(inner, "workers", 1) or 1)
             cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
                                     hall_of_fame=config.ga.hall_of_fame, margin=config.margin, on_progress=say)
