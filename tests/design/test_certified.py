@@ -7,6 +7,8 @@ import pytest
 
 from pneumorph.design import make_objective, run_exhaustive
 from pneumorph.design.certified import (
+    _cos_range,
+    _sin_range,
     certified_search,
     chain_errors,
     chain_scores,
@@ -114,3 +116,17 @@ def test_branch_and_bound_finds_every_design_that_matters(spec: str) -> None:
     outside = [i for i, d in enumerate(design_strings(full.bits)) if d not in found]
     assert full.optimistic[outside].min() >= bb.floor - 1e-9
     assert len(found) < 2**14 / 4
+
+
+def test_the_range_of_cos_and_sin_over_an_interval() -> None:
+    rng = np.random.default_rng(3)
+    lo = rng.uniform(-20.0, 20.0, 400)
+    hi = lo + np.concatenate([rng.uniform(0.0, 7.0, 390), np.zeros(10)])
+    for span, f in ((_cos_range, np.cos), (_sin_range, np.sin)):
+        bottom, top = span(lo, hi)
+        for a, b, least, most in zip(lo, hi, bottom, top):
+            v = f(np.linspace(a, b, 4001))
+            assert least <= v.min() + 1e-12 and most >= v.max() - 1e-12  # a valid range
+            assert least == pytest.approx(v.min(), abs=1e-5) and most == pytest.approx(v.max(), abs=1e-5)  # tight
+    assert _cos_range(np.array([-0.1]), np.array([0.1]))[1][0] == 1.0  # holds the maximum at 0
+    assert _sin_range(np.array([3.0]), np.array([3.3]))[0][0] == pytest.approx(np.sin(3.3))

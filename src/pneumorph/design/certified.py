@@ -203,35 +203,49 @@ def _chord_codes(bits: NDArray[np.uint8], j: int, w: int, n: int) -> NDArray[np.
     return code
 
 
+def _contains(lo: FloatArray, hi: FloatArray, phase: float) -> NDArray[np.bool_]:
+    """True where [lo, hi] contains ``phase + 2 pi m`` for some integer m."""
+    return 2 * np.pi * np.ceil((lo - phase) / (2 * np.pi)) + phase <= hi
+
+
 def _cos_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Least and greatest cosine over the angle intervals [lo, hi]."""
-    top = np.where(np.floor(hi / (2 * np.pi)) > np.floor(lo / (2 * np.pi) - 1e-15) - (lo % (2 * np.pi) == 0), 1.0,
-                   np.maximum(np.cos(lo), np.cos(hi)))
-    shifted_lo, shifted_hi = lo - np.pi, hi - np.pi
-    bottom = np.where(np.floor(shifted_hi / (2 * np.pi)) > np.floor(shifted_lo / (2 * np.pi) - 1e-15)
-                      - (shifted_lo % (2 * np.pi) == 0), -1.0, np.minimum(np.cos(lo), np.cos(hi)))
+    c_lo, c_hi = np.cos(lo), np.cos(hi)
+    top = np.where(_contains(lo, hi, 0.0), 1.0, np.maximum(c_lo, c_hi))
+    bottom = np.where(_contains(lo, hi, np.pi), -1.0, np.minimum(c_lo, c_hi))
     return bottom, top
 
 
-def _reach_box(table: Any, state: dict[str, Any], remaining: int) -> tuple[FloatArray, ...]:
+def _sin_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Least and greatest sine over the angle intervals [lo, hi]."""
+    s_lo, s_hi = np.sin(lo), np.sin(hi)
+    top = np.where(_contains(lo, hi, np.pi / 2), 1.0, np.maximum(s_lo, s_hi))
+    bottom = np.where(_contains(lo, hi, -np.pi / 2), -1.0, np.minimum(s_lo, s_hi))
+    return bottom, top
+
+
+def _reach_box(table: Any, state: dict[str, Any], remaining: int, axes: str = "xy") -> tuple[FloatArray, ...]:
     """A box (per prefix and level) holding every tip its remaining chords can reach.
 
     Chord ``i`` of the remaining ones turns by ``i`` tabulated turns at most, so its angle
-    lies in ``[a + i t_min, a + i t_max]``; its length in ``[L_min, L_max]``.
+    lies in ``[a + i t_min, a + i t_max]``; its length in ``[L_min, L_max]``. Only the
+    ``axes`` asked for are bounded (the others stay at the current point).
     """
     tmin, tmax = table.turn.min(axis=0), table.turn.max(axis=0)
     lmin, lmax = table.length.min(axis=0), table.length.max(axis=0)
     a = state["angle"]
-    x, y = state["point"][..., 0].copy(), state["point"][..., 1].copy()
+    x, y = state["point"][..., 0], state["point"][..., 1]
     xlo, xhi, ylo, yhi = x.copy(), x.copy(), y.copy(), y.copy()
     for i in range(1, remaining + 1):
         lo, hi = a + i * tmin, a + i * tmax
-        cmin, cmax = _cos_range(lo, hi)
-        smin, smax = _cos_range(lo - np.pi / 2, hi - np.pi / 2)
-        xhi += np.where(cmax >= 0, lmax * cmax, lmin * cmax)
-        xlo += np.where(cmin <= 0, lmax * cmin, lmin * cmin)
-        yhi += np.where(smax >= 0, lmax * smax, lmin * smax)
-        ylo += np.where(smin <= 0, lmax * smin, lmin * smin)
+        if "x" in axes:
+            cmin, cmax = _cos_range(lo, hi)
+            xhi += np.where(cmax >= 0, lmax * cmax, lmin * cmax)
+            xlo += np.where(cmin <= 0, lmax * cmin, lmin * cmin)
+        if "y" in axes:
+            smin, smax = _sin_range(lo, hi)
+            yhi += np.where(smax >= 0, lmax * smax, lmin * smax)
+            ylo += np.where(smin <= 0, lmax * smin, lmin * smin)
     return xlo, xhi, ylo, yhi
 
 
@@ -244,7 +258,8 @@ def _prefix_bound(chain: ChainModel, objective: Objective, state: dict[str, Any]
     if name == "max-curl":  # the rest of the turns and the end turn at their largest
         turns = np.degrees(remaining * table.turn.max(axis=0) + table.end.max(axis=0))
         return (-(np.degrees(state["angle"]) + turns)).min(axis=1)
-    xlo, xhi, ylo, yhi = _reach_box(table, state, remaining)
+    axes = {"max-x": "x", "min-x": "x", "max-y": "y", "min-y": "y"}.get(name, "xy")
+    xlo, xhi, ylo, yhi = _reach_box(table, state, remaining, axes)
     ylo, yhi = ylo - table.tip_ref[1], yhi - table.tip_ref[1]
     if name == "max-x":
         c = -xhi
@@ -335,8 +350,9 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
             bits = bits[keep]
             st = {key: v[keep] for key, v in st.items()}
             if len(bits) > max_nodes:
-                raise SearchConfigError(f"branch-and-bound: {len(bits):,} open prefixes at unit {p} of {n}; "
-                                        "the bound is too loose for this target - use --search ga")
+                raise SearchConfigError(f"branch-and-bound: {len(bits):,} open prefixes at unit {p} of {n}: too "
+                                        "many designs come within the chain's error bound of the best to list "
+                                        "them all - use --search ga")
         if profile:
             values = np.sqrt(st["sum"])
             if polar:
