@@ -4,6 +4,8 @@ The functions a front end calls:
 
 - :func:`make_objective` - an objective from text (``"sin"``, ``"max-y"``, ``"y = ..."``).
 - :func:`score` - a response's fitness at every pressure level and its best level.
+- :func:`certified_search` - every design scored by a chain model, the best verified by FE,
+  with a bound on what any other design could do.
 - :func:`run_ga` / :func:`run_exhaustive` - the searches, through any evaluator.
 - :func:`run_design` - a whole run into a folder (resumable), from a :class:`DesignConfig`.
 - :func:`population_study` - the population-size study of section 6.1.
@@ -15,6 +17,7 @@ Examples
 'sin: y = A*sin(2*pi*1*x/L), A = 15 mm'
 """
 
+from pneumorph.design.certified import CertifiedResult, certified_search
 from pneumorph.design.config import DesignConfig
 from pneumorph.design.exhaustive import (
     ExhaustiveResult,
@@ -41,6 +44,7 @@ __all__ = [
     "PRESETS",
     "TIP_GOALS",
     "Candidate",
+    "CertifiedResult",
     "DesignConfig",
     "ExhaustiveResult",
     "GAConfig",
@@ -52,6 +56,7 @@ __all__ = [
     "Score",
     "StudyResult",
     "TipGoal",
+    "certified_search",
     "make_objective",
     "mirror_response",
     "plot_study",

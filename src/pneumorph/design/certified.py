@@ -187,11 +187,6 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
     return ChainScores(bits, values, cost, level, optimistic, bound)
 
 
-def all_bits(n: int) -> NDArray[np.uint8]:
-    """Every design of ``n`` units in binary order, shape (2^n, n)."""
-    return ((np.arange(2**n, dtype=np.int64)[:, None] >> np.arange(n - 1, -1, -1)) & 1).astype(np.uint8)
-
-
 # -- growing designs unit by unit: enumeration and branch-and-bound ---------------------------
 def _chord_codes(bits: NDArray[np.uint8], j: int, w: int, n: int) -> NDArray[np.int64]:
     """Window codes of chord ``j`` of prefixes ``bits`` (which hold every unit it sees)."""
@@ -323,7 +318,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 st = {key: np.repeat(v, 2, axis=0) for key, v in st.items()}
             upto = n + 1 if p == n else max(p - w + 1, 0)
             for j in range(placed, upto):
-                rows = table._rows(_chord_codes(bits, j, w, n), table.codes, "chord")
+                rows = table.lookup(_chord_codes(bits, j, w, n))
                 st["angle"] = st["angle"] + table.turn[rows]
                 step = table.length[rows]
                 st["point"] = st["point"] + np.stack([step * np.cos(st["angle"]), step * np.sin(st["angle"])], -1)
@@ -362,7 +357,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 s = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
                 beta = np.broadcast_to(e * np.sqrt(n * (1.0 + s**2)), values.shape)
         else:
-            erows = table._rows(_chord_codes(bits, n, w, n), table.end_codes, "end")
+            erows = table.lookup(_chord_codes(bits, n, w, n), end=True)
             curl = np.degrees(st["angle"] + table.end[erows])
             values = tip_value_array(st["point"], np.asarray(table.tip_ref), curl, objective.name, objective.point)
             beta = np.broadcast_to(errors["curl"] if objective.name == "max-curl" else errors["tip"], values.shape)
@@ -490,47 +485,41 @@ def certified_search(
     book = ScoreBook(fe_model, objective, evaluator)
     sign = 1.0 if objective.sense == "min" else -1.0
     optimistic = scores.optimistic[order]
-    position = 0
+    done = np.zeros(len(designs), dtype=bool)
     verified: list[str] = []
 
     def winner_cost() -> float:
         costs = [sign * book.scores[d].value for d in verified if not book.scores[d].failed]
         return min(costs) if costs else float("inf")
 
-    while position < len(designs):
+    while True:
         best = winner_cost()
-        if verified and not certify and np.isfinite(best):
+        if np.isfinite(best) and not certify:
+            break  # one batch that converged
+        pending = np.flatnonzero(~done & (optimistic < best)) if np.isfinite(best) else np.flatnonzero(~done)
+        if not len(pending):
             break
-        if np.isfinite(best):
-            todo = [d for i, d in enumerate(designs[position:], position) if optimistic[i] < best][:verify]
-            if not todo:
-                break
-        else:
-            todo = designs[position : position + verify]
         if len(verified) >= max_verify:
             say(f"stopped after {len(verified)} FE verifications (max_verify)")
             break
+        batch = pending[:verify]
+        todo = [designs[i] for i in batch]
         book.score_many(todo)
+        done[batch] = True
         verified += todo
-        position = max(position, max(designs.index(d) for d in todo) + 1) if len(designs) < 70000 else \
-            position + len(todo)
-        say(f"verified {', '.join(todo)} by FE: " +
-            ", ".join(f"{book.scores[d].value:.4g}" for d in todo))
+        say(f"verified {', '.join(todo)} by FE: " + ", ".join(f"{book.scores[d].value:.4g}" for d in todo))
     if not any(not book.scores[d].failed for d in verified):
         raise SearchConfigError("no verified design converged in the FE model")
     best_cost = winner_cost()
-    ver = set(verified)
-    rest = np.array([i for i, d in enumerate(designs) if d not in ver]) if len(designs) <= 70000 else \
-        np.arange(position, len(designs))
-    rest_opt = float(optimistic[rest].min()) if len(rest) else float("inf")
-    could_beat = int((optimistic[rest] < best_cost).sum()) if len(rest) else 0
+    rest = optimistic[~done]
+    could_beat = int((rest < best_cost).sum())
     beat_floor = scores.floor < best_cost
-    gap = max(0.0, best_cost - min(rest_opt, scores.floor))
+    gap = max(0.0, best_cost - min(float(rest.min()) if len(rest) else float("inf"), scores.floor))
     winner = min((book.candidate(d) for d in verified if not book.scores[d].failed),
                  key=lambda c: (sign * c.value, c.design))
     hof = tuple(_candidate(chain, objective, d) for d in designs[:hall_of_fame])
     certificate = {
-        "bound": float(np.max(scores.bound[order[: max(len(verified), 1)]])),
+        "bound": float(scores.bound[order[designs.index(winner.design)]]),
         "bound_worst": float(np.max(scores.bound)),
         "gap": gap,
         "could_beat": could_beat,

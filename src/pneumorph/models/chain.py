@@ -302,7 +302,15 @@ class ChainTable:
         return h.hexdigest()[:16]
 
     # -- lookup and prediction ----------------------------------------------------------
-    def _rows(self, codes: IntArray, table: IntArray, what: str) -> IntArray:
+    def lookup(self, codes: IntArray, end: bool = False) -> IntArray:
+        """Rows of the chord (or end-turn) entries of window ``codes``.
+
+        Raises
+        ------
+        ChainTableError
+            A window the table has never seen (too short an actuator, another model).
+        """
+        table, what = (self.end_codes, "end") if end else (self.codes, "chord")
         idx = np.searchsorted(table, codes)
         idx = np.clip(idx, 0, len(table) - 1)
         missing = table[idx] != codes
@@ -348,8 +356,8 @@ class ChainTable:
         m, n = bits.shape
         self.check_units(n)
         codes = window_codes(bits, self.window)  # (m, n + 1)
-        rows = self._rows(codes, self.codes, "chord")
-        erows = self._rows(codes[:, -1], self.end_codes, "end")
+        rows = self.lookup(codes)
+        erows = self.lookup(codes[:, -1], end=True)
         angle = np.cumsum(self.turn[rows], axis=1)  # (m, n + 1, k)
         length = self.length[rows]
         steps = np.stack([length * np.cos(angle), length * np.sin(angle)], axis=-1)  # (m, n + 1, k, 2)
