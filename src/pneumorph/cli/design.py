@@ -39,6 +39,8 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--certify", is_flag=True, default=None,
               help="Certified search: verify by FE until no design can beat the winner.")
 @click.option("--verify", type=int, help="Certified search: designs verified by FE per batch (default: one per worker).")
+@click.option("--margin", type=float,
+              help="Certified search: factor on the chain's validated errors in the bound (default 1).")
 @click.option("--chain-table", metavar="FILE", type=click.Path(dir_okay=False),
               help="Certified search: a chain table file (default: the shipped one, or built on first use).")
 @click.option("--executor", type=click.Choice(["serial", "processes", "dask"]),
@@ -56,7 +58,7 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
            periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
            generations: int | None, seed: int | None, search: str | None, certify: bool | None,
-           verify: int | None, chain_table: str | None, executor: str | None,
+           verify: int | None, margin: float | None, chain_table: str | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
            unit_file: str | None, cache: str | None, out: str | None, overwrite: bool, as_json: bool) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
@@ -78,7 +80,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     changes: dict = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
                        ("point", point), ("units", units), ("search", search), ("seed", seed),
-                       ("certify", certify), ("verify", verify), ("chain_table", chain_table),
+                       ("certify", certify), ("verify", verify), ("margin", margin), ("chain_table", chain_table),
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
         if value is not None:
             changes[key] = value
