@@ -140,7 +140,7 @@ def test_the_shipped_tables_fit_the_default_models_and_their_validation_holds(fi
     model = make_model(15, {"fidelity": fidelity})
     check_source(table, model)  # the shipped table belongs to the model the CLI builds
     v = table.validation
-    assert len(v["designs"]) == 10 and not set(v["designs"]) & set(table.training)
+    assert len(v["designs"]) == 20 and not set(v["designs"]) & set(table.training)
     assert max(v["centre_worst_mm"]) <= 0.2
     assert v["centre_mean_mm"][-1] < 0.05
     assert np.allclose(table.pressures, model.pressures())

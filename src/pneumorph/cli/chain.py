@@ -22,7 +22,7 @@ def chain() -> None:
 @click.option("--window", type=int, help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
 @click.option("--tolerance", type=float, default=0.2, show_default=True,
               help="Worst held-out unit-centre error allowed at every level, mm.")
-@click.option("--heldout", type=int, default=10, show_default=True, help="Held-out random designs solved.")
+@click.option("--heldout", type=int, default=20, show_default=True, help="Held-out random designs solved.")
 @click.option("--workers", type=int, help="Processes solving designs (default: all cores).")
 @click.option("--cache", metavar="FILE", help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", required=True, metavar="FILE", help="Table file to write (JSON).")

@@ -644,7 +644,7 @@ def build_table(
     evaluator: Any = None,
     window: int | None = None,
     tolerance: float = DEFAULT_TOLERANCE,
-    heldout: int = 10,
+    heldout: int = 20,
     seed: int = 1,
     max_window: int = MAX_WINDOW,
     on_progress: Callable[[str], None] | None = None,
