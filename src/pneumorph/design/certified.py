@@ -39,7 +39,7 @@ from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
-from pneumorph.models.chain import ChainModel, design_strings, window_codes
+from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.response import ActuatorModel
 
 FloatArray = NDArray[np.float64]
@@ -370,8 +370,8 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     """Chain scores of every design that can matter, with a floor under the rest.
 
     Up to ``max_enumerate`` units: all ``2^n`` designs. Above: a beam search (the 4096
-    prefixes of lowest bound at every depth) gives a good cost ``c0``; branch-and-bound then returns every design of chain cost below
-    ``c0 + 2 beta`` (``beta`` the largest bound), the only ones whose FE value can beat a
+    prefixes of lowest bound at every depth) gives a good cost ``c0``; branch-and-bound
+    then returns every design of chain cost below ``c0 + 2 beta`` (``beta`` the largest bound), the only ones whose FE value can beat a
     design of chain cost ``c0``; all others are at least ``c0 + 2 beta`` by the chain, so
     their optimistic value is at least ``c0 + beta``.
     """
