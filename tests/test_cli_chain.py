@@ -1,0 +1,46 @@
+"""``pneumorph chain build``: a small table end to end, and bad input refused before any solve."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from pneumorph.cli import main
+from pneumorph.models.chain import ChainTable
+
+
+def test_chain_build_writes_a_validated_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    unit = tmp_path / "coarse.toml"
+    unit.write_text("[unit]\nelement_size = 3.0\n")
+    out = tmp_path / "t.json"
+    args = ["chain", "build", "--model", "2d", "--unit", str(unit), "--pressure", "20", "--units", "7",
+            "--heldout", "4", "--workers", "1", "--cache", str(tmp_path / "c.sqlite"), "--out", str(out), "--json"]
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    report = json.loads(captured.out)
+    assert "window +-1" in captured.err  # progress
+    table = ChainTable.load(out)
+    assert report["window"] == table.window and len(report["validation"]["designs"]) == 4
+    assert max(table.validation["centre_worst_mm"]) <= 0.2 and table.source["n_units"] == 7
+    assert table.metadata["pneumorph"] and table.metadata["created"]
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--out", "no/such/folder/t.json"], "existing folder"),
+        (["--window", "4", "--units", "7", "--out", "t.json"], "--window 4"),
+        (["--heldout", "0", "--out", "t.json"], "--heldout"),
+        (["--tolerance", "0", "--out", "t.json"], "tolerance"),
+    ],
+)
+def test_chain_build_refuses_bad_input(extra: list[str], message: str, tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["chain", "build", "--model", "2d", "--workers", "1", "--cache", str(tmp_path / "c.sqlite"),
+                 *extra]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert not (tmp_path / "t.json").exists()
