@@ -130,3 +130,20 @@ def test_the_range_of_cos_and_sin_over_an_interval() -> None:
             assert least == pytest.approx(v.min(), abs=1e-5) and most == pytest.approx(v.max(), abs=1e-5)  # tight
     assert _cos_range(np.array([-0.1]), np.array([0.1]))[1][0] == 1.0  # holds the maximum at 0
     assert _sin_range(np.array([3.0]), np.array([3.3]))[0][0] == pytest.approx(np.sin(3.3))
+
+
+def test_an_fe_model_that_never_converges_is_given_up_early(setup) -> None:
+    from pneumorph.errors import SearchConfigError
+    from pneumorph.fem import StepSettings
+
+    model, chain, _ = setup
+    starved = Reduced2D(N, UnitSpec(element_size=3.0),
+                        RampSpec(pressure=0.025, steps=StepSettings(increments=10, substeps=1, max_iterations=1,
+                                                                    max_cutbacks=1)))
+    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
+    with pytest.raises(SearchConfigError, match="did not converge for the chain's 4 best designs"):
+        certified_search(starved, chain, make_objective("sin", amplitude=5.0), evaluator, verify=2)
+    assert evaluator.solves == 4
+    other = Reduced2D(N, UnitSpec(element_size=3.0), RampSpec(pressure=0.03))
+    with pytest.raises(SearchConfigError, match="different pressure levels"):
+        certified_search(other, chain, make_objective("sin"), evaluator)

@@ -442,6 +442,7 @@ def certified_search(
     margin: float = 1.0,
     max_verify: int = 200,
     on_progress: Callable[[str], None] | None = None,
+    max_failures: int = 4,
 ) -> CertifiedResult:
     """Score every design with the chain, verify the best with FE, and bound the rest.
 
@@ -463,6 +464,9 @@ def certified_search(
         Factor on the chain's validated errors in the bound.
     max_verify : int
         Stop certifying after this many FE solves (the gap then stays open).
+    max_failures : int
+        Give up when this many verified designs in a row failed to converge in the FE model
+        before any converged (each failure can cost minutes).
 
     Raises
     ------
@@ -475,6 +479,9 @@ def certified_search(
         raise SearchConfigError(f"the FE model has {fe_model.n_units} units, the chain model {chain.n_units}")
     if verify < 1:
         raise SearchConfigError(f"at least one design must be verified per batch, got {verify}")
+    fe_p, chain_p = np.asarray(fe_model.pressures()), chain.pressures()
+    if fe_p.shape != chain_p.shape or not np.allclose(fe_p, chain_p, rtol=0, atol=1e-12):
+        raise SearchConfigError("the FE model and the chain model report different pressure levels")
     if not (np.isfinite(margin) and margin > 0):
         raise SearchConfigError(f"the bound's margin must be a positive number, got {margin!r}")
     scores = chain_scores(chain, objective, margin)
@@ -502,6 +509,10 @@ def certified_search(
         if len(verified) >= max_verify:
             say(f"stopped after {len(verified)} FE verifications (max_verify)")
             break
+        if not np.isfinite(best) and len(verified) >= max_failures:
+            failures = "; ".join(f"{d}: {book.outcomes[d].failure}" for d in verified[:2])
+            raise SearchConfigError(f"the FE model did not converge for the chain's {len(verified)} best designs "
+                                    f"({failures}); check the model (units, pressure) with pneumorph simulate")
         batch = pending[:verify]
         todo = [designs[i] for i in batch]
         book.score_many(todo)
@@ -509,7 +520,7 @@ def certified_search(
         verified += todo
         say(f"verified {', '.join(todo)} by FE: " + ", ".join(f"{book.scores[d].value:.4g}" for d in todo))
     if not any(not book.scores[d].failed for d in verified):
-        raise SearchConfigError("no verified design converged in the FE model")
+        raise SearchConfigError("no design converged in the FE model")
     best_cost = winner_cost()
     rest = optimistic[~done]
     could_beat = int((rest < best_cost).sum())
