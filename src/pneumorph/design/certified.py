@@ -39,7 +39,7 @@ from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
-from pneumorph.models.chain import ChainModel, design_strings
+from pneumorph.models.chain import ChainModel, design_strings, window_codes
 from pneumorph.models.response import ActuatorModel
 
 FloatArray = NDArray[np.float64]
@@ -188,16 +188,6 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
 
 
 # -- growing designs unit by unit: enumeration and branch-and-bound ---------------------------
-def _chord_codes(bits: NDArray[np.uint8], j: int, w: int, n: int) -> NDArray[np.int64]:
-    """Window codes of chord ``j`` of prefixes ``bits`` (which hold every unit it sees)."""
-    code = np.zeros(len(bits), dtype=np.int64)
-    for t in range(2 * w + 1):
-        u = j - w + t  # 1-based unit
-        sym = np.full(len(bits), 2 if u < 1 else 3, dtype=np.int64) if not 1 <= u <= n else bits[:, u - 1]
-        code += sym.astype(np.int64) * 4**t
-    return code
-
-
 def _contains(lo: FloatArray, hi: FloatArray, phase: float) -> NDArray[np.bool_]:
     """True where [lo, hi] contains ``phase + 2 pi m`` for some integer m."""
     return 2 * np.pi * np.ceil((lo - phase) / (2 * np.pi)) + phase <= hi
@@ -317,8 +307,9 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                                        np.tile(np.array([[0], [1]], dtype=np.uint8), (len(bits), 1))], axis=1)
                 st = {key: np.repeat(v, 2, axis=0) for key, v in st.items()}
             upto = n + 1 if p == n else max(p - w + 1, 0)
+            codes = window_codes(bits, w, range(placed, upto)) if upto > placed else None
             for j in range(placed, upto):
-                rows = table.lookup(_chord_codes(bits, j, w, n))
+                rows = table.lookup(codes[:, j - placed])
                 st["angle"] = st["angle"] + table.turn[rows]
                 step = table.length[rows]
                 st["point"] = st["point"] + np.stack([step * np.cos(st["angle"]), step * np.sin(st["angle"])], -1)
@@ -357,7 +348,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 s = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
                 beta = np.broadcast_to(e * np.sqrt(n * (1.0 + s**2)), values.shape)
         else:
-            erows = table.lookup(_chord_codes(bits, n, w, n), end=True)
+            erows = table.lookup(window_codes(bits, w, [n])[:, 0], end=True)
             curl = np.degrees(st["angle"] + table.end[erows])
             values = tip_value_array(st["point"], np.asarray(table.tip_ref), curl, objective.name, objective.point)
             beta = np.broadcast_to(errors["curl"] if objective.name == "max-curl" else errors["tip"], values.shape)

@@ -56,27 +56,37 @@ def design_strings(bits: NDArray[np.integer]) -> list[str]:
     return [text[i * n : (i + 1) * n] for i in range(bits.shape[0])]
 
 
-def window_symbols(bits: NDArray[np.integer], window: int) -> NDArray[np.int64]:
-    """The windows of every element (chord) of every design, shape (m, n + 1, 2w + 1).
+def window_symbols(bits: NDArray[np.integer], window: int, chords: Sequence[int] | None = None) -> NDArray[np.int64]:
+    """The windows of the elements (chords) of every design, shape (m, chords, 2w + 1).
 
     Element ``j`` sees the units ``j - w .. j + w`` (1-based); outside the actuator the
-    base symbol 2 and the tip symbol 3 stand in.
+    base symbol 2 and the tip symbol 3 stand in. ``chords`` picks elements (default all
+    ``n + 1``); for the first ``p`` units of longer designs, the elements ``j <= p - w``
+    are those of the whole designs.
 
     >>> window_symbols(np.array([[0, 1]]), 1)[0].tolist()
     [[2, 2, 0], [2, 0, 1], [0, 1, 3]]
     """
-    bits = np.asarray(bits, dtype=np.int64)
-    m, n = bits.shape
+    bits = np.asarray(bits)
+    n = bits.shape[1]
     w = int(window)
-    padded = np.concatenate([np.full((m, w + 1), BASE), bits, np.full((m, w + 1), TIP)], axis=1)
-    # element j (0..n) sees padded columns j .. j + 2w (unit j - w sits at column j)
-    idx = np.arange(n + 1)[:, None] + np.arange(2 * w + 1)[None, :]
-    return padded[:, idx]
+    elements = np.arange(n + 1) if chords is None else np.asarray(chords, dtype=np.int64)
+    # element j (0..n) sees units j - w .. j + w (1-based), i.e. columns j - w - 1 .. j + w - 1 of bits
+    units = elements[:, None] + np.arange(-w - 1, w)[None, :]
+    lo, hi = int(units.min()), int(units.max())
+    span = np.arange(lo, hi + 1)
+    seen = bits[:, np.clip(span, 0, n - 1)].astype(np.int64)  # only the columns the elements see
+    seen[:, span < 0] = BASE
+    seen[:, span >= n] = TIP
+    return seen[:, units - lo]
 
 
-def window_codes(bits: NDArray[np.integer], window: int) -> IntArray:
-    """Integer codes (base 4, first unit least significant) of every element's window, (m, n + 1)."""
-    sym = window_symbols(bits, window)
+def window_codes(bits: NDArray[np.integer], window: int, chords: Sequence[int] | None = None) -> IntArray:
+    """Integer codes (base 4, first unit least significant) of the elements' windows, (m, chords).
+
+    ``chords`` as for :func:`window_symbols`.
+    """
+    sym = window_symbols(bits, window, chords)
     weights = 4 ** np.arange(sym.shape[-1], dtype=np.int64)
     return sym @ weights
 
