@@ -18,10 +18,10 @@ Since the objective is the best over the levels, a design's FE value lies within
 verifies the best with FE and reports how far at most any unverified design could beat the
 verified winner; with ``certify`` it verifies in chain order until none can.
 
-Up to :data:`MAX_ENUMERATE` units every design is scored (in chunks); above, a
-branch-and-bound over the chain (the partial sums of Eq 4.1 only grow; the tip can move at
-most the summed length of the chords not yet placed) returns every design whose chain value
-is within reach of the best, and a floor under all others.
+Up to :data:`MAX_ENUMERATE` units every design is scored, grown unit by unit over shared
+prefixes; above, a branch-and-bound over the same growth (the partial sums of Eq 4.1 only
+grow; the tip stays in the box its remaining chords can reach) returns every design whose
+chain value is within reach of the best, and a floor under all others.
 """
 
 from __future__ import annotations
@@ -82,27 +82,49 @@ def _max_slope(f: Callable[[FloatArray], FloatArray], lo: float, hi: float, samp
     return float(d.max())
 
 
+def _target_length(chain: ChainModel) -> float:
+    """The undeformed length of the chain's actuator (the ``L`` of a profile target)."""
+    return float(chain.table.reference(np.zeros((1, chain.n_units), dtype=np.uint8))[1][0])
+
+
+def _target_slope(chain: ChainModel, objective: ProfileTarget, errors: dict[str, FloatArray]) -> float:
+    """The largest slope of a profile target wherever the actuator can reach.
+
+    ``|df/dx|`` over every x within the chords' summed greatest length of the base, or
+    ``|df/dtheta|`` over two turns either way.
+    """
+    length = _target_length(chain)
+    if objective.coordinates == "polar":
+        return _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
+    reach = float(chain.table.length.max()) * (chain.n_units + 1) + float(errors["centre"].max())
+    return _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+
+
+def _polar_term(r: FloatArray, e: FloatArray, slope: float) -> FloatArray:
+    """``(1 + S / (r - e))`` of one centre in the polar bound, infinite within ``e`` of the base."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(r > e, 1.0 + slope / (r - e), np.inf)
+
+
+def _uniform_bound(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
+                   slope: float) -> FloatArray:
+    """``beta_k`` of the objectives whose bound is the same for every design, shape (k,)."""
+    if isinstance(objective, ProfileTarget):
+        return errors["centre"] * np.sqrt(chain.n_units * (1.0 + slope**2))
+    return errors["curl"] if objective.name == "max-curl" else errors["tip"]
+
+
 def objective_bounds(chain: ChainModel, objective: Objective, centres: FloatArray, reference: FloatArray,
                      errors: dict[str, FloatArray]) -> FloatArray:
     """Bound ``beta`` on the objective error per design and level, shape (m, k)."""
     m, k = centres.shape[:2]
-    n = chain.n_units
-    if not isinstance(objective, ProfileTarget):
-        e = errors["curl"] if objective.name == "max-curl" else errors["tip"]
-        return np.broadcast_to(e, (m, k))
+    polar = isinstance(objective, ProfileTarget) and objective.coordinates == "polar"
+    slope = _target_slope(chain, objective, errors) if isinstance(objective, ProfileTarget) else 0.0
+    if not polar:
+        return np.broadcast_to(_uniform_bound(chain, objective, errors, slope), (m, k))
     e = errors["centre"]
-    length = float(chain.table.reference(np.zeros((1, n), dtype=np.uint8))[1][0])
-    reach = float(chain.table.length.max(axis=0).max()) * (n + 1) + float(e.max())
-    if objective.coordinates == "cartesian":
-        slope = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
-        return np.broadcast_to(e * np.sqrt(n * (1.0 + slope**2)), (m, k))
-    slope = _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
-    x = centres[..., 0]
-    y = centres[..., 1] - reference[:, None, :, 1]
-    r = np.hypot(x, y) - e[None, :, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        term = np.where(r > 0, 1.0 + slope / r, np.inf)
-    return e[None, :] * np.sqrt((term**2).sum(axis=-1))
+    r = np.hypot(centres[..., 0], centres[..., 1] - reference[:, None, :, 1])
+    return e[None, :] * np.sqrt((_polar_term(r, e[None, :, None], slope) ** 2).sum(axis=-1))
 
 
 # -- scoring every design -------------------------------------------------------------------
@@ -176,10 +198,8 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
     """Chain scores of the given designs (chunked)."""
     bits = np.asarray(bits, dtype=np.uint8)
     parts: list[tuple[FloatArray, ...]] = []
-    for lo in range(0, max(len(bits), 1), CHUNK):
+    for lo in range(0, len(bits), CHUNK):
         b = bits[lo : lo + CHUNK]
-        if not len(b):
-            break
         values, centres, ref_c = level_values(chain, objective, b)
         beta = objective_bounds(chain, objective, centres, ref_c, errors)
         parts.append((values, *_costs(values, beta, objective.sense)))
@@ -269,8 +289,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
 
     Designs grow unit by unit, sharing their prefixes: a prefix of ``p`` units fixes the
     chords whose windows it covers, hence the first centres and the partial sums of Eq 4.1
-    (which only grow), or the point where the remaining chords start (the tip can then move
-    at most their summed greatest length). Prefixes whose bound reaches ``threshold`` are
+    (which only grow), or the point where the remaining chords start (the tip then stays in
+    the box they can reach, :func:`_reach_box`). Prefixes whose bound reaches ``threshold`` are
     dropped (branch-and-bound); with no threshold this enumerates all ``2^n`` designs at
     about two chord placements per design. With ``beam``, only the ``beam`` prefixes of
     lowest bound are kept at every depth (a heuristic: no longer every design below the
@@ -285,11 +305,9 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     n, w, k = chain.n_units, table.window, table.n_levels
     profile = isinstance(objective, ProfileTarget)
     polar = profile and objective.coordinates == "polar"
-    length = float(table.reference(np.zeros((1, n), dtype=np.uint8))[1][0])
+    length = _target_length(chain)
     e = errors["centre"]
-    slope = 0.0
-    if polar:
-        slope = _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
+    slope = _target_slope(chain, objective, errors) if profile else 0.0
     cy = np.asarray(table.centre_y)
     bits = np.array([[0], [1]], dtype=np.uint8)
     m = 2
@@ -324,7 +342,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                         st["theta"] = th
                         r = np.hypot(x, y)
                         st["sum"] = st["sum"] + (objective.curve(th, length) - r) ** 2
-                        st["bsum"] = st["bsum"] + np.where(r > e, 1.0 + slope / (r - e), np.inf) ** 2
+                        st["bsum"] = st["bsum"] + _polar_term(r, e, slope) ** 2
             placed = max(placed, upto)
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
@@ -341,17 +359,14 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                                         "them all - use --search ga")
         if profile:
             values = np.sqrt(st["sum"])
-            if polar:
-                beta = e[None, :] * np.sqrt(st["bsum"])
-            else:
-                reach = float(table.length.max()) * (n + 1) + float(e.max())
-                s = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
-                beta = np.broadcast_to(e * np.sqrt(n * (1.0 + s**2)), values.shape)
         else:
             erows = table.lookup(window_codes(bits, w, [n])[:, 0], end=True)
             curl = np.degrees(st["angle"] + table.end[erows])
             values = tip_value_array(st["point"], np.asarray(table.tip_ref), curl, objective.name, objective.point)
-            beta = np.broadcast_to(errors["curl"] if objective.name == "max-curl" else errors["tip"], values.shape)
+        if polar:
+            beta = e[None, :] * np.sqrt(st["bsum"])
+        else:
+            beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
     return ChainScores(bits, values, cost, level, optimistic, bound)
 
@@ -362,9 +377,10 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
 
     Up to ``max_enumerate`` units: all ``2^n`` designs. Above: a beam search (the 4096
     prefixes of lowest bound at every depth) gives a good cost ``c0``; branch-and-bound
-    then returns every design of chain cost below ``c0 + 2 beta`` (``beta`` the largest bound), the only ones whose FE value can beat a
-    design of chain cost ``c0``; all others are at least ``c0 + 2 beta`` by the chain, so
-    their optimistic value is at least ``c0 + beta``.
+    then returns every design of chain cost below ``c0 + 2 beta`` (``beta`` the largest
+    bound), the only ones whose FE value can beat a design of chain cost ``c0``; all others
+    are at least ``c0 + 2 beta`` by the chain, so their optimistic value is at least
+    ``c0 + beta``.
     """
     errors = chain_errors(chain, margin)
     n = chain.n_units
