@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.fitness import profile_error_array, tip_value_array
+from pneumorph.design.fitness import profile_error_array, score, tip_value_array
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import SearchConfigError
@@ -405,6 +405,8 @@ class CertifiedResult:
     ----------
     winner : Candidate
         The best FE-verified design (its FE value, level and response).
+    winner_chain : Candidate
+        The same design as the chain model sees it.
     hall_of_fame : tuple of Candidate
         The best designs by chain value (chain values and responses), best first.
     verified : dict
@@ -421,19 +423,18 @@ class CertifiedResult:
     """
 
     winner: Candidate
+    winner_chain: Candidate
     hall_of_fame: tuple[Candidate, ...]
     verified: dict[str, Candidate]
     certificate: dict[str, Any]
     scores: ChainScores = field(repr=False)
-    chain_winner: Candidate | None = None
     solves: int = 0
     wall_time: float = 0.0
 
 
-def _candidate(chain: ChainModel, objective: Objective, design: str) -> Candidate:
+def chain_candidate(chain: ChainModel, objective: Objective, design: str) -> Candidate:
+    """A design as the chain model sees it: its response and its score."""
     r = chain.evaluate(design)
-    from pneumorph.design.fitness import score
-
     s = score(r, objective)
     return Candidate(design, s.value, s.level, s.pressure, None, r)
 
@@ -535,7 +536,9 @@ def certified_search(
     gap = max(0.0, best_cost - min(float(rest.min()) if len(rest) else float("inf"), scores.floor))
     winner = min((book.candidate(d) for d in verified if not book.scores[d].failed),
                  key=lambda c: (sign * c.value, c.design))
-    hof = tuple(_candidate(chain, objective, d) for d in designs[:hall_of_fame])
+    hof = tuple(chain_candidate(chain, objective, d) for d in designs[:hall_of_fame])
+    winner_chain = next((c for c in hof if c.design == winner.design), None) or \
+        chain_candidate(chain, objective, winner.design)
     certificate = {
         "bound": float(scores.bound[order[designs.index(winner.design)]]),
         "bound_worst": float(np.max(scores.bound)),
@@ -549,10 +552,9 @@ def certified_search(
         "margin": margin,
         "sense": objective.sense,
     }
-    return CertifiedResult(winner, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
-                           chain_winner=hof[0] if hof else None, solves=book.solves,
-                           wall_time=time.perf_counter() - start)
+    return CertifiedResult(winner, winner_chain, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
+                           solves=book.solves, wall_time=time.perf_counter() - start)
 
 
-__all__ = ["CertifiedResult", "ChainScores", "grow_designs", "certified_search", "chain_errors",
+__all__ = ["CertifiedResult", "ChainScores", "grow_designs", "certified_search", "chain_candidate", "chain_errors",
            "chain_scores", "objective_bounds", "score_designs"]

@@ -37,11 +37,11 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from pneumorph.design.certified import CertifiedResult, certified_search
+from pneumorph.design.certified import CertifiedResult, certified_search, chain_candidate
 from pneumorph.design.config import DesignConfig, to_toml
 from pneumorph.design.exhaustive import run_exhaustive
 from pneumorph.design.figures import plot_convergence, plot_profile
-from pneumorph.design.fitness import score
+from pneumorph.design.fitness import Score
 from pneumorph.design.ga import GenerationStats, run_ga
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
@@ -52,7 +52,7 @@ from pneumorph.execution.cache import (
     default_cache_path,
 )
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
-from pneumorph.models.chain import ChainModel
+from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.chaintables import find_table, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
@@ -278,8 +278,6 @@ def run_design(
                                     hall_of_fame=config.ga.hall_of_fame, margin=config.margin, on_progress=say)
             hof = cert.hall_of_fame
             order = cert.scores.order()[:1000]
-            from pneumorph.models.chain import design_strings
-
             names = design_strings(cert.scores.bits[order])
             ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order)]
         else:
@@ -302,7 +300,6 @@ def run_design(
     return replace(result, files=tuple(files))
 
 
-
 def _training(model: ActuatorModel) -> Any:
     """``n -> the same model with n units`` (the training actuator of a new chain table)."""
     with_units = getattr(model, "with_units", None)
@@ -314,10 +311,8 @@ def _training(model: ActuatorModel) -> Any:
     return with_units
 
 
-def _chain_score(cert: CertifiedResult, i: int) -> Any:
+def _chain_score(cert: CertifiedResult, i: int) -> Score:
     """The chain's :class:`Score` of the ``i``-th scored design."""
-    from pneumorph.design.fitness import Score
-
     sc = cert.scores
     sign = 1.0 if cert.certificate["sense"] == "min" else -1.0
     level = int(sc.level[i])
@@ -340,7 +335,8 @@ def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective
         return {}
     chain = ChainModel(table, config.units)
     designs = dict.fromkeys([cert.winner.design, *(c.design for c in cert.hall_of_fame)])
-    return {d: score(chain.evaluate(d), objective).value for d in designs}
+    return {d: chain_candidate(chain, objective, d).value for d in designs}
+
 
 def _write_outputs(
     result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any, figures: bool
@@ -370,10 +366,9 @@ def _write_outputs(
     best = result.best
     if figures and best is not None and best.response is not None and best.level is not None:
         files.append(plot_profile(best, result.objective, folder / "profile.png"))
-        if cert is not None and cert.winner.design in {c.design for c in cert.hall_of_fame}:
-            chain = next(c for c in cert.hall_of_fame if c.design == cert.winner.design)
+        if cert is not None:
             files.append(plot_profile(best, result.objective, folder / "chain-vs-fe.png",
-                                      compare=[("chain model", chain)]))
+                                      compare=[("chain model", cert.winner_chain)]))
         hook = getattr(model, "write_deformed", None)
         if callable(hook) and cert is None:  # a certified run does not solve its winner a second time
             files.extend(Path(p) for p in hook(best.response, best.level, folder / "winner"))
@@ -384,7 +379,6 @@ def _write_outputs(
     path.write_text(report_text(result, config, model, names), encoding="utf-8")
     files.append(path)
     return files
-
 
 
 def _top_rows(result: RunResult) -> list[dict[str, Any]]:
@@ -408,18 +402,17 @@ def _write_certificate(result: RunResult, folder: Path) -> list[Path]:
     cert = result.certified
     assert cert is not None
     w = cert.winner
+    rows = _top_rows(result)
     doc = {
         "objective": result.objective.label, "sense": result.objective.sense, "unit": result.objective.unit,
-        "winner": {**w.to_dict(), "chain_value": next((c.value for c in cert.hall_of_fame if c.design == w.design),
-                                                      None), "chain_2d": result.opinion_2d.get(w.design)},
+        "winner": {**w.to_dict(), "chain_value": cert.winner_chain.value, "chain_2d": result.opinion_2d.get(w.design)},
         "certificate": cert.certificate,
         "verified": {d: c.to_dict() for d, c in cert.verified.items()},
-        "top": _top_rows(result),
+        "top": rows,
     }
     path = folder / "certificate.json"
     path.write_text(json.dumps(doc, indent=1, default=float), encoding="utf-8")
     top = folder / "top.csv"
-    rows = _top_rows(result)
     with top.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
         writer.writeheader()
