@@ -24,7 +24,7 @@ def test_chain_build_writes_a_validated_table(tmp_path: Path, capsys: pytest.Cap
     table = ChainTable.load(out)
     assert report["window"] == table.window and len(report["validation"]["designs"]) == 4
     assert max(table.validation["centre_worst_mm"]) <= 0.2 and table.source["n_units"] == 7
-    assert table.metadata["pneumorph"] and table.metadata["created"]
+    assert table.metadata["pneumorph"] and table.metadata["created_utc"]
 
 
 @pytest.mark.parametrize(

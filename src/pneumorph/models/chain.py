@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.io.provenance import provenance
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.models.windows import (
     BASE,
@@ -494,17 +495,6 @@ def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed:
     return out
 
 
-def _provenance(solves: int, start: float) -> dict[str, Any]:
-    import platform
-    from datetime import UTC, datetime
-
-    from pneumorph import __version__
-
-    return {"solves": solves, "build_wall_s": time.perf_counter() - start, "pneumorph": __version__,
-            "created": datetime.now(UTC).isoformat(timespec="seconds"), "python": platform.python_version(),
-            "numpy": np.__version__}
-
-
 def build_table(
     model: Any,
     evaluator: Any = None,
@@ -587,7 +577,8 @@ def build_table(
         worst = max(val["centre_worst_mm"])
         say(f"window +-{w}: worst held-out centre error {worst:.4f} mm, mean at the last level "
             f"{val['centre_mean_mm'][-1]:.4f} mm")
-        table = ChainTable(**{**table.__dict__, "validation": val, "metadata": _provenance(len(solved), start)})
+        meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - start)
+        table = ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})
         best = table
         if worst <= tolerance:
             return table
