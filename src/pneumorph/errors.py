@@ -175,7 +175,15 @@ class UnknownObjectiveError(UnknownNameError):
         )
 
 
-class SearchConfigError(PneumorphError, ValueError):
+class SettingsError(PneumorphError, ValueError):
+    """A setting that cannot work: wrong type, out of range, not finite, beyond a limit.
+
+    Raised where the setting enters (CLI option, config key, API constructor); the message
+    names the option or key, the value given and what is allowed.
+    """
+
+
+class SearchConfigError(SettingsError):
     """Design-search settings that cannot work (population below 2, no units, ...)."""
 
 
@@ -188,7 +196,15 @@ class SchedulerUnreachableError(PneumorphError, ConnectionError):
 
 
 class RunFolderError(PneumorphError, ValueError):
-    """A run folder that holds a different run (other settings or another model)."""
+    """A run folder that holds a different run, is in use by another run, or cannot be written."""
+
+
+class OutputPathError(PneumorphError, OSError):
+    """An output file or folder that cannot be created or written."""
+
+
+class CacheError(PneumorphError, RuntimeError):
+    """An evaluation cache that cannot serve: damaged, not a cache, a folder, or read-only."""
 
 
 class ChainTableError(PneumorphError, ValueError):

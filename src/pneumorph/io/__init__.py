@@ -1,6 +1,26 @@
-"""Exports for other tools: ParaView (VTK) files and provenance records."""
+"""Outputs: safe file writing (atomic, strict JSON, paths checked first), ParaView (VTK)
+files and provenance records."""
 
+from pneumorph.io.files import (
+    atomic_write_bytes,
+    atomic_write_text,
+    check_writable_dir,
+    check_writable_file,
+    json_safe,
+    strict_json,
+    write_json,
+)
 from pneumorph.io.provenance import provenance
 from pneumorph.io.vtk import write_vtk_series
 
-__all__ = ["provenance", "write_vtk_series"]
+__all__ = [
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "check_writable_dir",
+    "check_writable_file",
+    "json_safe",
+    "provenance",
+    "strict_json",
+    "write_json",
+    "write_vtk_series",
+]

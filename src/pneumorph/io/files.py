@@ -1,0 +1,186 @@
+"""Writing outputs safely: paths checked before any computation, files replaced atomically,
+JSON that is strict JSON.
+
+A result file is either the old one or the complete new one, never half of each: it is
+written to a temporary file beside it and renamed over it (``os.replace`` is atomic on one
+file system). Output paths are checked up front, without creating anything, so a command
+that cannot write its results refuses before it solves.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from pneumorph.errors import OutputPathError
+
+
+def _existing_ancestor(path: Path) -> Path:
+    probe = path
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    return probe
+
+
+def check_writable_dir(path: str | Path, option: str = "--out") -> Path:
+    """Refuse a folder that could not be created or written, without creating it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The folder (need not exist).
+    option : str
+        The CLI option or key that gave it, named in the message.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    OutputPathError
+        ``path`` is empty, is a file, sits under a file, or its nearest existing folder is
+        not writable.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> check_writable_dir(d / "new" / "run") == d / "new" / "run"
+    True
+    >>> (d / "f").write_text("x")
+    1
+    >>> check_writable_dir(d / "f" / "run")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.OutputPathError: --out ...f/run: ...f is a file, not a folder
+    """
+    if str(path).strip() == "":
+        raise OutputPathError(f"{option} is empty; give a folder")
+    path = Path(path)
+    base = _existing_ancestor(path)
+    if not base.is_dir():
+        raise OutputPathError(f"{option} {path}: {base} is a file, not a folder")
+    if not os.access(base, os.W_OK | os.X_OK):
+        raise OutputPathError(f"{option} {path}: {base} is not writable")
+    return path
+
+
+def check_writable_file(path: str | Path, option: str = "--out") -> Path:
+    """Refuse a file that could not be written (a folder, under a file, read-only), creating nothing.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> check_writable_file(d / "sub" / "fig.png", "--plot").name
+    'fig.png'
+    >>> check_writable_file(d, "--plot")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.OutputPathError: --plot ...: is a folder, not a file
+    """
+    if str(path).strip() == "":
+        raise OutputPathError(f"{option} is empty; give a file name")
+    path = Path(path)
+    if path.is_dir():
+        raise OutputPathError(f"{option} {path}: is a folder, not a file")
+    if path.exists() and not os.access(path, os.W_OK):
+        raise OutputPathError(f"{option} {path}: the file is not writable")
+    check_writable_dir(path.parent, option)
+    return path
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` through a temporary file and a rename.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.bin"
+    >>> atomic_write_bytes(p, b"abc").read_bytes()
+    b'abc'
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically (see :func:`atomic_write_bytes`)."""
+    return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def _reason(value: float) -> str:
+    return "not a number" if math.isnan(value) else ("+infinite" if value > 0 else "-infinite")
+
+
+def json_safe(obj: Any) -> Any:
+    """``obj`` with every NaN or infinite float replaced by None (numpy scalars and arrays too).
+
+    In a mapping, a replaced value ``key`` gets a sibling ``key_reason`` saying what it was,
+    so the reader knows why it is null.
+
+    Examples
+    --------
+    >>> json_safe({"fitness": float("nan"), "tip": [1.0, float("inf")]})
+    {'fitness': None, 'fitness_reason': 'not a number', 'tip': [1.0, None]}
+    """
+    if isinstance(obj, bool) or obj is None or isinstance(obj, (str, int)):
+        return obj
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Mapping):
+        out: dict[str, Any] = {}
+        for key, value in obj.items():
+            clean = json_safe(value)
+            out[str(key)] = clean
+            if clean is None and _is_float(value):
+                out[f"{key}_reason"] = _reason(float(value))
+        return out
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if hasattr(obj, "tolist"):  # numpy arrays and scalars
+        return json_safe(obj.tolist())
+    if isinstance(obj, Path):
+        return str(obj)
+    return str(obj)
+
+
+def _is_float(value: Any) -> bool:
+    try:
+        return isinstance(value, float) or (hasattr(value, "dtype") and value.dtype.kind == "f" and value.ndim == 0)
+    except AttributeError:
+        return False
+
+
+def strict_json(obj: Any, indent: int | None = 1) -> str:
+    """Strict JSON (no NaN, no Infinity): :func:`json_safe`, then ``json.dumps(allow_nan=False)``.
+
+    Examples
+    --------
+    >>> strict_json({"value": float("inf")}, indent=None)
+    '{"value": null, "value_reason": "+infinite"}'
+    """
+    return json.dumps(json_safe(obj), indent=indent, allow_nan=False)
+
+
+def write_json(path: str | Path, obj: Any, indent: int | None = 1) -> Path:
+    """Write :func:`strict_json` of ``obj`` to ``path`` atomically."""
+    return atomic_write_text(path, strict_json(obj, indent=indent) + "\n")
