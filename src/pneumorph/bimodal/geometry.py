@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.checks import MAX_UNITS, MIN_ELEMENT_FRACTION
 from pneumorph.errors import GeometryError
 from pneumorph.geometry.assembly import grid_lines
 
@@ -135,14 +136,21 @@ class BimodalSpec:
     element_size: float = 1.5
 
     def __post_init__(self) -> None:
-        if not isinstance(self.voids, (int, np.integer)) or self.voids < 1:
-            raise GeometryError(f"the actuator needs at least one void, got voids={self.voids!r}")
+        if isinstance(self.voids, bool) or not isinstance(self.voids, (int, np.integer)) or not (
+                1 <= self.voids <= MAX_UNITS):
+            raise GeometryError(f"the actuator needs 1 to {MAX_UNITS} voids (limit MAX_UNITS), got voids={self.voids!r}")
         for key in _LENGTHS:
             value = getattr(self, key)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
                 raise GeometryError(f"{key} must be a positive, finite number of mm, got {value!r}")
-        if not math.isfinite(self.end_cap) or self.end_cap < 0:
+        if isinstance(self.end_cap, bool) or not isinstance(self.end_cap, (int, float)) or not math.isfinite(
+                self.end_cap) or self.end_cap < 0:
             raise GeometryError(f"end_cap must be >= 0 mm, got {self.end_cap!r}")
+        thinnest = min(getattr(self, key) for key in _LENGTHS if key != "element_size")
+        if self.element_size < MIN_ELEMENT_FRACTION * thinnest:
+            raise GeometryError(
+                f"element_size {self.element_size:g} mm is below {MIN_ELEMENT_FRACTION:g} x the thinnest layer "
+                f"({thinnest:g} mm), the limit MIN_ELEMENT_FRACTION: the mesh would not fit in memory")
         if self.pitch - 2 * self.end_wall <= 0:
             raise GeometryError(
                 f"the end walls leave no void: pitch {self.pitch} mm - 2 x end wall {self.end_wall} mm <= 0"

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph import __version__
+from pneumorph import __version__, checks
 from pneumorph.bimodal.geometry import (
     BILINEAR,
     BODY,
@@ -37,7 +37,7 @@ from pneumorph.bimodal.geometry import (
     mesh_actuator,
 )
 from pneumorph.bimodal.switch import Switch, find_switch
-from pneumorph.errors import SimulationFailed, UnknownMaterialError
+from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.materials import get
 
 FloatArray = np.ndarray
@@ -172,8 +172,18 @@ class BimodalModel:
         max_iterations: int = 12,
         half: bool = True,
     ) -> None:
-        if not (pmax > 0 and np.isfinite(pmax)) or not (step > 0 and np.isfinite(step)):
-            raise ValueError(f"pmax and step must be positive, got {pmax * 1e3:g} and {step * 1e3:g} kPa")
+        pmax = checks.real(pmax, "pmax", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
+                           limit="MAX_PRESSURE_KPA")
+        step = checks.real(step, "step", 0.0, pmax, low_open=True, unit="MPa")
+        increments = round(pmax / step)
+        if abs(pmax / step - increments) > 1e-6 or increments > checks.MAX_INCREMENTS:
+            raise SettingsError(
+                f"the step {step * 1e3:g} kPa must divide pmax {pmax * 1e3:g} kPa into at most "
+                f"{checks.MAX_INCREMENTS} equal steps (e.g. step {pmax / max(1, min(round(pmax / step), 1000)) * 1e3:.4g} "
+                "kPa); the ramp must end at pmax, not above it")
+        for name, value, low in (("substeps", substeps, 1), ("max_cutbacks", max_cutbacks, 0),
+                                 ("max_iterations", max_iterations, 1)):
+            checks.integer(value, name, low, 1000)
         self.spec = spec or BimodalSpec()
         self.crimp_ratio = crimp_ratio
         names = {"bilinear": None, "seal": "mold_star_15", "body": "mold_star_15", "strip": "smooth_sil_950"}
@@ -188,9 +198,9 @@ class BimodalModel:
         self.names = names
         self.materials = {k: get(v) for k, v in names.items()}
         self.bilinear_bulk = bilinear_bulk
-        self.increments = max(1, round(pmax / step))
+        self.increments = increments
         self.step = float(step)
-        self.pmax = self.increments * self.step
+        self.pmax = float(pmax)
         self.substeps = int(substeps)
         self.max_cutbacks = int(max_cutbacks)
         self.max_iterations = int(max_iterations)

@@ -7,7 +7,10 @@ ones users speak (kPa for pressure); the API works in mm, N, MPa.
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
+import threading
 
 import click
 
@@ -45,19 +48,65 @@ from pneumorph.cli.bimodal import bimodal  # noqa: E402
 cli.add_command(bimodal)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread so that a run stops as on Ctrl-C (exit 143)."""
+
+
+_terminated = threading.Event()
+
+
+def _on_sigterm(signum: int, frame: object) -> None:
+    _terminated.set()
+    raise Terminated()
+
+
+def _usage_line(exc: click.UsageError) -> str:
+    where = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+    return " ".join(exc.format_message().split()) + where
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit code (errors print one clear line)."""
+    """Run the command line; return the exit code.
+
+    Every error a user can cause prints one line and returns 2: bad options and arguments
+    (click's usage errors) and every :class:`~pneumorph.errors.PneumorphError`. Ctrl-C
+    returns 130, SIGTERM 143 (both after the run has written what it had); anything else
+    is a defect of pneumorph: one line asking for a report, exit 1 (``PNEUMORPH_DEBUG=1``
+    shows the traceback).
+    """
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    _terminated.clear()
     try:
         cli.main(args=argv, prog_name="pneumorph", standalone_mode=False)
-    except click.exceptions.Abort:
+    except Terminated:
+        click.echo("terminated", err=True)
+        return 143
+    except (click.exceptions.Abort, KeyboardInterrupt):
         click.echo("aborted", err=True)
         return 130
+    except click.UsageError as exc:
+        click.echo(f"error: {_usage_line(exc)}", err=True)
+        return 2
     except click.ClickException as exc:
-        exc.show()
+        click.echo(f"error: {' '.join(exc.format_message().split())}", err=True)
         return exc.exit_code
     except PneumorphError as exc:
-        click.echo(f"error: {exc}", err=True)
+        click.echo(f"error: {' '.join(str(exc).split())}", err=True)
         return 2
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        return 143 if code == 130 and _terminated.is_set() else code  # a run that stopped on SIGTERM
+    except Exception as exc:  # a defect, not a user error
+        if os.environ.get("PNEUMORPH_DEBUG"):
+            raise
+        click.echo(f"internal error: {type(exc).__name__}: {' '.join(str(exc).split())} - please report it "
+                   "(PNEUMORPH_DEBUG=1 shows the traceback)", err=True)
+        return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

@@ -5,11 +5,14 @@ Pressures in kPa, lengths in mm. FElupe and matplotlib are imported inside the c
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import click
+
+from pneumorph.checks import MAX_INCREMENTS
+from pneumorph.cli import params as P
+from pneumorph.io.files import strict_json, write_json
 
 
 def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
@@ -28,19 +31,19 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
 @click.command("bimodal")
 @click.option("--crimp-ratio", "-c", type=click.Choice(["0.2", "0.25", "0.3"]), required=True,
               help="Crimp ratio of the bilinear composite (Table B.1).")
-@click.option("--pmax", type=float, default=60.0, show_default=True, help="Top pressure of the ramp in kPa.")
-@click.option("--step", type=float, default=5.0, show_default=True, help="Pressure step in kPa.")
-@click.option("--voids", type=int, default=15, show_default=True, help="Number of voids (10.5 mm each).")
-@click.option("--element-size", type=float, default=2.5, show_default=True, help="Target element edge in mm.")
-@click.option("--end-cap", type=float, default=0.0, show_default=True,
+@click.option("--pmax", type=P.PRESSURE_KPA, default=60.0, show_default=True, help="Top pressure of the ramp in kPa.")
+@click.option("--step", type=P.PRESSURE_KPA, default=5.0, show_default=True, help="Pressure step in kPa.")
+@click.option("--voids", type=P.UNITS, default=15, show_default=True, help="Number of voids (10.5 mm each).")
+@click.option("--element-size", type=P.POSITIVE_MM, default=2.5, show_default=True, help="Target element edge in mm.")
+@click.option("--end-cap", type=P.Real(0.0, 1e4, unit="mm"), default=0.0, show_default=True,
               help="Extra solid beyond the last void in mm (the free end wall is 1.5 mm + this).")
-@click.option("--bilinear-nu", type=float, default=None,
+@click.option("--bilinear-nu", type=P.Real(-1.0, 0.5, low_open=True, high_open=True), default=None,
               help="Small-strain Poisson's ratio of the composite, sets its bulk modulus "
                    "[default: the library's assumed bulk modulus].")
-@click.option("--max-cutbacks", type=int, default=2, show_default=True,
+@click.option("--max-cutbacks", type=P.Count(0, 60), default=2, show_default=True,
               help="Halvings of a step that does not converge before the ramp ends there.")
-@click.option("--max-iterations", type=int, default=10, show_default=True, help="Newton iterations per trial.")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+@click.option("--max-iterations", type=P.Count(1, 1000), default=10, show_default=True, help="Newton iterations per trial.")
+@click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
@@ -53,11 +56,13 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     """
     from pneumorph.bimodal.geometry import BimodalSpec
     from pneumorph.bimodal.model import BimodalModel, bilinear_material
-    from pneumorph.errors import GeometryError
     from pneumorph.materials import get
 
-    if not (pmax > 0 and step > 0):
-        raise GeometryError(f"--pmax and --step must be positive kPa, got {pmax} and {step}")
+    n = round(pmax / step)
+    if step > pmax or abs(pmax / step - n) > 1e-6 or n > MAX_INCREMENTS:
+        raise click.BadParameter(f"--step {step:g} kPa must divide --pmax {pmax:g} kPa into at most {MAX_INCREMENTS} "
+                                 f"equal steps, so that the ramp ends at --pmax (e.g. --step "
+                                 f"{pmax / min(max(n, 1), MAX_INCREMENTS):.4g})", param_hint="'--step'")
     cr = float(crimp_ratio)
     bulk = None
     if bilinear_nu is not None:
@@ -73,9 +78,9 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     result = model.solve(on_level=progress)
     data = result.to_dict()
     if out is not None:
-        data["files"] = [str(p) for p in write_outputs(result, out)]
+        data["files"] = [str(p) for p in write_outputs(result, Path(out))]
     if as_json:
-        click.echo(json.dumps(data, indent=2))
+        click.echo(strict_json(data, indent=2))
         return
     click.echo(format_result(data))
 
@@ -106,7 +111,7 @@ def write_outputs(result: Any, out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     tag = f"cr{result.crimp_ratio:g}".replace(".", "_")
     js = out / f"bimodal-{tag}.json"
-    js.write_text(json.dumps(result.to_dict(), indent=2))
+    write_json(js, result.to_dict(), indent=2)
     tip = out / f"bimodal-{tag}-tip.png"
     figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)], title=f"Bimodal actuator, CR {result.crimp_ratio:g}",
                            path=tip)

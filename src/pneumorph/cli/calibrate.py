@@ -2,23 +2,25 @@
 
 from __future__ import annotations
 
-import json
 
 import click
 
+from pneumorph.checks import MAX_STARTS, MAX_UNITS
+from pneumorph.cli import params as P
+
 
 @click.command("calibrate")
-@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
+@click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
-@click.option("--units", "n_units", type=int, default=15, show_default=True, help="Actuator length in units.")
-@click.option("--pressures", default="5,10,15,20,25,30,35,40,45", show_default=True, metavar="LIST",
+@click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True, help="Actuator length in units.")
+@click.option("--pressures", type=P.RealList(P.PRESSURE_KPA, min_items=2, max_items=100), default="5,10,15,20,25,30,35,40,45", show_default=True, metavar="LIST",
               help="Calibration pressures, kPa, comma-separated.")
-@click.option("--runs", type=int, default=3, show_default=True, help="Independent runs (new random designs).")
-@click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--validate", "n_validate", type=int, default=10, show_default=True,
+@click.option("--runs", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=3, show_default=True, help="Independent runs (new random designs).")
+@click.option("--seed", type=P.SEED, default=0, show_default=True)
+@click.option("--validate", "n_validate", type=P.Count(0, MAX_STARTS, limit="MAX_STARTS"), default=10, show_default=True,
               help="Held-out random designs for the 2D-against-3D check.")
-@click.option("--cache", metavar="FILE", help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
-@click.option("--out", default="runs/calibration", show_default=True, metavar="DIR")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--out", type=P.OutputDir(), default="runs/calibration", show_default=True, metavar="DIR")
 @click.option("--references-only", is_flag=True,
               help="Only solve (and cache) the 3D references of the calibration and validation designs.")
 @click.option("--weighting", type=click.Choice(["relative", "sensitivity", "uniform"]), default="relative",
@@ -26,7 +28,7 @@ import click
               help="Weights of the points in the fits of E(P): relative error, relative error times the "
                    "measured sensitivity of Eq 5.1 (two more 2D solves per point), or none.")
 @click.option("--json", "as_json", is_flag=True)
-def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, seed: int, n_validate: int,
+def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs: int, seed: int, n_validate: int,
               cache: str | None, out: str, references_only: bool, weighting: str, as_json: bool) -> None:
     """Fit the filler law E(P) of the 2D model to the 3D model (chapter 5) and check it.
 
@@ -37,16 +39,15 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
 
     from pneumorph import calibration as cal_mod
     from pneumorph.design.config import to_toml
-    from pneumorph.errors import SearchConfigError
     from pneumorph.execution import EvaluationCache, default_cache_path
     from pneumorph.geometry.unit import UnitSpec
-    from pneumorph.io import provenance
+    from pneumorph.io import atomic_write_text, provenance, strict_json, write_json
     from pneumorph.models.fe import RampSpec
 
-    try:
-        levels = tuple(float(p) for p in pressures.split(","))
-    except ValueError:
-        raise SearchConfigError(f"--pressures takes numbers (kPa) separated by commas, got {pressures!r}") from None
+    levels = tuple(sorted(set(pressures)))
+    if len(levels) < 2:
+        raise click.BadParameter(f"--pressures needs at least two different pressures, got {pressures}",
+                                 param_hint="'--pressures'")
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     store = EvaluationCache(cache or default_cache_path())
     solve_3d = cal_mod.cached_3d_solver(store)
@@ -73,7 +74,7 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
     }
     if result.chosen is not None:
         calibrated = result.unit_with_law(unit)
-        (folder / "unit.toml").write_text(to_toml({"unit": calibrated.to_dict()}), encoding="utf-8")
+        atomic_write_text(folder / "unit.toml", to_toml({"unit": calibrated.to_dict()}))
         if n_validate > 0:
             designs = cal_mod.holdout_designs(n_units, n_validate, seed, cal_mod.calibration_designs(n_units, runs, seed))
             p_max = max(levels) / 1e3
@@ -81,10 +82,10 @@ def calibrate(unit_file: str | None, n_units: int, pressures: str, runs: int, se
             summary["validation"] = check.to_dict()
             summary["figures"] = _validation_figures(result, calibrated, n_units, designs[0], p_max, solve_3d,
                                                      folder)
-    (folder / "calibration.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
+    write_json(folder / "calibration.json", summary)
     store.close()
     if as_json:
-        click.echo(json.dumps({k: v for k, v in summary.items() if k != "provenance"}, indent=1, default=str))
+        click.echo(strict_json({k: v for k, v in summary.items() if k != "provenance"}))
         return
     for fit in (result.linear, result.quadratic):
         coeffs = ", ".join(f"{c:.5g}" for c in fit.coefficients)

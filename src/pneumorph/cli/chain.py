@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
-import json
 
 import click
+
+from pneumorph.checks import MAX_STARTS, MAX_UNITS
+from pneumorph.cli import params as P
 
 
 @click.group("chain")
@@ -15,17 +17,17 @@ def chain() -> None:
 @chain.command("build")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="3d", show_default=True,
               help="The FE model the table is fitted to.")
-@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
+@click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
-@click.option("--pressure", type=float, help="Maximum pressure, kPa (default 45).")
-@click.option("--units", "n_units", type=int, default=15, show_default=True, help="Units of the training designs.")
-@click.option("--window", type=int, help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
-@click.option("--tolerance", type=float, default=0.2, show_default=True,
+@click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
+@click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True, help="Units of the training designs.")
+@click.option("--window", type=P.Count(1, 3), help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
+@click.option("--tolerance", type=P.Real(0.0, 100.0, low_open=True, unit="mm"), default=0.2, show_default=True,
               help="Worst held-out unit-centre error allowed at every level, mm.")
-@click.option("--heldout", type=int, default=20, show_default=True, help="Held-out random designs solved.")
-@click.option("--workers", type=int, help="Processes solving designs (default: all cores).")
-@click.option("--cache", metavar="FILE", help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
-@click.option("--out", required=True, metavar="FILE", help="Table file to write (JSON).")
+@click.option("--heldout", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=20, show_default=True, help="Held-out random designs solved.")
+@click.option("--workers", type=P.WORKERS, help="Processes solving designs (default: all cores).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--out", required=True, metavar="FILE", type=P.OutputFile((".json",)), help="Table file to write (JSON).")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units: int, window: int | None,
           tolerance: float, heldout: int, workers: int | None, cache: str | None, out: str, as_json: bool) -> None:
@@ -38,6 +40,7 @@ def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units:
 
     from pneumorph.errors import ChainTableError
     from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
+    from pneumorph.io import strict_json
     from pneumorph.models.chain import build_table
     from pneumorph.models.factory import make_model
 
@@ -47,10 +50,6 @@ def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units:
     if pressure is not None:
         settings["pressure_kpa"] = pressure
     target = Path(out)
-    if target.is_dir() or not target.parent.exists() and target.parent != Path(""):
-        raise ChainTableError(f"--out {out}: give a file in an existing folder")
-    if heldout < 1:
-        raise ChainTableError(f"--heldout must be at least 1, got {heldout}")
     if window is not None and (window < 1 or 2 * window + 1 > n_units):
         raise ChainTableError(f"--window {window} needs 1 <= window and 2 window + 1 <= --units ({n_units})")
     model = make_model(n_units, settings)
@@ -60,11 +59,12 @@ def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units:
                             on_progress=lambda text: click.echo(text, err=True))
     finally:
         evaluator.close()
+    target.parent.mkdir(parents=True, exist_ok=True)
     table.save(target)
     v = table.validation
     if as_json:
-        click.echo(json.dumps({"file": str(target), "window": table.window, "training": list(table.training),
-                               "validation": v}, indent=1))
+        click.echo(strict_json({"file": str(target), "window": table.window, "training": list(table.training),
+                                "validation": v}))
     else:
         click.echo(f"{target}: window +-{table.window}, {len(table.training)} covering designs, "
                    f"{len(v['designs'])} held-out: worst centre error {max(v['centre_worst_mm']):.4f} mm, "

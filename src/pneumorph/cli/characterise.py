@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -11,7 +10,9 @@ from typing import Any
 import click
 import numpy as np
 
+from pneumorph.cli import params as P
 from pneumorph.errors import DataFormatError
+from pneumorph.io.files import read_text_file, strict_json
 from pneumorph.materials import characterise as ch
 
 _STRAIN_SCALE = {"fraction": 1.0, "percent": 0.01}
@@ -33,10 +34,7 @@ def read_columns(
         value; the message names the file and the row (1-based, header = row 1).
     """
     p = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise DataFormatError(f"cannot read the file ({exc.strerror})", p) from None
+    text = read_text_file(path, "data file", DataFormatError, encoding="utf-8-sig")
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise DataFormatError("empty file; expected a header row with " + ", ".join(required), p, 1)
@@ -77,7 +75,7 @@ def read_columns(
 
 
 def _emit(data: dict[str, Any], text: list[str], as_json: bool) -> None:
-    click.echo(json.dumps(data, indent=2) if as_json else "\n".join(text))
+    click.echo(strict_json(data, indent=2) if as_json else "\n".join(text))
 
 
 _strain_unit = click.option(
@@ -96,11 +94,11 @@ def characterise() -> None:
 
 
 @characterise.command("poisson")
-@click.argument("data", type=click.Path(exists=True, dir_okay=False))
+@click.argument("data", type=P.InputFile())
 @click.option(
     "--strain-range",
     nargs=2,
-    type=float,
+    type=P.Real(-1e6, 1e6),
     default=(0.0, 150.0),
     show_default=True,
     help="Axial strain range to average over, in percent (Table A.5 used 0-150 %).",
@@ -163,7 +161,7 @@ def poisson(data: str, strain_range: tuple[float, float], modulus: str, strain_u
 
 
 @characterise.command("thermal")
-@click.argument("data", type=click.Path(exists=True, dir_okay=False))
+@click.argument("data", type=P.InputFile())
 @_strain_unit
 @_json
 def thermal(data: str, strain_unit: str, as_json: bool) -> None:
@@ -196,15 +194,15 @@ def thermal(data: str, strain_unit: str, as_json: bool) -> None:
 
 
 @characterise.command("bilinear")
-@click.argument("data", type=click.Path(exists=True, dir_okay=False))
+@click.argument("data", type=P.InputFile())
 @click.option(
     "--primary-limit",
-    type=float,
+    type=P.Real(0.0, 1e6, low_open=True),
     default=10.0,
     show_default=True,
     help="Primary fit uses the points with strain up to this value, in percent.",
 )
-@click.option("--secondary-points", type=int, default=10, show_default=True, help="Secondary fit uses this many final points.")
+@click.option("--secondary-points", type=P.Count(2, 1_000_000), default=10, show_default=True, help="Secondary fit uses this many final points.")
 @_strain_unit
 @_json
 def bilinear(data: str, primary_limit: float, secondary_points: int, strain_unit: str, as_json: bool) -> None:

@@ -6,12 +6,14 @@ FElupe and matplotlib are imported only by the commands that need them.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
 
 import click
+
+from pneumorph.io.files import strict_json, write_json
+from pneumorph.cli import params as P
 
 from pneumorph.errors import CrimpError
 
@@ -32,10 +34,10 @@ def _crimp(crimp_ratio: float | None, wavelength: float | None, amplitude: float
 
 
 _CRIMP_OPTIONS = [
-    click.option("--crimp-ratio", "-c", type=float, default=None, help="CR = A / lambda."),
-    click.option("--wavelength", type=float, default=None, help="lambda in mm (instead of --crimp-ratio)."),
-    click.option("--amplitude", "-a", type=float, default=1.5, show_default=True, help="A in mm (paper between -A and +A)."),
-    click.option("--length", "-l", type=float, default=176.25, show_default=True, help="Crimped length L0 in mm."),
+    click.option("--crimp-ratio", "-c", type=P.Real(0.0, 10.0, low_open=True), default=None, help="CR = A / lambda."),
+    click.option("--wavelength", type=P.POSITIVE_MM, default=None, help="lambda in mm (instead of --crimp-ratio)."),
+    click.option("--amplitude", "-a", type=P.POSITIVE_MM, default=1.5, show_default=True, help="A in mm (paper between -A and +A)."),
+    click.option("--length", "-l", type=P.POSITIVE_MM, default=176.25, show_default=True, help="Crimped length L0 in mm."),
 ]
 
 
@@ -54,7 +56,7 @@ def transition(crimp_ratio: float | None, wavelength: float | None, amplitude: f
     c = _crimp(crimp_ratio, wavelength, amplitude, length)
     data = c.to_dict()
     if as_json:
-        click.echo(json.dumps(data, indent=2))
+        click.echo(strict_json(data, indent=2))
         return
     click.echo(
         "\n".join(
@@ -75,18 +77,18 @@ def transition(crimp_ratio: float | None, wavelength: float | None, amplitude: f
 
 @composite.command("coupon")
 @_crimp_options
-@click.option("--thickness", type=float, default=5.0, show_default=True, help="Coupon thickness in mm.")
-@click.option("--per-flute", type=int, default=4, show_default=True, help="Cells along each flute (half wavelength).")
-@click.option("--rows", type=int, default=4, show_default=True, help="Cell rows between the paper and each surface.")
-@click.option("--levels", type=int, default=100, show_default=True, help="Recorded load levels.")
-@click.option("--strain-max", type=float, default=None,
+@click.option("--thickness", type=P.POSITIVE_MM, default=5.0, show_default=True, help="Coupon thickness in mm.")
+@click.option("--per-flute", type=P.Count(1, 64), default=4, show_default=True, help="Cells along each flute (half wavelength).")
+@click.option("--rows", type=P.Count(1, 64), default=4, show_default=True, help="Cell rows between the paper and each surface.")
+@click.option("--levels", type=P.INCREMENTS, default=100, show_default=True, help="Recorded load levels.")
+@click.option("--strain-max", type=P.Real(0.0, 10.0, low_open=True), default=None,
               help="Final engineering strain [default: 2 s / lambda - 1 + 0.10].")
-@click.option("--bulk-modulus", type=float, default=None, help="Matrix bulk modulus in kPa [default: library].")
-@click.option("--gauges", type=int, default=None, help="Virtual strain gauges [default: Eq 3.5, 385; 0: none].")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the gauge placement.")
-@click.option("--snapshot", type=float, default=None,
+@click.option("--bulk-modulus", type=P.Real(0.0, 1e9, low_open=True, unit="kPa"), default=None, help="Matrix bulk modulus in kPa [default: library].")
+@click.option("--gauges", type=P.Count(0, 100_000), default=None, help="Virtual strain gauges [default: Eq 3.5, 385; 0: none].")
+@click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the gauge placement.")
+@click.option("--snapshot", type=P.Real(0.0, 10.0), default=None,
               help="Engineering strain of the deformed-shape and surface-strain figures [default: last level].")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+@click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the curve (CSV), summary (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float, length: float, thickness: float,
@@ -102,9 +104,9 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
     result = simulate_coupon(spec, strain_max=strain_max, levels=levels, snapshots=snaps)
     summary = summarise(result, gauges, seed)
     if out is not None:
-        write_outputs(result, summary, out, snapshot)
+        write_outputs(result, summary, Path(out), snapshot)
     if as_json:
-        click.echo(json.dumps(summary, indent=2))
+        click.echo(strict_json(summary, indent=2))
         return
     click.echo(format_summary(summary))
 
@@ -168,7 +170,7 @@ def write_outputs(result: Any, summary: dict[str, Any], out: Path, snapshot: flo
     np.savetxt(csv, np.column_stack([result.engineering_strain, result.surface_strain, result.force]),
                delimiter=",", header="engineering_strain,surface_strain,force_N_per_mm", comments="", fmt="%.8g")
     js = out / f"coupon-{tag}.json"
-    js.write_text(json.dumps(summary, indent=2))
+    write_json(js, summary, indent=2)
     paths = [csv, js]
     for name, fn in (("load", lambda p: figures.plot_load_strain([result], p)),
                      ("deformed", lambda p: figures.plot_deformed(result, snapshot, path=p)),

@@ -8,6 +8,9 @@ import sys
 
 import click
 
+from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
+from pneumorph.cli import params as P
+
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
 
 
@@ -21,38 +24,38 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 
 
 @click.command("design")
-@click.argument("config_file", required=False, type=click.Path(exists=True, dir_okay=False))
-@click.option("--target", metavar="TARGET",
+@click.argument("config_file", required=False, type=P.InputFile())
+@click.option("--target", metavar="TARGET", type=P.Text(),
               help="Profile to match: 'sin', 'cos', 'y = <expr in x, L, A>' or 'r = <expr in theta>'. "
                    "Default (no config file): sin, amplitude 10 mm, one period.")
 @click.option("--objective", type=click.Choice(_TIP_GOALS), help="A tip goal instead of a profile (Table 6.1).")
-@click.option("--amplitude", type=float, help="Amplitude A of the sin/cos target, mm (default 10).")
-@click.option("--periods", type=float, help="Periods of the sin/cos target over the actuator (default 1).")
-@click.option("--point", type=float, nargs=2, metavar="X Y", help="Tip point (mm) for --objective reach.")
-@click.option("--units", type=int, help="Number of articulating units (default 15).")
-@click.option("--pop", "population", type=int, help="GA population (default 100).")
-@click.option("--gen", "generations", type=int, help="GA generations (default 15).")
-@click.option("--seed", type=int, help="Random seed (default 0): the same seed gives the same run.")
+@click.option("--amplitude", type=P.POSITIVE_MM, help="Amplitude A of the sin/cos target, mm (default 10).")
+@click.option("--periods", type=P.Real(0.0, 1000.0, low_open=True), help="Periods of the sin/cos target over the actuator (default 1).")
+@click.option("--point", type=P.Real(-1e5, 1e5, unit="mm"), nargs=2, metavar="X Y", help="Tip point (mm) for --objective reach.")
+@click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
+@click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), help="GA population (default 100).")
+@click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"), help="GA generations (default 15).")
+@click.option("--seed", type=P.SEED, help="Random seed (default 0): the same seed gives the same run.")
 @click.option("--search", type=click.Choice(["certified", "ga", "exhaustive"]),
               help="certified (default): every design scored by the chain model, the best verified by FE; "
                    "ga: genetic algorithm; exhaustive: all 2^n designs by FE.")
 @click.option("--certify", is_flag=True, default=None,
               help="Certified search: verify by FE until no design can beat the winner.")
-@click.option("--verify", type=int, help="Certified search: designs verified by FE per batch (default: one per worker).")
-@click.option("--margin", type=float,
+@click.option("--verify", type=P.Count(1, 1024), help="Certified search: designs verified by FE per batch (default: one per worker).")
+@click.option("--margin", type=P.Real(0.0, 1e3, low_open=True),
               help="Certified search: factor on the chain's validated errors in the bound (default 1).")
-@click.option("--chain-table", metavar="FILE", type=click.Path(dir_okay=False),
+@click.option("--chain-table", metavar="FILE", type=P.InputFile(),
               help="Certified search: a chain table file (default: the shipped one, or built on first use).")
 @click.option("--executor", type=click.Choice(["serial", "processes", "dask"]),
               help="Where designs are solved (default processes: all cores).")
-@click.option("--workers", type=int, help="Processes or Dask workers (default: all cores).")
-@click.option("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://host:8786); default a local cluster.")
+@click.option("--workers", type=P.WORKERS, help="Processes or Dask workers (default: all cores).")
+@click.option("--scheduler", metavar="ADDR", type=P.ADDRESS, help="Dask scheduler address (tcp://host:8786); default a local cluster.")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]),
               help="Model fidelity (default: 3d for the certified search, 2d for ga and exhaustive).")
-@click.option("--pressure", type=float, help="Maximum pressure, kPa (default 45).")
-@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False), help="Unit TOML file.")
-@click.option("--cache", metavar="FILE", help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
-@click.option("--out", metavar="DIR", help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
+@click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
+@click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file.")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
+@click.option("--out", metavar="DIR", type=P.OutputDir(), help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
 @click.option("--overwrite", is_flag=True, help="Start afresh in a folder that holds another run.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
@@ -76,6 +79,19 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
 
     if target and objective:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
+    if target is not None:
+        from pneumorph.design.targets import make_objective
+
+        with P.blame("--target"):
+            goal = make_objective(target, amplitude if amplitude is not None else 10.0,
+                                  periods if periods is not None else 1.0)
+            if hasattr(goal, "check"):
+                goal.check((units or 15) * 10.5)
+    if unit_file is not None:
+        from pneumorph.geometry.unit import UnitSpec
+
+        with P.blame("--unit"):
+            UnitSpec.from_toml(unit_file)
     config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
     changes: dict = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
@@ -102,6 +118,9 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     config = DesignConfig.from_dict(config.to_dict())  # validate the combination
     folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
     model = make_model(config.units, config.model)
+    objective_ = config.make_objective()
+    if hasattr(objective_, "check"):  # a profile must be finite along this model's actuator
+        objective_.check(model.n_units * model.unit.pitch)
 
     label = config.make_objective().label
     click.echo(f"designing {config.units} units for {label} ({model.fidelity} model, {config.search}, "

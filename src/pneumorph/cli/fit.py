@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
-import json
 
 import click
+
+from pneumorph.checks import MAX_STARTS
+from pneumorph.cli import params as P
+from pneumorph.io.files import strict_json
 
 from pneumorph import __version__
 from pneumorph.materials.datasets import list_datasets, read_test_data
@@ -14,34 +17,34 @@ from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE
 
 
 @click.command("fit")
-@click.argument("data", nargs=-1, required=True)
-@click.option("--model", "-m", "models", multiple=True, metavar="NAME",
+@click.argument("data", nargs=-1, required=True, type=P.Text(1000))
+@click.option("--model", "-m", "models", multiple=True, metavar="NAME", type=P.Text(100),
               help=f"Model to fit, repeatable (several give a comparison table): "
                    f"{', '.join(MODEL_NAMES)}. Default ogden-3.")
 @click.option("--mode", type=click.Choice(MODES),
               help="Loading mode of the data files (default: from each file name, else uniaxial).")
-@click.option("--columns", metavar="ROLES",
+@click.option("--columns", metavar="ROLES", type=P.Text(200),
               help=f"Column roles, comma-separated, from {', '.join(COLUMN_ROLES)}; "
                    "e.g. 'stress,stretch' (default: from the header, else stretch,stress).")
 @click.option("--strain-unit", type=click.Choice(["fraction", "percent"]), help="Unit of a strain column.")
 @click.option("--stress-kind", type=click.Choice(["nominal", "true"]),
               help="Nominal (engineering) or true stress; true becomes sigma/lambda.")
-@click.option("--stress-unit", metavar="UNIT", help="MPa (default), kPa, Pa, N/mm^2, kgf/cm^2 or psi.")
-@click.option("--delimiter", metavar="CHAR", help="Column delimiter (default: detected).")
+@click.option("--stress-unit", metavar="UNIT", type=P.Text(20), help="MPa (default), kPa, Pa, N/mm^2, kgf/cm^2 or psi.")
+@click.option("--delimiter", metavar="CHAR", type=P.DELIMITER, help="Column delimiter (default: detected).")
 @click.option("--truncate", type=click.Choice(TRUNCATE),
               help="Keep the rows up to the largest stretch (loading) or stress (peak-stress); "
                    "default peak-stress for pull-to-failure database files, else none.")
-@click.option("--min-stretch", type=float, help="Fit only points with at least this stretch.")
-@click.option("--max-stretch", type=float, help="Fit only points with at most this stretch.")
+@click.option("--min-stretch", type=P.Real(0.0, 100.0, low_open=True), help="Fit only points with at least this stretch.")
+@click.option("--max-stretch", type=P.Real(0.0, 100.0, low_open=True), help="Fit only points with at most this stretch.")
 @click.option("--weighting", type=click.Choice(WEIGHTINGS), default="absolute", show_default=True,
               help="Residuals: plain stress, relative to the stress, or per-mode normalised.")
 @click.option("--stable", is_flag=True,
               help="Constrain parameter signs so that the model is Drucker-stable everywhere "
                    "(Ogden mu_n alpha_n >= 0; invariant models coefficients >= 0).")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Ogden starts.")
-@click.option("--starts", type=click.IntRange(min=1), default=8, show_default=True,
+@click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the Ogden starts.")
+@click.option("--starts", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=8, show_default=True,
               help="Number of Ogden starts.")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
+@click.option("--plot", "plot_path", type=P.OutputFile((".png", ".pdf", ".svg")),
               help="Write a figure of data and fits (PNG, SVG or PDF by extension).")
 @click.option("--json", "as_json", is_flag=True, help="Machine-readable output.")
 @click.option("--markdown", is_flag=True, help="Print only the R^2 table as Markdown.")
@@ -80,7 +83,7 @@ def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, column
                         "notes": sorted({n for c in test.curves for n in c.notes})},
                "modes": list(table.modes), "table": table.rows(),
                "fits": [r.to_dict() for r in table.results], "plot": plot_path}
-        click.echo(json.dumps(out, indent=2))
+        click.echo(strict_json(out, indent=2))
         return
     if markdown:
         click.echo(table.to_markdown())

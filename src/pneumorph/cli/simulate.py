@@ -2,26 +2,27 @@
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 
 import click
 
+from pneumorph.cli import params as P
+
 
 @click.command("simulate")
-@click.option("--orientation", "-o", required=True, metavar="DIGITS",
+@click.option("--orientation", "-o", required=True, metavar="DIGITS", type=P.Text(max_length=1000),
               help="The design, base first: one digit per unit, 1 = unit turned 180 degrees (e.g. 010011).")
-@click.option("--pressure", type=float, default=45.0, show_default=True, help="Final pressure in kPa.")
-@click.option("--increments", type=int, default=10, show_default=True, help="Reported pressure levels.")
+@click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure in kPa.")
+@click.option("--increments", type=P.INCREMENTS, default=10, show_default=True, help="Reported pressure levels.")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="2d", show_default=True,
               help="2D reduced-order (plane strain with filler) or 3D model.")
-@click.option("--unit", "unit_file", type=click.Path(exists=True, dir_okay=False),
+@click.option("--unit", "unit_file", type=P.InputFile(),
               help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
 @click.option("--gravity", type=click.Choice(["none", "hanging", "horizontal"]), default="none", show_default=True,
               help="Weight of the silicones, applied before the pressure: hanging from the clamped base "
                    "(appendix A.2.2) or lying horizontal with gravity across the height.")
-@click.option("--out", type=click.Path(file_okay=False), help="Folder for response (NPZ+JSON), VTK and PNG files.")
+@click.option("--out", type=P.OutputDir(), help="Folder for response (NPZ+JSON), VTK and PNG files.")
 @click.option("--json", "as_json", is_flag=True, help="Print tip, curl and unit centres of every level as JSON.")
 def simulate(
     orientation: str,
@@ -42,7 +43,13 @@ def simulate(
     from pneumorph.io import provenance, write_vtk_series
     from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 
+    from pneumorph.checks import MAX_UNITS
+    from pneumorph.errors import OrientationError
+    from pneumorph.io.files import strict_json, write_json
+
     design = parse_orientation(orientation)
+    if len(design) > MAX_UNITS:
+        raise OrientationError(f"--orientation has {len(design)} units; at most {MAX_UNITS} (limit MAX_UNITS)")
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     ramp = RampSpec(pressure=pressure / 1e3, steps=StepSettings(increments=increments, substeps=2))
     Model = Reduced2D if fidelity == "2d" else Full3D
@@ -66,7 +73,7 @@ def simulate(
         from pneumorph.plot.shape import plot_shape
 
         plot_shape(solution, folder / "shape.png", levels=sorted({resp.n_levels // 2 - 1, resp.n_levels - 1}))
-        (folder / "provenance.json").write_text(json.dumps(meta, indent=1, default=str), encoding="utf-8")
+        write_json(folder / "provenance.json", meta)
     if as_json:
         levels = [
             {
@@ -77,8 +84,8 @@ def simulate(
             }
             for k, p in enumerate(resp.pressures)
         ]
-        click.echo(json.dumps({"orientation": design, "model": fidelity, "converged": resp.converged,
-                               "levels": levels, "metadata": resp.metadata}, indent=1))
+        click.echo(strict_json({"orientation": design, "model": fidelity, "converged": resp.converged,
+                                "levels": levels, "metadata": resp.metadata}))
     else:
         click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} {'curl [deg]':>11}")
         for k, p in enumerate(resp.pressures):

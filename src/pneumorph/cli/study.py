@@ -2,26 +2,27 @@
 
 from __future__ import annotations
 
-import json
-
 import click
+
+from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_STARTS
+from pneumorph.cli import params as P
 
 
 @click.command("study")
-@click.argument("config_file", required=False, type=click.Path(exists=True, dir_okay=False))
-@click.option("--populations", default="20,40,60,80", show_default=True, metavar="LIST",
+@click.argument("config_file", required=False, type=P.InputFile())
+@click.option("--populations", type=P.RealList(P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), max_items=100), default="20,40,60,80", show_default=True, metavar="LIST",
               help="Population sizes, comma-separated.")
-@click.option("--seeds", type=int, default=5, show_default=True, help="Runs (seeds 0..N-1) per population size.")
-@click.option("--gen", "generations", type=int, default=25, show_default=True, help="Generations per run.")
-@click.option("--units", type=int, help="Number of units (default: the config's, else 15).")
-@click.option("--target", help="Profile target (default: the config's, else sin, amplitude 10 mm).")
-@click.option("--pressure", type=float, help="Maximum pressure, kPa (default 45).")
+@click.option("--seeds", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=5, show_default=True, help="Runs (seeds 0..N-1) per population size.")
+@click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"), default=25, show_default=True, help="Generations per run.")
+@click.option("--units", type=P.UNITS, help="Number of units (default: the config's, else 15).")
+@click.option("--target", type=P.Text(), help="Profile target (default: the config's, else sin, amplitude 10 mm).")
+@click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--executor", type=click.Choice(["serial", "processes", "dask"]), default="processes", show_default=True)
-@click.option("--cache", metavar="FILE", help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
-@click.option("--out", default="runs/population-study", show_default=True, metavar="DIR",
+@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--out", type=P.OutputDir(), default="runs/population-study", show_default=True, metavar="DIR",
               help="Folder for study.json and study.png.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
-def study(config_file: str | None, populations: str, seeds: int, generations: int, units: int | None,
+def study(config_file: str | None, populations: list[int], seeds: int, generations: int, units: int | None,
           target: str | None, pressure: float | None, executor: str, cache: str | None, out: str,
           as_json: bool) -> None:
     """Best fitness against GA population size over several seeds (lowest, largest, mean).
@@ -32,20 +33,16 @@ def study(config_file: str | None, populations: str, seeds: int, generations: in
     from pathlib import Path
 
     from pneumorph.design import DesignConfig, plot_study, population_study
-    from pneumorph.errors import SearchConfigError
     from pneumorph.execution import (
         CachedEvaluator,
         EvaluationCache,
         default_cache_path,
         make_evaluator,
     )
-    from pneumorph.io import provenance
+    from pneumorph.io import provenance, strict_json, write_json
     from pneumorph.models.factory import make_model
 
-    try:
-        pops = tuple(int(p) for p in populations.split(","))
-    except ValueError:
-        raise SearchConfigError(f"--populations takes whole numbers separated by commas, got {populations!r}") from None
+    pops = tuple(populations)
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
     changes = {k: v for k, v in (("units", units), ("objective", target)) if v is not None}
     model_settings = dict(config.model)
@@ -77,10 +74,10 @@ def study(config_file: str | None, populations: str, seeds: int, generations: in
         "rows": [row.as_dict() for row in result.rows],
         "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint(), config=config.to_dict()),
     }
-    (folder / "study.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
+    write_json(folder / "study.json", summary)
     plot_study(result, folder / "study.png")
     if as_json:
-        click.echo(json.dumps({k: v for k, v in summary.items() if k != "provenance"}, indent=1))
+        click.echo(strict_json({k: v for k, v in summary.items() if k != "provenance"}))
     else:
         click.echo(f"{'population':>10} {'lowest':>10} {'largest':>10} {'mean':>10}   [{result.unit}]")
         for row in result.rows:

@@ -33,10 +33,13 @@ from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from pneumorph import checks
 from pneumorph.design.ga import GAConfig
 from pneumorph.design.targets import Objective, make_objective
-from pneumorph.errors import SearchConfigError
+from pneumorph.errors import SearchConfigError, TargetExpressionError, UnknownObjectiveError
 from pneumorph.execution.evaluators import EXECUTORS
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.files import read_toml
 
 SEARCHES = ("certified", "ga", "exhaustive")
 
@@ -53,7 +56,7 @@ class DesignConfig:
     >>> DesignConfig(units=0)
     Traceback (most recent call last):
     ...
-    pneumorph.errors.SearchConfigError: the actuator needs at least 1 unit, got 0
+    pneumorph.errors.SettingsError: [design] units must be a whole number >= 1 and <= 100, got 0
     """
 
     objective: str = "sin"
@@ -76,24 +79,41 @@ class DesignConfig:
     model: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if int(self.units) != self.units or self.units < 1:
-            raise SearchConfigError(f"the actuator needs at least 1 unit, got {self.units}")
-        if self.search not in SEARCHES:
-            raise SearchConfigError(f"unknown search {self.search!r}; choose one of {', '.join(SEARCHES)}")
-        if self.executor not in EXECUTORS:
-            raise SearchConfigError(f"unknown executor {self.executor!r}; choose one of {', '.join(EXECUTORS)}")
-        for name in ("amplitude", "periods", "margin"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-        if self.verify is not None and (isinstance(self.verify, bool) or not isinstance(self.verify, int)
-                                        or self.verify < 1):
-            raise SearchConfigError(f"verify must be a whole number of designs >= 1, got {self.verify!r}")
-        if not (math.isfinite(self.margin) and self.margin > 0):
-            raise SearchConfigError(f"the bound's margin must be a positive number, got {self.margin!r}")
+        checks.integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+        checks.text(self.objective, "[design] objective")
+        checks.text(self.search, "[design] search", SEARCHES)
+        checks.text(self.executor, "[execution] executor", EXECUTORS)
+        checks.integer(self.seed, "[design] seed", 0, 2**32 - 1)
+        checks.flag(self.certify, "[design] certify")
+        checks.flag(self.anchored, "[design] anchored")
+        object.__setattr__(self, "amplitude", checks.real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
+                                                          unit="mm"))
+        object.__setattr__(self, "periods", checks.real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
+        object.__setattr__(self, "margin", checks.real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
+        if self.verify is not None:
+            checks.integer(self.verify, "[design] verify", 1, 1024)
+        if self.workers is not None:
+            checks.integer(self.workers, "[execution] workers", 1, 1024)
+        if self.scheduler is not None:
+            checks.address(self.scheduler, "[execution] scheduler")
+        for key in ("chain_table", "cache"):
+            if getattr(self, key) is not None:
+                checks.text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")
+        if not isinstance(self.model, dict):
+            raise SearchConfigError(f"[model] must be a table, got {self.model!r}")
         if self.ga.seed != self.seed:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
-            object.__setattr__(self, "point", tuple(float(v) for v in self.point))
-        self.make_objective()  # fail early on a bad objective
+            object.__setattr__(self, "point", checks.pair(self.point, "[design] point", unit="mm"))
+        try:  # fail early on a bad objective
+            objective = self.make_objective()
+            if hasattr(objective, "check"):  # a profile: finite along the actuator (the inline unit's pitch)
+                unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
+                pitch = unit.get("pitch", UnitSpec.pitch)
+                ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
+                objective.check(self.units * (pitch if ok else UnitSpec.pitch))
+        except (TargetExpressionError, UnknownObjectiveError) as exc:
+            raise SearchConfigError(f"[design] objective: {exc}") from None
 
     def make_objective(self) -> Objective:
         """The objective these settings describe."""
@@ -130,18 +150,16 @@ class DesignConfig:
                 raise SearchConfigError(f"unknown key {key!r} in [{table}]; known keys: {', '.join(sorted(known))}")
         kwargs.update(data.get("design", {}))
         kwargs.update(data.get("execution", {}))
-        if "point" in kwargs:
-            kwargs["point"] = tuple(kwargs["point"])
+        for table in ("design", "ga", "execution", "model"):
+            if not isinstance(data.get(table, {}), dict):
+                raise SearchConfigError(f"[{table}] must be a table of settings, got {data[table]!r}")
         ga = GAConfig(**{**data.get("ga", {}), "seed": kwargs.get("seed", 0)})
         return cls(ga=ga, model=dict(data.get("model", {})), **kwargs)
 
     @classmethod
     def read(cls, path: str | Path) -> DesignConfig:
         """Settings from a TOML file (a run folder's ``config.toml`` works too)."""
-        try:
-            data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-        except tomllib.TOMLDecodeError as exc:
-            raise SearchConfigError(f"{path}: not valid TOML: {exc}") from None
+        data = read_toml(path, "design config", SearchConfigError)
         return cls.from_dict(data)
 
 

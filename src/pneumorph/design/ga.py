@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from deap import base, creator, tools
 
+from pneumorph import checks
 from pneumorph.design.fitness import Score
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, Sense
@@ -88,16 +89,16 @@ class GAConfig:
     budget: int | None = None
 
     def __post_init__(self) -> None:
-        if int(self.population) != self.population or self.population < 2:
-            raise SearchConfigError(f"the population must hold at least 2 individuals, got {self.population}")
-        if int(self.generations) != self.generations or self.generations < 0:
-            raise SearchConfigError(f"the number of generations must be 0 or more, got {self.generations}")
+        checks.integer(self.population, "[ga] population", 2, checks.MAX_POPULATION, limit="MAX_POPULATION")
+        checks.integer(self.generations, "[ga] generations", 0, checks.MAX_GENERATIONS, limit="MAX_GENERATIONS")
         for name in ("cxpb", "mutpb", "indpb"):
-            value = getattr(self, name)
-            if not 0.0 <= value <= 1.0:
-                raise SearchConfigError(f"{name} is a probability between 0 and 1, got {value}")
-        if self.tournsize < 1:
-            raise SearchConfigError(f"the tournament size must be at least 1, got {self.tournsize}")
+            checks.real(getattr(self, name), f"[ga] {name}", 0.0, 1.0)
+        checks.integer(self.tournsize, "[ga] tournsize", 1, checks.MAX_POPULATION)
+        checks.integer(self.elitism, "[ga] elitism", 0)
+        checks.integer(self.hall_of_fame, "[ga] hall_of_fame", 1, checks.MAX_POPULATION)
+        checks.integer(self.seed, "[design] seed", 0, 2**32 - 1)
+        if self.budget is not None:
+            checks.integer(self.budget, "[ga] budget", 1)
         if not 0 <= self.elitism < self.population:
             raise SearchConfigError(
                 f"elitism must be between 0 and population - 1 = {self.population - 1}, got {self.elitism}"
@@ -106,8 +107,6 @@ class GAConfig:
             raise SearchConfigError(
                 f"a budget of {self.budget} designs does not cover the initial population of {self.population}"
             )
-        if self.hall_of_fame < 1:
-            raise SearchConfigError(f"the hall of fame must keep at least 1 design, got {self.hall_of_fame}")
 
 
 @dataclass(frozen=True)

@@ -88,6 +88,40 @@ class ProfileTarget:
         var = "x" if self.coordinates == "cartesian" else "theta"
         return self.expression(**{var: np.asarray(s, dtype=float)}, L=L, A=self.amplitude)
 
+    def check(self, length: float) -> ProfileTarget:
+        """Refuse a target that is not finite somewhere on the actuator's range.
+
+        The range is ``0 <= x <= L`` for ``y = f(x)`` and ``0 <= theta <= pi`` for
+        ``r = f(theta)``, sampled at 201 points.
+
+        Raises
+        ------
+        TargetExpressionError
+            Naming the first point where the target is NaN or infinite.
+
+        Examples
+        --------
+        >>> profile_target("y = 1/x").check(157.5)
+        Traceback (most recent call last):
+        ...
+        pneumorph.errors.TargetExpressionError: the target y = 1/x is not finite at x = 0 (inf); it must be finite for 0 <= x <= L = 157.5 mm
+        """
+        polar = self.coordinates == "polar"
+        s = np.linspace(0.0, np.pi if polar else float(length), 201)
+        with np.errstate(all="ignore"):
+            try:
+                values = np.broadcast_to(np.asarray(self.curve(s, length), dtype=float), s.shape)
+            except (ArithmeticError, ValueError) as exc:
+                raise TargetExpressionError(f"the target {self.label} cannot be evaluated: {exc}") from None
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            where = f"theta = {s[bad[0]]:.4g} rad" if polar else f"x = {s[bad[0]]:.4g}"
+            span = "0 <= theta <= pi" if polar else f"0 <= x <= L = {length:g} mm"
+            raise TargetExpressionError(
+                f"the target {self.label} is not finite at {where} ({values[bad[0]]}); it must be finite for {span}"
+            )
+        return self
+
     @property
     def label(self) -> str:
         lhs = "y" if self.coordinates == "cartesian" else "r"
@@ -165,7 +199,8 @@ def tip_goal(name: str, point: tuple[float, float] | None = None) -> TipGoal:
         raise UnknownObjectiveError(name, [*TIP_GOALS, *PRESETS])
     if key == "reach":
         if point is None or len(point) != 2 or not np.all(np.isfinite(point)):
-            raise SearchConfigError("the objective 'reach' needs a tip point (x, y) in mm, e.g. (60, 40)")
+            raise SearchConfigError("the objective 'reach' needs a tip point (x, y) in mm: --point X Y "
+                                    "(point = [x, y] in [design] of a config file), e.g. --point 60 40")
         point = (float(point[0]), float(point[1]))
     elif point is not None:
         raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {key!r}")

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph import checks
 from pneumorph.errors import SimulationFailed
 
 
@@ -57,13 +58,11 @@ class StepSettings:
     predictor: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("increments", "substeps", "max_iterations"):
-            if int(getattr(self, name)) < 1:
-                raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
-        if self.max_cutbacks < 0:
-            raise ValueError(f"max_cutbacks must be >= 0, got {self.max_cutbacks}")
-        if not self.tolerance > 0:
-            raise ValueError(f"tolerance must be positive, got {self.tolerance}")
+        checks.integer(self.increments, "increments", 1, checks.MAX_INCREMENTS, limit="MAX_INCREMENTS")
+        checks.integer(self.substeps, "substeps", 1, checks.MAX_SUBSTEPS, limit="MAX_SUBSTEPS")
+        checks.integer(self.max_iterations, "max_iterations", 1, 1000)
+        checks.integer(self.max_cutbacks, "max_cutbacks", 0, 60)
+        checks.real(self.tolerance, "tolerance", 0.0, 1.0, low_open=True)
 
     def levels(self) -> NDArray[np.float64]:
         """The reported load factors ``1/n, 2/n, ..., 1``."""

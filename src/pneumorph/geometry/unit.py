@@ -32,11 +32,11 @@ Examples
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
+from pneumorph.checks import MIN_ELEMENT_FRACTION
 from pneumorph.errors import GeometryError
 from pneumorph.materials.filler import FillerLaw
 
@@ -138,11 +138,14 @@ class UnitSpec:
         object.__setattr__(self, "filler_range_kpa", tuple(float(c) for c in self.filler_range_kpa))
         if self.filler_coefficients:
             self.filler_law()  # validates: positive modulus over the range, Poisson's ratio
-        if self.element_order not in (1, 2):
+        if isinstance(self.element_order, bool) or self.element_order not in (1, 2):
             raise GeometryError(f"element_order must be 1 (linear) or 2 (quadratic), got {self.element_order!r}")
+        for key in ("body_material", "layer_material", "name"):
+            if not isinstance(getattr(self, key), str) or not getattr(self, key).strip():
+                raise GeometryError(f"unit {key} must be a non-empty text, got {getattr(self, key)!r}")
         for key in _LENGTHS:
             value = getattr(self, key)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise GeometryError(f"unit {key} must be a finite number of mm, got {value!r}")
         for key in ("pitch", "width", "wall", "side_wall", "end_wall", "layer", "cavity_height", "element_size"):
             if getattr(self, key) <= 0:
@@ -150,6 +153,12 @@ class UnitSpec:
         for key in ("slit_width", "slit_depth", "end_cap"):
             if getattr(self, key) < 0:
                 raise GeometryError(f"unit {key} must be >= 0, got {getattr(self, key)} mm")
+        thinnest = min(self.wall, self.side_wall, self.end_wall, self.layer)
+        if self.element_size < MIN_ELEMENT_FRACTION * thinnest:
+            raise GeometryError(
+                f"unit element_size {self.element_size:g} mm is below {MIN_ELEMENT_FRACTION:g} x the thinnest wall "
+                f"({thinnest:g} mm), the limit MIN_ELEMENT_FRACTION: the mesh would not fit in memory"
+            )
         if self.cavity_length <= 0:
             raise GeometryError(
                 f"the walls leave no cavity: pitch {self.pitch} mm - 2 x end wall {self.end_wall} mm "
@@ -281,13 +290,10 @@ class UnitSpec:
         >>> UnitSpec.from_toml(p).cavity_length
         5.0
         """
+        from pneumorph.io.files import read_toml
+
         p = Path(path)
-        try:
-            data = tomllib.loads(p.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise GeometryError(f"{p}: cannot read the unit file ({exc.strerror})") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise GeometryError(f"{p}: not valid TOML: {exc}") from None
+        data = read_toml(p, "unit file", GeometryError)
         if "unit" not in data or not isinstance(data["unit"], dict):
             raise GeometryError(f"{p}: expected a [unit] table with the unit's dimensions in mm")
         return cls.from_dict(data["unit"], source=str(p))

@@ -13,11 +13,12 @@ import json
 import math
 import os
 import tempfile
+import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from pneumorph.errors import OutputPathError
+from pneumorph.errors import OutputPathError, PneumorphError, SettingsError
 
 
 def _existing_ancestor(path: Path) -> Path:
@@ -184,3 +185,57 @@ def strict_json(obj: Any, indent: int | None = 1) -> str:
 def write_json(path: str | Path, obj: Any, indent: int | None = 1) -> Path:
     """Write :func:`strict_json` of ``obj`` to ``path`` atomically."""
     return atomic_write_text(path, strict_json(obj, indent=indent) + "\n")
+
+
+def read_text_file(path: str | Path, what: str, error: type[PneumorphError] = SettingsError,
+                   encoding: str = "utf-8") -> str:
+    """The text of a file a user gave, or one line saying why it cannot be read.
+
+    Parameters
+    ----------
+    path : str or Path
+    what : str
+        What the file is (named in the message: "unit file", "design config").
+    error : PneumorphError subclass
+        Raised with the message (the caller's own kind of error).
+    encoding : str
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "b.toml"
+    >>> _ = p.write_bytes(b"\\xff\\xfe")
+    >>> read_text_file(p, "unit file")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: unit file ...b.toml: not a text file (byte 0 is not UTF-8)
+    """
+    p = Path(path)
+    try:
+        return p.read_bytes().decode(encoding)
+    except UnicodeDecodeError as exc:
+        raise error(f"{what} {p}: not a text file (byte {exc.start} is not UTF-8)") from None
+    except IsADirectoryError:
+        raise error(f"{what} {p}: is a folder, not a file") from None
+    except OSError as exc:
+        raise error(f"{what} {p}: cannot be read ({exc.strerror or exc})") from None
+
+
+def read_toml(path: str | Path, what: str, error: type[PneumorphError] = SettingsError) -> dict[str, Any]:
+    """The tables of a TOML file a user gave, or one line saying why it cannot be read.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "c.toml"
+    >>> _ = p.write_text("[design\\nunits = 3")
+    >>> read_toml(p, "design config")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: design config ...c.toml: not valid TOML: ...
+    """
+    text = read_text_file(path, what, error)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{what} {path}: not valid TOML: {exc}") from None

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -316,14 +315,8 @@ def load_library(path: str | Path) -> Library:
         Unreadable file, TOML syntax error, missing keys, wrong lengths, unknown units,
         non-positive moduli; the message names the file and the entry.
     """
+    from pneumorph.io.files import read_toml
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MaterialDataError(f"{p}: cannot read the material file ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise MaterialDataError(f"{p}: not valid TOML: {exc}") from None
-    return parse_library(data, str(p))
+    return parse_library(read_toml(p, "material file", MaterialDataError), str(p))
 

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph import __version__
-from pneumorph.errors import MaterialDataError, SimulationFailed
+from pneumorph import __version__, checks
+from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume, ramp
 from pneumorph.fem.fastassembly import PlaneStrainSystem
 from pneumorph.fem.fastassembly3d import SolidSystem3D
@@ -78,8 +78,8 @@ class RampSpec:
     steps: StepSettings = field(default_factory=lambda: StepSettings(increments=10, substeps=2))
 
     def __post_init__(self) -> None:
-        if not (self.pressure > 0 and np.isfinite(self.pressure)):
-            raise ValueError(f"the pressure must be positive, got {self.pressure * 1e3:g} kPa")
+        checks.real(self.pressure, "pressure", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
+                    limit="MAX_PRESSURE_KPA")
 
     def pressures(self) -> FloatArray:
         return self.pressure * self.steps.levels()
@@ -118,11 +118,9 @@ class FEModel:
     ) -> None:
         backend = backend or self.backends[0]
         if backend not in self.backends:
-            raise ValueError(f"backend must be one of {', '.join(self.backends)}, got {backend!r}")
+            raise SettingsError(f"backend must be one of {', '.join(self.backends)}, got {backend!r}")
         self.backend = backend
-        if int(n_units) < 1:
-            raise ValueError(f"an actuator needs at least 1 unit, got {n_units}")
-        self.n_units = int(n_units)
+        self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.unit = unit or UnitSpec()
         self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
         self.filler = filler
@@ -159,10 +157,8 @@ class FEModel:
         >>> Reduced2D(15).with_units(4).n_units
         4
         """
-        if int(n_units) < 1:
-            raise ValueError(f"an actuator needs at least 1 unit, got {n_units}")
         other = copy.copy(self)
-        other.n_units = int(n_units)
+        other.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         return other
 
     def fingerprint(self) -> str:
@@ -509,7 +505,7 @@ class Full3D(FEModel):
         super().__init__(n_units, unit, ramp_spec, None, backend, gravity)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
-            raise ValueError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
+            raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
                              "of the half model; use half=False")
 
     def describe(self) -> dict[str, Any]:

@@ -1,0 +1,175 @@
+"""Checks of settings where they enter, and the limits of what pneumorph agrees to compute.
+
+Every setting a user gives (a CLI option, a config key, a constructor argument) passes one
+of these functions, which refuse it with a :class:`~pneumorph.errors.SettingsError` that
+names the setting, the value and what is allowed. Types are strict: a bool is not a
+number, a float is not a count, a string is not a number (the CLI parses its text first,
+:mod:`pneumorph.cli.params`).
+
+Limits
+------
+Sizes beyond these are refused up front instead of hanging or exhausting memory; each is
+far beyond what the dissertation's actuators need (15 units, 45-85 kPa, 10 levels).
+
+=====================  =======  ==========================================================
+``MAX_UNITS``              100  units of an actuator (1.05 m of the built-in unit)
+``MAX_PRESSURE_KPA``      1000  kPa; the silicones tear long before (Table A.2 strains)
+``MAX_INCREMENTS``        1000  reported pressure levels of a ramp
+``MAX_SUBSTEPS``           100  substeps per level
+``MAX_POPULATION``      10 000  GA population
+``MAX_GENERATIONS``     10 000  GA generations
+``MAX_STARTS``            1000  multistarts of a fit, runs, seeds, held-out designs
+``MIN_ELEMENT_FRACTION``   1/8  element size against the unit's thinnest wall
+=====================  =======  ==========================================================
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import Any
+
+from pneumorph.errors import SettingsError
+
+MAX_UNITS = 100
+MAX_PRESSURE_KPA = 1000.0
+MAX_INCREMENTS = 1000
+MAX_SUBSTEPS = 100
+MAX_POPULATION = 10_000
+MAX_GENERATIONS = 10_000
+MAX_STARTS = 1000
+MIN_ELEMENT_FRACTION = 1.0 / 8.0
+
+
+def _bound_text(low: float | None, high: float | None, low_open: bool, high_open: bool) -> str:
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if low_open else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"{'<' if high_open else '<='} {high:g}")
+    return " and ".join(parts)
+
+
+def integer(value: Any, name: str, low: int | None = None, high: int | None = None, limit: str = "") -> int:
+    """``value`` as an int, refusing bools, floats, strings and values outside ``[low, high]``.
+
+    ``limit`` names the constant behind ``high`` for the message.
+
+    Examples
+    --------
+    >>> integer(15, "--units", 1, MAX_UNITS)
+    15
+    >>> integer(True, "units", 1)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: units must be a whole number >= 1, got True
+    >>> integer(500, "--units", 1, MAX_UNITS, limit="MAX_UNITS")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: --units must be a whole number >= 1 and <= 100 (limit MAX_UNITS), got 500
+    """
+    ok = isinstance(value, int) and not isinstance(value, bool)
+    if not ok and hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0 and value.dtype.kind in "iu":
+        value, ok = int(value), True
+    if ok and (low is None or value >= low) and (high is None or value <= high):
+        return int(value)
+    bounds = _bound_text(low, high, False, False)
+    suffix = f" (limit {limit})" if limit and ok and high is not None and value > high else ""
+    raise SettingsError(f"{name} must be a whole number{' ' + bounds if bounds else ''}{suffix}, got {value!r}")
+
+
+def real(value: Any, name: str, low: float | None = None, high: float | None = None, *, low_open: bool = False,
+         high_open: bool = False, unit: str = "", limit: str = "") -> float:
+    """``value`` as a finite float within the bounds; ints are accepted, bools and strings are not.
+
+    Examples
+    --------
+    >>> real(45, "--pressure", 0, MAX_PRESSURE_KPA, low_open=True, unit="kPa")
+    45.0
+    >>> real(float("nan"), "--pressure", 0, low_open=True, unit="kPa")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: --pressure must be a finite number > 0 (kPa), got nan
+    """
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if not ok and hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0 and value.dtype.kind in "iuf":
+        value, ok = float(value), True
+    if ok:
+        v = float(value)
+        if math.isfinite(v) and (low is None or (v > low if low_open else v >= low)) and (
+                high is None or (v < high if high_open else v <= high)):
+            return v
+    bounds = _bound_text(low, high, low_open, high_open)
+    what = f"a finite number{' ' + bounds if bounds else ''}{f' ({unit})' if unit else ''}"
+    suffix = f" (limit {limit})" if limit and ok and high is not None and math.isfinite(float(value)) \
+        and float(value) > high else ""
+    raise SettingsError(f"{name} must be {what}{suffix}, got {value!r}")
+
+
+def flag(value: Any, name: str) -> bool:
+    """``value`` if it is a bool (``true``/``false`` in TOML), else an error.
+
+    >>> flag(1, "certify")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: certify must be true or false, got 1
+    """
+    if isinstance(value, bool):
+        return value
+    raise SettingsError(f"{name} must be true or false, got {value!r}")
+
+
+def text(value: Any, name: str, choices: Iterable[str] | None = None) -> str:
+    """``value`` if it is a non-empty string (one of ``choices`` if given).
+
+    >>> text("", "objective")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: objective must be a non-empty text, got ''
+    >>> text("fast", "search", ("ga", "certified"))
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: search must be one of ga, certified, got 'fast'
+    """
+    if not isinstance(value, str) or not value.strip():
+        raise SettingsError(f"{name} must be a non-empty text, got {value!r}")
+    if choices is not None:
+        allowed = tuple(choices)
+        if value not in allowed:
+            raise SettingsError(f"{name} must be one of {', '.join(allowed)}, got {value!r}")
+    return value
+
+
+def pair(value: Any, name: str, unit: str = "") -> tuple[float, float]:
+    """Two finite numbers (a point, a range).
+
+    >>> pair([1, 2.5], "point")
+    (1.0, 2.5)
+    """
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        raise SettingsError(f"{name} must be two numbers{f' ({unit})' if unit else ''}, got {value!r}")
+    return real(value[0], name, unit=unit), real(value[1], name, unit=unit)
+
+
+_SCHEMES = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
+
+
+def address(value: Any, name: str) -> str:
+    """A Dask scheduler address ``scheme://host:port`` or ``host:port``, checked for its form only.
+
+    >>> address("tcp://10.0.0.5:8786", "--scheduler")
+    'tcp://10.0.0.5:8786'
+    >>> address("not a url", "--scheduler")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: --scheduler must be an address like tcp://host:8786, got 'not a url'
+    """
+    import re
+
+    ok = isinstance(value, str) and re.fullmatch(
+        rf"(?:(?:{'|'.join(_SCHEMES)})://)?[A-Za-z0-9_.\-\[\]:]+:\d{{1,5}}", value.strip()) is not None
+    if ok and value.startswith("inproc://"):
+        return value
+    if not ok or not 0 < int(value.rsplit(":", 1)[1]) < 65536:
+        raise SettingsError(f"{name} must be an address like tcp://host:8786, got {value!r}")
+    return value.strip()

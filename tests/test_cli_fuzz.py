@@ -1,0 +1,252 @@
+"""Bad input on every command and option: exit 2, one line, no traceback, nothing written.
+
+Each case starts from a command line that would run (a "baseline") and spoils one option,
+argument or config key. The FE solvers, the coupon and the evaluators are replaced by
+tripwires, so a value that gets past the checks fails the test at once instead of
+computing: every refusal must come before any solve.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from pneumorph.cli import main
+
+# -- the tripwires ------------------------------------------------------------------------
+
+
+class _Reached(Exception):
+    pass
+
+
+def _trip(*args: object, **kwargs: object) -> None:
+    raise _Reached("a solve was reached: the bad value was not refused up front")
+
+
+@pytest.fixture()
+def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    import pneumorph.bimodal.model as bimodal
+    import pneumorph.composite.coupon as coupon
+    import pneumorph.execution as execution
+    import pneumorph.execution.evaluators as evaluators
+    import pneumorph.models.fe as fe
+
+    monkeypatch.setattr(fe.FEModel, "solve", _trip)
+    monkeypatch.setattr(fe.FEModel, "evaluate", _trip)
+    monkeypatch.setattr(bimodal.BimodalModel, "solve", _trip)
+    monkeypatch.setattr(coupon, "simulate_coupon", _trip)
+    monkeypatch.setattr(execution, "make_evaluator", lambda *a, **k: evaluators.SerialEvaluator())
+    monkeypatch.setattr(evaluators, "make_evaluator", lambda *a, **k: evaluators.SerialEvaluator())
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    monkeypatch.delenv("PNEUMORPH_CACHE", raising=False)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "binary.bin").write_bytes(bytes(range(256)) * 4)
+    (tmp_path / "a-file").write_text("not a folder\n", encoding="utf-8")
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "stress.csv").write_text("stretch,stress\n1.0,0.0\n1.5,0.2\n2.0,0.35\n2.5,0.5\n", encoding="utf-8")
+    (tmp_path / "dic.csv").write_text("axial_strain,transverse_strain\n0.1,-0.04\n0.2,-0.08\n", encoding="utf-8")
+    (tmp_path / "thermal.csv").write_text("temperature,strain\n20,0\n30,0.002\n40,0.004\n", encoding="utf-8")
+    (tmp_path / "bilinear.csv").write_text(
+        "strain,stress\n" + "".join(f"{0.01 * i},{0.1 * i if i < 10 else 1 + 0.01 * i}\n" for i in range(40)),
+        encoding="utf-8")
+    return tmp_path
+
+
+def _listing(root: Path) -> set[str]:
+    return {str(p.relative_to(root)) for p in root.rglob("*")} - {"xdg"}
+
+
+def _refused(root: Path, capsys: pytest.CaptureFixture[str], argv: list[str]) -> str:
+    before = _listing(root)
+    code = main(argv)
+    out, err = capsys.readouterr()
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert "Traceback" not in err + out, err
+    assert code == 2, f"exit {code} for {argv}: {err or out}"
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    left = {p for p in _listing(root) - before if not p.startswith("xdg")}
+    assert not left, f"{argv} left {sorted(left)}"
+    return lines[0]
+
+
+# -- the commands and their options -------------------------------------------------------
+
+BASE = {
+    "design": ["design", "--out", "run", "--executor", "serial"],
+    "simulate": ["simulate", "-o", "0110", "--out", "run"],
+    "study": ["study", "--out", "run", "--executor", "serial", "--seeds", "1", "--gen", "1"],
+    "calibrate": ["calibrate", "--out", "run", "--runs", "1", "--validate", "1"],
+    "chain": ["chain", "build", "--out", "run/table.json", "--model", "2d", "--units", "4"],
+    "bimodal": ["bimodal", "-c", "0.2", "--out", "run"],
+    "coupon": ["composite", "coupon", "-c", "0.2", "--out", "run"],
+    "transition": ["composite", "transition", "-c", "0.2"],
+    "fit": ["materials", "fit", "stress.csv", "--plot", "run/fit.png"],
+    "poisson": ["materials", "characterise", "poisson", "dic.csv"],
+    "thermal": ["materials", "characterise", "thermal", "thermal.csv"],
+    "bilinear": ["materials", "characterise", "bilinear", "bilinear.csv"],
+}
+
+REAL = ["nan", "inf", "-inf", "1e999", "abc", ""]  # never a number
+POSITIVE = ["0", "-1", *REAL]
+NONNEG = ["-1", *REAL]
+COUNT = ["1.5", "true", "abc", "", "-1"]
+POS_COUNT = ["0", *COUNT]
+HUGE = ["100000", "1000000000"]
+
+OPTIONS: dict[str, dict[str, list[str]]] = {
+    "design": {
+        "--pressure": POSITIVE + ["1e9"], "--amplitude": POSITIVE, "--periods": POSITIVE, "--margin": POSITIVE,
+        "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
+        "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--target": ["", "   ", "y = 1/0",
+        "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')"], "--scheduler": ["not a url", ""],
+        "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
+        "--out": ["a-file", "a-file/sub", ""], "--chain-table": ["binary.bin", "folder", "missing.json", ""],
+    },
+    "simulate": {
+        "--pressure": POSITIVE + ["1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
+        "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
+    },
+    "study": {
+        "--populations": ["", "0", "1", "20,,40", "abc", "1.5", "-20"], "--seeds": POS_COUNT + HUGE,
+        "--gen": COUNT + HUGE, "--units": POS_COUNT + HUGE, "--pressure": POSITIVE, "--target": ["", "y = 1/0"],
+        "--cache": ["folder", ""], "--out": ["a-file", "a-file/sub", ""],
+    },
+    "calibrate": {
+        "--units": POS_COUNT + HUGE, "--pressures": ["", "0", "-5", "nan", "5,,10", "abc", "inf"],
+        "--runs": POS_COUNT + HUGE, "--seed": COUNT, "--validate": COUNT + HUGE, "--unit": ["binary.bin", ""],
+        "--cache": ["folder", ""], "--out": ["a-file", "a-file/sub", ""],
+    },
+    "chain": {
+        "--pressure": POSITIVE, "--units": POS_COUNT + HUGE, "--window": POS_COUNT + ["50"],
+        "--tolerance": POSITIVE, "--heldout": COUNT + HUGE, "--workers": POS_COUNT, "--unit": ["binary.bin", ""],
+        "--cache": ["folder", ""], "--out": ["folder", "a-file/t.json", ""],
+    },
+    "bimodal": {
+        "--pmax": POSITIVE + ["1e9"], "--step": POSITIVE + ["100"], "--voids": POS_COUNT + HUGE,
+        "--element-size": POSITIVE + ["1e-4"], "--end-cap": NONNEG, "--bilinear-nu": ["0.5", "-1.5", *REAL],
+        "--max-cutbacks": COUNT + HUGE, "--max-iterations": POS_COUNT + HUGE, "--out": ["a-file", "a-file/sub", ""],
+    },
+    "coupon": {
+        "--crimp-ratio": POSITIVE, "--amplitude": POSITIVE, "--length": POSITIVE, "--thickness": POSITIVE,
+        "--per-flute": POS_COUNT + HUGE, "--rows": POS_COUNT + HUGE, "--levels": POS_COUNT + HUGE,
+        "--strain-max": POSITIVE, "--bulk-modulus": POSITIVE, "--gauges": COUNT + HUGE, "--seed": COUNT,
+        "--snapshot": NONNEG, "--out": ["a-file", "a-file/sub", ""],
+    },
+    "transition": {"--crimp-ratio": POSITIVE, "--amplitude": POSITIVE, "--length": POSITIVE},
+    "fit": {
+        "--min-stretch": POSITIVE, "--max-stretch": POSITIVE, "--starts": POS_COUNT + HUGE, "--seed": COUNT,
+        "--delimiter": ["", "ab"], "--columns": ["", "stress", "stress,stress", "foo,bar"],
+        "--stress-unit": ["", "furlongs"], "--plot": ["folder", "a-file/x.png", ""], "--model": ["", "nope"],
+    },
+    "bilinear": {"--primary-limit": POSITIVE, "--secondary-points": ["0", "1", *COUNT, *HUGE]},
+}
+
+CASES = [(cmd, opt, bad) for cmd, options in OPTIONS.items() for opt, values in options.items() for bad in values]
+
+
+@pytest.mark.parametrize(("cmd", "option", "bad"), CASES, ids=[f"{c}{o}={b!r}" for c, o, b in CASES])
+def test_bad_option_value(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, option: str, bad: str) -> None:
+    argv = list(BASE[cmd])
+    if option in argv:  # replace the baseline's value
+        i = argv.index(option)
+        argv[i + 1] = bad
+    elif option == "--orientation":
+        argv[argv.index("-o") + 1] = bad
+    elif option == "--crimp-ratio":
+        argv[argv.index("-c") + 1] = bad
+    else:
+        argv += [option, bad]
+    line = _refused(sandbox, capsys, argv)
+    assert option in line or "orientation" in line or "crimp" in line.lower(), line
+
+
+@pytest.mark.parametrize("cmd", ["poisson", "thermal", "bilinear", "fit"])
+@pytest.mark.parametrize("data", ["binary.bin", "folder", "missing.csv", ""])
+def test_bad_data_file(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, data: str) -> None:
+    argv = [data if a.endswith(".csv") else a for a in BASE[cmd]]
+    _refused(sandbox, capsys, argv)
+
+
+# -- config files -------------------------------------------------------------------------
+
+CONFIG_KEYS: list[tuple[str, str, str]] = [
+    (table, key, value)
+    for table, key, values in [
+        ("design", "units", ['"four"', "true", "1.5", "0", "-1", "100000"]),
+        ("design", "objective", ['""', "1", '"y = 1/0"', '"y = nan"', '"nope"']),
+        ("design", "amplitude", ["nan", "inf", '"ten"', "true", "0"]),
+        ("design", "periods", ["nan", "-1", '"x"']),
+        ("design", "seed", ["1.5", "-1", '"0"', "true"]),
+        ("design", "search", ["1", '"fast"']),
+        ("design", "certify", ['"yes"', "1"]),
+        ("design", "verify", ["0", "1.5", "true"]),
+        ("design", "margin", ["0", "nan", '"1"']),
+        ("design", "point", ["[1]", '"1,2"', "[nan, 0]"]),
+        ("design", "anchored", ["1"]),
+        ("design", "chain_table", ["1", '""']),
+        ("ga", "population", ["1", "1.5", "true", '"100"', "100000000"]),
+        ("ga", "generations", ["1.5", "-1", "true", "100000000"]),
+        ("ga", "cxpb", ["nan", "2", '"x"']),
+        ("ga", "hall_of_fame", ["0", "1.5"]),
+        ("execution", "executor", ["1", '"gpu"']),
+        ("execution", "workers", ["0", "1.5", "true"]),
+        ("execution", "scheduler", ["1", '"not a url"']),
+        ("execution", "cache", ["1", '""']),
+        ("model", "fidelity", ['"4d"', "2"]),
+        ("model", "pressure_kpa", ["nan", "inf", "0", "-5", '"45"', "true", "1e9"]),
+        ("model", "increments", ["0", "1.5", "true", "1000000000"]),
+        ("model", "substeps", ["0", "1.5", "1000000"]),
+        ("model", "gravity", ['"sideways"', "1"]),
+        ("model", "unit_file", ['"binary.bin"', '"missing.toml"', "1"]),
+        ("model.unit", "pitch", ["nan", "0", '"ten"', "true"]),
+        ("model.unit", "element_size", ["1e-4", "0", "nan"]),
+    ]
+    for value in values
+]
+
+
+@pytest.mark.parametrize(("table", "key", "value"), CONFIG_KEYS, ids=[f"[{t}]{k}={v}" for t, k, v in CONFIG_KEYS])
+@pytest.mark.parametrize("cmd", ["design", "study"])
+def test_bad_config_key(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, table: str, key: str,
+                        value: str) -> None:
+    if cmd == "study" and table == "execution":
+        pytest.skip("the study takes its executor from its options")
+    config = sandbox / "config.toml"
+    config.write_text(f"[{table}]\n{key} = {value}\n", encoding="utf-8")
+    line = _refused(sandbox, capsys, [cmd, str(config), "--out", "run"])
+    assert key in line, line
+
+
+@pytest.mark.parametrize("content", [bytes(range(256)), b"[design\nunits = 3", b"[unknown]\nx = 1\n", b"units = 3\n"])
+@pytest.mark.parametrize("cmd", ["design", "study"])
+def test_bad_config_file(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, content: bytes) -> None:
+    config = sandbox / "config.toml"
+    config.write_bytes(content)
+    _refused(sandbox, capsys, [cmd, str(config), "--out", "run"])
+
+
+@pytest.mark.parametrize("content", [bytes(range(256)), b"[unit]\npitch = 'ten'\n", b"[unit]\nelement_size = 1e-4\n",
+                                     b"[unit]\npitch = nan\n", b"pitch = 10\n"])
+def test_bad_unit_file(sandbox: Path, capsys: pytest.CaptureFixture[str], content: bytes) -> None:
+    unit = sandbox / "unit.toml"
+    unit.write_bytes(content)
+    for argv in (BASE["simulate"], BASE["design"], BASE["chain"]):
+        _refused(sandbox, capsys, [*argv, "--unit", str(unit)])
+
+
+def test_target_and_objective_together(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line = _refused(sandbox, capsys, [*BASE["design"], "--target", "sin", "--objective", "max-y"])
+    assert "--target" in line and "--objective" in line
+
+
+def test_reach_needs_a_point(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line = _refused(sandbox, capsys, [*BASE["design"], "--objective", "reach"])
+    assert "--point" in line
+
+
+def test_unknown_command_and_option(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _refused(sandbox, capsys, ["nope"])
+    _refused(sandbox, capsys, ["design", "--nope"])
+    _refused(sandbox, capsys, ["simulate"])  # a required option missing
