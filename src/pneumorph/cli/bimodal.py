@@ -67,6 +67,10 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     bulk = None
     if bilinear_nu is not None:
         bulk = bulk_from_poisson(get(bilinear_material(cr)).shear_modulus, bilinear_nu)
+    for option, field, value in (("--voids", "voids", voids), ("--element-size", "element_size", element_size),
+                                 ("--end-cap", "end_cap", end_cap)):
+        with P.blame(option):
+            BimodalSpec(**{field: value})
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations)

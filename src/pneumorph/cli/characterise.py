@@ -216,6 +216,9 @@ def bilinear(data: str, primary_limit: float, secondary_points: int, strain_unit
     modulus: line through the last --secondary-points points; transition: where they meet.
     """
     cols = read_columns(data, ("strain", "stress"))
+    if secondary_points > cols["strain"].size:
+        raise click.BadParameter(f"{secondary_points} points asked for the secondary fit, but {data} has "
+                                 f"{cols['strain'].size}", param_hint="'--secondary-points'")
     r = ch.bilinear(
         cols["strain"] * _STRAIN_SCALE[strain_unit],
         cols["stress"],

@@ -84,7 +84,7 @@ def transition(crimp_ratio: float | None, wavelength: float | None, amplitude: f
 @click.option("--strain-max", type=P.Real(0.0, 10.0, low_open=True), default=None,
               help="Final engineering strain [default: 2 s / lambda - 1 + 0.10].")
 @click.option("--bulk-modulus", type=P.Real(0.0, 1e9, low_open=True, unit="kPa"), default=None, help="Matrix bulk modulus in kPa [default: library].")
-@click.option("--gauges", type=P.Count(0, 100_000), default=None, help="Virtual strain gauges [default: Eq 3.5, 385; 0: none].")
+@click.option("--gauges", type=P.Count(0, 10_000), default=None, help="Virtual strain gauges [default: Eq 3.5, 385; 0: none].")
 @click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the gauge placement.")
 @click.option("--snapshot", type=P.Real(0.0, 10.0), default=None,
               help="Engineering strain of the deformed-shape and surface-strain figures [default: last level].")

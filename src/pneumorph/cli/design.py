@@ -109,9 +109,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         model_settings.pop("unit", None)
     config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
     fidelity_given = "fidelity" in config.model
-    if config.search == "certified" and config.model.get("gravity") is not None:
-        click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
-                   "falling back to the genetic algorithm", err=True)
+    fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
+    if fallback:
         config = replace(config, search="ga")
     if "fidelity" not in config.model:  # the certified search works on the 3D model by default
         config = replace(config, model={**config.model, "fidelity": "3d" if config.search == "certified" else "2d"})
@@ -122,6 +121,9 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if hasattr(objective_, "check"):  # a profile must be finite along this model's actuator
         objective_.check(model.n_units * model.unit.pitch)
 
+    if fallback:  # said once every setting has been checked
+        click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
+                   "falling back to the genetic algorithm", err=True)
     label = config.make_objective().label
     click.echo(f"designing {config.units} units for {label} ({model.fidelity} model, {config.search}, "
                f"executor {config.executor}) -> {folder}", err=True)

@@ -60,11 +60,18 @@ def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, column
     (e.g. treloar1944). Several files are combined, each mode taken from its file name
     (Treloar_ut.dat, .../PS/...) unless --mode is given.
     """
+    from pneumorph.materials.testdata import column_roles, stress_unit_factor
+
     models = models or ("ogden-3",)
-    for name in models:
-        resolve_model(name)
-    if delimiter == "\\t":
-        delimiter = "\t"
+    with P.blame("--model"):
+        for name in models:
+            resolve_model(name)
+    if columns is not None:
+        with P.blame("--columns"):
+            column_roles(columns)
+    if stress_unit is not None:
+        with P.blame("--stress-unit"):
+            stress_unit_factor(stress_unit)
     given = {"columns": columns, "strain_unit": strain_unit, "stress_kind": stress_kind,
              "stress_unit": stress_unit, "delimiter": delimiter, "truncate": truncate}
     options = {k: v for k, v in given.items() if v is not None}

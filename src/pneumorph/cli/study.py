@@ -43,6 +43,13 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     from pneumorph.models.factory import make_model
 
     pops = tuple(populations)
+    if target is not None:
+        from pneumorph.design.targets import make_objective
+
+        with P.blame("--target"):
+            goal = make_objective(target)
+            if hasattr(goal, "check"):
+                goal.check((units or 15) * 10.5)
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
     changes = {k: v for k, v in (("units", units), ("objective", target)) if v is not None}
     model_settings = dict(config.model)

@@ -215,7 +215,33 @@ def guess_mode(path: str | Path) -> str | None:
     return found.pop() if len(found) == 1 else None
 
 
-def _stress_unit_factor(unit: str, path: str) -> float:
+def column_roles(columns: str | Sequence[str], path: str | None = None) -> list[str]:
+    """The roles of the columns (``"stretch,stress"``), checked: one stretch or strain, one stress, else skip.
+
+    Examples
+    --------
+    >>> column_roles("Skip, Stretch, stress")
+    ['skip', 'stretch', 'stress']
+    >>> column_roles("stress")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.DataFormatError: columns ['stress'] must name one of stretch/strain/true-strain, one stress and otherwise 'skip' (roles: stretch, strain, true-strain, stress, skip)
+    """
+    roles = [c.strip().lower() for c in (columns.split(",") if isinstance(columns, str) else columns)]
+    bad = [r for r in roles if r not in COLUMN_ROLES]
+    if bad or sum(r == "stress" for r in roles) != 1 or sum(r in ("stretch", "strain", "true-strain") for r in roles) != 1:
+        raise DataFormatError(
+            f"columns {roles} must name one of stretch/strain/true-strain, one stress and "
+            f"otherwise 'skip' (roles: {', '.join(COLUMN_ROLES)})", path=path)
+    return roles
+
+
+def stress_unit_factor(unit: str, path: str | None = None) -> float:
+    """The factor from ``unit`` to MPa (one of :data:`STRESS_UNITS`, case and spaces ignored).
+
+    >>> stress_unit_factor("kPa")
+    0.001
+    """
     key = unit.strip().lower().replace(" ", "")
     if key not in STRESS_UNITS:
         raise DataFormatError(f"unknown stress unit {unit!r}; expected one of "
@@ -367,12 +393,7 @@ def read_curve(
         else:
             roles = ["stretch", "stress"]
     else:
-        roles = [c.strip().lower() for c in (columns.split(",") if isinstance(columns, str) else columns)]
-    bad = [r for r in roles if r not in COLUMN_ROLES]
-    if bad or sum(r == "stress" for r in roles) != 1 or sum(r in ("stretch", "strain", "true-strain") for r in roles) != 1:
-        raise DataFormatError(
-            f"columns {roles} must name one of stretch/strain/true-strain, one stress and "
-            f"otherwise 'skip' (roles: {', '.join(COLUMN_ROLES)})", path=src)
+        roles = column_roles(columns, src)
     ncol = len(roles)
     if header is not None and len(header) != ncol:
         raise DataFormatError(f"the header has {len(header)} columns but columns= names {ncol}",
@@ -425,7 +446,7 @@ def read_curve(
             f"stretch must be positive, found {lam[i]:.6g} (column {roles.index(xrole) + 1}"
             f" read as {xrole}; is the column order right? see columns=)", path=src, row=int(rownum[i]))
     unit = stress_unit or info.get("stress_unit", "MPa")
-    factor = _stress_unit_factor(unit, src)
+    factor = stress_unit_factor(unit, src)
     p = y * factor
     if factor != 1.0:
         notes.append(f"stress converted from {unit} to MPa (x {factor:g})")

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
-from pneumorph.errors import SearchConfigError
+from pneumorph.errors import GeometryError, SearchConfigError
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
@@ -43,7 +43,10 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     if "unit" in s and "unit_file" in s:
         raise SearchConfigError("give the unit either inline ([model.unit]) or as unit_file, not both")
     if "unit_file" in s:
-        unit = UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file")))
+        try:
+            unit = UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file")))
+        except GeometryError as exc:
+            raise SearchConfigError(f"[model] unit_file: {exc}") from None
     else:
         if not isinstance(s.get("unit", {}), Mapping):
             raise SearchConfigError(f"[model.unit] must be a table of unit parameters, got {s['unit']!r}")

@@ -59,7 +59,7 @@ def gravity_vector(gravity: str | Sequence[float] | None, dim: int) -> tuple[flo
     else:
         g = np.asarray(gravity, dtype=float).ravel()
         if g.size not in (2, 3) or not np.all(np.isfinite(g)):
-            raise ValueError(f"gravity must be 2 or 3 finite components in mm/s^2, got {list(gravity)}")
+            raise ValueError(f"gravity must be 2 or 3 finite components in mm/s^2, got {gravity!r}")
     if g.size == 3 and dim == 2:
         if g[2] != 0.0:
             raise ValueError(f"the plane-strain model has no z axis: gravity {g.tolist()} mm/s^2 has a z "
