@@ -30,8 +30,8 @@ def test_chain_build_writes_a_validated_table(tmp_path: Path, capsys: pytest.Cap
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
-        (["--out", "no/such/folder/t.json"], "existing folder"),
-        (["--window", "4", "--units", "7", "--out", "t.json"], "--window 4"),
+        (["--out", "."], "is a folder"),
+        (["--window", "4", "--units", "7", "--out", "t.json"], "--window must be a whole number >= 1 and <= 3, got 4"),
         (["--heldout", "0", "--out", "t.json"], "--heldout"),
         (["--tolerance", "0", "--out", "t.json"], "tolerance"),
     ],

@@ -32,8 +32,8 @@ def test_tiny_design_run_writes_the_folder_and_resumes(tmp_path: Path, capsys: p
         (["--target", "sin", "--objective", "max-x"], "either --target"),
         (["--target", "y = x.__class__"], "attribute"),
         (["--target", "banana"], "banana"),
-        (["--pop", "1"], "population"),
-        (["--units", "0"], "at least 1 unit"),
+        (["--pop", "1"], "--pop must be a whole number >= 2"),
+        (["--units", "0"], "--units must be a whole number >= 1"),
     ],
 )
 def test_design_rejects_bad_input(extra: list[str], message: str, tmp_path: Path,

@@ -201,4 +201,4 @@ def test_characterise_help_documents_columns(capsys: pytest.CaptureFixture[str])
 
 def test_missing_file_is_a_usage_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(capsys, "materials", "characterise", "thermal", str(tmp_path / "none.csv"))
-    assert code == 2 and "does not exist" in err
+    assert code == 2 and "no such file" in err

@@ -2,7 +2,7 @@
 
 Every setting a user gives (a CLI option, a config key, a constructor argument) passes one
 of these functions, which refuse it with a :class:`~pneumorph.errors.SettingsError` that
-names the setting, the value and what is allowed. Types are strict: a bool is not a
+names the setting, the value and what is allowed (or the subclass given as ``error``). Types are strict: a bool is not a
 number, a float is not a count, a string is not a number (the CLI parses its text first,
 :mod:`pneumorph.cli.params`).
 
@@ -50,7 +50,8 @@ def _bound_text(low: float | None, high: float | None, low_open: bool, high_open
     return " and ".join(parts)
 
 
-def integer(value: Any, name: str, low: int | None = None, high: int | None = None, limit: str = "") -> int:
+def integer(value: Any, name: str, low: int | None = None, high: int | None = None, limit: str = "",
+            error: type[SettingsError] = SettingsError) -> int:
     """``value`` as an int, refusing bools, floats, strings and values outside ``[low, high]``.
 
     ``limit`` names the constant behind ``high`` for the message.
@@ -75,11 +76,11 @@ def integer(value: Any, name: str, low: int | None = None, high: int | None = No
         return int(value)
     bounds = _bound_text(low, high, False, False)
     suffix = f" (limit {limit})" if limit and ok and high is not None and value > high else ""
-    raise SettingsError(f"{name} must be a whole number{' ' + bounds if bounds else ''}{suffix}, got {value!r}")
+    raise error(f"{name} must be a whole number{' ' + bounds if bounds else ''}{suffix}, got {value!r}")
 
 
 def real(value: Any, name: str, low: float | None = None, high: float | None = None, *, low_open: bool = False,
-         high_open: bool = False, unit: str = "", limit: str = "") -> float:
+         high_open: bool = False, unit: str = "", limit: str = "", error: type[SettingsError] = SettingsError) -> float:
     """``value`` as a finite float within the bounds; ints are accepted, bools and strings are not.
 
     Examples
@@ -103,10 +104,10 @@ def real(value: Any, name: str, low: float | None = None, high: float | None = N
     what = f"a finite number{' ' + bounds if bounds else ''}{f' ({unit})' if unit else ''}"
     suffix = f" (limit {limit})" if limit and ok and high is not None and math.isfinite(float(value)) \
         and float(value) > high else ""
-    raise SettingsError(f"{name} must be {what}{suffix}, got {value!r}")
+    raise error(f"{name} must be {what}{suffix}, got {value!r}")
 
 
-def flag(value: Any, name: str) -> bool:
+def flag(value: Any, name: str, error: type[SettingsError] = SettingsError) -> bool:
     """``value`` if it is a bool (``true``/``false`` in TOML), else an error.
 
     >>> flag(1, "certify")
@@ -116,10 +117,11 @@ def flag(value: Any, name: str) -> bool:
     """
     if isinstance(value, bool):
         return value
-    raise SettingsError(f"{name} must be true or false, got {value!r}")
+    raise error(f"{name} must be true or false, got {value!r}")
 
 
-def text(value: Any, name: str, choices: Iterable[str] | None = None) -> str:
+def text(value: Any, name: str, choices: Iterable[str] | None = None,
+         error: type[SettingsError] = SettingsError) -> str:
     """``value`` if it is a non-empty string (one of ``choices`` if given).
 
     >>> text("", "objective")
@@ -132,29 +134,29 @@ def text(value: Any, name: str, choices: Iterable[str] | None = None) -> str:
     pneumorph.errors.SettingsError: search must be one of ga, certified, got 'fast'
     """
     if not isinstance(value, str) or not value.strip():
-        raise SettingsError(f"{name} must be a non-empty text, got {value!r}")
+        raise error(f"{name} must be a non-empty text, got {value!r}")
     if choices is not None:
         allowed = tuple(choices)
         if value not in allowed:
-            raise SettingsError(f"{name} must be one of {', '.join(allowed)}, got {value!r}")
+            raise error(f"{name} must be one of {', '.join(allowed)}, got {value!r}")
     return value
 
 
-def pair(value: Any, name: str, unit: str = "") -> tuple[float, float]:
+def pair(value: Any, name: str, unit: str = "", error: type[SettingsError] = SettingsError) -> tuple[float, float]:
     """Two finite numbers (a point, a range).
 
     >>> pair([1, 2.5], "point")
     (1.0, 2.5)
     """
     if not isinstance(value, (list, tuple)) or len(value) != 2:
-        raise SettingsError(f"{name} must be two numbers{f' ({unit})' if unit else ''}, got {value!r}")
-    return real(value[0], name, unit=unit), real(value[1], name, unit=unit)
+        raise error(f"{name} must be two numbers{f' ({unit})' if unit else ''}, got {value!r}")
+    return real(value[0], name, unit=unit, error=error), real(value[1], name, unit=unit, error=error)
 
 
 _SCHEMES = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
 
 
-def address(value: Any, name: str) -> str:
+def address(value: Any, name: str, error: type[SettingsError] = SettingsError) -> str:
     """A Dask scheduler address ``scheme://host:port`` or ``host:port``, checked for its form only.
 
     >>> address("tcp://10.0.0.5:8786", "--scheduler")
@@ -171,5 +173,5 @@ def address(value: Any, name: str) -> str:
     if ok and value.startswith("inproc://"):
         return value
     if not ok or not 0 < int(value.rsplit(":", 1)[1]) < 65536:
-        raise SettingsError(f"{name} must be an address like tcp://host:8786, got {value!r}")
+        raise error(f"{name} must be an address like tcp://host:8786, got {value!r}")
     return value.strip()

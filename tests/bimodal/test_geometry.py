@@ -69,7 +69,7 @@ def test_tip_corners_on_the_end_face() -> None:
 @pytest.mark.parametrize(
     "kwargs, words",
     [
-        ({"voids": 0}, "at least one void"),
+        ({"voids": 0}, "1 to 100 voids"),
         ({"end_wall": 5.25}, "end walls leave no void"),
         ({"side_wall": 7.5}, "side walls"),
         ({"top_wall": 17.5}, "top wall"),

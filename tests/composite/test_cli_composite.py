@@ -34,7 +34,7 @@ def test_transition_json_with_wavelength(capsys: pytest.CaptureFixture[str]) -> 
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--crimp-ratio", "0"], "crimp ratio"),
+        (["--crimp-ratio", "0"], "--crimp-ratio must be a finite number > 0"),
         (["--crimp-ratio", "0.3", "--amplitude", "-1"], "amplitude"),
         (["--crimp-ratio", "0.2", "--length", "5"], "longer than the coupon"),
         (["--crimp-ratio", "0.2", "--wavelength", "7.5"], "exactly one"),

@@ -132,9 +132,9 @@ def test_config_file_errors(tmp_path: Path) -> None:
     with pytest.raises(SearchConfigError, match="unknown key 'popsize' in \\[ga\\]"):
         DesignConfig.read(path)
     path.write_text("[ga]\npopulation = 1\n")
-    with pytest.raises(SearchConfigError, match="at least 2 individuals"):
+    with pytest.raises(SearchConfigError, match="population must be a whole number >= 2"):
         DesignConfig.read(path)
-    with pytest.raises(SearchConfigError, match="at least 1 unit"):
+    with pytest.raises(SearchConfigError, match="units must be a whole number >= 1"):
         DesignConfig(units=0)
 
 

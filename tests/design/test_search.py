@@ -190,9 +190,9 @@ def test_statistics_budget_elitism_and_hall_of_fame(model: ToyModel) -> None:
 
 
 def test_bad_search_settings_are_rejected() -> None:
-    with pytest.raises(SearchConfigError, match="at least 2 individuals, got 1"):
+    with pytest.raises(SearchConfigError, match="population must be a whole number >= 2 and <= 10000, got 1"):
         GAConfig(population=1)
-    with pytest.raises(SearchConfigError, match="probability between 0 and 1"):
+    with pytest.raises(SearchConfigError, match="cxpb must be a finite number >= 0 and <= 1, got 1.5"):
         GAConfig(cxpb=1.5)
     with pytest.raises(SearchConfigError, match="at least 1 unit, got 0"):
         run_ga(ToyModel(n_units=0), objective("sin"), GAConfig(population=4))

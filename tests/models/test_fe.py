@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pneumorph.errors import OrientationError, PressureRangeError, SimulationFailed
+from pneumorph.errors import OrientationError, PressureRangeError, SettingsError, SimulationFailed
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get_filler
@@ -62,14 +62,14 @@ def test_filler_path_independence() -> None:
 def test_pressure_outside_the_filler_range_is_refused() -> None:
     with pytest.raises(PressureRangeError, match="60 kPa is outside the calibrated range 0-45 kPa"):
         Reduced2D(3, ramp_spec=RampSpec(pressure=0.06))
-    with pytest.raises(ValueError, match="must be positive"):
+    with pytest.raises(SettingsError, match="pressure must be a finite number > 0"):
         RampSpec(pressure=-0.01)
 
 
 def test_orientation_of_the_wrong_length_is_refused() -> None:
     with pytest.raises(OrientationError, match="has 3 units, expected 2"):
         Reduced2D(2, ramp_spec=LOW).evaluate("010")
-    with pytest.raises(ValueError, match="at least 1 unit"):
+    with pytest.raises(SettingsError, match="n_units must be a whole number >= 1"):
         Reduced2D(0)
 
 

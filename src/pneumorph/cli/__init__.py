@@ -62,7 +62,13 @@ def _on_sigterm(signum: int, frame: object) -> None:
 
 def _usage_line(exc: click.UsageError) -> str:
     where = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
-    return " ".join(exc.format_message().split()) + where
+    text = " ".join(exc.format_message().split())
+    if isinstance(exc, click.BadParameter) and exc.param is not None:  # our types name the option themselves
+        names = [*getattr(exc.param, "opts", []), (exc.param.name or "").upper()]
+        head, _, rest = text.partition(": ")
+        if head.startswith("Invalid value for") and any(rest.startswith(n) for n in names if n):
+            text = rest
+    return text + where
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
@@ -12,7 +11,7 @@ from pneumorph.cli import params as P
 @click.command("calibrate")
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
-@click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True, help="Actuator length in units.")
+@click.option("--units", "n_units", type=P.Count(1, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True, help="Actuator length in units.")
 @click.option("--pressures", type=P.RealList(P.PRESSURE_KPA, min_items=2, max_items=100), default="5,10,15,20,25,30,35,40,45", show_default=True, metavar="LIST",
               help="Calibration pressures, kPa, comma-separated.")
 @click.option("--runs", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=3, show_default=True, help="Independent runs (new random designs).")

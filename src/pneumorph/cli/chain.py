@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
@@ -39,7 +38,12 @@ def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units:
     from pathlib import Path
 
     from pneumorph.errors import ChainTableError
-    from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
+    from pneumorph.execution import (
+        CachedEvaluator,
+        EvaluationCache,
+        default_cache_path,
+        make_evaluator,
+    )
     from pneumorph.io import strict_json
     from pneumorph.models.chain import build_table
     from pneumorph.models.factory import make_model

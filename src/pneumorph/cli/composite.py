@@ -12,10 +12,9 @@ from typing import Any
 
 import click
 
-from pneumorph.io.files import strict_json, write_json
 from pneumorph.cli import params as P
-
 from pneumorph.errors import CrimpError
+from pneumorph.io.files import strict_json, write_json
 
 
 @click.group()

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-
 import click
 
+from pneumorph import __version__
 from pneumorph.checks import MAX_STARTS
 from pneumorph.cli import params as P
 from pneumorph.io.files import strict_json
-
-from pneumorph import __version__
 from pneumorph.materials.datasets import list_datasets, read_test_data
 from pneumorph.materials.fitting import MODEL_NAMES, WEIGHTINGS, compare, resolve_model
 from pneumorph.materials.hyperelastic import MODES

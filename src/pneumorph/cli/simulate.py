@@ -37,15 +37,14 @@ def simulate(
     """Inflate one actuator design and report its shape at every pressure level."""
     from pathlib import Path
 
+    from pneumorph.checks import MAX_UNITS
+    from pneumorph.errors import OrientationError
     from pneumorph.fem import StepSettings
     from pneumorph.geometry import parse_orientation
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import provenance, write_vtk_series
-    from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
-
-    from pneumorph.checks import MAX_UNITS
-    from pneumorph.errors import OrientationError
     from pneumorph.io.files import strict_json, write_json
+    from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 
     design = parse_orientation(orientation)
     if len(design) > MAX_UNITS:

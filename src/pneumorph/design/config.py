@@ -28,20 +28,32 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from dataclasses import asdict, dataclass, field, fields, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
 from pneumorph.design.ga import GAConfig
 from pneumorph.design.targets import Objective, make_objective
-from pneumorph.errors import SearchConfigError, TargetExpressionError, UnknownObjectiveError
+from pneumorph.errors import (
+    SearchConfigError,
+    TargetExpressionError,
+    UnknownObjectiveError,
+)
 from pneumorph.execution.evaluators import EXECUTORS
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import read_toml
 
 SEARCHES = ("certified", "ga", "exhaustive")
+
+# the settings' checks, raising the search's own error
+_integer = partial(checks.integer, error=SearchConfigError)
+_real = partial(checks.real, error=SearchConfigError)
+_flag = partial(checks.flag, error=SearchConfigError)
+_text = partial(checks.text, error=SearchConfigError)
+_pair = partial(checks.pair, error=SearchConfigError)
+_address = partial(checks.address, error=SearchConfigError)
 
 
 @dataclass(frozen=True)
@@ -56,7 +68,7 @@ class DesignConfig:
     >>> DesignConfig(units=0)
     Traceback (most recent call last):
     ...
-    pneumorph.errors.SettingsError: [design] units must be a whole number >= 1 and <= 100, got 0
+    pneumorph.errors.SearchConfigError: [design] units must be a whole number >= 1 and <= 100, got 0
     """
 
     objective: str = "sin"
@@ -79,32 +91,32 @@ class DesignConfig:
     model: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        checks.integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
-        checks.text(self.objective, "[design] objective")
-        checks.text(self.search, "[design] search", SEARCHES)
-        checks.text(self.executor, "[execution] executor", EXECUTORS)
-        checks.integer(self.seed, "[design] seed", 0, 2**32 - 1)
-        checks.flag(self.certify, "[design] certify")
-        checks.flag(self.anchored, "[design] anchored")
-        object.__setattr__(self, "amplitude", checks.real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
+        _integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+        _text(self.objective, "[design] objective")
+        _text(self.search, "[design] search", SEARCHES)
+        _text(self.executor, "[execution] executor", EXECUTORS)
+        _integer(self.seed, "[design] seed", 0, 2**32 - 1)
+        _flag(self.certify, "[design] certify")
+        _flag(self.anchored, "[design] anchored")
+        object.__setattr__(self, "amplitude", _real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
                                                           unit="mm"))
-        object.__setattr__(self, "periods", checks.real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
-        object.__setattr__(self, "margin", checks.real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
+        object.__setattr__(self, "periods", _real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
+        object.__setattr__(self, "margin", _real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
         if self.verify is not None:
-            checks.integer(self.verify, "[design] verify", 1, 1024)
+            _integer(self.verify, "[design] verify", 1, 1024)
         if self.workers is not None:
-            checks.integer(self.workers, "[execution] workers", 1, 1024)
+            _integer(self.workers, "[execution] workers", 1, 1024)
         if self.scheduler is not None:
-            checks.address(self.scheduler, "[execution] scheduler")
+            _address(self.scheduler, "[execution] scheduler")
         for key in ("chain_table", "cache"):
             if getattr(self, key) is not None:
-                checks.text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")
+                _text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")
         if not isinstance(self.model, dict):
             raise SearchConfigError(f"[model] must be a table, got {self.model!r}")
         if self.ga.seed != self.seed:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
-            object.__setattr__(self, "point", checks.pair(self.point, "[design] point", unit="mm"))
+            object.__setattr__(self, "point", _pair(self.point, "[design] point", unit="mm"))
         try:  # fail early on a bad objective
             objective = self.make_objective()
             if hasattr(objective, "check"):  # a profile: finite along the actuator (the inline unit's pitch)

@@ -20,6 +20,7 @@ import random
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 from deap import base, creator, tools
@@ -39,6 +40,10 @@ for _sense, _weight in (("min", -1.0), ("max", 1.0)):
         creator.create(_FITNESS[_sense], base.Fitness, weights=(_weight,))
     if not hasattr(creator, _INDIVIDUAL[_sense]):
         creator.create(_INDIVIDUAL[_sense], list, fitness=getattr(creator, _FITNESS[_sense]))
+
+# the settings' checks, raising the search's own error
+_integer = partial(checks.integer, error=SearchConfigError)
+_real = partial(checks.real, error=SearchConfigError)
 
 
 @dataclass(frozen=True)
@@ -74,7 +79,7 @@ class GAConfig:
     >>> GAConfig(population=1)
     Traceback (most recent call last):
     ...
-    pneumorph.errors.SearchConfigError: the population must hold at least 2 individuals, got 1
+    pneumorph.errors.SearchConfigError: [ga] population must be a whole number >= 2 and <= 10000, got 1
     """
 
     population: int = 100
@@ -89,16 +94,16 @@ class GAConfig:
     budget: int | None = None
 
     def __post_init__(self) -> None:
-        checks.integer(self.population, "[ga] population", 2, checks.MAX_POPULATION, limit="MAX_POPULATION")
-        checks.integer(self.generations, "[ga] generations", 0, checks.MAX_GENERATIONS, limit="MAX_GENERATIONS")
+        _integer(self.population, "[ga] population", 2, checks.MAX_POPULATION, limit="MAX_POPULATION")
+        _integer(self.generations, "[ga] generations", 0, checks.MAX_GENERATIONS, limit="MAX_GENERATIONS")
         for name in ("cxpb", "mutpb", "indpb"):
-            checks.real(getattr(self, name), f"[ga] {name}", 0.0, 1.0)
-        checks.integer(self.tournsize, "[ga] tournsize", 1, checks.MAX_POPULATION)
-        checks.integer(self.elitism, "[ga] elitism", 0)
-        checks.integer(self.hall_of_fame, "[ga] hall_of_fame", 1, checks.MAX_POPULATION)
-        checks.integer(self.seed, "[design] seed", 0, 2**32 - 1)
+            _real(getattr(self, name), f"[ga] {name}", 0.0, 1.0)
+        _integer(self.tournsize, "[ga] tournsize", 1, checks.MAX_POPULATION)
+        _integer(self.elitism, "[ga] elitism", 0)
+        _integer(self.hall_of_fame, "[ga] hall_of_fame", 1, checks.MAX_POPULATION)
+        _integer(self.seed, "[design] seed", 0, 2**32 - 1)
         if self.budget is not None:
-            checks.integer(self.budget, "[ga] budget", 1)
+            _integer(self.budget, "[ga] budget", 1)
         if not 0 <= self.elitism < self.population:
             raise SearchConfigError(
                 f"elitism must be between 0 and population - 1 = {self.population - 1}, got {self.elitism}"

@@ -35,7 +35,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     >>> m.fidelity, m.n_units, round(m.ramp.pressure, 6), m.unit.slit_width
     ('2d', 4, 0.03, 1.0)
     """
-    checks.integer(units, "units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+    checks.integer(units, "units", 1, checks.MAX_UNITS, limit="MAX_UNITS", error=SearchConfigError)
     s = dict(settings or {})
     unknown = sorted(set(s) - set(MODEL_KEYS))
     if unknown:
@@ -44,24 +44,24 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         raise SearchConfigError("give the unit either inline ([model.unit]) or as unit_file, not both")
     if "unit_file" in s:
         try:
-            unit = UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file")))
+            unit = UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file", error=SearchConfigError)))
         except GeometryError as exc:
             raise SearchConfigError(f"[model] unit_file: {exc}") from None
     else:
         if not isinstance(s.get("unit", {}), Mapping):
             raise SearchConfigError(f"[model.unit] must be a table of unit parameters, got {s['unit']!r}")
         unit = UnitSpec.from_dict(dict(s.get("unit", {})), source="[model.unit]")
-    fidelity = checks.text(s.get("fidelity", "2d"), "[model] fidelity", ("2d", "3d"))
+    fidelity = checks.text(s.get("fidelity", "2d"), "[model] fidelity", ("2d", "3d"), error=SearchConfigError)
     Model: type[Reduced2D | Full3D] = Reduced2D if fidelity == "2d" else Full3D
     # the model class's tuned ramp (one substep per level, its iteration limit) unless asked otherwise,
     # so that API and CLI runs of the same design share their cache entries
     defaults = Model.default_steps
     pressure = checks.real(s.get("pressure_kpa", 45.0), "[model] pressure_kpa", 0.0, checks.MAX_PRESSURE_KPA,
-                           low_open=True, unit="kPa", limit="MAX_PRESSURE_KPA")
+                           low_open=True, unit="kPa", limit="MAX_PRESSURE_KPA", error=SearchConfigError)
     increments = checks.integer(s.get("increments", defaults.increments), "[model] increments", 1,
-                                checks.MAX_INCREMENTS, limit="MAX_INCREMENTS")
+                                checks.MAX_INCREMENTS, limit="MAX_INCREMENTS", error=SearchConfigError)
     substeps = checks.integer(s.get("substeps", defaults.substeps), "[model] substeps", 1, checks.MAX_SUBSTEPS,
-                              limit="MAX_SUBSTEPS")
+                              limit="MAX_SUBSTEPS", error=SearchConfigError)
     ramp = RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps))
     try:
         gravity = gravity_vector(s.get("gravity"), Model.dim)
