@@ -10,10 +10,12 @@ from pneumorph.io.files import (
     strict_json,
     write_json,
 )
+from pneumorph.io.lock import RunLock
 from pneumorph.io.provenance import provenance
 from pneumorph.io.vtk import write_vtk_series
 
 __all__ = [
+    "RunLock",
     "atomic_write_bytes",
     "atomic_write_text",
     "check_writable_dir",
