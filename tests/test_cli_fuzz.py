@@ -250,3 +250,10 @@ def test_unknown_command_and_option(sandbox: Path, capsys: pytest.CaptureFixture
     _refused(sandbox, capsys, ["nope"])
     _refused(sandbox, capsys, ["design", "--nope"])
     _refused(sandbox, capsys, ["simulate"])  # a required option missing
+
+
+def test_overflowing_stress_data_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rows = "".join(f"{1 + 0.1 * i},{1e300 * i}\n" for i in range(20))
+    (sandbox / "huge.csv").write_text("stretch,stress\n" + rows, encoding="utf-8")
+    line = _refused(sandbox, capsys, ["materials", "fit", "huge.csv", "-m", "neo-hooke"])
+    assert "stress unit" in line

@@ -408,3 +408,25 @@ def test_file_level_errors(tmp_path: Path) -> None:
         library.load_library(tmp_path / "missing.toml")
     with pytest.raises(MaterialDataError, match="schema_version 2"):
         library.load_library(write(tmp_path, "schema_version = 2\n" + GOOD_ENTRY))
+
+
+def test_materials_built_in_code_obey_the_library_rules() -> None:
+    from dataclasses import replace
+
+    from pneumorph.materials.material import Material, Quantity
+
+    good = library.get("smooth_sil_950")
+    with pytest.raises(MaterialDataError, match="needs a model"):
+        replace(good, model=None)
+    with pytest.raises(MaterialDataError, match="kind must be one of"):
+        replace(good, kind="plastic")
+    with pytest.raises(MaterialDataError, match="lower case"):
+        replace(good, name="Smooth Sil")
+    with pytest.raises(MaterialDataError, match="density must be positive"):
+        Quantity("density", -1e-9, "tonne/mm^3", -1.0, "g/cm^3", "test")
+    with pytest.raises(MaterialDataError, match="Poisson's ratio must lie in"):
+        Quantity("poisson_ratio", 0.5, "-", 0.5, "-", "test")
+    with pytest.raises(MaterialDataError, match="finite"):
+        Quantity("bulk_modulus", float("nan"), "MPa", float("nan"), "MPa", "test")
+    with pytest.raises(MaterialDataError, match="linear-elastic"):
+        Material("paper", "Paper", "linear-elastic", "test")

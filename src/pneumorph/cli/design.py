@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import re
 import sys
 
@@ -75,6 +74,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
 
     from pneumorph.design import DesignConfig, run_design
     from pneumorph.errors import LocalityError, SearchConfigError
+    from pneumorph.io.files import strict_json
     from pneumorph.models.factory import make_model
 
     if target and objective:
@@ -157,7 +157,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                             overwrite=overwrite, on_message=on_message)
     best = result.best
     if as_json:
-        click.echo(json.dumps({
+        click.echo(strict_json({
             "status": result.status,
             "folder": str(result.folder),
             "objective": label,
@@ -168,7 +168,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                               "failure": c.failure} for c in result.hall_of_fame],
             "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
             **_certified_json(result),
-        }, indent=1, default=_finite))
+        }))
     elif best is not None:
         click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: fitness {best.value:.4g} "
                    f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
@@ -184,11 +184,6 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
         sys.exit(130)
-
-
-def _finite(value):  # type: ignore[no-untyped-def]
-    """JSON for numpy scalars."""
-    return float(value)
 
 
 def _certified_json(result) -> dict:  # type: ignore[no-untyped-def]

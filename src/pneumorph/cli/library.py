@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import click
 
 from pneumorph.errors import UnknownMaterialError
+from pneumorph.io.files import strict_json
 from pneumorph.materials import library
 from pneumorph.materials.filler import FillerLaw
 from pneumorph.materials.library import Material, Quantity
@@ -67,7 +67,7 @@ def list_materials(as_json: bool, library_files: tuple[str, ...]) -> None:
                 {"name": f.name, "display_name": f.display_name, "source": f.source} for f in fillers
             ],
         }
-        click.echo(json.dumps(out, indent=2))
+        click.echo(strict_json(out, indent=2))
         return
     click.echo(f"{'name':<20} {'kind':<15} {'mu0 [kPa]':>10} {'K [kPa]':>9}  display name")
     for m in materials:
@@ -182,7 +182,7 @@ def show_material(name: str, as_json: bool, library_files: tuple[str, ...]) -> N
         obj = library.get_filler(name)
     if as_json:
         data: dict[str, Any] = obj.to_dict()
-        click.echo(json.dumps(data, indent=2))
+        click.echo(strict_json(data, indent=2))
     elif isinstance(obj, Material):
         click.echo(_material_text(obj))
     else:

@@ -16,11 +16,17 @@ the model stops the batch as :class:`~pneumorph.errors.EvaluationError`.
 
 from __future__ import annotations
 
+import atexit
 import multiprocessing
 import os
+import signal
+import threading
 import time
+import weakref
+from collections import deque
 from collections.abc import Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Protocol, runtime_checkable
 
 from pneumorph.errors import SchedulerUnreachableError, SearchConfigError
@@ -82,11 +88,64 @@ def _init_worker(model: ActuatorModel) -> None:
     global _WORKER_MODEL
     for name in THREAD_VARIABLES:
         os.environ[name] = "1"
+    try:  # Ctrl-C reaches the whole process group: the parent stops the workers, they do not print tracebacks
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except (ValueError, OSError):  # pragma: no cover - not the main thread of the worker
+        pass
     _WORKER_MODEL = model
 
 
 def _solve_in_worker(design: str) -> Outcome:
     return solve(_WORKER_MODEL, design)
+
+
+_LIVE_POOLS: weakref.WeakSet[ProcessPoolEvaluator] = weakref.WeakSet()
+
+
+def _close_all_pools() -> None:
+    """At interpreter exit: stop the workers of every pool still open (no process outlives the run)."""
+    for evaluator in list(_LIVE_POOLS):
+        try:
+            evaluator.close(grace=0.2)
+        except Exception:  # pragma: no cover - best effort at exit
+            pass
+
+
+# before concurrent.futures' own exit hook (those run last-registered first), which would wait for every
+# running solve to finish
+_register_atexit = getattr(threading, "_register_atexit", atexit.register)
+_register_atexit(_close_all_pools)
+
+
+def _describe_exit(code: int | None) -> str:
+    if code is None:
+        return "ended abruptly"
+    if code < 0:
+        try:
+            return f"was killed by {signal.Signals(-code).name}"
+        except ValueError:
+            return f"was killed by signal {-code}"
+    return f"exited with code {code}"
+
+
+def _stop_pool(pool: ProcessPoolExecutor, grace: float) -> dict[int, int | None]:
+    """Shut ``pool`` down: cancel what is queued, give the workers ``grace`` seconds to end, then
+    terminate (and at last kill) those still running. Returns their exit codes by pid."""
+    processes = dict(getattr(pool, "_processes", None) or {})
+    pool.shutdown(wait=False, cancel_futures=True)
+    deadline = time.monotonic() + grace
+    for p in processes.values():
+        p.join(max(0.0, deadline - time.monotonic()))
+    for p in processes.values():
+        if p.exitcode is None:
+            p.terminate()
+    for p in processes.values():
+        p.join(2.0)
+        if p.exitcode is None:  # pragma: no cover - a worker that ignores SIGTERM
+            p.kill()
+            p.join(2.0)
+    pool.shutdown(wait=True)
+    return {pid: p.exitcode for pid, p in processes.items()}
 
 
 class ProcessPoolEvaluator(_Base):
@@ -99,6 +158,20 @@ class ProcessPoolEvaluator(_Base):
 
     The pool starts on first use (processes are spawned, so they import fresh with one
     BLAS/OpenMP thread each) and is kept while the model's fingerprint stays the same.
+    At most ``workers`` designs are handed to the pool at a time, so the designs being
+    solved are known at every moment.
+
+    A worker process that dies (a crash of the solver, ``os._exit``, the out-of-memory
+    killer, ``kill -9``) breaks the pool: it is restarted and the run goes on. The designs
+    that were in flight are solved again one at a time; a design whose worker dies while
+    it is the only one in flight gets a failed :class:`Outcome` with ``failure`` starting
+    ``"worker died"`` and ``transient=True`` (not a property of the design: not to be
+    cached). Designs not yet started are simply handed to the new pool.
+
+    No worker outlives its evaluator: :meth:`close`, a ``KeyboardInterrupt`` (or its
+    subclasses) while solving, and the end of the interpreter stop them, terminating
+    those still busy. Workers ignore SIGINT (Ctrl-C reaches the whole process group; this
+    process stops them).
     """
 
     def __init__(self, workers: int | None = None) -> None:
@@ -107,6 +180,8 @@ class ProcessPoolEvaluator(_Base):
         self.workers = workers or os.cpu_count() or 1
         self._pool: ProcessPoolExecutor | None = None
         self._fingerprint: str | None = None
+        self.restarts = 0
+        _LIVE_POOLS.add(self)
 
     def _ensure_pool(self, model: ActuatorModel) -> ProcessPoolExecutor:
         fp = model.fingerprint()
@@ -125,6 +200,9 @@ class ProcessPoolEvaluator(_Base):
             # start the workers now, while the environment says one thread
             for f in [self._pool.submit(os.getpid) for _ in range(self.workers)]:
                 f.result()
+        except BaseException:
+            self.close(grace=0.0)
+            raise
         finally:
             for name, value in saved.items():
                 if value is None:
@@ -138,24 +216,75 @@ class ProcessPoolEvaluator(_Base):
         designs = list(designs)
         if not designs:
             return
-        pool = self._ensure_pool(model)
-        futures: dict[Future, int] = {pool.submit(_solve_in_worker, d): i for i, d in enumerate(designs)}
-        pending = set(futures)
+        queue = deque(range(len(designs)))  # handed to the pool, ``workers`` at a time
+        alone: deque[int] = deque()  # in flight when a worker died: solved one at a time
         try:
-            while pending:
-                done, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for f in sorted(done, key=futures.__getitem__):
-                    yield futures[f], f.result()
+            while queue or alone:
+                source, window = (alone, 1) if alone else (queue, self.workers)
+                lost = yield from self._stream(model, designs, source, window)
+                if not lost:
+                    continue
+                codes = self._restart()
+                if len(lost) == 1:
+                    (i,) = lost
+                    dead = [c for c in codes.values() if c not in (None, 0, -signal.SIGTERM)]
+                    how = _describe_exit(dead[0]) if len(dead) == 1 else "ended abruptly"
+                    yield i, Outcome(designs[i], None, failure=f"worker died: the process solving it {how}",
+                                     transient=True)
+                else:
+                    alone.extend(sorted(lost))
+        except KeyboardInterrupt:  # the solves in flight are abandoned: stop them now
+            self.close(grace=0.0)
+            raise
+
+    def _stream(self, model: ActuatorModel, designs: list[str], source: deque[int],
+                window: int) -> Iterator[tuple[int, Outcome]]:
+        """Solve the designs of ``source`` with at most ``window`` in flight, yielding them as they
+        finish; return the indices lost to a worker death (empty if none)."""
+        pool = self._ensure_pool(model)
+        flight: dict[Future, int] = {}
+        lost: set[int] = set()
+        try:
+            while source or flight:
+                while source and len(flight) < window and not lost:
+                    i = source.popleft()
+                    try:
+                        flight[pool.submit(_solve_in_worker, designs[i])] = i
+                    except BrokenProcessPool:
+                        source.appendleft(i)
+                        lost.add(-1)  # broken before this design started
+                if lost:  # the pool is broken: every future in flight ends now
+                    done, _ = wait(flight)
+                else:
+                    done, _ = wait(flight, return_when=FIRST_COMPLETED)
+                for f in sorted(done, key=flight.__getitem__):
+                    i = flight.pop(f)
+                    try:
+                        outcome = f.result()
+                    except BrokenProcessPool:
+                        lost.add(i)
+                        continue
+                    yield i, outcome
+                if lost and not flight:
+                    lost.discard(-1)
+                    return lost or {-1} if not lost else lost
+            return set()
         finally:
-            for f in pending:
+            for f in flight:
                 f.cancel()
 
-    def close(self) -> None:
-        """Shut the pool down (cancelling queued solves)."""
-        if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool = None
-            self._fingerprint = None
+    def _restart(self) -> dict[int, int | None]:
+        """Discard a broken pool (the next solve starts a new one); the exit codes of its workers."""
+        pool, self._pool, self._fingerprint = self._pool, None, None
+        self.restarts += 1
+        return {} if pool is None else _stop_pool(pool, grace=0.0)
+
+    def close(self, grace: float = 1.0) -> None:
+        """Shut the pool down: cancel queued solves, let idle workers end, terminate busy ones
+        after ``grace`` seconds."""
+        pool, self._pool, self._fingerprint = self._pool, None, None
+        if pool is not None:
+            _stop_pool(pool, grace)
 
 
 # -- dask --------------------------------------------------------------------------------

@@ -27,11 +27,17 @@ class Outcome:
         True if it came from the evaluation cache instead of a solve.
     wall_time : float
         Seconds the solve took (of the original solve, for a cached outcome).
+    transient : bool
+        True for a failure that says nothing about the design itself (the worker process
+        solving it died: ``failure`` starts with ``"worker died"``). Such an outcome is
+        not to be stored in the evaluation cache; the next run solves the design again.
 
     Examples
     --------
     >>> Outcome("01", None, failure="diverged", reached=0.0315).ok
     False
+    >>> Outcome("01", None, failure="worker died: exit code 1", transient=True).transient
+    True
     """
 
     design: str
@@ -40,6 +46,7 @@ class Outcome:
     reached: float | None = None
     cached: bool = False
     wall_time: float = 0.0
+    transient: bool = False
 
     @property
     def ok(self) -> bool:

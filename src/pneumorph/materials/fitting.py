@@ -53,7 +53,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -282,7 +281,10 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
 
 
 def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):  # type: ignore[no-untyped-def]
-    from scipy.optimize import least_squares, lsq_linear  # deferred: keeps the CLI start fast
+    from scipy.optimize import (  # deferred: keeps the CLI start fast
+        least_squares,
+        lsq_linear,
+    )
 
     """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
 
@@ -416,7 +418,10 @@ def fit(
     >>> round(r.parameters["C10"], 6), round(r.r2["uniaxial"], 6)
     (0.2, 1.0)
     """
-    from scipy.optimize import least_squares, lsq_linear  # deferred: keeps the CLI start fast
+    from scipy.optimize import (  # deferred: keeps the CLI start fast
+        least_squares,
+        lsq_linear,
+    )
 
     spec = resolve_model(model_name)
     if isinstance(data, TestCurve):
@@ -532,7 +537,9 @@ class FitComparison:
                 "fits": [r.to_dict() for r in self.results]}
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2)
+        from pneumorph.io.files import strict_json
+
+        return strict_json(self.to_dict(), indent=2)
 
     def render(self, fmt: str = "text") -> str:
         """``fmt`` one of ``text``, ``markdown``, ``json``."""

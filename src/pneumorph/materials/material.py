@@ -18,6 +18,8 @@ from pneumorph.materials.hyperelastic import (
 #: Origin recorded for the materials shipped with pneumorph.
 BUILTIN_ORIGIN = "pneumorph built-in library (materials/data/materials.toml)"
 
+#: Properties that must be positive (a Poisson's ratio lies in (-1, 0.5) instead).
+POSITIVE_PROPERTIES = frozenset({"density", "bulk_modulus", "youngs_modulus", "thickness"})
 Kind = Literal["hyperelastic", "linear-elastic"]
 KINDS: tuple[str, ...] = ("hyperelastic", "linear-elastic")
 
@@ -74,6 +76,19 @@ class Quantity:
     source: str
     assumed: bool = False
     reason: str | None = None
+
+    def __post_init__(self) -> None:
+        for key in ("value", "printed"):
+            v = getattr(self, key)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise MaterialDataError(f"{self.name}: {key} must be a finite number, got {v!r}")
+        if self.name in POSITIVE_PROPERTIES and self.value <= 0.0:
+            raise MaterialDataError(f"{self.name.replace('_', ' ')} must be positive, got {self.printed} "
+                                    f"{self.printed_unit}")
+        if self.name == "poisson_ratio" and not -1.0 < self.value < 0.5:
+            raise MaterialDataError(f"Poisson's ratio must lie in (-1, 0.5), got {self.printed}")
+        if not isinstance(self.assumed, bool):
+            raise MaterialDataError(f"{self.name}: 'assumed' must be true or false, got {self.assumed!r}")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (JSON-serialisable)."""
@@ -167,6 +182,33 @@ class Material:
     aliases: tuple[str, ...] = ()
     description: str = ""
     origin: str = BUILTIN_ORIGIN
+
+    def __post_init__(self) -> None:
+        """The rules a library file's entry obeys hold for a material built in code too."""
+        where = f"material {self.name!r}"
+        if not isinstance(self.name, str) or not self.name or normalise(self.name) != self.name:
+            raise MaterialDataError(f"{where}: the name must be lower case letters, digits and '_'")
+        if self.kind not in KINDS:
+            raise MaterialDataError(f"{where}: kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        for key in ("display_name", "source"):
+            if not isinstance(getattr(self, key), str) or not getattr(self, key).strip():
+                raise MaterialDataError(f"{where}: {key} must be a non-empty text")
+        if self.kind == "hyperelastic":
+            if self.model is None:
+                raise MaterialDataError(f"{where}: a hyperelastic material needs a model")
+            if self.youngs_modulus is not None or self.poisson_ratio is not None:
+                raise MaterialDataError(f"{where}: youngs_modulus and poisson_ratio belong to linear-elastic "
+                                        "materials")
+        elif self.model is not None or self.youngs_modulus is None or self.poisson_ratio is None:
+            raise MaterialDataError(f"{where}: a linear-elastic material takes youngs_modulus and poisson_ratio, "
+                                    "not a model")
+        for name in PROPERTIES:
+            q = getattr(self, name)
+            if q is not None and (not isinstance(q, Quantity) or q.name != name):
+                raise MaterialDataError(f"{where}: {name} must be a Quantity named {name!r}, got {q!r}")
+        for model_name, r in self.r_squared:
+            if isinstance(r, bool) or not isinstance(r, (int, float)) or not r <= 1.0:
+                raise MaterialDataError(f"{where}: R^2 of {model_name} must be a number <= 1, got {r!r}")
 
     @property
     def quantities(self) -> tuple[Quantity, ...]:

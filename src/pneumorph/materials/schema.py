@@ -18,6 +18,7 @@ from pneumorph.materials.hyperelastic import (
 from pneumorph.materials.material import (
     KINDS,
     PROPERTIES,
+    POSITIVE_PROPERTIES,
     Library,
     Material,
     ModelRecord,
@@ -26,7 +27,6 @@ from pneumorph.materials.material import (
 )
 from pneumorph.materials.units import INTERNAL_UNITS, UNITS, to_internal
 
-_POSITIVE = {"density", "bulk_modulus", "youngs_modulus", "thickness"}
 _MODEL_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     # type: (required, optional)
     "ogden": (("mu", "alpha"), ()),
@@ -113,7 +113,7 @@ def _quantity(where: _Where, name: str, data: dict[str, Any]) -> Quantity:
         raise w.error(f"'assumed' must be true or false, got {assumed!r}")
     reason = w.text(data, "reason", required=assumed)
     value = to_internal(printed, unit, dimension)
-    if name in _POSITIVE and value <= 0.0:
+    if name in POSITIVE_PROPERTIES and value <= 0.0:
         raise w.error(f"{name.replace('_', ' ')} must be positive, got {printed} {unit}")
     if name == "poisson_ratio" and not -1.0 < value < 0.5:
         raise w.error(f"Poisson's ratio must lie in (-1, 0.5), got {printed}")

@@ -79,6 +79,10 @@ _MODE_WORDS = {
     "planar": ("ps", "pt", "planar", "pureshear", "shear"),
 }
 
+#: Bounds of plausible test data: beyond them a number is a unit mistake (or overflows the fit).
+MAX_STRETCH = 100.0
+MAX_STRESS_MPA = 1e5
+
 
 @dataclass(frozen=True, eq=False)
 class TestCurve:
@@ -118,7 +122,16 @@ class TestCurve:
         lam = np.array(self.stretch, dtype=float)
         p = np.array(self.stress, dtype=float)
         if lam.ndim != 1 or lam.shape != p.shape:
-            raise ValueError("stretch and stress must be 1-D arrays of the same length")
+            raise DataFormatError("stretch and stress must be 1-D arrays of the same length", path=self.source)
+        if not (np.all(np.isfinite(lam)) and np.all(np.isfinite(p))):
+            raise DataFormatError("stretch and stress must be finite numbers", path=self.source)
+        if lam.size and (lam.min() <= 0 or lam.max() > MAX_STRETCH):
+            raise DataFormatError(f"stretch must lie in (0, {MAX_STRETCH:g}], found {lam.min():.6g} to {lam.max():.6g}",
+                                  path=self.source)
+        if p.size and np.abs(p).max() > MAX_STRESS_MPA:
+            raise DataFormatError(
+                f"a stress of {np.abs(p).max():.6g} MPa is beyond {MAX_STRESS_MPA:g} MPa, no rubber's; "
+                "check the stress unit (--stress-unit)", path=self.source)
         lam.setflags(write=False)
         p.setflags(write=False)
         object.__setattr__(self, "stretch", lam)
