@@ -1,9 +1,14 @@
-"""Serial, process-pool and Dask evaluators give the same outcomes; an unreachable scheduler."""
+"""Serial, process-pool and Dask evaluators give the same outcomes; an unreachable scheduler; a worker
+that dies fails its design only; no worker process outlives its evaluator."""
 
 from __future__ import annotations
 
+import json
 import os
+import signal
+import subprocess
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -23,6 +28,27 @@ sys.path.insert(0, str(REPO))  # the toy model lives in tests/design; workers im
 from tests.design.toy_model import ToyModel
 
 DESIGNS = ["000000", "010101", "111000", "001011", "100110", "011110"]
+
+
+class TroubleToy(ToyModel):
+    """The toy, but its process exits (``os._exit(1)``), is killed (SIGKILL) or sleeps on some designs."""
+
+    def __init__(self, exit=(), kill=(), sleep=(), seconds: float = 60.0, **kw) -> None:
+        super().__init__(**kw)
+        self.exit, self.kill, self.sleep, self.seconds = frozenset(exit), frozenset(kill), frozenset(sleep), seconds
+
+    def fingerprint(self) -> str:  # the workers keep a model while its fingerprint stays the same
+        trouble = json.dumps([sorted(self.exit), sorted(self.kill), sorted(self.sleep), self.seconds])
+        return super().fingerprint() + trouble
+
+    def evaluate(self, orientation: str):
+        if orientation in self.exit:
+            os._exit(1)
+        if orientation in self.kill:
+            os.kill(os.getpid(), signal.SIGKILL)
+        if orientation in self.sleep:
+            time.sleep(self.seconds)
+        return super().evaluate(orientation)
 
 
 def same(a, b) -> None:
@@ -83,3 +109,99 @@ def test_bad_executor_settings() -> None:
         make_evaluator("threads")
     with pytest.raises(SearchConfigError, match="at least 1, got 0"):
         ProcessPoolEvaluator(workers=0)
+
+
+def test_a_worker_that_dies_fails_its_design_and_the_others_finish(serial: list,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.syspath_prepend(str(REPO))
+    model = TroubleToy(n_units=6, fail={"111000"}, exit={"010101"}, kill={"100110"})
+    with ProcessPoolEvaluator(workers=2) as ev:
+        out = ev.evaluate_many(model, DESIGNS)
+        assert ev.restarts >= 2  # one pool per death, and the run went on
+        died = {o.design: o for o in out if o.failure and o.failure.startswith("worker died")}
+        assert set(died) == {"010101", "100110"}
+        assert died["010101"].failure == "worker died: the process solving it exited with code 1"
+        assert died["100110"].failure == "worker died: the process solving it was killed by SIGKILL"
+        assert all(o.transient and o.response is None and not o.ok for o in died.values())
+        others = [i for i, d in enumerate(DESIGNS) if d not in died]
+        same([out[i] for i in others], [serial[i] for i in others])
+        assert not any(out[i].transient for i in others)  # the toy's own failure of 111000 is a real one
+        again = ev.evaluate_many(model, DESIGNS[:1])  # the restarted pool serves on
+    same(again, serial[:1])
+
+
+def test_a_single_worker_dies_and_is_restarted(serial: list, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.syspath_prepend(str(REPO))
+    model = TroubleToy(n_units=6, fail={"111000"}, exit={"000000"})
+    with ProcessPoolEvaluator(workers=1) as ev:
+        out = ev.evaluate_many(model, DESIGNS[:3])
+        assert ev.restarts == 1
+    assert out[0].failure.startswith("worker died") and out[0].transient
+    same(out[1:], serial[1:3])
+
+
+_CHILDREN = """
+import json, multiprocessing, os, signal, sys, threading, time
+sys.path.insert(0, {repo!r})
+from pneumorph.execution import ProcessPoolEvaluator
+from tests.execution.test_evaluators import TroubleToy
+
+model = TroubleToy(n_units=6, sleep={{"111111"}}, seconds=60.0)
+ev = ProcessPoolEvaluator(workers=2)
+scenario = sys.argv[1]
+if scenario == "close":
+    ev.evaluate_many(model, ["000000", "010101", "001011"])
+    pids = list(ev._pool._processes)
+    ev.close()
+elif scenario == "interrupt":
+    stream = ev.iter_evaluate(model, ["000000", "111111", "111111"])
+    next(stream)
+    pids = list(ev._pool._processes)
+    threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT)).start()
+    try:
+        list(stream)
+    except KeyboardInterrupt:
+        pass
+    else:
+        raise SystemExit("no KeyboardInterrupt")
+elif scenario == "exit":  # the interpreter ends with a solve running and the evaluator never closed
+    stream = ev.iter_evaluate(model, ["000000", "111111"])
+    next(stream)
+    pids = list(ev._pool._processes)
+alive = [p.pid for p in multiprocessing.active_children()]
+print(json.dumps({{"pids": pids, "alive": alive}}), flush=True)
+"""
+
+
+def _running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+    except OSError:  # no /proc
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        return True
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize("scenario", ["close", "interrupt", "exit"])
+def test_no_worker_process_outlives_its_evaluator(scenario: str) -> None:
+    script = textwrap.dedent(_CHILDREN.format(repo=str(REPO)))
+    start = time.monotonic()
+    run = subprocess.run([sys.executable, "-c", script, scenario], check=False, capture_output=True, text=True,
+                         timeout=50, env={**os.environ, "PYTHONPATH": str(REPO)})
+    took = time.monotonic() - start
+    assert run.returncode == 0, run.stderr
+    report = json.loads(run.stdout.strip().splitlines()[-1])
+    assert len(report["pids"]) == 2
+    if scenario != "exit":
+        assert report["alive"] == []  # stopped and reaped before the script went on
+    assert took < 40  # a 60 s solve was running (interrupt, exit): its worker was stopped, not waited for
+    deadline = time.monotonic() + 5
+    while any(_running(pid) for pid in report["pids"]) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [pid for pid in report["pids"] if _running(pid)]

@@ -12,11 +12,17 @@ solves finish (so a cache can store each at once), and ``evaluate_many(model, de
 the outcomes in the order of the designs. A :class:`~pneumorph.errors.SimulationFailed`
 becomes a failed :class:`~pneumorph.execution.outcome.Outcome`; any other exception from
 the model stops the batch as :class:`~pneumorph.errors.EvaluationError`.
+
+A worker process that dies while solving a design (a crash, the out-of-memory killer)
+does not stop the run: the design gets a failed outcome whose ``failure`` starts with
+``"worker died"`` and which is marked ``transient`` (not a property of the design; a cache
+must not keep it), and the other designs are solved on.
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import multiprocessing
 import os
 import signal
@@ -24,12 +30,22 @@ import threading
 import time
 import weakref
 from collections import deque
-from collections.abc import Iterable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from collections.abc import Generator, Iterable, Iterator
+from concurrent.futures import (
+    ALL_COMPLETED,
+    FIRST_COMPLETED,
+    Future,
+    ProcessPoolExecutor,
+    wait,
+)
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Protocol, runtime_checkable
 
-from pneumorph.errors import SchedulerUnreachableError, SearchConfigError
+from pneumorph.errors import (
+    EvaluationError,
+    SchedulerUnreachableError,
+    SearchConfigError,
+)
 from pneumorph.execution.outcome import Outcome, solve
 from pneumorph.models.response import ActuatorModel
 
@@ -105,10 +121,8 @@ _LIVE_POOLS: weakref.WeakSet[ProcessPoolEvaluator] = weakref.WeakSet()
 def _close_all_pools() -> None:
     """At interpreter exit: stop the workers of every pool still open (no process outlives the run)."""
     for evaluator in list(_LIVE_POOLS):
-        try:
+        with contextlib.suppress(Exception):  # best effort at exit
             evaluator.close(grace=0.2)
-        except Exception:  # pragma: no cover - best effort at exit
-            pass
 
 
 # before concurrent.futures' own exit hook (those run last-registered first), which would wait for every
@@ -200,6 +214,11 @@ class ProcessPoolEvaluator(_Base):
             # start the workers now, while the environment says one thread
             for f in [self._pool.submit(os.getpid) for _ in range(self.workers)]:
                 f.result()
+        except BrokenProcessPool as exc:
+            self.close(grace=0.0)
+            raise EvaluationError(f"the worker processes died while starting (the model {type(model).__name__} "
+                                  "could not be sent to them, or they could not import pneumorph); "
+                                  "try --executor serial") from exc
         except BaseException:
             self.close(grace=0.0)
             raise
@@ -218,11 +237,12 @@ class ProcessPoolEvaluator(_Base):
             return
         queue = deque(range(len(designs)))  # handed to the pool, ``workers`` at a time
         alone: deque[int] = deque()  # in flight when a worker died: solved one at a time
+        idle_deaths = 0
         try:
             while queue or alone:
                 source, window = (alone, 1) if alone else (queue, self.workers)
-                lost = yield from self._stream(model, designs, source, window)
-                if not lost:
+                broken, lost = yield from self._stream(model, designs, source, window)
+                if not broken:
                     continue
                 codes = self._restart()
                 if len(lost) == 1:
@@ -233,42 +253,47 @@ class ProcessPoolEvaluator(_Base):
                                      transient=True)
                 else:
                     alone.extend(sorted(lost))
+                idle_deaths = 0 if lost else idle_deaths + 1
+                if idle_deaths >= 3:
+                    raise EvaluationError("the worker processes keep dying while idle (3 pools in a row); "
+                                          "check the memory and the processes' limits, or use --executor serial")
         except KeyboardInterrupt:  # the solves in flight are abandoned: stop them now
             self.close(grace=0.0)
             raise
 
     def _stream(self, model: ActuatorModel, designs: list[str], source: deque[int],
-                window: int) -> Iterator[tuple[int, Outcome]]:
+                window: int) -> Generator[tuple[int, Outcome], None, tuple[bool, set[int]]]:
         """Solve the designs of ``source`` with at most ``window`` in flight, yielding them as they
-        finish; return the indices lost to a worker death (empty if none)."""
+        finish. Returns ``(broken, lost)``: whether a worker died, and the designs it took along
+        (those in flight then; the others stay in ``source``)."""
         pool = self._ensure_pool(model)
         flight: dict[Future, int] = {}
         lost: set[int] = set()
+        broken = False
         try:
             while source or flight:
-                while source and len(flight) < window and not lost:
+                while source and len(flight) < window and not broken:
                     i = source.popleft()
                     try:
                         flight[pool.submit(_solve_in_worker, designs[i])] = i
                     except BrokenProcessPool:
                         source.appendleft(i)
-                        lost.add(-1)  # broken before this design started
-                if lost:  # the pool is broken: every future in flight ends now
-                    done, _ = wait(flight)
-                else:
-                    done, _ = wait(flight, return_when=FIRST_COMPLETED)
+                        broken = True
+                if not flight:
+                    break
+                done, _ = wait(flight, return_when=ALL_COMPLETED if broken else FIRST_COMPLETED)
                 for f in sorted(done, key=flight.__getitem__):
                     i = flight.pop(f)
                     try:
                         outcome = f.result()
                     except BrokenProcessPool:
+                        broken = True
                         lost.add(i)
                         continue
                     yield i, outcome
-                if lost and not flight:
-                    lost.discard(-1)
-                    return lost or {-1} if not lost else lost
-            return set()
+                if broken and not flight:
+                    break
+            return broken, lost
         finally:
             for f in flight:
                 f.cancel()
@@ -354,7 +379,7 @@ class DaskEvaluator(_Base):
         return self._model_future
 
     def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
-        from distributed import as_completed
+        from distributed import KilledWorker, as_completed
 
         designs = list(designs)
         if not designs:
@@ -366,7 +391,13 @@ self.client.submit(_solve_on_dask_worker, remote, d, pure=False) for d in design
         index = {f.key: i for i, f in enumerate(futures)}
         try:
             for f in as_completed(futures):
-                yield index[f.key], f.result()
+                i = index[f.key]
+                try:
+                    outcome = f.result()
+                except KilledWorker:  # every worker that tried it died (distributed's allowed-failures)
+                    outcome = Outcome(designs[i], None, transient=True,
+                                      failure="worker died: every Dask worker that solved it died (KilledWorker)")
+                yield i, outcome
         finally:
             self.client.cancel([f for f in futures if not f.done()])
 

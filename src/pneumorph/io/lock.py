@@ -25,13 +25,14 @@ False
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import socket
 import sys
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Self
 
 from pneumorph.errors import RunFolderError
 
@@ -71,7 +72,7 @@ def _pid_alive(pid: int) -> bool | None:
                 return code.value == 259  # STILL_ACTIVE
             finally:
                 kernel32.CloseHandle(handle)
-        except Exception:
+        except Exception:  # noqa: BLE001 - cannot tell: treated as running
             return None
     try:
         os.kill(pid, 0)
@@ -220,14 +221,13 @@ class RunLock:
             self._created = False
             self.path.unlink(missing_ok=True)
 
-    def __enter__(self) -> RunLock:
-        return self.acquire()
+    def __enter__(self) -> Self:
+        self.acquire()
+        return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.release()
 
     def __del__(self) -> None:  # pragma: no cover - a lock object dropped without release
-        try:
+        with contextlib.suppress(Exception):  # nothing to release at interpreter shutdown
             self.release()
-        except Exception:
-            pass
