@@ -257,3 +257,22 @@ def test_overflowing_stress_data_is_refused(sandbox: Path, capsys: pytest.Captur
     (sandbox / "huge.csv").write_text("stretch,stress\n" + rows, encoding="utf-8")
     line = _refused(sandbox, capsys, ["materials", "fit", "huge.csv", "-m", "neo-hooke"])
     assert "stress unit" in line
+
+
+@pytest.mark.parametrize("extra", [["--verify", "2", "--search", "ga"], ["--margin", "2", "--search", "exhaustive"],
+                                   ["--certify", "--search", "ga"]])
+def test_options_of_another_search_are_refused_not_ignored(sandbox: Path, capsys: pytest.CaptureFixture[str],
+                                                           extra: list[str]) -> None:
+    line = _refused(sandbox, capsys, [*BASE["design"], *extra])
+    assert "only appl" in line and extra[0] in line
+
+
+def test_exhaustive_search_beyond_its_limit_is_refused_before_anything_is_said(
+        sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line = _refused(sandbox, capsys, [*BASE["design"], "--search", "exhaustive", "--units", "30"])
+    assert "at most 20 units" in line and "1,073,741,824" in line
+
+
+def test_snapshot_beyond_the_final_strain_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line = _refused(sandbox, capsys, [*BASE["coupon"], "--snapshot", "5"])
+    assert "--snapshot" in line and "final strain" in line

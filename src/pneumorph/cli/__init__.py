@@ -68,6 +68,10 @@ def _usage_line(exc: click.UsageError) -> str:
         head, _, rest = text.partition(": ")
         if head.startswith("Invalid value for") and any(rest.startswith(n) for n in names if n):
             text = rest
+    elif text.startswith("Invalid value for '--"):  # raised with a hint whose text names the option again
+        head, _, rest = text.partition(": ")
+        if rest.startswith("--"):
+            text = rest
     return text + where
 
 

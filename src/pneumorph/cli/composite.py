@@ -97,6 +97,10 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
     from pneumorph.composite.coupon import CouponSpec, simulate_coupon
 
     c = _crimp(crimp_ratio, wavelength, amplitude, length)
+    final = strain_max if strain_max is not None else c.limit_transition_strain + 0.10
+    if snapshot is not None and snapshot > final:
+        raise click.BadParameter(f"--snapshot {snapshot:g} lies beyond the final strain {final:.4g} of the test",
+                                 param_hint="'--snapshot'")
     spec = CouponSpec(crimp=c, thickness=thickness, per_flute=per_flute, rows=rows,
                       bulk_modulus=None if bulk_modulus is None else bulk_modulus / 1000.0)
     snaps = () if snapshot is None else (snapshot,)

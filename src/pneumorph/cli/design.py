@@ -32,7 +32,7 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--periods", type=P.Real(0.0, 1000.0, low_open=True), help="Periods of the sin/cos target over the actuator (default 1).")
 @click.option("--point", type=P.Real(-1e5, 1e5, unit="mm"), nargs=2, metavar="X Y", help="Tip point (mm) for --objective reach.")
 @click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
-@click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), help="GA population (default 100).")
+@click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), help="GA population (default 100; also the GA a certified search falls back to).")
 @click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"), help="GA generations (default 15).")
 @click.option("--seed", type=P.SEED, help="Random seed (default 0): the same seed gives the same run.")
 @click.option("--search", type=click.Choice(["certified", "ga", "exhaustive"]),
@@ -108,6 +108,9 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if unit_file:
         model_settings.pop("unit", None)
     config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
+    # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
+    _check_options_apply(config.search, "certified",
+                         {"--certify": certify, "--verify": verify, "--margin": margin, "--chain-table": chain_table})
     fidelity_given = "fidelity" in config.model
     fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
     if fallback:
@@ -125,10 +128,16 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
                    "falling back to the genetic algorithm", err=True)
     label = config.make_objective().label
-    click.echo(f"designing {config.units} units for {label} ({model.fidelity} model, {config.search}, "
-               f"executor {config.executor}) -> {folder}", err=True)
+    said: list[str] = []
+
+    def announce() -> None:  # the run's first line, once it has started: an error before it stays one line
+        if not said:
+            said.append(folder)
+            click.echo(f"designing {config.units} units for {label} ({model.fidelity} model, {config.search}, "
+                       f"executor {config.executor}) -> {folder}", err=True)
 
     def on_generation(stats) -> None:  # type: ignore[no-untyped-def]
+        announce()
         total = config.ga.generations
         done = stats.generation
         bar = "#" * int(20 * done / max(total, 1))
@@ -136,10 +145,12 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                    f"solves {stats.solves}  cache hits {stats.cache_hits}  {stats.wall_time:.1f} s", err=True)
 
     def on_progress(done: int, total: int) -> None:
+        announce()
         bar = "#" * int(20 * done / max(total, 1))
         click.echo(f"  [{bar:<20}] {done}/{total} designs", err=True)
 
     def on_message(text: str) -> None:
+        announce()
         click.echo(f"  {text}", err=True)
 
     try:
@@ -153,8 +164,10 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         config = replace(config, search="ga", model=settings)
         model = make_model(config.units, config.model)
         folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
+        said.clear()  # the new run says its own first line
         result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
                             overwrite=overwrite, on_message=on_message)
+    announce()
     best = result.best
     if as_json:
         click.echo(strict_json({
@@ -184,6 +197,14 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
         sys.exit(130)
+
+
+def _check_options_apply(search: str, owner: str, options: dict) -> None:
+    """Refuse options of another search than the one that runs, instead of ignoring them."""
+    given = [name for name, value in options.items() if value is not None]
+    if given and search != owner:
+        raise click.UsageError(f"{'/'.join(given)} only appl{'y' if len(given) > 1 else 'ies'} to --search {owner}, "
+                               f"but this run's search is {search}; add --search {owner} or leave {'/'.join(given)} out")
 
 
 def _certified_json(result) -> dict:  # type: ignore[no-untyped-def]

@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
+from pneumorph.design.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.ga import GAConfig
 from pneumorph.design.targets import Objective, make_objective
 from pneumorph.errors import (
@@ -94,6 +95,10 @@ class DesignConfig:
         _integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         _text(self.objective, "[design] objective")
         _text(self.search, "[design] search", SEARCHES)
+        if self.search == "exhaustive" and self.units > EXHAUSTIVE_MAX_UNITS:
+            raise SearchConfigError(
+                f"the exhaustive search takes at most {EXHAUSTIVE_MAX_UNITS} units (2^{self.units} = "
+                f"{2 ** self.units:,} designs for {self.units}); use the certified search or the genetic algorithm")
         _text(self.executor, "[execution] executor", EXECUTORS)
         _integer(self.seed, "[design] seed", 0, 2**32 - 1)
         _flag(self.certify, "[design] certify")

@@ -19,25 +19,50 @@ Folder contents:
   writes (the deformed shape, VTK of the winner).
 
 Running the same settings into the same folder again resumes: the GA replays with the same
-seed and the evaluation cache answers every design solved before. Ctrl-C stops the run
-after the files written so far are flushed; :attr:`RunResult.status` is then
+seed and the evaluation cache answers every design solved before. Ctrl-C (or any
+``KeyboardInterrupt``, such as the CLI's SIGTERM) stops the run after the files written so
+far are flushed; the report is written and says so, and :attr:`RunResult.status` is
 ``"interrupted"``.
+
+Nothing a run writes is lost or mixed up:
+
+- one run at a time: the folder is held by a :class:`~pneumorph.io.RunLock`
+  (``.pneumorph.lock``, naming the pid, host and start of its run) from before anything
+  is written to the end; a second run into it is refused with :class:`RunFolderError`.
+  A lock left by a killed run is released by the operating system.
+- a start that fails (settings, model, chain table, cache, executor, another run in the
+  folder) leaves the folder as it was: it is created, and anything written, only once every
+  check has passed (and removed again if the run created it and then failed at once).
+- every result file is written to a temporary file and renamed over the old one
+  (``config.toml``, ``report.md``, the JSON and CSV files, the figures); JSON is strict.
+- ``generations.csv`` is appended to, never truncated by a resumed run (see
+  :class:`_GenerationLog`).
+- ``overwrite=True`` removes the files of the old run (:data:`RUN_FILES` and the files its
+  report lists), only once every check has passed; files of others in the folder stay.
 """
 
 from __future__ import annotations
 
 import csv
-import json
+import io
+import os
 import platform
+import re
+import tempfile
 import time
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from pneumorph.design.certified import CertifiedResult, certified_search, chain_candidate
+from pneumorph.design.certified import (
+    CertifiedResult,
+    certified_search,
+    chain_candidate,
+)
 from pneumorph.design.config import DesignConfig, to_toml
 from pneumorph.design.exhaustive import run_exhaustive
 from pneumorph.design.figures import plot_convergence, plot_profile
@@ -45,13 +70,21 @@ from pneumorph.design.fitness import Score
 from pneumorph.design.ga import GenerationStats, run_ga
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
-from pneumorph.errors import PneumorphError, RunFolderError, SearchConfigError
+from pneumorph.errors import (
+    OutputPathError,
+    PneumorphError,
+    RunFolderError,
+    SearchConfigError,
+)
 from pneumorph.execution.cache import (
     CachedEvaluator,
     EvaluationCache,
     default_cache_path,
 )
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
+from pneumorph.io.files import atomic_write_text, check_writable_dir, write_json
+from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
+from pneumorph.io.lock import RunLock
 from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.chaintables import find_table, table_for
 from pneumorph.models.factory import make_model
@@ -59,6 +92,25 @@ from pneumorph.models.response import ActuatorModel
 
 DEPENDENCIES = ("numpy", "scipy", "felupe", "tensortrax", "deap", "matplotlib", "distributed")
 _COMPARED = ("design", "ga", "model")
+
+#: The files a run writes into its folder (glob patterns, relative to it): what ``overwrite`` removes,
+#: besides the files the old run's report lists and the temporary files of an interrupted write.
+#: The lock file (``.pneumorph.lock``) is not a run file.
+RUN_FILES = (
+    "config.toml",
+    "generations.csv",
+    "ranking.csv",
+    "hall_of_fame.json",
+    "certificate.json",
+    "top.csv",
+    "profile.png",
+    "chain-vs-fe.png",
+    "convergence.png",
+    "winner/deformed.png",  # the FE models' write_deformed hook
+    "winner/vtk/winner.pvd",
+    "winner/vtk/winner_*.vtu",
+    "report.md",
+)
 
 
 def _version(name: str) -> str | None:
@@ -128,7 +180,11 @@ def _check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrit
     path = folder / "config.toml"
     if not path.exists() or overwrite:
         return False
-    old = tomllib.loads(path.read_text(encoding="utf-8"))
+    try:
+        old = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise RunFolderError(f"{folder} holds a config.toml that cannot be read ({exc}); choose another output "
+                             "folder or overwrite it") from None
     new = config.to_dict()
     for table in _COMPARED:
         if old.get(table, {}) != new.get(table, {}):
@@ -146,24 +202,158 @@ def _check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrit
 
 
 class _GenerationLog:
-    """``generations.csv``, one flushed row per generation."""
+    """``generations.csv``: one row per generation, written (flushed and synced) as it is known.
+
+    A new run starts the file with its header. A resumed run keeps every row the file holds
+    and appends to it; it never truncates it. The rule for rows: **a generation is logged
+    once, by the run that first computed it.** A resumed GA replays generations 0, 1, ...
+    with the same seed, the evaluation cache answering the designs solved before; a replayed
+    generation that the file already holds is not written again (the kept row has the same
+    fitness statistics, and the solves and wall time it really took), and the first
+    generation beyond them is appended. A last line cut short by a kill (no line end) or a
+    row that cannot be read is dropped; only then is the file rewritten, atomically, with the
+    rows it keeps.
+    """
 
     FIELDS = tuple(GenerationStats.__dataclass_fields__)
 
-    def __init__(self, path: Path) -> None:
-        self.file = path.open("w", newline="", encoding="utf-8")
-        self.writer = csv.DictWriter(self.file, fieldnames=self.FIELDS)
-        self.writer.writeheader()
-        self.file.flush()
+    def __init__(self, path: Path, resume: bool) -> None:
+        self.path = path
         self.rows: list[GenerationStats] = []
+        self.logged: set[int] = set()
+        kept, clean = self._existing() if resume else ([], False)
+        if not clean:
+            atomic_write_text(path, self._lines([self.FIELDS, *kept]))
+        self.file = path.open("a", newline="", encoding="utf-8")
+
+    def _existing(self) -> tuple[list[list[str]], bool]:
+        """The readable rows of the file, and whether it is exactly its header and those rows."""
+        try:
+            text = self.path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return [], False
+        lines = text.splitlines(keepends=True)
+        clean = True
+        if lines and not lines[-1].endswith(("\n", "\r")):
+            lines, clean = lines[:-1], False  # cut short by a kill
+        records = list(csv.reader(lines))
+        if not records or "generation" not in records[0]:
+            return [], False
+        header, kept = records[0], []
+        clean = clean and tuple(header) == self.FIELDS
+        for record in records[1:]:
+            row = dict(zip(header, record, strict=False))
+            try:
+                generation = int(row["generation"])
+            except ValueError:
+                generation = None
+            if len(record) != len(header) or generation is None or generation in self.logged:
+                clean = False
+                continue
+            self.logged.add(generation)
+            kept.append([row.get(f, "") for f in self.FIELDS])
+        return kept, clean
+
+    @staticmethod
+    def _lines(records: list) -> str:
+        buffer = io.StringIO()
+        csv.writer(buffer).writerows(records)
+        return buffer.getvalue()
 
     def __call__(self, stats: GenerationStats) -> None:
         self.rows.append(stats)
-        self.writer.writerow(stats.as_row())
+        if stats.generation in self.logged:
+            return
+        row = stats.as_row()
+        self.file.write(self._lines([[row[f] for f in self.FIELDS]]))  # one write: a whole line or nothing
         self.file.flush()
+        os.fsync(self.file.fileno())
+        self.logged.add(stats.generation)
 
     def close(self) -> None:
         self.file.close()
+
+
+def _created_top(folder: Path) -> Path | None:
+    """The outermost folder of ``folder`` and its parents that does not exist yet (None if it exists)."""
+    top = None
+    probe = folder
+    while not probe.exists() and probe.parent != probe:
+        top, probe = probe, probe.parent
+    return top
+
+
+def _remove_empty(folder: Path, top: Path) -> None:
+    """Remove ``folder`` and its parents up to ``top`` while they are empty."""
+    probe = folder
+    while True:
+        try:
+            probe.rmdir()
+        except OSError:
+            return
+        if probe == top or probe.parent == probe:
+            return
+        probe = probe.parent
+
+
+def _reported_files(folder: Path) -> list[Path]:
+    """The files of ``folder`` that its ``report.md`` lists (what the last run wrote)."""
+    try:
+        text = (folder / "report.md").read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return []
+    _, found, files = text.partition("\n## Files\n")
+    out = []
+    for name in re.findall(r"^- \[[^\]]*\]\(([^)\n]+)\)$", files if found else "", flags=re.MULTILINE):
+        rel = Path(name)
+        if rel.is_absolute() or ".." in rel.parts or rel.name == LOCK_FILE:
+            continue
+        out.append(folder / rel)
+    return out
+
+
+def run_files(folder: str | Path) -> list[Path]:
+    """The files of an earlier run in ``folder``: :data:`RUN_FILES`, the files its report lists and
+    the temporary files of an interrupted write, ``config.toml`` last."""
+    folder = Path(folder)
+    found: set[Path] = set(_reported_files(folder))
+    for pattern in RUN_FILES:
+        parent, _, name = pattern.rpartition("/")
+        found.update(folder.glob(pattern))
+        found.update(folder.glob(f"{parent}/.{name}.*.tmp*" if parent else f".{name}.*.tmp*"))
+    files = [p for p in found if p.name != LOCK_FILE and (p.is_file() or p.is_symlink())]
+    return sorted(files, key=lambda p: (p.name == "config.toml", str(p)))
+
+
+def _remove_run_files(folder: Path) -> None:
+    """Remove the old run's files (``config.toml`` last: a removal cut short still reads as that run)."""
+    parents = set()
+    for path in run_files(folder):
+        try:
+            path.unlink()
+        except FileNotFoundError:
+            continue
+        except OSError as exc:
+            raise RunFolderError(f"{folder}: cannot remove {path.name} of the old run ({exc.strerror or exc})") from None
+        parents.update(p for p in path.parents if p != folder and p.is_relative_to(folder))
+    for parent in sorted(parents, key=lambda p: len(p.parts), reverse=True):
+        try:
+            parent.rmdir()  # only if empty
+        except OSError:
+            pass
+
+
+def _atomic_figure(path: Path, draw: Callable[[Path], Any]) -> Path:
+    """Draw a figure into a temporary file beside ``path`` (same suffix, for its format), then rename it."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent)
+    os.close(fd)
+    try:
+        draw(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
 
 
 def run_design(
@@ -210,14 +400,13 @@ def run_design(
     RunFolderError
         The folder holds another run and ``overwrite`` is not set.
     """
-    folder = Path(folder)
+    folder = check_writable_dir(folder, "run folder")
     if int(model.n_units) != config.units:
         raise SearchConfigError(f"the model has {model.n_units} units but the config asks for {config.units}")
     objective = config.make_objective()
     fingerprint = model.fingerprint()
-    resumed = _check_folder(folder, config, fingerprint, overwrite)
+    _check_folder(folder, config, fingerprint, overwrite)  # checked again under the lock
     say = on_message or (lambda text: None)
-    table_dir = None
     if config.search == "certified":
         if getattr(model, "gravity", None) is not None:
             from pneumorph.errors import LocalityError
@@ -231,73 +420,111 @@ def run_design(
             table = table_for(model, _training(model), path=config.chain_table)
             ChainModel(table, config.units)
 
-    own_evaluator = evaluator is None
-    inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
-    own_cache = cache is None
-    cache = cache or EvaluationCache(config.cache or default_cache_path())
-    if cache.path != ":memory:":
-        table_dir = Path(cache.path).parent / "chain-tables"
-    cached = CachedEvaluator(inner, cache)
-    chain = None
-    if config.search == "certified":
-        # the table (built on first use, through the cache) before the folder is claimed: a model the
-        # chain cannot represent leaves nothing behind
+    own_evaluator, own_cache = evaluator is None, cache is None
+    inner: Evaluator | None = evaluator
+    lock: RunLock | None = None
+    log: _GenerationLog | None = None
+    made: Path | None = None  # the outermost folder this run created
+    started = False  # True once a result (config.toml) is written
+
+    closed = False
+
+    def release() -> None:
+        """Stop the workers and close the cache (once; the results need neither)."""
+        nonlocal closed
+        if closed:
+            return
+        closed = True
         try:
-            table = table_for(model, _training(model), folder=table_dir, path=config.chain_table, evaluator=cached,
-                              on_progress=say)
-            chain = ChainModel(table, config.units)
-        except BaseException:
-            if own_evaluator:
+            if own_evaluator and inner is not None:
                 inner.close()
-            if own_cache:
+        finally:
+            if own_cache and cache is not None:
                 cache.close()
-            raise
-    folder.mkdir(parents=True, exist_ok=True)
-    prov = provenance(config, model)
-    prov["resumed"] = resumed
-    if chain is not None:
-        prov["chain_table"] = chain.table.fingerprint()
-    (folder / "config.toml").write_text(to_toml({**config.to_dict(), "provenance": prov}), encoding="utf-8")
-    start = time.perf_counter()
-    log = _GenerationLog(folder / "generations.csv") if config.search == "ga" else None
 
-    def on_gen(stats: GenerationStats) -> None:
-        log(stats)  # type: ignore[misc]
-        if on_generation:
-            on_generation(stats)
-
-    status, hof, history, ranking, cert = "finished", (), (), None, None
     try:
-        if config.search == "ga":
-            ga = run_ga(model, objective, config.ga, cached, on_gen)
-            hof, history = ga.hall_of_fame, ga.history
-        elif config.search == "certified":
-            assert chain is not None
-            verify = config.verify or int(getattr(inner, "workers", 1) or 1)
-            cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
-                                    hall_of_fame=config.ga.hall_of_fame, margin=config.margin, on_progress=say)
-            hof = cert.hall_of_fame
-            order = cert.scores.order()[:1000]
-            names = design_strings(cert.scores.bits[order])
-            ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order)]
-        else:
-            ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame, on_progress=on_progress)
-            hof, ranking = ex.hall_of_fame, [(d, ex.scores[d]) for d in ex.ranking]
-    except KeyboardInterrupt:
-        status = "interrupted"
-        history = tuple(log.rows) if log else ()
+        inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
+        cache = cache or EvaluationCache(config.cache or default_cache_path())
+        table_dir = None if cache.path == ":memory:" else Path(cache.path).parent / "chain-tables"
+        cached = CachedEvaluator(inner, cache)
+        chain = None
+        if config.search == "certified":
+            # the table (built on first use, through the cache) before the folder is claimed: a model the
+            # chain cannot represent leaves nothing behind
+            table = table_for(model, _training(model), folder=table_dir, path=config.chain_table,
+                              evaluator=cached, on_progress=say)
+            chain = ChainModel(table, config.units)
+        made = _created_top(folder)
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputPathError(f"run folder {folder}: cannot be created ({exc.strerror or exc})") from None
+        lock = RunLock(folder).acquire()
+        # under the lock, no other run can have written the folder since the first look
+        resumed = _check_folder(folder, config, fingerprint, overwrite)
+        if overwrite:
+            _remove_run_files(folder)
+        prov = provenance(config, model)
+        prov["resumed"] = resumed
+        if chain is not None:
+            prov["chain_table"] = chain.table.fingerprint()
+        atomic_write_text(folder / "config.toml", to_toml({**config.to_dict(), "provenance": prov}))
+        started = True
+        start = time.perf_counter()
+        log = _GenerationLog(folder / "generations.csv", resume=resumed) if config.search == "ga" else None
+
+        def on_gen(stats: GenerationStats) -> None:
+            log(stats)  # type: ignore[misc]
+            if on_generation:
+                on_generation(stats)
+
+        status, hof, history, ranking, cert = "finished", (), (), None, None
+        try:
+            if config.search == "ga":
+                ga = run_ga(model, objective, config.ga, cached, on_gen)
+                hof, history = ga.hall_of_fame, ga.history
+            elif config.search == "certified":
+                assert chain is not None
+                verify = config.verify or int(getattr(inner, "workers", 1) or 1)
+                cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
+                                        hall_of_fame=config.ga.hall_of_fame, margin=config.margin,
+                                        on_progress=say)
+                hof = cert.hall_of_fame
+                order = cert.scores.order()[:1000]
+                names = design_strings(cert.scores.bits[order])
+                ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order)]
+            else:
+                ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame,
+                                    on_progress=on_progress)
+                hof, ranking = ex.hall_of_fame, [(d, ex.scores[d]) for d in ex.ranking]
+        except KeyboardInterrupt:  # Ctrl-C, and its subclasses (the CLI's SIGTERM)
+            status = "interrupted"
+            history = tuple(log.rows) if log else ()
+            hof, ranking, cert = (), None, None
+        finally:
+            if log:
+                log.close()
+            release()
+        result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
+                           time.perf_counter() - start, certified=cert)
+        files: list[Path] = []
+        try:
+            if cert is not None:
+                result = replace(result, opinion_2d=_opinion_2d(config, model, objective, cert))
+            _write_outputs(result, config, model, ranking, figures, files)
+        except KeyboardInterrupt:  # while writing the results: the report still says what there is
+            result = replace(result, status="interrupted")
+            files = [f for f in files if f.exists() and f.name != "report.md"]
+            files.append(_write_report(result, config, model, files))
+        return replace(result, files=tuple(files))
     finally:
         if log:
             log.close()
-        if own_evaluator:
-            inner.close()
-        if own_cache:
-            cache.close()
-    opinion = _opinion_2d(config, model, objective, cert) if cert is not None else {}
-    result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
-                       time.perf_counter() - start, certified=cert, opinion_2d=opinion)
-    files = _write_outputs(result, config, model, ranking, figures)
-    return replace(result, files=tuple(files))
+        release()
+        if lock is not None:
+            lock.release()
+        if not started and made is not None:
+            _remove_empty(folder, made)
 
 
 def _training(model: ActuatorModel) -> Any:
@@ -338,47 +565,56 @@ def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective
     return {d: chain_candidate(chain, objective, d).value for d in designs}
 
 
+def _csv_text(header: list[str], rows: Any) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer)
+    writer.writerow(header)
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
 def _write_outputs(
-    result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any, figures: bool
-) -> list[Path]:
-    folder, files = result.folder, []
+    result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any, figures: bool, files: list[Path]
+) -> None:
+    """Write the results into the run folder, each file atomically; ``files`` collects them as they are
+    written, the report last."""
+    folder = result.folder
     if result.history:
         files.append(folder / "generations.csv")
     if ranking is not None:
-        path = folder / "ranking.csv"
-        with path.open("w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(["rank", "design", "value", "level", "pressure_kPa", "failed"])
-            for i, (d, s) in enumerate(ranking, 1):
-                p = "" if s.pressure is None else round(s.pressure * 1e3, 9)
-                w.writerow([i, d, s.value, "" if s.level is None else s.level, p, s.failed])
-        files.append(path)
+        rows = []
+        for i, (d, s) in enumerate(ranking, 1):
+            p = "" if s.pressure is None else round(s.pressure * 1e3, 9)
+            rows.append([i, d, s.value, "" if s.level is None else s.level, p, s.failed])
+        text = _csv_text(["rank", "design", "value", "level", "pressure_kPa", "failed"], rows)
+        files.append(atomic_write_text(folder / "ranking.csv", text))
     if result.hall_of_fame:
-        path = folder / "hall_of_fame.json"
         entries = [{"rank": i, **c.to_dict()} for i, c in enumerate(result.hall_of_fame, 1)]
         doc = {"objective": result.objective.label, "sense": result.objective.sense,
                "unit": result.objective.unit, "designs": entries}
-        path.write_text(json.dumps(doc, indent=1), encoding="utf-8")
-        files.append(path)
+        files.append(write_json(folder / "hall_of_fame.json", doc))
     cert = result.certified
     if cert is not None:
         files += _write_certificate(result, folder)
     best = result.best
     if figures and best is not None and best.response is not None and best.level is not None:
-        files.append(plot_profile(best, result.objective, folder / "profile.png"))
+        files.append(_atomic_figure(folder / "profile.png", lambda p: plot_profile(best, result.objective, p)))
         if cert is not None:
-            files.append(plot_profile(best, result.objective, folder / "chain-vs-fe.png",
-                                      compare=[("chain model", cert.winner_chain)]))
+            files.append(_atomic_figure(folder / "chain-vs-fe.png", lambda p: plot_profile(
+                best, result.objective, p, compare=[("chain model", cert.winner_chain)])))
         hook = getattr(model, "write_deformed", None)
         if callable(hook) and cert is None:  # a certified run does not solve its winner a second time
             files.extend(Path(p) for p in hook(best.response, best.level, folder / "winner"))
     if figures and result.history:
-        files.append(plot_convergence(result.history, folder / "convergence.png", result.objective.unit))
-    path = folder / "report.md"
+        files.append(_atomic_figure(folder / "convergence.png",
+                                    lambda p: plot_convergence(result.history, p, result.objective.unit)))
+    files.append(_write_report(result, config, model, files))
+
+
+def _write_report(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[Path]) -> Path:
+    folder = result.folder
     names = [f.relative_to(folder).as_posix() if f.is_relative_to(folder) else f.name for f in files]
-    path.write_text(report_text(result, config, model, names), encoding="utf-8")
-    files.append(path)
-    return files
+    return atomic_write_text(folder / "report.md", report_text(result, config, model, names))
 
 
 def _top_rows(result: RunResult) -> list[dict[str, Any]]:
@@ -410,14 +646,9 @@ def _write_certificate(result: RunResult, folder: Path) -> list[Path]:
         "verified": {d: c.to_dict() for d, c in cert.verified.items()},
         "top": rows,
     }
-    path = folder / "certificate.json"
-    path.write_text(json.dumps(doc, indent=1, default=float), encoding="utf-8")
-    top = folder / "top.csv"
-    with top.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    return [path, top]
+    path = write_json(folder / "certificate.json", doc)
+    text = _csv_text(list(rows[0]), [list(row.values()) for row in rows])
+    return [path, atomic_write_text(folder / "top.csv", text)]
 
 
 def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[str]) -> str:
