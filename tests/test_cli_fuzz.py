@@ -86,6 +86,8 @@ BASE = {
     "poisson": ["materials", "characterise", "poisson", "dic.csv"],
     "thermal": ["materials", "characterise", "thermal", "thermal.csv"],
     "bilinear": ["materials", "characterise", "bilinear", "bilinear.csv"],
+    "show": ["materials", "show", "mold_star_15"],
+    "list": ["materials", "list"],
 }
 
 REAL = ["nan", "inf", "-inf", "1e999", "abc", ""]  # never a number
@@ -141,6 +143,9 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--stress-unit": ["", "furlongs"], "--plot": ["folder", "a-file/x.png", ""], "--model": ["", "nope"],
     },
     "bilinear": {"--primary-limit": POSITIVE, "--secondary-points": ["0", "1", *COUNT, *HUGE]},
+    "poisson": {"--strain-range": ["nan", "abc", ""]},
+    "show": {"--library": ["binary.bin", "folder", "missing.toml", ""]},
+    "list": {"--library": ["binary.bin", "folder", ""]},
 }
 
 CASES = [(cmd, opt, bad) for cmd, options in OPTIONS.items() for opt, values in options.items() for bad in values]
@@ -156,6 +161,8 @@ def test_bad_option_value(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd
         argv[argv.index("-o") + 1] = bad
     elif option == "--crimp-ratio":
         argv[argv.index("-c") + 1] = bad
+    elif option == "--strain-range":
+        argv += [option, bad, "10"]
     else:
         argv += [option, bad]
     line = _refused(sandbox, capsys, argv)
@@ -276,3 +283,71 @@ def test_exhaustive_search_beyond_its_limit_is_refused_before_anything_is_said(
 def test_snapshot_beyond_the_final_strain_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
     line = _refused(sandbox, capsys, [*BASE["coupon"], "--snapshot", "5"])
     assert "--snapshot" in line and "final strain" in line
+
+
+# -- every option of every command is covered ---------------------------------------------
+
+def _commands() -> dict[str, object]:
+    import click
+
+    from pneumorph.cli import cli
+
+    found: dict[str, object] = {}
+
+    def walk(group: click.Group, path: tuple[str, ...]) -> None:
+        for name, command in group.commands.items():
+            if isinstance(command, click.Group):
+                walk(command, (*path, name))
+            else:
+                found[" ".join((*path, name))] = command
+
+    walk(cli, ())
+    return found
+
+
+def _key(path: str) -> str:
+    return {"chain build": "chain", "composite coupon": "coupon", "composite transition": "transition",
+            "materials fit": "fit"}.get(path, path.split()[-1])
+
+
+# options whose every value is valid or whose bad values are tried elsewhere in this file
+COVERED_ELSEWHERE = {
+    "--json", "--quiet", "--overwrite", "--certify", "--references-only", "--stable", "--markdown", "--help",
+    "--objective",  # a choice; with --target: test_target_and_objective_together; reach: test_reach_needs_a_point
+    "--point",  # test_reach_needs_a_point and the two-number type
+    "--wavelength",  # test_impossible_crimp_is_a_one_line_error (tests/composite)
+}
+
+
+def test_every_command_has_a_baseline_and_every_option_is_fuzzed() -> None:
+    import click
+
+    for path, command in _commands().items():
+        key = _key(path)
+        assert key in BASE, f"no baseline for pneumorph {path}"
+        for param in command.params:  # type: ignore[attr-defined]
+            if not isinstance(param, click.Option) or param.is_flag:
+                continue
+            name = max(param.opts, key=len)
+            fuzzed = name in OPTIONS.get(key, {}) or isinstance(param.type, click.Choice) \
+                or name in COVERED_ELSEWHERE
+            assert fuzzed, f"pneumorph {path} {name} is not in the fuzz table"
+
+
+CHOICES = [(path, max(p.opts, key=len)) for path, command in _commands().items()
+           for p in command.params if isinstance(p, __import__("click").Option)  # type: ignore[attr-defined]
+           and isinstance(p.type, __import__("click").Choice)]
+
+
+@pytest.mark.parametrize(("path", "option"), CHOICES, ids=[f"{p} {o}" for p, o in CHOICES])
+def test_a_value_outside_a_choice_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str], path: str,
+                                             option: str) -> None:
+    argv = list(BASE[_key(path)])
+    if option in argv:
+        argv[argv.index(option) + 1] = "nope"
+    elif option == "--crimp-ratio":
+        argv[argv.index("-c") + 1] = "nope"
+    else:
+        argv += [option, "nope"]
+    line = _refused(sandbox, capsys, argv)
+    assert "nope" in line and option in line

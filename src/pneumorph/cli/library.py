@@ -7,6 +7,7 @@ from typing import Any
 import click
 
 from pneumorph.errors import UnknownMaterialError
+from pneumorph.cli import params as P
 from pneumorph.io.files import strict_json
 from pneumorph.materials import library
 from pneumorph.materials.filler import FillerLaw
@@ -31,7 +32,7 @@ _library_option = click.option(
     "--library",
     "library_files",
     multiple=True,
-    type=click.Path(exists=True, dir_okay=False),
+    type=P.InputFile(),
     help="Also load materials from this TOML file (same schema as the built-in library; repeatable).",
 )
 
