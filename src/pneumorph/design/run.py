@@ -376,7 +376,8 @@ def run_design(
     model : ActuatorModel
         Built for ``config`` (its ``n_units`` must equal ``config.units``).
     folder : str or Path
-        The run folder; created if missing; resumed if it holds the same run.
+        The run folder; created if missing (once every check has passed); resumed if it
+        holds the same run. Held by a :class:`~pneumorph.io.RunLock` for the whole run.
     evaluator : Evaluator, optional
         By default made from ``config.executor`` (and closed at the end).
     cache : EvaluationCache, optional
@@ -385,7 +386,8 @@ def run_design(
         Progress callbacks: a GA generation's stats; exhaustive (done, total); a line of
         text from the certified search (table build, scoring, verification).
     overwrite : bool
-        Start afresh in a folder that holds another run.
+        Start afresh in a folder that holds another run: once every check has passed, the
+        old run's files are removed (:func:`run_files`); other files in the folder stay.
     figures : bool
         Draw the figures (and call the model's ``write_deformed`` hook).
 
@@ -398,7 +400,14 @@ def run_design(
     SearchConfigError
         The model's number of units differs from the config's.
     RunFolderError
-        The folder holds another run and ``overwrite`` is not set.
+        The folder holds another run and ``overwrite`` is not set, its ``config.toml``
+        cannot be read, or another run is writing into it now (its pid, host and start).
+    OutputPathError
+        The folder cannot be created or written.
+
+    Any error raised before the run starts leaves the folder as it was. A
+    ``KeyboardInterrupt`` (or a subclass) during the search or while the results are
+    written ends the run with ``status == "interrupted"`` and a report saying so.
     """
     folder = check_writable_dir(folder, "run folder")
     if int(model.n_units) != config.units:
