@@ -341,7 +341,6 @@ def test_a_worker_that_dies_fails_its_design_and_the_run_goes_on(tmp_path: Path,
     assert sum(r["failed"] == "True" for r in rows.values()) == 2  # the design and its mirror, derived from it
 
 
-@pytest.mark.xfail(reason="needs CachedEvaluator to skip storing Outcome.transient (cache.py)", strict=False)
 def test_a_worker_death_is_not_cached(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.syspath_prepend(str(REPO))
     from tests.execution.test_evaluators import TroubleToy

@@ -441,7 +441,8 @@ class CachedEvaluator:
         unique = list(todo)
         start = time.perf_counter()
         for j, outcome in self.inner.iter_evaluate(model, unique):
-            self.cache.put(fp, outcome)
+            if not outcome.transient:  # a dead worker says nothing about the design
+                self.cache.put(fp, outcome)
             self.solves += 1
             first, *rest = todo[unique[j]]
             yield first, outcome
