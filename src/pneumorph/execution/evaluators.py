@@ -109,6 +109,23 @@ def _init_worker(model: ActuatorModel) -> None:
     except (ValueError, OSError):  # pragma: no cover - not the main thread of the worker
         pass
     _WORKER_MODEL = model
+    _watch_parent(os.getppid())
+
+
+def _watch_parent(parent: int, every: float = 0.5) -> None:
+    """End this worker when its parent is gone (a SIGKILL of the run leaves no orphan solving on).
+
+    A killed parent cannot stop its workers, so each worker checks every ``every`` s that
+    its parent process is still the one that started it, and exits at once otherwise.
+    """
+
+    def watch() -> None:
+        while True:
+            time.sleep(every)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="pneumorph-parent-watch", daemon=True).start()
 
 
 def _solve_in_worker(design: str) -> Outcome:
