@@ -151,3 +151,21 @@ def test_a_model_the_chain_cannot_represent_falls_back_to_the_ga(tmp_path: Path,
     out = json.loads(captured.out)
     assert "certificate" not in out and out["folder"].endswith("-ga-seed0")
     assert not list((tmp_path / "runs").glob("*certified*"))  # the refused search left no folder
+
+
+def test_a_tampered_cache_entry_is_solved_again_and_reported(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    import sqlite3
+
+    args = ["design", *TINY, "--cache", str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"), "--json"]
+    assert main(args) == 0
+    first = json.loads(capsys.readouterr().out)
+    with sqlite3.connect(tmp_path / "c.sqlite") as db:  # someone edits a stored response
+        (design, text), *_ = db.execute("SELECT design, response FROM evaluations").fetchall()
+        db.execute("UPDATE evaluations SET response = ? WHERE design = ?",
+                   (text.replace('"curl"', '"curl" ', 1).replace("1", "2", 1), design))
+    assert main(args) == 0
+    second = json.loads(capsys.readouterr().out)
+    assert second["cache_entries_rejected"] == 1 and second["solves"] == 1
+    assert second["best"] == first["best"]  # the tampered value was never used
+    assert "1 damaged cache entries were solved again" in (tmp_path / "run" / "report.md").read_text()

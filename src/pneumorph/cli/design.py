@@ -168,6 +168,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
                             overwrite=overwrite, on_message=on_message)
     announce()
+    if result.rejected:
+        click.echo(f"  {result.rejected} cache entries failed their checksum: solved again, not used", err=True)
     best = result.best
     if as_json:
         click.echo(strict_json({
@@ -180,6 +182,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             "hall_of_fame": [{"design": c.design, "pressure_kpa": _kpa(c.pressure), "fitness": c.value,
                               "failure": c.failure} for c in result.hall_of_fame],
             "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
+            "cache_entries_rejected": result.rejected,
             **_certified_json(result),
         }))
     elif best is not None:

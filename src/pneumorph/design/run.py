@@ -152,6 +152,8 @@ class RunResult:
     solves, cache_hits : int
         New model solves and designs answered by the evaluation cache in this run.
     wall_time : float
+    rejected : int
+        Cache entries that failed their checksum and were solved again instead of used.
     files : tuple of Path
     """
 
@@ -166,6 +168,7 @@ class RunResult:
     files: tuple[Path, ...] = field(default=())
     certified: CertifiedResult | None = None
     opinion_2d: dict[str, float] = field(default_factory=dict)
+    rejected: int = 0
 
     @property
     def best(self) -> Candidate | None:
@@ -515,7 +518,7 @@ def run_design(
                 log.close()
             release()
         result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
-                           time.perf_counter() - start, certified=cert)
+                           time.perf_counter() - start, certified=cert, rejected=int(getattr(cache, "rejected", 0)))
         files: list[Path] = []
         try:
             if cert is not None:
@@ -677,7 +680,8 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
         f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",
         f"- search: {search}",
         (f"- new solves: {result.solves}, answered by the cache: {result.cache_hits}, "
-        f"wall time {result.wall_time:.1f} s"),
+        f"wall time {result.wall_time:.1f} s"
+         + (f"; {result.rejected} damaged cache entries were solved again, not used" if result.rejected else "")),
         "",
     ]
     best = result.best
