@@ -189,6 +189,8 @@ CONFIG_KEYS: list[tuple[str, str, str]] = [
         ("design", "search", ["1", '"fast"']),
         ("design", "certify", ['"yes"', "1"]),
         ("design", "verify", ["0", "1.5", "true"]),
+        ("ga", "elitism", ["-1", "100", "1.5"]),
+        ("ga", "budget", ["1", "0", "1.5"]),
         ("design", "margin", ["0", "nan", '"1"']),
         ("design", "point", ["[1]", '"1,2"', "[nan, 0]"]),
         ("design", "anchored", ["1"]),
@@ -226,7 +228,9 @@ def test_bad_config_key(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: 
     assert key in line, line
 
 
-@pytest.mark.parametrize("content", [bytes(range(256)), b"[design\nunits = 3", b"[unknown]\nx = 1\n", b"units = 3\n"])
+@pytest.mark.parametrize("content", [bytes(range(256)), b"[design\nunits = 3", b"[unknown]\nx = 1\n", b"units = 3\n",
+                                     b"design = 3\n", b"ga = [1]\n", b"[design]\nverify = 3\nsearch = 'ga'\n",
+                                     b"[design]\nmargin = 2.0\nsearch = 'exhaustive'\nunits = 4\n"])
 @pytest.mark.parametrize("cmd", ["design", "study"])
 def test_bad_config_file(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, content: bytes) -> None:
     config = sandbox / "config.toml"

@@ -10,6 +10,7 @@ import click
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli import params as P
 
+_NOT_CERTIFIED = {"certify": False, "verify": None, "margin": 1.0, "chain_table": None}  # a fallback to the GA
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
 
 
@@ -107,14 +108,14 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             model_settings[key] = value
     if unit_file:
         model_settings.pop("unit", None)
-    config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
     # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
-    _check_options_apply(config.search, "certified",
+    _check_options_apply(search or config.search, "certified",
                          {"--certify": certify, "--verify": verify, "--margin": margin, "--chain-table": chain_table})
+    config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
     fidelity_given = "fidelity" in config.model
     fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
     if fallback:
-        config = replace(config, search="ga")
+        config = replace(config, search="ga", **_NOT_CERTIFIED)
     if "fidelity" not in config.model:  # the certified search works on the 3D model by default
         config = replace(config, model={**config.model, "fidelity": "3d" if config.search == "certified" else "2d"})
     config = DesignConfig.from_dict(config.to_dict())  # validate the combination
@@ -161,7 +162,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             raise
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
         settings = dict(config.model) if fidelity_given else {**config.model, "fidelity": "2d"}
-        config = replace(config, search="ga", model=settings)
+        config = replace(config, search="ga", model=settings, **_NOT_CERTIFIED)
         model = make_model(config.units, config.model)
         folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
         said.clear()  # the new run says its own first line

@@ -104,9 +104,16 @@ class DesignConfig:
         _flag(self.certify, "[design] certify")
         _flag(self.anchored, "[design] anchored")
         object.__setattr__(self, "amplitude", _real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
-                                                          unit="mm"))
+                                                    unit="mm"))
         object.__setattr__(self, "periods", _real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
         object.__setattr__(self, "margin", _real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
+        if self.search != "certified":
+            given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
+                                    ("chain_table", self.chain_table), ("margin", self.margin != 1.0)) if v]
+            if given:
+                raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} to the "
+                                        "certified search, not to "
+                                        f"search = {self.search!r}; leave them out or set search = \"certified\"")
         if self.verify is not None:
             _integer(self.verify, "[design] verify", 1, 1024)
         if self.workers is not None:
@@ -161,15 +168,15 @@ class DesignConfig:
         tables = {"design": known_design, "ga": known_ga, "execution": known_exec}
         for table in set(data) - {*tables, "model", "provenance"}:
             raise SearchConfigError(f"unknown table [{table}] in the design config; known: design, ga, execution, model")
+        for table in ("design", "ga", "execution", "model"):
+            if not isinstance(data.get(table, {}), dict):
+                raise SearchConfigError(f"[{table}] must be a table of settings, got {data[table]!r}")
         kwargs: dict[str, Any] = {}
         for table, known in tables.items():
             for key in set(data.get(table, {})) - known:
                 raise SearchConfigError(f"unknown key {key!r} in [{table}]; known keys: {', '.join(sorted(known))}")
         kwargs.update(data.get("design", {}))
         kwargs.update(data.get("execution", {}))
-        for table in ("design", "ga", "execution", "model"):
-            if not isinstance(data.get(table, {}), dict):
-                raise SearchConfigError(f"[{table}] must be a table of settings, got {data[table]!r}")
         ga = GAConfig(**{**data.get("ga", {}), "seed": kwargs.get("seed", 0)})
         return cls(ga=ga, model=dict(data.get("model", {})), **kwargs)
 

@@ -106,11 +106,11 @@ class GAConfig:
             _integer(self.budget, "[ga] budget", 1)
         if not 0 <= self.elitism < self.population:
             raise SearchConfigError(
-                f"elitism must be between 0 and population - 1 = {self.population - 1}, got {self.elitism}"
+                f"[ga] elitism must be between 0 and population - 1 = {self.population - 1}, got {self.elitism}"
             )
         if self.budget is not None and self.budget < self.population:
             raise SearchConfigError(
-                f"a budget of {self.budget} designs does not cover the initial population of {self.population}"
+                f"[ga] budget of {self.budget} designs does not cover the initial population of {self.population}"
             )
 
 
