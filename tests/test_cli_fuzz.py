@@ -48,6 +48,8 @@ def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     (tmp_path / "stress.csv").write_text("stretch,stress\n1.0,0.0\n1.5,0.2\n2.0,0.35\n2.5,0.5\n", encoding="utf-8")
     (tmp_path / "dic.csv").write_text("axial_strain,transverse_strain\n0.1,-0.04\n0.2,-0.08\n", encoding="utf-8")
     (tmp_path / "thermal.csv").write_text("temperature,strain\n20,0\n30,0.002\n40,0.004\n", encoding="utf-8")
+    (tmp_path / "trace.csv").write_text("x,y\n" + "".join(f"{i},{(i % 3)}\n" for i in range(160)),
+                                         encoding="utf-8")
     (tmp_path / "bilinear.csv").write_text(
         "strain,stress\n" + "".join(f"{0.01 * i},{0.1 * i if i < 10 else 1 + 0.01 * i}\n" for i in range(40)),
         encoding="utf-8")
@@ -87,6 +89,7 @@ BASE = {
     "thermal": ["materials", "characterise", "thermal", "thermal.csv"],
     "bilinear": ["materials", "characterise", "bilinear", "bilinear.csv"],
     "show": ["materials", "show", "mold_star_15"],
+    "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--scale", "0.2", "--out", "run"],
     "list": ["materials", "list"],
 }
 
@@ -146,6 +149,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "poisson": {"--strain-range": ["nan", "abc", ""]},
     "show": {"--library": ["binary.bin", "folder", "missing.toml", ""]},
     "list": {"--library": ["binary.bin", "folder", ""]},
+    "correlate": {"--design": ["", "0120", "abc"], "--pressure": POSITIVE + ["1e9"], "--unit": ["binary.bin", ""],
+                  "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 
 CASES = [(cmd, opt, bad) for cmd, options in OPTIONS.items() for opt, values in options.items() for bad in values]
@@ -355,3 +360,19 @@ def test_a_value_outside_a_choice_is_refused(sandbox: Path, capsys: pytest.Captu
         argv += [option, "nope"]
     line = _refused(sandbox, capsys, argv)
     assert "nope" in line and option in line
+
+
+@pytest.mark.parametrize(("content", "name", "extra"), [
+    (b"", "scan.stl", []), (b"solid x\nnot a facet\n" * 3, "scan.stl", []), (bytes(range(256)), "scan.csv", []),
+    (b"x,y\n1,2\n", "scan.csv", []), (b"u,v\n" + b"1,2\n" * 20, "scan.csv", []), (b"1 2 3\n", "scan.dat", []),
+    (None, "trace.csv", ["--scan-unit", "m"]),  # a trace in mm read as metres: 1000 times too large
+])
+def test_bad_scans_are_refused_before_the_model_is_solved(sandbox: Path, capsys: pytest.CaptureFixture[str],
+                                                         content: bytes | None, name: str, extra: list[str]) -> None:
+    if content is not None:
+        (sandbox / name).write_bytes(content)
+    argv = ["correlate", name, "--design", "0110", "--model", "2d", *extra]
+    if not extra:
+        argv += ["--scale", "0.2"]
+    line = _refused(sandbox, capsys, argv)
+    assert name in line

@@ -213,3 +213,7 @@ class ChainTableError(PneumorphError, ValueError):
 
 class LocalityError(SearchConfigError):
     """The chain model cannot represent this model (gravity, or units that interact further)."""
+
+
+class ScanError(PneumorphError, ValueError):
+    """A scan that cannot be compared with a model: unreadable, empty, too few points, wrong units."""

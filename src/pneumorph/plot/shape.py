@@ -12,13 +12,13 @@ from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
 from pneumorph import __version__
+from pneumorph.geometry.boundary import boundary_facets
 
 COLOURS = {"body": "#4daf4a", "layer": "#377eb8", "filler": "#d9d9d9"}
 LABELS = {"body": "body", "layer": "stiff layer", "filler": "filler (2D model)"}
 
 # quad8 outline through the mid-side nodes; corner faces of a hexahedron
 _QUAD8_OUTLINE = [0, 4, 1, 5, 2, 6, 3, 7]
-_HEX_FACES = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
 
 
 def _section(ax: Any, solution: Any, level: int | None, outline: bool) -> None:
@@ -41,17 +41,12 @@ def _surface(ax: Any, solution: Any, level: int | None) -> None:
     mesh = solution.mesh
     x = mesh.points if level is None else mesh.points + solution.displacements[level]
     x = x[:, [0, 2, 1]]  # drawn as (x, z, y): the height y points up
-    corners = mesh.cells[:, :8]
-    faces = corners[:, _HEX_FACES].reshape(-1, 4)  # (6 c, 4)
-    owner = np.repeat(np.arange(len(corners)), 6)
-    key = np.sort(faces, axis=1)
-    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
-    outer = first[counts == 1]
+    faces, owner = boundary_facets(mesh.cells)
     region_of = np.empty(len(mesh.cells), dtype=object)
     for name, idx in mesh.regions.items():
         region_of[idx] = name
-    colours = [COLOURS[region_of[owner[f]]] for f in outer]
-    ax.add_collection3d(Poly3DCollection(x[faces[outer]], facecolors=colours, edgecolor="k", linewidths=0.05))
+    colours = [COLOURS[region_of[c]] for c in owner]
+    ax.add_collection3d(Poly3DCollection(x[faces], facecolors=colours, edgecolor="k", linewidths=0.05))
     lo, hi = x.min(axis=0), x.max(axis=0)
     span = (hi - lo).max() / 2
     mid = (hi + lo) / 2

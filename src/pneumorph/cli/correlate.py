@@ -1,0 +1,76 @@
+"""``pneumorph correlate``: a scan or photo of an inflated actuator against the model."""
+
+from __future__ import annotations
+
+import click
+
+from pneumorph.cli import params as P
+
+
+@click.command("correlate")
+@click.argument("scan", type=P.InputFile(text=False))
+@click.option("--design", "-d", required=True, type=P.Text(1000), help="The design scanned (e.g. 001111010001001).")
+@click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Its pressure, kPa.")
+@click.option("--model", "fidelity", type=click.Choice(["3d", "2d"]), default="3d", show_default=True,
+              help="The model to compare with (a 3D scan needs 3d).")
+@click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]), default="mm", show_default=True,
+              help="The unit of the scan's coordinates.")
+@click.option("--scale", type=P.Real(0.0, 1e6, low_open=True),
+              help="mm per unit of the scan (a photo's mm per pixel), instead of --scan-unit.")
+@click.option("--fit-scale", is_flag=True, help="Fit a scale too (a photo whose scale is not known exactly).")
+@click.option("--photo", type=P.InputFile(text=False), help="The photo the 2D trace was taken on (drawn under it).")
+@click.option("--out", type=P.OutputDir(), help="Folder for correlation.json and correlation.png.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file: str | None, scan_unit: str,
+              scale: float | None, fit_scale: bool, photo: str | None, out: str | None, as_json: bool) -> None:
+    """Align SCAN (STL, PLY, OBJ, OFF, XYZ, or a CSV of x,y traced on a photo) to the model's
+    inflated shape by least squares, and report RMS and maximum distances on the surface,
+    along the outline and along the centreline.
+    """
+    from pathlib import Path
+
+    from pneumorph.correlation import correlate as align_and_measure
+    from pneumorph.correlation import model_shape, plot_correlation, read_scan
+    from pneumorph.correlation.compare import check_length, check_units
+    from pneumorph.errors import ScanError
+    from pneumorph.geometry import parse_orientation
+    from pneumorph.io import provenance, strict_json, write_json
+    from pneumorph.models.factory import make_model
+
+    with P.blame("--design"):
+        orientation = parse_orientation(design)
+    data = read_scan(scan, scan_unit, scale)  # a bad scan is refused before the model is solved
+    if photo is not None and data.dim != 2:
+        raise click.BadParameter("a photo goes with a 2D trace (a CSV of x,y), not a 3D scan", param_hint="'--photo'")
+    if data.dim == 3 and fidelity == "2d":
+        raise ScanError("a 3D scan needs the 3D model: leave out --model 2d")
+    settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure}
+    if unit_file:
+        settings["unit_file"] = unit_file
+    model = make_model(len(orientation), settings)
+    check_length(data, len(orientation) * model.unit.pitch)
+    click.echo(f"solving design {orientation} at {pressure:g} kPa ({fidelity} model)", err=True)
+    solution = model.solve(orientation)
+    shape = model_shape(solution)
+    check_units(data, shape)
+    result = align_and_measure(data, shape, scale=fit_scale)
+    summary = {"scan": str(scan), "design": orientation, "pressure_kpa": pressure, "model": fidelity,
+               "scan_points": len(data.points), **result.to_dict()}
+    if out:
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        write_json(folder / "correlation.json",
+                   {**summary, "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint())})
+        plot_correlation(result, shape, folder / "correlation.png", photo=photo, photo_scale=scale)
+    if as_json:
+        click.echo(strict_json(summary))
+        return
+    t = result.alignment.transform
+    click.echo(f"aligned {len(data.points)} scan points: rotation {t.angle_deg:.3f} deg, translation "
+               f"{', '.join(f'{v:.3f}' for v in t.translation)} mm, scale {t.scale:.5g}; ICP RMS {result.alignment.rms:.4g} mm")
+    for name, m in (("surface", result.surface), ("outline", result.outline), ("centreline", result.centreline)):
+        if m.count:
+            click.echo(f"  {name:<10} RMS {m.rms:.4g} mm, max {m.max:.4g} mm ({m.count} points)")
+    if out:
+        click.echo(f"written to {out}/ (correlation.json, correlation.png)")

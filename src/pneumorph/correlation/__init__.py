@@ -1,0 +1,26 @@
+"""Scan correlation: an inflated actuator's scan or photo against the model (section 6.5, 8.5).
+
+Read a scan (:func:`read_scan`), take the model's deformed shape (:func:`model_shape`),
+align and measure (:func:`correlate`), draw (:func:`plot_correlation`).
+"""
+
+from pneumorph.correlation.align import Alignment, Transform, fit_transform, icp
+from pneumorph.correlation.compare import Correlation, Measure, ModelShape, correlate, model_shape
+from pneumorph.correlation.figures import plot_correlation
+from pneumorph.correlation.scans import SCAN_UNITS, Scan, read_scan
+
+__all__ = [
+    "SCAN_UNITS",
+    "Alignment",
+    "Correlation",
+    "Measure",
+    "ModelShape",
+    "Scan",
+    "Transform",
+    "correlate",
+    "fit_transform",
+    "icp",
+    "model_shape",
+    "plot_correlation",
+    "read_scan",
+]

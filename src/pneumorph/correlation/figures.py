@@ -1,0 +1,74 @@
+"""The scan over the model (Figs 6.15-6.19 of the dissertation): outline, centreline, photo."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+
+from pneumorph import __version__
+from pneumorph.correlation.compare import Correlation, ModelShape
+
+
+def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | None = None,
+                     photo: Any = None, photo_scale: float | None = None, title: str = "") -> Figure:
+    """The aligned scan's outline points over the model's outline and centreline, in the bending plane.
+
+    Parameters
+    ----------
+    result : Correlation
+    shape : ModelShape
+    path : str or Path, optional
+        Write the figure there (atomically).
+    photo : str or Path, optional
+        An image in the coordinates the 2D trace was taken in (pixels, rows down), drawn
+        under the outlines through the same alignment.
+    photo_scale : float, optional
+        mm per pixel of the photo (the scan's ``--scale``).
+    """
+    fig = Figure(figsize=(8, 4.5))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    if photo is not None:
+        _photo(ax, result, photo, photo_scale or 1.0)
+    ax.add_collection(LineCollection(shape.outline, colors="k", linewidths=0.8, label="model outline"))
+    ax.plot(shape.centres[:, 0], shape.centres[:, 1], "k.--", lw=0.6, ms=3, label="model unit centres")
+    pts = result.outline_points
+    ax.plot(pts[:, 0], pts[:, 1], ".", color="tab:red", ms=1.5, alpha=0.6, label="scan (aligned)")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.set(xlabel="x (mm)", ylabel="y (mm)")
+    o, c = result.outline, result.centreline
+    ax.set_title(title or f"outline RMS {o.rms:.3g} mm, max {o.max:.3g} mm; centreline RMS {c.rms:.3g} mm, "
+                          f"max {c.max:.3g} mm", fontsize=9)
+    ax.legend(loc="best", fontsize=7)
+    fig.text(0.99, 0.01, f"pneumorph {__version__}", ha="right", fontsize=6, color="0.5")
+    if path is not None:
+        from io import BytesIO
+
+        from pneumorph.io.files import atomic_write_bytes
+
+        buffer = BytesIO()
+        fig.savefig(buffer, dpi=150, format=Path(path).suffix.lstrip(".") or "png", bbox_inches="tight")
+        atomic_write_bytes(path, buffer.getvalue())
+    return fig
+
+
+def _photo(ax: Any, result: Correlation, photo: Any, scale: float) -> None:
+    from matplotlib.image import imread
+    from matplotlib.transforms import Affine2D
+
+    image = imread(str(photo))
+    h, w = image.shape[:2]
+    t = result.alignment.transform
+    if t.rotation.shape != (2, 2):
+        return  # a photo goes with a 2D trace only
+    matrix = np.eye(3)
+    matrix[:2, :2] = t.scale * t.rotation
+    matrix[:2, 2] = t.translation
+    shown = ax.imshow(image, extent=(0, w * scale, h * scale, 0), alpha=0.6, zorder=0)
+    shown.set_transform(Affine2D(matrix) + ax.transData)

@@ -1,0 +1,140 @@
+"""Reading scans of inflated actuators: meshes and point clouds, or points traced on a photo.
+
+A scan is a cloud of points in mm. Meshes (STL, PLY, OBJ) and point clouds (PLY, OBJ,
+XYZ) are read with trimesh, which is made for these formats; the faces are kept. A CSV
+holds traced points, ``x,y`` (2D, from a photo) or ``x,y,z`` with a header row. The scan's
+unit (mm, cm, m or in; or a scale in mm per unit, e.g. mm per pixel) converts it to mm.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.errors import ScanError
+from pneumorph.io.files import read_text_file
+
+FloatArray = NDArray[np.float64]
+
+#: Millimetres per unit of a scan.
+SCAN_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+MESH_SUFFIXES = (".stl", ".ply", ".obj", ".off", ".xyz")
+MIN_POINTS = 10
+
+
+@dataclass(frozen=True)
+class Scan:
+    """Points of a scan in mm, and its faces if it is a mesh.
+
+    Attributes
+    ----------
+    points : ndarray, shape (n, 2) or (n, 3)
+    faces : ndarray, shape (m, 3), or None
+    source : str
+    """
+
+    points: FloatArray
+    faces: NDArray[np.int64] | None
+    source: str
+
+    @property
+    def dim(self) -> int:
+        return int(self.points.shape[1])
+
+    @property
+    def extent(self) -> float:
+        """Diagonal of the bounding box, mm."""
+        return float(np.linalg.norm(self.points.max(axis=0) - self.points.min(axis=0)))
+
+
+def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) -> Scan:
+    """A scan from a mesh, point-cloud or CSV file, in mm.
+
+    Parameters
+    ----------
+    path : str or Path
+    unit : {"mm", "cm", "m", "in"}
+        The unit the file is written in.
+    scale : float, optional
+        mm per unit of the file (a photo's mm per pixel), instead of ``unit``.
+
+    Raises
+    ------
+    ScanError
+        Unreadable, empty, not a mesh or point cloud, fewer than 10 points, not finite.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "trace.csv"
+    >>> _ = p.write_text("x,y\\n" + "".join(f"{i},{i * i}\\n" for i in range(12)))
+    >>> s = read_scan(p, scale=0.5)
+    >>> s.dim, s.points[-1].tolist()
+    (2, [5.5, 60.5])
+    """
+    p = Path(path)
+    if unit not in SCAN_UNITS:
+        raise ScanError(f"unknown scan unit {unit!r}; known: {', '.join(SCAN_UNITS)}")
+    factor = SCAN_UNITS[unit] if scale is None else float(scale)
+    if not (np.isfinite(factor) and factor > 0):
+        raise ScanError(f"the scan's scale must be a positive number of mm per unit, got {scale!r}")
+    if not p.is_file():
+        raise ScanError(f"scan {p}: no such file")
+    if p.stat().st_size == 0:
+        raise ScanError(f"scan {p}: the file is empty")
+    suffix = p.suffix.lower()
+    if suffix in (".csv", ".txt"):
+        points, faces = _read_csv(p), None
+    elif suffix in MESH_SUFFIXES:
+        points, faces = _read_mesh(p)
+    else:
+        raise ScanError(f"scan {p}: unknown format {suffix or '(none)'}; give STL, PLY, OBJ, OFF, XYZ or CSV")
+    if len(points) < MIN_POINTS:
+        raise ScanError(f"scan {p}: {len(points)} points; at least {MIN_POINTS} are needed")
+    if not np.all(np.isfinite(points)):
+        raise ScanError(f"scan {p}: some coordinates are not finite")
+    return Scan(points * factor, faces, str(p))
+
+
+def _read_csv(path: Path) -> FloatArray:
+    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig")
+    rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    if not rows:
+        raise ScanError(f"scan {path}: no rows")
+    header = [c.strip().lower() for c in rows[0]]
+    if header[:2] != ["x", "y"] or (len(header) > 2 and header[2] != "z"):
+        raise ScanError(f"scan {path}: expected a header row 'x,y' or 'x,y,z', found {','.join(rows[0])!r}")
+    width = 3 if len(header) > 2 else 2
+    values = []
+    for number, row in enumerate(rows[1:], start=2):
+        try:
+            values.append([float(c) for c in row[:width]])
+        except ValueError:
+            raise ScanError(f"scan {path}, row {number}: expected {width} numbers, got {row!r}") from None
+        if len(values[-1]) != width:
+            raise ScanError(f"scan {path}, row {number}: expected {width} numbers, got {row!r}")
+    return np.array(values, dtype=float).reshape(-1, width)
+
+
+def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
+    import trimesh
+
+    try:
+        loaded = trimesh.load(path, force=None, process=False)
+    except Exception as exc:  # noqa: BLE001 - any parser failure is a file that is not a scan
+        raise ScanError(f"scan {path}: not a readable mesh or point cloud ({type(exc).__name__}: {exc})") from None
+    if isinstance(loaded, trimesh.Scene):
+        geometries = list(loaded.geometry.values())
+        if not geometries:
+            raise ScanError(f"scan {path}: the file holds no geometry")
+        loaded = trimesh.util.concatenate(geometries) if len(geometries) > 1 else geometries[0]
+    vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float)
+    if vertices.ndim != 2 or vertices.shape[1] != 3 or len(vertices) == 0:
+        raise ScanError(f"scan {path}: no points found")
+    faces = getattr(loaded, "faces", None)
+    return vertices, (None if faces is None or len(faces) == 0 else np.asarray(faces, dtype=np.int64))

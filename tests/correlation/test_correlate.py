@@ -1,0 +1,128 @@
+"""Scan correlation: a synthetic scan (the model's own deformed surface, moved, with noise) is
+put back where it came from, within the noise; a photo trace of unknown scale too."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from pneumorph.cli import main
+from pneumorph.correlation import Scan, Transform, correlate, fit_transform, icp, model_shape, read_scan
+from pneumorph.errors import ScanError
+from pneumorph.fem import StepSettings
+from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
+
+RAMP = RampSpec(0.02, StepSettings(increments=2, substeps=1))
+SIGMA = 0.05  # mm of scanner noise
+
+
+@pytest.fixture(scope="module")
+def shape3d():  # type: ignore[no-untyped-def]
+    return model_shape(Full3D(4, ramp_spec=RAMP).solve("0110"))
+
+
+@pytest.fixture(scope="module")
+def shape2d():  # type: ignore[no-untyped-def]
+    return model_shape(Reduced2D(4, ramp_spec=RAMP).solve("0110"))
+
+
+def test_matched_points_give_the_transform_exactly() -> None:
+    rng = np.random.default_rng(4)
+    p = rng.normal(size=(30, 3))
+    true = Transform(Rotation.from_rotvec([0.4, 0.1, -0.7]).as_matrix(), np.array([3.0, -2.0, 1.0]), 1.7)
+    found = fit_transform(p, true(p), scale=True)
+    assert np.allclose(found.rotation, true.rotation, atol=1e-12)
+    assert np.allclose(found.translation, true.translation, atol=1e-12) and found.scale == pytest.approx(1.7)
+    assert np.linalg.det(found.rotation) == pytest.approx(1.0)
+
+
+def test_a_moved_noisy_3d_scan_is_put_back_within_the_noise(shape3d) -> None:  # type: ignore[no-untyped-def]
+    rng = np.random.default_rng(0)
+    true = Transform(Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix(), np.array([5.0, -3.0, 7.0]))
+    points = shape3d.surface[rng.choice(len(shape3d.surface), 1000, replace=False)]
+    scan = Scan(true(points) + rng.normal(scale=SIGMA, size=points.shape), None, "synthetic")
+    result = correlate(scan, shape3d)
+    back = true.then(result.alignment.transform)  # the identity if the transform was recovered
+    assert back.angle_deg < 0.1 and np.linalg.norm(back.translation) < SIGMA
+    # the surface distances are the noise: RMS sigma*sqrt(3) for 3D Gaussian noise
+    assert result.surface.rms == pytest.approx(SIGMA * np.sqrt(3), rel=0.1)
+    assert result.centreline.count == 4 and result.centreline.max < 3 * SIGMA
+
+
+def test_a_photo_trace_of_unknown_scale_is_aligned_in_the_plane(shape2d) -> None:  # type: ignore[no-untyped-def]
+    rng = np.random.default_rng(1)
+    outline = shape2d.samples[rng.choice(len(shape2d.samples), 800, replace=False)]
+    turn = Rotation.from_rotvec([0.0, 0.0, 0.4]).as_matrix()[:2, :2]
+    pixels = (outline @ turn.T + [10.0, 4.0]) / 0.2 + rng.normal(scale=0.25, size=outline.shape)  # 0.2 mm/px
+    scan = Scan(pixels * 0.2 * 1.03, None, "photo")  # the scale given is 3 % off
+    result = correlate(scan, shape2d, scale=True)
+    t = result.alignment.transform
+    assert t.scale == pytest.approx(1 / 1.03, rel=2e-3)
+    assert t.angle_deg == pytest.approx(np.degrees(0.4), abs=0.1)
+    assert result.outline.rms < 2 * 0.25 * 0.2  # the tracing noise, in mm
+
+
+def test_icp_finds_a_curve_from_any_start() -> None:
+    t = np.linspace(0, 3, 5000)
+    model = np.c_[100 * t / 3, 10 * np.sin(t)]  # sampled every 0.02 mm
+    u = np.random.default_rng(2).uniform(0, 3, 150)  # the scan's points lie between the model's samples
+    curve = np.c_[100 * u / 3, 10 * np.sin(u)]
+    for angle in (0.2, 2.5, -2.0):
+        c, s = np.cos(angle), np.sin(angle)
+        scan = (curve - [5, 1]) @ np.array([[c, s], [-s, c]])
+        tangent = np.gradient(model, axis=0)
+        normals = np.c_[-tangent[:, 1], tangent[:, 0]] / np.linalg.norm(tangent, axis=1, keepdims=True)
+        found = icp(scan, model, normals=normals)
+        # exact up to the 0.02 mm sampling of the model: the points slide along it to the true fit
+        assert found.rms < 0.01 and abs(found.transform.angle_deg - np.degrees(abs(angle))) < 1e-4
+
+
+def test_scans_of_the_wrong_size_or_no_scan_at_all_are_refused(tmp_path: Path, shape3d) -> None:  # type: ignore[no-untyped-def]
+    metres = Scan(shape3d.surface / 1000.0, None, "in-metres")
+    with pytest.raises(ScanError, match="--scan-unit"):
+        correlate(metres, shape3d)
+    empty = tmp_path / "empty.stl"
+    empty.write_bytes(b"")
+    with pytest.raises(ScanError, match="empty"):
+        read_scan(empty)
+    garbage = tmp_path / "garbage.stl"
+    garbage.write_bytes(b"solid nonsense\nthis is not a facet\n" * 3)
+    with pytest.raises(ScanError, match="garbage.stl"):
+        read_scan(garbage)
+    few = tmp_path / "few.csv"
+    few.write_text("x,y\n1,2\n3,4\n", encoding="utf-8")
+    with pytest.raises(ScanError, match="at least 10"):
+        read_scan(few)
+    few.write_text("a,b\n" + "1,2\n" * 12, encoding="utf-8")
+    with pytest.raises(ScanError, match="header"):
+        read_scan(few)
+
+
+def test_a_mesh_scan_round_trips_through_stl(tmp_path: Path, shape3d) -> None:  # type: ignore[no-untyped-def]
+    import trimesh
+
+    cloud = trimesh.PointCloud(shape3d.surface)
+    path = tmp_path / "scan.ply"
+    cloud.export(path)
+    scan = read_scan(path)
+    assert scan.dim == 3 and len(scan.points) == len(shape3d.surface)
+    assert np.allclose(np.sort(scan.points, axis=0), np.sort(shape3d.surface, axis=0), atol=1e-5)
+
+
+def test_correlate_command_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                      shape2d) -> None:  # type: ignore[no-untyped-def]
+    trace = tmp_path / "trace.csv"
+    rows = "".join(f"{x / 0.2:.4f},{y / 0.2:.4f}\n" for x, y in shape2d.samples[::7])
+    trace.write_text("x,y\n" + rows, encoding="utf-8")
+    # the command solves the default ramp (10 levels to the pressure): the same shape at 20 kPa
+    code = main(["correlate", str(trace), "--design", "0110", "--model", "2d", "--pressure", "20",
+                 "--scale", "0.2", "--out", str(tmp_path / "c"), "--json"])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["outline"]["rms_mm"] < 0.05 and abs(data["transform"]["angle_deg"]) < 0.2
+    assert (tmp_path / "c" / "correlation.png").stat().st_size > 0
+    assert json.loads((tmp_path / "c" / "correlation.json").read_text())["provenance"]["fingerprint"]
