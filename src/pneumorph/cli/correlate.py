@@ -68,7 +68,8 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
         return
     t = result.alignment.transform
     click.echo(f"aligned {len(data.points)} scan points: rotation {t.angle_deg:.3f} deg, translation "
-               f"{', '.join(f'{v:.3f}' for v in t.translation)} mm, scale {t.scale:.5g}; ICP RMS {result.alignment.rms:.4g} mm")
+               f"{', '.join(f'{v:.3f}' for v in t.translation)} mm, scale {t.scale:.5g}; "
+               f"ICP RMS {result.alignment.rms:.4g} mm")
     for name, m in (("surface", result.surface), ("outline", result.outline), ("centreline", result.centreline)):
         if m.count:
             click.echo(f"  {name:<10} RMS {m.rms:.4g} mm, max {m.max:.4g} mm ({m.count} points)")
