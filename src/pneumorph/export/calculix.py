@@ -1,0 +1,754 @@
+"""The 3D model as a CalculiX/Abaqus input deck, and CalculiX's displacements read back.
+
+:func:`calculix_deck` writes what :class:`~pneumorph.models.fe.Full3D` solves for one
+design as a ``.inp`` deck: the same mesh (``C3D20`` from FElupe's ``hexahedron20``, or
+``C3D8`` for linear units), one element set and one material per silicone, the clamped
+base (``BASE``: u = 0), the half model's symmetry plane z = width / 2 (``SYMMETRY``:
+u_z = 0), a follower pressure on the cavity walls (``*DLOAD`` ``Pn`` on the element faces
+whose nodes all lie on the cavity walls - the faces FElupe's pressure acts on), and one
+``*STEP, NLGEOM`` whose ``*STATIC`` increments and ``*TIME POINTS`` are the model's
+reported levels. :func:`run_calculix` runs ``ccx`` on it; :func:`read_dat_displacements`
+and :func:`read_frd_displacements` read its displacements and :func:`tip_positions`
+turns them into the tip pneumorph reports (the mean deformed (x, y) of the end-face
+nodes on the mid-plane, ``ActuatorMesh.end_points``, node set ``TIP``).
+
+Node order
+    FElupe's ``hexahedron20`` is VTK's quadratic hexahedron; CalculiX's ``C3D20`` lists
+    the same nodes in the same order (corners of the face zeta = -1, of zeta = +1, the
+    midside nodes of those two faces, then of the four edges along zeta). The permutation
+    is not assumed: :func:`c3d20_permutation` derives it from the natural coordinates of
+    both elements and :func:`check_element_order` checks every element of the deck
+    (midside nodes at the middle of their edges, a positive Jacobian at every corner).
+    C3D20's faces: 1 (zeta = -1), 2 (zeta = +1), 3 (eta = -1), 4 (xi = +1), 5 (eta = +1),
+    6 (xi = -1); a positive ``Pn`` load pushes into the element, so on a cavity wall it
+    inflates the cavity, and it follows the deformed face (as pneumorph's pressure does).
+
+Units
+    mm, Pa and micronewtons (mass in grams): stresses are written in Pa, not MPa.
+    CalculiX's residual test has an absolute floor of 1e-6; in N-mm-MPa this actuator's
+    nodal forces are about 1e-3 N and every increment would "converge" at once, in
+    micronewtons they are about 1e3. Displacements are in mm either way.
+
+Materials
+    pneumorph (Eq 2.12; :class:`pneumorph.fem.OgdenCompressible`) uses
+    ``W = sum mu_n/alpha_n (sum_a lb_a^alpha_n - 3) + 9/2 K (J^(1/3) - 1)^2`` with the
+    published (Marc) moduli ``mu_n`` and the isochoric stretches ``lb``. CalculiX writes
+    ``U = sum 2 mu_i/alpha_i^2 (sum_a lb_a^alpha_i - 3) + sum_i (J - 1)^(2i)/D_i``, so
+    ``mu_ccx = mu_marc alpha / 2`` (the exponents are the same), ``D1 = 2/K``, and ``D2``
+    and ``D3`` are written as 1e30 (CalculiX replaces a zero by ``(0.1/mu0)^i``, which
+    would add a volumetric term of its own). The deviatoric parts are then identical; the
+    volumetric parts are not and the format has no way to write ours: CalculiX's pressure
+    is ``K (J - 1)``, Eq 2.12's is ``3K (J^(-1/3) - J^(-2/3))``. Both have the slope K at
+    J = 1, but Mold Star 15 is compressible (K = 0.119 MPa, nu0 about 0.1) and J reaches
+    1.37 in its walls, where CalculiX's term is stiffer: CalculiX's tip moves 4.9-5.2 %
+    less at 20 kPa (``shared/notes/calculix-facts.md``; with the same volumetric term in
+    both codes the tips agree to 0.006 %). The test and ``benchmarks/calculix.py`` record
+    the difference measured here.
+
+Not written: gravity (:class:`~pneumorph.models.fe.Full3D` with ``gravity`` is refused),
+the end-face rotation (curl) and the cavity volume pneumorph also reports.
+
+Examples
+--------
+>>> from pneumorph.models.fe import Full3D, RampSpec
+>>> deck = calculix_deck(Full3D(1, ramp_spec=RampSpec(pressure=0.02)), "0")
+>>> [line for line in deck.splitlines() if line.startswith("*ELEMENT")]
+['*ELEMENT, TYPE=C3D20, ELSET=EALL']
+>>> deck.count("*MATERIAL"), "*HYPERELASTIC, OGDEN, N=3" in deck
+(2, True)
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph import __version__
+from pneumorph.errors import (
+    DataFormatError,
+    GeometryError,
+    MaterialDataError,
+    SettingsError,
+    SimulationFailed,
+)
+from pneumorph.geometry.assembly import ActuatorMesh, assemble
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.io.files import atomic_write_text, check_writable_file
+from pneumorph.materials.hyperelastic import Ogden
+
+__all__ = [
+    "C3D20_FACES",
+    "C3D20_NATURAL",
+    "CalculixResult",
+    "NodalDisplacements",
+    "c3d20_permutation",
+    "calculix_deck",
+    "cavity_faces",
+    "check_element_order",
+    "read_dat_displacements",
+    "read_frd_displacements",
+    "run_calculix",
+    "tip_positions",
+    "write_calculix_deck",
+]
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: Stress in the deck per MPa (the deck is in mm, Pa and micronewtons).
+PA_PER_MPA = 1.0e6
+#: D2 and D3 of the Ogden entry: large enough that only D1 acts (0 would not do, see above).
+HUGE_D = 1.0e30
+
+#: Natural coordinates (xi, eta, zeta) of C3D20's nodes 1..20 (CalculiX/Abaqus manuals).
+C3D20_NATURAL: tuple[tuple[float, float, float], ...] = (
+    (-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),
+    (-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1),
+    (0, -1, -1), (1, 0, -1), (0, 1, -1), (-1, 0, -1),
+    (0, -1, 1), (1, 0, 1), (0, 1, 1), (-1, 0, 1),
+    (-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0),
+)
+
+#: C3D20's faces as (natural axis, side): face 1 is zeta = -1, ..., face 6 is xi = -1.
+_FACE_PLANES = {1: (2, -1), 2: (2, 1), 3: (1, -1), 4: (0, 1), 5: (1, 1), 6: (0, -1)}
+
+#: Nodes (0-based, C3D20 order) of each face, the manuals' listing: 1-2-3-4, 5-8-7-6,
+#: 1-5-6-2, 2-6-7-3, 3-7-8-4, 4-8-5-1 and their midside nodes; checked against
+#: :data:`C3D20_NATURAL` in the tests.
+C3D20_FACES: dict[int, tuple[int, ...]] = {
+    1: (0, 1, 2, 3, 8, 9, 10, 11),
+    2: (4, 7, 6, 5, 15, 14, 13, 12),
+    3: (0, 4, 5, 1, 16, 12, 17, 8),
+    4: (1, 5, 6, 2, 17, 13, 18, 9),
+    5: (2, 6, 7, 3, 18, 14, 19, 10),
+    6: (3, 7, 4, 0, 19, 15, 16, 11),
+}
+
+#: The 12 edges as (corner, corner, midside), 0-based C3D20 numbering.
+C3D20_EDGES: tuple[tuple[int, int, int], ...] = (
+    (0, 1, 8), (1, 2, 9), (2, 3, 10), (3, 0, 11),
+    (4, 5, 12), (5, 6, 13), (6, 7, 14), (7, 4, 15),
+    (0, 4, 16), (1, 5, 17), (2, 6, 18), (3, 7, 19),
+)
+
+_ELEMENT_TYPES = {"hexahedron20": "C3D20", "hexahedron": "C3D8"}
+
+
+def c3d20_permutation() -> IntArray:
+    """``perm`` with C3D20 node ``k`` (0-based) = FElupe ``hexahedron20`` node ``perm[k]``.
+
+    Derived by matching the natural coordinates of FElupe's element to
+    :data:`C3D20_NATURAL`; the two orders coincide, so this is ``0, 1, ..., 19``.
+
+    Raises
+    ------
+    GeometryError
+        If FElupe's element has nodes that C3D20 has not (a changed FElupe element).
+
+    Examples
+    --------
+    >>> c3d20_permutation().tolist() == list(range(20))
+    True
+    """
+    import felupe as fem
+
+    felupe_points = np.asarray(fem.QuadraticHexahedron().points, dtype=float)
+    natural = np.asarray(C3D20_NATURAL, dtype=float)
+    d = np.abs(natural[:, None, :] - felupe_points[None, :, :]).sum(axis=-1)
+    perm = np.argmin(d, axis=1)
+    if not (np.allclose(d[np.arange(20), perm], 0.0) and len(set(perm.tolist())) == 20):
+        raise GeometryError("FElupe's hexahedron20 nodes do not match C3D20's natural coordinates")
+    return perm.astype(np.int64)
+
+
+def _corner_jacobians(x: FloatArray) -> FloatArray:
+    """det of dx/d(xi) of the trilinear corner map at each of the 8 corners, shape (c, 8)."""
+    signs = np.asarray(C3D20_NATURAL[:8], dtype=float)  # (8, 3)
+    dets = []
+    for corner in signs:
+        # derivatives of N_i = 1/8 prod(1 + s_i r) at r = corner
+        dN = np.empty((8, 3))
+        for a in range(3):
+            others = [b for b in range(3) if b != a]
+            dN[:, a] = signs[:, a] / 8 * np.prod(1 + signs[:, others] * corner[others], axis=1)
+        jac = np.einsum("cid,ie->cde", x[:, :8], dN)
+        dets.append(np.linalg.det(jac))
+    return np.stack(dets, axis=1)
+
+
+def check_element_order(points: FloatArray, cells: IntArray) -> None:
+    """Check that ``cells`` are valid C3D20 (or C3D8) connectivities of straight-edged elements.
+
+    Every element must have a positive Jacobian at each corner (CalculiX refuses a
+    negative one) and, for 20 nodes, each midside node at the middle of the edge C3D20
+    puts it on (:data:`C3D20_EDGES`).
+
+    Parameters
+    ----------
+    points : ndarray, shape (p, 3)
+    cells : ndarray, shape (c, 20) or (c, 8)
+        0-based node indices in C3D20 order.
+
+    Raises
+    ------
+    GeometryError
+        Naming the first element (1-based, as in the deck) that fails.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pts = np.array(C3D20_NATURAL, dtype=float)
+    >>> check_element_order(pts, np.arange(20)[None])
+    >>> check_element_order(pts, np.arange(20)[None][:, [1, 0, *range(2, 20)]])
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.GeometryError: element 1: ...
+    """
+    x = np.asarray(points, dtype=float)[np.asarray(cells)]
+    dets = _corner_jacobians(x)
+    bad = np.flatnonzero((dets <= 0).any(axis=1))
+    if bad.size:
+        raise GeometryError(f"element {bad[0] + 1}: a non-positive Jacobian at a corner; the nodes are not "
+                            "in C3D20 order (bottom face counter-clockwise seen from the top face)")
+    if x.shape[1] == 20:
+        size = np.ptp(x, axis=1).max(axis=1)
+        for a, b, m in C3D20_EDGES:
+            off = np.linalg.norm(x[:, m] - (x[:, a] + x[:, b]) / 2, axis=1)
+            wrong = np.flatnonzero(off > 1e-9 * size)
+            if wrong.size:
+                raise GeometryError(f"element {wrong[0] + 1}: node {m + 1} is not the middle of the edge of "
+                                    f"nodes {a + 1}-{b + 1}; the node order is not C3D20's")
+
+
+def _face_nodes(n_nodes: int) -> dict[int, tuple[int, ...]]:
+    return C3D20_FACES if n_nodes == 20 else {k: v[:4] for k, v in C3D20_FACES.items()}
+
+
+def cavity_faces(cells: IntArray, cavity_points: NDArray[np.bool_]) -> tuple[IntArray, IntArray]:
+    """The element faces the cavity pressure acts on: on the surface, all nodes on the cavity walls.
+
+    The rule of pneumorph's pressure (FElupe's boundary region with the mask
+    ``ActuatorMesh.cavity_points``): a face that belongs to one element only and whose
+    nodes all lie on the cavity walls.
+
+    Parameters
+    ----------
+    cells : ndarray, shape (c, 20) or (c, 8)
+        Connectivity in C3D20 (C3D8) order.
+    cavity_points : ndarray of bool, shape (p,)
+
+    Returns
+    -------
+    elements : ndarray
+        0-based element index of each loaded face.
+    faces : ndarray
+        Its C3D20 face number (1..6).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cells = np.arange(20)[None]
+    >>> mask = np.zeros(20, bool); mask[list(C3D20_FACES[4])] = True
+    >>> cavity_faces(cells, mask)
+    (array([0]), array([4]))
+    """
+    cells = np.asarray(cells)
+    table = _face_nodes(cells.shape[1])
+    numbers = np.array(sorted(table))
+    nodes = np.stack([cells[:, list(table[k])] for k in numbers], axis=1)  # (c, 6, m)
+    flat = np.sort(nodes.reshape(-1, nodes.shape[-1]), axis=1)
+    _, inverse, counts = np.unique(flat, axis=0, return_inverse=True, return_counts=True)
+    on_surface = counts[inverse.ravel()] == 1
+    on_wall = np.asarray(cavity_points, dtype=bool)[flat].all(axis=1)
+    chosen = np.flatnonzero(on_surface & on_wall)
+    return (chosen // len(numbers)).astype(np.int64), numbers[chosen % len(numbers)].astype(np.int64)
+
+
+def _check_model(model: Any) -> None:
+    from pneumorph.models.fe import Full3D
+
+    if not isinstance(model, Full3D):
+        raise SettingsError(f"a CalculiX deck is written for the 3D model (Full3D), got {type(model).__name__}")
+    if model.gravity is not None:
+        raise SettingsError("the CalculiX deck does not include gravity; export the model without gravity")
+
+
+def _ogden_line(material: Any, role: str) -> list[str]:
+    """The *MATERIAL block of one silicone in the deck's units."""
+    model = material.model
+    if not isinstance(model, Ogden):
+        raise MaterialDataError(f"{role} material {material.name!r}: the deck writes Ogden materials, "
+                                f"got {type(model).__name__}")
+    if model.terms > 3:
+        raise MaterialDataError(f"{role} material {material.name!r}: CalculiX's Ogden takes at most 3 terms, "
+                                f"got {model.terms}")
+    if material.bulk_modulus is None:
+        raise MaterialDataError(f"{role} material {material.name!r}: no bulk modulus; the deck needs one")
+    k = material.bulk_modulus.value
+    values = []
+    for mu, alpha in zip(model.mu, model.alpha):
+        values += [mu * alpha / 2.0 * PA_PER_MPA, alpha]
+    d = [2.0 / (k * PA_PER_MPA)] + [HUGE_D] * (model.terms - 1)
+    values += d
+    name = f"{role.upper()}_{material.name.upper()}"[:80]
+    lines = [
+        f"** {role}: {material.display_name} ({material.name}), K {k} MPa",
+        f"** Marc convention (MPa): mu {list(model.mu)}, alpha {list(model.alpha)}",
+        f"** mu_ccx = mu_marc * alpha / 2 in Pa, D1 = 2 / K (1/Pa), D2 = D3 = {HUGE_D:g} (inactive)",
+        f"*MATERIAL, NAME={name}",
+        f"*HYPERELASTIC, OGDEN, N={model.terms}",
+    ]
+    lines += _rows((_num(v) for v in values), 8)
+    lines.append(f"*SOLID SECTION, ELSET={role.upper()}, MATERIAL={name}")
+    return lines
+
+
+def _num(v: float) -> str:
+    return format(float(v), ".15g")
+
+
+def _rows(items: Iterable[str], per_line: int) -> list[str]:
+    items = list(items)
+    return [", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line)]
+
+
+def _nset(name: str, indices: Iterable[int]) -> list[str]:
+    ids = [str(int(i) + 1) for i in indices]
+    if not ids:
+        raise GeometryError(f"node set {name} is empty")
+    return [f"*NSET, NSET={name}", *_rows(ids, 16)]
+
+
+def calculix_mesh(model: Any, design: str) -> ActuatorMesh:
+    """The mesh :meth:`Full3D.build` would solve for ``design`` (without FElupe's objects)."""
+    _check_model(model)
+    design = parse_orientation(design, model.n_units)
+    return assemble(model.unit, design, 3, half=model.half)
+
+
+def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
+    """The CalculiX/Abaqus input deck of one design of a 3D model.
+
+    Parameters
+    ----------
+    model : Full3D
+        The 3D model: unit, materials, half or full, pressure ramp (its reported levels
+        become the step's increments and output times).
+    design : str
+        The orientation vector, one digit per unit (``"0101..."``).
+    full_output : bool
+        Also write every node's displacement at every level to the ``.frd`` file
+        (``*NODE FILE``); the tip nodes always go to the ``.dat`` file (``*NODE PRINT``).
+
+    Returns
+    -------
+    str
+        The deck, in mm, Pa and micronewtons (see the module's notes).
+
+    Raises
+    ------
+    OrientationError
+        If ``design`` is not 0/1 digits, one per unit of ``model``.
+    SettingsError
+        If ``model`` is not a :class:`~pneumorph.models.fe.Full3D` or has gravity.
+    MaterialDataError
+        If a silicone is not Ogden with at most three terms and a bulk modulus.
+    GeometryError
+        If an element is not in C3D20 order (never for pneumorph's meshes) or the mesh
+        has no cavity faces.
+
+    Examples
+    --------
+    >>> from pneumorph.models.fe import Full3D, RampSpec
+    >>> deck = calculix_deck(Full3D(2, ramp_spec=RampSpec(pressure=0.01)), "01")
+    >>> deck.count("\\n*NODE\\n"), "*BOUNDARY" in deck, "NLGEOM" in deck
+    (1, True, True)
+    """
+    mesh = calculix_mesh(model, design)
+    if mesh.cell_type not in _ELEMENT_TYPES:  # pragma: no cover - assemble makes hexahedra in 3D
+        raise GeometryError(f"no CalculiX element for {mesh.cell_type!r} cells")
+    etype = _ELEMENT_TYPES[mesh.cell_type]
+    cells = mesh.cells[:, c3d20_permutation()] if etype == "C3D20" else mesh.cells
+    check_element_order(mesh.points, cells)
+    elements, faces = cavity_faces(cells, mesh.cavity_points)
+    if elements.size == 0:
+        raise GeometryError("the mesh has no cavity faces to load")
+    levels = model.ramp.steps.levels()
+    pressure_pa = model.ramp.pressure * PA_PER_MPA
+    dt = float(np.min(np.diff(np.concatenate([[0.0], levels]))))
+
+    halves = "half model, u_z = 0 on z = width/2" if model.half else "full model"
+    out = [
+        f"** pneumorph {__version__}: CalculiX/Abaqus deck of the 3D model (Full3D)",
+        f"** design {mesh.orientation} ({mesh.n_units} unit{'s' if mesh.n_units > 1 else ''}), {halves}, fingerprint {model.fingerprint()}",
+        f"** units: mm, Pa, micronewtons; pressure {model.ramp.pressure * 1e3:g} kPa in {len(levels)} levels",
+        "** tip = mean (x, y) of x + u over node set TIP (the end face on the mid-plane), as pneumorph's",
+        "** volumetric term: CalculiX (J-1)^2/D1, pneumorph 9/2 K (J^(1/3)-1)^2 (Eq 2.12);",
+        "** CalculiX's tip moves about 5 % less (see pneumorph.export.calculix)",
+        "*HEADING",
+        f"pneumorph design {mesh.orientation}",
+        "*NODE",
+    ]
+    out += [f"{i + 1}, {_num(x)}, {_num(y)}, {_num(z)}" for i, (x, y, z) in enumerate(mesh.points)]
+    out.append(f"*ELEMENT, TYPE={etype}, ELSET=EALL")
+    first = 15 if cells.shape[1] == 20 else cells.shape[1]  # 16 entries on a line at most
+    for e, conn in enumerate(cells + 1):
+        ids = [str(e + 1), *(str(n) for n in conn)]
+        out.append(", ".join(ids[: first + 1]) + ("," if len(ids) > first + 1 else ""))
+        if len(ids) > first + 1:
+            out.append(", ".join(ids[first + 1:]))
+    for region in ("body", "layer"):
+        ids = [str(int(i) + 1) for i in mesh.regions[region]]
+        out += [f"*ELSET, ELSET={region.upper()}", *_rows(ids, 16)]
+    out += _nset("BASE", np.flatnonzero(mesh.base_points))
+    if mesh.symmetry_points is not None:
+        out += _nset("SYMMETRY", np.flatnonzero(mesh.symmetry_points))
+    out += _nset("TIP", mesh.end_points)
+    out += _ogden_line(model.body, "body")
+    out += _ogden_line(model.layer, "layer")
+    out += ["*BOUNDARY", "BASE, 1, 3, 0."]
+    if mesh.symmetry_points is not None:
+        out.append("SYMMETRY, 3, 3, 0.")
+    out += ["*AMPLITUDE, NAME=RAMP", "0., 0., 1., 1."]
+    out += ["*TIME POINTS, NAME=LEVELS", *_rows((_num(t) for t in levels), 8)]
+    out += [
+        "*STEP, NLGEOM, INC=10000",
+        "*STATIC",
+        f"{_num(dt)}, 1., {_num(dt * 1e-5)}, {_num(dt)}",
+        "** follower pressure on the cavity walls: element, face (C3D20 numbering), Pa",
+        "*DLOAD, AMPLITUDE=RAMP",
+    ]
+    out += [f"{e + 1}, P{f}, {_num(pressure_pa)}" for e, f in zip(elements, faces)]
+    out += ["*NODE PRINT, NSET=TIP, TIME POINTS=LEVELS", "U"]
+    if full_output:
+        out += ["*NODE FILE, TIME POINTS=LEVELS", "U"]
+    out += ["*END STEP", ""]
+    return "\n".join(out)
+
+
+def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *, full_output: bool = True) -> Path:
+    """Write :func:`calculix_deck` to ``path`` atomically (the old file or the complete new one).
+
+    Parameters
+    ----------
+    model : Full3D
+    design : str
+    path : str or path-like
+        The ``.inp`` file; its folder must exist. CalculiX names its outputs after it
+        (``job.inp`` -> ``job.dat``, ``job.frd``).
+    full_output : bool
+        See :func:`calculix_deck`.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    OutputPathError
+        If ``path`` is a folder, read-only, or under a file.
+    OrientationError, SettingsError, MaterialDataError, GeometryError
+        As :func:`calculix_deck`.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from pneumorph.models.fe import Full3D, RampSpec
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.inp"
+    >>> write_calculix_deck(Full3D(1, ramp_spec=RampSpec(pressure=0.01)), "1", p).name
+    'a.inp'
+    """
+    target = check_writable_file(path, "deck")
+    text = calculix_deck(model, design, full_output=full_output)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    return atomic_write_text(target, text)
+
+
+# -- reading CalculiX's results ------------------------------------------------------------
+
+@dataclass(frozen=True)
+class NodalDisplacements:
+    """Displacements of some nodes at one output time.
+
+    Attributes
+    ----------
+    time : float
+        Step time (the load factor: 1 = the full pressure).
+    nodes : ndarray of int
+        Node numbers as in the deck (1-based).
+    values : ndarray, shape (m, 3)
+        Displacements (mm).
+    """
+
+    time: float
+    nodes: IntArray
+    values: FloatArray
+
+
+_DAT_HEADER = re.compile(r"^\s*displacements \(vx,vy,vz\) for set (\S+) and time\s+(\S+)", re.IGNORECASE)
+
+
+def read_dat_displacements(path: str | os.PathLike[str], nset: str = "TIP") -> list[NodalDisplacements]:
+    """The ``*NODE PRINT`` displacement blocks of node set ``nset`` in a CalculiX ``.dat`` file.
+
+    Parameters
+    ----------
+    path : str or path-like
+    nset : str
+        The node set (case-insensitive).
+
+    Returns
+    -------
+    list of NodalDisplacements
+        In file order (increasing time).
+
+    Raises
+    ------
+    DataFormatError
+        If the file is missing, or a line of a block is not ``node ux uy uz``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.dat"
+    >>> _ = p.write_text(" displacements (vx,vy,vz) for set TIP and time  0.5000000E+00\\n\\n"
+    ...                  "         7  1.0E-01 -2.0E-01  0.0E+00\\n")
+    >>> r = read_dat_displacements(p)
+    >>> r[0].time, r[0].nodes.tolist(), r[0].values.tolist()
+    (0.5, [7], [[0.1, -0.2, 0.0]])
+    """
+    p = Path(path)
+    try:
+        lines = p.read_text(errors="replace").splitlines()
+    except OSError as exc:
+        raise DataFormatError(f"cannot read CalculiX results: {exc.strerror or exc}", path=str(p)) from None
+    out: list[NodalDisplacements] = []
+    i = 0
+    while i < len(lines):
+        m = _DAT_HEADER.match(lines[i])
+        i += 1
+        if not m or m.group(1).upper() != nset.upper():
+            continue
+        t = float(m.group(2))
+        nodes, values = [], []
+        while i < len(lines) and not lines[i].strip():
+            i += 1
+        while i < len(lines) and lines[i].strip():
+            parts = lines[i].split()
+            try:
+                if len(parts) != 4:
+                    raise ValueError
+                nodes.append(int(parts[0]))
+                values.append([float(v) for v in parts[1:]])
+            except ValueError:
+                raise DataFormatError(f"expected 'node ux uy uz', got {lines[i].strip()!r}", path=str(p),
+                                      row=i + 1) from None
+            i += 1
+        out.append(NodalDisplacements(t, np.asarray(nodes, dtype=np.int64), np.asarray(values, dtype=float)))
+    return out
+
+
+def read_frd_displacements(path: str | os.PathLike[str], nodes: Sequence[int] | None = None
+                           ) -> list[NodalDisplacements]:
+    """The ``DISP`` result blocks of a CalculiX ``.frd`` file (ASCII).
+
+    Parameters
+    ----------
+    path : str or path-like
+    nodes : sequence of int, optional
+        Keep these node numbers (1-based) only; all by default.
+
+    Returns
+    -------
+    list of NodalDisplacements
+        One per output time, in file order.
+
+    Raises
+    ------
+    DataFormatError
+        If the file is missing or a result line cannot be read.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.frd"
+    >>> _ = p.write_text("  100CL  101 1.000000000           1                     0    1           1\\n"
+    ...                  " -4  DISP        4    1\\n"
+    ...                  " -1         3 1.00000E-01-2.00000E-01 0.00000E+00\\n -3\\n")
+    >>> r = read_frd_displacements(p)
+    >>> r[0].time, r[0].nodes.tolist(), r[0].values.tolist()
+    (1.0, [3], [[0.1, -0.2, 0.0]])
+    """
+    p = Path(path)
+    keep = None if nodes is None else {int(n) for n in nodes}
+    try:
+        fh = p.open(errors="replace")
+    except OSError as exc:
+        raise DataFormatError(f"cannot read CalculiX results: {exc.strerror or exc}", path=str(p)) from None
+    out: list[NodalDisplacements] = []
+    t = float("nan")
+    block: tuple[list[int], list[list[float]]] | None = None
+    with fh:
+        for row, line in enumerate(fh, start=1):
+            key = line[:3].strip()
+            if line[2:6] == "100C":  # result block header: the time follows the set number
+                try:
+                    t = float(line[12:24])
+                except ValueError:
+                    raise DataFormatError(f"cannot read the time in {line.strip()!r}", path=str(p),
+                                          row=row) from None
+            elif key == "-4":
+                block = ([], []) if line[5:13].strip() == "DISP" else None
+            elif block is not None and key == "-1":
+                try:
+                    n = int(line[3:13])
+                    vals = [float(line[13 + 12 * k: 25 + 12 * k]) for k in range(3)]
+                except ValueError:
+                    raise DataFormatError(f"cannot read the result line {line.rstrip()!r}", path=str(p),
+                                          row=row) from None
+                if keep is None or n in keep:
+                    block[0].append(n)
+                    block[1].append(vals)
+            elif block is not None and key == "-3":
+                out.append(NodalDisplacements(t, np.asarray(block[0], dtype=np.int64),
+                                              np.asarray(block[1], dtype=float).reshape(-1, 3)))
+                block = None
+    return out
+
+
+def tip_positions(results: Sequence[NodalDisplacements], mesh: ActuatorMesh) -> tuple[FloatArray, FloatArray]:
+    """The tip pneumorph reports - mean deformed (x, y) of ``mesh.end_points`` - at each time.
+
+    Parameters
+    ----------
+    results : sequence of NodalDisplacements
+        From :func:`read_dat_displacements` (node set ``TIP``) or
+        :func:`read_frd_displacements`; node numbers are the mesh's indices + 1.
+    mesh : ActuatorMesh
+        The mesh the deck was written from (:func:`calculix_mesh`).
+
+    Returns
+    -------
+    times : ndarray, shape (k,)
+    tip : ndarray, shape (k, 2)
+        mm, as :attr:`pneumorph.models.response.Response.tip`.
+
+    Raises
+    ------
+    DataFormatError
+        If a result lacks one of the end-face nodes.
+    """
+    wanted = mesh.end_points + 1
+    x0 = mesh.points[mesh.end_points][:, :2]
+    times, tips = [], []
+    for r in results:
+        where = {int(n): k for k, n in enumerate(r.nodes)}
+        missing = [int(n) for n in wanted if int(n) not in where]
+        if missing:
+            raise DataFormatError(f"the results at time {r.time:g} lack end-face node(s) {missing[:5]}")
+        u = r.values[[where[int(n)] for n in wanted]][:, :2]
+        times.append(r.time)
+        tips.append((x0 + u).mean(axis=0))
+    return np.asarray(times, dtype=float), np.asarray(tips, dtype=float).reshape(-1, 2)
+
+
+# -- running CalculiX -------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class CalculixResult:
+    """What :func:`run_calculix` found.
+
+    Attributes
+    ----------
+    deck : Path
+        The ``.inp`` file run (``.dat`` and ``.frd`` beside it).
+    pressures : ndarray, shape (k,)
+        The pressures (MPa) of the output times, as ``Response.pressures``.
+    tip : ndarray, shape (k, 2)
+        The tip (mm) at those pressures, as ``Response.tip``.
+    wall_time_s : float
+        Time ``ccx`` took.
+    log : str
+        Its standard output and error.
+    """
+
+    deck: Path
+    pressures: FloatArray
+    tip: FloatArray
+    wall_time_s: float
+    log: str
+
+
+def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, executable: str = "ccx",
+                 threads: int | None = None, timeout: float | None = None, full_output: bool = False
+                 ) -> CalculixResult:
+    """Write the deck of ``design`` into ``folder``, run CalculiX on it and read the tip.
+
+    Parameters
+    ----------
+    model : Full3D
+    design : str
+    folder : str or path-like
+        Where ``design.inp`` and CalculiX's outputs go (created if needed).
+    executable : str
+        The CalculiX program (``ccx`` on Debian's ``calculix-ccx``).
+    threads : int, optional
+        ``OMP_NUM_THREADS`` and ``CCX_NPROC_EQUATION_SOLVER`` for ``ccx`` (default: the
+        environment's, else 1).
+    timeout : float, optional
+        Seconds before ``ccx`` is stopped.
+    full_output : bool
+        Also write all displacements to the ``.frd`` file.
+
+    Returns
+    -------
+    CalculixResult
+
+    Raises
+    ------
+    SettingsError
+        If ``executable`` is not found.
+    SimulationFailed
+        If ``ccx`` stops with an error, times out, or does not reach the full pressure.
+    """
+    exe = shutil.which(executable)
+    if exe is None:
+        raise SettingsError(f"CalculiX ({executable!r}) is not on the PATH; on Debian: apt-get install calculix-ccx")
+    design = parse_orientation(design, getattr(model, "n_units", None))
+    out_dir = Path(folder)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    deck = write_calculix_deck(model, design, out_dir / f"design_{design}.inp", full_output=full_output)
+    dat, frd = deck.with_suffix(".dat"), deck.with_suffix(".frd")
+    for old in (dat, frd):
+        old.unlink(missing_ok=True)
+    env = dict(os.environ)
+    n = str(threads) if threads is not None else env.get("OMP_NUM_THREADS", "1")
+    env.update(OMP_NUM_THREADS=n, CCX_NPROC_EQUATION_SOLVER=n)
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.run([exe, "-i", deck.stem], cwd=out_dir, env=env, capture_output=True, text=True,
+                              timeout=timeout, check=False)
+    except subprocess.TimeoutExpired:
+        raise SimulationFailed(reached=0.0, cause=f"CalculiX did not finish within {timeout:g} s", design=design,
+                               pressure=model.ramp.pressure) from None
+    wall = time.perf_counter() - t0
+    log = proc.stdout + proc.stderr
+    mesh = calculix_mesh(model, design)
+    times, tip = tip_positions(read_dat_displacements(dat), mesh) if dat.exists() else (np.zeros(0), np.zeros((0, 2)))
+    reached = float(times[-1]) if times.size else 0.0
+    errors = [line.strip() for line in log.splitlines() if "*ERROR" in line]
+    if proc.returncode != 0 or errors or not np.isclose(reached, 1.0):
+        cause = errors[0] if errors else f"ccx exited with {proc.returncode} at load factor {reached:g}"
+        raise SimulationFailed(reached=reached, cause=f"CalculiX: {cause}", design=design,
+                               pressure=model.ramp.pressure)
+    return CalculixResult(deck, times * model.ramp.pressure, tip, wall, log)

@@ -1,0 +1,265 @@
+"""The CalculiX/Abaqus deck of the 3D model: its text always, CalculiX's answer where ``ccx`` is installed.
+
+The deck checks need no CalculiX: node and element counts and connectivity equal the
+model's mesh, the C3D20 node order and face numbering are derived and checked, the loaded
+faces are exactly those pneumorph's pressure acts on, and the materials are converted as
+the module says.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pneumorph.errors import (
+    DataFormatError,
+    GeometryError,
+    OrientationError,
+    OutputPathError,
+    SettingsError,
+)
+from pneumorph.export.calculix import (
+    C3D20_FACES,
+    C3D20_NATURAL,
+    NodalDisplacements,
+    c3d20_permutation,
+    calculix_deck,
+    calculix_mesh,
+    cavity_faces,
+    check_element_order,
+    read_dat_displacements,
+    tip_positions,
+    write_calculix_deck,
+)
+from pneumorph.fem import StepSettings
+from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
+
+#: 20 kPa in 4 levels: the notes' pressure, few levels to keep ccx short
+RAMP = RampSpec(pressure=0.02, steps=StepSettings(increments=4, substeps=1, max_iterations=25))
+
+
+def parse_deck(text: str) -> list[tuple[str, list[str]]]:
+    """Keyword blocks of a deck, in order: (keyword line, data lines), comments dropped."""
+    blocks: list[tuple[str, list[str]]] = []
+    for line in text.splitlines():
+        if line.startswith("**") or not line.strip():
+            continue
+        if line.startswith("*"):
+            blocks.append((line, []))
+        else:
+            blocks[-1][1].append(line)
+    return blocks
+
+
+def block(blocks, prefix: str) -> list[str]:
+    found = [data for key, data in blocks if key.upper().startswith(prefix.upper())]
+    assert len(found) == 1, f"{prefix}: {len(found)} blocks"
+    return found[0]
+
+
+def ids(lines: list[str]) -> list[int]:
+    return [int(v) for line in lines for v in line.split(",") if v.strip()]
+
+
+def elements(lines: list[str], n_nodes: int) -> np.ndarray:
+    """C3D20 connectivity (1-based) from *ELEMENT lines, continuation lines joined."""
+    flat = ids(lines)
+    return np.asarray(flat).reshape(-1, n_nodes + 1)
+
+
+@pytest.fixture(scope="module")
+def one_unit():
+    model = Full3D(1, ramp_spec=RAMP)
+    text = calculix_deck(model, "0")
+    return model, text, parse_deck(text)
+
+
+# -- node order and faces -------------------------------------------------------------------
+
+def test_felupe_hexahedron20_is_c3d20_node_for_node() -> None:
+    import felupe as fem
+
+    perm = c3d20_permutation()
+    assert perm.tolist() == list(range(20))
+    assert np.array_equal(np.asarray(fem.QuadraticHexahedron().points)[perm], np.asarray(C3D20_NATURAL, float))
+
+
+def test_face_table_follows_the_natural_coordinates_and_points_into_the_element() -> None:
+    natural = np.asarray(C3D20_NATURAL, dtype=float)
+    planes = {1: (2, -1), 2: (2, 1), 3: (1, -1), 4: (0, 1), 5: (1, 1), 6: (0, -1)}
+    for face, nodes in C3D20_FACES.items():
+        axis, side = planes[face]
+        assert set(nodes) == set(np.flatnonzero(natural[:, axis] == side).tolist())
+        a, b, _, d = natural[list(nodes[:4])]
+        inward = np.cross(b - a, d - a)  # the manuals list each face with its normal inwards
+        assert np.dot(inward, -side * np.eye(3)[axis]) > 0  # towards the centre, xi = eta = zeta = 0
+        # midside nodes between consecutive corners
+        corners = nodes[:4]
+        for k in range(4):
+            mid = natural[nodes[4 + k]]
+            assert np.allclose(mid, (natural[corners[k]] + natural[corners[(k + 1) % 4]]) / 2)
+
+
+def test_a_known_element_passes_and_a_mirrored_one_is_refused() -> None:
+    import felupe as fem
+
+    mesh = fem.Cube(n=2).add_midpoints_edges()  # one hexahedron20 on the unit cube
+    cells = np.asarray(mesh.cells)[:, c3d20_permutation()]
+    check_element_order(mesh.points, cells)
+    # its corners in C3D20 order: node 1 at the origin, 2 along x, 4 along y, 5 along z
+    x = np.asarray(mesh.points)[cells[0]]
+    assert np.allclose(x[[0, 1, 3, 4]], [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    mirrored = cells[:, [4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11, 16, 17, 18, 19]]
+    with pytest.raises(GeometryError, match="element 1: a non-positive Jacobian"):
+        check_element_order(mesh.points, mirrored)
+    swapped = cells.copy()
+    swapped[:, [8, 9]] = swapped[:, [9, 8]]
+    with pytest.raises(GeometryError, match="node 9 is not the middle"):
+        check_element_order(mesh.points, swapped)
+
+
+def test_cavity_faces_of_one_element() -> None:
+    cells = np.arange(20)[None]
+    for face, nodes in C3D20_FACES.items():
+        mask = np.zeros(20, dtype=bool)
+        mask[list(nodes)] = True
+        e, f = cavity_faces(cells, mask)
+        assert e.tolist() == [0] and f.tolist() == [face]
+
+
+# -- the deck's text ----------------------------------------------------------------------
+
+def test_mesh_nodes_and_elements_equal_the_models(one_unit) -> None:
+    model, _, blocks = one_unit
+    built = model.build("0")
+    mesh = built["mesh"]
+    node_lines = next(data for key, data in blocks if key == "*NODE")
+    nodes = np.array([[float(v) for v in line.split(",")] for line in node_lines])
+    assert len(nodes) == len(mesh.points) == 1438
+    assert nodes[:, 0].tolist() == list(range(1, len(mesh.points) + 1))
+    assert np.allclose(nodes[:, 1:], mesh.points, rtol=0, atol=1e-12)
+    conn = elements(block(blocks, "*ELEMENT, TYPE=C3D20"), 20)
+    assert conn.shape == (len(mesh.cells), 21) == (232, 21)
+    assert conn[:, 0].tolist() == list(range(1, len(mesh.cells) + 1))
+    assert np.array_equal(conn[:, 1:] - 1, mesh.cells)  # the identity permutation, node for node
+    check_element_order(nodes[:, 1:], conn[:, 1:] - 1)
+    # element sets: one per material, together all elements once
+    body, layer = ids(block(blocks, "*ELSET, ELSET=BODY")), ids(block(blocks, "*ELSET, ELSET=LAYER"))
+    assert np.array_equal(np.asarray(body) - 1, mesh.regions["body"])
+    assert np.array_equal(np.asarray(layer) - 1, mesh.regions["layer"])
+    assert sorted(body + layer) == list(range(1, len(mesh.cells) + 1))
+
+
+def test_boundary_sets_and_tip(one_unit) -> None:
+    model, _, blocks = one_unit
+    mesh = calculix_mesh(model, "0")
+    base = np.asarray(ids(block(blocks, "*NSET, NSET=BASE"))) - 1
+    sym = np.asarray(ids(block(blocks, "*NSET, NSET=SYMMETRY"))) - 1
+    tip = np.asarray(ids(block(blocks, "*NSET, NSET=TIP"))) - 1
+    assert np.allclose(mesh.points[base, 0], 0.0) and len(base) == mesh.base_points.sum()
+    assert np.allclose(mesh.points[sym, 2], model.unit.width / 2) and len(sym) == mesh.symmetry_points.sum()
+    assert np.array_equal(tip, mesh.end_points)
+    assert block(blocks, "*BOUNDARY") == ["BASE, 1, 3, 0.", "SYMMETRY, 3, 3, 0."]
+
+
+def test_loaded_faces_are_pneumorphs_pressure_faces(one_unit) -> None:
+    """Every (element, Pn) face holds the nodes of one face FElupe's pressure acts on, and all of them."""
+    model, _, blocks = one_unit
+    built = model.build("0")
+    mesh = built["mesh"]
+    felupe_faces = {frozenset(f.tolist()) for f in built["wall_field"][0].region.mesh.cells_faces}
+    conn = elements(block(blocks, "*ELEMENT, TYPE=C3D20"), 20)[:, 1:] - 1
+    loads = block(blocks, "*DLOAD")
+    deck_faces = set()
+    x0, x1, y0, y1 = model.unit.cavity
+    for line in loads:
+        e, face, value = (v.strip() for v in line.split(","))
+        assert re.fullmatch(r"P[1-6]", face) and float(value) == pytest.approx(20e3)  # 20 kPa in Pa
+        nodes = conn[int(e) - 1, list(C3D20_FACES[int(face[1])])]
+        deck_faces.add(frozenset(nodes.tolist()))
+        # the face lies on the cavity's wall, its element outside the cavity: the
+        # element's outward normal points into the cavity, so +P inflates it
+        centre = mesh.points[nodes].mean(axis=0)
+        element_centre = mesh.points[conn[int(e) - 1]].mean(axis=0)
+        inside = (x0 < element_centre[0] < x1) and (y0 < element_centre[1] < y1)
+        assert not (inside and element_centre[2] > model.unit.side_wall)
+        assert x0 - 1e-9 <= centre[0] <= x1 + 1e-9 and y0 - 1e-9 <= centre[1] <= y1 + 1e-9
+    assert deck_faces == felupe_faces and len(loads) == len(felupe_faces)
+    # the loaded area per outward direction is the cavity's (half) walls: floor and
+    # ceiling, the two end walls, the side wall; nothing on the open symmetry plane
+    area: dict[tuple[int, ...], float] = {}
+    for line in loads:
+        e, face, _ = (v.strip() for v in line.split(","))
+        corners = mesh.points[conn[int(e) - 1, list(C3D20_FACES[int(face[1])][:4])]]
+        inward = np.cross(corners[1] - corners[0], corners[3] - corners[0])  # parallelogram faces here
+        key = tuple(np.round(-inward / np.linalg.norm(inward)).astype(int).tolist())
+        area[key] = area.get(key, 0.0) + float(np.linalg.norm(inward))
+    length, height = x1 - x0, y1 - y0
+    depth = model.unit.width / 2 - model.unit.side_wall
+    expected = {(0, 1, 0): length * depth, (0, -1, 0): length * depth, (1, 0, 0): height * depth,
+                (-1, 0, 0): height * depth, (0, 0, 1): length * height}
+    assert area.keys() == expected.keys()
+    for key, value in expected.items():
+        assert area[key] == pytest.approx(value, rel=1e-12), key
+
+
+def test_materials_in_calculix_convention(one_unit) -> None:
+    model, text, blocks = one_unit
+    assert text.count("*MATERIAL") == 2 and text.count("*HYPERELASTIC, OGDEN, N=3") == 2
+    for role, material in (("BODY", model.body), ("LAYER", model.layer)):
+        name = f"{role}_{material.name.upper()}"
+        index = next(i for i, (key, _) in enumerate(blocks) if key == f"*MATERIAL, NAME={name}")
+        _, data = blocks[index + 1]
+        values = [float(v) for line in data for v in line.split(",")]
+        mu, alpha, d = values[0:6:2], values[1:6:2], values[6:]
+        assert alpha == pytest.approx(material.model.alpha, rel=1e-14)
+        assert mu == pytest.approx([m * a / 2 * 1e6 for m, a in zip(material.model.mu, material.model.alpha)])
+        assert sum(mu) == pytest.approx(material.shear_modulus * 1e6)  # CalculiX's mu0 = sum mu_i
+        assert d == pytest.approx([2 / (material.bulk_modulus.value * 1e6), 1e30, 1e30])
+        assert (f"*SOLID SECTION, ELSET={role}, MATERIAL={name}", []) in blocks
+
+
+def test_step_levels_and_outputs(one_unit) -> None:
+    _, text, blocks = one_unit
+    assert "*STEP, NLGEOM, INC=10000" in text
+    static = block(blocks, "*STATIC")
+    assert [float(v) for v in static[0].split(",")] == pytest.approx([0.25, 1.0, 0.25e-5, 0.25])
+    assert [float(v) for v in block(blocks, "*TIME POINTS")[0].split(",")] == [0.25, 0.5, 0.75, 1.0]
+    assert block(blocks, "*NODE PRINT, NSET=TIP, TIME POINTS=LEVELS") == ["U"]
+    assert block(blocks, "*NODE FILE, TIME POINTS=LEVELS") == ["U"]
+    assert block(blocks, "*AMPLITUDE, NAME=RAMP") == ["0., 0., 1., 1."]
+    assert text.rstrip().endswith("*END STEP")
+
+
+def test_write_is_atomic_and_errors_are_specific(tmp_path: Path) -> None:
+    model = Full3D(2, ramp_spec=RAMP)
+    path = write_calculix_deck(model, "01", tmp_path / "a.inp")
+    assert path.read_text() == calculix_deck(model, "01")
+    assert [p.name for p in tmp_path.iterdir()] == ["a.inp"]  # no temporary left behind
+    with pytest.raises(OrientationError):
+        calculix_deck(model, "012")
+    with pytest.raises(OrientationError):
+        calculix_deck(model, "0")
+    with pytest.raises(SettingsError, match="3D model"):
+        calculix_deck(Reduced2D(2, ramp_spec=RAMP), "01")
+    with pytest.raises(SettingsError, match="gravity"):
+        calculix_deck(Full3D(2, ramp_spec=RAMP, gravity="hanging"), "01")
+    with pytest.raises(OutputPathError):
+        write_calculix_deck(model, "01", tmp_path)
+    with pytest.raises(DataFormatError):
+        read_dat_displacements(tmp_path / "missing.dat")
+    bad = tmp_path / "bad.dat"
+    bad.write_text(" displacements (vx,vy,vz) for set TIP and time  0.1E+00\n\n  1 x y z\n")
+    with pytest.raises(DataFormatError, match="row 3"):
+        read_dat_displacements(bad)
+    mesh = calculix_mesh(model, "01")
+    with pytest.raises(DataFormatError, match="lack end-face node"):
+        tip_positions([NodalDisplacements(1.0, np.array([1]), np.zeros((1, 3)))], mesh)
+
+
+def test_full_model_has_no_symmetry_plane() -> None:
+    text = calculix_deck(Full3D(1, ramp_spec=RAMP, half=False), "1")
+    assert "SYMMETRY" not in text and "BASE, 1, 3, 0." in text
