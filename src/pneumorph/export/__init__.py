@@ -1,0 +1,21 @@
+"""Export: the actuator's parts as watertight meshes (STL), its casting mould, and solver decks."""
+
+# Parts and moulds (pneumorph.export.parts, .moulds, .figures).
+from pneumorph.export.parts import (
+    BaseBlock,
+    LayerPiece,
+    actuator_parts,
+    actuator_solids,
+    layer_pieces,
+    write_stl,
+)
+
+__all__ = [
+    # parts and moulds
+    "BaseBlock",
+    "LayerPiece",
+    "actuator_parts",
+    "actuator_solids",
+    "layer_pieces",
+    "write_stl",
+]
