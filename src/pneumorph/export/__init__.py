@@ -1,6 +1,8 @@
 """Export: the actuator's parts as watertight meshes (STL), its casting mould, and solver decks."""
 
 # Parts and moulds (pneumorph.export.parts, .moulds, .figures).
+from pneumorph.export.figures import plot_mould
+from pneumorph.export.moulds import Mould, MouldCheck, MouldSpec, casting_mould
 from pneumorph.export.parts import (
     BaseBlock,
     LayerPiece,
@@ -14,8 +16,13 @@ __all__ = [
     # parts and moulds
     "BaseBlock",
     "LayerPiece",
+    "Mould",
+    "MouldCheck",
+    "MouldSpec",
     "actuator_parts",
     "actuator_solids",
+    "casting_mould",
     "layer_pieces",
+    "plot_mould",
     "write_stl",
 ]

@@ -1,0 +1,560 @@
+"""The casting mould of the Mold Star body, as printable parts that are checked to fit.
+
+How the body is cast
+    The body's cavities are closed voids, and a rigid core cannot be pulled out of a closed
+    void. The body is therefore cast in two pieces in one pour, as Pneu-nets are, and glued
+    together with Sil-Poxy (the dissertation glues its sections the same way, section
+    6.4.1):
+
+    ``open_body``
+        The body above the plane z = ``side_wall`` (its thickness ``width - side_wall``):
+        every cavity opens through that face, where a core stood.
+    ``side_sheet``
+        The rest, the ``side_wall`` thick slab of the body's outline, which closes the
+        cavities when glued on. Before gluing, the 1.5 mm holes between adjacent units
+        (section 6.4.1) are punched through the end walls from the open side.
+
+    Glued back in place the two pieces are the body exactly (:class:`MouldCheck`
+    ``reassembly_error``). The mould lies on its side: z (the actuator's width) is up, the
+    pull direction, and every part is in the actuator's frame (mm), so the mould's pocket
+    is the body itself, not a copy of it.
+
+The parts (:func:`casting_mould`)
+    ``base_plate``
+        ``plate`` thick, under everything; its top is the cavities' open face (z =
+        ``side_wall``). It holds a square pocket for each core's tenon and a blind hole
+        for each pin.
+    ``side_walls``
+        One frame from the base plate to the lid, ``wall`` wide around the pockets: the
+        body's pocket (its outline, staggered where the units turn, with the layer pieces
+        and the slits as walls) through its full height, and beside it a ``side_wall`` deep
+        blind pocket for the side sheet, so that both pieces fill from the same pour and
+        are pressed flat by the same lid. It lifts off upwards: the pocket is a prism along
+        z, so it has no undercut.
+    ``core_01``, ``core_02``, ...
+        One per cavity, its exact box (or, with a draft, tapered towards its tip) standing
+        on a square tenon that drops into the base plate's pocket.
+    ``lid``
+        The plate that closes the open end (section 6.4.1: the mould is overfilled and a
+        plate pressed on forces the excess out; the pressed face is the flattest). It has
+        the pour opening, a ``pour_diameter`` hole over the first unit, and a
+        ``vent_diameter`` hole over the last unit, for each pocket: pour through one,
+        the air and the excess leave through the other.
+    ``pin_1`` ... ``pin_4``
+        Alignment pins (3 mm dowels by default) at the corners, through the side walls
+        into blind holes of the base plate and of the lid.
+
+Clearance and draft
+    ``clearance`` is the gap between mating printed parts only: pins in their holes
+    (radially and at both ends) and the core tenons in their pockets. The faces that touch
+    the silicone are exact (no clearance), so the cast is the body and nothing else: the
+    tenon is set back from the core's root face by more than the clearance, so the gap
+    around it is closed off by the core and cannot fill. ``draft`` tapers the cores, the
+    only parts pulled out of cured silicone that grips them on four sides: the root is the
+    exact cavity and each side face leans in by ``draft`` degrees towards the tip, so a
+    drafted cavity is smaller than designed (:class:`MouldCheck` ``cavity_volume_change``);
+    the outline walls are not drafted (the soft Mold Star 15 strips from straight walls,
+    and a draft there would change the walls the model was designed with; Appendix E:
+    0.1 mm matters). The default draft is 0: the cast is the designed body exactly.
+
+The checks (:class:`MouldCheck`, run by :func:`casting_mould`)
+    - every part is one closed, oriented volume (watertight);
+    - no two parts overlap: every pairwise intersection volume is below the tolerance;
+    - the mould's empty space inside its outer box is the cast (the open body and the
+      side sheet in their pockets), plus the pour and vent openings, plus the clearance
+      gaps around the pins and tenons, boolean for boolean; the gaps do not touch the cast
+      (minimum distance > 0), so no silicone reaches them;
+    - the two cast pieces glued back together are the body (draft 0) or the body with the
+      drafted cavities.
+
+Examples
+--------
+>>> from pneumorph.geometry.unit import UnitSpec
+>>> mould = casting_mould(UnitSpec(), "01")
+>>> sorted(mould.parts)
+['base_plate', 'core_1', 'core_2', 'lid', 'pin_1', 'pin_2', 'pin_3', 'pin_4', 'side_walls']
+>>> c = mould.check
+>>> c.max_overlap < 1e-6, c.cavity_error < 1e-6, c.reassembly_error < 1e-6, c.gap_distance > 0.1
+(True, True, True, True)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from pneumorph.errors import GeometryError
+from pneumorph.export.parts import (
+    _cavity_boxes,
+    actuator_solids,
+    box,
+    outline_solid,
+    to_trimesh,
+)
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.unit import UnitSpec
+
+if TYPE_CHECKING:  # pragma: no cover
+    import manifold3d
+    import trimesh
+
+__all__ = ["Mould", "MouldCheck", "MouldSpec", "casting_mould"]
+
+_OUT = 1.0  # how far cutters reach past the faces they open, mm
+
+
+@dataclass(frozen=True)
+class MouldSpec:
+    """Settings of the casting mould (mm and degrees).
+
+    Parameters
+    ----------
+    clearance : float
+        Gap between mating printed parts: each pin and its holes (radius and ends), each
+        core's tenon and its pocket (default 0.2 mm, for FDM or resin prints; 0 for
+        machined parts fitted by hand). The silicone-facing faces have none.
+    draft : float
+        Taper of the cavity cores, degrees (default 0: exact cavities; 0.5-1 eases pulling
+        the cured body off the cores, at the cost of cavities up to ``depth x tan(draft)``
+        narrower per side at their closed end).
+    wall : float
+        Width of the mould's walls around and between the pockets (default 6 mm).
+    plate : float
+        Thickness of the base plate and of the lid (default 5 mm).
+    pin_diameter : float
+        Alignment pins (default 3 mm, a standard dowel).
+    pin_depth : float
+        How far each pin reaches into the base plate and into the lid (default 3 mm).
+    pour_diameter, vent_diameter : float
+        The holes in the lid over the first and the last unit (default 4 and 2 mm).
+    segments : int
+        Sides of the polygons of the pins and the round holes (default 32).
+
+    Raises
+    ------
+    GeometryError
+        A negative clearance or draft, a draft of 45 degrees or more, a non-positive size,
+        pins whose holes do not fit in the wall or the plates; the message names the
+        parameter.
+
+    Examples
+    --------
+    >>> MouldSpec().clearance, MouldSpec().draft
+    (0.2, 0.0)
+    >>> MouldSpec(clearance=2.0)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.GeometryError: mould clearance 2 mm is too large: a pin hole of 3 + 2 x 2 mm leaves less than 0.5 mm of the 6 mm wall on each side (clearance, pin_diameter, wall)
+    """
+
+    clearance: float = 0.2
+    draft: float = 0.0
+    wall: float = 6.0
+    plate: float = 5.0
+    pin_diameter: float = 3.0
+    pin_depth: float = 3.0
+    pour_diameter: float = 4.0
+    vent_diameter: float = 2.0
+    segments: int = 32
+
+    def __post_init__(self) -> None:
+        for key in ("clearance", "draft", "wall", "plate", "pin_diameter", "pin_depth", "pour_diameter",
+                    "vent_diameter"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise GeometryError(f"mould {key} must be a finite number, got {value!r}")
+        if self.clearance < 0:
+            raise GeometryError(f"mould clearance must be >= 0 mm, got {self.clearance:g} mm")
+        if not 0 <= self.draft < 45:
+            raise GeometryError(f"mould draft must be >= 0 and < 45 degrees, got {self.draft:g}")
+        for key in ("wall", "plate", "pin_diameter", "pin_depth", "pour_diameter", "vent_diameter"):
+            if getattr(self, key) <= 0:
+                raise GeometryError(f"mould {key} must be > 0 mm, got {getattr(self, key):g} mm")
+        if isinstance(self.segments, bool) or not isinstance(self.segments, int) or not 8 <= self.segments <= 256:
+            raise GeometryError(f"mould segments must be a whole number from 8 to 256, got {self.segments!r}")
+        rim = (self.wall - self.pin_diameter - 2 * self.clearance) / 2
+        if rim < 0.5:
+            raise GeometryError(
+                f"mould clearance {self.clearance:g} mm is too large: a pin hole of {self.pin_diameter:g} + 2 x "
+                f"{self.clearance:g} mm leaves less than 0.5 mm of the {self.wall:g} mm wall on each side "
+                "(clearance, pin_diameter, wall)"
+            )
+        if self.pin_depth + self.clearance > self.plate - 0.5:
+            raise GeometryError(
+                f"mould pin_depth {self.pin_depth:g} mm + clearance {self.clearance:g} mm leaves less than 0.5 mm of "
+                f"the {self.plate:g} mm plate under the pin holes (pin_depth, clearance, plate)"
+            )
+
+    @property
+    def tenon_depth(self) -> float:
+        """How deep each core's tenon sits in the base plate: half the plate, mm."""
+        return self.plate / 2
+
+
+@dataclass(frozen=True)
+class MouldCheck:
+    """What :func:`casting_mould` measured on the assembled mould (volumes in mm^3).
+
+    Attributes
+    ----------
+    watertight : dict of str to bool
+        Each part: one closed, oriented volume.
+    max_overlap : float
+        The largest intersection volume of two parts.
+    overlap_pairs : int
+        How many pairs of parts were intersected (those whose bounding boxes overlap).
+    cavity_error : float
+        Volume of the symmetric difference between the mould's empty space (inside its
+        outer box) and the cast + openings + clearance gaps.
+    cast_volume, openings_volume, gaps_volume : float
+        The cast pieces, the pour and vent holes, the clearance gaps.
+    gap_distance : float
+        The smallest distance from a clearance gap to the cast or its openings, mm
+        (positive: the gaps are closed off; at most 10, the search length).
+    reassembly_error : float
+        Volume of the symmetric difference between the two cast pieces glued back and the
+        body as cast: the designed body with the cores' shapes as cavities (the designed
+        body itself when the draft is 0).
+    cavity_volume_change : float
+        The body as cast minus the designed body, mm^3: what the cores' draft adds to the
+        silicone (0 without draft).
+    tolerance : float
+        The volume below which a difference counts as none.
+    """
+
+    watertight: dict[str, bool]
+    max_overlap: float
+    overlap_pairs: int
+    cavity_error: float
+    cast_volume: float
+    openings_volume: float
+    gaps_volume: float
+    gap_distance: float
+    reassembly_error: float
+    cavity_volume_change: float
+    tolerance: float
+
+    @property
+    def ok(self) -> bool:
+        """All checks passed."""
+        return (all(self.watertight.values()) and self.max_overlap <= self.tolerance
+                and self.cavity_error <= self.tolerance and self.reassembly_error <= self.tolerance
+                and self.gap_distance > 0)
+
+    def to_dict(self) -> dict:
+        """Plain values, for JSON."""
+        return {
+            "ok": self.ok,
+            "watertight": dict(self.watertight),
+            "max_overlap_mm3": self.max_overlap,
+            "overlap_pairs": self.overlap_pairs,
+            "cavity_error_mm3": self.cavity_error,
+            "cast_volume_mm3": self.cast_volume,
+            "openings_volume_mm3": self.openings_volume,
+            "gaps_volume_mm3": self.gaps_volume,
+            "gap_distance_mm": self.gap_distance,
+            "reassembly_error_mm3": self.reassembly_error,
+            "cavity_volume_change_mm3": self.cavity_volume_change,
+            "tolerance_mm3": self.tolerance,
+        }
+
+
+@dataclass(frozen=True)
+class Mould:
+    """A casting mould: printable parts in their assembled places, and what they cast.
+
+    Attributes
+    ----------
+    parts : dict of str to trimesh.Trimesh
+        The printable parts (see the module's description), in the actuator's frame, mm.
+    cast : dict of str to trimesh.Trimesh
+        ``"open_body"`` and ``"side_sheet"``: the silicone as it lies in the mould (the
+        sheet in its own pocket, moved by ``sheet_offset`` from its place on the body).
+    openings : trimesh.Trimesh
+        The pour and vent holes through the lid.
+    sheet_offset : (float, float, float)
+        Where the side sheet is cast relative to its place on the body, mm.
+    explode : dict of str to (float, float, float)
+        How far to move each part (and ``"cast"``, the cast pieces) in an exploded view, mm.
+    outer : (float, float, float, float, float, float)
+        The mould's outer box ``(x0, x1, y0, y1, z0, z1)``.
+    check : MouldCheck
+    spec : MouldSpec
+    unit : UnitSpec
+    orientation : str
+    """
+
+    parts: dict[str, trimesh.Trimesh]
+    cast: dict[str, trimesh.Trimesh]
+    openings: trimesh.Trimesh
+    sheet_offset: tuple[float, float, float]
+    explode: dict[str, tuple[float, float, float]]
+    outer: tuple[float, float, float, float, float, float]
+    check: MouldCheck
+    spec: MouldSpec = field(repr=False)
+    unit: UnitSpec = field(repr=False)
+    orientation: str = ""
+
+
+def _cylinder(cx: float, cy: float, z0: float, z1: float, radius: float, segments: int) -> manifold3d.Manifold:
+    import manifold3d as m3
+
+    return m3.Manifold.cylinder(z1 - z0, radius, -1.0, segments).translate((cx, cy, z0))
+
+
+def _core(cavity: tuple, tip_inset: float, tenon_inset: float, tenon_depth: float) -> manifold3d.Manifold:
+    """The core of one cavity: the cavity (tapered by ``tip_inset`` at its tip) on a tenon."""
+    import manifold3d as m3
+
+    x0, x1, y0, y1, z0, z1 = cavity
+    if tip_inset > 0:
+        d = tip_inset
+        points = [(x, y, z0) for x in (x0, x1) for y in (y0, y1)]
+        points += [(x, y, z1) for x in (x0 + d, x1 - d) for y in (y0 + d, y1 - d)]
+        body = m3.Manifold.hull_points(np.array(points, dtype=float))
+    else:
+        body = box(cavity)
+    t = tenon_inset
+    tenon = box((x0 + t, x1 - t, y0 + t, y1 - t, z0 - tenon_depth, z0 + (z1 - z0) / 2))
+    return body + tenon
+
+
+def _hole_centres(spec: UnitSpec, orientation: str, mould: MouldSpec) -> list[tuple[str, float, float, float]]:
+    """The pour and vent holes of the body's pocket: (name, x, y, radius), checked to fit."""
+    n, P, H = len(orientation), spec.pitch, spec.height
+    span = P - spec.slit_width  # the unit's top face along x, without its slit
+    out = []
+    for name, unit, frac, diameter in (("pour_diameter", 0, 0.3, mould.pour_diameter),
+                                       ("vent_diameter", n - 1, 0.75, mould.vent_diameter)):
+        r = diameter / 2
+        y0, y1 = (0.0, H - spec.layer) if orientation[unit] == "0" else (spec.layer, H)
+        x = unit * P + frac * span
+        lo, hi = unit * P, unit * P + span
+        if x - r < lo or x + r > hi or 2 * r > (y1 - y0):
+            raise GeometryError(
+                f"mould {name} {diameter:g} mm does not fit on the top face of unit {unit + 1} "
+                f"({span:g} x {y1 - y0:g} mm, the hole centred {x - lo:g} mm from its start); make it smaller"
+            )
+        out.append((name, x, (y0 + y1) / 2, r))
+    (_, xa, ya, ra), (_, xb, yb, rb) = out
+    if math.hypot(xa - xb, ya - yb) < ra + rb + 0.5:
+        raise GeometryError(
+            f"mould pour_diameter {mould.pour_diameter:g} mm and vent_diameter {mould.vent_diameter:g} mm: the two "
+            f"holes over the single unit are less than 0.5 mm apart; make them smaller"
+        )
+    return out
+
+
+def _check_fit(spec: UnitSpec, mould: MouldSpec) -> tuple[float, float]:
+    """Unit-dependent limits: the tenon's inset and the cores' tip inset."""
+    x0, x1, y0, y1 = spec.cavity
+    smaller = min(x1 - x0, y1 - y0)
+    inset = smaller / 4
+    if mould.clearance >= inset:
+        raise GeometryError(
+            f"mould clearance {mould.clearance:g} mm is not smaller than the core tenon's setback {inset:g} mm "
+            f"(a quarter of the cavity's smaller side, {smaller:g} mm): silicone would run into the tenon pockets"
+        )
+    depth = spec.width - 2 * spec.side_wall
+    tip = depth * math.tan(math.radians(mould.draft))
+    if tip > smaller / 4:
+        raise GeometryError(
+            f"mould draft {mould.draft:g} degrees narrows each side of the {depth:g} mm deep cores by {tip:.3g} mm, more "
+            f"than a quarter of the cavity's smaller side ({smaller:g} mm); use at most "
+            f"{math.degrees(math.atan(smaller / 4 / depth)):.3g} degrees"
+        )
+    return inset, tip
+
+
+def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = None, check: bool = True) -> Mould:
+    """Build the casting mould of the body and check that its parts fit.
+
+    Parameters
+    ----------
+    spec : UnitSpec
+        The articulating unit.
+    orientation : str
+        The design, base first.
+    mould : MouldSpec, optional
+        Clearance, draft and sizes (default :class:`MouldSpec`'s).
+    check : bool
+        Measure the assembly (:class:`MouldCheck`) and refuse a mould that fails; False
+        skips the booleans (the ``check`` field is then all NaN).
+
+    Returns
+    -------
+    Mould
+
+    Raises
+    ------
+    GeometryError
+        Settings that do not fit the unit (a clearance as wide as the tenon's setback, a
+        draft that eats the cores, holes that do not fit on a unit's face), or a mould that
+        fails a check: overlapping parts, a part that is not watertight, an empty space
+        that is not the cast.
+
+    Examples
+    --------
+    >>> m = casting_mould(UnitSpec(), "0", MouldSpec(draft=1.0))
+    >>> round(m.check.cavity_volume_change, 2)   # mm^3: the drafted core leaves more silicone
+    25.69
+    >>> casting_mould(UnitSpec(), "0", MouldSpec(clearance=1.2, wall=8.0))
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.GeometryError: mould clearance 1.2 mm is not smaller than the core tenon's setback 1.125 mm (a quarter of the cavity's smaller side, 4.5 mm): silicone would run into the tenon pockets
+    """
+    import manifold3d as m3
+
+    mould = MouldSpec() if mould is None else mould
+    orientation = parse_orientation(orientation)
+    inset, tip = _check_fit(spec, mould)
+    holes = _hole_centres(spec, orientation, mould)
+    n = len(orientation)
+    s, W, H = spec.side_wall, spec.width, spec.height
+    L = n * spec.pitch + spec.end_cap
+    w, t, c, seg = mould.wall, mould.plate, mould.clearance, mould.segments
+    dy = H + w  # the side sheet's pocket beside the body's, in y
+    sheet_offset = (0.0, dy, W - s)
+    Y = 2 * H + w  # both pockets
+    outer = (-w, L + w, -w, Y + w, s - t, W + t)
+    X0, X1, Y0, Y1, Z0, Z1 = outer
+
+    # the cores (exact cavities on tenons) and the tenons' pockets in the base plate
+    td = mould.tenon_depth
+    cavities = _cavity_boxes(spec, orientation)
+    cores = [_core(cav, tip, inset, td) for cav in cavities]
+    pockets = [box((a + inset - c, b - inset + c, p + inset - c, q - inset + c, s - td - c, s + _OUT))
+               for a, b, p, q, _, _ in cavities]
+
+    # alignment pins at the corners, their holes through the walls and into both plates
+    r = mould.pin_diameter / 2
+    pin_xy = [(x, y) for x in (-w / 2, L + w / 2) for y in (-w / 2, Y + w / 2)]
+    pins = [_cylinder(x, y, s - mould.pin_depth, W + mould.pin_depth, r, seg) for x, y in pin_xy]
+    pin_holes = [_cylinder(x, y, s - mould.pin_depth - c, W + mould.pin_depth + c, r + c, seg) for x, y in pin_xy]
+
+    # pour and vent holes through the lid, over both pockets
+    hole_cutters, openings = [], []
+    for _, x, y, radius in holes:
+        for oy in (0.0, dy):
+            hole_cutters.append(_cylinder(x, y + oy, W - _OUT, Z1 + _OUT, radius, seg))
+            openings.append(_cylinder(x, y + oy, W, Z1, radius, seg))
+
+    body_pocket = outline_solid(spec, orientation, s - _OUT, W + _OUT)
+    sheet_pocket = outline_solid(spec, orientation, W - s, W + _OUT).translate((0.0, dy, 0.0))
+    solids: dict[str, m3.Manifold] = {
+        "base_plate": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, Z0, s)), *pockets, *pin_holes],
+                                                m3.OpType.Subtract),
+        "side_walls": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, s, W)), body_pocket, sheet_pocket,
+                                                 *pin_holes], m3.OpType.Subtract),
+        "lid": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, W, Z1)), *hole_cutters, *pin_holes],
+                                         m3.OpType.Subtract),
+    }
+    digits = len(str(n))
+    for k, core in enumerate(cores, start=1):
+        solids[f"core_{k:0{digits}d}"] = core
+    for k, pin in enumerate(pins, start=1):
+        solids[f"pin_{k}"] = pin
+
+    open_body = m3.Manifold.batch_boolean([outline_solid(spec, orientation, s, W), *cores], m3.OpType.Subtract)
+    sheet = outline_solid(spec, orientation, 0.0, s)
+    cast = {"open_body": open_body, "side_sheet": sheet.translate(sheet_offset)}
+    opening = m3.Manifold.batch_boolean(openings, m3.OpType.Add)
+
+    e = W + t  # exploded view: each layer of the assembly one mould height apart
+    explode = {"base_plate": (0.0, 0.0, -e), "side_walls": (0.0, 0.0, 2 * e), "lid": (0.0, 0.0, 3 * e),
+               "cast": (0.0, 0.0, e)}
+    explode.update({name: (0.0, 0.0, 0.0) for name in solids if name.startswith("core_")})
+    explode.update({name: (0.0, 0.0, e) for name in solids if name.startswith("pin_")})
+
+    if check:
+        gaps = [hole - pin for hole, pin in zip(pin_holes, pins)]
+        gaps += [(pocket ^ box((X0, X1, Y0, Y1, Z0, s))) - core for pocket, core in zip(pockets, cores)]
+        body = actuator_solids(spec, orientation, base_block=None)["body"]
+        core_tops = m3.Manifold.batch_boolean(cores, m3.OpType.Add) ^ box((X0, X1, Y0, Y1, s, W))
+        as_cast = outline_solid(spec, orientation, 0.0, W) - core_tops
+        result = _measure(solids, cast, opening, m3.Manifold.batch_boolean(gaps, m3.OpType.Add), body, as_cast,
+                          sheet_offset, outer)
+        if not result.ok:
+            raise GeometryError(_failure(result))
+    else:
+        nan = float("nan")
+        result = MouldCheck({}, nan, 0, nan, nan, nan, nan, nan, nan, nan, nan)
+    return Mould(
+        parts={name: to_trimesh(solid) for name, solid in solids.items()},
+        cast={name: to_trimesh(solid) for name, solid in cast.items()},
+        openings=to_trimesh(opening),
+        sheet_offset=sheet_offset,
+        explode=explode,
+        outer=outer,
+        check=result,
+        spec=mould,
+        unit=spec,
+        orientation=orientation,
+    )
+
+
+def _bounds_overlap(a: manifold3d.Manifold, b: manifold3d.Manifold) -> bool:
+    (ax0, ay0, az0, ax1, ay1, az1), (bx0, by0, bz0, bx1, by1, bz1) = a.bounding_box(), b.bounding_box()
+    return ax0 < bx1 and bx0 < ax1 and ay0 < by1 and by0 < ay1 and az0 < bz1 and bz0 < az1
+
+
+def _xor_volume(a: manifold3d.Manifold, b: manifold3d.Manifold) -> float:
+    return (a - b).volume() + (b - a).volume()
+
+
+def _measure(solids: dict, cast: dict, opening, gaps, body, as_cast, sheet_offset: tuple,
+             outer: tuple) -> MouldCheck:
+    """The checks of :class:`MouldCheck`, on manifold3d solids."""
+    import manifold3d as m3
+
+    outer_box = box(outer)
+    tolerance = 1e-9 * outer_box.volume()
+    watertight = {}
+    for name, solid in solids.items():
+        shells = solid.decompose()
+        watertight[name] = (solid.status() == m3.Error.NoError and len(shells) == 1 and solid.volume() > 0)
+    names = list(solids)
+    max_overlap, pairs = 0.0, 0
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if _bounds_overlap(solids[a], solids[b]):
+                pairs += 1
+                max_overlap = max(max_overlap, (solids[a] ^ solids[b]).volume())
+    empty = m3.Manifold.batch_boolean([outer_box, *solids.values()], m3.OpType.Subtract)
+    cast_all = cast["open_body"] + cast["side_sheet"]
+    expected = m3.Manifold.batch_boolean([cast_all, opening, gaps], m3.OpType.Add)
+    reach = 10.0  # mm: min_gap reports at most this
+    gap_distance = gaps.min_gap(cast_all + opening, reach) if not gaps.is_empty() else reach
+    back = cast["open_body"] + cast["side_sheet"].translate(tuple(-v for v in sheet_offset))
+    return MouldCheck(
+        watertight=watertight,
+        max_overlap=max_overlap,
+        overlap_pairs=pairs,
+        cavity_error=_xor_volume(empty, expected),
+        cast_volume=cast_all.volume(),
+        openings_volume=opening.volume(),
+        gaps_volume=gaps.volume(),
+        gap_distance=gap_distance,
+        reassembly_error=_xor_volume(back, as_cast),
+        cavity_volume_change=as_cast.volume() - body.volume(),
+        tolerance=tolerance,
+    )
+
+
+def _failure(c: MouldCheck) -> str:
+    problems = []
+    bad = [name for name, ok in c.watertight.items() if not ok]
+    if bad:
+        problems.append(f"part(s) {', '.join(bad)} are not one closed volume")
+    if c.max_overlap > c.tolerance:
+        problems.append(f"parts overlap by up to {c.max_overlap:.3g} mm^3")
+    if c.cavity_error > c.tolerance:
+        problems.append(f"the empty space differs from the cast by {c.cavity_error:.3g} mm^3")
+    if c.gap_distance <= 0:
+        problems.append("a clearance gap touches the cast (silicone would leak into it)")
+    if c.reassembly_error > c.tolerance:
+        problems.append(f"the cast pieces differ from the body by {c.reassembly_error:.3g} mm^3")
+    return "the mould fails its checks: " + "; ".join(problems)
