@@ -193,6 +193,27 @@ class MouldSpec:
         """How deep each core's tenon sits in the base plate: half the plate, mm."""
         return self.plate / 2
 
+    def check(self, spec: UnitSpec, orientation: str) -> None:
+        """Refuse settings that do not fit this unit and design, before anything is built.
+
+        Raises
+        ------
+        GeometryError
+            A clearance as wide as the core tenon's setback (a quarter of the cavity's
+            smaller side), a draft that narrows the cores' tips by more than that, pour or
+            vent holes that do not fit on the first or last unit's face; the message names
+            the parameter.
+
+        Examples
+        --------
+        >>> MouldSpec(draft=8.0).check(UnitSpec(), "01")
+        Traceback (most recent call last):
+        ...
+        pneumorph.errors.GeometryError: mould draft 8 degrees narrows each side of the 12 mm deep cores by 1.69 mm, more than a quarter of the cavity's smaller side (4.5 mm); use at most 5.36 degrees
+        """
+        _check_fit(spec, self)
+        _hole_centres(spec, parse_orientation(orientation), self)
+
 
 @dataclass(frozen=True)
 class MouldCheck:
@@ -410,7 +431,7 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
 
     mould = MouldSpec() if mould is None else mould
     orientation = parse_orientation(orientation)
-    inset, tip = _check_fit(spec, mould)
+    inset, tip = _check_fit(spec, mould)  # the same checks as MouldSpec.check
     holes = _hole_centres(spec, orientation, mould)
     n = len(orientation)
     s, W, H = spec.side_wall, spec.width, spec.height

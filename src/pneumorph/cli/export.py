@@ -1,0 +1,129 @@
+"""``pneumorph export``: a design's parts as STL, and the casting mould of its body."""
+
+from __future__ import annotations
+
+import click
+
+from pneumorph.cli import params as P
+
+_MOULD_ONLY = ("clearance", "draft")
+
+
+@click.command("export")
+@click.argument("design", type=P.Text(1000))
+@click.option("--stl", "stl_dir", type=P.OutputDir(),
+              help="Folder for the parts' STL files (mm): body, layer pieces, base block.")
+# (--inp FILE, the CalculiX/Abaqus deck of pneumorph.export.calculix, is wired in separately.)
+@click.option("--mould", "with_mould", is_flag=True,
+              help="Also the body's casting mould: its parts' STL and an exploded drawing in DIR/mould/.")
+@click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--clearance", type=P.Real(0.0, 5.0, unit="mm"), default=0.2, show_default=True,
+              help="Mould: gap between mating printed parts (pins, core tenons), mm.")
+@click.option("--draft", type=P.Real(0.0, 45.0, high_open=True, unit="degrees"), default=0.0, show_default=True,
+              help="Mould: taper of the cavity cores, degrees (0: exact cavities).")
+@click.option("--json", "as_json", is_flag=True, help="Print the files and volumes as JSON.")
+@click.pass_context
+def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: bool, unit_file: str | None,
+           clearance: float, draft: float, as_json: bool) -> None:
+    """Write DESIGN's parts (the Mold Star body with its cavities, the Smooth-Sil layer
+    pieces, the base block) as watertight STL files, and with --mould the printable
+    casting mould of the body (docs/manufacturing.md).
+    """
+    from pathlib import Path
+
+    from pneumorph.export import (
+        BaseBlock,
+        MouldSpec,
+        actuator_parts,
+        casting_mould,
+        layer_pieces,
+        plot_mould,
+        write_stl,
+    )
+    from pneumorph.geometry import parse_orientation
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.io import check_writable_dir, strict_json
+
+    # everything is checked before anything is built or written
+    with P.blame("DESIGN"):
+        orientation = parse_orientation(design)
+    if stl_dir is None:
+        raise click.UsageError("nothing to export: give --stl DIR (the folder for the STL files)")
+    if not with_mould:
+        given = [f"--{k}" for k in _MOULD_ONLY
+                 if ctx.get_parameter_source(k) is not click.core.ParameterSource.DEFAULT]
+        if given:
+            raise click.UsageError(f"{' and '.join(given)} {'apply' if len(given) > 1 else 'applies'} to the "
+                                   "mould only: add --mould")
+    with P.blame("--unit"):
+        unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
+    folder = Path(stl_dir)
+    mould_spec = None
+    if with_mould:
+        with P.blame("--clearance"):
+            MouldSpec(clearance=clearance).check(unit, orientation)
+        with P.blame("--draft"):
+            MouldSpec(draft=draft).check(unit, orientation)
+        with P.blame("--unit"):
+            mould_spec = MouldSpec(clearance=clearance, draft=draft)
+            mould_spec.check(unit, orientation)
+        with P.blame("--stl"):
+            check_writable_dir(folder / "mould", "--stl")
+
+    block = BaseBlock()
+    parts = actuator_parts(unit, orientation, block)
+    paths = write_stl(parts, folder)
+    pieces = layer_pieces(unit, orientation)
+    n = len(orientation)
+    length = n * unit.pitch + unit.end_cap
+    describe = {"body": f"{unit.body_material} body, {n} cavit{'y' if n == 1 else 'ies'}",
+                "base_block": f"base block {block.length:g} x {unit.height + 2 * block.margin:g} x "
+                              f"{unit.width + 2 * block.margin:g} mm, {block.material}"}
+    layer_names = [k for k in parts if k.startswith("layer_")]
+    for name, p in zip(layer_names, pieces):
+        units = f"unit {p.first + 1}" if p.first == p.last else f"units {p.first + 1}-{p.last + 1}"
+        describe[name] = f"{unit.layer_material} strip, {units}, {p.side}, cut {p.length:g} mm"
+    summary: dict = {
+        "design": orientation,
+        "units": n,
+        "length_mm": length,
+        "unit": unit.name,
+        "files": [str(p) for p in paths],
+        "volumes_mm3": {name: float(mesh.volume) for name, mesh in parts.items()},
+        "layer_pieces": [{"name": name, "first_unit": p.first + 1, "last_unit": p.last + 1, "side": p.side,
+                          "length_mm": p.length} for name, p in zip(layer_names, pieces)],
+    }
+    mould = None
+    if mould_spec is not None:
+        mould = casting_mould(unit, orientation, mould_spec)
+        mould_dir = folder / "mould"
+        mould_paths = write_stl(mould.parts, mould_dir)
+        drawing = mould_dir / "mould.png"
+        plot_mould(mould, drawing)
+        summary["mould"] = {
+            "clearance_mm": mould_spec.clearance,
+            "draft_deg": mould_spec.draft,
+            "files": [str(p) for p in mould_paths],
+            "drawing": str(drawing),
+            "volumes_mm3": {name: float(mesh.volume) for name, mesh in mould.parts.items()},
+            "cast_mm3": {name: float(mesh.volume) for name, mesh in mould.cast.items()},
+            "check": mould.check.to_dict(),
+        }
+    if as_json:
+        click.echo(strict_json(summary))
+        return
+    click.echo(f"design {orientation}: {n} unit{'s' if n > 1 else ''}, {length:g} mm long (unit {unit.name!r})")
+    click.echo(f"wrote {len(paths)} STL files (mm) to {folder}/:")
+    width = max(len(p.name) for p in paths)
+    for path, (name, mesh) in zip(paths, parts.items()):
+        click.echo(f"  {path.name:<{width}}  {float(mesh.volume):10.2f} mm^3  {describe[name]}")
+    if mould is not None:
+        c = mould.check
+        click.echo(f"mould: {len(mould.parts)} parts (clearance {mould_spec.clearance:g} mm, draft "
+                   f"{mould_spec.draft:g} deg) in {folder / 'mould'}/, drawing mould.png")
+        click.echo(f"  cast: open body {float(mould.cast['open_body'].volume):.2f} mm^3 + side sheet "
+                   f"{float(mould.cast['side_sheet'].volume):.2f} mm^3, glued = the body "
+                   f"(difference {c.reassembly_error:.2g} mm^3; the draft adds {c.cavity_volume_change:.4g} mm^3)")
+        click.echo(f"  checked: all parts watertight, largest overlap {c.max_overlap:.2g} mm^3 "
+                   f"({c.overlap_pairs} pairs), empty space = cast + pour/vent holes + clearance gaps "
+                   f"(difference {c.cavity_error:.2g} mm^3), gaps {c.gap_distance:.3g} mm from the cast")

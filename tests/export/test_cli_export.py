@@ -1,0 +1,105 @@
+"""``pneumorph export``: parses, checks before building, writes the STL files and the mould."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import trimesh
+from click.testing import CliRunner
+
+from pneumorph.cli.export import export
+
+DEFAULT = "001111010001001"
+
+
+def run(*args: str):
+    return CliRunner().invoke(export, list(args))
+
+
+def test_default_design_stl_and_json(tmp_path):
+    out = tmp_path / "stl"
+    result = run(DEFAULT, "--stl", str(out), "--json")
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert summary["design"] == DEFAULT and summary["units"] == 15 and summary["length_mm"] == 157.5
+    assert summary["volumes_mm3"]["body"] == pytest.approx(16402.5, rel=1e-12)
+    assert sum(v for k, v in summary["volumes_mm3"].items() if k.startswith("layer_")) == pytest.approx(7087.5)
+    assert summary["volumes_mm3"]["base_block"] == pytest.approx(1800.0)
+    assert [(p["first_unit"], p["last_unit"], p["side"], p["length_mm"]) for p in summary["layer_pieces"]][:3] == [
+        (1, 2, "top", 21.0), (3, 6, "bottom", 42.0), (7, 7, "top", 10.5)]
+    assert sorted(p.name for p in out.iterdir()) == sorted(f"{k}.stl" for k in summary["volumes_mm3"])
+    body = trimesh.load_mesh(out / "body.stl")
+    assert body.is_watertight and body.volume == pytest.approx(16402.5, rel=1e-6)
+    assert "mould" not in summary and not (out / "mould").exists()
+
+
+def test_text_output_lists_files_volumes_and_cuts(tmp_path):
+    result = run("01", "--stl", str(tmp_path))
+    assert result.exit_code == 0, result.output
+    assert "design 01: 2 units, 21 mm long" in result.output
+    text = " ".join(result.output.split())
+    assert "body.stl 2187.00 mm^3 mold_star_15 body, 2 cavities" in text
+    assert "layer_2.stl 472.50 mm^3 smooth_sil_950 strip, unit 2, bottom, cut 10.5 mm" in text
+    assert "base_block.stl 1800.00 mm^3 base block 10 x 12 x 15 mm" in text
+
+
+def test_mould(tmp_path):
+    result = run(DEFAULT, "--stl", str(tmp_path), "--mould", "--clearance", "0.3", "--json")
+    assert result.exit_code == 0, result.output
+    mould = json.loads(result.output)["mould"]
+    assert mould["clearance_mm"] == 0.3 and mould["draft_deg"] == 0.0
+    check = mould["check"]
+    assert check["ok"] and all(check["watertight"].values()) and len(check["watertight"]) == 22
+    assert check["max_overlap_mm3"] < 1e-9 and check["cavity_error_mm3"] < 1e-9
+    assert check["cast_volume_mm3"] == pytest.approx(16402.5, rel=1e-12)
+    assert mould["cast_mm3"] == pytest.approx({"open_body": 14276.25, "side_sheet": 2126.25}, rel=1e-12)
+    folder = tmp_path / "mould"
+    assert sorted(p.name for p in folder.iterdir()) == sorted([*(f"{k}.stl" for k in mould["volumes_mm3"]),
+                                                               "mould.png"])
+    assert (folder / "mould.png").read_bytes()[:4] == b"\x89PNG"
+    lid = trimesh.load_mesh(folder / "lid.stl")
+    assert lid.is_watertight and lid.volume == pytest.approx(mould["volumes_mm3"]["lid"], rel=1e-6)
+
+
+def test_mould_text_and_draft(tmp_path):
+    result = run("0", "--stl", str(tmp_path), "--mould", "--draft", "1")
+    assert result.exit_code == 0, result.output
+    assert "mould: 8 parts (clearance 0.2 mm, draft 1 deg)" in result.output
+    assert "the draft adds 25.69 mm^3" in result.output
+
+
+@pytest.mark.parametrize("args, message", [
+    (["0120", "--stl", "{tmp}"], "Invalid value for 'DESIGN': orientation '0120' contains '2'"),
+    (["", "--stl", "{tmp}"], "DESIGN must not be empty"),
+    (["01"], "nothing to export: give --stl DIR"),
+    (["01", "--stl", "{tmp}", "--draft", "1"], "--draft applies to the mould only: add --mould"),
+    (["01", "--stl", "{tmp}", "--clearance", "0.1", "--draft", "1"], "--clearance and --draft apply to the mould"),
+    (["01", "--stl", "{tmp}", "--mould", "--clearance", "1.2"], "'--clearance': mould clearance 1.2 mm is too large"),
+    (["01", "--stl", "{tmp}", "--mould", "--clearance", "-0.1"], "--clearance must be a finite number"),
+    (["01", "--stl", "{tmp}", "--mould", "--draft", "9"], "'--draft': mould draft 9 degrees narrows"),
+    (["01", "--stl", "{tmp}", "--mould", "--draft", "nan"], "--draft must be a finite number"),
+    (["01", "--stl", "{tmp}/file.txt"], "is a file, not a folder"),
+    (["01", "--stl", "{tmp}", "--unit", "{tmp}/missing.toml"], "no such file"),
+])
+def test_bad_input_is_refused_before_anything_is_written(tmp_path, args, message):
+    (tmp_path / "file.txt").write_text("x")
+    result = run(*(a.format(tmp=tmp_path) for a in args))
+    assert result.exit_code == 2, result.output
+    assert message in " ".join(result.output.split())
+    assert [p.name for p in tmp_path.iterdir()] == ["file.txt"]
+
+
+def test_unit_file(tmp_path):
+    unit = tmp_path / "unit.toml"
+    unit.write_text("[unit]\npitch = 12.0\nslit_width = 1.0\nslit_depth = 4.0\n")
+    result = run("0", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--json")
+    assert result.exit_code == 0, result.output
+    volumes = json.loads(result.output)["volumes_mm3"]
+    # 12 x 9 x 15 - slit 1 x 4 x 15 - cavity (12 - 6 - 1) x 6 x 12
+    assert volumes["body"] == pytest.approx(1620 - 60 - 360, rel=1e-12)
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[unit]\npitch = 5.0\n")
+    result = run("0", "--stl", str(tmp_path / "out2"), "--unit", str(bad))
+    assert result.exit_code == 2 and "'--unit'" in result.output and "leave no cavity" in result.output
+    assert not (tmp_path / "out2").exists()
