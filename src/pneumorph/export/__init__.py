@@ -1,5 +1,15 @@
 """Export: the actuator's parts as watertight meshes (STL), its casting mould, and solver decks."""
 
+# Solver decks (pneumorph.export.calculix).
+from pneumorph.export.calculix import (
+    calculix_deck,
+    read_dat_displacements,
+    read_frd_displacements,
+    run_calculix,
+    tip_positions,
+    write_calculix_deck,
+)
+
 # Parts and moulds (pneumorph.export.parts, .moulds, .figures).
 from pneumorph.export.figures import plot_mould
 from pneumorph.export.moulds import Mould, MouldCheck, MouldSpec, casting_mould
@@ -25,4 +35,14 @@ __all__ = [
     "layer_pieces",
     "plot_mould",
     "write_stl",
+]
+
+# solver decks
+__all__ += [
+    "calculix_deck",
+    "read_dat_displacements",
+    "read_frd_displacements",
+    "run_calculix",
+    "tip_positions",
+    "write_calculix_deck",
 ]
