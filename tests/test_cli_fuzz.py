@@ -89,6 +89,7 @@ BASE = {
     "thermal": ["materials", "characterise", "thermal", "thermal.csv"],
     "bilinear": ["materials", "characterise", "bilinear", "bilinear.csv"],
     "show": ["materials", "show", "mold_star_15"],
+    "export": ["export", "0110", "--stl", "run", "--inp", "run/deck.inp", "--mould"],
     "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--scale", "0.2", "--out", "run"],
     "list": ["materials", "list"],
 }
@@ -149,6 +150,9 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "poisson": {"--strain-range": ["nan", "abc", ""]},
     "show": {"--library": ["binary.bin", "folder", "missing.toml", ""]},
     "list": {"--library": ["binary.bin", "folder", ""]},
+    "export": {"--stl": ["a-file", "a-file/sub", ""], "--inp": ["folder", "a-file/x.inp", "x.txt", ""],
+               "--pressure": POSITIVE + ["1e9"], "--clearance": ["-1", "10", *REAL], "--draft": ["-1", "45", *REAL],
+               "--unit": ["binary.bin", "folder", ""]},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": POSITIVE + ["1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
@@ -376,3 +380,16 @@ def test_bad_scans_are_refused_before_the_model_is_solved(sandbox: Path, capsys:
         argv += ["--scale", "0.2"]
     line = _refused(sandbox, capsys, argv)
     assert name in line
+
+
+@pytest.mark.parametrize("design", ["", "012", "abc", "0" * 101])
+def test_a_bad_design_to_export_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str], design: str) -> None:
+    _refused(sandbox, capsys, ["export", design, "--stl", "run"])
+
+
+@pytest.mark.parametrize("argv", [["export", "0110"], ["export", "0110", "--stl", "run", "--draft", "1"],
+                                  ["export", "0110", "--inp", "d.inp", "--mould"],
+                                  ["export", "0110", "--stl", "run", "--pressure", "30"]])
+def test_export_options_that_do_not_apply_are_refused(sandbox: Path, capsys: pytest.CaptureFixture[str],
+                                                      argv: list[str]) -> None:
+    _refused(sandbox, capsys, argv)

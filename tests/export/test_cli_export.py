@@ -103,3 +103,21 @@ def test_unit_file(tmp_path):
     result = run("0", "--stl", str(tmp_path / "out2"), "--unit", str(bad))
     assert result.exit_code == 2 and "'--unit'" in result.output and "leave no cavity" in result.output
     assert not (tmp_path / "out2").exists()
+
+
+def test_export_writes_the_calculix_deck_of_the_3d_model(tmp_path: Path) -> None:
+    import json
+
+    from pneumorph.cli import main
+    from pneumorph.models.factory import make_model
+
+    deck = tmp_path / "decks" / "d.inp"
+    result = CliRunner().invoke(export, ["0110", "--inp", str(deck), "--pressure", "20", "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    model = make_model(4, {"fidelity": "3d", "pressure_kpa": 20})
+    assert data["deck"]["fingerprint"] == model.fingerprint() and data["deck"]["levels"] == 10
+    text = deck.read_text(encoding="utf-8")
+    assert "*NODE" in text and "C3D20" in text and "design 0110" in text and "pressure 20 kPa" in text
+    assert "files" not in data  # no --stl: the deck only
+    assert main(["export", "0110", "--stl", str(tmp_path / "s"), "--pressure", "30"]) == 2  # a deck option alone

@@ -7,13 +7,17 @@ import click
 from pneumorph.cli import params as P
 
 _MOULD_ONLY = ("clearance", "draft")
+_DECK_ONLY = ("pressure",)
 
 
 @click.command("export")
 @click.argument("design", type=P.Text(1000))
 @click.option("--stl", "stl_dir", type=P.OutputDir(),
               help="Folder for the parts' STL files (mm): body, layer pieces, base block.")
-# (--inp FILE, the CalculiX/Abaqus deck of pneumorph.export.calculix, is wired in separately.)
+@click.option("--inp", "inp_file", type=P.OutputFile((".inp",)),
+              help="The 3D model as a CalculiX/Abaqus input deck (mm, Pa; docs/manufacturing.md).")
+@click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True,
+              help="Deck: the final pressure of the ramp, kPa (levels as the 3D model's).")
 @click.option("--mould", "with_mould", is_flag=True,
               help="Also the body's casting mould: its parts' STL and an exploded drawing in DIR/mould/.")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
@@ -23,11 +27,12 @@ _MOULD_ONLY = ("clearance", "draft")
               help="Mould: taper of the cavity cores, degrees (0: exact cavities).")
 @click.option("--json", "as_json", is_flag=True, help="Print the files and volumes as JSON.")
 @click.pass_context
-def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: bool, unit_file: str | None,
-           clearance: float, draft: float, as_json: bool) -> None:
+def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str | None, pressure: float,
+           with_mould: bool, unit_file: str | None, clearance: float, draft: float, as_json: bool) -> None:
     """Write DESIGN's parts (the Mold Star body with its cavities, the Smooth-Sil layer
-    pieces, the base block) as watertight STL files, and with --mould the printable
-    casting mould of the body (docs/manufacturing.md).
+    pieces, the base block) as watertight STL files, with --mould the printable casting
+    mould of the body, and with --inp the 3D model as a CalculiX/Abaqus deck
+    (docs/manufacturing.md).
     """
     from pathlib import Path
 
@@ -47,8 +52,13 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: boo
     # everything is checked before anything is built or written
     with P.blame("DESIGN"):
         orientation = parse_orientation(design)
-    if stl_dir is None:
-        raise click.UsageError("nothing to export: give --stl DIR (the folder for the STL files)")
+    if stl_dir is None and inp_file is None:
+        raise click.UsageError("nothing to export: give --stl DIR (the parts' STL files) and/or --inp FILE "
+                               "(a CalculiX deck)")
+    if with_mould and stl_dir is None:
+        raise click.UsageError("--mould writes into the --stl folder: give --stl DIR")
+    if inp_file is None and ctx.get_parameter_source("pressure") is not click.core.ParameterSource.DEFAULT:
+        raise click.UsageError("--pressure applies to the deck only: add --inp FILE")
     if not with_mould:
         given = [f"--{k}" for k in _MOULD_ONLY
                  if ctx.get_parameter_source(k) is not click.core.ParameterSource.DEFAULT]
@@ -57,7 +67,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: boo
                                    "mould only: add --mould")
     with P.blame("--unit"):
         unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
-    folder = Path(stl_dir)
+    folder = Path(stl_dir) if stl_dir is not None else Path()
     mould_spec = None
     if with_mould:
         with P.blame("--clearance"):
@@ -70,6 +80,27 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: boo
         with P.blame("--stl"):
             check_writable_dir(folder / "mould", "--stl")
 
+    model = None
+    if inp_file is not None:
+        from pneumorph.models.factory import make_model
+
+        settings: dict = {"fidelity": "3d", "pressure_kpa": pressure}
+        if unit_file:
+            settings["unit_file"] = unit_file
+        model = make_model(len(orientation), settings)
+    summary: dict = {"design": orientation, "units": len(orientation)}
+    if model is not None:
+        from pneumorph.export import write_calculix_deck
+
+        deck = write_calculix_deck(model, orientation, inp_file)  # type: ignore[arg-type]
+        summary["deck"] = {"file": str(deck), "pressure_kpa": pressure, "levels": int(model.ramp.steps.increments),
+                           "fingerprint": model.fingerprint()}
+    if stl_dir is None:
+        if as_json:
+            click.echo(strict_json(summary))
+        else:
+            click.echo(f"wrote the CalculiX deck of design {orientation} at {pressure:g} kPa to {inp_file}")
+        return
     block = BaseBlock()
     parts = actuator_parts(unit, orientation, block)
     paths = write_stl(parts, folder)
@@ -83,16 +114,14 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: boo
     for name, p in zip(layer_names, pieces):
         units = f"unit {p.first + 1}" if p.first == p.last else f"units {p.first + 1}-{p.last + 1}"
         describe[name] = f"{unit.layer_material} strip, {units}, {p.side}, cut {p.length:g} mm"
-    summary: dict = {
-        "design": orientation,
-        "units": n,
+    summary.update({
         "length_mm": length,
         "unit": unit.name,
         "files": [str(p) for p in paths],
         "volumes_mm3": {name: float(mesh.volume) for name, mesh in parts.items()},
         "layer_pieces": [{"name": name, "first_unit": p.first + 1, "last_unit": p.last + 1, "side": p.side,
                           "length_mm": p.length} for name, p in zip(layer_names, pieces)],
-    }
+    })
     mould = None
     if mould_spec is not None:
         mould = casting_mould(unit, orientation, mould_spec)
@@ -113,6 +142,8 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, with_mould: boo
         click.echo(strict_json(summary))
         return
     click.echo(f"design {orientation}: {n} unit{'s' if n > 1 else ''}, {length:g} mm long (unit {unit.name!r})")
+    if inp_file is not None:
+        click.echo(f"wrote the CalculiX deck at {pressure:g} kPa to {inp_file}")
     click.echo(f"wrote {len(paths)} STL files (mm) to {folder}/:")
     width = max(len(p.name) for p in paths)
     for path, (name, mesh) in zip(paths, parts.items()):

@@ -37,8 +37,6 @@ def simulate(
     """Inflate one actuator design and report its shape at every pressure level."""
     from pathlib import Path
 
-    from pneumorph.checks import MAX_UNITS
-    from pneumorph.errors import OrientationError
     from pneumorph.fem import StepSettings
     from pneumorph.geometry import parse_orientation
     from pneumorph.geometry.unit import UnitSpec
@@ -46,9 +44,8 @@ def simulate(
     from pneumorph.io.files import strict_json, write_json
     from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 
-    design = parse_orientation(orientation)
-    if len(design) > MAX_UNITS:
-        raise OrientationError(f"--orientation has {len(design)} units; at most {MAX_UNITS} (limit MAX_UNITS)")
+    with P.blame("--orientation"):
+        design = parse_orientation(orientation)
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     ramp = RampSpec(pressure=pressure / 1e3, steps=StepSettings(increments=increments, substeps=2))
     Model = Reduced2D if fidelity == "2d" else Full3D

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from pneumorph.checks import MAX_UNITS
 from pneumorph.errors import OrientationError
 
 
@@ -53,6 +54,8 @@ def parse_orientation(design: str | Iterable[int], n_units: int | None = None) -
             f"orientation {design!r} contains {', '.join(repr(b) for b in bad)}; only the digits 0 and 1 "
             "are allowed (0 = unit as built, 1 = unit turned 180 degrees about the long axis)"
         )
+    if len(text) > MAX_UNITS:
+        raise OrientationError(f"the design has {len(text)} units; at most {MAX_UNITS} (limit MAX_UNITS)")
     if n_units is not None and len(text) != n_units:
         raise OrientationError(f"orientation {text!r} has {len(text)} units, expected {n_units}")
     return text
