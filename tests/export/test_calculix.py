@@ -231,7 +231,11 @@ def test_step_levels_and_outputs(one_unit) -> None:
     _, text, blocks = one_unit
     assert "*STEP, NLGEOM, INC=10000" in text
     static = block(blocks, "*STATIC")
-    assert [float(v) for v in static[0].split(",")] == pytest.approx([0.25, 1.0, 0.25e-5, 0.25])
+    # a twentieth of the first level first, then at most one level per increment
+    assert [float(v) for v in static[0].split(",")] == pytest.approx([0.0125, 1.0, 0.25e-6, 0.25])
+    # residual against a fixed force: 0.005 x 20000 = 100 micronewtons; up to 10 cut-backs
+    assert block(blocks, "*CONTROLS, PARAMETERS=FIELD") == ["0.005, 0.01, , 20000"]
+    assert block(blocks, "*CONTROLS, PARAMETERS=TIME INCREMENTATION") == ["4, 8, 9, 16, 10, 4, 12, 10"]
     assert [float(v) for v in block(blocks, "*TIME POINTS")[0].split(",")] == [0.25, 0.5, 0.75, 1.0]
     assert block(blocks, "*NODE PRINT, NSET=TIP, TIME POINTS=LEVELS") == ["U"]
     assert block(blocks, "*NODE FILE, TIME POINTS=LEVELS") == ["U"]
@@ -252,6 +256,8 @@ def test_write_is_atomic_and_errors_are_specific(tmp_path: Path) -> None:
         calculix_deck(Reduced2D(2, ramp_spec=RAMP), "01")
     with pytest.raises(SettingsError, match="gravity"):
         calculix_deck(Full3D(2, ramp_spec=RAMP, gravity="hanging"), "01")
+    with pytest.raises(SettingsError, match="residual_force"):
+        calculix_deck(model, "01", residual_force=0.0)
     with pytest.raises(OutputPathError):
         write_calculix_deck(model, "01", tmp_path)
     with pytest.raises(DataFormatError):
@@ -301,7 +307,7 @@ def _relative_tip_difference(model: Full3D, folder: Path) -> np.ndarray:
 
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed (Debian: calculix-ccx)")
 def test_calculix_tip_agrees_within_the_volumetric_difference(tmp_path: Path) -> None:
-    """1 unit, 20 kPa in 4 levels (ccx 2.20, dev-2c, about 4 s per run).
+    """1 unit, 20 kPa in 4 levels (ccx 2.20, dev-2c, about 8 s per run).
 
     Measured: CalculiX's tip displacement is 4.31 % smaller at 20 kPa (0.89, 1.83, 2.93,
     4.31 % at the four levels; 4.29 % with 10 levels; 4.94 % for "01", in line with the

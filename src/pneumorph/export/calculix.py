@@ -45,6 +45,21 @@ Materials
     both codes the tips agree to 0.006 %). The test and ``benchmarks/calculix.py`` record
     the difference measured here.
 
+Solver controls
+    CalculiX's Ogden routine (``rubber.f``) finds the principal stretches from the roots
+    of a cubic and divides their derivatives by the stretch differences: where the
+    stretches (nearly) coincide - at the start of the step and in the actuator's almost
+    unstrained, rigidly turning parts - its stresses carry a residual-force noise of
+    about 10-100 micronewtons, and at C = I its tangent is so soft that a first increment
+    of 4.5 kPa on a 15-unit actuator diverges. The deck therefore starts with a twentieth
+    of the first level (``*STATIC``; the increments grow to one level, never beyond) and
+    measures the residual against a fixed force, ``*CONTROLS, PARAMETERS=FIELD`` with
+    ``q_u = residual_force / 0.005`` (100 micronewtons by default, 1e-4 N: with walls of
+    about 0.2 N/mm stiffness, a displacement error below 1e-3 mm), not against the
+    running average of the nodal forces, which is itself tiny in the first increments;
+    up to 10 cut-backs per increment. The displacement-correction criterion (1 %) is
+    CalculiX's default.
+
 Not written: gravity (:class:`~pneumorph.models.fe.Full3D` with ``gravity`` is refused),
 the end-face rotation (curl) and the cavity volume pneumorph also reports.
 
@@ -336,7 +351,7 @@ def calculix_mesh(model: Any, design: str) -> ActuatorMesh:
     return assemble(model.unit, design, 3, half=model.half)
 
 
-def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
+def calculix_deck(model: Any, design: str, *, full_output: bool = True, residual_force: float = 1.0e-4) -> str:
     """The CalculiX/Abaqus input deck of one design of a 3D model.
 
     Parameters
@@ -349,6 +364,9 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
     full_output : bool
         Also write every node's displacement at every level to the ``.frd`` file
         (``*NODE FILE``); the tip nodes always go to the ``.dat`` file (``*NODE PRINT``).
+    residual_force : float
+        Largest residual nodal force (N) of a converged iteration (see the module's
+        notes on solver controls); written as CalculiX's user-defined average force.
 
     Returns
     -------
@@ -360,7 +378,8 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
     OrientationError
         If ``design`` is not 0/1 digits, one per unit of ``model``.
     SettingsError
-        If ``model`` is not a :class:`~pneumorph.models.fe.Full3D` or has gravity.
+        If ``model`` is not a :class:`~pneumorph.models.fe.Full3D` or has gravity, or
+        ``residual_force`` is not a positive number.
     MaterialDataError
         If a silicone is not Ogden with at most three terms and a bulk modulus.
     GeometryError
@@ -386,11 +405,15 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
     levels = model.ramp.steps.levels()
     pressure_pa = model.ramp.pressure * PA_PER_MPA
     dt = float(np.min(np.diff(np.concatenate([[0.0], levels]))))
+    if not (isinstance(residual_force, (int, float)) and np.isfinite(residual_force) and residual_force > 0):
+        raise SettingsError(f"residual_force must be a positive number of newtons, got {residual_force!r}")
+    q_u = residual_force * 1e6 / 0.005  # micronewtons; CalculiX's R_n = 0.005
 
     halves = "half model, u_z = 0 on z = width/2" if model.half else "full model"
     out = [
         f"** pneumorph {__version__}: CalculiX/Abaqus deck of the 3D model (Full3D)",
-        f"** design {mesh.orientation} ({mesh.n_units} unit{'s' if mesh.n_units > 1 else ''}), {halves}, fingerprint {model.fingerprint()}",
+        f"** design {mesh.orientation} ({mesh.n_units} unit{'s' if mesh.n_units > 1 else ''}), {halves}",
+        f"** model fingerprint {model.fingerprint()}",
         f"** units: mm, Pa, micronewtons; pressure {model.ramp.pressure * 1e3:g} kPa in {len(levels)} levels",
         "** tip = mean (x, y) of x + u over node set TIP (the end face on the mid-plane), as pneumorph's",
         "** volumetric term: CalculiX (J-1)^2/D1, pneumorph 9/2 K (J^(1/3)-1)^2 (Eq 2.12);",
@@ -424,7 +447,13 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
     out += [
         "*STEP, NLGEOM, INC=10000",
         "*STATIC",
-        f"{_num(dt)}, 1., {_num(dt * 1e-5)}, {_num(dt)}",
+        f"{_num(dt / 20)}, 1., {_num(dt * 1e-6)}, {_num(dt)}",
+        f"** residual criterion 0.005 x {_num(q_u)} = {_num(residual_force * 1e6)} micronewtons (fixed)",
+        "*CONTROLS, PARAMETERS=FIELD",
+        f"0.005, 0.01, , {_num(q_u)}",
+        "** up to 10 cut-backs per increment, the other settings CalculiX's defaults",
+        "*CONTROLS, PARAMETERS=TIME INCREMENTATION",
+        "4, 8, 9, 16, 10, 4, 12, 10",
         "** follower pressure on the cavity walls: element, face (C3D20 numbering), Pa",
         "*DLOAD, AMPLITUDE=RAMP",
     ]
@@ -436,7 +465,8 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True) -> str:
     return "\n".join(out)
 
 
-def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *, full_output: bool = True) -> Path:
+def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *, full_output: bool = True,
+                        residual_force: float = 1.0e-4) -> Path:
     """Write :func:`calculix_deck` to ``path`` atomically (the old file or the complete new one).
 
     Parameters
@@ -446,7 +476,7 @@ def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *
     path : str or path-like
         The ``.inp`` file; its folder must exist. CalculiX names its outputs after it
         (``job.inp`` -> ``job.dat``, ``job.frd``).
-    full_output : bool
+    full_output, residual_force
         See :func:`calculix_deck`.
 
     Returns
@@ -469,7 +499,7 @@ def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *
     'a.inp'
     """
     target = check_writable_file(path, "deck")
-    text = calculix_deck(model, design, full_output=full_output)
+    text = calculix_deck(model, design, full_output=full_output, residual_force=residual_force)
     target.parent.mkdir(parents=True, exist_ok=True)
     return atomic_write_text(target, text)
 
@@ -690,8 +720,8 @@ class CalculixResult:
 
 
 def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, executable: str = "ccx",
-                 threads: int | None = None, timeout: float | None = None, full_output: bool = False
-                 ) -> CalculixResult:
+                 threads: int | None = None, timeout: float | None = None, full_output: bool = False,
+                 residual_force: float = 1.0e-4) -> CalculixResult:
     """Write the deck of ``design`` into ``folder``, run CalculiX on it and read the tip.
 
     Parameters
@@ -709,6 +739,8 @@ def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, exe
         Seconds before ``ccx`` is stopped.
     full_output : bool
         Also write all displacements to the ``.frd`` file.
+    residual_force : float
+        See :func:`calculix_deck`.
 
     Returns
     -------
@@ -727,7 +759,8 @@ def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, exe
     design = parse_orientation(design, getattr(model, "n_units", None))
     out_dir = Path(folder)
     out_dir.mkdir(parents=True, exist_ok=True)
-    deck = write_calculix_deck(model, design, out_dir / f"design_{design}.inp", full_output=full_output)
+    deck = write_calculix_deck(model, design, out_dir / f"design_{design}.inp", full_output=full_output,
+                               residual_force=residual_force)
     dat, frd = deck.with_suffix(".dat"), deck.with_suffix(".frd")
     for old in (dat, frd):
         old.unlink(missing_ok=True)
