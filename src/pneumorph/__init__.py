@@ -4,6 +4,18 @@ The public API is grouped by sub-package:
 
 - :mod:`pneumorph.materials` - hyperelastic models, the material library, fitting and
   characterisation of silicones and paper-silicone composites.
+- :mod:`pneumorph.geometry` - the articulating unit (``UnitSpec``), designs (orientation
+  vectors) and the meshed actuator.
+- :mod:`pneumorph.models` - the 2D and 3D FE models, the model factory and the chain model.
+- :mod:`pneumorph.design` - targets and tip goals, the certified search, the genetic
+  algorithm, exhaustive search, run folders.
+- :mod:`pneumorph.execution` - evaluators (serial, processes, Dask) and the evaluation cache.
+- :mod:`pneumorph.composite`, :mod:`pneumorph.bimodal` - the bilinear composite and the
+  bimodal actuator (chapter 3).
+- :mod:`pneumorph.export` - STL parts, casting moulds and CalculiX decks;
+  :mod:`pneumorph.correlation` - scans against the model.
+- :mod:`pneumorph.io` - safe writing, VTK and provenance; :mod:`pneumorph.checks` - the
+  checks of settings and the limits; :mod:`pneumorph.errors` - the exceptions.
 
 Examples
 --------

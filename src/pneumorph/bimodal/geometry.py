@@ -192,9 +192,6 @@ class BimodalSpec:
         x0, x1, y0, y1 = self.void
         return (x1 - x0) * (y1 - y0) * (self.width - 2 * self.side_wall)
 
-    def layer_thicknesses(self) -> dict[str, float]:
-        return {"bilinear": self.bilinear, "seal": self.seal, "body": self.body_height, "strip": self.strip}
-
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
@@ -241,11 +238,6 @@ class BimodalMesh:
     section_points: IntArray
     spec: BimodalSpec
     station: IntArray | None = None
-
-    def cells_of(self, name: str) -> IntArray:
-        """Cells of one layer (``"bilinear"``, ``"seal"``, ``"body"``, ``"strip"``)."""
-        code = {v: k for k, v in LABELS.items()}[name]
-        return self.cells[self.label == code]
 
 
 def _label(spec: BimodalSpec, centres: FloatArray) -> IntArray:

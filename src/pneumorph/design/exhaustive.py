@@ -124,10 +124,6 @@ class ExhaustiveResult:
     def best(self) -> Candidate:
         return self.hall_of_fame[0]
 
-    def rank_of(self, design: str) -> int:
-        """1-based rank of a design (1 = the global optimum)."""
-        return self.ranking.index(design) + 1
-
 
 def all_designs(n: int, first: str | None = None) -> list[str]:
     """Every orientation vector of ``n`` units in binary order (optionally a fixed first unit).

@@ -50,11 +50,6 @@ def worst(sense: Sense) -> float:
     return float("inf") if sense == "min" else float("-inf")
 
 
-def is_better(a: float, b: float, sense: Sense) -> bool:
-    """True if fitness ``a`` is strictly better than ``b``."""
-    return a < b if sense == "min" else a > b
-
-
 @dataclass(frozen=True)
 class Score:
     """The fitness of one design at every reported level, and its best level.

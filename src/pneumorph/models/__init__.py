@@ -1,11 +1,36 @@
 """Actuator models of every fidelity and what they return (:class:`Response`).
 
-The FE models live in :mod:`pneumorph.models.fe` (``Reduced2D``, ``Full3D``) and are built
-from plain settings by :func:`pneumorph.models.factory.make_model`; the chain model fitted
-to them is :class:`ChainModel` (:mod:`pneumorph.models.chain`).
+- :class:`Reduced2D` (plane strain with the pressure-dependent filler, chapter 5) and
+  :class:`Full3D` (chapter 4), FE models on FElupe, with their ramp (:class:`RampSpec`) and
+  full fields (:class:`Solution`);
+- :func:`make_model`, the factory from plain settings (a config's ``[model]`` table, CLI
+  options), with the model classes' own tuned defaults;
+- :class:`ChainModel`, the chain model fitted to them (:class:`ChainTable`,
+  :func:`build_table`);
+- :class:`ActuatorModel`, the protocol every model implements, and :class:`Response`.
+
+Examples
+--------
+>>> from pneumorph.models import make_model
+>>> make_model(4, {"fidelity": "3d"}).fidelity
+'3d'
 """
 
 from pneumorph.models.chain import ChainModel, ChainTable, build_table
+from pneumorph.models.factory import make_model
+from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D, Solution
 from pneumorph.models.response import ActuatorModel, Response
 
-__all__ = ["ActuatorModel", "ChainModel", "ChainTable", "Response", "build_table"]
+__all__ = [
+    "ActuatorModel",
+    "ChainModel",
+    "ChainTable",
+    "FEModel",
+    "Full3D",
+    "RampSpec",
+    "Reduced2D",
+    "Response",
+    "Solution",
+    "build_table",
+    "make_model",
+]
