@@ -281,11 +281,6 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
 
 
 def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):  # type: ignore[no-untyped-def]
-    from scipy.optimize import (  # deferred: keeps the CLI start fast
-        least_squares,
-        lsq_linear,
-    )
-
     """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
 
     The exponents are parametrised as ``alpha_1`` and the gaps ``alpha_(k+1) - alpha_k >=
@@ -294,6 +289,11 @@ def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):  # type:
     every term keeps ``mu_n alpha_n >= 0`` (such pairs cannot cancel, so the final polish
     works on the exponents directly, each keeping its sign).
     """
+    from scipy.optimize import (  # deferred: keeps the CLI start fast
+        least_squares,
+        lsq_linear,
+    )
+
     yw = y * w
     tri = np.tril(np.ones((n, n)))
 
