@@ -52,3 +52,15 @@ def test_simulate_with_gravity_applies_the_weight_first(capsys: pytest.CaptureFi
     # the weight pulls the tip down (-y) at every level
     for a, b in zip(lying["levels"], plain["levels"]):
         assert a["tip_mm"][1] < b["tip_mm"][1]
+
+
+def test_simulate_builds_the_same_model_as_design_and_the_api(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from pneumorph.models import RampSpec, Reduced2D, make_model
+
+    assert main(["simulate", "-o", "0110", "--pressure", "10", "--increments", "2", "--out", str(tmp_path / "s")]) == 0
+    written = json.loads((tmp_path / "s" / "provenance.json").read_text(encoding="utf-8"))["fingerprint"]
+    api = Reduced2D(4, ramp_spec=RampSpec(0.01, replace(Reduced2D.default_steps, increments=2)))
+    assert written == make_model(4, {"fidelity": "2d", "pressure_kpa": 10, "increments": 2}).fingerprint()
+    assert written == api.fingerprint()  # one source of defaults: the cache entries are shared
