@@ -20,25 +20,11 @@ from pneumorph.design import (
 from pneumorph.errors import RunFolderError, SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 
-from .toy_model import ToyModel
+from .toy_model import DyingToy, ToyModel
 
 
 class Killed(BaseException):
     """Stands for the process being killed: nothing catches it."""
-
-
-class DyingToy(ToyModel):
-    """Solves ``budget`` designs, then dies (same fingerprint as the plain toy)."""
-
-    def __init__(self, budget: int, signal: type[BaseException] = Killed, **kw) -> None:
-        super().__init__(**kw)
-        self.budget = budget
-        self.signal = signal
-
-    def evaluate(self, orientation: str):
-        if len(self.calls) >= self.budget:
-            raise self.signal()
-        return super().evaluate(orientation)
 
 
 def config(tmp_path: Path, **kw) -> DesignConfig:
@@ -74,7 +60,7 @@ def test_run_folder_contents(tmp_path: Path) -> None:
 def test_a_killed_run_resumes_without_solving_any_cached_design(tmp_path: Path) -> None:
     reference = run_design(config(tmp_path / "ref"), ToyModel(), tmp_path / "ref" / "run", figures=False)
     total = reference.solves
-    dying = DyingToy(budget=37)
+    dying = DyingToy(budget=37, signal=Killed)
     with pytest.raises(Killed):
         run_design(config(tmp_path), dying, tmp_path / "run", figures=False)
     cache = EvaluationCache(tmp_path / "cache.sqlite")

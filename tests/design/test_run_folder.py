@@ -25,24 +25,10 @@ from pneumorph.errors import (
 from pneumorph.execution import EvaluationCache
 from pneumorph.io import RunLock
 
-from .toy_model import ToyModel
+from .toy_model import DyingToy, ToyModel
 
 REPO = Path(__file__).resolve().parents[2]
 LOCK = ".pneumorph.lock"
-
-
-class DyingToy(ToyModel):
-    """Solves ``budget`` designs, then raises ``signal`` (same fingerprint as the plain toy)."""
-
-    def __init__(self, budget: int, signal: type[BaseException] = KeyboardInterrupt, **kw) -> None:
-        super().__init__(**kw)
-        self.budget = budget
-        self.signal = signal
-
-    def evaluate(self, orientation: str):
-        if len(self.calls) >= self.budget:
-            raise self.signal()
-        return super().evaluate(orientation)
 
 
 class Terminated(KeyboardInterrupt):

@@ -106,3 +106,17 @@ class ToyModel:
             reached=float(p[-1]),
             metadata=r.metadata,
         )
+
+
+class DyingToy(ToyModel):
+    """Solves ``budget`` designs, then raises ``signal`` (same fingerprint as the plain toy)."""
+
+    def __init__(self, budget: int, signal: type[BaseException] = KeyboardInterrupt, **kw: object) -> None:
+        super().__init__(**kw)
+        self.budget = budget
+        self.signal = signal
+
+    def evaluate(self, orientation: str):  # type: ignore[no-untyped-def]
+        if len(self.calls) >= self.budget:
+            raise self.signal()
+        return super().evaluate(orientation)
