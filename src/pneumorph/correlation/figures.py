@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 
 from pneumorph import __version__
 from pneumorph.correlation.compare import Correlation, ModelShape
+from pneumorph.io.files import save_figure
 
 
 def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | None = None,
@@ -48,13 +49,7 @@ def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | 
     ax.legend(loc="best", fontsize=7)
     fig.text(0.99, 0.01, f"pneumorph {__version__}", ha="right", fontsize=6, color="0.5")
     if path is not None:
-        from io import BytesIO
-
-        from pneumorph.io.files import atomic_write_bytes
-
-        buffer = BytesIO()
-        fig.savefig(buffer, dpi=150, format=Path(path).suffix.lstrip(".") or "png", bbox_inches="tight")
-        atomic_write_bytes(path, buffer.getvalue())
+        save_figure(fig, path, bbox_inches="tight")
     return fig
 
 

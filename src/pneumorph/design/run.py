@@ -48,7 +48,6 @@ import io
 import os
 import platform
 import re
-import tempfile
 import time
 import tomllib
 from collections.abc import Callable
@@ -82,7 +81,12 @@ from pneumorph.execution.cache import (
     default_cache_path,
 )
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
-from pneumorph.io.files import atomic_write_text, check_writable_dir, write_json
+from pneumorph.io.files import (
+    atomic_path,
+    atomic_write_text,
+    check_writable_dir,
+    write_json,
+)
 from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 from pneumorph.io.lock import RunLock
 from pneumorph.models.chain import ChainModel, design_strings
@@ -348,14 +352,8 @@ def _remove_run_files(folder: Path) -> None:
 
 def _atomic_figure(path: Path, draw: Callable[[Path], Any]) -> Path:
     """Draw a figure into a temporary file beside ``path`` (same suffix, for its format), then rename it."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent)
-    os.close(fd)
-    try:
-        draw(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp:
+        draw(tmp)
     return path
 
 

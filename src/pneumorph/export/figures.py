@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 
 from pneumorph import __version__
 from pneumorph.export.moulds import Mould
+from pneumorph.io.files import save_figure
 
 __all__ = ["plot_mould"]
 
@@ -86,11 +87,5 @@ def plot_mould(mould: Mould, path: str | Path | None = None, cast: bool = True, 
                           f"(clearance {spec.clearance:g} mm, draft {spec.draft:g} deg)", fontsize=9)
     fig.text(0.99, 0.01, f"pneumorph {__version__}", ha="right", fontsize=6, color="0.5")
     if path is not None:
-        from io import BytesIO
-
-        from pneumorph.io.files import atomic_write_bytes
-
-        buffer = BytesIO()
-        fig.savefig(buffer, dpi=150, format=Path(path).suffix.lstrip(".") or "png", bbox_inches="tight")
-        atomic_write_bytes(path, buffer.getvalue())
+        save_figure(fig, path, bbox_inches="tight")
     return fig

@@ -9,12 +9,13 @@ that cannot write its results refuses before it solves.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import tempfile
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -99,8 +100,36 @@ def check_writable_file(path: str | Path, option: str = "--out") -> Path:
     return path
 
 
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """A temporary path beside ``path`` to write to; renamed over ``path`` if the block succeeds.
+
+    The temporary name ends in ``path``'s suffix, so writers that pick their format from
+    the name (matplotlib's ``savefig``) write the right one. If the block fails, the
+    temporary file is removed and ``path`` is left as it was.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
+    >>> with atomic_path(p) as tmp:
+    ...     _ = tmp.write_text("done")
+    >>> p.read_text(), sorted(f.name for f in p.parent.iterdir())
+    ('done', ['a.txt'])
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a temporary file and a rename.
+    """Write ``data`` to ``path`` through a temporary file and a rename (:func:`atomic_path`).
 
     Examples
     --------
@@ -109,18 +138,18 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     >>> atomic_write_bytes(p, b"abc").read_bytes()
     b'abc'
     """
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    with atomic_path(path) as tmp, tmp.open("wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    return Path(path)
+
+
+def save_figure(fig: Any, path: str | Path, dpi: int = 150, **options: Any) -> Path:
+    """Save a matplotlib figure to ``path`` atomically (format from the suffix)."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, **options)
+    return Path(path)
 
 
 def atomic_write_text(path: str | Path, text: str) -> Path:
