@@ -8,6 +8,8 @@ leaves them out, so what remains is what a scan or a photo of the actuator sees.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -124,12 +126,7 @@ def mirrored_surface_points(mesh: ActuatorMesh, displacement: FloatArray | None 
     x = mesh.points if displacement is None else mesh.points + displacement
     facets, _ = outer_facets(mesh)
     nodes = np.unique(facets)
-    points = x[nodes]
-    if mesh.dim == 3 and mesh.symmetry_points is not None:  # the other half; mid-plane nodes once
-        mirror = x[nodes[~mesh.symmetry_points[nodes]]].copy()
-        mirror[:, 2] = mesh.spec.width - mirror[:, 2]
-        points = np.vstack([points, mirror])
-    return points
+    return _full_width(mesh, nodes, x[nodes], lambda z: mesh.spec.width - z)
 
 
 def surface_normals(mesh: ActuatorMesh, displacement: FloatArray | None = None) -> FloatArray:
@@ -157,9 +154,17 @@ def surface_normals(mesh: ActuatorMesh, displacement: FloatArray | None = None) 
         np.add.at(total, facets[:, corner], face)
     normals = total[nodes]
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
-    if mesh.symmetry_points is not None:
-        mirror = normals[~mesh.symmetry_points[nodes]].copy()
-        mirror[:, 2] *= -1
-        normals = np.vstack([normals, mirror])
-    return normals
+    return _full_width(mesh, nodes, normals, np.negative)
+
+
+def _full_width(mesh: ActuatorMesh, nodes: IntArray, values: FloatArray, mirror_z: Any) -> FloatArray:
+    """``values`` at ``nodes``, then, for a half model, at their mirror images (mid-plane nodes once).
+
+    The one place that fixes the order of the full-width surface, so points and normals match.
+    """
+    if mesh.symmetry_points is None:
+        return values
+    mirror = values[~mesh.symmetry_points[nodes]].copy()
+    mirror[:, 2] = mirror_z(mirror[:, 2])
+    return np.vstack([values, mirror])
 
