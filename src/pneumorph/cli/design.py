@@ -82,12 +82,12 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
     if target is not None:
         from pneumorph.design.targets import make_objective
+        from pneumorph.geometry.unit import UnitSpec
 
-        with P.blame("--target"):
-            goal = make_objective(target, amplitude if amplitude is not None else 10.0,
-                                  periods if periods is not None else 1.0)
-            if hasattr(goal, "check"):
-                goal.check((units or 15) * 10.5)
+        with P.blame("--target"):  # along the built-in unit; checked again below along the model's
+            make_objective(target, amplitude if amplitude is not None else DesignConfig.amplitude,
+                           periods if periods is not None else DesignConfig.periods,
+                           length=(units or DesignConfig.units) * UnitSpec.pitch)
     if unit_file is not None:
         from pneumorph.geometry.unit import UnitSpec
 
@@ -121,9 +121,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     config = DesignConfig.from_dict(config.to_dict())  # validate the combination
     folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
     model = make_model(config.units, config.model)
-    objective_ = config.make_objective()
-    if hasattr(objective_, "check"):  # a profile must be finite along this model's actuator
-        objective_.check(model.n_units * model.unit.pitch)
+    config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
 
     if fallback:  # said once every setting has been checked
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "

@@ -45,11 +45,10 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     pops = tuple(populations)
     if target is not None:
         from pneumorph.design.targets import make_objective
+        from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):
-            goal = make_objective(target)
-            if hasattr(goal, "check"):
-                goal.check((units or 15) * 10.5)
+            make_objective(target, length=(units or DesignConfig.units) * UnitSpec.pitch)
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
     changes = {k: v for k, v in (("units", units), ("objective", target)) if v is not None}
     model_settings = dict(config.model)

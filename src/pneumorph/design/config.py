@@ -129,19 +129,17 @@ class DesignConfig:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
             object.__setattr__(self, "point", _pair(self.point, "[design] point", unit="mm"))
-        try:  # fail early on a bad objective
-            objective = self.make_objective()
-            if hasattr(objective, "check"):  # a profile: finite along the actuator (the inline unit's pitch)
-                unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
-                pitch = unit.get("pitch", UnitSpec.pitch)
-                ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
-                objective.check(self.units * (pitch if ok else UnitSpec.pitch))
+        unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
+        pitch = unit.get("pitch", UnitSpec.pitch)  # the inline unit's, else the built-in unit's
+        ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
+        try:  # fail early on a bad objective: a profile finite along the actuator
+            self.make_objective(length=self.units * (pitch if ok else UnitSpec.pitch))
         except (TargetExpressionError, UnknownObjectiveError) as exc:
             raise SearchConfigError(f"[design] objective: {exc}") from None
 
-    def make_objective(self) -> Objective:
-        """The objective these settings describe."""
-        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored)
+    def make_objective(self, length: float | None = None) -> Objective:
+        """The objective these settings describe (a profile checked along ``length`` mm, if given)."""
+        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length)
 
     # -- plain-data form --------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:

@@ -266,8 +266,12 @@ def make_objective(
     periods: float = 1.0,
     point: tuple[float, float] | None = None,
     anchored: bool = True,
+    length: float | None = None,
 ) -> Objective:
     """Any objective from its text: a tip goal, a preset or a profile expression.
+
+    With ``length`` (mm), a profile is also checked to be finite along an actuator that long
+    (:meth:`ProfileTarget.check`).
 
     Examples
     --------
@@ -285,9 +289,9 @@ def make_objective(
         return tip_goal(key, point)
     if point is not None:
         raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {spec!r}")
-    if key in PRESETS or "=" in spec:
-        return profile_target(spec, amplitude, periods, anchored=anchored)
-    words = re.fullmatch(r"[A-Za-z_][\w\- ]*", spec.strip())
-    if words and spec.strip() not in (*_CARTESIAN, *_POLAR, "pi", "e"):
-        raise UnknownObjectiveError(spec, [*TIP_GOALS, *PRESETS])
-    return profile_target(spec, amplitude, periods, anchored=anchored)
+    if key not in PRESETS and "=" not in spec:
+        words = re.fullmatch(r"[A-Za-z_][\w\- ]*", spec.strip())
+        if words and spec.strip() not in (*_CARTESIAN, *_POLAR, "pi", "e"):
+            raise UnknownObjectiveError(spec, [*TIP_GOALS, *PRESETS])
+    target = profile_target(spec, amplitude, periods, anchored=anchored)
+    return target if length is None else target.check(length)
