@@ -6,8 +6,8 @@ from typing import Any
 
 import click
 
-from pneumorph.errors import UnknownMaterialError
 from pneumorph.cli import params as P
+from pneumorph.errors import UnknownMaterialError
 from pneumorph.io.files import strict_json
 from pneumorph.materials import library
 from pneumorph.materials.filler import FillerLaw
