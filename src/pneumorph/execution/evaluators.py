@@ -161,20 +161,23 @@ def _describe_exit(code: int | None) -> str:
 
 def _stop_pool(pool: ProcessPoolExecutor, grace: float) -> dict[int, int | None]:
     """Shut ``pool`` down: cancel what is queued, give the workers ``grace`` seconds to end, then
-    terminate (and at last kill) those still running. Returns their exit codes by pid."""
+    terminate (and at last kill) those still running. Returns their exit codes by pid.
+
+    The pool's own manager thread joins (reaps) the workers; this function only signals them
+    and waits for that thread. Joining them here as well would race it for the same exit
+    status, and the loser would report a reaped worker as still running.
+    """
     processes = dict(getattr(pool, "_processes", None) or {})
+    manager = getattr(pool, "_executor_manager_thread", None)
     pool.shutdown(wait=False, cancel_futures=True)
-    deadline = time.monotonic() + grace
-    for p in processes.values():
-        p.join(max(0.0, deadline - time.monotonic()))
-    for p in processes.values():
-        if p.exitcode is None:
-            p.terminate()
-    for p in processes.values():
-        p.join(2.0)
-        if p.exitcode is None:  # pragma: no cover - a worker that ignores SIGTERM
-            p.kill()
-            p.join(2.0)
+    if manager is not None:
+        manager.join(grace)
+        for stop in ("terminate", "kill"):  # busy workers: a signal only, no reaping
+            if not manager.is_alive():
+                break
+            for p in processes.values():
+                getattr(p, stop)()
+            manager.join(2.0)
     pool.shutdown(wait=True)
     return {pid: p.exitcode for pid, p in processes.items()}
 
