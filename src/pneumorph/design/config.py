@@ -76,6 +76,7 @@ class DesignConfig:
     amplitude: float = 10.0
     periods: float = 1.0
     point: tuple[float, float] | None = None
+    curve: tuple[tuple[float, float], ...] | None = None
     anchored: bool = True
     units: int = 15
     search: str = "certified"
@@ -129,6 +130,13 @@ class DesignConfig:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
             object.__setattr__(self, "point", _pair(self.point, "[design] point", unit="mm"))
+        if self.curve is not None:
+            try:
+                points = tuple((float(x), float(y)) for x, y in self.curve)
+            except (TypeError, ValueError):
+                raise SearchConfigError(f"[design] curve must be a list of [x, y] points in mm, got {self.curve!r}") \
+                    from None
+            object.__setattr__(self, "curve", points)
         unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
         pitch = unit.get("pitch", UnitSpec.pitch)  # the inline unit's, else the built-in unit's
         ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
@@ -139,21 +147,25 @@ class DesignConfig:
 
     def make_objective(self, length: float | None = None) -> Objective:
         """The objective these settings describe (a profile checked along ``length`` mm, if given)."""
-        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length)
+        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
+                              self.curve)
 
     # -- plain-data form --------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """Nested tables ``design``, ``ga``, ``execution``, ``model`` (None values left out)."""
         design = {
             k: getattr(self, k)
-            for k in ("objective", "amplitude", "periods", "point", "anchored", "units", "search", "seed",
+            for k in ("objective", "amplitude", "periods", "point", "curve", "anchored", "units", "search", "seed",
                       "certify", "verify", "margin", "chain_table")
         }
         ga = {k: v for k, v in asdict(self.ga).items() if k != "seed"}
         execution = {k: getattr(self, k) for k in ("executor", "workers", "scheduler", "cache")}
 
         def clean(d: dict[str, Any]) -> dict[str, Any]:
-            return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items() if v is not None}
+            def plain(v: Any) -> Any:
+                return [plain(x) for x in v] if isinstance(v, tuple) else v
+
+            return {k: plain(v) for k, v in d.items() if v is not None}
 
         return {"design": clean(design), "ga": clean(ga), "execution": clean(execution), "model": dict(self.model)}
 

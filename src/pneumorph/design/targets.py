@@ -11,6 +11,10 @@ An objective says *what* is wanted; :mod:`pneumorph.design.fitness` measures a
   ``min-distance`` (tip to base, Table 6.1's "minimum radius of curvature"), ``max-curl``
   and ``reach`` (a given tip point).
 
+A profile can also be a drawn curve: :func:`curve_target` takes points ``(x, y)`` in mm and
+follows the polyline through them (:class:`Polyline`, held level beyond its ends);
+:func:`smooth_curve` turns a hand-drawn stroke into such points.
+
 Presets (section 6.3): ``sin`` is ``A*sin(2*pi*m*x/L)`` and ``cos`` is
 ``A*(cos(2*pi*m*x/L) - 1)``, ``m`` periods over the actuator length (one by default).
 The dissertation does not print its cos formula; the actuator's base is clamped at
@@ -48,14 +52,121 @@ _HINTS_POLAR = {
 }
 
 
+MAX_CURVE_POINTS = 2000
+"""Most points accepted for a drawn curve."""
+MIN_CURVE_SPAN = 0.2
+"""Least part of the actuator length a drawn curve must span."""
+
+
+@dataclass(frozen=True)
+class Polyline:
+    """A piecewise-linear ``y(x)`` through knots, level beyond the first and last knot.
+
+    It stands in for an :class:`~pneumorph.design.expressions.Expression` in a
+    :class:`ProfileTarget` (same call signature; ``L`` and ``A`` are ignored).
+
+    Examples
+    --------
+    >>> f = Polyline((0.0, 10.0, 20.0), (0.0, 5.0, 0.0))
+    >>> f(x=[-5.0, 5.0, 10.0, 30.0], L=20.0, A=1.0).tolist()
+    [0.0, 2.5, 5.0, 0.0]
+    """
+
+    xs: tuple[float, ...]
+    ys: tuple[float, ...]
+    variables: tuple[str, ...] = field(default=_CARTESIAN, init=False)
+    used: frozenset[str] = field(default=frozenset({"x"}), init=False)
+
+    @property
+    def text(self) -> str:
+        return f"curve through {len(self.xs)} points"
+
+    def __call__(self, **values: ArrayLike) -> NDArray[np.float64]:
+        return np.interp(np.asarray(values["x"], dtype=float), self.xs, self.ys)
+
+
+def _curve_points(points: ArrayLike) -> NDArray[np.float64]:
+    """Points as a checked (n, 2) array of finite mm values."""
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise TargetExpressionError(f"a curve is a list of [x, y] points in mm, got an array of shape {p.shape}")
+    if not 2 <= len(p) <= MAX_CURVE_POINTS:
+        raise TargetExpressionError(f"a curve needs 2 to {MAX_CURVE_POINTS} points, got {len(p)}")
+    if not np.isfinite(p).all() or np.abs(p).max() > 1e5:
+        raise TargetExpressionError("every point of a curve must be a finite number of mm, at most 1e5 in size")
+    return p
+
+
+def smooth_curve(points: ArrayLike, length: float, knots: int = 41,
+                 bandwidth: float | None = None) -> NDArray[np.float64]:
+    """A hand-drawn stroke as ``knots`` evenly spaced points of a smooth curve.
+
+    The stroke's points are averaged with a Gaussian weight in x (standard deviation
+    ``bandwidth``, default ``length / 40``) at knots evenly spaced over the range the stroke
+    covers (clipped to ``0 <= x <= length``).
+
+    Raises
+    ------
+    TargetExpressionError
+        Too few or too many points, values that are not finite, or a stroke spanning less than
+        :data:`MIN_CURVE_SPAN` of the length.
+
+    Examples
+    --------
+    >>> x = np.linspace(0.0, 100.0, 400)
+    >>> knots = smooth_curve(np.c_[x, 0.5 * x], 100.0, knots=5, bandwidth=1.0)
+    >>> knots[:, 0].tolist(), np.round(knots[1:-1, 1], 3).tolist()
+    ([0.0, 25.0, 50.0, 75.0, 100.0], [12.5, 25.0, 37.5])
+    """
+    p = _curve_points(points)
+    if not (np.isfinite(length) and length > 0):
+        raise TargetExpressionError(f"the actuator length must be positive, got {length!r}")
+    lo, hi = max(float(p[:, 0].min()), 0.0), min(float(p[:, 0].max()), float(length))
+    if hi - lo < MIN_CURVE_SPAN * length:
+        raise TargetExpressionError(
+            f"the curve spans {max(hi - lo, 0.0):.3g} mm of the actuator; draw at least "
+            f"{MIN_CURVE_SPAN * length:.3g} mm ({MIN_CURVE_SPAN:.0%} of its {length:g} mm)")
+    h = float(bandwidth) if bandwidth is not None else length / 40.0
+    xk = np.linspace(lo, hi, int(knots))
+    w = np.exp(-0.5 * ((xk[:, None] - p[None, :, 0]) / h) ** 2)
+    yk = (w @ p[:, 1]) / np.maximum(w.sum(axis=1), 1e-300)
+    return np.c_[xk, yk]
+
+
+def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarget:
+    """A profile target through the points ``(x, y)`` (mm): the polyline joining them.
+
+    Points are sorted by x; repeated x are averaged. The target is level beyond the first
+    and last point.
+
+    Examples
+    --------
+    >>> t = curve_target([[0, 0], [50, 10], [100, 0]])
+    >>> t.curve([25.0, 50.0, 120.0], length=100.0).tolist()
+    [5.0, 10.0, 0.0]
+    >>> t.label
+    'curve: y = curve through 3 points'
+    """
+    p = _curve_points(points)
+    xs, inverse = np.unique(p[:, 0], return_inverse=True)
+    ys = np.bincount(inverse, weights=p[:, 1]) / np.bincount(inverse)
+    if len(xs) < 2:
+        raise TargetExpressionError("a curve needs points at two different x at least")
+    line = Polyline(tuple(float(v) for v in xs), tuple(float(v) for v in ys))
+    return ProfileTarget(line, "cartesian", 0.0, length, "curve")
+
+
 @dataclass(frozen=True)
 class ProfileTarget:
     """A target curve for the unit centres, matched by Eq 4.1 (minimised).
 
     Attributes
     ----------
-    expression : Expression
-        The checked right-hand side.
+    expression : Expression or Polyline
+        The checked right-hand side (or a drawn curve's polyline).
     coordinates : {"cartesian", "polar"}
         ``y = f(x)`` or ``r = f(theta)`` (theta in radians from the x axis, about the base).
     amplitude : float
@@ -74,7 +185,7 @@ class ProfileTarget:
     [1.0]
     """
 
-    expression: Expression
+    expression: Expression | Polyline
     coordinates: Literal["cartesian", "polar"] = "cartesian"
     amplitude: float = 10.0
     length: float | None = None
@@ -267,11 +378,13 @@ def make_objective(
     point: tuple[float, float] | None = None,
     anchored: bool = True,
     length: float | None = None,
+    curve: ArrayLike | None = None,
 ) -> Objective:
     """Any objective from its text: a tip goal, a preset or a profile expression.
 
     With ``length`` (mm), a profile is also checked to be finite along an actuator that long
-    (:meth:`ProfileTarget.check`).
+    (:meth:`ProfileTarget.check`). ``"curve"`` takes its points from ``curve``
+    (:func:`curve_target`).
 
     Examples
     --------
@@ -285,6 +398,15 @@ def make_objective(
     pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y, min-y, min-distance, max-curl, reach, sin, cos, or a profile 'y = f(x)' / 'r = f(theta)'
     """
     key = _ALIASES.get(_normalise(spec), _normalise(spec))
+    if (key == "curve") != (curve is not None):
+        raise SearchConfigError("the objective 'curve' needs its points: curve = [[x, y], ...] in mm"
+                                if key == "curve" else f"curve points are only used by the objective 'curve', "
+                                f"not by {spec!r}")
+    if key == "curve":
+        if point is not None:
+            raise SearchConfigError("a tip point is only used by the objective 'reach', not by 'curve'")
+        target = curve_target(curve)  # type: ignore[arg-type]
+        return target if length is None else target.check(length)
     if key in TIP_GOALS:
         return tip_goal(key, point)
     if point is not None:
