@@ -629,6 +629,11 @@ class ChainModel:
     def pressures(self) -> FloatArray:
         return self.table.pressures.copy()
 
+    @property
+    def length(self) -> float:
+        """The undeformed length of the actuator, base to tip (mm): the ``L`` of a profile target."""
+        return float(self.table.reference(np.zeros((1, self.n_units), dtype=np.uint8))[1][0])
+
     def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Centres (m, k, n, 2), tip (m, k, 2), curl (m, k) of many designs at once."""
         bits = np.atleast_2d(np.asarray(bits))

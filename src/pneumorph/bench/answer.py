@@ -1,0 +1,249 @@
+"""The bench's answers: the chain model's certified ranking of every design for a query.
+
+:class:`Bench` holds one FE model and its chain model per fidelity (built as the design
+command builds them, so the bench, the CLI and the API share tables, cache entries and
+fingerprints) and answers a :class:`~pneumorph.bench.query.Query` with the chain model's
+best design, its pressure and error, the designs listed by chain value, and what the
+chain's validated error bound proves before any FE solve: the model's optimum is among the
+designs whose optimistic value beats the winner's pessimistic one
+(:mod:`pneumorph.design.certified`). An FE verification (a background job) then certifies
+the winner in the model itself.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections import OrderedDict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pneumorph.bench.query import Query, QueryError
+from pneumorph.bench.shapes import chain_placement, surface
+from pneumorph.design.certified import chain_scores
+from pneumorph.design.targets import ProfileTarget
+from pneumorph.geometry.assembly import assemble
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.io.files import atomic_write_text
+from pneumorph.models.chain import ChainModel, design_strings
+from pneumorph.models.chaintables import find_table
+from pneumorph.models.factory import make_model
+
+TARGET_SAMPLES = 201
+
+
+class Bench:
+    """Models, chain models and a memo of answers, shared by every request (thread-safe).
+
+    Parameters
+    ----------
+    units : int
+        Units of the actuator (15, as the shipped tables).
+    table_dir : path, optional
+        Where chain tables built by the bench (or by design runs on the same cache) are kept.
+    memo : int
+        Answers kept for repeated queries (a page reload, a pressure slider).
+
+    Examples
+    --------
+    >>> from pneumorph.bench.query import parse_query
+    >>> bench = Bench()
+    >>> q = parse_query({"target": {"kind": "preset", "name": "sin"}, "model": "3d"}, bench.length("3d"))
+    >>> bench.answer(q)["winner"]["design"]
+    '001111010001001'
+    """
+
+    def __init__(self, units: int = 15, table_dir: str | Path | None = None, memo: int = 256) -> None:
+        self.units = int(units)
+        self.table_dir = None if table_dir is None else Path(table_dir)
+        self._models: dict[str, Any] = {}
+        self._chains: dict[str, ChainModel] = {}
+        self._memo: OrderedDict[str, dict[str, Any]] = OrderedDict()
+        self._memo_size = int(memo)
+        self._lock = threading.Lock()
+        self.shape_dir: Path | None = None  # where FE shapes of verified designs are kept (set by the app)
+
+    # -- models -------------------------------------------------------------------------
+    def model(self, fidelity: str) -> Any:
+        """The FE model of a fidelity, as ``pneumorph design --model <fidelity>`` builds it."""
+        with self._lock:
+            if fidelity not in self._models:
+                self._models[fidelity] = make_model(self.units, {"fidelity": fidelity})
+            return self._models[fidelity]
+
+    def chain(self, fidelity: str) -> ChainModel:
+        """The chain model of a fidelity (the shipped table or one kept in ``table_dir``).
+
+        Raises
+        ------
+        QueryError
+            No table exists for the model (field ``model``).
+        """
+        model = self.model(fidelity)
+        with self._lock:
+            if fidelity not in self._chains:
+                table = find_table(model, self.table_dir)
+                if table is None:
+                    raise QueryError("model", f"no chain table for the {fidelity} model of this unit yet; "
+                                              "build one with `pneumorph chain build`")
+                self._chains[fidelity] = ChainModel(table, self.units)
+            return self._chains[fidelity]
+
+    def length(self, fidelity: str = "3d") -> float:
+        """The undeformed actuator length (mm), the ``L`` of profile targets."""
+        return self.chain(fidelity).length
+
+    # -- answers ------------------------------------------------------------------------
+    def answer(self, query: Query) -> dict[str, Any]:
+        """The chain model's answer to ``query`` as plain JSON-ready data (memoised).
+
+        Keys: ``query_id``, ``label``, ``model``, ``units``, ``length_mm``,
+        ``pressures_kpa``, ``sense``, ``value_unit``, ``winner`` (design, value, level,
+        pressure_kpa), ``certificate`` (bound, candidates, designs_scored, complete,
+        statement), ``top`` (rank, design, value, pressure_kpa, optimistic), ``target``
+        (curve samples or None), ``point``, ``profiles`` (the winner's base, centres and tip
+        at every level, heights above the undeformed axis) and ``elapsed_ms``.
+        """
+        key = query.key()
+        with self._lock:
+            hit = self._memo.get(key)
+            if hit is not None:
+                self._memo.move_to_end(key)
+        if hit is not None:
+            return {**hit, "elapsed_ms": 0.0, "memo": True}
+        start = time.perf_counter()
+        out = self._answer(query)
+        out["elapsed_ms"] = round(1e3 * (time.perf_counter() - start), 3)
+        out["memo"] = False
+        with self._lock:
+            self._memo[key] = out
+            while len(self._memo) > self._memo_size:
+                self._memo.popitem(last=False)
+        return out
+
+    def _answer(self, query: Query) -> dict[str, Any]:
+        chain = self.chain(query.model)
+        length = chain.length
+        objective = query.objective(length)
+        scores = chain_scores(chain, objective)
+        order = scores.order()
+        sign = 1.0 if objective.sense == "min" else -1.0
+        top = order[: query.top]
+        designs = design_strings(scores.bits[top])
+        kpa = chain.pressures() * 1e3
+        best = int(order[0])
+        worst_case = float(scores.cost[best] + scores.bound[best])  # the winner's FE value is at least this good
+        candidates = int(np.count_nonzero(scores.optimistic < worst_case))
+        winner = designs[0]
+        response = chain.evaluate(winner)
+        level = int(scores.level[best])
+        unit = objective.unit
+        certificate = {
+            "bound": float(scores.bound[best]),
+            "candidates": candidates,
+            "designs_scored": int(len(scores.cost)),
+            "complete": bool(scores.complete),
+            "statement": (f"Within the chain's validated error bound ({float(scores.bound[best]):.3g} {unit}), the "
+                          f"{query.model.upper()} model's optimum is {'this design' if candidates == 1 else f'one of {candidates} designs'}"
+                          f" of the {len(scores.cost):,} scored; an FE verification certifies it."),
+        }
+        return {
+            "query_id": key_id(query.key()),
+            "label": objective.label,
+            "model": query.model,
+            "units": self.units,
+            "length_mm": length,
+            "pressures_kpa": [round(float(p), 9) for p in kpa],
+            "sense": objective.sense,
+            "value_unit": unit,
+            "winner": {"design": winner, "value": sign * float(scores.cost[best]), "level": level,
+                       "pressure_kpa": float(kpa[level])},
+            "certificate": certificate,
+            "top": [{"rank": i + 1, "design": d, "value": sign * float(scores.cost[j]),
+                     "pressure_kpa": float(kpa[int(scores.level[j])]), "optimistic": sign * float(scores.optimistic[j])}
+                    for i, (d, j) in enumerate(zip(designs, top))],
+            "target": _target_samples(objective, length),
+            "point": list(objective.point) if getattr(objective, "point", None) is not None else None,
+            "profiles": profiles(response),
+        }
+
+    def chain_profiles(self, design: str, fidelity: str) -> list[list[list[float]]]:
+        """A design's predicted centrelines at every level (see :func:`profiles`)."""
+        chain = self.chain(fidelity)
+        try:
+            design = parse_orientation(design, self.units)
+        except Exception as exc:  # a pneumorph error naming the bad character or length
+            raise QueryError("design", str(exc)) from None
+        return profiles(chain.evaluate(design))
+
+    def chain_shape(self, design: str, fidelity: str, level: int) -> dict[str, Any]:
+        """The 3D surface of a design laid along its predicted centreline at ``level``."""
+        chain = self.chain(fidelity)
+        try:
+            design = parse_orientation(design, self.units)
+        except Exception as exc:
+            raise QueryError("design", str(exc)) from None
+        k = len(chain.pressures())
+        if isinstance(level, bool) or not isinstance(level, int) or not 0 <= level < k:
+            raise QueryError("level", f"level must be a whole number from 0 to {k - 1}, got {level!r}")
+        fe = self.fe_shape_file(design)
+        if fe is not None:
+            data = json.loads(fe.read_text(encoding="utf-8"))
+            return {"source": "fe", "indices": data["indices"], **data["levels"][level]}
+        model = self.model("3d")
+        mesh = assemble(model.unit, design, 3, half=True)
+        return {"source": "chain", **surface(mesh, chain_placement(mesh, chain.evaluate(design), level))}
+
+    # -- FE shapes of verified designs --------------------------------------------------
+    def fe_shape_file(self, design: str) -> Path | None:
+        """The kept 3D FE surface of a design (every level), if one was solved."""
+        if self.shape_dir is None:
+            return None
+        path = self.shape_dir / f"{self.model('3d').fingerprint()}-{design}.json"
+        return path if path.is_file() else None
+
+    def add_fe_shape(self, design: str, shape: dict[str, Any]) -> Path:
+        """Keep a design's 3D FE surface (from :func:`pneumorph.bench.jobs.fe_solve_shape`)."""
+        if self.shape_dir is None:
+            raise RuntimeError("the bench keeps no shapes (no shape_dir)")
+        self.shape_dir.mkdir(parents=True, exist_ok=True)
+        path = self.shape_dir / f"{self.model('3d').fingerprint()}-{design}.json"
+        atomic_write_text(path, json.dumps(shape))
+        return path
+
+
+def key_id(key: str) -> str:
+    """A short stable id of a query key."""
+    import hashlib
+
+    return hashlib.sha256(key.encode()).hexdigest()[:16]
+
+
+def profiles(response: Any) -> list[list[list[float]]]:
+    """Base, unit centres and tip at every level, heights above the undeformed axis (mm)."""
+    c = response.centres.copy()
+    c[..., 1] -= response.reference_centres[None, :, 1]
+    tip = response.tip.copy()
+    tip[:, 1] -= response.reference_tip[1]
+    base = np.zeros((len(c), 1, 2))
+    pts = np.concatenate([base, c, tip[:, None]], axis=1)
+    return np.round(pts, 4).tolist()
+
+
+def _target_samples(objective: Any, length: float) -> dict[str, list[float]] | None:
+    if not isinstance(objective, ProfileTarget):
+        return None
+    if objective.coordinates == "cartesian":
+        x = np.linspace(0.0, length, TARGET_SAMPLES)
+        y = objective.curve(x, length)
+    else:
+        th = np.linspace(0.0, np.pi, TARGET_SAMPLES)
+        r = objective.curve(th, length)
+        x, y = r * np.cos(th), r * np.sin(th)
+    return {"x": np.round(x, 4).tolist(), "y": np.round(y, 4).tolist()}
+
+
+__all__ = ["Bench", "profiles"]

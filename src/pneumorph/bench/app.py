@@ -1,0 +1,183 @@
+"""The bench's web application: the page, its JSON API and the background jobs (FastAPI).
+
+Every route is a thin shell over :class:`~pneumorph.bench.answer.Bench` (answers, shapes)
+and :class:`~pneumorph.bench.jobs.JobBoard` (verification, export); the page holds no
+logic of its own. A browser session is a random cookie; a session sees only its own jobs.
+"""
+
+from __future__ import annotations
+
+import json
+import secrets
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.concurrency import run_in_threadpool
+from fastapi.responses import FileResponse, JSONResponse
+from fastapi.staticfiles import StaticFiles
+
+from pneumorph.bench.answer import Bench
+from pneumorph.bench.jobs import JobBoard
+from pneumorph.bench.query import MODELS, QueryError, parse_query
+from pneumorph.design.targets import PRESETS, TIP_GOALS
+
+COOKIE = "pneumorph_session"
+MAX_BODY = 1 << 20  # bytes of a JSON request
+
+
+def static_dir() -> Path:
+    """The page's files, installed with the package."""
+    return Path(str(resources.files("pneumorph.bench") / "static"))
+
+
+def default_state_dir() -> Path:
+    """Where the bench keeps its jobs and shapes: beside the evaluation cache."""
+    from pneumorph.execution.cache import default_cache_path
+
+    return default_cache_path().parent / "bench"
+
+
+def create_app(state_dir: str | Path | None = None, cache: str | Path | None = None, workers: int = 1) -> FastAPI:
+    """The bench as an ASGI application.
+
+    Parameters
+    ----------
+    state_dir : path, optional
+        Jobs and FE shapes (default: ``bench/`` beside the evaluation cache).
+    cache : path, optional
+        The evaluation cache (default: the design command's, so both share solves).
+    workers : int
+        FE worker processes of background jobs.
+    """
+    from pneumorph import __version__
+    from pneumorph.execution.cache import default_cache_path
+
+    cache_path = Path(cache) if cache is not None else default_cache_path()
+    state = Path(state_dir) if state_dir is not None else default_state_dir()
+    state.mkdir(parents=True, exist_ok=True)
+    bench = Bench(table_dir=cache_path.parent / "chain-tables")
+    bench.shape_dir = state / "shapes"
+    board = JobBoard(bench, state, cache_path, workers)
+
+    app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None)
+    app.state.bench, app.state.board = bench, board
+
+    def error(status: int, field: str, message: str) -> JSONResponse:
+        return JSONResponse({"error": {"field": field, "message": message}}, status_code=status)
+
+    @app.exception_handler(QueryError)
+    async def _query_error(request: Request, exc: QueryError) -> JSONResponse:
+        return error(422, exc.field, exc.message)
+
+    @app.middleware("http")
+    async def _session(request: Request, call_next: Any) -> Any:
+        length = request.headers.get("content-length")
+        if length is not None and (not length.isdigit() or int(length) > MAX_BODY):
+            return error(413, "target", f"requests are limited to {MAX_BODY} bytes")
+        sid = request.cookies.get(COOKIE)
+        fresh = sid is None or len(sid) != 32 or not all(c in "0123456789abcdef" for c in sid)
+        if fresh:
+            sid = secrets.token_hex(16)
+        request.state.session = sid
+        response = await call_next(request)
+        if fresh:
+            response.set_cookie(COOKIE, sid, httponly=True, samesite="strict", max_age=30 * 86400)
+        return response
+
+    async def body_of(request: Request) -> Any:
+        raw = await request.body()
+        if len(raw) > MAX_BODY:
+            raise QueryError("target", f"requests are limited to {MAX_BODY} bytes")
+        try:
+            return json.loads(raw or b"null")
+        except (ValueError, UnicodeDecodeError):
+            raise QueryError("target", "the request is not valid JSON") from None
+
+    @app.get("/", include_in_schema=False)
+    async def index() -> FileResponse:
+        return FileResponse(static_dir() / "index.html", headers={"Cache-Control": "no-cache"})
+
+    app.mount("/static", StaticFiles(directory=static_dir()), name="static")
+
+    @app.get("/api/info")
+    async def info() -> dict[str, Any]:
+        length = await run_in_threadpool(bench.length, "3d")
+        chain = bench.chain("3d")
+        return {"version": __version__, "models": list(MODELS), "default_model": "3d", "units": bench.units,
+                "length_mm": length, "pressures_kpa": [float(p) * 1e3 for p in chain.pressures()],
+                "presets": list(PRESETS), "tip_goals": list(TIP_GOALS),
+                "defaults": {"kind": "preset", "name": "sin", "amplitude": 10.0, "periods": 1.0}}
+
+    def parse(body: Any) -> Any:
+        model = body.get("model", "3d") if isinstance(body, dict) else "3d"
+        if model not in MODELS:
+            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        return parse_query(body, bench.length(model))
+
+    @app.post("/api/design")
+    async def design(request: Request) -> dict[str, Any]:
+        body = await body_of(request)
+        return await run_in_threadpool(lambda: bench.answer(parse(body)))
+
+    @app.get("/api/profiles")
+    async def profiles(design: str, model: str = "3d") -> dict[str, Any]:
+        if model not in MODELS:
+            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        return {"design": design, "profiles": await run_in_threadpool(bench.chain_profiles, design, model)}
+
+    @app.get("/api/shape")
+    async def shape(design: str, level: int, model: str = "3d") -> dict[str, Any]:
+        if model not in MODELS:
+            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        return await run_in_threadpool(bench.chain_shape, design, model, level)
+
+    @app.post("/api/jobs", status_code=202)
+    async def start_job(request: Request) -> dict[str, Any]:
+        body = await body_of(request)
+        kind = body.get("kind") if isinstance(body, dict) else None
+        session = request.state.session
+        if kind == "verify":
+            query = await run_in_threadpool(parse, body.get("query"))
+            job = board.verify(session, query)
+        elif kind == "export":
+            design = body.get("design")
+            chain_units = bench.units
+            from pneumorph.geometry.orientation import parse_orientation
+
+            try:
+                design = parse_orientation(design if isinstance(design, str) else "", chain_units)
+            except Exception as exc:
+                raise QueryError("design", str(exc)) from None
+            job = board.export(session, design)
+        else:
+            raise QueryError("kind", f"a job is 'verify' or 'export', got {kind!r}")
+        return {"job_id": job.id}
+
+    @app.get("/api/jobs")
+    async def jobs(request: Request) -> dict[str, Any]:
+        return {"jobs": [j.to_dict() for j in board.of(request.state.session)]}
+
+    @app.get("/api/jobs/{job_id}")
+    async def job(job_id: str, request: Request) -> Any:
+        found = board.get(request.state.session, job_id)
+        if found is None:
+            return error(404, "job", "no such job in this session")
+        return found.to_dict()
+
+    @app.get("/api/jobs/{job_id}/files/{name}")
+    async def job_file(job_id: str, name: str, request: Request) -> Any:
+        path = board.file(request.state.session, job_id, name)
+        if path is None:
+            return error(404, "file", "no such file in this session's jobs")
+        return FileResponse(path, filename=name)
+
+    @app.on_event("shutdown")
+    def _close() -> None:
+        board.close()
+
+    return app
+
+
+__all__ = ["create_app", "default_state_dir", "static_dir"]
