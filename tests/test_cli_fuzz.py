@@ -37,6 +37,9 @@ def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.setattr(fe.FEModel, "evaluate", _trip)
     monkeypatch.setattr(bimodal.BimodalModel, "solve", _trip)
     monkeypatch.setattr(coupon, "simulate_coupon", _trip)
+    import uvicorn
+
+    monkeypatch.setattr(uvicorn, "run", _trip)  # the bench's server never starts on a bad value
     monkeypatch.setattr(execution, "make_evaluator", lambda *a, **k: evaluators.SerialEvaluator())
     monkeypatch.setattr(evaluators, "make_evaluator", lambda *a, **k: evaluators.SerialEvaluator())
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
@@ -92,6 +95,7 @@ BASE = {
     "export": ["export", "0110", "--stl", "run", "--inp", "run/deck.inp", "--mould"],
     "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--scale", "0.2", "--out", "run"],
     "list": ["materials", "list"],
+    "serve": ["serve", "--port", "18765", "--state", "run"],
 }
 
 REAL = ["nan", "inf", "-inf", "1e999", "abc", ""]  # never a number
@@ -153,6 +157,9 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "export": {"--stl": ["a-file", "a-file/sub", ""], "--inp": ["folder", "a-file/x.inp", "x.txt", ""],
                "--pressure": POSITIVE + ["1e9"], "--clearance": ["-1", "10", *REAL], "--draft": ["-1", "45", *REAL],
                "--unit": ["binary.bin", "folder", ""]},
+    "serve": {"--host": ["", "   ", "nosuchhost.invalid"], "--port": POS_COUNT + ["65536", "100000"],
+              "--state": ["a-file", "a-file/sub", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
+              "--workers": POS_COUNT},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": POSITIVE + ["1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
@@ -393,3 +400,14 @@ def test_a_bad_design_to_export_is_refused(sandbox: Path, capsys: pytest.Capture
 def test_export_options_that_do_not_apply_are_refused(sandbox: Path, capsys: pytest.CaptureFixture[str],
                                                       argv: list[str]) -> None:
     _refused(sandbox, capsys, argv)
+
+
+def test_a_port_in_use_is_refused_before_the_bench_starts(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        line = _refused(sandbox, capsys, ["serve", "--port", str(port), "--state", "run"])
+    assert f"127.0.0.1:{port} is in use" in line

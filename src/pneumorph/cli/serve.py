@@ -1,0 +1,75 @@
+"""``pneumorph serve``: the designer's bench, a local web page over the certified search."""
+
+from __future__ import annotations
+
+import errno
+import ipaddress
+import socket
+
+import click
+
+from pneumorph.cli import params as P
+
+
+def _check_port(host: str, port: int) -> None:
+    """Refuse a host that does not resolve or a port that is taken, before anything starts."""
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+    except socket.gaierror as exc:
+        raise click.BadParameter(f"cannot resolve {host!r} ({exc.strerror})", param_hint="--host") from None
+    family, _, _, _, address = infos[0]
+    with socket.socket(family, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(address)
+        except OSError as exc:
+            why = "is in use" if exc.errno == errno.EADDRINUSE else f"cannot be used ({exc.strerror})"
+            raise click.BadParameter(f"{host}:{port} {why}; choose another with --port", param_hint="--port") \
+                from None
+
+
+def _is_local(host: str) -> bool:
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return host == "localhost"
+
+
+@click.command("serve")
+@click.option("--host", default="127.0.0.1", show_default=True, type=P.Text(),
+              help="Address to listen on (this machine only by default).")
+@click.option("--port", default=8000, show_default=True, type=P.Count(1, 65535), help="Port to listen on.")
+@click.option("--open", "open_browser", is_flag=True, help="Open the page in the default browser.")
+@click.option("--state", metavar="DIR", type=P.OutputDir(),
+              help="Jobs and shapes of the bench (default: bench/ beside the evaluation cache).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="Evaluation cache (SQLite) shared with design runs; default ~/.cache/pneumorph/evaluations.sqlite.")
+@click.option("--workers", default=1, show_default=True, type=P.WORKERS, help="FE worker processes of background jobs.")
+def serve(host: str, port: int, open_browser: bool, state: str | None, cache: str | None, workers: int) -> None:
+    """Open the designer's bench: type or draw a target, see the certified design at once.
+
+    A local web page: the target as a preset, an expression, a tip goal or a curve drawn
+    with the mouse; the chain model's certified optimum, its pressure, error and
+    certificate, the best designs, the profile at every pressure and the 3D shape; FE
+    verification and export (STL, mould, CalculiX deck) in the background, with downloads.
+    Stop it with Ctrl-C.
+    """
+    try:
+        import uvicorn
+
+        from pneumorph.bench.app import create_app
+    except ImportError as exc:
+        raise click.UsageError(f"the bench needs the web extra ({exc.name} is missing): "
+                               "pip install -e \".[web]\"") from None
+    _check_port(host, port)
+    app = create_app(state_dir=state, cache=cache, workers=workers)
+    url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
+    click.echo(f"pneumorph bench at {url} (Ctrl-C stops it)")
+    if not _is_local(host):
+        click.echo(f"warning: listening on {host}: anyone who can reach this machine can use the bench", err=True)
+    if open_browser:
+        import threading
+        import webbrowser
+
+        threading.Timer(1.0, webbrowser.open, args=(url,)).start()
+    uvicorn.run(app, host=host, port=port, log_level="warning")
