@@ -7,8 +7,10 @@ logic of its own. A browser session is a random cookie; a session sees only its 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import secrets
+from collections.abc import AsyncIterator
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -61,7 +63,12 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     bench.shape_dir = state / "shapes"
     board = JobBoard(bench, state, cache_path, workers)
 
-    app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None)
+    @contextlib.asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        yield
+        board.close()
+
+    app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None, lifespan=lifespan)
     app.state.bench, app.state.board = bench, board
 
     def error(status: int, field: str, message: str) -> JSONResponse:
@@ -172,10 +179,6 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
         if path is None:
             return error(404, "file", "no such file in this session's jobs")
         return FileResponse(path, filename=name)
-
-    @app.on_event("shutdown")
-    def _close() -> None:
-        board.close()
 
     return app
 

@@ -43,10 +43,12 @@ def surface(mesh: ActuatorMesh, x: FloatArray) -> dict[str, Any]:
     quads = local.reshape(facets.shape)
     tris = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
     pos = np.asarray(x, dtype=float)[nodes]
-    if mesh.symmetry_points is not None:  # the other half: z mirrored about the full width's middle
-        other = pos.copy()
+    if mesh.symmetry_points is not None:  # the other half: z mirrored, welded to this one on the mid-plane
+        seam = mesh.symmetry_points[nodes]
+        index = np.where(seam, np.arange(len(nodes)), len(nodes) + np.cumsum(~seam) - 1)
+        other = pos[~seam].copy()
         other[:, 2] = mesh.spec.width - other[:, 2]
-        tris = np.concatenate([tris, tris[:, ::-1] + len(pos)])
+        tris = np.concatenate([tris, index[tris][:, ::-1]])
         pos = np.concatenate([pos, other])
     return {"positions": np.round(pos, 4).ravel().tolist(), "indices": tris.ravel().astype(int).tolist(),
             "bounds": [pos.min(axis=0).round(4).tolist(), pos.max(axis=0).round(4).tolist()]}

@@ -104,9 +104,10 @@ def smooth_curve(points: ArrayLike, length: float, knots: int = 41,
                  bandwidth: float | None = None) -> NDArray[np.float64]:
     """A hand-drawn stroke as ``knots`` evenly spaced points of a smooth curve.
 
-    The stroke's points are averaged with a Gaussian weight in x (standard deviation
-    ``bandwidth``, default ``length / 40``) at knots evenly spaced over the range the stroke
-    covers (clipped to ``0 <= x <= length``).
+    At knots evenly spaced over the range the stroke covers (clipped to ``0 <= x <= length``),
+    a straight line is fitted to the stroke's points with a Gaussian weight in x (standard
+    deviation ``bandwidth``, default ``length / 40``): local linear smoothing, which follows a
+    sloped stroke to its ends where a plain weighted mean would pull it flat.
 
     Raises
     ------
@@ -131,8 +132,14 @@ def smooth_curve(points: ArrayLike, length: float, knots: int = 41,
             f"{MIN_CURVE_SPAN * length:.3g} mm ({MIN_CURVE_SPAN:.0%} of its {length:g} mm)")
     h = float(bandwidth) if bandwidth is not None else length / 40.0
     xk = np.linspace(lo, hi, int(knots))
-    w = np.exp(-0.5 * ((xk[:, None] - p[None, :, 0]) / h) ** 2)
-    yk = (w @ p[:, 1]) / np.maximum(w.sum(axis=1), 1e-300)
+    d = p[None, :, 0] - xk[:, None]
+    w = np.exp(-0.5 * (d / h) ** 2)
+    # a local straight line through the weighted points (no bias at the ends of a sloped stroke)
+    s0, s1, s2 = w.sum(axis=1), (w * d).sum(axis=1), (w * d * d).sum(axis=1)
+    t0, t1 = w @ p[:, 1], (w * d) @ p[:, 1]
+    det = s0 * s2 - s1 * s1
+    flat = det <= 1e-9 * np.maximum(s0 * s2, 1e-300)  # points at one x only: their mean
+    yk = np.where(flat, t0 / np.maximum(s0, 1e-300), (s2 * t0 - s1 * t1) / np.where(flat, 1.0, det))
     return np.c_[xk, yk]
 
 

@@ -1,0 +1,195 @@
+"""The bench's JSON API: answers equal the certified search's, bad input is a field error, jobs are private."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("fastapi")
+from fastapi.testclient import TestClient  # noqa: E402
+
+from pneumorph.bench import Bench, create_app, parse_query  # noqa: E402
+from pneumorph.bench.shapes import chain_placement  # noqa: E402
+from pneumorph.design.certified import chain_scores  # noqa: E402
+from pneumorph.design.targets import make_objective  # noqa: E402
+from pneumorph.geometry.assembly import assemble  # noqa: E402
+
+SIN = {"target": {"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}}
+
+
+@pytest.fixture(scope="module")
+def state(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("bench")
+
+
+@pytest.fixture(scope="module")
+def app(state: Path):  # type: ignore[no-untyped-def]
+    return create_app(state_dir=state / "state", cache=state / "cache.sqlite")
+
+
+@pytest.fixture()
+def client(app) -> TestClient:  # type: ignore[no-untyped-def]
+    return TestClient(app)
+
+
+def test_default_answer_is_the_design_commands_certified_optimum(client: TestClient) -> None:
+    a = client.post("/api/design", json=SIN).json()
+    # docs/chain-model.md: the main job's winner, chain value 7.405 mm at 36 kPa, bound 0.036 mm
+    assert a["winner"]["design"] == "001111010001001"
+    assert a["winner"]["value"] == pytest.approx(7.405, abs=5e-4)
+    assert a["winner"]["pressure_kpa"] == pytest.approx(36.0)
+    assert a["certificate"]["bound"] == pytest.approx(0.036, abs=5e-4)
+    assert a["certificate"]["designs_scored"] == 2**15 and a["certificate"]["complete"]
+    assert [r["rank"] for r in a["top"]] == list(range(1, 11))
+    values = [r["value"] for r in a["top"]]
+    assert values == sorted(values) and values[0] == a["winner"]["value"]
+    assert a["top"][1]["value"] > a["top"][0]["optimistic"]
+    assert len(a["profiles"]) == len(a["pressures_kpa"]) == 10
+    assert len(a["profiles"][0]) == 17  # base, 15 centres, tip
+    assert a["target"]["y"][50] == pytest.approx(10.0)  # A sin(2 pi x / L) at x = L/4
+
+
+def test_the_certificate_counts_every_design_that_could_still_win() -> None:
+    bench = Bench()
+    q = parse_query({"target": {"kind": "preset", "name": "cos", "amplitude": 20}}, bench.length("3d"))
+    a = bench.answer(q)
+    chain = bench.chain("3d")
+    s = chain_scores(chain, make_objective("cos", 20.0, length=chain.length))
+    best = int(np.argmin(s.cost))
+    worst_case = s.cost[best] + s.bound[best]
+    assert a["certificate"]["candidates"] == int((s.optimistic < worst_case).sum()) >= 1
+    assert a["winner"]["value"] == pytest.approx(float(s.cost[best]))
+
+
+def test_a_drawn_sin_gets_the_presets_answer(client: TestClient) -> None:
+    x = np.linspace(0.0, 157.5, 120)
+    rng = np.random.default_rng(0)
+    stroke = np.c_[x, 10 * np.sin(2 * np.pi * x / 157.5) + rng.normal(0.0, 0.3, x.size)]
+    a = client.post("/api/design", json={"target": {"kind": "curve", "points": stroke.tolist()}}).json()
+    assert a["winner"]["design"] == "001111010001001"
+    # Eq 4.1 is a 2-norm over 15 centres: the drawn target moves it by at most sqrt(15) times
+    # the largest gap between the smoothed stroke and the sin
+    drawn = np.interp(x, a["target"]["x"], a["target"]["y"])
+    gap = np.abs(drawn - 10 * np.sin(2 * np.pi * x / 157.5)).max()
+    assert gap < 0.5
+    assert abs(a["winner"]["value"] - 7.405) <= np.sqrt(15) * gap + 5e-4
+
+
+def test_answers_are_remembered(client: TestClient) -> None:
+    body = {"target": {"kind": "preset", "name": "sin", "amplitude": 12.5}}
+    first = client.post("/api/design", json=body).json()
+    again = client.post("/api/design", json=body).json()
+    assert not first["memo"] and again["memo"]
+    assert again["winner"] == first["winner"] and again["query_id"] == first["query_id"]
+
+
+@pytest.mark.parametrize(("body", "field"), [
+    ({"target": {"kind": "expression", "expression": "y = __import__('os').system('true')"}}, "expression"),
+    ({"target": {"kind": "expression", "expression": "y = 1/x"}}, "expression"),
+    ({"target": {"kind": "expression", "expression": ""}}, "expression"),
+    ({"target": {"kind": "preset", "name": "sin", "amplitude": -1}}, "amplitude"),
+    ({"target": {"kind": "preset", "name": "sin", "amplitude": "ten"}}, "amplitude"),
+    ({"target": {"kind": "preset", "name": "sin", "periods": 0}}, "periods"),
+    ({"target": {"kind": "preset", "name": "tan"}}, "preset"),
+    ({"target": {"kind": "tip", "goal": "reach"}}, "point"),
+    ({"target": {"kind": "tip", "goal": "max-z"}}, "goal"),
+    ({"target": {"kind": "curve", "points": [[0, 0], [10, 1]]}}, "points"),
+    ({"target": {"kind": "curve", "points": [[0, 0], [100, "nan"]]}}, "points"),
+    ({"target": {"kind": "curve", "points": "a line"}}, "points"),
+    ({"target": {"kind": "spline"}}, "target"),
+    ({"target": SIN["target"], "model": "4d"}, "model"),
+    ({"target": SIN["target"], "top": 0}, "top"),
+    ([1, 2], "target"),
+])
+def test_bad_input_is_a_field_error(client: TestClient, body: object, field: str) -> None:
+    r = client.post("/api/design", json=body)
+    assert r.status_code == 422
+    err = r.json()["error"]
+    assert err["field"] == field and err["message"] and "\n" not in err["message"]
+
+
+def test_malformed_and_oversized_requests(client: TestClient) -> None:
+    r = client.post("/api/design", content=b"{not json", headers={"content-type": "application/json"})
+    assert r.status_code == 422 and r.json()["error"]["field"] == "target"
+    r = client.post("/api/design", content=b"[" + b"0," * (1 << 20) + b"0]",
+                    headers={"content-type": "application/json"})
+    assert r.status_code == 413
+    assert client.get("/api/shape", params={"design": "0120", "level": 1}).json()["error"]["field"] == "design"
+    assert client.get("/api/shape", params={"design": "0" * 15, "level": 10}).json()["error"]["field"] == "level"
+
+
+def test_the_chain_view_puts_the_units_on_the_predicted_centres() -> None:
+    bench = Bench()
+    design = "001111010001001"
+    response = bench.chain("3d").evaluate(design)
+    mesh = assemble(bench.model("3d").unit, design, 3, half=True)
+    for level in (0, 7, 9):
+        x = chain_placement(mesh, response, level)
+        centres = mesh.unit_centres(x - mesh.points)
+        assert np.abs(centres - response.centres[level]).max() < 0.5  # mm, against curls up to 300 degrees
+
+
+def test_the_shape_endpoint_gives_a_closed_triangle_surface(client: TestClient) -> None:
+    s = client.get("/api/shape", params={"design": "001111010001001", "level": 7}).json()
+    assert s["source"] == "chain"
+    pos = np.reshape(s["positions"], (-1, 3))
+    tri = np.reshape(s["indices"], (-1, 3))
+    assert tri.max() < len(pos) and tri.min() >= 0
+    edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    assert (counts == 2).all()  # every edge shared by two triangles: watertight, both halves joined
+    assert pos[:, 2].min() == pytest.approx(0.0) and pos[:, 2].max() == pytest.approx(15.0)
+
+
+def _wait(client: TestClient, job_id: str, timeout: float = 120.0) -> dict:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        job = client.get(f"/api/jobs/{job_id}").json()
+        if job["state"] in ("done", "failed"):
+            return job
+        time.sleep(0.2)
+    raise AssertionError(f"job {job_id} did not finish in {timeout} s")
+
+
+def test_verification_runs_the_design_command_and_is_private(client: TestClient, app, state: Path) -> None:  # type: ignore[no-untyped-def]
+    body = {"kind": "verify", "query": {**SIN, "model": "2d"}}
+    r = client.post("/api/jobs", json=body)
+    assert r.status_code == 202
+    job = _wait(client, r.json()["job_id"])
+    assert job["state"] == "done", job["message"]
+    res = job["result"]
+    # docs/chain-model.md: the 2D model's optimum for the default target is 001111010001000
+    assert res["design"] == "001111010001000" and res["model"] == "2d"
+    assert res["fe_value"] == pytest.approx(res["chain_value"], abs=0.3)
+    names = {f["name"] for f in job["files"]}
+    assert {"report.md", "run.zip", "certificate.json", "profile.png"} <= names
+    report = client.get(f"/api/jobs/{job['id']}/files/report.md")
+    assert report.status_code == 200 and "001111010001000" in report.text
+    # another browser session sees none of it
+    other = TestClient(app)
+    assert other.get("/api/jobs").json()["jobs"] == []
+    assert other.get(f"/api/jobs/{job['id']}").status_code == 404
+    assert other.get(f"/api/jobs/{job['id']}/files/report.md").status_code == 404
+    assert client.get(f"/api/jobs/{job['id']}/files/..%2Fjob.json").status_code == 404
+    # a restarted server lists the finished job again
+    again = TestClient(create_app(state_dir=state / "state", cache=state / "cache.sqlite"),
+                       cookies={"pneumorph_session": client.cookies["pneumorph_session"]})
+    assert [j["id"] for j in again.get("/api/jobs").json()["jobs"]] == [job["id"]]
+
+
+def test_a_bad_job_is_refused(client: TestClient) -> None:
+    assert client.post("/api/jobs", json={"kind": "mine"}).json()["error"]["field"] == "kind"
+    assert client.post("/api/jobs", json={"kind": "export", "design": "012"}).json()["error"]["field"] == "design"
+    r = client.post("/api/jobs", json={"kind": "verify", "query": {"target": {"kind": "preset", "name": "x"}}})
+    assert r.status_code == 422 and r.json()["error"]["field"] == "preset"
+
+
+def test_the_page_and_its_assets_are_served_from_the_package(client: TestClient) -> None:
+    page = client.get("/")
+    assert page.status_code == 200 and "<html" in page.text.lower()
+    for ref in ("/static/app.js", "/static/style.css"):
+        assert client.get(ref).status_code == 200
+    assert "http://" not in page.text and "https://" not in page.text  # nothing fetched from the network
