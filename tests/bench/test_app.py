@@ -193,3 +193,26 @@ def test_the_page_and_its_assets_are_served_from_the_package(client: TestClient)
     for ref in ("/static/app.js", "/static/style.css"):
         assert client.get(ref).status_code == 200
     assert "http://" not in page.text and "https://" not in page.text  # nothing fetched from the network
+
+
+def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient) -> None:
+    from pneumorph.design.config import to_toml
+    from pneumorph.geometry.unit import UnitSpec
+
+    def upload(content: bytes, model: str = "2d") -> dict:
+        r = client.post("/api/jobs/table", files={"unit": ("u.toml", content)}, data={"model": model})
+        return {"status": r.status_code, **r.json()}
+
+    for content, words in [(b"\xff\xfe", "UTF-8"), (b"[unit\n", "TOML"), (b"pitch = 1\n", "[unit] table"),
+                           (b"[unit]\nflux = 1\n", "unknown unit parameter"), (b"[unit]\npitch = -1\n", "pitch"),
+                           (b"#" * (65 * 1024), "at most 64 kB")]:
+        r = upload(content)
+        assert r["status"] == 422 and r["error"]["field"] == "unit" and words in r["error"]["message"], r
+    assert upload(b"[unit]\n", model="1d")["error"]["field"] == "model"
+    # the built-in unit's parameters: its shipped table is found at once
+    r = upload(to_toml({"unit": UnitSpec().to_dict()}).encode())
+    job = _wait(client, r["job_id"], timeout=60)
+    assert job["state"] == "done", job["message"]
+    assert job["result"]["unit_id"] == "builtin" and job["result"]["window"] >= 1
+    assert job["result"]["centre_worst_mm"] < 0.2  # the table's held-out tolerance (docs/chain-model.md)
+    assert client.post("/api/design", json={**SIN, "unit": "u0123"}).json()["error"]["field"] == "unit"

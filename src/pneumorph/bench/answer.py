@@ -27,12 +27,14 @@ from pneumorph.design.certified import chain_scores
 from pneumorph.design.targets import ProfileTarget
 from pneumorph.geometry.assembly import assemble
 from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import atomic_write_text
 from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.chaintables import find_table
 from pneumorph.models.factory import make_model
 
 TARGET_SAMPLES = 201
+BUILTIN = "builtin"
 
 
 class Bench:
@@ -56,45 +58,83 @@ class Bench:
     '001111010001001'
     """
 
-    def __init__(self, units: int = 15, table_dir: str | Path | None = None, memo: int = 256) -> None:
+    def __init__(self, units: int = 15, table_dir: str | Path | None = None, memo: int = 256,
+                 unit_dir: str | Path | None = None) -> None:
         self.units = int(units)
         self.table_dir = None if table_dir is None else Path(table_dir)
-        self._models: dict[str, Any] = {}
-        self._chains: dict[str, ChainModel] = {}
+        self.unit_dir = None if unit_dir is None else Path(unit_dir)
+        self._specs: dict[str, UnitSpec] = {BUILTIN: UnitSpec()}
+        self._models: dict[tuple[str, str], Any] = {}
+        self._chains: dict[tuple[str, str], ChainModel] = {}
         self._memo: OrderedDict[str, dict[str, Any]] = OrderedDict()
         self._memo_size = int(memo)
-        self._lock = threading.Lock()
+        self._meshes: OrderedDict[str, Any] = OrderedDict()
+        self._lock = threading.RLock()
         self.shape_dir: Path | None = None  # where FE shapes of verified designs are kept (set by the app)
+        if self.unit_dir is not None and self.unit_dir.is_dir():
+            for path in sorted(self.unit_dir.glob("*.toml")):
+                try:
+                    self._specs[path.stem] = UnitSpec.from_toml(path)
+                except Exception:  # a unit file this version cannot read: not offered
+                    continue
+
+    # -- units --------------------------------------------------------------------------
+    @property
+    def unit_ids(self) -> tuple[str, ...]:
+        """The units queries may name: ``"builtin"`` and the uploaded ones."""
+        return tuple(self._specs)
+
+    def unit_spec(self, unit: str = BUILTIN) -> UnitSpec:
+        return self._specs[unit]
+
+    def add_unit(self, spec: UnitSpec) -> str:
+        """Offer a unit to queries (kept in ``unit_dir``); its id is a hash of its parameters."""
+        import hashlib
+
+        text = json.dumps(spec.to_dict(), sort_keys=True)
+        unit_id = "builtin" if spec == UnitSpec() else "u" + hashlib.sha256(text.encode()).hexdigest()[:15]
+        with self._lock:
+            if unit_id not in self._specs:
+                if self.unit_dir is not None:
+                    from pneumorph.design.config import to_toml
+
+                    self.unit_dir.mkdir(parents=True, exist_ok=True)
+                    atomic_write_text(self.unit_dir / f"{unit_id}.toml", to_toml({"unit": spec.to_dict()}))
+                self._specs[unit_id] = spec
+        return unit_id
 
     # -- models -------------------------------------------------------------------------
-    def model(self, fidelity: str) -> Any:
-        """The FE model of a fidelity, as ``pneumorph design --model <fidelity>`` builds it."""
+    def model(self, fidelity: str, unit: str = BUILTIN) -> Any:
+        """The FE model of a fidelity and unit, as ``pneumorph design --model <fidelity>`` builds it."""
         with self._lock:
-            if fidelity not in self._models:
-                self._models[fidelity] = make_model(self.units, {"fidelity": fidelity})
-            return self._models[fidelity]
+            if (fidelity, unit) not in self._models:
+                settings: dict[str, Any] = {"fidelity": fidelity}
+                if unit != BUILTIN:
+                    settings["unit"] = self._specs[unit].to_dict()
+                self._models[fidelity, unit] = make_model(self.units, settings)
+            return self._models[fidelity, unit]
 
-    def chain(self, fidelity: str) -> ChainModel:
-        """The chain model of a fidelity (the shipped table or one kept in ``table_dir``).
+    def chain(self, fidelity: str, unit: str = BUILTIN) -> ChainModel:
+        """The chain model of a fidelity and unit (the shipped table or one kept in ``table_dir``).
 
         Raises
         ------
         QueryError
             No table exists for the model (field ``model``).
         """
-        model = self.model(fidelity)
+        model = self.model(fidelity, unit)
         with self._lock:
-            if fidelity not in self._chains:
+            if (fidelity, unit) not in self._chains:
                 table = find_table(model, self.table_dir)
                 if table is None:
                     raise QueryError("model", f"no chain table for the {fidelity} model of this unit yet; "
-                                              "build one with `pneumorph chain build`")
-                self._chains[fidelity] = ChainModel(table, self.units)
-            return self._chains[fidelity]
+                                              "upload the unit to build one")
+                self._chains[fidelity, unit] = ChainModel(table, self.units)
+            return self._chains[fidelity, unit]
 
-    def length(self, fidelity: str = "3d") -> float:
+    def length(self, fidelity: str = "3d", unit: str = BUILTIN) -> float:
         """The undeformed actuator length (mm), the ``L`` of profile targets."""
-        return self.chain(fidelity).length
+        return self.chain(fidelity, unit).length
 
     # -- answers ------------------------------------------------------------------------
     def answer(self, query: Query) -> dict[str, Any]:
@@ -125,16 +165,18 @@ class Bench:
         return out
 
     def _answer(self, query: Query) -> dict[str, Any]:
-        chain = self.chain(query.model)
+        chain = self.chain(query.model, query.unit)
         length = chain.length
         objective = query.objective(length)
         scores = chain_scores(chain, objective)
-        order = scores.order()
         sign = 1.0 if objective.sense == "min" else -1.0
-        top = order[: query.top]
+        k = min(query.top, len(scores.cost))
+        top = np.argpartition(scores.cost, k - 1)[:k]
+        as_int = (scores.bits[top].astype(np.int64) << np.arange(self.units - 1, -1, -1)).sum(axis=1)
+        top = top[np.lexsort((as_int, scores.cost[top]))]  # ties: the smaller design first
         designs = design_strings(scores.bits[top])
         kpa = chain.pressures() * 1e3
-        best = int(order[0])
+        best = int(top[0])
         worst_case = float(scores.cost[best] + scores.bound[best])  # the winner's FE value is at least this good
         candidates = int(np.count_nonzero(scores.optimistic < worst_case))
         winner = designs[0]
@@ -170,18 +212,19 @@ class Bench:
             "profiles": profiles(response),
         }
 
-    def chain_profiles(self, design: str, fidelity: str) -> list[list[list[float]]]:
+    def chain_profiles(self, design: str, fidelity: str, unit: str = BUILTIN) -> list[list[list[float]]]:
         """A design's predicted centrelines at every level (see :func:`profiles`)."""
-        chain = self.chain(fidelity)
+        chain = self.chain(fidelity, unit)
         try:
             design = parse_orientation(design, self.units)
         except Exception as exc:  # a pneumorph error naming the bad character or length
             raise QueryError("design", str(exc)) from None
         return profiles(chain.evaluate(design))
 
-    def chain_shape(self, design: str, fidelity: str, level: int) -> dict[str, Any]:
-        """The 3D surface of a design laid along its predicted centreline at ``level``."""
-        chain = self.chain(fidelity)
+    def chain_shape(self, design: str, fidelity: str, level: int, unit: str = BUILTIN) -> dict[str, Any]:
+        """The 3D surface of a design at ``level``: its FE solution if one was kept, else laid along its
+        predicted centreline."""
+        chain = self.chain(fidelity, unit)
         try:
             design = parse_orientation(design, self.units)
         except Exception as exc:
@@ -189,28 +232,40 @@ class Bench:
         k = len(chain.pressures())
         if isinstance(level, bool) or not isinstance(level, int) or not 0 <= level < k:
             raise QueryError("level", f"level must be a whole number from 0 to {k - 1}, got {level!r}")
-        fe = self.fe_shape_file(design)
-        if fe is not None:
+        fe = self.fe_shape_file(design, unit)
+        if fe is not None and fidelity == "3d":
             data = json.loads(fe.read_text(encoding="utf-8"))
             return {"source": "fe", "indices": data["indices"], **data["levels"][level]}
-        model = self.model("3d")
-        mesh = assemble(model.unit, design, 3, half=True)
+        mesh = self._mesh(design, unit)
         return {"source": "chain", **surface(mesh, chain_placement(mesh, chain.evaluate(design), level))}
 
     # -- FE shapes of verified designs --------------------------------------------------
-    def fe_shape_file(self, design: str) -> Path | None:
+    def _mesh(self, design: str, unit: str) -> Any:
+        """The 3D half mesh of a design (the last few kept: a pressure slider asks for the same one)."""
+        key = f"{unit}:{design}"
+        with self._lock:
+            mesh = self._meshes.get(key)
+        if mesh is None:
+            mesh = assemble(self.model("3d", unit).unit, design, 3, half=True)
+            with self._lock:
+                self._meshes[key] = mesh
+                while len(self._meshes) > 16:
+                    self._meshes.popitem(last=False)
+        return mesh
+
+    def fe_shape_file(self, design: str, unit: str = BUILTIN) -> Path | None:
         """The kept 3D FE surface of a design (every level), if one was solved."""
         if self.shape_dir is None:
             return None
-        path = self.shape_dir / f"{self.model('3d').fingerprint()}-{design}.json"
+        path = self.shape_dir / f"{self.model('3d', unit).fingerprint()}-{design}.json"
         return path if path.is_file() else None
 
-    def add_fe_shape(self, design: str, shape: dict[str, Any]) -> Path:
+    def add_fe_shape(self, design: str, shape: dict[str, Any], unit: str = BUILTIN) -> Path:
         """Keep a design's 3D FE surface (from :func:`pneumorph.bench.jobs.fe_solve_shape`)."""
         if self.shape_dir is None:
             raise RuntimeError("the bench keeps no shapes (no shape_dir)")
         self.shape_dir.mkdir(parents=True, exist_ok=True)
-        path = self.shape_dir / f"{self.model('3d').fingerprint()}-{design}.json"
+        path = self.shape_dir / f"{self.model('3d', unit).fingerprint()}-{design}.json"
         atomic_write_text(path, json.dumps(shape))
         return path
 

@@ -24,9 +24,40 @@ from pneumorph.bench.answer import Bench
 from pneumorph.bench.jobs import JobBoard
 from pneumorph.bench.query import MODELS, QueryError, parse_query
 from pneumorph.design.targets import PRESETS, TIP_GOALS
+from pneumorph.errors import PneumorphError
+from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.unit import UnitSpec
 
 COOKIE = "pneumorph_session"
+MAX_UNIT_FILE = 64 * 1024  # bytes of an uploaded unit TOML
 MAX_BODY = 1 << 20  # bytes of a JSON request
+
+
+def read_unit(raw: bytes) -> UnitSpec:
+    """An uploaded unit TOML file, checked: size, UTF-8 text, TOML, a valid ``[unit]`` table.
+
+    Raises
+    ------
+    QueryError
+        Field ``unit``, saying what is wrong.
+    """
+    import tomllib
+
+    if len(raw) > MAX_UNIT_FILE:
+        raise QueryError("unit", f"a unit file is at most {MAX_UNIT_FILE // 1024} kB")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise QueryError("unit", "the unit file is not UTF-8 text") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise QueryError("unit", f"the unit file is not valid TOML: {exc}") from None
+    table = data.get("unit")
+    if not isinstance(table, dict):
+        raise QueryError("unit", "the unit file needs a [unit] table (lengths in mm)")
+    try:
+        return UnitSpec.from_dict(table, "uploaded unit")
+    except PneumorphError as exc:
+        raise QueryError("unit", str(exc)) from None
 
 
 def static_dir() -> Path:
@@ -59,7 +90,7 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     cache_path = Path(cache) if cache is not None else default_cache_path()
     state = Path(state_dir) if state_dir is not None else default_state_dir()
     state.mkdir(parents=True, exist_ok=True)
-    bench = Bench(table_dir=cache_path.parent / "chain-tables")
+    bench = Bench(table_dir=cache_path.parent / "chain-tables", unit_dir=state / "units")
     bench.shape_dir = state / "shapes"
     board = JobBoard(bench, state, cache_path, workers)
 
@@ -119,26 +150,50 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
 
     def parse(body: Any) -> Any:
         model = body.get("model", "3d") if isinstance(body, dict) else "3d"
+        unit = body.get("unit", "builtin") if isinstance(body, dict) else "builtin"
         if model not in MODELS:
             raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        return parse_query(body, bench.length(model))
+        if not isinstance(unit, str) or unit not in bench.unit_ids:
+            raise QueryError("unit", f"unknown unit {unit!r}; upload its TOML file to build its chain table first")
+        return parse_query(body, bench.length(model, unit), bench.unit_ids)
 
     @app.post("/api/design")
     async def design(request: Request) -> dict[str, Any]:
         body = await body_of(request)
         return await run_in_threadpool(lambda: bench.answer(parse(body)))
 
-    @app.get("/api/profiles")
-    async def profiles(design: str, model: str = "3d") -> dict[str, Any]:
+    def check_model(model: str, unit: str) -> None:
         if model not in MODELS:
             raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        return {"design": design, "profiles": await run_in_threadpool(bench.chain_profiles, design, model)}
+        if unit not in bench.unit_ids:
+            raise QueryError("unit", f"unknown unit {unit!r}")
+
+    @app.get("/api/profiles")
+    async def profiles(design: str, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
+        check_model(model, unit)
+        return {"design": design, "profiles": await run_in_threadpool(bench.chain_profiles, design, model, unit)}
 
     @app.get("/api/shape")
-    async def shape(design: str, level: int, model: str = "3d") -> dict[str, Any]:
+    async def shape(design: str, level: int, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
+        check_model(model, unit)
+        return await run_in_threadpool(bench.chain_shape, design, model, level, unit)
+
+    @app.get("/api/units")
+    async def units(request: Request) -> dict[str, Any]:
+        return {"units": [{"id": "builtin", "name": bench.unit_spec().name, "model": "3d and 2d"},
+                          *board.units_of(request.state.session)]}
+
+    @app.post("/api/jobs/table", status_code=202)
+    async def start_table(request: Request) -> dict[str, Any]:
+        form = await request.form(max_files=1, max_fields=4)
+        upload, model = form.get("unit"), form.get("model", "3d")
         if model not in MODELS:
             raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        return await run_in_threadpool(bench.chain_shape, design, model, level)
+        if upload is None or isinstance(upload, str):
+            raise QueryError("unit", "attach a unit TOML file (a [unit] table, lengths in mm)")
+        raw = await upload.read(MAX_UNIT_FILE + 1)
+        spec = await run_in_threadpool(read_unit, raw)
+        return {"job_id": board.table(request.state.session, spec, str(model)).id}
 
     @app.post("/api/jobs", status_code=202)
     async def start_job(request: Request) -> dict[str, Any]:
@@ -149,15 +204,13 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
             query = await run_in_threadpool(parse, body.get("query"))
             job = board.verify(session, query)
         elif kind == "export":
-            design = body.get("design")
-            chain_units = bench.units
-            from pneumorph.geometry.orientation import parse_orientation
-
+            design, unit = body.get("design"), body.get("unit", "builtin")
+            check_model("3d", unit)
             try:
-                design = parse_orientation(design if isinstance(design, str) else "", chain_units)
-            except Exception as exc:
+                design = parse_orientation(design if isinstance(design, str) else "", bench.units)
+            except PneumorphError as exc:
                 raise QueryError("design", str(exc)) from None
-            job = board.export(session, design)
+            job = board.export(session, design, unit)
         else:
             raise QueryError("kind", f"a job is 'verify' or 'export', got {kind!r}")
         return {"job_id": job.id}

@@ -133,9 +133,20 @@ class JobBoard:
         """Verify a query's certified optimum by FE (a design run, as the CLI's), then solve its 3D shape."""
         return self.submit(session, "verify", {"query": json.loads(query.key())}, lambda job: self._verify(job, query))
 
-    def export(self, session: str, design: str) -> Job:
+    def export(self, session: str, design: str, unit: str = "builtin") -> Job:
         """STL parts, casting mould and CalculiX deck of a design, zipped."""
-        return self.submit(session, "export", {"design": design}, lambda job: self._export(job, design))
+        return self.submit(session, "export", {"design": design, "unit": unit},
+                           lambda job: self._export(job, design, unit))
+
+    def table(self, session: str, spec: Any, fidelity: str) -> Job:
+        """The chain table of an uploaded unit (built on first use through the evaluation cache)."""
+        return self.submit(session, "table", {"model": fidelity, "unit": spec.to_dict()},
+                           lambda job: self._table(job, spec, fidelity))
+
+    def units_of(self, session: str) -> list[dict[str, Any]]:
+        """The units this session's finished table jobs made available."""
+        return [{"id": j.result["unit_id"], "name": j.result["name"], "model": j.result["model"]}
+                for j in self.of(session) if j.kind == "table" and j.state == "done" and j.result]
 
     def close(self) -> None:
         self._runner.shutdown(wait=False, cancel_futures=True)
@@ -172,12 +183,13 @@ class JobBoard:
     def _verify(self, job: Job, query: Query) -> None:
         from pneumorph.design.run import run_design
 
-        config = query.config(self.bench.units, executor="processes", workers=self.workers, cache=str(self.cache))
-        model = self.bench.model(query.model)
+        unit = None if query.unit == "builtin" else self.bench.unit_spec(query.unit).to_dict()
+        config = query.config(self.bench.units, unit, executor="processes", workers=self.workers, cache=str(self.cache))
+        model = self.bench.model(query.model, query.unit)
         if query.model == "3d":  # solve the chain's best once, keeping its fields for the 3D view
             design = self.bench.answer(query)["winner"]["design"]
             self._say(job, f"solving {design} by 3D FE (its shape and its verification)", 0.05)
-            self._presolve(job, model, design)
+            self._presolve(model, design, query.unit)
         run = job.folder / "run"
         self._say(job, f"design run: certified search on the {query.model.upper()} model", 0.5)
         result = run_design(config, model, run, on_progress=lambda text: self._say(job, str(text)))
@@ -196,30 +208,46 @@ class JobBoard:
                       "certified": bool(cert.certificate["certified"]), "gap": cert.certificate["gap"],
                       "could_beat": cert.certificate["could_beat"], "verified": cert.certificate["verified"],
                       "solves": result.solves, "unit": result.objective.unit, "model": query.model,
-                      "shape": self.bench.fe_shape_file(winner.design) is not None}
+                      "shape": self.bench.fe_shape_file(winner.design, query.unit) is not None}
 
-    def _presolve(self, job: Job, model: Any, design: str) -> None:
+    def _presolve(self, model: Any, design: str, unit: str) -> None:
         """Solve ``design`` in a worker process: its surface for the viewer, its response into the cache."""
         from pneumorph.execution.cache import EvaluationCache
         from pneumorph.execution.outcome import Outcome
 
         with EvaluationCache(self.cache) as cache:
-            if cache.get(model.fingerprint(), design) is not None and self.bench.fe_shape_file(design) is not None:
+            if cache.get(model.fingerprint(), design) is not None and self.bench.fe_shape_file(design, unit) is not None:
                 return  # verified and drawn before
         with ProcessPoolExecutor(max_workers=1) as pool:
             response, shape, wall = pool.submit(fe_solve_shape, model, design).result()
         if response is None:
             return  # the design run solves it again and reports the failure
-        self.bench.add_fe_shape(design, shape)
+        self.bench.add_fe_shape(design, shape, unit)
         with EvaluationCache(self.cache) as cache:
             if cache.get(model.fingerprint(), design) is None:
                 cache.put(model.fingerprint(), Outcome(design, response, wall_time=wall))
 
-    def _export(self, job: Job, design: str) -> None:
+    def _table(self, job: Job, spec: Any, fidelity: str) -> None:
+        from pneumorph.execution import CachedEvaluator, EvaluationCache, make_evaluator
+        from pneumorph.models.chaintables import table_for
+
+        unit_id = self.bench.add_unit(spec)
+        model = self.bench.model(fidelity, unit_id)
+        self._say(job, f"chain table of unit {spec.name!r} for the {fidelity.upper()} model", 0.02)
+        with EvaluationCache(self.cache) as cache, make_evaluator("processes", self.workers) as inner:
+            table = table_for(model, model.with_units, folder=self.bench.table_dir,
+                              evaluator=CachedEvaluator(inner, cache), on_progress=lambda t: self._say(job, str(t)))
+        val = table.validation
+        job.result = {"unit_id": unit_id, "name": spec.name, "model": fidelity, "window": table.window,
+                      "centre_worst_mm": max(val.get("centre_worst_mm", [float("nan")]))}
+        self._say(job, f"unit {spec.name!r} ready: window {table.window}, held-out centre error at most "
+                       f"{job.result['centre_worst_mm']:.3g} mm", 0.99)
+
+    def _export(self, job: Job, design: str, unit_id: str = "builtin") -> None:
         from pneumorph.export import BaseBlock, MouldSpec, actuator_parts, casting_mould, plot_mould, write_stl
         from pneumorph.export.calculix import write_calculix_deck
 
-        model = self.bench.model("3d")
+        model = self.bench.model("3d", unit_id)
         unit = model.unit
         out = job.folder / "export"
         self._say(job, f"parts of {design}", 0.1)

@@ -59,6 +59,8 @@ class Query:
     model : {"3d", "2d"}
     top : int
         Designs listed, best first.
+    unit : str
+        ``"builtin"`` or the id of a unit uploaded to the bench.
     """
 
     kind: str
@@ -69,6 +71,7 @@ class Query:
     curve: tuple[tuple[float, float], ...] | None = None
     model: str = "3d"
     top: int = 10
+    unit: str = "builtin"
 
     def objective(self, length: float) -> Objective:
         """The objective, a profile checked along ``length`` mm."""
@@ -78,11 +81,16 @@ class Query:
         """A canonical text of the query (equal queries, equal keys)."""
         return json.dumps(asdict(self), sort_keys=True)
 
-    def config(self, units: int, **settings: Any) -> DesignConfig:
-        """The design run of this query (certified search on its model), as the CLI would run it."""
+    def config(self, units: int, unit: dict[str, Any] | None = None, **settings: Any) -> DesignConfig:
+        """The design run of this query (certified search on its model), as the CLI would run it.
+
+        ``unit`` is the unit's parameters when it is not the built-in one.
+        """
+        model: dict[str, Any] = {"fidelity": self.model}
+        if unit is not None:
+            model["unit"] = dict(unit)
         return DesignConfig(objective=self.spec, amplitude=self.amplitude, periods=self.periods, point=self.point,
-                            curve=self.curve, units=units, search="certified",
-                            model={"fidelity": self.model}, **settings)
+                            curve=self.curve, units=units, search="certified", model=model, **settings)
 
 
 def _number(data: dict[str, Any], name: str, default: float, low: float, high: float) -> float:
@@ -102,7 +110,7 @@ def _text(data: dict[str, Any], name: str) -> str:
     return value.strip()
 
 
-def parse_query(body: Any, length: float) -> Query:
+def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",)) -> Query:
     """Check a query's JSON body against an actuator ``length`` mm long.
 
     Parameters
@@ -116,6 +124,8 @@ def parse_query(body: Any, length: float) -> Query:
     length : float
         The undeformed actuator length (mm): profiles must be finite on it, strokes are
         smoothed over it.
+    units : tuple of str
+        The unit ids the query may name in ``"unit"`` (default: the built-in unit only).
 
     Raises
     ------
@@ -146,7 +156,10 @@ def parse_query(body: Any, length: float) -> Query:
     kind = target.get("kind")
     if kind not in KINDS:
         raise QueryError("target", f"the target kind must be one of {', '.join(KINDS)}, got {kind!r}")
-    fields: dict[str, Any] = {"kind": kind, "model": model, "top": top}
+    unit = body.get("unit", "builtin")
+    if unit not in units:
+        raise QueryError("unit", f"unknown unit {unit!r}; upload its TOML file to build its chain table first")
+    fields: dict[str, Any] = {"kind": kind, "model": model, "top": top, "unit": unit}
     if kind == "preset":
         name = target.get("name", "sin")
         if name not in PRESETS:
