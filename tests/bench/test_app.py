@@ -216,3 +216,23 @@ def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient
     assert job["result"]["unit_id"] == "builtin" and job["result"]["window"] >= 1
     assert job["result"]["centre_worst_mm"] < 0.2  # the table's held-out tolerance (docs/chain-model.md)
     assert client.post("/api/design", json={**SIN, "unit": "u0123"}).json()["error"]["field"] == "unit"
+
+
+def test_export_zips_the_parts_the_mould_and_the_deck(client: TestClient) -> None:
+    import io
+    import zipfile
+
+    import trimesh
+
+    design = "001111010001001"
+    job = _wait(client, client.post("/api/jobs", json={"kind": "export", "design": design}).json()["job_id"])
+    assert job["state"] == "done", job["message"]
+    assert job["result"]["mould_parts"] == 22  # docs/manufacturing.md
+    data = client.get(f"/api/jobs/{job['id']}/files/export-{design}.zip").content
+    with zipfile.ZipFile(io.BytesIO(data)) as z:
+        names = set(z.namelist())
+        assert {"parts/body.stl", "parts/base_block.stl", f"{design}.inp", "mould/mould.png"} <= names
+        body = trimesh.load(io.BytesIO(z.read("parts/body.stl")), file_type="stl")
+        deck = z.read(f"{design}.inp").decode()
+    assert body.is_watertight
+    assert "*NODE" in deck.upper() and "C3D20" in deck.upper()

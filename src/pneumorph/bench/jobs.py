@@ -161,7 +161,7 @@ class JobBoard:
             job.state, job.message = "failed", f"{type(exc).__name__}: {exc}"
             job.log.append(job.message)
         else:
-            job.state, job.progress = "done", 1.0
+            job.state, job.progress, job.message = "done", 1.0, "done"
         job.save()
 
     def _say(self, job: Job, text: str, progress: float | None = None) -> None:
@@ -192,7 +192,7 @@ class JobBoard:
             self._presolve(model, design, query.unit)
         run = job.folder / "run"
         self._say(job, f"design run: certified search on the {query.model.upper()} model", 0.5)
-        result = run_design(config, model, run, on_progress=lambda text: self._say(job, str(text)))
+        result = run_design(config, model, run, on_message=lambda text: self._say(job, str(text)))
         cert = result.certified
         if result.status != "finished" or cert is None:
             raise RuntimeError(f"the design run ended {result.status}")
