@@ -236,3 +236,15 @@ def test_export_zips_the_parts_the_mould_and_the_deck(client: TestClient) -> Non
         deck = z.read(f"{design}.inp").decode()
     assert body.is_watertight
     assert "*NODE" in deck.upper() and "C3D20" in deck.upper()
+
+
+def test_answers_from_worker_processes_equal_answers_computed_here(state: Path) -> None:
+    app = create_app(state_dir=state / "pool", cache=state / "cache.sqlite", answer_workers=1)
+    body = {"target": {"kind": "expression", "expression": "y = 0.2*x", "amplitude": 1}, "model": "2d"}
+    with TestClient(app) as c:  # the lifespan starts the worker
+        remote = c.post("/api/design", json=body).json()
+        assert c.post("/api/design", json={**body, "unit": "u99"}).json()["error"]["field"] == "unit"
+    bench = Bench()
+    here = bench.compute(bench.parse(body))
+    assert remote["winner"] == here["winner"] and remote["top"] == here["top"]
+    assert remote["certificate"] == here["certificate"]

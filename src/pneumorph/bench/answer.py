@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.bench.query import Query, QueryError
+from pneumorph.bench.query import MODELS, Query, QueryError, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import chain_scores
 from pneumorph.design.targets import ProfileTarget
@@ -84,6 +84,17 @@ class Bench:
         """The units queries may name: ``"builtin"`` and the uploaded ones."""
         return tuple(self._specs)
 
+    def knows(self, unit: str) -> bool:
+        """True for a unit queries may name (one added by another process is read from ``unit_dir``)."""
+        if unit in self._specs:
+            return True
+        path = None if self.unit_dir is None else self.unit_dir / f"{unit}.toml"
+        if path is None or not unit.isalnum() or not path.is_file():
+            return False
+        with self._lock:
+            self._specs[unit] = UnitSpec.from_toml(path)
+        return True
+
     def unit_spec(self, unit: str = BUILTIN) -> UnitSpec:
         return self._specs[unit]
 
@@ -137,31 +148,61 @@ class Bench:
         return self.chain(fidelity, unit).length
 
     # -- answers ------------------------------------------------------------------------
+    def parse(self, body: Any) -> Query:
+        """A query's JSON body checked against its model and unit (:func:`parse_query`).
+
+        Raises
+        ------
+        QueryError
+        """
+        model = body.get("model", "3d") if isinstance(body, dict) else "3d"
+        unit = body.get("unit", BUILTIN) if isinstance(body, dict) else BUILTIN
+        if model not in MODELS:
+            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        if not isinstance(unit, str) or not self.knows(unit):
+            raise QueryError("unit", f"unknown unit {unit!r}; upload its TOML file to build its chain table first")
+        return parse_query(body, self.length(model, unit), self.unit_ids)
+
+    def recall(self, query: Query) -> dict[str, Any] | None:
+        """A remembered answer to ``query`` (marked ``memo``), or None."""
+        key = query.key()
+        with self._lock:
+            hit = self._memo.get(key)
+            if hit is None:
+                return None
+            self._memo.move_to_end(key)
+        return {**hit, "elapsed_ms": 0.0, "memo": True}
+
+    def remember(self, query: Query, answer: dict[str, Any]) -> None:
+        """Keep an answer for the next equal query (the oldest ones go first)."""
+        with self._lock:
+            self._memo[query.key()] = answer
+            while len(self._memo) > self._memo_size:
+                self._memo.popitem(last=False)
+
     def answer(self, query: Query) -> dict[str, Any]:
-        """The chain model's answer to ``query`` as plain JSON-ready data (memoised).
+        """The chain model's answer to ``query`` as plain JSON-ready data (remembered).
 
         Keys: ``query_id``, ``label``, ``model``, ``units``, ``length_mm``,
         ``pressures_kpa``, ``sense``, ``value_unit``, ``winner`` (design, value, level,
         pressure_kpa), ``certificate`` (bound, candidates, designs_scored, complete,
         statement), ``top`` (rank, design, value, pressure_kpa, optimistic), ``target``
         (curve samples or None), ``point``, ``profiles`` (the winner's base, centres and tip
-        at every level, heights above the undeformed axis) and ``elapsed_ms``.
+        at every level, heights above the undeformed axis), ``elapsed_ms`` and ``memo``.
         """
-        key = query.key()
-        with self._lock:
-            hit = self._memo.get(key)
-            if hit is not None:
-                self._memo.move_to_end(key)
+        hit = self.recall(query)
         if hit is not None:
-            return {**hit, "elapsed_ms": 0.0, "memo": True}
+            return hit
+        out = self.compute(query)
+        self.remember(query, out)
+        return out
+
+    def compute(self, query: Query) -> dict[str, Any]:
+        """The answer to ``query``, computed (no memo)."""
         start = time.perf_counter()
         out = self._answer(query)
         out["elapsed_ms"] = round(1e3 * (time.perf_counter() - start), 3)
         out["memo"] = False
-        with self._lock:
-            self._memo[key] = out
-            while len(self._memo) > self._memo_size:
-                self._memo.popitem(last=False)
         return out
 
     def _answer(self, query: Query) -> dict[str, Any]:

@@ -7,9 +7,14 @@ logic of its own. A browser session is a random cookie; a session sees only its 
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import json
+import multiprocessing
+import os
 import secrets
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from collections.abc import AsyncIterator
 from importlib import resources
 from pathlib import Path
@@ -22,7 +27,7 @@ from fastapi.staticfiles import StaticFiles
 
 from pneumorph.bench.answer import Bench
 from pneumorph.bench.jobs import JobBoard
-from pneumorph.bench.query import MODELS, QueryError, parse_query
+from pneumorph.bench.query import MODELS, Query, QueryError
 from pneumorph.design.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import PneumorphError
 from pneumorph.geometry.orientation import parse_orientation
@@ -60,6 +65,74 @@ def read_unit(raw: bytes) -> UnitSpec:
         raise QueryError("unit", str(exc)) from None
 
 
+_POOL_BENCH: Bench | None = None
+
+
+def _start_answer_worker(table_dir: Path | None, unit_dir: Path | None) -> None:
+    global _POOL_BENCH
+    from pneumorph.execution.evaluators import prepare_worker
+
+    prepare_worker()
+    _POOL_BENCH = Bench(table_dir=table_dir, unit_dir=unit_dir, memo=0)
+
+
+def _answer_in_worker(query: Query) -> dict[str, Any]:
+    assert _POOL_BENCH is not None
+    if not _POOL_BENCH.knows(query.unit):
+        raise QueryError("unit", f"unknown unit {query.unit!r}")
+    return _POOL_BENCH.compute(query)
+
+
+def _warm_worker(fidelity: str) -> int:
+    assert _POOL_BENCH is not None
+    _POOL_BENCH.compute(Query("preset", "sin", model=fidelity))
+    return os.getpid()
+
+
+class AnswerPool:
+    """Answers computed in worker processes, so that concurrent queries use every core.
+
+    Each worker holds its own :class:`Bench` (models and chain tables loaded once); a query
+    travels as a :class:`Query` and its answer comes back as plain data. With no workers,
+    answers are computed on the server's threads.
+    """
+
+    def __init__(self, bench: Bench, workers: int | None = None) -> None:
+        self.bench = bench
+        self.workers = min(os.cpu_count() or 1, 4) if workers is None else int(workers)
+        self._pool: ProcessPoolExecutor | None = None
+
+    def _make(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=_start_answer_worker, initargs=(self.bench.table_dir, self.bench.unit_dir))
+
+    async def start(self) -> None:
+        """Start the workers and load their tables (before the first query is taken)."""
+        if self.workers < 1:
+            return
+        self._pool = self._make()
+        loop = asyncio.get_running_loop()
+        for fidelity in ("3d", "2d"):
+            await asyncio.gather(*(loop.run_in_executor(self._pool, _warm_worker, fidelity)
+                                   for _ in range(self.workers)))
+
+    async def compute(self, query: Query) -> dict[str, Any]:
+        if self._pool is None:
+            return await run_in_threadpool(self.bench.compute, query)
+        loop = asyncio.get_running_loop()
+        try:
+            return await loop.run_in_executor(self._pool, _answer_in_worker, query)
+        except BrokenProcessPool:  # a worker died (killed, out of memory): start afresh once
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = self._make()
+            return await loop.run_in_executor(self._pool, _answer_in_worker, query)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = None
+
+
 def static_dir() -> Path:
     """The page's files, installed with the package."""
     return Path(str(resources.files("pneumorph.bench") / "static"))
@@ -72,7 +145,8 @@ def default_state_dir() -> Path:
     return default_cache_path().parent / "bench"
 
 
-def create_app(state_dir: str | Path | None = None, cache: str | Path | None = None, workers: int = 1) -> FastAPI:
+def create_app(state_dir: str | Path | None = None, cache: str | Path | None = None, workers: int = 1,
+               answer_workers: int | None = None) -> FastAPI:
     """The bench as an ASGI application.
 
     Parameters
@@ -83,6 +157,9 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
         The evaluation cache (default: the design command's, so both share solves).
     workers : int
         FE worker processes of background jobs.
+    answer_workers : int, optional
+        Processes that compute answers (default: one per core, at most 4); 0 computes them
+        on the server's threads.
     """
     from pneumorph import __version__
     from pneumorph.execution.cache import default_cache_path
@@ -93,10 +170,13 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     bench = Bench(table_dir=cache_path.parent / "chain-tables", unit_dir=state / "units")
     bench.shape_dir = state / "shapes"
     board = JobBoard(bench, state, cache_path, workers)
+    answers = AnswerPool(bench, answer_workers)
 
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        await answers.start()
         yield
+        answers.close()
         board.close()
 
     app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None, lifespan=lifespan)
@@ -148,19 +228,16 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
                 "presets": list(PRESETS), "tip_goals": list(TIP_GOALS),
                 "defaults": {"kind": "preset", "name": "sin", "amplitude": 10.0, "periods": 1.0}}
 
-    def parse(body: Any) -> Any:
-        model = body.get("model", "3d") if isinstance(body, dict) else "3d"
-        unit = body.get("unit", "builtin") if isinstance(body, dict) else "builtin"
-        if model not in MODELS:
-            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        if not isinstance(unit, str) or unit not in bench.unit_ids:
-            raise QueryError("unit", f"unknown unit {unit!r}; upload its TOML file to build its chain table first")
-        return parse_query(body, bench.length(model, unit), bench.unit_ids)
-
     @app.post("/api/design")
     async def design(request: Request) -> dict[str, Any]:
         body = await body_of(request)
-        return await run_in_threadpool(lambda: bench.answer(parse(body)))
+        query = await run_in_threadpool(bench.parse, body)
+        hit = bench.recall(query)
+        if hit is not None:
+            return hit
+        answer = await answers.compute(query)
+        bench.remember(query, answer)
+        return answer
 
     def check_model(model: str, unit: str) -> None:
         if model not in MODELS:
@@ -201,7 +278,7 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
         kind = body.get("kind") if isinstance(body, dict) else None
         session = request.state.session
         if kind == "verify":
-            query = await run_in_threadpool(parse, body.get("query"))
+            query = await run_in_threadpool(bench.parse, body.get("query"))
             job = board.verify(session, query)
         elif kind == "export":
             design, unit = body.get("design"), body.get("unit", "builtin")

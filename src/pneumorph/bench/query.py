@@ -40,6 +40,9 @@ class QueryError(SettingsError):
         self.field = field
         self.message = message
 
+    def __reduce__(self) -> tuple[type, tuple[str, str]]:  # crosses process boundaries whole
+        return (QueryError, (self.field, self.message))
+
 
 @dataclass(frozen=True)
 class Query:

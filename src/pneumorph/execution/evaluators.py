@@ -100,16 +100,23 @@ class SerialEvaluator(_Base):
 _WORKER_MODEL: Any = None
 
 
-def _init_worker(model: ActuatorModel) -> None:
-    global _WORKER_MODEL
+def prepare_worker() -> None:
+    """Set up a worker process of a pool: one thread for the linear algebra, Ctrl-C left to the
+    parent (it reaches the whole process group; the parent stops the workers, which print no
+    tracebacks), and an exit of its own when the parent dies (:func:`_watch_parent`)."""
     for name in THREAD_VARIABLES:
         os.environ[name] = "1"
-    try:  # Ctrl-C reaches the whole process group: the parent stops the workers, they do not print tracebacks
+    try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     except (ValueError, OSError):  # pragma: no cover - not the main thread of the worker
         pass
-    _WORKER_MODEL = model
     _watch_parent(os.getppid())
+
+
+def _init_worker(model: ActuatorModel) -> None:
+    global _WORKER_MODEL
+    prepare_worker()
+    _WORKER_MODEL = model
 
 
 def _watch_parent(parent: int, every: float = 0.5) -> None:
