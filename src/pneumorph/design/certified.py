@@ -26,7 +26,9 @@ chain value is within reach of the best, and a floor under all others.
 
 from __future__ import annotations
 
+import threading
 import time
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -82,18 +84,13 @@ def _max_slope(f: Callable[[FloatArray], FloatArray], lo: float, hi: float, samp
     return float(d.max())
 
 
-def _target_length(chain: ChainModel) -> float:
-    """The undeformed length of the chain's actuator (the ``L`` of a profile target)."""
-    return float(chain.table.reference(np.zeros((1, chain.n_units), dtype=np.uint8))[1][0])
-
-
 def _target_slope(chain: ChainModel, objective: ProfileTarget, errors: dict[str, FloatArray]) -> float:
     """The largest slope of a profile target wherever the actuator can reach.
 
     ``|df/dx|`` over every x within the chords' summed greatest length of the base, or
     ``|df/dtheta|`` over two turns either way.
     """
-    length = _target_length(chain)
+    length = chain.length
     if objective.coordinates == "polar":
         return _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
     reach = float(chain.table.length.max()) * (chain.n_units + 1) + float(errors["centre"].max())
@@ -283,6 +280,169 @@ def _prefix_bound(chain: ChainModel, objective: Objective, state: dict[str, Any]
     return c.min(axis=1)
 
 
+# -- the prefix tree: chords placed unit by unit ---------------------------------------------
+def _seed_prefixes(chain: ChainModel, polar: bool = False) -> tuple[NDArray[np.uint8], dict[str, Any]]:
+    """The two one-unit prefixes and their state: base point, angle (and polar angle, radius)."""
+    k = chain.table.n_levels
+    bits = np.array([[0], [1]], dtype=np.uint8)
+    st: dict[str, Any] = {"point": np.zeros((2, k, 2)), "angle": np.zeros((2, k))}
+    st["point"][..., 1] = np.asarray(chain.table.centre_y)[bits[:, 0]][:, None]
+    if polar:
+        st.update(theta=np.zeros((2, k)), r=np.zeros((2, k)))
+    return bits, st
+
+
+def _grow(bits: NDArray[np.uint8], st: dict[str, Any]) -> tuple[NDArray[np.uint8], dict[str, Any]]:
+    """Every prefix extended by a 0 and a 1 unit (child ``2 i + b`` of prefix ``i``)."""
+    bits = np.concatenate([np.repeat(bits, 2, axis=0),
+                           np.tile(np.array([[0], [1]], dtype=np.uint8), (len(bits), 1))], axis=1)
+    return bits, {key: np.repeat(v, 2, axis=0) for key, v in st.items()}
+
+
+def _place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], placed: int, upto: int,
+                  polar: bool = False) -> Any:
+    """Place chords ``placed .. upto - 1`` of every prefix (their windows are covered), updating ``st``.
+
+    Yields ``(j, x, y)`` after chord ``j`` with the centre ``j + 1`` it fixes (heights above
+    the undeformed axis), for ``j + 1 <= n``; with ``polar``, ``st["theta"]`` (unwrapped)
+    and ``st["r"]`` of that centre too.
+    """
+    table = chain.table
+    n, w = chain.n_units, table.window
+    if upto <= placed:
+        return
+    cy = np.asarray(table.centre_y)
+    codes = window_codes(bits, w, range(placed, upto))
+    for j in range(placed, upto):
+        rows = table.lookup(codes[:, j - placed])
+        st["angle"] = st["angle"] + table.turn[rows]
+        step = table.length[rows]
+        st["point"] = st["point"] + np.stack([step * np.cos(st["angle"]), step * np.sin(st["angle"])], -1)
+        if j + 1 <= n:  # centre j + 1 is now known
+            x = st["point"][..., 0]
+            y = st["point"][..., 1] - cy[bits[:, j]][:, None]
+            if polar:
+                raw = np.arctan2(y, x)
+                st["theta"] = raw if j == 0 else st["theta"] + (raw - st["theta"] + np.pi) % (2 * np.pi) - np.pi
+                st["r"] = np.hypot(x, y)
+            yield j, x, y
+
+
+def _tip_and_curl(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
+    """Tip point and curl (degrees) of whole designs from their final state."""
+    table = chain.table
+    erows = table.lookup(window_codes(bits, table.window, [chain.n_units])[:, 0], end=True)
+    return st["point"], np.degrees(st["angle"] + table.end[erows])
+
+
+@dataclass(frozen=True)
+class ChainGeometry:
+    """The centres, tip and curl of every design of a chain model, by prefix depth.
+
+    Centre ``j`` is fixed once the prefix covers its windows, at depth ``depth[j]`` (then
+    ``2**depth[j]`` prefixes); ``x[j]``, ``y[j]`` (and ``theta[j]``, ``r[j]``) hold it for
+    every prefix at every level, so an objective is evaluated once per prefix, not per
+    design. ``tip`` and ``curl`` are those of all ``2**n`` designs, in the order of
+    :attr:`bits` (the first unit most significant).
+    """
+
+    bits: NDArray[np.uint8]
+    depth: tuple[int, ...]
+    x: tuple[FloatArray, ...]
+    y: tuple[FloatArray, ...]
+    theta: tuple[FloatArray, ...]
+    r: tuple[FloatArray, ...]
+    tip: FloatArray
+    curl: FloatArray
+
+
+_GEOMETRY: weakref.WeakKeyDictionary[ChainModel, ChainGeometry] = weakref.WeakKeyDictionary()
+_GEOMETRY_LOCK = threading.Lock()
+
+
+def chain_geometry(chain: ChainModel) -> ChainGeometry:
+    """Every design's centres, tip and curl, grown over shared prefixes (kept per chain model).
+
+    Memory: about ``3 w 2^n k`` numbers for window ``w`` (15 units, 10 levels: ~25 MB).
+
+    Examples
+    --------
+    >>> from pneumorph.models.chaintables import find_table
+    >>> from pneumorph.models.factory import make_model
+    >>> chain = ChainModel(find_table(make_model(5, {"fidelity": "2d"})), 5)
+    >>> g = chain_geometry(chain)
+    >>> g.bits.shape, len(g.depth), g.tip.shape, chain_geometry(chain) is g
+    ((32, 5), 5, (32, 10, 2), True)
+    """
+    with _GEOMETRY_LOCK:
+        hit = _GEOMETRY.get(chain)
+    if hit is not None:
+        return hit
+    n, w = chain.n_units, chain.table.window
+    bits, st = _seed_prefixes(chain, polar=True)
+    depth: list[int] = []
+    xs: list[FloatArray] = []
+    ys: list[FloatArray] = []
+    ths: list[FloatArray] = []
+    rs: list[FloatArray] = []
+    placed = 0
+    with np.errstate(all="ignore"):
+        for p in range(1, n + 1):
+            if p > 1:
+                bits, st = _grow(bits, st)
+            upto = n + 1 if p == n else max(p - w + 1, 0)
+            for _, x, y in _place_chords(chain, bits, st, placed, upto, polar=True):
+                depth.append(p)
+                xs.append(x)
+                ys.append(y)
+                ths.append(st["theta"])
+                rs.append(st["r"])
+            placed = max(placed, upto)
+        tip, curl = _tip_and_curl(chain, bits, st)
+    geom = ChainGeometry(bits, tuple(depth), tuple(xs), tuple(ys), tuple(ths), tuple(rs), tip, curl)
+    with _GEOMETRY_LOCK:
+        _GEOMETRY[chain] = geom
+    return geom
+
+
+def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]) -> ChainScores:
+    """Chain scores of all ``2^n`` designs from :func:`chain_geometry`."""
+    g = chain_geometry(chain)
+    n = chain.n_units
+    e = errors["centre"]
+    profile = isinstance(objective, ProfileTarget)
+    polar = profile and objective.coordinates == "polar"
+    slope = _target_slope(chain, objective, errors) if profile else 0.0
+    length = chain.length
+    with np.errstate(all="ignore"):
+        if profile:
+            total = np.zeros((2, chain.table.n_levels))
+            bsum = np.zeros_like(total) if polar else None
+            at = 1
+            for j, p in enumerate(g.depth):
+                if p > at:
+                    total = np.repeat(total, 2 ** (p - at), axis=0)
+                    bsum = None if bsum is None else np.repeat(bsum, 2 ** (p - at), axis=0)
+                    at = p
+                if polar:
+                    total += (objective.curve(g.theta[j], length) - g.r[j]) ** 2
+                    bsum += _polar_term(g.r[j], e, slope) ** 2  # type: ignore[operator]
+                else:
+                    total += (objective.curve(g.x[j], length) - g.y[j]) ** 2
+            if at < n:
+                total = np.repeat(total, 2 ** (n - at), axis=0)
+                bsum = None if bsum is None else np.repeat(bsum, 2 ** (n - at), axis=0)
+            values = np.sqrt(total)
+        else:
+            values = tip_value_array(g.tip, np.asarray(chain.table.tip_ref), g.curl, objective.name, objective.point)
+        if polar:
+            beta = e[None, :] * np.sqrt(bsum)  # type: ignore[arg-type]
+        else:
+            beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
+    cost, level, optimistic, bound = _costs(values, beta, objective.sense)
+    return ChainScores(g.bits, values, cost, level, optimistic, bound)
+
+
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
                  threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None) -> ChainScores:
     """Chain scores of every design whose cost is below ``threshold`` (all designs for ``inf``).
@@ -301,50 +461,35 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     SearchConfigError
         More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose).
     """
+    if not np.isfinite(threshold) and beam is None:  # every design: from the kept geometry
+        return _score_all(chain, objective, errors)
     table = chain.table
     n, w, k = chain.n_units, table.window, table.n_levels
     profile = isinstance(objective, ProfileTarget)
     polar = profile and objective.coordinates == "polar"
-    length = _target_length(chain)
+    length = chain.length
     e = errors["centre"]
     slope = _target_slope(chain, objective, errors) if profile else 0.0
-    cy = np.asarray(table.centre_y)
-    bits = np.array([[0], [1]], dtype=np.uint8)
-    m = 2
-    st: dict[str, Any] = {"point": np.zeros((m, k, 2)), "angle": np.zeros((m, k))}
+    bits, st = _seed_prefixes(chain, polar)
     if profile:
-        st["sum"] = np.zeros((m, k))
+        st["sum"] = np.zeros((2, k))
     if polar:
-        st.update(bsum=np.zeros((m, k)), theta=np.zeros((m, k)))
-    st["point"][..., 1] = cy[bits[:, 0]][:, None]
+        st["bsum"] = np.zeros((2, k))
     placed = 0
     with np.errstate(all="ignore"):
         for p in range(1, n + 1):
             if p > 1:
-                bits = np.concatenate([np.repeat(bits, 2, axis=0),
-                                       np.tile(np.array([[0], [1]], dtype=np.uint8), (len(bits), 1))], axis=1)
-                st = {key: np.repeat(v, 2, axis=0) for key, v in st.items()}
+                bits, st = _grow(bits, st)
             upto = n + 1 if p == n else max(p - w + 1, 0)
-            codes = window_codes(bits, w, range(placed, upto)) if upto > placed else None
-            for j in range(placed, upto):
-                rows = table.lookup(codes[:, j - placed])
-                st["angle"] = st["angle"] + table.turn[rows]
-                step = table.length[rows]
-                st["point"] = st["point"] + np.stack([step * np.cos(st["angle"]), step * np.sin(st["angle"])], -1)
-                if profile and j + 1 <= n:  # centre j + 1 is now known
-                    x = st["point"][..., 0]
-                    y = st["point"][..., 1] - cy[bits[:, j]][:, None]
+            for j, x, y in _place_chords(chain, bits, st, placed, upto, polar):
+                if profile:
                     if not polar:
                         st["sum"] = st["sum"] + (objective.curve(x, length) - y) ** 2
                     else:
-                        raw = np.arctan2(y, x)
-                        th = raw if j == 0 else st["theta"] + (raw - st["theta"] + np.pi) % (2 * np.pi) - np.pi
-                        st["theta"] = th
-                        r = np.hypot(x, y)
-                        st["sum"] = st["sum"] + (objective.curve(th, length) - r) ** 2
-                        st["bsum"] = st["bsum"] + _polar_term(r, e, slope) ** 2
+                        st["sum"] = st["sum"] + (objective.curve(st["theta"], length) - st["r"]) ** 2
+                        st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
             placed = max(placed, upto)
-            if p == n or (not np.isfinite(threshold) and beam is None):
+            if p == n:
                 continue
             bound = _prefix_bound(chain, objective, st, n + 1 - placed)
             keep = bound < threshold
@@ -360,9 +505,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         if profile:
             values = np.sqrt(st["sum"])
         else:
-            erows = table.lookup(window_codes(bits, w, [n])[:, 0], end=True)
-            curl = np.degrees(st["angle"] + table.end[erows])
-            values = tip_value_array(st["point"], np.asarray(table.tip_ref), curl, objective.name, objective.point)
+            tip, curl = _tip_and_curl(chain, bits, st)
+            values = tip_value_array(tip, np.asarray(table.tip_ref), curl, objective.name, objective.point)
         if polar:
             beta = e[None, :] * np.sqrt(st["bsum"])
         else:
@@ -556,5 +700,5 @@ def certified_search(
                            solves=book.solves, wall_time=time.perf_counter() - start)
 
 
-__all__ = ["CertifiedResult", "ChainScores", "grow_designs", "certified_search", "chain_candidate", "chain_errors",
+__all__ = ["CertifiedResult", "ChainGeometry", "ChainScores", "chain_geometry", "grow_designs", "certified_search", "chain_candidate", "chain_errors",
            "chain_scores", "objective_bounds", "score_designs"]
