@@ -181,12 +181,17 @@ def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integ
 
 
 def _costs(values: FloatArray, beta: FloatArray, sense: str) -> tuple[FloatArray, ...]:
-    sign = 1.0 if sense == "min" else -1.0
-    c = np.where(np.isfinite(values), sign * values, np.inf)
+    c = values * -1.0 if sense == "max" else values.copy()
+    c[~np.isfinite(c)] = np.inf
     level = np.argmin(c, axis=1)
     cost = c[np.arange(len(c)), level]
-    optimistic = np.min(c - beta, axis=1)
-    bound = np.max(np.where(np.isfinite(beta), beta, np.inf), axis=1)
+    if beta.ndim == 2 and beta.strides[0] == 0:  # the same bound for every design: one row
+        row = np.where(np.isfinite(beta[0]), beta[0], np.inf)
+        optimistic = np.min(c - row, axis=1)
+        bound = np.full(len(c), row.max())
+    else:
+        optimistic = np.min(c - beta, axis=1)
+        bound = np.max(np.where(np.isfinite(beta), beta, np.inf), axis=1)
     return cost, level, optimistic, bound
 
 
