@@ -13,6 +13,7 @@ import json
 import multiprocessing
 import os
 import secrets
+from http.cookies import CookieError, SimpleCookie
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from collections.abc import AsyncIterator
@@ -22,7 +23,7 @@ from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.concurrency import run_in_threadpool
-from fastapi.responses import FileResponse, JSONResponse
+from fastapi.responses import FileResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
 
 from pneumorph.bench.answer import Bench
@@ -32,6 +33,7 @@ from pneumorph.design.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import PneumorphError
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.files import json_safe
 
 COOKIE = "pneumorph_session"
 MAX_UNIT_FILE = 64 * 1024  # bytes of an uploaded unit TOML
@@ -133,6 +135,47 @@ class AnswerPool:
             self._pool = None
 
 
+class Sessions:
+    """ASGI middleware: every request gets a browser session (a random cookie), oversized bodies a 413.
+
+    The session id is ``request.state.session``; a request without a valid cookie gets a
+    new one, sent back with the response (HttpOnly, SameSite=Strict).
+    """
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+        if scope["type"] != "http":
+            return await self.app(scope, receive, send)
+        headers = dict(scope["headers"])
+        length = headers.get(b"content-length")
+        if length is not None and (not length.isdigit() or int(length) > MAX_BODY):
+            refusal = JSONResponse({"error": {"field": "target", "message": f"requests are limited to {MAX_BODY} "
+                                              "bytes"}}, status_code=413)
+            return await refusal(scope, receive, send)
+        jar = SimpleCookie()
+        try:
+            jar.load(headers.get(b"cookie", b"").decode("latin-1"))
+        except CookieError:
+            pass
+        sid = jar[COOKIE].value if COOKIE in jar else ""
+        fresh = len(sid) != 32 or not all(c in "0123456789abcdef" for c in sid)
+        if fresh:
+            sid = secrets.token_hex(16)
+        scope.setdefault("state", {})["session"] = sid
+        if not fresh:
+            return await self.app(scope, receive, send)
+        cookie = f"{COOKIE}={sid}; HttpOnly; Max-Age={30 * 86400}; Path=/; SameSite=strict".encode()
+
+        async def send_with_cookie(message: Any) -> None:
+            if message["type"] == "http.response.start":
+                message["headers"] = [*message.get("headers", []), (b"set-cookie", cookie)]
+            await send(message)
+
+        await self.app(scope, receive, send_with_cookie)
+
+
 def static_dir() -> Path:
     """The page's files, installed with the package."""
     return Path(str(resources.files("pneumorph.bench") / "static"))
@@ -189,20 +232,7 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     async def _query_error(request: Request, exc: QueryError) -> JSONResponse:
         return error(422, exc.field, exc.message)
 
-    @app.middleware("http")
-    async def _session(request: Request, call_next: Any) -> Any:
-        length = request.headers.get("content-length")
-        if length is not None and (not length.isdigit() or int(length) > MAX_BODY):
-            return error(413, "target", f"requests are limited to {MAX_BODY} bytes")
-        sid = request.cookies.get(COOKIE)
-        fresh = sid is None or len(sid) != 32 or not all(c in "0123456789abcdef" for c in sid)
-        if fresh:
-            sid = secrets.token_hex(16)
-        request.state.session = sid
-        response = await call_next(request)
-        if fresh:
-            response.set_cookie(COOKIE, sid, httponly=True, samesite="strict", max_age=30 * 86400)
-        return response
+    app.add_middleware(Sessions)
 
     async def body_of(request: Request) -> Any:
         raw = await request.body()
@@ -229,15 +259,19 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
                 "defaults": {"kind": "preset", "name": "sin", "amplitude": 10.0, "periods": 1.0}}
 
     @app.post("/api/design")
-    async def design(request: Request) -> dict[str, Any]:
+    async def design(request: Request) -> Response:
         body = await body_of(request)
-        query = await run_in_threadpool(bench.parse, body)
-        hit = bench.recall(query)
-        if hit is not None:
-            return hit
-        answer = await answers.compute(query)
-        bench.remember(query, answer)
-        return answer
+        query = bench.parse(body)  # a fraction of a millisecond
+        answer = bench.recall(query)
+        if answer is None:
+            answer = await answers.compute(query)
+            bench.remember(query, answer)
+        # plain data of floats, ints, strings and lists: json.dumps directly, not FastAPI's generic encoder
+        try:
+            text = json.dumps(answer, allow_nan=False)
+        except ValueError:  # an infinite optimistic value, say: null, as in every JSON pneumorph writes
+            text = json.dumps(json_safe(answer), allow_nan=False)
+        return Response(text, media_type="application/json")
 
     def check_model(model: str, unit: str) -> None:
         if model not in MODELS:

@@ -430,14 +430,18 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
                     bsum = None if bsum is None else np.repeat(bsum, 2 ** (p - at), axis=0)
                     at = p
                 if polar:
-                    total += (objective.curve(g.theta[j], length) - g.r[j]) ** 2
+                    d = objective.curve(g.theta[j], length)
+                    d -= g.r[j]
                     bsum += _polar_term(g.r[j], e, slope) ** 2  # type: ignore[operator]
                 else:
-                    total += (objective.curve(g.x[j], length) - g.y[j]) ** 2
+                    d = objective.curve(g.x[j], length)
+                    d -= g.y[j]
+                d *= d
+                total += d
             if at < n:
                 total = np.repeat(total, 2 ** (n - at), axis=0)
                 bsum = None if bsum is None else np.repeat(bsum, 2 ** (n - at), axis=0)
-            values = np.sqrt(total)
+            values = np.sqrt(total, out=total)
         else:
             values = tip_value_array(g.tip, np.asarray(chain.table.tip_ref), g.curl, objective.name, objective.point)
         if polar:

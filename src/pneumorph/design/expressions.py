@@ -150,7 +150,10 @@ class Expression:
             out = self.root(env)
         given = [np.shape(env[k]) for k in self.variables if k in env]
         shape = np.broadcast_shapes(*given) if given else ()
-        return np.broadcast_to(np.asarray(out, dtype=float), shape).copy()
+        out = np.asarray(out, dtype=float)
+        fresh = out.shape == shape and out.flags.writeable and out.flags.owndata and \
+            not any(np.may_share_memory(out, env[k]) for k in self.variables if k in env)
+        return out if fresh else np.broadcast_to(out, shape).copy()  # never a view of the caller's arrays
 
 
 # -- checking and building --------------------------------------------------------------
