@@ -130,7 +130,11 @@ class JobBoard:
         return job
 
     def verify(self, session: str, query: Query) -> Job:
-        """Verify a query's certified optimum by FE (a design run, as the CLI's), then solve its 3D shape."""
+        """Certify a query's optimum by FE: ``pneumorph design --certify`` for its target and model.
+
+        In 3D the chain's best design is solved first in a worker process, keeping its fields
+        for the 3D view; its response goes into the cache, where the design run finds it.
+        """
         return self.submit(session, "verify", {"query": json.loads(query.key())}, lambda job: self._verify(job, query))
 
     def export(self, session: str, design: str, unit: str = "builtin") -> Job:
@@ -184,7 +188,8 @@ class JobBoard:
         from pneumorph.design.run import run_design
 
         unit = None if query.unit == "builtin" else self.bench.unit_spec(query.unit).to_dict()
-        config = query.config(self.bench.units, unit, executor="processes", workers=self.workers, cache=str(self.cache))
+        config = query.config(self.bench.units, unit, certify=True, executor="processes", workers=self.workers,
+                              cache=str(self.cache))
         model = self.bench.model(query.model, query.unit)
         if query.model == "3d":  # solve the chain's best once, keeping its fields for the 3D view
             design = self.bench.answer(query)["winner"]["design"]

@@ -1,0 +1,271 @@
+// The bench page: reads the target fields, asks the server, shows its answer. No design logic here.
+import { drawProfile } from "./plot.js";
+import { Viewer } from "./viewer.js";
+import { DrawArea } from "./draw.js";
+
+const $ = (id) => document.getElementById(id);
+const state = { info: null, answer: null, seq: 0, selected: null, profiles: null, curve: null, job: null,
+  polling: new Set(), shapeSeq: 0 };
+const FIELDS = ["target", "preset", "amplitude", "periods", "expression", "goal", "point", "points", "model", "unit", "top"];
+
+async function api(path, options = {}) {
+  const response = await fetch(path, { credentials: "same-origin", ...options });
+  let data = null;
+  try { data = await response.json(); } catch { data = null; }
+  if (!response.ok) {
+    const error = (data && data.error) || { field: "target", message: `the server answered ${response.status}` };
+    throw Object.assign(new Error(error.message), { field: error.field });
+  }
+  return data;
+}
+const post = (path, body) => api(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+
+function number(id) {
+  const text = $(id).value.trim();
+  const value = Number(text);
+  return text === "" || !Number.isFinite(value) ? text : value;   // the server says what is wrong
+}
+
+function currentBody() {
+  const kind = $("target-kind").value;
+  let target;
+  if (kind === "preset") target = { kind, name: $("preset").value, amplitude: number("amplitude"), periods: number("periods") };
+  else if (kind === "expression") target = { kind, expression: $("expression").value, amplitude: number("expr-amplitude") };
+  else if (kind === "tip") {
+    target = { kind, goal: $("goal").value };
+    if (target.goal === "reach") target.point = [number("point-x"), number("point-y")];
+  } else target = { kind, points: state.curve || [] };
+  return { target, model: $("model").value, unit: $("unit").value, top: 10 };
+}
+
+function clearErrors() {
+  for (const f of FIELDS) { const el = $(`${f}-error`); if (el) el.textContent = ""; }
+  document.querySelectorAll("[aria-invalid]").forEach((el) => el.removeAttribute("aria-invalid"));
+}
+
+function showError(field, message) {
+  const el = $(`${field}-error`) || $("target-error");
+  el.textContent = message;
+  const input = $(field === "amplitude" && $("target-kind").value === "expression" ? "expr-amplitude" : field);
+  if (input && input.tagName === "INPUT") input.setAttribute("aria-invalid", "true");
+}
+
+// -- the answer ----------------------------------------------------------------------------
+let timer = null;
+function schedule() {
+  clearTimeout(timer);
+  timer = setTimeout(ask, 150);
+}
+
+async function ask() {
+  if ($("target-kind").value === "curve" && !state.curve) return;   // nothing drawn yet
+  const seq = ++state.seq;
+  $("answer").dataset.state = "loading";
+  try {
+    const answer = await post("/api/design", currentBody());
+    if (seq !== state.seq) return;                                  // a newer question is on its way
+    clearErrors();
+    show(answer);
+  } catch (error) {
+    if (seq !== state.seq) return;
+    clearErrors();
+    showError(error.field, error.message);
+    $("answer").dataset.state = "error";
+  }
+}
+
+function show(answer) {
+  state.answer = answer;
+  state.selected = answer.winner.design;
+  state.profiles = answer.profiles;
+  const w = answer.winner;
+  $("answer").dataset.queryId = answer.query_id;
+  $("answer").dataset.state = "ok";
+  $("winner-design").textContent = w.design;
+  $("design-boxes").innerHTML = [...w.design].map((b, i) => `<span class="b${b}" title="unit ${i + 1}">${b}</span>`).join("");
+  $("winner-pressure").textContent = `${w.pressure_kpa.toFixed(1)} kPa (level ${w.level + 1} of ${answer.pressures_kpa.length})`;
+  $("winner-error").textContent = `${w.value.toFixed(3)} ${answer.value_unit}` +
+    (answer.sense === "max" ? " (maximised)" : answer.value_unit === "mm" ? " (Eq 4.1)" : "");
+  $("winner-label").textContent = answer.label;
+  $("certificate").textContent = answer.certificate.statement;
+  $("answer-time").textContent = answer.memo ? "(remembered)" : `(${answer.elapsed_ms.toFixed(0)} ms)`;
+  const body = $("top-table").querySelector("tbody");
+  body.innerHTML = answer.top.map((r) => `<tr data-design="${r.design}"${r.design === state.selected ? ' class="selected"' : ""}>` +
+    `<td>${r.rank}</td><td><code>${r.design}</code></td><td>${r.value.toFixed(3)} ${answer.value_unit}</td>` +
+    `<td>${r.pressure_kpa.toFixed(1)} kPa</td><td>${r.optimistic.toFixed(3)}</td></tr>`).join("");
+  const slider = $("pressure-slider");
+  slider.max = String(answer.pressures_kpa.length - 1);
+  slider.value = String(w.level);
+  redraw();
+  loadShape();
+}
+
+function redraw() {
+  const a = state.answer;
+  if (!a) return;
+  const k = Number($("pressure-slider").value);
+  $("slider-value").textContent = `${a.pressures_kpa[k].toFixed(1)} kPa`;
+  const target = a.target ? a.target.x.map((x, i) => [x, a.target.y[i]]) : null;
+  drawProfile($("profile-plot"), { target, point: a.point, profile: state.profiles[k], label: `design ${state.selected}` });
+}
+
+async function select(design) {
+  const a = state.answer;
+  state.selected = design;
+  document.querySelectorAll("#top-table tbody tr").forEach((tr) => tr.classList.toggle("selected", tr.dataset.design === design));
+  const data = await api(`/api/profiles?design=${design}&model=${a.model}&unit=${encodeURIComponent($("unit").value)}`);
+  state.profiles = data.profiles;
+  redraw();
+  loadShape();
+}
+
+let shapeTimer = null;
+function loadShape() {
+  clearTimeout(shapeTimer);
+  shapeTimer = setTimeout(async () => {
+    const a = state.answer;
+    if (!a) return;
+    const seq = ++state.shapeSeq;
+    const level = $("pressure-slider").value;
+    try {
+      const shape = await api(`/api/shape?design=${state.selected}&level=${level}&model=${a.model}&unit=${encodeURIComponent($("unit").value)}`);
+      if (seq !== state.shapeSeq) return;
+      viewer.show(shape, shape.source === "fe" ? [0.3, 0.62, 0.45] : [0.35, 0.55, 0.8]);
+      $("shape-source").textContent = shape.source === "fe" ? "(3D FE solution)" : "(laid along the chain model's centreline)";
+    } catch (error) {
+      $("shape-source").textContent = `(${error.message})`;
+    }
+  }, 60);
+}
+
+// -- jobs ----------------------------------------------------------------------------------
+function renderJob(job) {
+  if (!state.job || job.id !== state.job) return;
+  $("job-progress").value = job.progress;
+  $("job-status").textContent = job.state;
+  $("job-status").title = job.message;
+  $("job-log").textContent = job.log.join("\n");
+  $("downloads").innerHTML = job.files.map((f) => `<li><a href="${f.url}" download="${f.name}">${f.name}</a></li>`).join("");
+  if (job.state === "done" && job.kind === "verify" && job.result) {
+    const r = job.result;
+    $("job-status").textContent = `done: ${r.design} ${r.fe_value.toFixed(3)} ${r.unit} by FE ` +
+      `(chain ${r.chain_value.toFixed(3)})${r.certified ? ", certified" : `, gap ${r.gap.toFixed(3)}`}`;
+    $("job-status").dataset.state = "done";
+  } else {
+    $("job-status").dataset.state = job.state;
+  }
+}
+
+async function refreshJobs() {
+  const { jobs } = await api("/api/jobs");
+  $("jobs").innerHTML = jobs.map((j) => `<li data-job="${j.id}"><a href="#" data-job="${j.id}">${j.kind}</a> ` +
+    `${j.state}${j.state === "running" ? ` (${Math.round(100 * j.progress)} %)` : ""}` +
+    `${j.state === "done" ? summary(j) : `: ${escape(j.message)}`}</li>`).join("");
+  for (const j of jobs) {
+    if (j.state === "queued" || j.state === "running") poll(j.id);
+  }
+  return jobs;
+}
+
+function summary(job) {
+  const r = job.result || {};
+  if (job.kind === "verify") return `: ${r.design} ${r.fe_value.toFixed(3)} ${r.unit} by ${r.model.toUpperCase()} FE`;
+  if (job.kind === "export") return `: ${r.design}`;
+  if (job.kind === "table") return `: unit ${escape(r.name)} (${r.model})`;
+  return "";
+}
+
+function escape(text) {
+  return String(text).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
+}
+
+async function poll(id) {
+  if (state.polling.has(id)) return;
+  state.polling.add(id);
+  try {
+    for (;;) {
+      const job = await api(`/api/jobs/${id}`);
+      renderJob(job);
+      if (job.state === "done" || job.state === "failed") {
+        await refreshJobs();
+        if (job.kind === "verify" && job.state === "done") loadShape();
+        if (job.kind === "table" && job.state === "done") await refreshUnits(job.result.unit_id);
+        break;
+      }
+      await new Promise((r) => setTimeout(r, 1000));
+    }
+  } finally {
+    state.polling.delete(id);
+  }
+}
+
+async function start(body, path = "/api/jobs", options = null) {
+  try {
+    const { job_id } = options ? await api(path, options) : await post(path, body);
+    state.job = job_id;
+    $("job-status").textContent = "queued";
+    $("job-status").dataset.state = "queued";
+    $("job-progress").value = 0;
+    $("downloads").innerHTML = "";
+    await refreshJobs();
+    poll(job_id);
+  } catch (error) {
+    clearErrors();
+    showError(error.field, error.message);
+  }
+}
+
+async function refreshUnits(choose) {
+  const { units } = await api("/api/units");
+  $("unit").innerHTML = units.map((u) => `<option value="${u.id}">${escape(u.name)} (${u.id === "builtin" ? "built-in" : u.model})</option>`).join("");
+  if (choose) { $("unit").value = choose; schedule(); }
+}
+
+// -- wiring --------------------------------------------------------------------------------
+function showKind() {
+  const kind = $("target-kind").value;
+  document.querySelectorAll("fieldset[data-kind]").forEach((f) => { f.hidden = f.dataset.kind !== kind; });
+  $("point-fields").hidden = $("goal").value !== "reach";
+}
+
+const viewer = new Viewer($("viewer"));
+let drawArea = null;
+
+async function main() {
+  state.info = await api("/api/info");
+  $("goal").innerHTML = state.info.tip_goals.map((g) => `<option value="${g}">${g}</option>`).join("");
+  drawArea = new DrawArea($("draw-canvas"), state.info.length_mm, (points) => { state.curve = points; schedule(); });
+  const changed = () => { showKind(); schedule(); };
+  for (const id of ["target-kind", "preset", "amplitude", "periods", "expression", "expr-amplitude", "goal", "point-x",
+    "point-y", "model", "unit"]) {
+    $(id).addEventListener("input", changed);
+    if ($(id).tagName === "SELECT") $(id).addEventListener("change", changed);
+  }
+  $("draw-clear").addEventListener("click", () => { drawArea.clear(); state.curve = null; });
+  $("pressure-slider").addEventListener("input", () => { redraw(); loadShape(); });
+  $("top-table").addEventListener("click", (e) => { const tr = e.target.closest("tr[data-design]"); if (tr) select(tr.dataset.design); });
+  $("verify-button").addEventListener("click", () => start({ kind: "verify", query: currentBody() }));
+  $("export-button").addEventListener("click", () => start({ kind: "export", design: state.selected, unit: $("unit").value }));
+  $("unit-upload").addEventListener("click", () => {
+    const file = $("unit-file").files[0];
+    if (!file) { showError("unit", "choose a unit TOML file first"); return; }
+    const form = new FormData();
+    form.append("unit", file);
+    form.append("model", $("model").value);
+    start(null, "/api/jobs/table", { method: "POST", body: form });
+  });
+  $("jobs").addEventListener("click", async (e) => {
+    const a = e.target.closest("a[data-job]");
+    if (!a) return;
+    e.preventDefault();
+    state.job = a.dataset.job;
+    renderJob(await api(`/api/jobs/${state.job}`));
+  });
+  showKind();
+  await refreshUnits();
+  const jobs = await refreshJobs();
+  if (jobs.length) { state.job = jobs[0].id; renderJob(jobs[0]); }
+  ask();
+}
+
+main().catch((error) => { $("target-error").textContent = `the page could not start: ${error.message}`; });

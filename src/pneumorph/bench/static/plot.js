@@ -1,0 +1,92 @@
+// The profile plot: the target curve and an actuator's centreline, in mm, equal scales.
+
+function niceStep(span, count) {
+  const raw = span / Math.max(count, 1);
+  const power = Math.pow(10, Math.floor(Math.log10(raw)));
+  for (const m of [1, 2, 5, 10]) {
+    if (m * power >= raw) return m * power;
+  }
+  return 10 * power;
+}
+
+function bounds(sets) {
+  let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+  for (const pts of sets) {
+    for (const [x, y] of pts) {
+      if (!Number.isFinite(x) || !Number.isFinite(y)) continue;
+      x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+    }
+  }
+  if (!Number.isFinite(x0)) return [0, 1, 0, 1];
+  return [x0, x1, y0, y1];
+}
+
+// Draw on `canvas`: {target: [[x, y]...] or null, point: [x, y] or null,
+// profile: [[x, y]...] (base, centres, tip), label: string, clip: [xmin, xmax, ymin, ymax] optional}.
+export function drawProfile(canvas, { target, point, profile, label }) {
+  const ctx = canvas.getContext("2d");
+  const W = canvas.width, H = canvas.height, pad = { l: 48, r: 14, t: 14, b: 34 };
+  ctx.clearRect(0, 0, W, H);
+  const sets = [profile || [], [[0, 0]]];
+  if (target) sets.push(target);
+  if (point) sets.push([point]);
+  let [x0, x1, y0, y1] = bounds(sets);
+  const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
+  const pw = W - pad.l - pad.r, ph = H - pad.t - pad.b;
+  const scale = Math.min(pw / (Math.max(x1 - x0, 10) * 1.08), ph / (Math.max(y1 - y0, 10) * 1.15));  // px per mm, both axes
+  const X = (x) => pad.l + pw / 2 + (x - cx) * scale;
+  const Y = (y) => pad.t + ph / 2 - (y - cy) * scale;
+  const xmin = cx - pw / 2 / scale, xmax = cx + pw / 2 / scale;
+  const ymin = cy - ph / 2 / scale, ymax = cy + ph / 2 / scale;
+
+  // grid and ticks
+  const step = niceStep(Math.max(xmax - xmin, ymax - ymin), 8);
+  ctx.font = "11px system-ui, sans-serif";
+  ctx.fillStyle = "#626a73";
+  ctx.strokeStyle = "#eceff2";
+  ctx.lineWidth = 1;
+  ctx.textAlign = "center";
+  for (let v = Math.ceil(xmin / step) * step; v <= xmax; v += step) {
+    ctx.beginPath(); ctx.moveTo(X(v), pad.t); ctx.lineTo(X(v), pad.t + ph); ctx.stroke();
+    ctx.fillText(String(+v.toFixed(6)), X(v), H - pad.b + 14);
+  }
+  ctx.textAlign = "right";
+  for (let v = Math.ceil(ymin / step) * step; v <= ymax; v += step) {
+    ctx.beginPath(); ctx.moveTo(pad.l, Y(v)); ctx.lineTo(pad.l + pw, Y(v)); ctx.stroke();
+    ctx.fillText(String(+v.toFixed(6)), pad.l - 5, Y(v) + 4);
+  }
+  ctx.textAlign = "center";
+  ctx.fillText("x (mm)", pad.l + pw / 2, H - 4);
+  ctx.save(); ctx.translate(12, pad.t + ph / 2); ctx.rotate(-Math.PI / 2); ctx.fillText("y (mm)", 0, 0); ctx.restore();
+  ctx.strokeStyle = "#b8c0c8";
+  ctx.setLineDash([4, 4]);
+  ctx.beginPath(); ctx.moveTo(pad.l, Y(0)); ctx.lineTo(pad.l + pw, Y(0)); ctx.stroke();
+  ctx.setLineDash([]);
+
+  const line = (pts, colour, width) => {
+    ctx.strokeStyle = colour; ctx.lineWidth = width; ctx.beginPath();
+    pts.forEach(([x, y], i) => (i ? ctx.lineTo(X(x), Y(y)) : ctx.moveTo(X(x), Y(y))));
+    ctx.stroke();
+  };
+  if (target) line(target, "#e07b1a", 2.5);
+  if (point) {
+    ctx.strokeStyle = "#e07b1a"; ctx.lineWidth = 2;
+    const [px, py] = [X(point[0]), Y(point[1])];
+    ctx.beginPath(); ctx.moveTo(px - 7, py); ctx.lineTo(px + 7, py); ctx.moveTo(px, py - 7); ctx.lineTo(px, py + 7); ctx.stroke();
+  }
+  if (profile && profile.length) {
+    line(profile, "#0b6bcb", 2);
+    ctx.fillStyle = "#0b6bcb";
+    profile.slice(1, -1).forEach(([x, y]) => { ctx.beginPath(); ctx.arc(X(x), Y(y), 3, 0, 2 * Math.PI); ctx.fill(); });
+  }
+  // legend
+  ctx.textAlign = "left";
+  ctx.font = "12px system-ui, sans-serif";
+  let ly = pad.t + 14;
+  const legend = (colour, text) => {
+    ctx.fillStyle = colour; ctx.fillRect(pad.l + 8, ly - 8, 16, 3);
+    ctx.fillStyle = "#1f2328"; ctx.fillText(text, pad.l + 30, ly - 3); ly += 16;
+  };
+  if (target || point) legend("#e07b1a", target ? "target" : "tip goal");
+  if (profile) legend("#0b6bcb", label || "unit centres");
+}

@@ -1,0 +1,171 @@
+"""The bench in a real browser: Debian's chromium, headless, driven by Selenium against a live server.
+
+Set ``PNEUMORPH_SCREENSHOTS=1`` to write the screenshots of ``docs/bench.md`` into
+``docs/figures/``.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("selenium")
+uvicorn = pytest.importorskip("uvicorn")
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+DRIVER = shutil.which("chromedriver")
+if not (CHROMIUM and DRIVER):
+    pytest.skip("Debian's chromium and chromium-driver are not installed (tests/browser-deps.sh installs them)",
+                allow_module_level=True)
+
+from selenium import webdriver  # noqa: E402
+from selenium.webdriver.chrome.options import Options  # noqa: E402
+from selenium.webdriver.chrome.service import Service  # noqa: E402
+from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
+from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.common.keys import Keys  # noqa: E402
+from selenium.webdriver.support.ui import Select  # noqa: E402
+
+from pneumorph.bench import create_app  # noqa: E402
+
+FIGURES = Path(__file__).resolve().parents[2] / "docs" / "figures"
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+    root = tmp_path_factory.mktemp("browser")
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    app = create_app(state_dir=root / "state", cache=root / "cache.sqlite", answer_workers=1)
+    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=srv.run, daemon=True)
+    thread.start()
+    for _ in range(600):
+        if srv.started:
+            break
+        time.sleep(0.05)
+    assert srv.started, "the bench did not start"
+    yield f"http://127.0.0.1:{port}/"
+    srv.should_exit = True
+    thread.join(10)
+
+
+@pytest.fixture(scope="module")
+def browser(server: str):  # type: ignore[no-untyped-def]
+    options = Options()
+    options.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1400,1000",
+                "--use-angle=swiftshader", "--enable-unsafe-swiftshader"):
+        options.add_argument(arg)
+    driver = webdriver.Chrome(options=options, service=Service(DRIVER))
+    driver.get(server)
+    yield driver
+    driver.quit()
+
+
+def _el(driver, id_: str):  # type: ignore[no-untyped-def]
+    return driver.find_element(By.ID, id_)
+
+
+def _wait(predicate, timeout: float = 10.0, step: float = 0.02) -> float:  # type: ignore[no-untyped-def]
+    start = time.perf_counter()
+    while time.perf_counter() - start < timeout:
+        if predicate():
+            return time.perf_counter() - start
+        time.sleep(step)
+    raise AssertionError(f"not within {timeout} s")
+
+
+def _answered(driver) -> bool:  # type: ignore[no-untyped-def]
+    return _el(driver, "answer").get_attribute("data-state") == "ok"
+
+
+def _shot(driver, name: str) -> None:  # type: ignore[no-untyped-def]
+    if os.environ.get("PNEUMORPH_SCREENSHOTS") == "1":
+        time.sleep(0.5)  # the 3D view follows its answer
+        driver.save_screenshot(str(FIGURES / f"bench-{name}.png"))
+
+
+def _retype(element, text: str) -> None:  # type: ignore[no-untyped-def]
+    element.send_keys(Keys.CONTROL, "a")
+    element.send_keys(text)
+
+
+def test_the_page_opens_on_the_certified_design_of_the_default_target(browser) -> None:  # type: ignore[no-untyped-def]
+    _wait(lambda: _answered(browser), timeout=30)
+    assert _el(browser, "winner-design").text == "001111010001001"  # the main job's answer
+    assert "36.0 kPa" in _el(browser, "winner-pressure").text
+    assert _el(browser, "winner-error").text.startswith("7.405 mm")
+    assert "optimum is this design" in _el(browser, "certificate").text
+    assert len(browser.find_elements(By.CSS_SELECTOR, "#top-table tbody tr")) == 10
+    _wait(lambda: "chain" in _el(browser, "shape-source").text)
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    _shot(browser, "default")
+
+
+def test_a_new_amplitude_is_answered_within_a_second(browser) -> None:  # type: ignore[no-untyped-def]
+    before = _el(browser, "answer").get_attribute("data-query-id")
+    field = _el(browser, "amplitude")
+    start = time.perf_counter()
+    _retype(field, "20")
+    _wait(lambda: _el(browser, "answer").get_attribute("data-query-id") != before and _answered(browser))
+    latency = time.perf_counter() - start
+    print(f"answer {latency:.3f} s after the change")
+    assert latency < 1.0, f"the answer came {latency:.2f} s after the change"
+    assert "A = 20 mm" in _el(browser, "winner-label").text
+
+
+def test_an_expression_and_a_bad_one(browser) -> None:  # type: ignore[no-untyped-def]
+    Select(_el(browser, "target-kind")).select_by_value("expression")
+    field = _el(browser, "expression")
+    _retype(field, "y = 0.3*x")
+    _wait(lambda: "0.3*x" in _el(browser, "winner-label").text and _answered(browser))
+    good = _el(browser, "winner-design").text
+    assert _el(browser, "expression-error").text == ""
+    _retype(field, "y = __import__('os').getcwd()")
+    _wait(lambda: _el(browser, "expression-error").text != "")
+    assert "__import__" in _el(browser, "expression-error").text
+    assert _el(browser, "winner-design").text == good  # the last good answer stays
+    assert _el(browser, "answer").get_attribute("data-state") == "error"
+    _shot(browser, "expression-error")
+    _retype(field, "y = 0.3*x")
+    _wait(lambda: _el(browser, "expression-error").text == "" and _answered(browser))
+
+
+def test_a_drawn_curve(browser) -> None:  # type: ignore[no-untyped-def]
+    Select(_el(browser, "target-kind")).select_by_value("curve")
+    canvas = _el(browser, "draw-canvas")
+    w = canvas.size["width"]
+    chain = ActionChains(browser).move_to_element_with_offset(canvas, -w // 2 + 12, 0).click_and_hold()
+    for i in range(1, 41):  # a rising then falling stroke along the whole length
+        chain = chain.move_by_offset((w - 30) // 40, -3 if i < 20 else 3)
+    chain.release().perform()
+    _wait(lambda: "curve" in _el(browser, "winner-label").text and _answered(browser))
+    assert len(_el(browser, "winner-design").text) == 15
+    _shot(browser, "drawn")
+
+
+def test_switching_model_and_verifying_by_fe_survives_a_reload(browser) -> None:  # type: ignore[no-untyped-def]
+    Select(_el(browser, "target-kind")).select_by_value("preset")
+    _retype(_el(browser, "amplitude"), "10")
+    Select(_el(browser, "model")).select_by_value("2d")
+    # docs/chain-model.md: the 2D model's certified optimum for the default target
+    _wait(lambda: _el(browser, "winner-design").text == "001111010001000" and _answered(browser))
+    _el(browser, "verify-button").click()
+    _wait(lambda: _el(browser, "job-status").get_attribute("data-state") in ("done", "failed"), timeout=180, step=0.2)
+    assert _el(browser, "job-status").get_attribute("data-state") == "done", _el(browser, "job-log").text
+    assert "001111010001000" in _el(browser, "job-status").text and "by FE" in _el(browser, "job-status").text
+    names = [a.text for a in browser.find_elements(By.CSS_SELECTOR, "#downloads a")]
+    assert {"report.md", "run.zip", "profile.png"} <= set(names)
+    browser.execute_script("document.getElementById('verify-button').scrollIntoView({block: 'center'})")
+    _shot(browser, "verified")
+    browser.refresh()
+    _wait(lambda: _answered(browser), timeout=30)
+    _wait(lambda: "verify" in _el(browser, "jobs").text and "done" in _el(browser, "jobs").text)
+    assert _el(browser, "job-status").get_attribute("data-state") == "done"
