@@ -248,3 +248,20 @@ def test_answers_from_worker_processes_equal_answers_computed_here(state: Path) 
     here = bench.compute(bench.parse(body))
     assert remote["winner"] == here["winner"] and remote["top"] == here["top"]
     assert remote["certificate"] == here["certificate"]
+
+
+def test_an_fe_shape_is_the_solved_surface_at_every_level() -> None:
+    from pneumorph.bench.jobs import fe_solve_shape
+    from pneumorph.models.factory import make_model
+
+    model = make_model(2, {"fidelity": "3d", "pressure_kpa": 20})
+    response, shape, wall = fe_solve_shape(model, "01")
+    assert response is not None and response.converged and wall > 0
+    assert len(shape["levels"]) == len(model.pressures())
+    tri = np.reshape(shape["indices"], (-1, 3))
+    for level, tip in zip(shape["levels"], response.tip):
+        pos = np.reshape(level["positions"], (-1, 3))
+        assert tri.max() < len(pos)
+        lo, hi = np.array(level["bounds"])
+        assert np.all(tip >= lo[:2] - 1e-6) and np.all(tip <= hi[:2] + 1e-6)  # the tip is on the surface's box
+    assert np.reshape(shape["levels"][-1]["positions"], (-1, 3))[:, 2].max() > 15.0  # the side walls balloon

@@ -14,6 +14,7 @@ Jobs belong to a browser session; one session cannot see or fetch another's jobs
 from __future__ import annotations
 
 import json
+import multiprocessing
 import shutil
 import threading
 import time
@@ -26,6 +27,7 @@ from typing import Any
 
 from pneumorph.bench.answer import Bench
 from pneumorph.bench.query import Query
+from pneumorph.execution.evaluators import prepare_worker
 from pneumorph.io.files import atomic_write_text, json_safe
 
 STATES = ("queued", "running", "done", "failed")
@@ -223,7 +225,9 @@ class JobBoard:
         with EvaluationCache(self.cache) as cache:
             if cache.get(model.fingerprint(), design) is not None and self.bench.fe_shape_file(design, unit) is not None:
                 return  # verified and drawn before
-        with ProcessPoolExecutor(max_workers=1) as pool:
+        # spawned, as the evaluators' workers: a fork of the threaded server could inherit a held lock
+        with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=prepare_worker) as pool:
             response, shape, wall = pool.submit(fe_solve_shape, model, design).result()
         if response is None:
             return  # the design run solves it again and reports the failure
