@@ -52,6 +52,9 @@ CHUNK = 8192
 """Designs scored at once (memory: about 2 kB per design and level)."""
 MAX_NODES = 500_000
 """Most open prefixes the branch-and-bound keeps at one depth."""
+KEEP_GEOMETRY_UNITS = 15
+"""Longest actuator whose prefix geometry is kept between queries (15 units: about 50 MB;
+the memory doubles with every unit)."""
 
 
 # -- errors of the chain and the bound on the objective --------------------------------------
@@ -368,7 +371,9 @@ _GEOMETRY_LOCK = threading.Lock()
 def chain_geometry(chain: ChainModel) -> ChainGeometry:
     """Every design's centres, tip and curl, grown over shared prefixes (kept per chain model).
 
-    Memory: about ``3 w 2^n k`` numbers for window ``w`` (15 units, 10 levels: ~25 MB).
+    Memory: four arrays of about ``(w + 1) 2^n k`` numbers for window ``w`` (15 units,
+    window 3, 10 levels: about 50 MB); :func:`grow_designs` keeps it up to
+    :data:`KEEP_GEOMETRY_UNITS` units.
 
     Examples
     --------
@@ -470,8 +475,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     SearchConfigError
         More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose).
     """
-    if not np.isfinite(threshold) and beam is None:  # every design: from the kept geometry
-        return _score_all(chain, objective, errors)
+    if not np.isfinite(threshold) and beam is None and chain.n_units <= KEEP_GEOMETRY_UNITS:
+        return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
     n, w, k = chain.n_units, table.window, table.n_levels
     profile = isinstance(objective, ProfileTarget)
@@ -498,7 +503,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                         st["sum"] = st["sum"] + (objective.curve(st["theta"], length) - st["r"]) ** 2
                         st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
             placed = max(placed, upto)
-            if p == n:
+            if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
             bound = _prefix_bound(chain, objective, st, n + 1 - placed)
             keep = bound < threshold
