@@ -42,7 +42,7 @@ def test_default_answer_is_the_design_commands_certified_optimum(client: TestCli
     assert a["winner"]["value"] == pytest.approx(7.405, abs=5e-4)
     assert a["winner"]["pressure_kpa"] == pytest.approx(36.0)
     assert a["certificate"]["bound"] == pytest.approx(0.036, abs=5e-4)
-    assert a["certificate"]["designs_scored"] == 2**15 and a["certificate"]["complete"]
+    assert a["certificate"]["designs"] == 2**15 and 10 <= a["certificate"]["scored"] <= 2**15
     assert [r["rank"] for r in a["top"]] == list(range(1, 11))
     values = [r["value"] for r in a["top"]]
     assert values == sorted(values) and values[0] == a["winner"]["value"]

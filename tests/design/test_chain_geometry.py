@@ -46,3 +46,23 @@ def test_the_geometry_is_kept_per_chain_model(chain: ChainModel) -> None:
     assert chain_geometry(chain) is chain_geometry(chain)
     other = ChainModel(chain.table, chain.n_units)
     assert chain_geometry(other) is not chain_geometry(chain)
+
+
+@pytest.mark.parametrize(("spec", "amplitude", "periods"), [("sin", 10.0, 1.0), ("cos", 20.0, 1.0), ("sin", 3.0, 0.5),
+                                                         ("y = 0.3*x", 1.0, 1.0), ("y = 0.001*x**2", 1.0, 1.0)])
+def test_best_scores_keep_the_top_and_every_design_that_could_beat_the_best(chain: ChainModel, spec: str,
+                                                                             amplitude: float, periods: float) -> None:
+    from pneumorph.design.certified import best_scores, chain_scores
+
+    objective = make_objective(spec, amplitude, periods, length=chain.length)
+    full = chain_scores(chain, objective)
+    best = best_scores(chain, objective, top=10)
+    f, b = full.order()[:10], best.order()[:10]
+    assert np.array_equal(full.bits[f], best.bits[b])
+    np.testing.assert_allclose(best.cost[b], full.cost[f], rtol=1e-12)
+    worst_case = full.cost[f[0]] + full.bound[f[0]]
+    assert (best.optimistic < worst_case).sum() == (full.optimistic < worst_case).sum()
+    # every design left out is at least as bad as the floor says
+    listed = {bytes(r) for r in best.bits}
+    left = np.array([bytes(r) not in listed for r in full.bits])
+    assert best.complete or full.optimistic[left].min() >= best.floor

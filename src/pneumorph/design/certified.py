@@ -457,6 +457,87 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
     return ChainScores(g.bits, values, cost, level, optimistic, bound)
 
 
+def _children(alive: NDArray[np.int64], steps: int) -> NDArray[np.int64]:
+    """Indices of the prefixes ``steps`` units longer than the prefixes ``alive`` (child ``2 i + b``)."""
+    return (alive[:, None] * 2**steps + np.arange(2**steps)).ravel()
+
+
+def _accumulate(g: ChainGeometry, objective: ProfileTarget, length: float, alive: NDArray[np.int64],
+                total: FloatArray, at: int, centres: range, prune: Callable[[FloatArray], NDArray[np.bool_]] | None
+                ) -> tuple[NDArray[np.int64], FloatArray, int]:
+    """Add the squared Eq 4.1 terms of ``centres`` for the prefixes ``alive`` (at depth ``at``).
+
+    With ``prune``, prefixes whose partial sums it flags are dropped after every centre.
+    """
+    for j in centres:
+        p = g.depth[j]
+        if p > at:
+            alive, total, at = _children(alive, p - at), np.repeat(total, 2 ** (p - at), axis=0), p
+        d = objective.curve(g.x[j][alive], length)
+        d -= g.y[j][alive]
+        d *= d
+        total += d
+        if prune is not None:
+            keep = ~prune(total)
+            alive, total = alive[keep], total[keep]
+    return alive, total, at
+
+
+def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: float = 1.0,
+                probe: int = 256) -> ChainScores:
+    """Chain scores of the designs that can matter: the ``top`` best and every one that could beat the best.
+
+    For a Cartesian profile target the partial sums of Eq 4.1 only grow, so a prefix whose
+    optimistic value (``min_k sqrt(partial_k) - beta_k``) already reaches a threshold ``T``
+    can be dropped with all its designs. ``T`` comes from a probe: the ``probe`` prefixes of
+    lowest partial sum two units before the end, completed exactly, give ``c_1`` and
+    ``c_top`` (upper bounds on the true best and top-th costs), and ``T = max(c_top, c_1 +
+    beta)``. Every dropped design then has an optimistic value ``>= T``: it is neither among
+    the ``top`` best nor able to beat the best design's worst case (cost + bound). The
+    answer lists the survivors with ``floor = T``. Other objectives score every design
+    (:func:`chain_scores`).
+
+    Examples
+    --------
+    >>> from pneumorph.models.chaintables import find_table
+    >>> from pneumorph.models.factory import make_model
+    >>> from pneumorph.design.targets import make_objective
+    >>> chain = ChainModel(find_table(make_model(15, {"fidelity": "3d"})), 15)
+    >>> s = best_scores(chain, make_objective("sin", 10.0, length=chain.length))
+    >>> design_strings(s.bits[s.order()[:1]]), bool(len(s.bits) < 2**15), s.complete
+    (['001111010001001'], True, False)
+    """
+    errors = chain_errors(chain, margin)
+    n = chain.n_units
+    if (not isinstance(objective, ProfileTarget) or objective.coordinates != "cartesian"
+            or n > KEEP_GEOMETRY_UNITS or n < 4):
+        return chain_scores(chain, objective, margin)
+    g = chain_geometry(chain)
+    length = chain.length
+    slope = _target_slope(chain, objective, errors)
+    beta = np.asarray(_uniform_bound(chain, objective, errors, slope), dtype=float)
+    optimistic = lambda total: np.min(np.sqrt(total) - beta, axis=1)  # noqa: E731
+    cut = n - 2
+    early = range(sum(1 for p in g.depth if p <= cut))
+    with np.errstate(all="ignore"):
+        alive, total, at = _accumulate(g, objective, length, np.arange(2), np.zeros((2, len(beta))), 1, early, None)
+        lb = optimistic(total)
+        few = np.argsort(lb, kind="stable")[:probe]
+        _, probe_total, _ = _accumulate(g, objective, length, alive[few], total[few], at,
+                                        range(len(early), len(g.depth)), None)
+        costs = np.sort(np.sqrt(probe_total).min(axis=1))
+        k = min(top, len(costs)) - 1
+        threshold = max(float(costs[k]), float(costs[0] + beta.max())) + 1e-9
+        keep = lb < threshold
+        alive, total = _accumulate(g, objective, length, alive[keep], total[keep], at,
+                                   range(len(early), len(g.depth)), lambda t: optimistic(t) >= threshold)[:2]
+        if (at := max(g.depth)) < n:  # pragma: no cover - the last centres are fixed by the whole design
+            alive, total = _children(alive, n - at), np.repeat(total, 2 ** (n - at), axis=0)
+        values = np.sqrt(total)
+    cost, level, opt, bound = _costs(values, np.broadcast_to(beta, values.shape), objective.sense)
+    return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold)
+
+
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
                  threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None) -> ChainScores:
     """Chain scores of every design whose cost is below ``threshold`` (all designs for ``inf``).
@@ -714,5 +795,5 @@ def certified_search(
                            solves=book.solves, wall_time=time.perf_counter() - start)
 
 
-__all__ = ["CertifiedResult", "ChainGeometry", "ChainScores", "chain_geometry", "grow_designs", "certified_search", "chain_candidate", "chain_errors",
+__all__ = ["CertifiedResult", "ChainGeometry", "ChainScores", "best_scores", "chain_geometry", "grow_designs", "certified_search", "chain_candidate", "chain_errors",
            "chain_scores", "objective_bounds", "score_designs"]
