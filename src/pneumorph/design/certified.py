@@ -336,6 +336,25 @@ def _place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any]
             yield j, x, y
 
 
+def _depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], polar: bool = False) -> Any:
+    """Grow the prefixes unit by unit: yields ``(p, placed, bits, st, centres)`` at every depth ``p``.
+
+    ``centres`` iterates over the chords placed at this depth (:func:`_place_chords`); the
+    caller consumes it, and may then ``send`` back pruned ``(bits, st)`` for the next depth.
+    """
+    n, w = chain.n_units, chain.table.window
+    placed = 0
+    for p in range(1, n + 1):
+        if p > 1:
+            bits, st = _grow(bits, st)
+        upto = n + 1 if p == n else max(p - w + 1, 0)
+        pruned = yield p, max(placed, upto), bits, st, _place_chords(chain, bits, st, placed, upto, polar)
+        placed = max(placed, upto)
+        if pruned is not None:
+            bits, st = pruned
+            yield None  # the value of ``send``
+
+
 def _tip_and_curl(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
     """Tip point and curl (degrees) of whole designs from their final state."""
     table = chain.table
@@ -388,26 +407,19 @@ def chain_geometry(chain: ChainModel) -> ChainGeometry:
         hit = _GEOMETRY.get(chain)
     if hit is not None:
         return hit
-    n, w = chain.n_units, chain.table.window
-    bits, st = _seed_prefixes(chain, polar=True)
     depth: list[int] = []
     xs: list[FloatArray] = []
     ys: list[FloatArray] = []
     ths: list[FloatArray] = []
     rs: list[FloatArray] = []
-    placed = 0
     with np.errstate(all="ignore"):
-        for p in range(1, n + 1):
-            if p > 1:
-                bits, st = _grow(bits, st)
-            upto = n + 1 if p == n else max(p - w + 1, 0)
-            for _, x, y in _place_chords(chain, bits, st, placed, upto, polar=True):
+        for p, _, bits, st, centres in _depths(chain, *_seed_prefixes(chain, polar=True), polar=True):
+            for _, x, y in centres:
                 depth.append(p)
                 xs.append(x)
                 ys.append(y)
                 ths.append(st["theta"])
                 rs.append(st["r"])
-            placed = max(placed, upto)
         tip, curl = _tip_and_curl(chain, bits, st)
     geom = ChainGeometry(bits, tuple(depth), tuple(xs), tuple(ys), tuple(ths), tuple(rs), tip, curl)
     with _GEOMETRY_LOCK:
@@ -559,7 +571,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     if not np.isfinite(threshold) and beam is None and chain.n_units <= KEEP_GEOMETRY_UNITS:
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
-    n, w, k = chain.n_units, table.window, table.n_levels
+    n, k = chain.n_units, table.n_levels
     profile = isinstance(objective, ProfileTarget)
     polar = profile and objective.coordinates == "polar"
     length = chain.length
@@ -570,20 +582,16 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         st["sum"] = np.zeros((2, k))
     if polar:
         st["bsum"] = np.zeros((2, k))
-    placed = 0
     with np.errstate(all="ignore"):
-        for p in range(1, n + 1):
-            if p > 1:
-                bits, st = _grow(bits, st)
-            upto = n + 1 if p == n else max(p - w + 1, 0)
-            for j, x, y in _place_chords(chain, bits, st, placed, upto, polar):
+        growth = _depths(chain, bits, st, polar)
+        for p, placed, bits, st, centres in growth:
+            for _, x, y in centres:
                 if profile:
                     if not polar:
                         st["sum"] = st["sum"] + (objective.curve(x, length) - y) ** 2
                     else:
                         st["sum"] = st["sum"] + (objective.curve(st["theta"], length) - st["r"]) ** 2
                         st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
-            placed = max(placed, upto)
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
             bound = _prefix_bound(chain, objective, st, n + 1 - placed)
@@ -593,6 +601,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 keep[np.argpartition(bound, beam)[:beam]] = True
             bits = bits[keep]
             st = {key: v[keep] for key, v in st.items()}
+            growth.send((bits, st))
             if len(bits) > max_nodes:
                 raise SearchConfigError(f"branch-and-bound: {len(bits):,} open prefixes at unit {p} of {n}: too "
                                         "many designs come within the chain's error bound of the best to list "
