@@ -245,7 +245,8 @@ class JobBoard:
         self._say(job, f"chain table of unit {spec.name!r} for the {fidelity.upper()} model", 0.02)
         with EvaluationCache(self.cache) as cache, make_evaluator("processes", self.workers) as inner:
             table = table_for(model, model.with_units, folder=self.bench.table_dir,
-                              evaluator=CachedEvaluator(inner, cache), on_progress=lambda t: self._say(job, str(t)))
+                              evaluator=CachedEvaluator(inner, cache), on_progress=lambda t: self._say(
+                                  job, str(t), _fraction(str(t))))
         val = table.validation
         job.result = {"unit_id": unit_id, "name": spec.name, "model": fidelity, "window": table.window,
                       "centre_worst_mm": max(val.get("centre_worst_mm", [float("nan")]))}
@@ -272,6 +273,14 @@ class JobBoard:
         self._offer(job, Path(archive))
         job.result = {"design": design, "parts": sorted(p.name for p in (out / "parts").glob("*.stl")),
                       "mould_parts": len(mould.parts)}
+
+
+def _fraction(text: str) -> float | None:
+    """The share done in a table build's progress line ("covering: 12/30 solved ..."), if it says."""
+    import re
+
+    found = re.search(r"(\d+)/(\d+) solved", text)
+    return None if found is None else 0.05 + 0.9 * int(found.group(1)) / max(int(found.group(2)), 1)
 
 
 def fe_solve_shape(model: Any, design: str) -> tuple[Any, dict[str, Any] | None, float]:
