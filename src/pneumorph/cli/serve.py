@@ -62,6 +62,10 @@ def serve(host: str, port: int, open_browser: bool, state: str | None, cache: st
         raise click.UsageError(f"the bench needs the web extra ({exc.name} is missing): "
                                "pip install -e \".[web]\"") from None
     _check_port(host, port)
+    from pneumorph.bench.app import default_state_dir
+    from pneumorph.io.files import check_writable_dir
+
+    check_writable_dir(state if state is not None else default_state_dir(), "--state")
     app = create_app(state_dir=state, cache=cache, workers=workers)
     url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
     click.echo(f"pneumorph bench at {url} (Ctrl-C stops it)")
