@@ -51,6 +51,12 @@ class OgdenCompressible:
         Exponents (non-zero).
     bulk : float
         Bulk modulus ``K`` of the volumetric term ``9/2 K (J^(1/3) - 1)^2`` (MPa).
+    thermal_stretch : float
+        ``theta = 1 + a dT``, the free thermal stretch of a uniform temperature change
+        ``dT`` for a linear expansion coefficient ``a`` (default 1: none). The deformation
+        splits as ``F = F_e theta``; the energy per reference volume is
+        ``W(F) = theta^3 W_e(F / theta)``, so ``P = theta^2 P_e(F / theta)`` and
+        ``A = theta A_e(F / theta)``: a free body expands by ``theta`` without stress.
 
     Examples
     --------
@@ -62,7 +68,7 @@ class OgdenCompressible:
     0.0
     """
 
-    def __init__(self, mu: Sequence[float], alpha: Sequence[float], bulk: float) -> None:
+    def __init__(self, mu: Sequence[float], alpha: Sequence[float], bulk: float, thermal_stretch: float = 1.0) -> None:
         self.mu = np.asarray(mu, dtype=float)
         self.alpha = np.asarray(alpha, dtype=float)
         if self.mu.shape != self.alpha.shape or self.mu.ndim != 1 or self.mu.size == 0:
@@ -72,7 +78,10 @@ class OgdenCompressible:
         if not bulk > 0:
             raise ValueError(f"the bulk modulus must be positive, got {bulk}")
         self.bulk = float(bulk)
-        self.kwargs = {"mu": self.mu, "alpha": self.alpha, "bulk": self.bulk}
+        if not (np.isfinite(thermal_stretch) and thermal_stretch > 0):
+            raise ValueError(f"the thermal stretch must be a positive number, got {thermal_stretch}")
+        self.thermal_stretch = float(thermal_stretch)
+        self.kwargs = {"mu": self.mu, "alpha": self.alpha, "bulk": self.bulk, "thermal_stretch": self.thermal_stretch}
         self.x = [np.eye(3), np.zeros(0)]
         self._cache: tuple[FloatArray, tuple[FloatArray, ...]] | None = None
 
@@ -108,14 +117,23 @@ class OgdenCompressible:
     def gradient(self, x: list, **kwargs: object) -> list:
         """First Piola-Kirchhoff stress ``P = F S`` and (no) state variables."""
         F, statevars = x[0], x[-1]
+        theta = self.thermal_stretch
+        if theta != 1.0:
+            F = F / theta
         _, N, _, _, _, S, _ = self._principal(F)
         S_mat = np.einsum("...Ia,...a,...Ja->IJ...", N, S, N)
         P = np.einsum("iI...,IJ...->iJ...", F, S_mat)
-        return [P, statevars]
+        return [P * theta**2 if theta != 1.0 else P, statevars]
 
     def hessian(self, x: list, **kwargs: object) -> list:
         """Fourth-order tangent ``A_iJkL = dP_iJ / dF_kL``."""
         F = x[0]
+        theta = self.thermal_stretch
+        if theta != 1.0:
+            return [self._tangent(F / theta) * theta]
+        return [self._tangent(F)]
+
+    def _tangent(self, F: FloatArray) -> FloatArray:
         c, N, J, lba, m, S, h = self._principal(F)
         eye = np.eye(3)
         # d beta_iso_a / d c_b = sum_n mu_n alpha_n / (2 c_b) [lb_a (d_ab - 1/3) - (lb_b - m)/3]
@@ -160,4 +178,4 @@ class OgdenCompressible:
         A = np.ascontiguousarray(np.matmul(L, R).transpose(1, 2, 0)).reshape(3, 3, 3, 3, *pts)
         for i in range(3):
             A[i, :, i, :] += S_mat
-        return [A]
+        return A

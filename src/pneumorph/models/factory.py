@@ -13,7 +13,8 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
 
-MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity")
+MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
+              "temperature_change")
 
 
 def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel:
@@ -67,4 +68,10 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         gravity = gravity_vector(s.get("gravity"), Model.dim)
     except (ValueError, TypeError) as exc:
         raise SearchConfigError(f"[model] gravity: {exc}") from None
+    change = checks.real(s.get("temperature_change", 0.0), "[model] temperature_change", -100.0, 100.0, unit="degC",
+                         error=SearchConfigError)
+    if change != 0.0:
+        if Model is not Full3D:
+            raise SearchConfigError("[model] temperature_change is a 3D model option (fidelity = \"3d\")")
+        return Full3D(units, unit, ramp, gravity=gravity, temperature_change=change)
     return Model(units, unit, ramp, gravity=gravity)

@@ -115,6 +115,7 @@ class FEModel:
         filler: FillerLaw | None = None,
         backend: str | None = None,
         gravity: str | Sequence[float] | None = None,
+        temperature_change: float = 0.0,
     ) -> None:
         backend = backend or self.backends[0]
         if backend not in self.backends:
@@ -127,6 +128,17 @@ class FEModel:
         self.body = get(self.unit.body_material)
         self.layer = get(self.unit.layer_material)
         self.gravity = gravity_vector(gravity, self.dim)
+        self.temperature_change = checks.real(temperature_change, "temperature_change", -100.0, 100.0, unit="degC")
+        if self.temperature_change != 0.0 and backend != "fast":
+            # the thermal strain loads the body before any pressure; FElupe's Newton check on that first
+            # state does not converge (seen on a 1-unit actuator), the fast path's does
+            raise SettingsError("a temperature change needs the fast backend (the 3D model's default)")
+        if self.temperature_change != 0.0:
+            for material in (self.body, self.layer):
+                if material.thermal_expansion is None:
+                    raise MaterialDataError(f"a temperature change needs the thermal expansion of {material.name!r}, "
+                                            "which has none (Table A.6 gives it for the built-in silicones); add "
+                                            "one to its material entry or leave the temperature unchanged")
         if self.gravity is not None:
             for material in (self.body, self.layer):
                 if material.density is None:
@@ -149,6 +161,8 @@ class FEModel:
             out["filler"] = self.filler.to_dict()
         if self.gravity is not None:  # absent without gravity: earlier fingerprints stay valid
             out["gravity_mm_s2"] = list(self.gravity)
+        if self.temperature_change != 0.0:  # likewise
+            out["temperature_change_c"] = self.temperature_change
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -173,8 +187,15 @@ class FEModel:
         """(Region class, boundary region class, field class) for this dimension."""
         raise NotImplementedError  # pragma: no cover
 
+    def thermal_stretch(self, material: Any) -> float:
+        """``1 + a dT``: the free stretch of ``material`` under the model's temperature change."""
+        if self.temperature_change == 0.0:
+            return 1.0
+        return 1.0 + material.thermal_expansion.value * self.temperature_change
+
     def _silicone_umat(self, material: Any) -> OgdenCompressible:
-        return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value)
+        return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value,
+                                 self.thermal_stretch(material))
 
     def _extra_bodies(self, mesh: ActuatorMesh, field: Any) -> tuple[list[Any], Any]:
         """Further items (the 2D filler) and a callback ``set_pressure(p)`` for them."""
@@ -424,6 +445,7 @@ class Reduced2D(FEModel):
     ) -> None:
         unit = unit or UnitSpec()
         super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity)
+        # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
         self.filler.modulus(self.ramp.pressure)
@@ -474,6 +496,11 @@ class Full3D(FEModel):
     gravity : str or sequence of float, optional
         As for :class:`Reduced2D`; a half model needs gravity in its plane of symmetry
         (no z component).
+    temperature_change : float
+        A uniform temperature change (degC, default 0) from the casting temperature: each
+        silicone expands freely by ``1 + a dT`` with its linear coefficient ``a`` (Table A.6;
+        appendix D.3), in the energy of :class:`~pneumorph.fem.ogden.OgdenCompressible`.
+        The clamped base holds the expansion back; the pressure ramp starts from there.
 
     The fingerprint holds the result-determining ramp settings only - the reported
     increments, the pressure and the tolerance - not how the ramp is solved (substeps,
@@ -500,9 +527,9 @@ class Full3D(FEModel):
 
     def __init__(
         self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
-        backend: str | None = None, gravity: str | Sequence[float] | None = None,
+        backend: str | None = None, gravity: str | Sequence[float] | None = None, temperature_change: float = 0.0,
     ) -> None:
-        super().__init__(n_units, unit, ramp_spec, None, backend, gravity)
+        super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
