@@ -72,6 +72,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pneumorph.errors import GeometryError
+from pneumorph.geometry.features import BaseBlock, Box
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 
@@ -93,7 +94,6 @@ __all__ = [
 ]
 
 #: A box ``(x0, x1, y0, y1, z0, z1)`` in mm.
-Box = tuple[float, float, float, float, float, float]
 
 # The 12 outward triangles of a box whose 8 corners are numbered by bits (x, y, z).
 _BOX_FACES = np.array(
@@ -107,56 +107,6 @@ _BOX_FACES = np.array(
     ],
     dtype=np.uint64,
 )
-
-
-@dataclass(frozen=True)
-class BaseBlock:
-    """The solid silicone block glued to the clamped base face of the actuator.
-
-    The syringe that inflates the actuator is pushed through it into the first cavity;
-    the thick slab keeps the air from escaping around the needle (section 6.4.2). The
-    model clamps the face x = 0, so the block's size does not change the predicted shape.
-
-    Parameters
-    ----------
-    length : float
-        Thickness along the actuator, mm (default 10: about one unit's pitch, enough to
-        grip in a clamp and seal around an 18 gauge needle).
-    margin : float
-        How far it overhangs the actuator's section on each side (y and z), mm (default 0:
-        the block has the actuator's ``height x width`` section).
-    material : str
-        Library name of its silicone (default ``mold_star_15``, the body's).
-
-    Raises
-    ------
-    GeometryError
-        A non-positive length, a negative margin or a blank material name.
-
-    Examples
-    --------
-    >>> BaseBlock().box(UnitSpec())
-    (-10.0, 0.0, 0.0, 12.0, 0.0, 15.0)
-    >>> BaseBlock(length=-1.0)
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.GeometryError: base block length must be a finite number > 0 mm, got -1.0
-    """
-
-    length: float = 10.0
-    margin: float = 0.0
-    material: str = "mold_star_15"
-
-    def __post_init__(self) -> None:
-        _check_length("base block length", self.length, positive=True)
-        _check_length("base block margin", self.margin, positive=False)
-        if not isinstance(self.material, str) or not self.material.strip():
-            raise GeometryError(f"base block material must be a non-empty text, got {self.material!r}")
-
-    def box(self, spec: UnitSpec) -> Box:
-        """The block ``(x0, x1, y0, y1, z0, z1)`` beside the base face of an actuator of ``spec``."""
-        m = float(self.margin)
-        return (-float(self.length), 0.0, 0.0 - m, spec.height + m, 0.0 - m, spec.width + m)
 
 
 @dataclass(frozen=True)
@@ -189,12 +139,6 @@ class LayerPiece:
         """The piece ``(x0, x1, y0, y1, z0, z1)`` in the actuator's frame."""
         y0, y1 = (spec.height - spec.layer, spec.height) if self.side == "top" else (0.0, spec.layer)
         return (self.x0, self.x1, y0, y1, 0.0, spec.width)
-
-
-def _check_length(name: str, value: float, positive: bool) -> None:
-    ok = not isinstance(value, bool) and isinstance(value, (int, float)) and np.isfinite(value)
-    if not ok or (value <= 0 if positive else value < 0):
-        raise GeometryError(f"{name} must be a finite number {'> 0' if positive else '>= 0'} mm, got {value!r}")
 
 
 def layer_pieces(spec: UnitSpec, orientation: str) -> list[LayerPiece]:

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError
+from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 
@@ -26,7 +27,7 @@ IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 FloatArray = NDArray[np.float64]
 
-BODY, LAYER, CAVITY, SLIT = 0, 1, 2, 3
+BODY, LAYER, CAVITY, SLIT, BASE, VOID = 0, 1, 2, 3, 4, 5
 
 
 @dataclass(frozen=True)
@@ -41,15 +42,16 @@ class ActuatorMesh:
         Quadratic cells (``quad8`` in 2D, ``hexahedron20`` in 3D) in FElupe's ordering.
     cell_type : str
     regions : dict of str to ndarray
-        Cell indices of ``"body"``, ``"layer"`` and, in 2D, ``"filler"`` (the cavities).
+        Cell indices of ``"body"``, ``"layer"``, in 2D ``"filler"`` (the cavities), and
+        ``"base"`` (the base block) if there is one.
     cavity_points : ndarray of bool, shape (p,)
-        Points on the cavity walls (and, in 2D, inside the filler).
+        Points on the cavity walls, passages included (and, in 2D, inside the filler).
     tracked : ndarray, shape (n, 4)
         Per unit, the points at the cavity's four vertices (Fig 4.4; mid-width in 3D).
     end_points : ndarray
         Points of the free end face in the section plane, ordered by height.
     base_points : ndarray of bool, shape (p,)
-        Points of the clamped base face (x = 0).
+        The clamped points: the base face x = 0, or the jaw faces of the base block.
     orientation : str
     spec : UnitSpec
     symmetry_points : ndarray of bool, shape (p,)
@@ -119,8 +121,13 @@ def _section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
     return xb, yb
 
 
-def _label(spec: UnitSpec, orientation: str, centres: FloatArray) -> IntArray:
-    """Label of each linear cell from its centroid: BODY, LAYER, CAVITY or SLIT."""
+def _label(spec: UnitSpec, orientation: str, centres: FloatArray, passage: float = 0.0,
+           base: BaseBlock | None = None) -> IntArray:
+    """Label of each linear cell from its centroid: BODY, LAYER, CAVITY, SLIT, BASE or VOID.
+
+    ``passage`` is the side of the square channels between adjacent cavities (labelled
+    CAVITY); cells outside the actuator's section (beside a base block with a margin) are VOID.
+    """
     n, P, H = len(orientation), spec.pitch, spec.height
     unit = np.clip(np.floor(centres[:, 0] / P).astype(int), 0, n - 1)
     lx = centres[:, 0] - unit * P
@@ -137,10 +144,23 @@ def _label(spec: UnitSpec, orientation: str, centres: FloatArray) -> IntArray:
     if spec.slit is not None:
         sx0, _, _, sy1 = spec.slit
         label = np.where((lx > sx0) & (ly < sy1) & ~cap, SLIT, label)
+    if passage > 0:  # the wall between cavity i and cavity i + 1, at mid-height and mid-width
+        between = ((lx > x1) & (unit < n - 1)) | ((lx < x0) & (unit > 0))
+        through = between & ~cap & (centres[:, 0] > 0) & (np.abs(centres[:, 1] - H / 2) < passage / 2)
+        if centres.shape[1] == 3:
+            through &= np.abs(centres[:, 2] - spec.width / 2) < passage / 2
+        label = np.where(through, CAVITY, label)
+    outside = (centres[:, 1] < 0) | (centres[:, 1] > H)
+    if centres.shape[1] == 3:
+        outside |= (centres[:, 2] < 0) | (centres[:, 2] > spec.width)
+    label = np.where(outside, VOID, label)
+    if base is not None:
+        label = np.where(centres[:, 0] < 0, BASE, label)
     return label
 
 
-def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False) -> ActuatorMesh:
+def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False, passage: float = 0.0,
+             base: BaseBlock | None = None) -> ActuatorMesh:
     """Mesh an actuator of ``len(orientation)`` units.
 
     Parameters
@@ -156,6 +176,14 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
         3D only: mesh the half 0 <= z <= width / 2; the model then holds u_z = 0 on the
         mid-plane (``symmetry_points``). The actuator is symmetric across its width, so this
         gives the same solution with half the unknowns.
+    passage : float
+        3D only: the diameter (mm) of an air passage through every wall between adjacent
+        cavities (appendix D.1), meshed as a square channel of the same area at mid-height
+        and mid-width (:func:`~pneumorph.geometry.features.check_passage`); 0 (default):
+        closed cavities.
+    base : BaseBlock, optional
+        The base block (appendix D.2): a solid slab at ``-length <= x <= 0`` (region
+        ``"base"``), clamped by its jaw faces instead of the face x = 0.
 
     Returns
     -------
@@ -168,25 +196,38 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
     ('quad8', (2, 4), ['body', 'filler', 'layer'])
     >>> np.round(m.unit_centres(), 3).tolist()
     [[5.25, 4.5], [15.75, 7.5]]
+
+    Raises
+    ------
+    GeometryError
+        A bad ``dim`` or design, a passage in 2D or one that does not fit the walls.
     """
     import felupe as fem
 
     if dim not in (2, 3):
         raise GeometryError(f"dim must be 2 or 3, got {dim!r}")
     orientation = parse_orientation(orientation)
+    if passage and dim != 3:
+        raise GeometryError("a passage between cavities is a 3D feature: the 2D section would be cut in two")
+    side = check_passage(spec, passage)
     n, P, H, W = len(orientation), spec.pitch, spec.height, spec.width
     h = spec.element_size
     xb_local, yb = _section_breaks(spec)
-    xs = grid_lines([i * P + x for i in range(n) for x in xb_local] + [n * P + spec.end_cap], h)
-    ys = grid_lines(yb, h)
-    if dim == 3:
-        zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
-        zs = grid_lines(zb, h)
-        grid = fem.Grid(xs, ys, zs)
-    else:
-        grid = fem.Grid(xs, ys)
-    label = _label(spec, orientation, grid.points[grid.cells].mean(axis=1))
-    keep = label != SLIT if dim == 2 else (label == BODY) | (label == LAYER)
+    xb = [i * P + x for i in range(n) for x in xb_local] + [n * P + spec.end_cap]
+    zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+    if side:
+        yb += [H / 2 - side / 2, H / 2 + side / 2]
+        zb += [W / 2 - side / 2] if half else [W / 2 - side / 2, W / 2 + side / 2]
+    if base is not None:
+        m = base.margin
+        xb.append(-base.length)
+        yb += [-m, H + m]
+        zb += [-m] if half else [-m, W + m]
+    xs, ys = grid_lines(xb, h), grid_lines(yb, h)
+    grid = fem.Grid(xs, ys, grid_lines(zb, h)) if dim == 3 else fem.Grid(xs, ys)
+    label = _label(spec, orientation, grid.points[grid.cells].mean(axis=1), side, base)
+    solid = (label == BODY) | (label == LAYER) | (label == BASE)
+    keep = solid | (label == CAVITY) if dim == 2 else solid
     cells, label = grid.cells[keep], label[keep]
     used = np.unique(cells)
     renumber = np.full(len(grid.points), -1)
@@ -197,6 +238,8 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
     regions = {"body": np.flatnonzero(label == BODY), "layer": np.flatnonzero(label == LAYER)}
     if dim == 2:
         regions["filler"] = np.flatnonzero(label == CAVITY)
+    if base is not None:
+        regions["base"] = np.flatnonzero(label == BASE)
 
     tol = 1e-6
     x0, x1, y0, y1 = spec.cavity
@@ -221,6 +264,18 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
             tracked[i, k] = int(np.argmin(d))
             if d[tracked[i, k]] > tol**2:  # pragma: no cover - the grid has these lines
                 raise GeometryError(f"no mesh point at cavity vertex {k} of unit {i}")
+    if side:  # the passages' walls are loaded by the pressure too
+        for i in range(n - 1):
+            inside = ((points[:, 0] > i * P + x1 - tol) & (points[:, 0] < (i + 1) * P + x0 + tol)
+                      & (np.abs(points[:, 1] - H / 2) < side / 2 + tol))
+            if dim == 3:
+                inside &= np.abs(points[:, 2] - W / 2) < side / 2 + tol
+            cavity_points |= inside
+    if base is None:
+        clamped = np.isclose(points[:, 0], 0.0)
+    else:  # the jaws of the clamp hold the block's bottom and top faces
+        jaws = np.isclose(points[:, 1], -base.margin) | np.isclose(points[:, 1], H + base.margin)
+        clamped = jaws & (points[:, 0] < tol)
     on_end = np.isclose(points[:, 0], n * P + spec.end_cap)
     if dim == 3:
         on_end &= np.isclose(points[:, 2], W / 2)
@@ -234,7 +289,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False)
         cavity_points=cavity_points,
         tracked=tracked,
         end_points=end_points,
-        base_points=np.isclose(points[:, 0], 0.0),
+        base_points=clamped,
         orientation=orientation,
         spec=spec,
         symmetry_points=np.isclose(points[:, 2], W / 2) if (dim == 3 and half) else None,

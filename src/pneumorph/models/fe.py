@@ -32,6 +32,7 @@ from pneumorph.fem.fastassembly3d import SolidSystem3D
 from pneumorph.fem.fastnewton import FastSubstep
 from pneumorph.fem.parts import clamped_dofs, linked_solid
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
+from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get, get_filler
@@ -116,6 +117,8 @@ class FEModel:
         backend: str | None = None,
         gravity: str | Sequence[float] | None = None,
         temperature_change: float = 0.0,
+        passage: float = 0.0,
+        base_block: BaseBlock | None = None,
     ) -> None:
         backend = backend or self.backends[0]
         if backend not in self.backends:
@@ -129,21 +132,37 @@ class FEModel:
         self.layer = get(self.unit.layer_material)
         self.gravity = gravity_vector(gravity, self.dim)
         self.temperature_change = checks.real(temperature_change, "temperature_change", -100.0, 100.0, unit="degC")
+        if passage and self.dim != 3:
+            raise SettingsError("a passage between cavities is a 3D model option: the 2D section would be cut in two")
+        self.passage = float(passage)
+        check_passage(self.unit, self.passage)
+        if base_block is not None and not isinstance(base_block, BaseBlock):
+            raise SettingsError(f"base_block must be a BaseBlock or None, got {base_block!r}")
+        self.base_block = base_block
+        self.base = get(base_block.material) if base_block is not None else None
         if self.temperature_change != 0.0 and backend != "fast":
             # the thermal strain loads the body before any pressure; FElupe's Newton check on that first
             # state does not converge (seen on a 1-unit actuator), the fast path's does
             raise SettingsError("a temperature change needs the fast backend (the 3D model's default)")
         if self.temperature_change != 0.0:
-            for material in (self.body, self.layer):
+            for material in self.silicones.values():
                 if material.thermal_expansion is None:
                     raise MaterialDataError(f"a temperature change needs the thermal expansion of {material.name!r}, "
                                             "which has none (Table A.6 gives it for the built-in silicones); add "
                                             "one to its material entry or leave the temperature unchanged")
         if self.gravity is not None:
-            for material in (self.body, self.layer):
+            for material in self.silicones.values():
                 if material.density is None:
                     raise MaterialDataError(f"gravity needs the density of {material.name!r}, which has none; "
                                             "add one to its material entry or run without gravity")
+
+    @property
+    def silicones(self) -> dict[str, Any]:
+        """The material of every silicone region of the mesh: body, layer and base block if any."""
+        out = {"body": self.body, "layer": self.layer}
+        if self.base is not None:
+            out["base"] = self.base
+        return out
 
     # -- identity -----------------------------------------------------------------------
     def describe(self) -> dict[str, Any]:
@@ -163,6 +182,11 @@ class FEModel:
             out["gravity_mm_s2"] = list(self.gravity)
         if self.temperature_change != 0.0:  # likewise
             out["temperature_change_c"] = self.temperature_change
+        if self.passage:  # likewise
+            out["passage_mm"] = self.passage
+        if self.base_block is not None:  # likewise
+            assert self.base is not None
+            out["base_block"] = {**self.base_block.to_dict(), "material_data": self.base.to_dict()}
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -205,16 +229,16 @@ class FEModel:
         """FElupe objects for one design (mesh, fields, bodies, boundary conditions)."""
         import felupe as fem
 
-        mesh = assemble(self.unit, orientation, self.dim, half=self.half)
+        mesh = assemble(self.unit, orientation, self.dim, half=self.half, passage=self.passage, base=self.base_block)
         Region, BoundaryRegion, Field = self._regions(mesh)
         fmesh = fem.Mesh(mesh.points, mesh.cells, mesh.cell_type)
         field = fem.FieldContainer([Field(Region(fmesh), dim=self.dim)])
         bodies = []
-        for name, material in (("body", self.body), ("layer", self.layer)):
+        for name, material in self.silicones.items():
             bodies.append(linked_solid(self._silicone_umat(material), mesh.points, mesh.cells[mesh.regions[name]],
                                        mesh.cell_type, Region, Field, self.dim, field))
         extra, set_extra = self._extra_bodies(mesh, field)
-        silicone = np.concatenate([mesh.regions["body"], mesh.regions["layer"]])
+        silicone = np.concatenate([mesh.regions[name] for name in self.silicones])
         walls_mesh = fem.Mesh(mesh.points, mesh.cells[silicone], mesh.cell_type)
         kwargs = {"ensure_3d": True} if self.dim == 2 else {}
         walls = BoundaryRegion(walls_mesh, mask=mesh.cavity_points, **kwargs)
@@ -224,7 +248,7 @@ class FEModel:
         forces = []
         if self.gravity is not None:  # dead loads rho g on the silicones, switched on by the gravity stage
             forces = [fem.SolidBodyForce(body.field, values=np.zeros(self.dim), scale=material.density.value)
-                      for body, material in zip(bodies, (self.body, self.layer))]
+                      for body, material in zip(bodies, self.silicones.values())]
         dof0, dof1 = clamped_dofs(field, mesh.base_points, mesh.symmetry_points)
         return {
             "mesh": mesh,
@@ -442,9 +466,11 @@ class Reduced2D(FEModel):
         filler: FillerLaw | None = None,
         backend: str | None = None,
         gravity: str | Sequence[float] | None = None,
+        base_block: BaseBlock | None = None,
     ) -> None:
         unit = unit or UnitSpec()
-        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity)
+        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity,
+                         base_block=base_block)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
@@ -501,6 +527,13 @@ class Full3D(FEModel):
         silicone expands freely by ``1 + a dT`` with its linear coefficient ``a`` (Table A.6;
         appendix D.3), in the energy of :class:`~pneumorph.fem.ogden.OgdenCompressible`.
         The clamped base holds the expansion back; the pressure ramp starts from there.
+    passage : float
+        The diameter (mm) of an air passage through every wall between adjacent cavities
+        (appendix D.1; 1.5 mm in the physical actuators, section 6.4.1), meshed as a square
+        channel of the same area; 0 (default): closed cavities.
+    base_block : BaseBlock, optional
+        Mesh the silicone block at the base, held by the clamp's jaws (appendix D.2),
+        instead of clamping the base face (default).
 
     The fingerprint holds the result-determining ramp settings only - the reported
     increments, the pressure and the tolerance - not how the ramp is solved (substeps,
@@ -528,8 +561,9 @@ class Full3D(FEModel):
     def __init__(
         self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
         backend: str | None = None, gravity: str | Sequence[float] | None = None, temperature_change: float = 0.0,
+        passage: float = 0.0, base_block: BaseBlock | None = None,
     ) -> None:
-        super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change)
+        super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
