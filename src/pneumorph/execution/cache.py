@@ -457,5 +457,29 @@ class CachedEvaluator:
             out[i] = outcome
         return out  # type: ignore[return-value]
 
+    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]:
+        """``(model, design)`` pairs of different models: cached ones first, the others as they are solved."""
+        cases = list(cases)
+        keys = [(m.fingerprint(), d) for m, d in cases]
+        todo: dict[tuple[str, str], list[int]] = {}
+        for i, (fp, d) in enumerate(keys):
+            found = None if (fp, d) in todo else self.cache.get(fp, d)
+            if found is not None:
+                self.hits += 1
+                yield i, found
+            else:
+                todo.setdefault((fp, d), []).append(i)
+        unique = list(todo)
+        start = time.perf_counter()
+        for j, outcome in self.inner.iter_cases([cases[todo[k][0]] for k in unique]):
+            if not outcome.transient:
+                self.cache.put(unique[j][0], outcome)
+            self.solves += 1
+            first, *rest = todo[unique[j]]
+            yield first, outcome
+            for i in rest:
+                yield i, outcome.as_cached()
+        self.solve_time += time.perf_counter() - start
+
     def close(self) -> None:
         self.inner.close()

@@ -9,7 +9,9 @@
 
 Every evaluator has ``iter_evaluate(model, designs)``, yielding ``(index, Outcome)`` as
 solves finish (so a cache can store each at once), and ``evaluate_many(model, designs)``,
-the outcomes in the order of the designs. A :class:`~pneumorph.errors.SimulationFailed`
+the outcomes in the order of the designs. ``iter_cases(cases)`` does the same for
+``(model, design)`` pairs of different models (the variants of a sensitivity study); each
+case carries its model to the worker. A :class:`~pneumorph.errors.SimulationFailed`
 becomes a failed :class:`~pneumorph.execution.outcome.Outcome`; any other exception from
 the model stops the batch as :class:`~pneumorph.errors.EvaluationError`.
 
@@ -60,6 +62,8 @@ class Evaluator(Protocol):
 
     def evaluate_many(self, model: ActuatorModel, designs: Iterable[str]) -> list[Outcome]: ...
 
+    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]: ...
+
     def close(self) -> None: ...
 
 
@@ -93,6 +97,10 @@ class SerialEvaluator(_Base):
 
     def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
         for i, design in enumerate(designs):
+            yield i, solve(model, design)
+
+    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]:
+        for i, (model, design) in enumerate(cases):
             yield i, solve(model, design)
 
 
@@ -137,6 +145,14 @@ def _watch_parent(parent: int, every: float = 0.5) -> None:
 
 def _solve_in_worker(design: str) -> Outcome:
     return solve(_WORKER_MODEL, design)
+
+
+def _solve_case_in_worker(case: tuple[ActuatorModel, str]) -> Outcome:
+    return solve(*case)
+
+
+#: the pool of :meth:`ProcessPoolEvaluator.iter_cases` holds no model (each case brings its own)
+_CASES = "cases"
 
 
 _LIVE_POOLS: weakref.WeakSet[ProcessPoolEvaluator] = weakref.WeakSet()
@@ -224,8 +240,8 @@ class ProcessPoolEvaluator(_Base):
         self.restarts = 0
         _LIVE_POOLS.add(self)
 
-    def _ensure_pool(self, model: ActuatorModel) -> ProcessPoolExecutor:
-        fp = model.fingerprint()
+    def _ensure_pool(self, model: ActuatorModel | None) -> ProcessPoolExecutor:
+        fp = _CASES if model is None else model.fingerprint()
         if self._pool is not None and fp == self._fingerprint:
             return self._pool
         self.close()
@@ -260,6 +276,16 @@ class ProcessPoolEvaluator(_Base):
 
     def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
         designs = list(designs)
+        yield from self._iterate(model, designs, [(_solve_in_worker, d) for d in designs])
+
+    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]:
+        """Solve ``(model, design)`` pairs of different models in one pool, yielding ``(index, Outcome)``."""
+        cases = list(cases)
+        yield from self._iterate(None, [d for _, d in cases], [(_solve_case_in_worker, c) for c in cases])
+
+    def _iterate(self, model: ActuatorModel | None, designs: list[str],
+                 tasks: list[tuple[Any, Any]]) -> Iterator[tuple[int, Outcome]]:
+        """Run ``tasks`` (function, argument) of ``designs``; see :meth:`iter_evaluate`."""
         if not designs:
             return
         queue = deque(range(len(designs)))  # handed to the pool, ``workers`` at a time
@@ -268,7 +294,7 @@ class ProcessPoolEvaluator(_Base):
         try:
             while queue or alone:
                 source, window = (alone, 1) if alone else (queue, self.workers)
-                broken, lost = yield from self._stream(model, designs, source, window)
+                broken, lost = yield from self._stream(model, tasks, source, window)
                 if not broken:
                     continue
                 codes = self._restart()
@@ -288,9 +314,9 @@ class ProcessPoolEvaluator(_Base):
             self.close(grace=0.0)
             raise
 
-    def _stream(self, model: ActuatorModel, designs: list[str], source: deque[int],
+    def _stream(self, model: ActuatorModel | None, tasks: list[tuple[Any, Any]], source: deque[int],
                 window: int) -> Generator[tuple[int, Outcome], None, tuple[bool, set[int]]]:
-        """Solve the designs of ``source`` with at most ``window`` in flight, yielding them as they
+        """Run the tasks of ``source`` with at most ``window`` in flight, yielding them as they
         finish. Returns ``(broken, lost)``: whether a worker died, and the designs it took along
         (those in flight then; the others stay in ``source``)."""
         pool = self._ensure_pool(model)
@@ -302,7 +328,7 @@ class ProcessPoolEvaluator(_Base):
                 while source and len(flight) < window and not broken:
                     i = source.popleft()
                     try:
-                        flight[pool.submit(_solve_in_worker, designs[i])] = i
+                        flight[pool.submit(*tasks[i])] = i
                     except BrokenProcessPool:
                         source.appendleft(i)
                         broken = True
@@ -425,6 +451,19 @@ self.client.submit(_solve_on_dask_worker, remote, d, pure=False) for d in design
                     outcome = Outcome(designs[i], None, transient=True,
                                       failure="worker died: every Dask worker that solved it died (KilledWorker)")
                 yield i, outcome
+        finally:
+            self.client.cancel([f for f in futures if not f.done()])
+
+    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]:
+        """Solve ``(model, design)`` pairs of different models, each sent with its case."""
+        from distributed import as_completed
+
+        cases = list(cases)
+        futures = [self.client.submit(_solve_on_dask_worker, m, d, pure=False) for m, d in cases]
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for f in as_completed(futures):
+                yield index[f.key], f.result()
         finally:
             self.client.cancel([f for f in futures if not f.done()])
 

@@ -18,7 +18,7 @@ import copy
 import hashlib
 import json
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
@@ -37,6 +37,7 @@ from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get, get_filler
 from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.material import Material
 from pneumorph.models.gravity import gravity_vector
 from pneumorph.models.response import FloatArray, Response
 
@@ -119,6 +120,7 @@ class FEModel:
         temperature_change: float = 0.0,
         passage: float = 0.0,
         base_block: BaseBlock | None = None,
+        materials: Mapping[str, Material] | None = None,
     ) -> None:
         backend = backend or self.backends[0]
         if backend not in self.backends:
@@ -128,8 +130,12 @@ class FEModel:
         self.unit = unit or UnitSpec()
         self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
         self.filler = filler
-        self.body = get(self.unit.body_material)
-        self.layer = get(self.unit.layer_material)
+        self.materials = dict(materials or {})
+        for name, material in self.materials.items():
+            if not isinstance(material, Material) or material.kind != "hyperelastic":
+                raise SettingsError(f"materials[{name!r}] must be a hyperelastic Material, got {material!r}")
+        self.body = self._material(self.unit.body_material)
+        self.layer = self._material(self.unit.layer_material)
         self.gravity = gravity_vector(gravity, self.dim)
         self.temperature_change = checks.real(temperature_change, "temperature_change", -100.0, 100.0, unit="degC")
         if passage and self.dim != 3:
@@ -139,7 +145,7 @@ class FEModel:
         if base_block is not None and not isinstance(base_block, BaseBlock):
             raise SettingsError(f"base_block must be a BaseBlock or None, got {base_block!r}")
         self.base_block = base_block
-        self.base = get(base_block.material) if base_block is not None else None
+        self.base = self._material(base_block.material) if base_block is not None else None
         if self.temperature_change != 0.0 and backend != "fast":
             # the thermal strain loads the body before any pressure; FElupe's Newton check on that first
             # state does not converge (seen on a 1-unit actuator), the fast path's does
@@ -155,6 +161,25 @@ class FEModel:
                 if material.density is None:
                     raise MaterialDataError(f"gravity needs the density of {material.name!r}, which has none; "
                                             "add one to its material entry or run without gravity")
+
+    def _material(self, name: str) -> Material:
+        """``name`` from the model's own materials, else from the library."""
+        return self.materials.get(name) or get(name)
+
+    def options(self) -> dict[str, Any]:
+        """The constructor's arguments that give this model (see :meth:`variant`)."""
+        out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
+                               "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
+                               "base_block": self.base_block, "materials": dict(self.materials)}
+        return out
+
+    def variant(self, **changes: Any) -> FEModel:
+        """The same model with some constructor arguments changed (a sensitivity study's variant).
+
+        >>> Full3D(15).variant(passage=1.5).passage
+        1.5
+        """
+        return type(self)(**{**self.options(), **changes})
 
     @property
     def silicones(self) -> dict[str, Any]:
@@ -467,14 +492,19 @@ class Reduced2D(FEModel):
         backend: str | None = None,
         gravity: str | Sequence[float] | None = None,
         base_block: BaseBlock | None = None,
+        materials: Mapping[str, Material] | None = None,
     ) -> None:
         unit = unit or UnitSpec()
+        self._given_filler = filler
         super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity,
-                         base_block=base_block)
+                         base_block=base_block, materials=materials)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
         self.filler.modulus(self.ramp.pressure)
+
+    def options(self) -> dict[str, Any]:
+        return {**super().options(), "filler": self._given_filler}
 
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem
@@ -561,9 +591,10 @@ class Full3D(FEModel):
     def __init__(
         self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
         backend: str | None = None, gravity: str | Sequence[float] | None = None, temperature_change: float = 0.0,
-        passage: float = 0.0, base_block: BaseBlock | None = None,
+        passage: float = 0.0, base_block: BaseBlock | None = None, materials: Mapping[str, Material] | None = None,
     ) -> None:
-        super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block)
+        super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block,
+                         materials)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
@@ -576,6 +607,10 @@ class Full3D(FEModel):
         steps = self.ramp.steps
         out["steps"] = {"increments": steps.increments, "tolerance": steps.tolerance}
         return out
+
+    def options(self) -> dict[str, Any]:
+        return {**super().options(), "half": self.half, "temperature_change": self.temperature_change,
+                "passage": self.passage}
 
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem

@@ -14,8 +14,8 @@ from matplotlib.figure import Figure
 from pneumorph import __version__
 from pneumorph.geometry.boundary import boundary_facets
 
-COLOURS = {"body": "#4daf4a", "layer": "#377eb8", "filler": "#d9d9d9"}
-LABELS = {"body": "body", "layer": "stiff layer", "filler": "filler (2D model)"}
+COLOURS = {"body": "#4daf4a", "layer": "#377eb8", "filler": "#d9d9d9", "base": "#a6d96a"}
+LABELS = {"body": "body", "layer": "stiff layer", "filler": "filler (2D model)", "base": "base block"}
 
 # quad8 outline through the mid-side nodes; corner faces of a hexahedron
 _QUAD8_OUTLINE = [0, 4, 1, 5, 2, 6, 3, 7]

@@ -1,0 +1,184 @@
+"""``pneumorph sensitivity``: the studies of appendices D and E for any design and model."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+import click
+
+from pneumorph.cli import params as P
+
+
+def _common(command: Callable[..., Any]) -> Callable[..., Any]:
+    """The options every study shares: the design, the model, the executor, the outputs."""
+    options = [
+        click.option("--design", metavar="DIGITS", type=P.Text(max_length=1000),
+                     help="The design, base first (default: all units aligned, as appendix E)."),
+        click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="3d", show_default=True,
+                     help="The FE model."),
+        click.option("--units", "n_units", type=P.UNITS, default=15, show_default=True,
+                     help="Units of the default design (ignored with --design)."),
+        click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure, kPa."),
+        click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit)."),
+        click.option("--executor", type=click.Choice(["serial", "processes"]), default="processes", show_default=True,
+                     help="Solve the cases one after another, or in parallel processes."),
+        click.option("--workers", type=P.WORKERS, help="Processes (default: all cores)."),
+        click.option("--cache", metavar="FILE", type=P.CacheFile(),
+                     help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes."),
+        click.option("--out", type=P.OutputDir(), help="Folder for study.json and study.png."),
+        click.option("--json", "as_json", is_flag=True, help="Print the results as JSON."),
+    ]
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
+@click.group("sensitivity")
+def sensitivity() -> None:
+    """How far a design's inflated shape moves with the model's simplifications, mould
+    tolerances and material data (appendices D and E; docs/sensitivity.md)."""
+
+
+def _run(name: str, common: dict[str, Any], **options: Any) -> None:
+    from pathlib import Path
+
+    from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
+    from pneumorph.geometry import parse_orientation
+    from pneumorph.io import provenance, strict_json
+    from pneumorph.io.files import write_json
+    from pneumorph.models import make_model
+    from pneumorph.sensitivity import BUILDERS, run_study
+
+    design, n = common["design"], common["n_units"]
+    if design is not None:
+        with P.blame("--design"):
+            n = len(parse_orientation(design))
+    settings: dict[str, Any] = {"fidelity": common["fidelity"], "pressure_kpa": common["pressure"]}
+    if common["unit_file"]:
+        settings["unit_file"] = common["unit_file"]
+    model = make_model(n, settings)
+    study = BUILDERS[name](model, design, **options)  # every variant is built (and checked) before any solve
+    total = len(study.cases) + 1
+    click.echo(f"{name} study of design {study.design} ({common['fidelity']} model, {model.n_units} units, "
+               f"{common['pressure']:g} kPa): {total} solves", err=True)
+    cache = EvaluationCache(common["cache"] or default_cache_path())
+    evaluator = CachedEvaluator(make_evaluator(common["executor"], common["workers"]), cache)
+    t0 = time.perf_counter()
+
+    def progress(done: int, total: int, r: Any) -> None:
+        state = "cached" if r.outcome.cached else ("solved" if r.outcome.ok else f"failed: {r.outcome.failure}")
+        curl = f", curl {r.outcome.response.curl[-1]:.2f} deg" if r.outcome.ok else ""
+        click.echo(f"  [{done}/{total}] {r.case.label}: {state}{curl}  [{time.perf_counter() - t0:.0f} s]", err=True)
+
+    try:
+        result = run_study(study, evaluator, on_case=progress)
+    finally:
+        evaluator.close()
+    data = result.to_dict()
+    data["provenance"] = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
+    if common["out"]:
+        from pneumorph.plot.sensitivity import plot_study
+
+        folder = Path(common["out"])
+        folder.mkdir(parents=True, exist_ok=True)
+        write_json(folder / "study.json", data)
+        plot_study(result, folder / "study.png")
+    if common["as_json"]:
+        click.echo(strict_json(data))
+        return
+    _print(result)
+    if common["out"]:
+        click.echo(f"written to {common['out']}/ (study.json, study.png)")
+
+
+def _print(result: Any) -> None:
+    ref = result.reference
+    level = result.study.level
+    r = ref.outcome.response
+    if ref.outcome.ok:
+        click.echo(f"reference ({ref.case.label}): curl {r.curl[level]:.2f} deg, tip ({r.tip[level, 0]:.2f}, "
+                   f"{r.tip[level, 1]:.2f}) mm at {r.pressures[level] * 1e3:g} kPa")
+    else:
+        click.echo(f"reference ({ref.case.label}) failed: {ref.outcome.failure}")
+    click.echo(f"{'case':<28} {'distance [mm]':>13} {'X [%]':>7} {'Y [%]':>7} {'tip [mm]':>9} {'curl [deg]':>10}")
+    for c in result.cases:
+        if c.difference is None:
+            click.echo(f"{c.case.label:<28} failed: {c.outcome.failure}")
+            continue
+        d = c.difference
+        click.echo(f"{c.case.label:<28} {d.distance_mm:13.3f} {d.x_error_pct:7.2f} {d.y_error_pct:7.2f} "
+                   f"{d.tip_mm:9.3f} {d.curl_deg:10.2f}")
+        if c.matching_kpa is not None:
+            click.echo(f"{'':<28} closest to the reference shape at {c.matching_kpa:.1f} kPa "
+                       f"(max distance {c.matching_mm:.3f} mm)")
+    s = result.summary()
+    if "curl_min_deg" in s:
+        fields = list(s["minimum_curl_inputs"])
+        click.echo(f"curl {s['curl_min_deg']:.2f} .. {s['curl_max_deg']:.2f} deg (mean {s['curl_mean_deg']:.2f}, "
+                   f"sd {s['curl_std_deg']:.2f}); tip spread {s['tip_spread_mm']:.2f} mm; distance mean "
+                   f"{s['distance_mean_mm']:.3f}, 95th percentile {s['distance_p95_mm']:.3f}, worst "
+                   f"{s['worst_distance_mm']:.3f} mm")
+        click.echo(f"{'':<16}" + "".join(f"{f:>12}" for f in fields))
+        for key, label in (("minimum_curl_inputs", "minimum curl"), ("maximum_curl_inputs", "maximum curl")):
+            click.echo(f"{label:<16}" + "".join(f"{s[key][f]:12.3f}" for f in fields))
+
+
+@sensitivity.command("simplifications")
+@_common
+@click.option("--passage", type=P.Real(0.0, 100.0, low_open=True, unit="mm"), default=1.5, show_default=True,
+              help="Diameter of the air passages between cavities (section 6.4.1), mm.")
+@click.option("--base-length", type=P.POSITIVE_MM, default=10.0, show_default=True,
+              help="Length of the silicone base block held by the clamp, mm.")
+@click.option("--change", type=P.Real(-100.0, 100.0, unit="degC"), default=10.0, show_default=True,
+              help="Temperature change, degC.")
+def simplifications_cmd(passage: float, base_length: float, change: float, **common: Any) -> None:
+    """Appendix D: passages between cavities, the base block, a temperature change, all three."""
+    from pneumorph.geometry.features import BaseBlock
+
+    _run("simplifications", common, passage=passage, base=BaseBlock(length=base_length), temperature_change=change)
+
+
+@sensitivity.command("tolerances")
+@_common
+@click.option("--tolerance", type=P.Real(0.0, 1.0, low_open=True, unit="mm"), default=0.1, show_default=True,
+              help="Mould tolerance on the side walls, the Mold Star wall and the Smooth-Sil layer, +- mm "
+                   "(0.1: FDM-printed moulds; 0.02: machined).")
+@click.option("--samples", type=P.Count(0, 10_000), default=30, show_default=True,
+              help="Random combinations besides the one-at-a-time extremes.")
+@click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the random combinations.")
+def tolerances_cmd(tolerance: float, samples: int, seed: int, **common: Any) -> None:
+    """Appendix E.2: mould tolerances (Table E.1, Figs E.5-E.6)."""
+    from pneumorph.sensitivity import Tolerance
+
+    _run("tolerances", common, tolerance=Tolerance(tolerance), samples=samples, seed=seed)
+
+
+@sensitivity.command("bulk-modulus")
+@_common
+@click.option("--factor", "factors", type=P.Real(0.0, 100.0, low_open=True), multiple=True,
+              help="Factor on the body silicone's bulk modulus (repeat; default 1.05 and 1.10).")
+def bulk_modulus_cmd(factors: tuple[float, ...], **common: Any) -> None:
+    """Appendix E.1.2: the body silicone's bulk modulus raised."""
+    _run("bulk-modulus", common, factors=factors or (1.05, 1.10))
+
+
+@sensitivity.command("calibration")
+@_common
+@click.option("--reach", type=P.Real(1.0, 10.0), default=2.0, show_default=True,
+              help="The tension-only model is ramped to this multiple of the pressure.")
+def calibration_cmd(reach: float, **common: Any) -> None:
+    """Appendix E.1.1: the body silicone calibrated on tension only, and the pressure that
+    brings it to the reference shape."""
+    _run("calibration", common, reach=reach)
+
+
+@sensitivity.command("temperature")
+@_common
+@click.option("--change", "changes", type=P.Real(-100.0, 100.0, unit="degC"), multiple=True,
+              help="Uniform temperature change, degC (repeat; default 10).")
+def temperature_cmd(changes: tuple[float, ...], **common: Any) -> None:
+    """Appendix D.3: a uniform temperature change from the casting temperature."""
+    _run("temperature", common, changes=changes or (10.0,))

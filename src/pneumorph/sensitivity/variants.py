@@ -1,0 +1,86 @@
+"""Materials of the sensitivity studies' variants (appendix E.1).
+
+- :func:`scaled_bulk_modulus` - a silicone with its bulk modulus raised (E.1.2: +5 %, +10 %).
+- :func:`tension_only` - a silicone's Ogden model refitted to its uniaxial *tension* curve
+  alone (E.1.1), the calibration a lab without compression grips would make.
+
+Where the data come from. The dissertation's measured curves are not public; its Table
+A.4 model of each silicone was calibrated on tension and compression tests (appendix
+A.2). :func:`tension_only` therefore samples that model's uniaxial curve over the tension
+range of the tests (stretch 1 to 3: the dumbbells were preconditioned to 200 % strain) and
+fits the same Ogden N = 3 form to the tension points only, with pneumorph's fitter
+(:func:`pneumorph.materials.fitting.fit`). The reference is the library's (tension and
+compression) model itself; refitting it to tension and compression points together
+recovers it (R^2 = 1 to 6 digits), so the two differ by the calibration data alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from pneumorph import checks
+from pneumorph.materials.fitting import FitResult, fit
+from pneumorph.materials.material import Material, ModelRecord
+from pneumorph.materials.testdata import TestCurve
+
+#: the tension range of the calibration data (stretch), appendix A.2: preconditioned to 200 % strain
+TENSION_RANGE = (1.0, 3.0)
+#: the compression range the tension-only fit leaves out (stretch), ISO 7743 pucks to 40 % strain
+COMPRESSION_RANGE = (0.6, 1.0)
+
+
+def scaled_bulk_modulus(material: Material, factor: float) -> Material:
+    """``material`` with its bulk modulus multiplied by ``factor`` (same name, new value).
+
+    Examples
+    --------
+    >>> from pneumorph.materials import get
+    >>> round(scaled_bulk_modulus(get("mold_star_15"), 1.05).bulk_modulus.value * 1e3, 2)   # kPa
+    124.95
+    """
+    factor = checks.real(factor, "bulk modulus factor", 0.0, 100.0, low_open=True)
+    q = material.bulk_modulus
+    if q is None:
+        from pneumorph.errors import MaterialDataError
+
+        raise MaterialDataError(f"{material.name!r} has no bulk modulus to scale")
+    scaled = replace(q, value=q.value * factor, printed=q.printed * factor,
+                     source=f"{q.source}, x {factor:g} (sensitivity study, appendix E.1.2)")
+    return replace(material, bulk_modulus=scaled)
+
+
+def tension_curve(material: Material, stretch: tuple[float, float] = TENSION_RANGE, points: int = 41) -> TestCurve:
+    """The uniaxial curve of ``material``'s model at ``points`` stretches in ``stretch``."""
+    assert material.model is not None
+    lam = np.linspace(stretch[0], stretch[1], points)
+    lam = lam[lam != 1.0]
+    return TestCurve("uniaxial", lam, material.model.uniaxial(lam), description=f"{material.name} model curve")
+
+
+def tension_only(material: Material, seed: int = 0) -> tuple[Material, FitResult]:
+    """``material`` with an Ogden N = 3 model fitted to its model's tension curve alone.
+
+    Returns the material (same name, new model and provenance) and the fit.
+
+    Examples
+    --------
+    >>> from pneumorph.materials import get
+    >>> ms, result = tension_only(get("mold_star_15"))
+    >>> round(result.r2["uniaxial"], 6)   # tension is matched ...
+    1.0
+    >>> bool(ms.model.uniaxial(np.array([0.6]))[0] > get("mold_star_15").model.uniaxial(np.array([0.6]))[0])
+    True
+    """
+    result = fit("ogden-3", tension_curve(material), seed=seed)
+    mu = tuple(float(result.parameters[f"mu{i}"]) for i in (1, 2, 3))
+    alpha = tuple(float(result.parameters[f"alpha{i}"]) for i in (1, 2, 3))
+    record = ModelRecord(type="ogden", convention="marc", unit="MPa", parameters=(("mu", mu), ("alpha", alpha)),
+                         source=f"Ogden N=3 fitted to the tension branch (stretch {TENSION_RANGE[0]:g}-"
+                                f"{TENSION_RANGE[1]:g}) of {material.display_name}'s model (sensitivity study, "
+                                "appendix E.1.1)")
+    return replace(material, model=result.model, model_record=record), result
+
+
+__all__ = ["COMPRESSION_RANGE", "TENSION_RANGE", "scaled_bulk_modulus", "tension_curve", "tension_only"]
