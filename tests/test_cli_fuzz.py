@@ -96,6 +96,8 @@ BASE = {
     "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--scale", "0.2", "--out", "run"],
     "list": ["materials", "list"],
     "serve": ["serve", "--port", "18765", "--state", "run"],
+    **{study: ["sensitivity", study, "--units", "2", "--executor", "serial", "--out", "run"]
+       for study in ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature")},
 }
 
 REAL = ["nan", "inf", "-inf", "1e999", "abc", ""]  # never a number
@@ -160,6 +162,16 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "serve": {"--host": ["", "   ", "nosuchhost.invalid"], "--port": POS_COUNT + ["65536", "100000"],
               "--state": ["a-file", "a-file/sub", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
               "--workers": POS_COUNT},
+    **{study: {"--design": ["", "0120", "abc"], "--units": POS_COUNT + HUGE, "--pressure": POSITIVE + ["1e9"],
+               "--unit": ["binary.bin", "folder", ""], "--workers": POS_COUNT, "--cache": ["folder", "a-file/x.sqlite", ""],
+               "--out": ["a-file", "a-file/sub", ""], **extra}
+       for study, extra in (
+           ("simplifications", {"--passage": POSITIVE + ["5"], "--base-length": POSITIVE, "--change": REAL + ["101"]}),
+           ("tolerances", {"--tolerance": POSITIVE + ["2"], "--samples": COUNT + HUGE, "--seed": COUNT}),
+           ("bulk-modulus", {"--factor": POSITIVE}),
+           ("calibration", {"--reach": ["0.5", "11", *REAL]}),
+           ("temperature", {"--change": REAL + ["-101"]}),
+       )},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": POSITIVE + ["1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }

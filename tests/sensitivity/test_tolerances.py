@@ -58,3 +58,20 @@ def test_the_corners_bracket_the_curl_of_random_samples() -> None:
     # thinner walls bend more, as Table E.1 found
     thin, thick = curl(np.array([-PRINTED, -PRINTED, 0.0])), curl(np.array([PRINTED, PRINTED, 0.0]))
     assert thin > thick
+
+
+def test_every_unit_of_a_tolerance_box_is_meshed_alike() -> None:
+    from dataclasses import replace
+
+    from pneumorph.sensitivity.tolerances import _grid_shape, matched_element_size
+
+    unit = UnitSpec()
+    for tolerance in (Tolerance(PRINTED), Tolerance(MACHINED)):
+        size = matched_element_size(unit, tolerance)
+        assert unit.element_size <= size < 1.2 * unit.element_size
+        shapes = {_grid_shape(perturbed(replace(unit, element_size=size), FIELDS, o))
+                  for o in np.vstack([tolerance.corners(), tolerance.samples(5, seed=0)])}
+        # one topology, and the nominal unit's own (the reference is the design model's mesh)
+        assert shapes == {_grid_shape(unit)}
+    # at the unit's own size a thicker layer gains a row of elements across the whole actuator
+    assert _grid_shape(perturbed(unit, FIELDS, np.array([0.0, 0.0, 0.1]))) != _grid_shape(unit)

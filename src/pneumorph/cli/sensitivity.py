@@ -136,8 +136,13 @@ def _print(result: Any) -> None:
               help="Temperature change, degC.")
 def simplifications_cmd(passage: float, base_length: float, change: float, **common: Any) -> None:
     """Appendix D: passages between cavities, the base block, a temperature change, all three."""
-    from pneumorph.geometry.features import BaseBlock
+    from pneumorph.geometry.features import BaseBlock, check_passage
+    from pneumorph.geometry.unit import UnitSpec
 
+    with P.blame("--unit"):
+        unit = UnitSpec.from_toml(common["unit_file"]) if common["unit_file"] else UnitSpec()
+    with P.blame("--passage"):
+        check_passage(unit, passage)
     _run("simplifications", common, passage=passage, base=BaseBlock(length=base_length), temperature_change=change)
 
 

@@ -74,6 +74,49 @@ class Tolerance:
         return np.array(list(product((-self.tolerance, self.tolerance), repeat=len(self.fields))), dtype=float)
 
 
+def _grid_shape(unit: UnitSpec) -> tuple[int, int]:
+    """Points and cells of a 2-unit half 3D mesh with both orientations: the grid's topology."""
+    from pneumorph.geometry.assembly import assemble
+
+    mesh = assemble(unit, "01", dim=3, half=True)
+    return len(mesh.points), len(mesh.cells)
+
+
+def matched_element_size(unit: UnitSpec, tolerance: Tolerance, steps: int = 40) -> float:
+    """The smallest element size (>= the unit's) that meshes every unit of the tolerance box alike.
+
+    The mesh has a grid line at every interface and at most ``element_size`` between lines,
+    so a thickness that grows past a multiple of the element size gains a layer of
+    elements across the whole actuator: a change of mesh as large as the tolerance's own
+    effect (the built-in unit's walls are exactly one 1.5 mm element; at 1.6 mm they would
+    be two). Meshing every case with the same cell counts isolates the geometry, as the
+    dissertation's mesh update did (appendix C.4). The counts are monotone in each
+    segment's length, which is affine in the offsets, so checking the corners of the box
+    checks every unit in it.
+
+    Raises
+    ------
+    GeometryError
+        No element size up to ``1 + steps / 100`` times the unit's keeps the topology.
+
+    Examples
+    --------
+    >>> matched_element_size(UnitSpec(), Tolerance(0.1))   # wall 1.4 + layer 3.1: a 1.7 mm segment
+    1.71
+    """
+    from pneumorph.errors import GeometryError
+
+    corners = [perturbed(unit, tolerance.fields, c) for c in tolerance.corners()]
+    for k in range(steps + 1):
+        size = round(unit.element_size * (1 + k / 100), 6)
+        shapes = {_grid_shape(replace(u, element_size=size)) for u in [replace(unit, element_size=size), *corners]}
+        if len(shapes) == 1:
+            return size
+    raise GeometryError(f"no element size from {unit.element_size:g} to {unit.element_size * (1 + steps / 100):g} mm "
+                        f"meshes every unit within +-{tolerance.tolerance:g} mm alike; give the unit a smaller "
+                        "tolerance or an element size that is not a divisor of its thicknesses")
+
+
 def perturbed(unit: UnitSpec, fields: tuple[str, ...], offsets: FloatArray) -> UnitSpec:
     """``unit`` with ``offsets`` (mm) added to its ``fields``.
 
@@ -91,4 +134,4 @@ def perturbed(unit: UnitSpec, fields: tuple[str, ...], offsets: FloatArray) -> U
     return replace(unit, **values)
 
 
-__all__ = ["FIELDS", "MACHINED", "PRINTED", "Tolerance", "perturbed"]
+__all__ = ["FIELDS", "MACHINED", "PRINTED", "Tolerance", "matched_element_size", "perturbed"]
