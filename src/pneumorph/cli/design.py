@@ -46,6 +46,14 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
               help="Certified search: factor on the chain's validated errors in the bound (default 1).")
 @click.option("--chain-table", metavar="FILE", type=P.InputFile(),
               help="Certified search: a chain table file (default: the shipped one, or built on first use).")
+@click.option("--tolerance", type=P.Real(0.0, 1.0, unit="mm"),
+              help="Mould tolerance of the winner's robustness report, +- mm on the side walls, the Mold Star wall and "
+                   "the Smooth-Sil layer (default 0.1: FDM-printed moulds; 0: no report).")
+@click.option("--robust", type=click.Choice(["worst", "mean"]),
+              help="Certified search: rank every design by its worst or mean error under the tolerance (chain model "
+                   "with tolerance tables) and verify the most robust by FE.")
+@click.option("--robust-samples", type=P.Count(1, 10_000),
+              help="Seeded samples of the tolerance class (default 30 by the chain model, 8 FE solves otherwise).")
 @click.option("--executor", type=click.Choice(["serial", "processes", "dask"]),
               help="Where designs are solved (default processes: all cores).")
 @click.option("--workers", type=P.WORKERS, help="Processes or Dask workers (default: all cores).")
@@ -61,7 +69,8 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
            periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
            generations: int | None, seed: int | None, search: str | None, certify: bool | None,
-           verify: int | None, margin: float | None, chain_table: str | None, executor: str | None,
+           verify: int | None, margin: float | None, chain_table: str | None, tolerance: float | None,
+           robust: str | None, robust_samples: int | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
            unit_file: str | None, cache: str | None, out: str | None, overwrite: bool, as_json: bool) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
@@ -98,6 +107,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
                        ("point", point), ("units", units), ("search", search), ("seed", seed),
                        ("certify", certify), ("verify", verify), ("margin", margin), ("chain_table", chain_table),
+                       ("tolerance", tolerance), ("robust", robust), ("robust_samples", robust_samples),
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
         if value is not None:
             changes[key] = value
@@ -182,6 +192,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                               "failure": c.failure} for c in result.hall_of_fame],
             "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
             "cache_entries_rejected": result.rejected,
+            "robustness": None if result.robustness is None else
+            {k: v for k, v in result.robustness.items() if k not in ("offsets_mm", "winner_values")},
             **_certified_json(result),
         }))
     elif best is not None:
@@ -195,6 +207,12 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                        + ("no other design can beat it" if c["certified"] else
                           f"{c['could_beat']} could beat it by up to {c['gap']:.3g} (--certify verifies them)")
                        + ("" if two_d is None else f"; the 2D model's value: {two_d:.4g}"))
+        rob = result.robustness
+        if rob is not None and "mean" in rob["winner"]:
+            w = rob["winner"]
+            click.echo(f"  under +-{rob['tolerance_mm']:g} mm mould tolerances ({rob['samples']} samples, "
+                       f"{rob['method'].split(',')[0]}): {w['design']} mean {w['mean']:.4g}, 95th percentile "
+                       f"{w['p95']:.4g}, worst {w['worst']:.4g}")
         click.echo(f"report: {result.folder / 'report.md'}")
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)

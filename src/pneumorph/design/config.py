@@ -11,6 +11,9 @@ A config file::
     seed = 0
     certify = false          # certified search: verify until no design can beat the winner
     verify = 2               # designs verified by FE per batch (default: one per worker)
+    tolerance = 0.1          # mould tolerance of the winner's robustness report, +- mm (0: none)
+    robust = "worst"         # certified search: rank designs by their worst (or mean) error under it
+    robust_samples = 30      # seeded samples of the tolerance class (default 30 by the chain, 8 by FE)
 
     [ga]
     population = 100
@@ -47,6 +50,8 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import read_toml
 
 SEARCHES = ("certified", "ga", "exhaustive")
+#: what ``robust`` ranks designs by (pneumorph.sensitivity.robust.STATISTICS)
+ROBUST = ("worst", "mean")
 
 # the settings' checks, raising the search's own error
 _integer = partial(checks.integer, error=SearchConfigError)
@@ -85,6 +90,9 @@ class DesignConfig:
     verify: int | None = None
     margin: float = 1.0
     chain_table: str | None = None
+    tolerance: float = 0.1
+    robust: str | None = None
+    robust_samples: int | None = None
     ga: GAConfig = field(default_factory=GAConfig)
     executor: str = "serial"
     workers: int | None = None
@@ -108,6 +116,14 @@ class DesignConfig:
                                                     unit="mm"))
         object.__setattr__(self, "periods", _real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
         object.__setattr__(self, "margin", _real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
+        object.__setattr__(self, "tolerance", _real(self.tolerance, "[design] tolerance", 0.0, 1.0, unit="mm"))
+        if self.robust_samples is not None:
+            _integer(self.robust_samples, "[design] robust_samples", 1, 10_000)
+        if self.robust is not None:
+            _text(self.robust, "[design] robust", ROBUST)
+            if self.search != "certified" or self.tolerance == 0:
+                raise SearchConfigError("[design] robust ranks every design by the chain model under the mould "
+                                        "tolerance: it needs search = \"certified\" and a tolerance > 0")
         if self.search != "certified":
             given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
                                     ("chain_table", self.chain_table), ("margin", self.margin != 1.0)) if v]
@@ -145,6 +161,10 @@ class DesignConfig:
         except (TargetExpressionError, UnknownObjectiveError) as exc:
             raise SearchConfigError(f"[design] objective: {exc}") from None
 
+    def samples(self, chain: bool) -> int:
+        """Samples of the tolerance class: ``robust_samples``, else 30 by the chain model, 8 by FE solves."""
+        return self.robust_samples or (30 if chain else 8)
+
     def make_objective(self, length: float | None = None) -> Objective:
         """The objective these settings describe (a profile checked along ``length`` mm, if given)."""
         return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
@@ -156,7 +176,7 @@ class DesignConfig:
         design = {
             k: getattr(self, k)
             for k in ("objective", "amplitude", "periods", "point", "curve", "anchored", "units", "search", "seed",
-                      "certify", "verify", "margin", "chain_table")
+                      "certify", "verify", "margin", "chain_table", "tolerance", "robust", "robust_samples")
         }
         ga = {k: v for k, v in asdict(self.ga).items() if k != "seed"}
         execution = {k: getattr(self, k) for k in ("executor", "workers", "scheduler", "cache")}

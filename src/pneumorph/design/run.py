@@ -67,6 +67,7 @@ from pneumorph.design.exhaustive import run_exhaustive
 from pneumorph.design.figures import plot_convergence, plot_profile
 from pneumorph.design.fitness import Score
 from pneumorph.design.ga import GenerationStats, run_ga
+from pneumorph.design.robustness import chain_robustness, fe_robustness, robust_ranking, robust_winner
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import (
@@ -93,6 +94,8 @@ from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.chaintables import find_table, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
+from pneumorph.sensitivity.robust import tolerance_tables_for
+from pneumorph.sensitivity.tolerances import Tolerance
 
 DEPENDENCIES = ("numpy", "scipy", "felupe", "tensortrax", "deap", "matplotlib", "distributed")
 _COMPARED = ("design", "ga", "model")
@@ -107,6 +110,7 @@ RUN_FILES = (
     "hall_of_fame.json",
     "certificate.json",
     "top.csv",
+    "robustness.json",
     "profile.png",
     "chain-vs-fe.png",
     "convergence.png",
@@ -173,10 +177,15 @@ class RunResult:
     certified: CertifiedResult | None = None
     opinion_2d: dict[str, float] = field(default_factory=dict)
     rejected: int = 0
+    robustness: dict[str, Any] | None = None
+    robust_winner: Candidate | None = None
 
     @property
     def best(self) -> Candidate | None:
-        """The winner: the FE-verified one of a certified search, else the first of the hall of fame."""
+        """The winner: the most robust design of a ``robust`` run (FE-verified), the FE-verified one of a
+        certified search, else the first of the hall of fame."""
+        if self.robust_winner is not None:
+            return self.robust_winner
         if self.certified is not None:
             return self.certified.winner
         return self.hall_of_fame[0] if self.hall_of_fame else None
@@ -458,12 +467,16 @@ def run_design(
         table_dir = None if cache.path == ":memory:" else Path(cache.path).parent / "chain-tables"
         cached = CachedEvaluator(inner, cache)
         chain = None
+        tol_tables = None
         if config.search == "certified":
             # the table (built on first use, through the cache) before the folder is claimed: a model the
             # chain cannot represent leaves nothing behind
             table = table_for(model, _training(model), folder=table_dir, path=config.chain_table,
                               evaluator=cached, on_progress=say)
             chain = ChainModel(table, config.units)
+            if config.tolerance > 0 and hasattr(model, "variant"):  # the unit's tolerance tables, likewise
+                tol_tables = tolerance_tables_for(model, Tolerance(config.tolerance), folder=table_dir,
+                                                  evaluator=cached, on_progress=say)
         made = _created_top(folder)
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -489,6 +502,7 @@ def run_design(
                 on_generation(stats)
 
         status, hof, history, ranking, cert = "finished", (), (), None, None
+        robustness, robust_best = None, None
         try:
             if config.search == "ga":
                 ga = run_ga(model, objective, config.ga, cached, on_gen)
@@ -507,16 +521,18 @@ def run_design(
                 ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame,
                                     on_progress=on_progress)
                 hof, ranking = ex.hall_of_fame, [(d, ex.scores[d]) for d in ex.ranking]
+            robustness, robust_best = _robustness(config, model, objective, cached, cert, chain, tol_tables, hof, say)
         except KeyboardInterrupt:  # Ctrl-C, and its subclasses (the CLI's SIGTERM)
             status = "interrupted"
             history = tuple(log.rows) if log else ()
-            hof, ranking, cert = (), None, None
+            hof, ranking, cert, robustness, robust_best = (), None, None, None, None
         finally:
             if log:
                 log.close()
             release()
         result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
-                           time.perf_counter() - start, certified=cert, rejected=int(getattr(cache, "rejected", 0)))
+                           time.perf_counter() - start, certified=cert, rejected=int(getattr(cache, "rejected", 0)),
+                           robustness=robustness, robust_winner=robust_best)
         files: list[Path] = []
         try:
             if cert is not None:
@@ -535,6 +551,34 @@ def run_design(
             lock.release()
         if not started and made is not None:
             _remove_empty(folder, made)
+
+
+def _robustness(config: DesignConfig, model: ActuatorModel, objective: Objective, evaluator: Any,
+                cert: CertifiedResult | None, chain: ChainModel | None, tables: Any, hof: Any,
+                say: Callable[[str], None]) -> tuple[dict[str, Any] | None, Candidate | None]:
+    """The winner's spread under the mould tolerance and, with ``robust``, the most robust design."""
+    if config.tolerance == 0:
+        return None, None
+    if cert is not None and tables is not None:
+        assert chain is not None
+        out = chain_robustness(config, chain, tables, objective, cert.winner)
+        best = None
+        if config.robust is not None:
+            rows, _ = robust_ranking(config, chain, tables, objective, cert.scores.bits)
+            best = robust_winner(config, model, objective, evaluator, rows)
+            say(f"most robust by the {config.robust} error under +-{config.tolerance:g} mm: {best.design} "
+                f"(chain {rows[0][config.robust]:.4g}; FE nominal {best.value:.4g})")
+            winner = chain_robustness(config, chain, tables, objective, best)["winner"]
+            out.update(statistic=config.robust, ranking=rows, robust_winner=winner)
+        w = out["winner"]
+        say(f"robustness of {w['design']} under +-{config.tolerance:g} mm ({config.samples(True)} samples, chain): "
+            f"mean {w['mean']:.4g}, 95th percentile {w['p95']:.4g}, worst {w['worst']:.4g}")
+        return out, best
+    best_candidate = cert.winner if cert is not None else (hof[0] if hof else None)
+    if best_candidate is None or best_candidate.failure is not None:
+        return None, None
+    say(f"robustness of {best_candidate.design}: {config.samples(False) + 1} FE solves under +-{config.tolerance:g} mm")
+    return fe_robustness(config, model, objective, best_candidate, evaluator), None
 
 
 def _training(model: ActuatorModel) -> Any:
@@ -606,6 +650,10 @@ def _write_outputs(
     cert = result.certified
     if cert is not None:
         files += _write_certificate(result, folder)
+    if result.robustness is not None:
+        doc = {"objective": result.objective.label, "sense": result.objective.sense, "unit": result.objective.unit,
+               **result.robustness}
+        files.append(write_json(folder / "robustness.json", doc))
     best = result.best
     if figures and best is not None and best.response is not None and best.level is not None:
         files.append(_atomic_figure(folder / "profile.png", lambda p: plot_profile(best, result.objective, p)))
@@ -731,6 +779,37 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
             lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
                          f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kPa'] or row['chain_pressure_kPa'])} |")
         lines.append("")
+    if result.robustness is not None:
+        lines += _robustness_lines(result.robustness, o)
     if files:
         lines += ["## Files", "", *[f"- [{f}]({f})" for f in files], ""]
     return "\n".join(lines)
+
+
+def _robustness_lines(rob: dict[str, Any], o: Objective) -> list[str]:
+    """The report's section on mould tolerances."""
+    u = o.unit
+    lines = ["## Robustness to mould tolerances", "",
+             f"Every thickness of Fig E.4 (side walls, Mold Star wall, Smooth-Sil layer) within +-{rob['tolerance_mm']:g} "
+             f"mm, {rob['samples']} seeded samples (seed {rob['seed']}); {rob['method']}.", ""]
+
+    def row(label: str, w: dict[str, Any]) -> str:
+        p = "-" if w.get("pressure_kPa") is None else f"{w['pressure_kPa']:.4g}"
+        if "mean" not in w:
+            return f"| {label} | `{w['design']}` | {p} | {w['nominal_fe']:.4g} | - | - | - |"
+        return (f"| {label} | `{w['design']}` | {p} | {w['nominal_fe']:.4g} | {w['mean']:.4g} | {w['p95']:.4g} | "
+                f"{w['worst']:.4g} |")
+
+    lines += [f"| | design | pressure (kPa) | nominal FE ({u}) | mean ({u}) | 95th percentile ({u}) | worst ({u}) |",
+              "|---|---|---:|---:|---:|---:|---:|", row("winner", rob["winner"])]
+    if "robust_winner" in rob:
+        lines.append(row(f"most robust ({rob['statistic']})", rob["robust_winner"]))
+    if rob.get("failed"):
+        lines.append(f"\n{rob['failed']} of the samples did not converge in the FE model.")
+    if "ranking" in rob:
+        lines += ["", f"Designs by their {rob['statistic']} error under the tolerance (chain model):", "",
+                  f"| rank | design | pressure (kPa) | mean ({u}) | 95th percentile ({u}) | worst ({u}) |",
+                  "|---:|---|---:|---:|---:|---:|"]
+        lines += [f"| {r['rank']} | `{r['design']}` | {r['pressure_kPa']:.4g} | {r['mean']:.4g} | {r['p95']:.4g} | "
+                  f"{r['worst']:.4g} |" for r in rob["ranking"]]
+    return [*lines, ""]

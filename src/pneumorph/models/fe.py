@@ -504,7 +504,8 @@ class Reduced2D(FEModel):
         self.filler.modulus(self.ramp.pressure)
 
     def options(self) -> dict[str, Any]:
-        return {**super().options(), "filler": self._given_filler}
+        # the law in use, given or the unit's: a variant of another unit (a mould tolerance) keeps it
+        return {**super().options(), "filler": self.filler}
 
     def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
         import felupe as fem

@@ -1,0 +1,316 @@
+"""Robustness of every design to mould tolerances, through the chain model.
+
+A chain table (:mod:`pneumorph.models.chain`) holds the chord turns and lengths of every
+window of units. Under a mould tolerance each of these moves smoothly with the three
+thicknesses of Fig E.4, and the change is local again (a unit's response depends on its
+neighbourhood), so it is tabulated the same way, with a narrower window: a
+:class:`ToleranceTables` holds window-1 tables of the unit at its nominal thicknesses and
+at ``-t`` and ``+t`` of each thickness alone (7 tables, 2 FE solves each for 15 units).
+:meth:`ToleranceTables.perturbed` then gives the chain table of *any* offsets within the
+class, second order in each thickness:
+
+    T(d) = T0 + sum_f [ (T+_f - T-_f) / (2 t) d_f + (T+_f + T-_f - 2 T0_f) / (2 t^2) d_f^2 ]
+
+with ``T0`` the full nominal table and the differences read at each window's inner three
+units. Scoring every design under ``S`` seeded samples of the class costs ``S`` chain
+scorings (:func:`design_robustness`). The tolerance study's FE solves of a design check it
+(``docs/sensitivity.md``).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph import checks
+from pneumorph.errors import ChainTableError
+from pneumorph.models.chain import ChainModel, ChainTable, covering_designs, fit_table, source_description, source_key
+from pneumorph.sensitivity.tolerances import Tolerance, matched_element_size, perturbed
+
+FloatArray = NDArray[np.float64]
+
+#: window of the tolerance tables (2 covering designs)
+TOLERANCE_WINDOW = 1
+#: the statistics ``--robust`` ranks by
+STATISTICS = ("worst", "mean")
+
+
+def inner_codes(codes: NDArray[np.int64], window: int, inner: int = TOLERANCE_WINDOW) -> NDArray[np.int64]:
+    """The codes of the inner ``inner``-windows of ``window``-window codes (same centre unit).
+
+    >>> from pneumorph.models.windows import window_codes
+    >>> bits = np.array([[0, 1, 1, 0, 1]])
+    >>> bool((inner_codes(window_codes(bits, 3), 3) == window_codes(bits, 1)).all())
+    True
+    """
+    codes = np.asarray(codes, dtype=np.int64)
+    shift = 4 ** (window - inner)
+    return (codes // shift) % 4 ** (2 * inner + 1)
+
+
+@dataclass(frozen=True)
+class ToleranceTables:
+    """Window-1 chain tables at the nominal thicknesses and at ``-t``/``+t`` of each (see the module).
+
+    Attributes
+    ----------
+    tolerance : Tolerance
+    nominal : ChainTable
+    minus, plus : tuple of ChainTable
+        One per field of the tolerance, in its order.
+    source : dict
+        ``key`` (the chain source key of the nominal model), ``element_size`` (the matched
+        mesh size of every table), ``fingerprints`` of the FE models solved.
+    """
+
+    tolerance: Tolerance
+    nominal: ChainTable
+    minus: tuple[ChainTable, ...]
+    plus: tuple[ChainTable, ...]
+    source: dict[str, Any]
+
+    def perturbed(self, table: ChainTable, offsets: FloatArray) -> ChainTable:
+        """``table`` (the nominal unit's, any window >= 1) moved to thickness ``offsets`` (mm, per field).
+
+        Examples
+        --------
+        >>> tables = shipped_tolerance_tables()
+        >>> from pneumorph.models.chaintables import shipped_path
+        >>> nominal = ChainTable.load(shipped_path("3d"))
+        >>> same = tables.perturbed(nominal, np.zeros(3))
+        >>> bool(np.array_equal(same.turn, nominal.turn))
+        True
+        """
+        offsets = np.asarray(offsets, dtype=float)
+        t = self.tolerance.tolerance
+        if offsets.shape != (len(self.tolerance.fields),) or not np.isfinite(offsets).all():
+            raise ChainTableError(f"offsets must be {len(self.tolerance.fields)} finite numbers (mm), got {offsets!r}")
+        if np.abs(offsets).max(initial=0.0) > t + 1e-12:
+            raise ChainTableError(f"offsets {offsets.tolist()} lie outside the tolerance tables' +-{t:g} mm")
+        if table.window < TOLERANCE_WINDOW:
+            raise ChainTableError(f"a chain table of window +-{table.window} is narrower than the tolerance tables'")
+        inner, inner_end = inner_codes(table.codes, table.window), inner_codes(table.end_codes, table.window)
+        rows = [x.lookup(inner) for x in (self.nominal, *self.minus, *self.plus)]
+        erows = [x.lookup(inner_end, end=True) for x in (self.nominal, *self.minus, *self.plus)]
+        m = len(self.tolerance.fields)
+        out: dict[str, Any] = {}
+        for name, rr in (("turn", rows), ("length", rows), ("end", erows)):
+            base = getattr(table, name).copy()
+            n0 = getattr(self.nominal, name)[rr[0]]
+            for i, d in enumerate(offsets):
+                lo, hi = getattr(self.minus[i], name)[rr[1 + i]], getattr(self.plus[i], name)[rr[1 + m + i]]
+                base += (hi - lo) / (2 * t) * d + (hi + lo - 2 * n0) / (2 * t * t) * d * d
+            out[name] = base
+        scalars: dict[str, Any] = {}
+        for name in ("centre_y", "tip_ref"):
+            v = np.asarray(getattr(table, name), dtype=float).copy()
+            n0 = np.asarray(getattr(self.nominal, name), dtype=float)
+            for i, d in enumerate(offsets):
+                lo, hi = np.asarray(getattr(self.minus[i], name)), np.asarray(getattr(self.plus[i], name))
+                v += (hi - lo) / (2 * t) * d + (hi + lo - 2 * n0) / (2 * t * t) * d * d
+            scalars[name] = tuple(float(x) for x in v)
+        source = {**table.source, "tolerance_offsets_mm": dict(zip(self.tolerance.fields, offsets.tolist()))}
+        return replace(table, **out, **scalars, source=source)
+
+    # -- persistence --------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": "pneumorph tolerance tables", "tolerance_mm": self.tolerance.tolerance,
+                "fields": list(self.tolerance.fields), "source": self.source, "nominal": self.nominal.to_dict(),
+                "minus": [x.to_dict() for x in self.minus], "plus": [x.to_dict() for x in self.plus]}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], where: str = "tolerance tables") -> ToleranceTables:
+        try:
+            if data.get("kind") != "pneumorph tolerance tables":
+                raise KeyError("kind")
+            tolerance = Tolerance(float(data["tolerance_mm"]), tuple(data["fields"]))
+            return cls(tolerance, ChainTable.from_dict(data["nominal"], where),
+                       tuple(ChainTable.from_dict(x, where) for x in data["minus"]),
+                       tuple(ChainTable.from_dict(x, where) for x in data["plus"]), dict(data["source"]))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ChainTableError(f"{where}: not a tolerance table file ({exc})") from None
+
+    def save(self, path: str | Path) -> Path:
+        from pneumorph.io.files import write_json
+
+        return write_json(Path(path), self.to_dict())
+
+    @classmethod
+    def load(cls, path: str | Path) -> ToleranceTables:
+        p = Path(path)
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise ChainTableError(f"{p}: cannot read the tolerance tables ({exc})") from None
+        return cls.from_dict(data, str(p))
+
+
+def _variants(model: Any, tolerance: Tolerance) -> list[tuple[str, Any]]:
+    """The 7 FE models of the tables: nominal, then -t and +t of each field, at the matched element size."""
+    size = matched_element_size(model.unit, tolerance)
+    unit = replace(model.unit, element_size=size)
+    out = [("nominal", model.variant(unit=unit))]
+    for sign in (-1.0, 1.0):
+        for i, f in enumerate(tolerance.fields):
+            o = np.zeros(len(tolerance.fields))
+            o[i] = sign * tolerance.tolerance
+            out.append((f"{f} {sign * tolerance.tolerance:+g}", model.variant(unit=perturbed(unit, tolerance.fields, o))))
+    return out
+
+
+def build_tolerance_tables(model: Any, tolerance: Tolerance | None = None, evaluator: Any = None, n_units: int = 15,
+                           on_progress: Callable[[str], None] | None = None) -> ToleranceTables:
+    """Solve the covering designs of the 7 variants of ``model``'s unit and fit their window-1 tables.
+
+    ``model`` is any FE model of the nominal unit (its number of units is replaced by
+    ``n_units``, the training actuator). The solves go through ``evaluator.iter_cases``
+    (cached: resumable).
+    """
+    from pneumorph.execution.evaluators import SerialEvaluator
+
+    tolerance = tolerance or Tolerance()
+    evaluator = evaluator or SerialEvaluator()
+    say = on_progress or (lambda text: None)
+    training = model.with_units(n_units)
+    variants = _variants(training, tolerance)
+    designs = covering_designs(n_units, TOLERANCE_WINDOW)
+    cases = [(m, d) for _, m in variants for d in designs]
+    responses: list[Any] = [None] * len(cases)
+    for done, (i, outcome) in enumerate(evaluator.iter_cases(cases), start=1):
+        if not outcome.ok:
+            raise ChainTableError(f"tolerance table design {outcome.design} ({variants[i // len(designs)][0]}) did "
+                                  f"not converge: {outcome.failure}")
+        responses[i] = outcome.response
+        say(f"tolerance tables: {done}/{len(cases)} solves")
+    tables = []
+    for j, (label, m) in enumerate(variants):
+        src = {"fidelity": getattr(m, "fidelity", "?"), "key": source_key(m), "fingerprint": m.fingerprint(),
+               "n_units": n_units, "description": source_description(m), "variant": label}
+        tables.append(fit_table(responses[j * len(designs):(j + 1) * len(designs)], TOLERANCE_WINDOW, src))
+    k = len(tolerance.fields)
+    source = {"key": source_key(model), "element_size": variants[0][1].unit.element_size,
+              "fingerprints": [m.fingerprint() for _, m in variants], "n_units": n_units}
+    return ToleranceTables(tolerance, tables[0], tuple(tables[1:1 + k]), tuple(tables[1 + k:]), source)
+
+
+def shipped_tolerance_path(fidelity: str = "3d", tolerance: float = 0.1) -> Path:
+    """The shipped tolerance tables of the built-in unit."""
+    from importlib import resources
+
+    return Path(str(resources.files("pneumorph.models") / "data" / f"chain-{fidelity}-tolerance-{tolerance:g}.json"))
+
+
+def shipped_tolerance_tables(fidelity: str = "3d", tolerance: float = 0.1) -> ToleranceTables:
+    """The shipped tolerance tables (``ChainTableError`` if there are none for this fidelity and class)."""
+    path = shipped_tolerance_path(fidelity, tolerance)
+    if not path.is_file():
+        raise ChainTableError(f"no shipped tolerance tables for the {fidelity} model and +-{tolerance:g} mm")
+    return ToleranceTables.load(path)
+
+
+def tolerance_tables_for(model: Any, tolerance: Tolerance, folder: str | Path | None = None, evaluator: Any = None,
+                         on_progress: Callable[[str], None] | None = None) -> ToleranceTables:
+    """The tolerance tables of ``model``'s unit: shipped, kept in ``folder``, or built now (cached) and kept."""
+    key = source_key(model)
+    candidates = [shipped_tolerance_path(str(getattr(model, "fidelity", "")), tolerance.tolerance)]
+    name = f"chain-{getattr(model, 'fidelity', 'model')}-{key}-tolerance-{tolerance.tolerance:g}.json"
+    if folder is not None:
+        candidates.append(Path(folder) / name)
+    for path in candidates:
+        if path.is_file():
+            tables = ToleranceTables.load(path)
+            if tables.source.get("key") == key and tables.tolerance == tolerance:
+                return tables
+    tables = build_tolerance_tables(model, tolerance, evaluator, on_progress=on_progress)
+    if folder is not None:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        tables.save(Path(folder) / name)
+    return tables
+
+
+@dataclass(frozen=True)
+class Robustness:
+    """Every design's objective under ``samples`` offsets of a tolerance class, at its chosen level.
+
+    Attributes
+    ----------
+    bits : ndarray, shape (m, n)
+    level : ndarray, shape (m,)
+        The level (pressure) each design is judged at.
+    values : ndarray, shape (samples, m)
+        The objective of each design under each sample.
+    offsets : ndarray, shape (samples, fields)
+    sense : {"min", "max"}
+    """
+
+    bits: NDArray[np.uint8]
+    level: NDArray[np.int64]
+    values: FloatArray
+    offsets: FloatArray
+    sense: str
+
+    def statistic(self, name: str) -> FloatArray:
+        """``"worst"``, ``"mean"`` or ``"p95"`` (the 95th percentile toward the worse side) per design."""
+        v = self.values if self.sense == "min" else -self.values
+        if name == "worst":
+            out = v.max(axis=0)
+        elif name == "mean":
+            out = v.mean(axis=0)
+        elif name == "p95":
+            out = np.percentile(v, 95, axis=0)
+        else:
+            raise ValueError(f"unknown statistic {name!r}")
+        return out if self.sense == "min" else -out
+
+    def summary(self, i: int = 0) -> dict[str, float]:
+        """Mean, worst and 95th percentile of design ``i``, and the spread of its values."""
+        return {"mean": float(self.statistic("mean")[i]), "worst": float(self.statistic("worst")[i]),
+                "p95": float(self.statistic("p95")[i]), "best": float(
+                    self.values[:, i].min() if self.sense == "min" else self.values[:, i].max()),
+                "samples": int(len(self.values))}
+
+
+def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any, bits: NDArray[np.integer],
+                      level: NDArray[np.integer] | None = None, samples: int = 30, seed: int = 0,
+                      choose: str | None = None) -> Robustness:
+    """The objective of designs ``bits`` under ``samples`` seeded offsets of the tolerance class.
+
+    Parameters
+    ----------
+    level : ndarray, optional
+        The level each design is judged at (its nominal best level, say); with ``choose``
+        instead, the level of each design that minimises that statistic (``"worst"`` or
+        ``"mean"``: the pressure at which it is most robust).
+    """
+    from pneumorph.design.certified import level_values
+
+    samples = checks.integer(samples, "samples", 1, 10_000)
+    bits = np.atleast_2d(np.asarray(bits, dtype=np.uint8))
+    offsets = tables.tolerance.samples(samples, seed)
+    n = bits.shape[1]
+    per = []  # (samples, m, k)
+    for o in offsets:
+        chain = ChainModel(tables.perturbed(table, o), n)
+        values, _, _ = level_values(chain, objective, bits)
+        per.append(np.where(np.isfinite(values), values, np.inf if objective.sense == "min" else -np.inf))
+    stack = np.stack(per)
+    if level is None:
+        name = choose or "worst"
+        probe = Robustness(bits, np.zeros(len(bits), dtype=np.int64), stack.reshape(samples, -1), offsets,
+                           objective.sense).statistic(name).reshape(len(bits), -1)
+        cost = probe if objective.sense == "min" else -probe
+        level = np.argmin(cost, axis=1)
+    level = np.asarray(level, dtype=np.int64)
+    values = stack[:, np.arange(len(bits)), level]
+    return Robustness(bits, level, values, offsets, objective.sense)
+
+
+__all__ = ["STATISTICS", "TOLERANCE_WINDOW", "Robustness", "ToleranceTables", "build_tolerance_tables",
+           "design_robustness", "inner_codes", "shipped_tolerance_path", "shipped_tolerance_tables",
+           "tolerance_tables_for"]
