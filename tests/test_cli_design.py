@@ -118,8 +118,11 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     captured = capsys.readouterr()
     first = json.loads(captured.out)
     assert "covering designs" in captured.err and "held-out" in captured.err  # progress of the build
-    tables = list((tmp_path / "cache" / "chain-tables").glob("chain-2d-*.json"))
-    assert len(tables) == 1
+    kept = sorted((tmp_path / "cache" / "chain-tables").glob("chain-2d-*.json"))
+    tables = [p for p in kept if "tolerance" not in p.name]
+    assert len(tables) == 1 and [p.name for p in kept if "tolerance" in p.name] == [
+        tables[0].name.replace(".json", "-tolerance-0.1.json")]  # the unit's tolerance tables, kept beside it
+    assert first["robustness"]["winner"]["worst"] >= first["robustness"]["winner"]["mean"]
     from pneumorph.models.chain import ChainTable
 
     table = ChainTable.load(tables[0])
@@ -161,9 +164,9 @@ def test_a_tampered_cache_entry_is_solved_again_and_reported(tmp_path: Path,
     assert main(args) == 0
     first = json.loads(capsys.readouterr().out)
     with sqlite3.connect(tmp_path / "c.sqlite") as db:  # someone edits a stored response
-        (design, text), *_ = db.execute("SELECT design, response FROM evaluations").fetchall()
-        db.execute("UPDATE evaluations SET response = ? WHERE design = ?",
-                   (text.replace('"curl"', '"curl" ', 1).replace("1", "2", 1), design))
+        (row, text), *_ = db.execute("SELECT rowid, response FROM evaluations").fetchall()
+        db.execute("UPDATE evaluations SET response = ? WHERE rowid = ?",  # one entry (of one model)
+                   (text.replace('"curl"', '"curl" ', 1).replace("1", "2", 1), row))
     assert main(args) == 0
     second = json.loads(capsys.readouterr().out)
     assert second["cache_entries_rejected"] == 1 and second["solves"] == 1

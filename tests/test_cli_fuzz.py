@@ -111,7 +111,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "design": {
         "--pressure": POSITIVE + ["1e9"], "--amplitude": POSITIVE, "--periods": POSITIVE, "--margin": POSITIVE,
         "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
-        "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--target": ["", "   ", "y = 1/0",
+        "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": NONNEG + ["2"],
+        "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')"], "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""], "--chain-table": ["binary.bin", "folder", "missing.json", ""],
