@@ -93,3 +93,18 @@ def test_bad_features_are_refused() -> None:
         assemble(UnitSpec(), "01", dim=2, passage=1.5)
     with pytest.raises(GeometryError, match="margin"):
         BaseBlock(margin=-1.0)
+
+
+def test_the_model_factory_takes_the_features_and_refuses_bad_ones() -> None:
+    from pneumorph.errors import SearchConfigError
+    from pneumorph.models.factory import make_model
+
+    m = make_model(3, {"fidelity": "3d", "passage": 1.5, "base_block": {"length": 8.0, "margin": 1.0}})
+    assert m.passage == 1.5 and m.base_block == BaseBlock(length=8.0, margin=1.0)
+    assert m.fingerprint() == Full3D(3, passage=1.5, base_block=BaseBlock(length=8.0, margin=1.0)).fingerprint()
+    assert make_model(3, {"base_block": {}}).base_block == BaseBlock()  # 2D takes the block
+    for bad, message in (({"passage": 1.5}, "3D model option"), ({"fidelity": "3d", "passage": 9.0}, "wider"),
+                         ({"base_block": {"length": -1}}, "length"), ({"base_block": {"foo": 1}}, "foo"),
+                         ({"base_block": 3}, "must be a table")):
+        with pytest.raises(SearchConfigError, match=message):
+            make_model(3, bad)

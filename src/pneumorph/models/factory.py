@@ -9,12 +9,13 @@ from typing import Any
 
 from pneumorph import checks
 from pneumorph.errors import GeometryError, SearchConfigError
+from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
-              "temperature_change")
+              "temperature_change", "passage", "base_block")
 
 
 def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel:
@@ -28,7 +29,11 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         ``fidelity`` ("2d" default, or "3d"), ``pressure_kpa`` (45), ``increments`` (10),
         ``substeps`` (the model class's default: 1), ``gravity`` (none; ``"hanging"``, ``"horizontal"`` or a vector in
         mm/s^2, :func:`pneumorph.models.gravity.gravity_vector`), and the unit: ``unit`` (a
-        table of UnitSpec parameters) or ``unit_file`` (a TOML file with a ``[unit]`` table).
+        table of UnitSpec parameters) or ``unit_file`` (a TOML file with a ``[unit]`` table);
+        the features of appendix D: ``temperature_change`` (degC, 3D), ``passage`` (the
+        diameter of the holes between cavities, mm, 3D) and ``base_block`` (a table of
+        :class:`~pneumorph.geometry.features.BaseBlock` parameters: ``length``, ``margin``,
+        ``material``).
 
     Examples
     --------
@@ -70,8 +75,26 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         raise SearchConfigError(f"[model] gravity: {exc}") from None
     change = checks.real(s.get("temperature_change", 0.0), "[model] temperature_change", -100.0, 100.0, unit="degC",
                          error=SearchConfigError)
-    if change != 0.0:
+    passage = checks.real(s.get("passage", 0.0), "[model] passage", 0.0, 100.0, unit="mm", error=SearchConfigError)
+    block = s.get("base_block")
+    if block is not None:
+        if not isinstance(block, Mapping):
+            raise SearchConfigError(f"[model.base_block] must be a table (length, margin, material), got {block!r}")
+        unknown = sorted(set(block) - {"length", "margin", "material"})
+        if unknown:
+            raise SearchConfigError(f"unknown base block setting(s) {', '.join(unknown)}; known: length, margin, "
+                                    "material")
+        try:
+            block = BaseBlock(**block)
+        except GeometryError as exc:
+            raise SearchConfigError(f"[model.base_block] {exc}") from None
+    extra: dict[str, Any] = {"base_block": block} if block is not None else {}
+    if change != 0.0 or passage != 0.0:
         if Model is not Full3D:
-            raise SearchConfigError("[model] temperature_change is a 3D model option (fidelity = \"3d\")")
-        return Full3D(units, unit, ramp, gravity=gravity, temperature_change=change)
-    return Model(units, unit, ramp, gravity=gravity)
+            what = "temperature_change" if change != 0.0 else "passage"
+            raise SearchConfigError(f"[model] {what} is a 3D model option (fidelity = \"3d\")")
+        try:
+            return Full3D(units, unit, ramp, gravity=gravity, temperature_change=change, passage=passage, **extra)
+        except GeometryError as exc:
+            raise SearchConfigError(f"[model] passage: {exc}") from None
+    return Model(units, unit, ramp, gravity=gravity, **extra)
