@@ -35,7 +35,7 @@ import sqlite3
 import threading
 import time
 import uuid
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, Self
@@ -431,24 +431,8 @@ class CachedEvaluator:
         designs = list(designs)
         fp = model.fingerprint()
         found = self.cache.get_many(fp, designs)
-        todo: dict[str, list[int]] = {}
-        for i, d in enumerate(designs):
-            if d in found:
-                self.hits += 1
-                yield i, found[d]
-            else:
-                todo.setdefault(d, []).append(i)
-        unique = list(todo)
-        start = time.perf_counter()
-        for j, outcome in self.inner.iter_evaluate(model, unique):
-            if not outcome.transient:  # a dead worker says nothing about the design
-                self.cache.put(fp, outcome)
-            self.solves += 1
-            first, *rest = todo[unique[j]]
-            yield first, outcome
-            for i in rest:
-                yield i, outcome.as_cached()
-        self.solve_time += time.perf_counter() - start
+        yield from self._answer([(fp, d) for d in designs], lambda key: found.get(key[1]),
+                                lambda keys: self.inner.iter_evaluate(model, [d for _, d in keys]))
 
     def evaluate_many(self, model: ActuatorModel, designs: Iterable[str]) -> list[Outcome]:
         designs = list(designs)
@@ -461,18 +445,28 @@ class CachedEvaluator:
         """``(model, design)`` pairs of different models: cached ones first, the others as they are solved."""
         cases = list(cases)
         keys = [(m.fingerprint(), d) for m, d in cases]
+        first: dict[tuple[str, str], tuple[ActuatorModel, str]] = {}
+        for key, case in zip(keys, cases):
+            first.setdefault(key, case)
+        yield from self._answer(keys, lambda key: self.cache.get(*key),
+                                lambda todo: self.inner.iter_cases([first[key] for key in todo]))
+
+    def _answer(self, keys: list[tuple[str, str]], lookup: Callable[[tuple[str, str]], Outcome | None],
+                solve: Callable[[list[tuple[str, str]]], Iterator[tuple[int, Outcome]]]) -> Iterator[tuple[int, Outcome]]:
+        """Yield ``(index, Outcome)`` of every ``(fingerprint, design)`` key: the cache's first, then each key
+        solved once (``solve(unique keys)``), stored the moment it arrives."""
         todo: dict[tuple[str, str], list[int]] = {}
-        for i, (fp, d) in enumerate(keys):
-            found = None if (fp, d) in todo else self.cache.get(fp, d)
+        for i, key in enumerate(keys):
+            found = None if key in todo else lookup(key)
             if found is not None:
                 self.hits += 1
                 yield i, found
             else:
-                todo.setdefault((fp, d), []).append(i)
+                todo.setdefault(key, []).append(i)
         unique = list(todo)
         start = time.perf_counter()
-        for j, outcome in self.inner.iter_cases([cases[todo[k][0]] for k in unique]):
-            if not outcome.transient:
+        for j, outcome in solve(unique):
+            if not outcome.transient:  # a dead worker says nothing about the design
                 self.cache.put(unique[j][0], outcome)
             self.solves += 1
             first, *rest = todo[unique[j]]
