@@ -469,7 +469,7 @@ def cached_3d_solver(cache: Any) -> Callable[[Full3D, str], Response]:
         outcome = hit if hit is not None else solve(model, design)
         if hit is None:
             cache.put(key, outcome)
-        if outcome.response is None:
+        if not outcome.ok:
             raise SimulationFailed(reached=0.0, cause=f"3D reference failed: {outcome.failure}", design=design)
         return outcome.response
 

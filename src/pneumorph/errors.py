@@ -118,11 +118,15 @@ class SimulationFailed(PneumorphError, RuntimeError):
         The orientation vector of the design, as a string of digits.
     pressure : float, optional
         The full pressure of the ramp, in MPa; the message then names the pressure reached.
+    partial : Response, optional
+        What was solved before the failure: the converged levels, NaN after them.
     """
 
     def __init__(
-        self, reached: float, cause: str, design: str | None = None, pressure: float | None = None
+        self, reached: float, cause: str, design: str | None = None, pressure: float | None = None,
+        partial: object = None,
     ) -> None:
+        self.partial = partial
         self.reached = reached
         self.cause = cause
         self.design = design

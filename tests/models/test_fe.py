@@ -184,3 +184,27 @@ def test_3d_fingerprint_holds_the_result_determining_ramp_settings_only() -> Non
     assert Full3D(2, ramp_spec=RampSpec(steps=StepSettings(increments=5))).fingerprint() != base.fingerprint()
     assert Full3D(2, ramp_spec=RampSpec(steps=StepSettings(tolerance=1e-6))).fingerprint() != base.fingerprint()
     assert Full3D(2, ramp_spec=RampSpec(pressure=0.03)).fingerprint() != base.fingerprint()
+
+
+def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyPatch) -> None:
+    import pneumorph.models.fe as fe
+    from pneumorph.execution.outcome import solve
+
+    ramp = RampSpec(pressure=0.01)  # 10 levels
+    full = Reduced2D(2, ramp_spec=ramp).evaluate("01")
+    real = fe.ramp
+
+    def failing(*args, on_level=None, **kwargs):  # the real ramp, stopped after its third level
+        def level(k, t):
+            on_level(k, t)
+            if k == 2:
+                raise SimulationFailed(reached=0.3, cause="stopped by the test")
+
+        return real(*args, on_level=level, **kwargs)
+
+    monkeypatch.setattr(fe, "ramp", failing)
+    outcome = solve(Reduced2D(2, ramp_spec=ramp), "01")
+    partial = outcome.response
+    assert not outcome.ok and outcome.failure == "stopped by the test" and outcome.reached == pytest.approx(0.003)
+    assert partial is not None and not partial.converged and partial.failure == "stopped by the test"
+    assert np.array_equal(partial.curl[:3], full.curl[:3]) and np.isnan(partial.curl[3:]).all()

@@ -107,6 +107,9 @@ def _print(result: Any) -> None:
     for c in result.cases:
         if c.difference is None:
             click.echo(f"{c.case.label:<28} failed: {c.outcome.failure}")
+            if c.matching_kpa is not None:
+                click.echo(f"{'':<28} closest to the reference shape at {c.matching_kpa:.1f} kPa before it failed "
+                           f"(max distance {c.matching_mm:.3f} mm)")
             continue
         d = c.difference
         click.echo(f"{c.case.label:<28} {d.distance_mm:13.3f} {d.x_error_pct:7.2f} {d.y_error_pct:7.2f} "

@@ -18,7 +18,8 @@ class Outcome:
     design : str
         The orientation vector, base first.
     response : Response or None
-        The response; None if the solve failed before any usable result.
+        The response; for a failed solve, the levels that converged before it failed (NaN
+        after them), or None if nothing usable was solved.
     failure : str or None
         Why the solve failed (None if it converged).
     reached : float or None
@@ -68,7 +69,8 @@ def solve(model: ActuatorModel, design: str) -> Outcome:
         response = model.evaluate(design)
     except SimulationFailed as exc:
         p_max = exc.pressure if exc.pressure is not None else float(model.pressures()[-1])
-        return Outcome(design, None, exc.cause or str(exc), exc.reached * p_max, wall_time=time.perf_counter() - start)
+        partial = exc.partial if isinstance(exc.partial, Response) else None  # the levels it did converge
+        return Outcome(design, partial, exc.cause or str(exc), exc.reached * p_max, wall_time=time.perf_counter() - start)
     except Exception as exc:
         raise EvaluationError(f"design {design}: the model raised {type(exc).__name__}: {exc}") from exc
     wall = time.perf_counter() - start

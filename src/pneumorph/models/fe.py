@@ -375,8 +375,10 @@ class FEModel:
                 predictor_order=self.predictor_order,
             )
         except SimulationFailed as exc:
+            partial = replace(response, converged=False, reached=exc.reached * self.ramp.pressure,
+                              failure=exc.cause)
             raise SimulationFailed(
-                reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure
+                reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure, partial=partial
             ) from None
         meta = dict(response.metadata)
         meta.update(

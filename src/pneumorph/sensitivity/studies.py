@@ -99,6 +99,8 @@ class CaseResult:
                                "wall_time_s": self.outcome.wall_time}
         if not self.outcome.ok:
             out["failure"] = self.outcome.failure
+            if self.outcome.reached is not None:
+                out["reached_kpa"] = self.outcome.reached * 1e3
         if r is not None and self.outcome.ok:
             out["curl_deg"] = float(r.curl[-1])
             out["tip_mm"] = r.tip[-1].tolist()
@@ -269,6 +271,8 @@ def _matching(reference: Any, response: Any, level: int) -> tuple[float, float]:
     """
     d = np.array([shape_difference(reference, response, level, j).distance_mm for j in range(response.n_levels)])
     k = int(np.nanargmin(d))
+    if k + 1 < len(d) and not np.isfinite(d[k + 1]):  # the last converged level: the match may lie beyond
+        return float(response.pressures[k] * 1e3), float(d[k])
     p = response.pressures * 1e3
     if 0 < k < len(d) - 1:
         a, b, c = d[k - 1], d[k], d[k + 1]
@@ -301,8 +305,9 @@ def run_study(study: Study, evaluator: Any, on_case: Callable[[int, int, CaseRes
         diff = matching = close = None
         if outcome.ok and ref_outcome.ok:
             diff = shape_difference(ref_outcome.response, outcome.response, study.level)  # type: ignore[arg-type]
-            if study.match:
-                matching, close = _matching(ref_outcome.response, outcome.response, study.level)
+        partial = outcome.response is not None and np.isfinite(outcome.response.curl).any()
+        if study.match and ref_outcome.ok and partial:  # a ramp that failed still shows where it came closest
+            matching, close = _matching(ref_outcome.response, outcome.response, study.level)
         results.append(CaseResult(case, outcome, diff, matching, close))
     return StudyResult(study, reference, tuple(results))
 
