@@ -58,7 +58,7 @@ def robust_ranking(config: Any, chain: Any, tables: Any, objective: Any, bits: n
     names = design_strings(rob.bits[order])
     pressures = chain.pressures()
     rows = [{"rank": r + 1, "design": d, "pressure_kPa": float(pressures[rob.level[i]] * 1e3),
-             **_stats(rob.values[:, i], objective.sense)} for r, (d, i) in enumerate(zip(names, order))]
+             **_stats(rob.values[:, i], objective.sense)} for r, (d, i) in enumerate(zip(names, order, strict=True))]
     return rows, rob
 
 

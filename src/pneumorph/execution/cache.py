@@ -446,7 +446,7 @@ class CachedEvaluator:
         cases = list(cases)
         keys = [(m.fingerprint(), d) for m, d in cases]
         first: dict[tuple[str, str], tuple[ActuatorModel, str]] = {}
-        for key, case in zip(keys, cases):
+        for key, case in zip(keys, cases, strict=True):
             first.setdefault(key, case)
         yield from self._answer(keys, lambda key: self.cache.get(*key),
                                 lambda todo: self.inner.iter_cases([first[key] for key in todo]))

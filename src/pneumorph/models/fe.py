@@ -273,7 +273,7 @@ class FEModel:
         forces = []
         if self.gravity is not None:  # dead loads rho g on the silicones, switched on by the gravity stage
             forces = [fem.SolidBodyForce(body.field, values=np.zeros(self.dim), scale=material.density.value)
-                      for body, material in zip(bodies, self.silicones.values())]
+                      for body, material in zip(bodies, self.silicones.values(), strict=True)]
         dof0, dof1 = clamped_dofs(field, mesh.base_points, mesh.symmetry_points)
         return {
             "mesh": mesh,

@@ -115,7 +115,7 @@ class ToleranceTables:
                 lo, hi = np.asarray(getattr(self.minus[i], name)), np.asarray(getattr(self.plus[i], name))
                 v += (hi - lo) / (2 * t) * d + (hi + lo - 2 * n0) / (2 * t * t) * d * d
             scalars[name] = tuple(float(x) for x in v)
-        source = {**table.source, "tolerance_offsets_mm": dict(zip(self.tolerance.fields, offsets.tolist()))}
+        source = {**table.source, "tolerance_offsets_mm": dict(zip(self.tolerance.fields, offsets.tolist(), strict=True))}
         return replace(table, **out, **scalars, source=source)
 
     # -- persistence --------------------------------------------------------------------------

@@ -203,7 +203,7 @@ def tolerances(model: FEModel, design: str | None = None, tolerance: Tolerance |
     cases = []
     extremes = tolerance.extremes()
     labels = [f"{f} {s}{tolerance.tolerance:g}" for f in tolerance.fields for s in ("-", "+")]
-    offsets = [*zip(labels, extremes)]
+    offsets = [*zip(labels, extremes, strict=True)]
     if samples:
         offsets += [(f"sample {k + 1}", o) for k, o in enumerate(tolerance.samples(samples, seed))]
     for label, o in offsets:
@@ -300,7 +300,7 @@ def run_study(study: Study, evaluator: Any, on_case: Callable[[int, int, CaseRes
     assert ref_outcome is not None
     reference = CaseResult(study.reference, ref_outcome)
     results = []
-    for case, outcome in zip(cases[1:], outcomes[1:]):
+    for case, outcome in zip(cases[1:], outcomes[1:], strict=True):
         assert outcome is not None
         diff = matching = close = None
         if outcome.ok and ref_outcome.ok:
