@@ -89,11 +89,12 @@ def test_simplifications_study_on_a_small_actuator(tmp_path: Path) -> None:
 
 def test_tolerance_study_reports_the_spread_and_the_inputs_of_the_extreme_curls(tmp_path: Path) -> None:
     model = Full3D(2, ramp_spec=LOW)
+    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(tmp_path / "c.sqlite"))
     study = tolerances(model, "01", Tolerance(0.1), samples=3, seed=4)
     again = tolerances(model, "01", Tolerance(0.1), samples=3, seed=4)
     assert [c.inputs for c in study.cases] == [c.inputs for c in again.cases]  # seeded
     assert [c.inputs for c in study.cases] != [c.inputs for c in tolerances(model, "01", samples=3, seed=5).cases]
-    result = run_study(study, SerialEvaluator())
+    result = run_study(study, evaluator)
     s = result.summary()
     curls = [c.difference.curl_deg for c in result.cases]
     assert s["curl_min_deg"] == min(curls) and s["curl_max_deg"] == max(curls) and s["failed"] == 0
@@ -101,6 +102,10 @@ def test_tolerance_study_reports_the_spread_and_the_inputs_of_the_extreme_curls(
     assert s["minimum_curl_inputs"] == lo.inputs and set(lo.inputs) == {"side_wall", "wall", "layer"}
     assert all(abs(v - {"side_wall": 1.5, "wall": 1.5, "layer": 3.0}[k]) <= 0.1 + 1e-12
                for c in study.cases for k, v in c.inputs.items())
+    assert 0 <= s["samples_within_extremes"] <= 3 and "samples_within_corners" not in s
+    # the corners of the box bracket every sample's curl (monotone in each thickness)
+    boxed = run_study(tolerances(model, "01", Tolerance(0.1), samples=3, seed=4, corners=True), evaluator)
+    assert boxed.summary()["samples_within_corners"] == 3
 
 
 def test_bulk_modulus_and_calibration_variants() -> None:

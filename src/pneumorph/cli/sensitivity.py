@@ -157,11 +157,12 @@ def simplifications_cmd(passage: float, base_length: float, change: float, **com
 @click.option("--samples", type=P.Count(0, 10_000), default=30, show_default=True,
               help="Random combinations besides the one-at-a-time extremes.")
 @click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the random combinations.")
-def tolerances_cmd(tolerance: float, samples: int, seed: int, **common: Any) -> None:
+@click.option("--corners", is_flag=True, help="Also every combination of the thicknesses at their ends (8 cases).")
+def tolerances_cmd(tolerance: float, samples: int, seed: int, corners: bool, **common: Any) -> None:
     """Appendix E.2: mould tolerances (Table E.1, Figs E.5-E.6)."""
     from pneumorph.sensitivity import Tolerance
 
-    _run("tolerances", common, tolerance=Tolerance(tolerance), samples=samples, seed=seed)
+    _run("tolerances", common, tolerance=Tolerance(tolerance), samples=samples, seed=seed, corners=corners)
 
 
 @sensitivity.command("bulk-modulus")

@@ -138,6 +138,14 @@ class StudyResult:
                 distance_mean_mm=float(d.mean()), distance_p95_mm=float(np.percentile(d, 95)),
                 minimum_curl_inputs=ok[lo].case.inputs, maximum_curl_inputs=ok[hi].case.inputs,
             )
+            kind = np.array([c.case.label.split()[0] for c in ok])
+            kind = np.where(np.isin(kind, ["sample", "corner"]), kind, "extreme")
+            sampled = curl[kind == "sample"]
+            for name in ("extreme", "corner"):  # do the one-at-a-time extremes, the corners, bracket the samples?
+                members = curl[kind == name]
+                if members.size and sampled.size:
+                    inside = (sampled >= members.min()) & (sampled <= members.max())
+                    out[f"samples_within_{name}s"] = int(inside.sum())
         return out
 
     def to_dict(self) -> dict[str, Any]:
@@ -180,8 +188,9 @@ def simplifications(model: FEModel, design: str | None = None, passage: float = 
 
 
 def tolerances(model: FEModel, design: str | None = None, tolerance: Tolerance | None = None, samples: int = 30,
-               seed: int = 0) -> Study:
-    """Appendix E.2: the one-at-a-time extremes and ``samples`` seeded random combinations.
+               seed: int = 0, corners: bool = False) -> Study:
+    """Appendix E.2: the one-at-a-time extremes, optionally the ``corners`` of the box, and ``samples``
+    seeded random combinations.
 
     All cases, the nominal one included, are meshed with the same cell counts
     (:func:`~pneumorph.sensitivity.tolerances.matched_element_size`): for the built-in
@@ -204,6 +213,8 @@ def tolerances(model: FEModel, design: str | None = None, tolerance: Tolerance |
     extremes = tolerance.extremes()
     labels = [f"{f} {s}{tolerance.tolerance:g}" for f in tolerance.fields for s in ("-", "+")]
     offsets = [*zip(labels, extremes, strict=True)]
+    if corners:  # every thickness at an end: these bracket any combination's curl when it is monotone in each
+        offsets += [("corner " + " ".join(f"{'-' if v < 0 else '+'}" for v in o), o) for o in tolerance.corners()]
     if samples:
         offsets += [(f"sample {k + 1}", o) for k, o in enumerate(tolerance.samples(samples, seed))]
     for label, o in offsets:
