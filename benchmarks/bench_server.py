@@ -68,7 +68,8 @@ async def client(url: str, n: int, think: float, seed: int, out: list[float], er
                 errors.append(f"{r.status_code} {r.text[:100]}")
 
 
-async def load(url: str, clients: int, queries: int, think: float, timeout: float) -> tuple[list[float], list[str], float]:
+async def load(url: str, clients: int, queries: int, think: float,
+               timeout: float) -> tuple[list[float], list[str], float]:
     out: list[float] = []
     errors: list[str] = []
     start = time.monotonic()

@@ -96,7 +96,7 @@ def main() -> None:
     u_ours, u_theirs = ours.tip[k] - x0, tip - x0
     n_ours, n_theirs = np.linalg.norm(u_ours, axis=1), np.linalg.norm(u_theirs, axis=1)
     print(f"{'kPa':>6} {'|u| pneumorph':>14} {'|u| CalculiX':>13} {'rel. diff':>10} {'|du|/|u|':>9}  (mm, %)")
-    for p, a, b, ua, ub in zip(ours.pressures[k] * 1e3, n_ours, n_theirs, u_ours, u_theirs):
+    for p, a, b, ua, ub in zip(ours.pressures[k] * 1e3, n_ours, n_theirs, u_ours, u_theirs, strict=False):
         print(f"{p:6.1f} {a:14.4f} {b:13.4f} {100 * (b - a) / a:+10.2f} {100 * np.linalg.norm(ub - ua) / a:9.2f}")
     last = ours.pressures[k[-1]] * 1e3
     distance = np.linalg.norm(u_theirs[-1] - u_ours[-1])

@@ -23,8 +23,8 @@ import time
 import numpy as np
 
 from pneumorph.design import make_objective
-from pneumorph.errors import SearchConfigError
 from pneumorph.design.certified import certified_search, chain_errors, chain_scores, grow_designs
+from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel, ChainTable
 from pneumorph.models.chaintables import shipped_path
 
@@ -47,7 +47,7 @@ def score() -> None:
         for spec, a in TARGETS[:1] + TARGETS[3:5]:
             objective = make_objective(spec, amplitude=a)
             errors = chain_errors(chain)
-            t = best_of(lambda: grow_designs(chain, objective, errors), 5 if n == 15 else 2)
+            t = best_of(lambda c=chain, o=objective, e=errors: grow_designs(c, o, e), 5 if n == 15 else 2)
             print(f"score all 2^{n} = {2**n:,} designs, {spec}: {t:.3f} s CPU")
 
 
@@ -61,7 +61,8 @@ def search() -> None:
             try:
                 s = chain_scores(chain, objective)
             except SearchConfigError as exc:
-                print(f"n = {n}, {spec} A = {a:g}: refused after {time.process_time() - t0:.1f} s CPU: {exc}", flush=True)
+                print(f"n = {n}, {spec} A = {a:g}: refused after {time.process_time() - t0:.1f} s CPU: "
+                      f"{exc}", flush=True)
                 continue
             t = time.process_time() - t0
             print(f"n = {n}, {spec} A = {a:g}: {t:.2f} s CPU, {len(s.cost):,} designs kept"

@@ -109,16 +109,16 @@ HUGE = ["100000", "1000000000"]
 
 OPTIONS: dict[str, dict[str, list[str]]] = {
     "design": {
-        "--pressure": POSITIVE + ["1e9"], "--amplitude": POSITIVE, "--periods": POSITIVE, "--margin": POSITIVE,
+        "--pressure": [*POSITIVE, "1e9"], "--amplitude": POSITIVE, "--periods": POSITIVE, "--margin": POSITIVE,
         "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
-        "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": NONNEG + ["2"],
+        "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')"], "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""], "--chain-table": ["binary.bin", "folder", "missing.json", ""],
     },
     "simulate": {
-        "--pressure": POSITIVE + ["1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
+        "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
     },
     "study": {
@@ -132,13 +132,13 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--cache": ["folder", ""], "--out": ["a-file", "a-file/sub", ""],
     },
     "chain": {
-        "--pressure": POSITIVE, "--units": POS_COUNT + HUGE, "--window": POS_COUNT + ["50"],
+        "--pressure": POSITIVE, "--units": POS_COUNT + HUGE, "--window": [*POS_COUNT, "50"],
         "--tolerance": POSITIVE, "--heldout": COUNT + HUGE, "--workers": POS_COUNT, "--unit": ["binary.bin", ""],
         "--cache": ["folder", ""], "--out": ["folder", "a-file/t.json", ""],
     },
     "bimodal": {
-        "--pmax": POSITIVE + ["1e9"], "--step": POSITIVE + ["100"], "--voids": POS_COUNT + HUGE,
-        "--element-size": POSITIVE + ["1e-4"], "--end-cap": NONNEG, "--bilinear-nu": ["0.5", "-1.5", *REAL],
+        "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE,
+        "--element-size": [*POSITIVE, "1e-4"], "--end-cap": NONNEG, "--bilinear-nu": ["0.5", "-1.5", *REAL],
         "--max-cutbacks": COUNT + HUGE, "--max-iterations": POS_COUNT + HUGE, "--out": ["a-file", "a-file/sub", ""],
     },
     "coupon": {
@@ -158,22 +158,23 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "show": {"--library": ["binary.bin", "folder", "missing.toml", ""]},
     "list": {"--library": ["binary.bin", "folder", ""]},
     "export": {"--stl": ["a-file", "a-file/sub", ""], "--inp": ["folder", "a-file/x.inp", "x.txt", ""],
-               "--pressure": POSITIVE + ["1e9"], "--clearance": ["-1", "10", *REAL], "--draft": ["-1", "45", *REAL],
+               "--pressure": [*POSITIVE, "1e9"], "--clearance": ["-1", "10", *REAL], "--draft": ["-1", "45", *REAL],
                "--unit": ["binary.bin", "folder", ""]},
-    "serve": {"--host": ["", "   ", "nosuchhost.invalid"], "--port": POS_COUNT + ["65536", "100000"],
+    "serve": {"--host": ["", "   ", "nosuchhost.invalid"], "--port": [*POS_COUNT, "65536", "100000"],
               "--state": ["a-file", "a-file/sub", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
               "--workers": POS_COUNT},
-    **{study: {"--design": ["", "0120", "abc"], "--units": POS_COUNT + HUGE, "--pressure": POSITIVE + ["1e9"],
-               "--unit": ["binary.bin", "folder", ""], "--workers": POS_COUNT, "--cache": ["folder", "a-file/x.sqlite", ""],
+    **{study: {"--design": ["", "0120", "abc"], "--units": POS_COUNT + HUGE, "--pressure": [*POSITIVE, "1e9"],
+               "--unit": ["binary.bin", "folder", ""], "--workers": POS_COUNT,
+               "--cache": ["folder", "a-file/x.sqlite", ""],
                "--out": ["a-file", "a-file/sub", ""], **extra}
        for study, extra in (
-           ("simplifications", {"--passage": POSITIVE + ["5"], "--base-length": POSITIVE, "--change": REAL + ["101"]}),
-           ("tolerances", {"--tolerance": POSITIVE + ["2"], "--samples": COUNT + HUGE, "--seed": COUNT}),
+           ("simplifications", {"--passage": [*POSITIVE, "5"], "--base-length": POSITIVE, "--change": [*REAL, "101"]}),
+           ("tolerances", {"--tolerance": [*POSITIVE, "2"], "--samples": COUNT + HUGE, "--seed": COUNT}),
            ("bulk-modulus", {"--factor": POSITIVE}),
            ("calibration", {"--reach": ["0.5", "11", *REAL]}),
-           ("temperature", {"--change": REAL + ["-101"]}),
+           ("temperature", {"--change": [*REAL, "-101"]}),
        )},
-    "correlate": {"--design": ["", "0120", "abc"], "--pressure": POSITIVE + ["1e9"], "--unit": ["binary.bin", ""],
+    "correlate": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 

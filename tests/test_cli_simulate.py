@@ -19,7 +19,8 @@ def test_simulate_writes_every_output_and_json(tmp_path: Path, capsys: pytest.Ca
     data = json.loads(capsys.readouterr().out)
     assert [lvl["pressure_kpa"] for lvl in data["levels"]] == [5.0, 10.0]
     assert len(data["levels"][1]["unit_centres_mm"]) == 2
-    for name in ("response.npz", "response.json", "shape.png", "provenance.json", "vtk/actuator.pvd", "vtk/actuator_01.vtu"):
+    for name in ("response.npz", "response.json", "shape.png", "provenance.json", "vtk/actuator.pvd",
+                 "vtk/actuator_01.vtu"):
         assert (out / name).is_file(), name
     saved = Response.load(out / "response")
     np.testing.assert_allclose(saved.tip[-1], data["levels"][1]["tip_mm"])
@@ -50,7 +51,7 @@ def test_simulate_with_gravity_applies_the_weight_first(capsys: pytest.CaptureFi
     assert lying["metadata"]["gravity_mm_s2"] == [0.0, -9806.65]
     assert "gravity_mm_s2" not in plain["metadata"]
     # the weight pulls the tip down (-y) at every level
-    for a, b in zip(lying["levels"], plain["levels"]):
+    for a, b in zip(lying["levels"], plain["levels"], strict=False):
         assert a["tip_mm"][1] < b["tip_mm"][1]
 
 

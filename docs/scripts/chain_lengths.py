@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 
-
 from pneumorph.execution import CachedEvaluator, EvaluationCache, ProcessPoolEvaluator, default_cache_path
 from pneumorph.models.chain import ChainModel, ChainTable, heldout_designs, prediction_errors
 from pneumorph.models.chaintables import shipped_path

@@ -28,7 +28,8 @@ def main() -> None:
     rng = np.random.default_rng(0)
     t0 = time.perf_counter()
     shape = model_shape(make_model(15, {"fidelity": "3d"}).solve(DESIGN))
-    print(f"3D solve {time.perf_counter() - t0:.1f} s; surface {len(shape.surface)} nodes, extent {shape.extent:.1f} mm")
+    print(f"3D solve {time.perf_counter() - t0:.1f} s; surface {len(shape.surface)} nodes, "
+          f"extent {shape.extent:.1f} mm")
     true = Transform(Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix(), np.array([5.0, -3.0, 7.0]))
     points = shape.surface[rng.choice(len(shape.surface), 3000, replace=False)]
     scan = Scan(true(points) + rng.normal(scale=SIGMA, size=points.shape), None, "synthetic 3D scan")

@@ -94,8 +94,8 @@ def main() -> None:
               "version of this page: GA over the 2D model, mostly 24 x 8, the sin-10 run 100 x 15.", ""]
     for name in ORDER:
         if "certified_3d" in saved.get(name, {}):
-            lines += [f"![{name}, 3D](figures/examples/{name}-3d.png)", f"![{name}, 2D](figures/examples/{name}-2d.png)",
-                      ""]
+            lines += [f"![{name}, 3D](figures/examples/{name}-3d.png)",
+                      f"![{name}, 2D](figures/examples/{name}-2d.png)", ""]
     (ROOT / "docs" / "examples.md").write_text("\n".join(lines), encoding="utf-8")
 
 

@@ -51,8 +51,8 @@ def rows(data: dict) -> list[str]:
             out.append(f"| {c['label']} | failed | | | | |")
             continue
         match = f" (closest at {c['matching_kpa']:.1f} kPa, {c['matching_mm']:.2f} mm)" if "matching_kpa" in c else ""
-        out.append(f"| {c['label']}{match} | {d['distance_mm']:.2f} | {d['x_error_pct']:.2f} | {d['y_error_pct']:.2f} | "
-                   f"{d['tip_mm']:.2f} | {d['curl_deg']:.1f} |")
+        out.append(f"| {c['label']}{match} | {d['distance_mm']:.2f} | {d['x_error_pct']:.2f} | "
+                   f"{d['y_error_pct']:.2f} | {d['tip_mm']:.2f} | {d['curl_deg']:.1f} |")
     return out
 
 

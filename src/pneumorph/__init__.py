@@ -14,6 +14,8 @@ The public API is grouped by sub-package:
   bimodal actuator (chapter 3).
 - :mod:`pneumorph.export` - STL parts, casting moulds and CalculiX decks;
   :mod:`pneumorph.correlation` - scans against the model.
+- :mod:`pneumorph.sensitivity` - how much to trust a design: the modelling simplifications
+  and sensitivities of appendices D and E, and robustness to mould tolerances.
 - :mod:`pneumorph.io` - safe writing, VTK and provenance; :mod:`pneumorph.checks` - the
   checks of settings and the limits; :mod:`pneumorph.errors` - the exceptions.
 

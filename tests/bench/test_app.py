@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 pytest.importorskip("fastapi")
-from fastapi.testclient import TestClient  # noqa: E402
+from fastapi.testclient import TestClient
 
-from pneumorph.bench import Bench, create_app, parse_query  # noqa: E402
-from pneumorph.bench.shapes import chain_placement  # noqa: E402
-from pneumorph.design.certified import chain_scores  # noqa: E402
-from pneumorph.design.targets import make_objective  # noqa: E402
-from pneumorph.geometry.assembly import assemble  # noqa: E402
+from pneumorph.bench import Bench, create_app, parse_query
+from pneumorph.bench.shapes import chain_placement
+from pneumorph.design.certified import chain_scores
+from pneumorph.design.targets import make_objective
+from pneumorph.geometry.assembly import assemble
 
 SIN = {"target": {"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}}
 
@@ -259,7 +259,7 @@ def test_an_fe_shape_is_the_solved_surface_at_every_level() -> None:
     assert response is not None and response.converged and wall > 0
     assert len(shape["levels"]) == len(model.pressures())
     tri = np.reshape(shape["indices"], (-1, 3))
-    for level, tip in zip(shape["levels"], response.tip):
+    for level, tip in zip(shape["levels"], response.tip, strict=False):
         pos = np.reshape(level["positions"], (-1, 3))
         assert tri.max() < len(pos)
         lo, hi = np.array(level["bounds"])

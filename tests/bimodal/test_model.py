@@ -53,7 +53,7 @@ def test_bulk_modulus_override() -> None:
 
 def test_only_table_b1_crimp_ratios() -> None:
     assert bilinear_material(0.3) == "bilinear_0_3"
-    with pytest.raises(UnknownMaterialError, match="0.35"):
+    with pytest.raises(UnknownMaterialError, match=r"0\.35"):
         bilinear_material(0.35)
 
 

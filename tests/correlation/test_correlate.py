@@ -91,7 +91,7 @@ def test_scans_of_the_wrong_size_or_no_scan_at_all_are_refused(tmp_path: Path, s
         read_scan(empty)
     garbage = tmp_path / "garbage.stl"
     garbage.write_bytes(b"solid nonsense\nthis is not a facet\n" * 3)
-    with pytest.raises(ScanError, match="garbage.stl"):
+    with pytest.raises(ScanError, match=r"garbage\.stl"):
         read_scan(garbage)
     few = tmp_path / "few.csv"
     few.write_text("x,y\n1,2\n3,4\n", encoding="utf-8")

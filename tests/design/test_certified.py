@@ -124,7 +124,7 @@ def test_the_range_of_cos_and_sin_over_an_interval() -> None:
     hi = lo + np.concatenate([rng.uniform(0.0, 7.0, 390), np.zeros(10)])
     for span, f in ((_cos_range, np.cos), (_sin_range, np.sin)):
         bottom, top = span(lo, hi)
-        for a, b, least, most in zip(lo, hi, bottom, top):
+        for a, b, least, most in zip(lo, hi, bottom, top, strict=False):
             v = f(np.linspace(a, b, 4001))
             assert least <= v.min() + 1e-12 and most >= v.max() - 1e-12  # a valid range
             assert least == pytest.approx(v.min(), abs=1e-5) and most == pytest.approx(v.max(), abs=1e-5)  # tight
@@ -136,7 +136,7 @@ def test_an_fe_model_that_never_converges_is_given_up_early(setup) -> None:
     from pneumorph.errors import SearchConfigError
     from pneumorph.fem import StepSettings
 
-    model, chain, _ = setup
+    _model, chain, _ = setup
     starved = Reduced2D(N, UnitSpec(element_size=3.0),
                         RampSpec(pressure=0.025, steps=StepSettings(increments=10, substeps=1, max_iterations=1,
                                                                     max_cutbacks=1)))

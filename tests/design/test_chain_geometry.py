@@ -36,7 +36,7 @@ def test_kept_geometry_gives_the_grown_scores(chain: ChainModel, spec: str) -> N
     np.testing.assert_allclose(kept.bound, grown.bound, rtol=1e-12)
     # and the chain model's own prediction of a few designs
     picks = [0, 1, 2**chain.n_units // 3, 2**chain.n_units - 1]
-    centres, tip, curl = chain.predict(kept.bits[picks])
+    _centres, tip, curl = chain.predict(kept.bits[picks])
     geom = chain_geometry(chain)
     np.testing.assert_allclose(geom.tip[picks], tip, atol=1e-9)
     np.testing.assert_allclose(geom.curl[picks], curl, atol=1e-9)

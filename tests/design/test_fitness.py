@@ -43,7 +43,8 @@ def test_best_level_gives_the_pressure() -> None:
 
 def test_heights_are_measured_from_the_undeformed_positions() -> None:
     target = profile_target("y = 0.1*x")
-    np.testing.assert_allclose(profile_errors(three_units(7.5), target), profile_errors(three_units(), target), atol=1e-12)
+    np.testing.assert_allclose(profile_errors(three_units(7.5), target), profile_errors(three_units(), target),
+                               atol=1e-12)
 
 
 def test_polar_target_uses_radius_and_unwrapped_angle() -> None:

@@ -39,7 +39,8 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     folder = tmp_path / "run"
     assert result.status == "finished"
     names = {p.name for p in folder.iterdir()}
-    assert {"config.toml", "generations.csv", "hall_of_fame.json", "report.md", "profile.png", "convergence.png"} <= names
+    written = {"config.toml", "generations.csv", "hall_of_fame.json", "report.md", "profile.png", "convergence.png"}
+    assert written <= names
     saved = tomllib.loads((folder / "config.toml").read_text())
     assert DesignConfig.from_dict(saved) == cfg
     prov = saved["provenance"]

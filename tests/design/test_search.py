@@ -162,7 +162,8 @@ def test_same_seed_same_history_other_seed_another(model: ToyModel) -> None:
     obj, cfg = objective("cos"), GAConfig(population=12, generations=6, elitism=1, seed=3)
 
     def fingerprint(result):
-        return [(h.best, h.mean, h.worst, h.std, h.evaluations, h.best_design) for h in result.history], result.population
+        history = [(h.best, h.mean, h.worst, h.std, h.evaluations, h.best_design) for h in result.history]
+        return history, result.population
 
     a = run_ga(model, obj, cfg)
     random.seed(12345)  # the global generator plays no part
@@ -192,7 +193,7 @@ def test_statistics_budget_elitism_and_hall_of_fame(model: ToyModel) -> None:
 def test_bad_search_settings_are_rejected() -> None:
     with pytest.raises(SearchConfigError, match="population must be a whole number >= 2 and <= 10000, got 1"):
         GAConfig(population=1)
-    with pytest.raises(SearchConfigError, match="cxpb must be a finite number >= 0 and <= 1, got 1.5"):
+    with pytest.raises(SearchConfigError, match=r"cxpb must be a finite number >= 0 and <= 1, got 1\.5"):
         GAConfig(cxpb=1.5)
     with pytest.raises(SearchConfigError, match="at least 1 unit, got 0"):
         run_ga(ToyModel(n_units=0), objective("sin"), GAConfig(population=4))

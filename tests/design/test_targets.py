@@ -104,7 +104,7 @@ def test_bad_expressions_are_rejected_with_the_offending_part(text: str, fragmen
 def test_polar_expression_rejects_x() -> None:
     with pytest.raises(TargetExpressionError, match="x is the variable of Cartesian targets"):
         profile_target("r = x + theta")
-    with pytest.raises(TargetExpressionError, match="left-hand side .* must be y"):
+    with pytest.raises(TargetExpressionError, match=r"left-hand side .* must be y"):
         profile_target("z = x")
 
 

@@ -24,7 +24,7 @@ from pneumorph.execution import (
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))  # the toy model lives in tests/design
-from tests.design.toy_model import ToyModel
+from tests.design.toy_model import ToyModel  # noqa: E402 - after the path it is found on
 
 
 def test_response_round_trip_is_bit_exact(tmp_path: Path) -> None:

@@ -25,7 +25,7 @@ from pneumorph.execution import (
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))  # the toy model lives in tests/design; workers import it too
-from tests.design.toy_model import ToyModel
+from tests.design.toy_model import ToyModel  # noqa: E402 - after the path it is found on
 
 DESIGNS = ["000000", "010101", "111000", "001011", "100110", "011110"]
 

@@ -221,7 +221,8 @@ def test_materials_in_calculix_convention(one_unit) -> None:
         values = [float(v) for line in data for v in line.split(",")]
         mu, alpha, d = values[0:6:2], values[1:6:2], values[6:]
         assert alpha == pytest.approx(material.model.alpha, rel=1e-14)
-        assert mu == pytest.approx([m * a / 2 * 1e6 for m, a in zip(material.model.mu, material.model.alpha)])
+        pairs = zip(material.model.mu, material.model.alpha, strict=True)
+        assert mu == pytest.approx([m * a / 2 * 1e6 for m, a in pairs])
         assert sum(mu) == pytest.approx(material.shear_modulus * 1e6)  # CalculiX's mu0 = sum mu_i
         assert d == pytest.approx([2 / (material.bulk_modulus.value * 1e6), 1e30, 1e30])
         assert (f"*SOLID SECTION, ELSET={role}, MATERIAL={name}", []) in blocks

@@ -114,7 +114,7 @@ def test_clearance_and_draft():
 
 def test_bad_settings_name_the_parameter():
     spec = UnitSpec()
-    with pytest.raises(GeometryError, match="clearance 1.2 mm is not smaller than the core tenon's setback 1.125"):
+    with pytest.raises(GeometryError, match=r"clearance 1\.2 mm is not smaller than the core tenon's setback 1\.125"):
         casting_mould(spec, DEFAULT, MouldSpec(clearance=1.2, wall=8.0))
     with pytest.raises(GeometryError, match="clearance 2 mm is too large"):
         MouldSpec(clearance=2.0)

@@ -84,7 +84,8 @@ def test_parts_are_the_regions_of_the_assembled_mesh():
         for region, names in (("body", ["body"]), ("layer", [k for k in solids if k.startswith("layer_")])):
             corners = mesh.points[mesh.cells[mesh.regions[region]]]
             lo, hi = corners.min(axis=1), corners.max(axis=1)
-            cells = m3.Manifold.batch_boolean([box((a[0], b[0], a[1], b[1], a[2], b[2])) for a, b in zip(lo, hi)],
+            boxes = [box((a[0], b[0], a[1], b[1], a[2], b[2])) for a, b in zip(lo, hi, strict=True)]
+            cells = m3.Manifold.batch_boolean(boxes,
                                               m3.OpType.Add)
             mine = m3.Manifold.batch_boolean([solids[k] for k in names], m3.OpType.Add)
             assert (cells - mine).volume() < 1e-9 and (mine - cells).volume() < 1e-9, region
@@ -139,7 +140,7 @@ def test_stl_files_round_trip(tmp_path):
     paths = write_stl(parts, tmp_path / "stl")
     assert [p.name for p in paths] == [f"{k}.stl" for k in parts]
     assert sorted(p.name for p in (tmp_path / "stl").iterdir()) == sorted(p.name for p in paths)  # no temp files
-    for path, (name, mesh) in zip(paths, parts.items()):
+    for path, (name, mesh) in zip(paths, parts.items(), strict=False):
         assert path.stat().st_size == 84 + 50 * len(mesh.faces)  # binary STL
         back = trimesh.load_mesh(path)
         assert back.is_watertight and back.is_volume, name

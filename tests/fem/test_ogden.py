@@ -20,7 +20,7 @@ def energy(F: np.ndarray) -> np.ndarray:
     c = np.linalg.eigvalsh(np.einsum("...ki,...kj->...ij", Ft, Ft))
     J = np.sqrt(c.prod(-1))
     lbar = J[..., None] ** (-1 / 3) * np.sqrt(c)
-    W = sum(m / a * ((lbar**a).sum(-1) - 3) for m, a in zip(MU, ALPHA))
+    W = sum(m / a * ((lbar**a).sum(-1) - 3) for m, a in zip(MU, ALPHA, strict=False))
     return W + 4.5 * K * (J ** (1 / 3) - 1) ** 2
 
 

@@ -53,7 +53,7 @@ def test_the_fast_kernel_follows_the_thermal_stretch() -> None:
     P, A, J = _kernel_of(umat)(F, True, principal_3d(F))
     np.testing.assert_allclose(P, umat.gradient([F4, None])[0][:, :, 0], rtol=1e-9, atol=1e-12)
     full = umat.hessian([F4, None])[0][:, :, :, :, 0]
-    for n, (i, k) in enumerate([(i, k) for i in range(3) for k in range(i, 3)]):
+    for n, (i, k) in enumerate([(a, b) for a in range(3) for b in range(a, 3)]):
         np.testing.assert_allclose(A[n], full[i, :, k, :], rtol=1e-8, atol=1e-11)
     np.testing.assert_allclose(J, np.linalg.det(np.moveaxis(F, -1, 0)) / 1.05**3, rtol=1e-12)
 

@@ -54,7 +54,8 @@ def test_tracked_points_are_the_cavity_vertices() -> None:
     np.testing.assert_allclose(m.points[m.tracked[0]], [[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     H = u.height
     np.testing.assert_allclose(
-        m.points[m.tracked[1]], [[u.pitch + x0, H - y1], [u.pitch + x1, H - y1], [u.pitch + x1, H - y0], [u.pitch + x0, H - y0]]
+        m.points[m.tracked[1]],
+        [[u.pitch + x0, H - y1], [u.pitch + x1, H - y1], [u.pitch + x1, H - y0], [u.pitch + x0, H - y0]],
     )
     np.testing.assert_allclose(m.unit_centres(), [[5.25, 4.5], [15.75, 7.5]])
 
@@ -74,7 +75,7 @@ def test_3d_mesh_has_empty_cavities_and_tracks_the_mid_plane() -> None:
     assert m.cell_type == "hexahedron20" and "filler" not in m.regions
     np.testing.assert_allclose(m.points[m.tracked][..., 2], u.width / 2)
     # the cavity walls are exactly the points of the cavity boxes' surfaces
-    x0, x1, y0, y1 = u.cavity
+    x0, _x1, _y0, _y1 = u.cavity
     p = m.points[m.cavity_points]
     assert np.all((p[:, 0] >= x0 - 1e-9) & (p[:, 2] >= u.side_wall - 1e-9) & (p[:, 2] <= u.width - u.side_wall + 1e-9))
 

@@ -76,7 +76,8 @@ def test_features_solve_and_change_the_shape_as_expected() -> None:
     # block and its jaws give a stiffer response than the clamped face, as appendix D.2 found
     assert holed.curl[-1] > plain.curl[-1] > based.curl[-1] > 0
     assert Reduced2D(2, ramp_spec=ramp, base_block=BaseBlock()).evaluate("00").converged
-    fps = {Full3D(2).fingerprint(), Full3D(2, passage=1.5).fingerprint(), Full3D(2, base_block=BaseBlock()).fingerprint()}
+    fps = {Full3D(2).fingerprint(), Full3D(2, passage=1.5).fingerprint(),
+           Full3D(2, base_block=BaseBlock()).fingerprint()}
     assert len(fps) == 3
 
 

@@ -44,7 +44,7 @@ def rows_after(lines: list[str], marker: str, n: int) -> list[list[str]]:
 def test_table_a2_densities(thesis: list[str]) -> None:
     names, values = rows_after(thesis, "Table A.2:", 2)
     assert [n.strip() for n in names] == list(SILICONES)
-    for display, printed in zip(names, values):
+    for display, printed in zip(names, values, strict=False):
         q = library.get(display).density
         assert q.printed == float(printed) and q.printed_unit == "kg/m^3" and not q.assumed
         assert "Table A.2" in q.source
@@ -57,7 +57,7 @@ def test_table_a3_r_squared(thesis: list[str]) -> None:
     keys = {"Ogden": "ogden", "MR2": "mooney-rivlin-2", "MR3": "mooney-rivlin-3", "Yeoh": "yeoh"}
     for row in rows:
         m = library.get(row[0])
-        printed = {keys[h]: float(v) for h, v in zip(header[1:], row[1:]) if v.strip()}
+        printed = {keys[h]: float(v) for h, v in zip(header[1:], row[1:], strict=False) if v.strip()}
         assert dict(m.r_squared) == printed
         assert "Table A.3" in (m.r_squared_source or "")
     assert dict(library.get("ecoflex_0030").r_squared) == {"mooney-rivlin-2": 0.7991}
@@ -91,7 +91,7 @@ def test_table_a5_bulk_moduli(thesis: list[str]) -> None:
 def test_table_a6_thermal_expansion(thesis: list[str]) -> None:
     names, values = rows_after(thesis, "Table A.6:", 2)
     assert "mu mm/mm" in next(line for line in thesis if line.startswith("Table A.6:"))
-    for display, printed in zip(names, values):
+    for display, printed in zip(names, values, strict=False):
         q = library.get(display).thermal_expansion
         assert (q.printed, q.printed_unit) == (float(printed), "micro-mm/mm/degC")
         assert q.value == pytest.approx(float(printed) * 1e-6, rel=1e-15) and q.unit == "1/K"
@@ -125,7 +125,7 @@ def test_initial_shear_modulus_in_both_conventions() -> None:
         m = library.get(name)
         assert m.shear_modulus == pytest.approx(mu0, rel=1e-12)
         felupe = m.ogden_felupe_mu
-        assert felupe == pytest.approx([a * b / 2 for a, b in zip(m.model.mu, m.model.alpha)], rel=1e-12)
+        assert felupe == pytest.approx([a * b / 2 for a, b in zip(m.model.mu, m.model.alpha, strict=False)], rel=1e-12)
         assert math.fsum(felupe) == pytest.approx(mu0, rel=1e-12)
     assert round(expected["ecoflex_0030"] * 1e3, 2) == 37.35  # kPa
     assert round(expected["smooth_sil_950"], 4) == 0.5334
@@ -354,10 +354,12 @@ source = "s"
         ('type = "ogden"', 'type = "arruda-boyce"', "unknown model type"),
         ('kind = "hyperelastic"', 'kind = "plastic"', "kind must be one of"),
         ('convention = "marc"', 'convention = "felupe"', "not supported"),
-        ('source = "s"\n[materials.x.model]', 'source = "s"\ncolour = "red"\n[materials.x.model]', "unknown key(s) colour"),
+        ('source = "s"\n[materials.x.model]', 'source = "s"\ncolour = "red"\n[materials.x.model]',
+         "unknown key(s) colour"),
         ("value = 100", "value = true", "finite number"),
         ("mu = [0.1, 0.01]", "mu = []", "non-empty list"),
-        ('value = 100\nunit = "kPa"\nsource = "s"', 'value = 100\nunit = "kPa"\nsource = "s"\nassumed = true', "missing key 'reason'"),
+        ('value = 100\nunit = "kPa"\nsource = "s"', 'value = 100\nunit = "kPa"\nsource = "s"\nassumed = true',
+         "missing key 'reason'"),
     ],
 )
 def test_validation_errors_name_file_and_entry(tmp_path: Path, old: str, new: str, message: str) -> None:

@@ -191,7 +191,7 @@ def test_bad_rows_name_file_and_row(tmp_path: Path, text: str, row: int, what: s
 def test_bad_files(tmp_path: Path) -> None:
     empty = tmp_path / "empty.csv"
     empty.write_text("# nothing\n\n")
-    with pytest.raises(DataFormatError, match="empty.csv: no data rows"):
+    with pytest.raises(DataFormatError, match=r"empty\.csv: no data rows"):
         read_curve(empty)
     one = tmp_path / "one.csv"
     one.write_text("1.0,0\n")
@@ -205,7 +205,7 @@ def test_bad_files(tmp_path: Path) -> None:
     ok.write_text("1,0\n2,1\n")
     with pytest.raises(DataFormatError, match="unknown stress unit"):
         read_curve(ok, stress_unit="bar")
-    with pytest.raises(DataFormatError, match="missing.csv: cannot read"):
+    with pytest.raises(DataFormatError, match=r"missing\.csv: cannot read"):
         read_curve(tmp_path / "missing.csv")
 
 
@@ -235,7 +235,7 @@ def test_read_test_data_mixes_files_and_datasets(reference_dir: Path) -> None:
     both = read_test_data(["treloar1944", files[0]], columns="stress,stretch")
     merged = both.curve("uniaxial")  # two uniaxial curves become one, sorted
     assert len(merged) == 25 + 33 and np.all(np.diff(merged.stretch) >= 0)
-    with pytest.raises(UnknownDatasetError, match="'nonesuch'.*treloar1944"):
+    with pytest.raises(UnknownDatasetError, match=r"'nonesuch'.*treloar1944"):
         read_test_data(["nonesuch"])
     with pytest.raises(UnknownDatasetError):
         load_dataset("nonesuch")

@@ -58,7 +58,7 @@ def test_a_base_window_needs_one_design_per_pattern_of_its_units() -> None:
 
 
 def test_the_table_reproduces_held_out_designs_of_the_real_2d_model(small) -> None:
-    model, table, _ = small
+    _model, table, _ = small
     v = table.validation
     assert table.window >= 1 and len(v["designs"]) == 6
     assert max(v["centre_worst_mm"]) <= 0.2
@@ -68,7 +68,7 @@ def test_the_table_reproduces_held_out_designs_of_the_real_2d_model(small) -> No
 
 
 def test_the_table_serves_other_lengths(small) -> None:
-    model, table, evaluator = small
+    _model, table, evaluator = small
     longer = Reduced2D(10, COARSE, RAMP)
     designs = ["0110100111", "1110001010"]
     for outcome in evaluator.evaluate_many(longer, designs):
@@ -89,7 +89,7 @@ def test_a_mirrored_design_gives_the_mirrored_response(small) -> None:
 
 
 def test_a_table_survives_its_file_and_refuses_tampering(small, tmp_path: Path) -> None:
-    model, table, _ = small
+    _model, table, _ = small
     path = table.save(tmp_path / "t.json")
     again = ChainTable.load(path)
     assert again.fingerprint() == table.fingerprint()
@@ -113,7 +113,7 @@ def test_a_table_survives_its_file_and_refuses_tampering(small, tmp_path: Path) 
 
 
 def test_a_table_of_another_model_or_too_short_an_actuator_is_refused(small) -> None:
-    model, table, _ = small
+    _model, table, _ = small
     check_source(table, Reduced2D(12, COARSE, RAMP))  # same unit, model and ramp: any length
     with pytest.raises(ChainTableError, match="another model"):
         check_source(table, Reduced2D(7, UnitSpec(element_size=3.0, wall=1.4), RAMP))

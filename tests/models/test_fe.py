@@ -75,7 +75,8 @@ def test_orientation_of_the_wrong_length_is_refused() -> None:
 
 def test_failed_solve_names_the_design_and_the_pressure_reached() -> None:
     starved = RampSpec(pressure=0.01, steps=StepSettings(increments=2, substeps=1, max_iterations=1, max_cutbacks=1))
-    with pytest.raises(SimulationFailed, match=r"design 01: simulation failed, converged up to 0 kPa of 10 kPa") as info:
+    failed = r"design 01: simulation failed, converged up to 0 kPa of 10 kPa"
+    with pytest.raises(SimulationFailed, match=failed) as info:
         Reduced2D(2, ramp_spec=starved).evaluate("01")
     assert info.value.design == "01" and info.value.reached == 0.0
 

@@ -153,6 +153,6 @@ def test_cli_study_writes_its_results_and_resumes(tmp_path: Path, capsys: pytest
     data = json.loads((tmp_path / "run" / "study.json").read_text())
     assert data["study"] == "bulk-modulus" and data["cases"][0]["difference"]["distance_mm"] > 0
     assert data["provenance"]["fingerprint"] and (tmp_path / "run" / "study.png").stat().st_size > 10_000
-    assert main(argv + ["--json"]) == 0
+    assert main([*argv, "--json"]) == 0
     out, err = capsys.readouterr()
     assert "bulk modulus x1.1: cached" in err and json.loads(out)["cases"][0]["cached"]

@@ -228,10 +228,11 @@ class Bench:
             "bound": float(scores.bound[best]),
             "candidates": candidates,
             "designs": 2**self.units,
-            "scored": int(len(scores.cost)),  # the others are bounded above the threshold (floor)
+            "scored": len(scores.cost),  # the others are bounded above the threshold (floor)
             "complete": bool(scores.complete),
             "statement": (f"Within the chain's validated error bound ({float(scores.bound[best]):.3g} {unit}), the "
-                          f"{query.model.upper()} model's optimum is {'this design' if candidates == 1 else f'one of {candidates} designs'}"
+                          f"{query.model.upper()} model's optimum is "
+                          f"{'this design' if candidates == 1 else f'one of {candidates} designs'}"
                           f" of all {2**self.units:,}; an FE verification certifies it."),
         }
         return {
@@ -248,7 +249,7 @@ class Bench:
             "certificate": certificate,
             "top": [{"rank": i + 1, "design": d, "value": sign * float(scores.cost[j]),
                      "pressure_kpa": float(kpa[int(scores.level[j])]), "optimistic": sign * float(scores.optimistic[j])}
-                    for i, (d, j) in enumerate(zip(designs, top))],
+                    for i, (d, j) in enumerate(zip(designs, top, strict=False))],
             "target": _target_samples(objective, length),
             "point": list(objective.point) if getattr(objective, "point", None) is not None else None,
             "profiles": profiles(response),

@@ -13,10 +13,10 @@ import json
 import multiprocessing
 import os
 import secrets
-from http.cookies import CookieError, SimpleCookie
+from collections.abc import AsyncIterator
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from collections.abc import AsyncIterator
+from http.cookies import CookieError, SimpleCookie
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -106,7 +106,8 @@ class AnswerPool:
 
     def _make(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                   initializer=_start_answer_worker, initargs=(self.bench.table_dir, self.bench.unit_dir))
+                                   initializer=_start_answer_worker,
+                                   initargs=(self.bench.table_dir, self.bench.unit_dir))
 
     async def start(self) -> None:
         """Start the workers and load their tables (before the first query is taken)."""

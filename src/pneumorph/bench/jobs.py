@@ -223,7 +223,8 @@ class JobBoard:
         from pneumorph.execution.outcome import Outcome
 
         with EvaluationCache(self.cache) as cache:
-            if cache.get(model.fingerprint(), design) is not None and self.bench.fe_shape_file(design, unit) is not None:
+            fe_known = self.bench.fe_shape_file(design, unit) is not None
+            if cache.get(model.fingerprint(), design) is not None and fe_known:
                 return  # verified and drawn before
         # spawned, as the evaluators' workers: a fork of the threaded server could inherit a held lock
         with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
@@ -306,4 +307,4 @@ def fe_solve_shape(model: Any, design: str) -> tuple[Any, dict[str, Any] | None,
     return solution.response, shape, wall
 
 
-__all__ = ["Job", "JobBoard", "STATES", "fe_solve_shape"]
+__all__ = ["STATES", "Job", "JobBoard", "fe_solve_shape"]

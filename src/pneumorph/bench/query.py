@@ -140,7 +140,8 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
     >>> q = parse_query({"target": {"kind": "preset", "name": "cos", "amplitude": 20}}, 157.5)
     >>> q.spec, q.amplitude, q.model
     ('cos', 20.0, '3d')
-    >>> parse_query({"target": {"kind": "expression", "expression": "y = __import__('os')"}}, 157.5)  # doctest: +ELLIPSIS
+    >>> bad = {"target": {"kind": "expression", "expression": "y = __import__('os')"}}
+    >>> parse_query(bad, 157.5)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     pneumorph.bench.query.QueryError: in expression "__import__('os')": unknown function '__import__' ...

@@ -56,7 +56,7 @@ def plot_tip_paths(
             extra.append(f"ramp ends at {p[-1]:g} kPa")
         full = f"{label}: " + ", ".join(extra)
         ax.plot(v, u, "o-", color=c, ms=3.5, lw=1.2, label=full)
-        for vi, ui, pi in zip(v[1:], u[1:], p[1:]):
+        for vi, ui, pi in zip(v[1:], u[1:], p[1:], strict=False):
             ax.annotate(f"{pi:g}", (vi, ui), textcoords="offset points", xytext=(4, 2), fontsize=6, color=c)
         ax2.plot(p, v, "o-", color=c, ms=3.5, lw=1.2, label=label)
         if s.switch is not None:

@@ -138,7 +138,8 @@ class BimodalSpec:
     def __post_init__(self) -> None:
         if isinstance(self.voids, bool) or not isinstance(self.voids, (int, np.integer)) or not (
                 1 <= self.voids <= MAX_UNITS):
-            raise GeometryError(f"the actuator needs 1 to {MAX_UNITS} voids (limit MAX_UNITS), got voids={self.voids!r}")
+            raise GeometryError(f"the actuator needs 1 to {MAX_UNITS} voids (limit MAX_UNITS), "
+                                f"got voids={self.voids!r}")
         for key in _LENGTHS:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:

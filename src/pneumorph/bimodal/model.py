@@ -179,7 +179,8 @@ class BimodalModel:
         if abs(pmax / step - increments) > 1e-6 or increments > checks.MAX_INCREMENTS:
             raise SettingsError(
                 f"the step {step * 1e3:g} kPa must divide pmax {pmax * 1e3:g} kPa into at most "
-                f"{checks.MAX_INCREMENTS} equal steps (e.g. step {pmax / max(1, min(round(pmax / step), 1000)) * 1e3:.4g} "
+                f"{checks.MAX_INCREMENTS} equal steps "
+                f"(e.g. step {pmax / max(1, min(round(pmax / step), 1000)) * 1e3:.4g} "
                 "kPa); the ramp must end at pmax, not above it")
         for name, value, low in (("substeps", substeps, 1), ("max_cutbacks", max_cutbacks, 0),
                                  ("max_iterations", max_iterations, 1)):

@@ -39,7 +39,9 @@ class Switch:
     switch: float | None
 
     def to_dict(self) -> dict[str, Any]:
-        kpa = lambda v: None if v is None else round(1e3 * v, 4)
+        def kpa(v: float | None) -> float | None:
+            return None if v is None else round(1e3 * v, 4)
+
         return {
             "first_direction": self.first_direction,
             "turning_kpa": kpa(self.turning),

@@ -42,7 +42,8 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
                    "[default: the library's assumed bulk modulus].")
 @click.option("--max-cutbacks", type=P.Count(0, 60), default=2, show_default=True,
               help="Halvings of a step that does not converge before the ramp ends there.")
-@click.option("--max-iterations", type=P.Count(1, 1000), default=10, show_default=True, help="Newton iterations per trial.")
+@click.option("--max-iterations", type=P.Count(1, 1000), default=10, show_default=True,
+              help="Newton iterations per trial.")
 @click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
@@ -96,7 +97,7 @@ def format_result(d: dict[str, Any]) -> str:
     head = (f"bimodal actuator, CR {d['crimp_ratio']:g}: {m['dofs']} dofs, {m['wall_time_s']:.0f} s, "
             f"bilinear bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa")
     lines = [head, "pressure (kPa)   tip u_x (mm)   tip u_y (mm)"]
-    for p, ux, uy in zip(d["pressures_kpa"], d["tip_ux_mm"], d["tip_uy_mm"]):
+    for p, ux, uy in zip(d["pressures_kpa"], d["tip_ux_mm"], d["tip_uy_mm"], strict=False):
         lines.append(f"{p:10.1f}   {ux:12.3f}   {uy:12.3f}")
     if not d["completed"]:
         lines.append(f"ramp ended early: {d['cause'].strip()}")
@@ -117,8 +118,8 @@ def write_outputs(result: Any, out: Path) -> list[Path]:
     js = out / f"bimodal-{tag}.json"
     write_json(js, result.to_dict(), indent=2)
     tip = out / f"bimodal-{tag}-tip.png"
-    figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)], title=f"Bimodal actuator, CR {result.crimp_ratio:g}",
-                           path=tip)
+    figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)],
+                           title=f"Bimodal actuator, CR {result.crimp_ratio:g}", path=tip)
     shape = out / f"bimodal-{tag}-shape.png"
     figures.plot_outlines(result, title=f"Mid-plane outline, CR {result.crimp_ratio:g}", path=shape)
     return [js, tip, shape]

@@ -11,14 +11,19 @@ from pneumorph.cli import params as P
 @click.command("calibrate")
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
-@click.option("--units", "n_units", type=P.Count(1, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True, help="Actuator length in units.")
-@click.option("--pressures", type=P.RealList(P.PRESSURE_KPA, min_items=2, max_items=100), default="5,10,15,20,25,30,35,40,45", show_default=True, metavar="LIST",
+@click.option("--units", "n_units", type=P.Count(1, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,
+              help="Actuator length in units.")
+@click.option("--pressures", type=P.RealList(P.PRESSURE_KPA, min_items=2, max_items=100),
+              default="5,10,15,20,25,30,35,40,45", show_default=True, metavar="LIST",
               help="Calibration pressures, kPa, comma-separated.")
-@click.option("--runs", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=3, show_default=True, help="Independent runs (new random designs).")
+@click.option("--runs", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=3, show_default=True,
+              help="Independent runs (new random designs).")
 @click.option("--seed", type=P.SEED, default=0, show_default=True)
-@click.option("--validate", "n_validate", type=P.Count(0, MAX_STARTS, limit="MAX_STARTS"), default=10, show_default=True,
+@click.option("--validate", "n_validate", type=P.Count(0, MAX_STARTS, limit="MAX_STARTS"), default=10,
+              show_default=True,
               help="Held-out random designs for the 2D-against-3D check.")
-@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", type=P.OutputDir(), default="runs/calibration", show_default=True, metavar="DIR")
 @click.option("--references-only", is_flag=True,
               help="Only solve (and cache) the 3D references of the calibration and validation designs.")
@@ -75,7 +80,8 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
         calibrated = result.unit_with_law(unit)
         atomic_write_text(folder / "unit.toml", to_toml({"unit": calibrated.to_dict()}))
         if n_validate > 0:
-            designs = cal_mod.holdout_designs(n_units, n_validate, seed, cal_mod.calibration_designs(n_units, runs, seed))
+            taken = cal_mod.calibration_designs(n_units, runs, seed)
+            designs = cal_mod.holdout_designs(n_units, n_validate, seed, taken)
             p_max = max(levels) / 1e3
             check = cal_mod.validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
             summary["validation"] = check.to_dict()
@@ -95,7 +101,7 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
         click.echo("no acceptable law: nothing written to unit.toml", err=True)
     if "validation" in summary:
         v = summary["validation"]
-        for p, m, x in zip(v["pressures_kpa"], v["mean_mm"], v["max_mm"]):
+        for p, m, x in zip(v["pressures_kpa"], v["mean_mm"], v["max_mm"], strict=False):
             click.echo(f"  {p:5.1f} kPa: 2D-3D unit-centre distance mean {m:.3f} mm, max {x:.3f} mm")
     written = "calibration.json, calibration.png" + (", unit.toml" if result.chosen is not None else "")
     click.echo(f"written to {folder}/ ({written})")
@@ -119,7 +125,7 @@ def _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d) -
         try:
             r = solve_3d(model, design)
             msg = f"curl {r.curl[-1]:.1f} deg"
-        except Exception as exc:  # noqa: BLE001 - a failed reference is reported, the others go on
+        except Exception as exc:  # a failed reference is reported, the others go on
             msg = f"FAILED: {exc}"
         click.echo(f"  3D reference {i}/{len(jobs)} ({kind}) {design}: {msg}, "
                    f"{time.perf_counter() - t0:.0f} s", err=True)

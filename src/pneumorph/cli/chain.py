@@ -19,13 +19,17 @@ def chain() -> None:
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
-@click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True, help="Units of the training designs.")
-@click.option("--window", type=P.Count(1, 3), help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
+@click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,
+              help="Units of the training designs.")
+@click.option("--window", type=P.Count(1, 3),
+              help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
 @click.option("--tolerance", type=P.Real(0.0, 100.0, low_open=True, unit="mm"), default=0.2, show_default=True,
               help="Worst held-out unit-centre error allowed at every level, mm.")
-@click.option("--heldout", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=20, show_default=True, help="Held-out random designs solved.")
+@click.option("--heldout", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=20, show_default=True,
+              help="Held-out random designs solved.")
 @click.option("--workers", type=P.WORKERS, help="Processes solving designs (default: all cores).")
-@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", required=True, metavar="FILE", type=P.OutputFile((".json",)), help="Table file to write (JSON).")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units: int, window: int | None,

@@ -202,7 +202,8 @@ def thermal(data: str, strain_unit: str, as_json: bool) -> None:
     show_default=True,
     help="Primary fit uses the points with strain up to this value, in percent.",
 )
-@click.option("--secondary-points", type=P.Count(2, 1_000_000), default=10, show_default=True, help="Secondary fit uses this many final points.")
+@click.option("--secondary-points", type=P.Count(2, 1_000_000), default=10, show_default=True,
+              help="Secondary fit uses this many final points.")
 @_strain_unit
 @_json
 def bilinear(data: str, primary_limit: float, secondary_points: int, strain_unit: str, as_json: bool) -> None:
@@ -238,8 +239,10 @@ def bilinear(data: str, primary_limit: float, secondary_points: int, strain_unit
     }
     text = [
         f"{data}:",
-        f"  primary modulus   {r.primary_modulus * 1e3:.4g} kPa (R^2 {r.primary.r_squared:.4f}, {r.primary.n} points <= {primary_limit:g} %)",
-        f"  secondary modulus {r.secondary_modulus:.4g} MPa (R^2 {r.secondary.r_squared:.4f}, last {r.secondary.n} points)",
+        f"  primary modulus   {r.primary_modulus * 1e3:.4g} kPa (R^2 {r.primary.r_squared:.4f}, "
+        f"{r.primary.n} points <= {primary_limit:g} %)",
+        f"  secondary modulus {r.secondary_modulus:.4g} MPa (R^2 {r.secondary.r_squared:.4f}, "
+        f"last {r.secondary.n} points)",
         f"  transition        {r.transition_strain * 100:.4g} % strain at {r.transition_stress * 1e3:.4g} kPa",
     ]
     _emit(out, text, as_json)

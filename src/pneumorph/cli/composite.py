@@ -35,8 +35,10 @@ def _crimp(crimp_ratio: float | None, wavelength: float | None, amplitude: float
 _CRIMP_OPTIONS = [
     click.option("--crimp-ratio", "-c", type=P.Real(0.0, 10.0, low_open=True), default=None, help="CR = A / lambda."),
     click.option("--wavelength", type=P.POSITIVE_MM, default=None, help="lambda in mm (instead of --crimp-ratio)."),
-    click.option("--amplitude", "-a", type=P.POSITIVE_MM, default=1.5, show_default=True, help="A in mm (paper between -A and +A)."),
-    click.option("--length", "-l", type=P.POSITIVE_MM, default=176.25, show_default=True, help="Crimped length L0 in mm."),
+    click.option("--amplitude", "-a", type=P.POSITIVE_MM, default=1.5, show_default=True,
+                 help="A in mm (paper between -A and +A)."),
+    click.option("--length", "-l", type=P.POSITIVE_MM, default=176.25, show_default=True,
+                 help="Crimped length L0 in mm."),
 ]
 
 
@@ -77,13 +79,17 @@ def transition(crimp_ratio: float | None, wavelength: float | None, amplitude: f
 @composite.command("coupon")
 @_crimp_options
 @click.option("--thickness", type=P.POSITIVE_MM, default=5.0, show_default=True, help="Coupon thickness in mm.")
-@click.option("--per-flute", type=P.Count(1, 64), default=4, show_default=True, help="Cells along each flute (half wavelength).")
-@click.option("--rows", type=P.Count(1, 64), default=4, show_default=True, help="Cell rows between the paper and each surface.")
+@click.option("--per-flute", type=P.Count(1, 64), default=4, show_default=True,
+              help="Cells along each flute (half wavelength).")
+@click.option("--rows", type=P.Count(1, 64), default=4, show_default=True,
+              help="Cell rows between the paper and each surface.")
 @click.option("--levels", type=P.INCREMENTS, default=100, show_default=True, help="Recorded load levels.")
 @click.option("--strain-max", type=P.Real(0.0, 10.0, low_open=True), default=None,
               help="Final engineering strain [default: 2 s / lambda - 1 + 0.10].")
-@click.option("--bulk-modulus", type=P.Real(0.0, 1e9, low_open=True, unit="kPa"), default=None, help="Matrix bulk modulus in kPa [default: library].")
-@click.option("--gauges", type=P.Count(0, 10_000), default=None, help="Virtual strain gauges [default: Eq 3.5, 385; 0: none].")
+@click.option("--bulk-modulus", type=P.Real(0.0, 1e9, low_open=True, unit="kPa"), default=None,
+              help="Matrix bulk modulus in kPa [default: library].")
+@click.option("--gauges", type=P.Count(0, 10_000), default=None,
+              help="Virtual strain gauges [default: Eq 3.5, 385; 0: none].")
 @click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the gauge placement.")
 @click.option("--snapshot", type=P.Real(0.0, 10.0), default=None,
               help="Engineering strain of the deformed-shape and surface-strain figures [default: last level].")

@@ -30,18 +30,23 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
                    "Default (no config file): sin, amplitude 10 mm, one period.")
 @click.option("--objective", type=click.Choice(_TIP_GOALS), help="A tip goal instead of a profile (Table 6.1).")
 @click.option("--amplitude", type=P.POSITIVE_MM, help="Amplitude A of the sin/cos target, mm (default 10).")
-@click.option("--periods", type=P.Real(0.0, 1000.0, low_open=True), help="Periods of the sin/cos target over the actuator (default 1).")
-@click.option("--point", type=P.Real(-1e5, 1e5, unit="mm"), nargs=2, metavar="X Y", help="Tip point (mm) for --objective reach.")
+@click.option("--periods", type=P.Real(0.0, 1000.0, low_open=True),
+              help="Periods of the sin/cos target over the actuator (default 1).")
+@click.option("--point", type=P.Real(-1e5, 1e5, unit="mm"), nargs=2, metavar="X Y",
+              help="Tip point (mm) for --objective reach.")
 @click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
-@click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), help="GA population (default 100; also the GA a certified search falls back to).")
-@click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"), help="GA generations (default 15).")
+@click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"),
+              help="GA population (default 100; also the GA a certified search falls back to).")
+@click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"),
+              help="GA generations (default 15).")
 @click.option("--seed", type=P.SEED, help="Random seed (default 0): the same seed gives the same run.")
 @click.option("--search", type=click.Choice(["certified", "ga", "exhaustive"]),
               help="certified (default): every design scored by the chain model, the best verified by FE; "
                    "ga: genetic algorithm; exhaustive: all 2^n designs by FE.")
 @click.option("--certify", is_flag=True, default=None,
               help="Certified search: verify by FE until no design can beat the winner.")
-@click.option("--verify", type=P.Count(1, 1024), help="Certified search: designs verified by FE per batch (default: one per worker).")
+@click.option("--verify", type=P.Count(1, 1024),
+              help="Certified search: designs verified by FE per batch (default: one per worker).")
 @click.option("--margin", type=P.Real(0.0, 1e3, low_open=True),
               help="Certified search: factor on the chain's validated errors in the bound (default 1).")
 @click.option("--chain-table", metavar="FILE", type=P.InputFile(),
@@ -57,13 +62,16 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--executor", type=click.Choice(["serial", "processes", "dask"]),
               help="Where designs are solved (default processes: all cores).")
 @click.option("--workers", type=P.WORKERS, help="Processes or Dask workers (default: all cores).")
-@click.option("--scheduler", metavar="ADDR", type=P.ADDRESS, help="Dask scheduler address (tcp://host:8786); default a local cluster.")
+@click.option("--scheduler", metavar="ADDR", type=P.ADDRESS,
+              help="Dask scheduler address (tcp://host:8786); default a local cluster.")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]),
               help="Model fidelity (default: 3d for the certified search, 2d for ga and exhaustive).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file.")
-@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
-@click.option("--out", metavar="DIR", type=P.OutputDir(), help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
+@click.option("--out", metavar="DIR", type=P.OutputDir(),
+              help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
 @click.option("--overwrite", is_flag=True, help="Start afresh in a folder that holds another run.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
@@ -224,7 +232,8 @@ def _check_options_apply(search: str, owner: str, options: dict) -> None:
     given = [name for name, value in options.items() if value is not None]
     if given and search != owner:
         raise click.UsageError(f"{'/'.join(given)} only appl{'y' if len(given) > 1 else 'ies'} to --search {owner}, "
-                               f"but this run's search is {search}; add --search {owner} or leave {'/'.join(given)} out")
+                               f"but this run's search is {search}; add --search {owner} or leave "
+                               f"{'/'.join(given)} out")
 
 
 def _certified_json(result) -> dict:  # type: ignore[no-untyped-def]

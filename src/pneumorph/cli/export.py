@@ -111,7 +111,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
                 "base_block": f"base block {block.length:g} x {unit.height + 2 * block.margin:g} x "
                               f"{unit.width + 2 * block.margin:g} mm, {block.material}"}
     layer_names = [k for k in parts if k.startswith("layer_")]
-    for name, p in zip(layer_names, pieces):
+    for name, p in zip(layer_names, pieces, strict=False):
         units = f"unit {p.first + 1}" if p.first == p.last else f"units {p.first + 1}-{p.last + 1}"
         describe[name] = f"{unit.layer_material} strip, {units}, {p.side}, cut {p.length:g} mm"
     summary.update({
@@ -120,7 +120,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         "files": [str(p) for p in paths],
         "volumes_mm3": {name: float(mesh.volume) for name, mesh in parts.items()},
         "layer_pieces": [{"name": name, "first_unit": p.first + 1, "last_unit": p.last + 1, "side": p.side,
-                          "length_mm": p.length} for name, p in zip(layer_names, pieces)],
+                          "length_mm": p.length} for name, p in zip(layer_names, pieces, strict=False)],
     })
     mould = None
     if mould_spec is not None:
@@ -146,7 +146,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         click.echo(f"wrote the CalculiX deck at {pressure:g} kPa to {inp_file}")
     click.echo(f"wrote {len(paths)} STL files (mm) to {folder}/:")
     width = max(len(p.name) for p in paths)
-    for path, (name, mesh) in zip(paths, parts.items()):
+    for path, (name, mesh) in zip(paths, parts.items(), strict=False):
         click.echo(f"  {path.name:<{width}}  {float(mesh.volume):10.2f} mm^3  {describe[name]}")
     if mould is not None:
         c = mould.check

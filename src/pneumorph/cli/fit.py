@@ -32,8 +32,10 @@ from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE
 @click.option("--truncate", type=click.Choice(TRUNCATE),
               help="Keep the rows up to the largest stretch (loading) or stress (peak-stress); "
                    "default peak-stress for pull-to-failure database files, else none.")
-@click.option("--min-stretch", type=P.Real(0.0, 100.0, low_open=True), help="Fit only points with at least this stretch.")
-@click.option("--max-stretch", type=P.Real(0.0, 100.0, low_open=True), help="Fit only points with at most this stretch.")
+@click.option("--min-stretch", type=P.Real(0.0, 100.0, low_open=True),
+              help="Fit only points with at least this stretch.")
+@click.option("--max-stretch", type=P.Real(0.0, 100.0, low_open=True),
+              help="Fit only points with at most this stretch.")
 @click.option("--weighting", type=click.Choice(WEIGHTINGS), default="absolute", show_default=True,
               help="Residuals: plain stress, relative to the stress, or per-mode normalised.")
 @click.option("--stable", is_flag=True,

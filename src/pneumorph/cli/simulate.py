@@ -57,11 +57,12 @@ def simulate(
     t0 = time.perf_counter()
 
     def progress(k: int, p: float) -> None:
-        click.echo(f"  level {k + 1:2d}/{increments}: {p * 1e3:7.3f} kPa converged  [{time.perf_counter() - t0:6.1f} s]",
-                   err=True)
+        click.echo(f"  level {k + 1:2d}/{increments}: {p * 1e3:7.3f} kPa converged  "
+                   f"[{time.perf_counter() - t0:6.1f} s]", err=True)
 
     weight = "" if gravity == "none" else f", {gravity} under gravity"
-    click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa{weight})", err=True)
+    click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa{weight})",
+               err=True)
     solution = model.solve(design, on_level=progress)
     resp = solution.response
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())

@@ -10,15 +10,19 @@ from pneumorph.cli import params as P
 
 @click.command("study")
 @click.argument("config_file", required=False, type=P.InputFile())
-@click.option("--populations", type=P.RealList(P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), max_items=100), default="20,40,60,80", show_default=True, metavar="LIST",
+@click.option("--populations", type=P.RealList(P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"), max_items=100),
+              default="20,40,60,80", show_default=True, metavar="LIST",
               help="Population sizes, comma-separated.")
-@click.option("--seeds", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=5, show_default=True, help="Runs (seeds 0..N-1) per population size.")
-@click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"), default=25, show_default=True, help="Generations per run.")
+@click.option("--seeds", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=5, show_default=True,
+              help="Runs (seeds 0..N-1) per population size.")
+@click.option("--gen", "generations", type=P.Count(0, MAX_GENERATIONS, limit="MAX_GENERATIONS"), default=25,
+              show_default=True, help="Generations per run.")
 @click.option("--units", type=P.UNITS, help="Number of units (default: the config's, else 15).")
 @click.option("--target", type=P.Text(), help="Profile target (default: the config's, else sin, amplitude 10 mm).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--executor", type=click.Choice(["serial", "processes", "dask"]), default="processes", show_default=True)
-@click.option("--cache", metavar="FILE", type=P.CacheFile(), help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", type=P.OutputDir(), default="runs/population-study", show_default=True, metavar="DIR",
               help="Folder for study.json and study.png.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")

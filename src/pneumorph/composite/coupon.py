@@ -371,7 +371,7 @@ def _displacement_ramp(
         return [f.values.copy() for f in fields.fields]
 
     def restore(vals: list[FloatArray]) -> None:
-        for f, v in zip(fields.fields, vals):
+        for f, v in zip(fields.fields, vals, strict=False):
             f.values[:] = v
 
     iterations = cutbacks = 0
@@ -384,7 +384,7 @@ def _displacement_ramp(
             t_try = min(t_now + dt, level)
             if settings.predictor and prev is not None and t_now > t_prev:
                 s = (t_try - t_now) / (t_now - t_prev)
-                restore([c + s * (c - p) for c, p in zip(current, prev)])
+                restore([c + s * (c - p) for c, p in zip(current, prev, strict=False)])
             cause = None
             try:
                 with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -416,7 +416,8 @@ def _displacement_ramp(
             if cut_here > settings.max_cutbacks:
                 raise SimulationFailed(
                     reached=t_now,
-                    cause=f"no convergence at load factor {t_try:.4g} after {settings.max_cutbacks} cut-backs ({cause})",
+                    cause=f"no convergence at load factor {t_try:.4g} after {settings.max_cutbacks} cut-backs "
+                          f"({cause})",
                 )
             dt /= 2.0
         on_level(k, level)

@@ -50,7 +50,8 @@ def plot_load_strain(results: Sequence[CouponResult], path: str | Path | None = 
     grid = fig.subplots(2, 2, sharex="col")
     knee = 0.0
     for row, zoom in ((grid[0], False), (grid[1], True)):
-        for ax, kind, title in zip(row, ("surface", "engineering"), ("Averaged surface strain", "Engineering strain")):
+        titles = ("Averaged surface strain", "Engineering strain")
+        for ax, kind, title in zip(row, ("surface", "engineering"), titles, strict=True):
             for i, r in enumerate(results):
                 colour = f"C{i}"
                 eps = r.strain(kind)  # type: ignore[arg-type]

@@ -190,7 +190,7 @@ def icp(scan: ArrayLike, model: ArrayLike, scale: bool = False, max_iterations: 
 
     def run(start: Transform, step: Any) -> Alignment:
         current, previous, it = start, np.inf, 0
-        for it in range(1, max_iterations + 1):
+        for it in range(1, max_iterations + 1):  # noqa: B007 - the count is reported after the loop
             moved = current(p)
             dist, index = tree.query(moved)
             mse = float(np.mean(dist**2))
@@ -222,7 +222,7 @@ def _refine(p: FloatArray, q: FloatArray, n: FloatArray, tree: cKDTree, start: A
             max_iterations: int) -> Alignment:
     """Point-to-plane iterations from ``start`` until the transform stops changing."""
     current, it = start.transform, 0
-    for it in range(1, max_iterations + 1):
+    for it in range(1, max_iterations + 1):  # noqa: B007 - the count is reported after the loop
         moved = current(p)
         _, index = tree.query(moved)
         step = plane_step(moved, q[index], n[index], scale)

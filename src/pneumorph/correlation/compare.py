@@ -183,7 +183,7 @@ def _slab_mids(points: FloatArray, centres: FloatArray, pitch: float) -> FloatAr
     tangents /= np.linalg.norm(tangents, axis=1, keepdims=True)
     normals = np.c_[-tangents[:, 1], tangents[:, 0]]
     out = np.full(len(centres), np.nan)
-    for i, (c, t, n) in enumerate(zip(centres, tangents, normals)):
+    for i, (c, t, n) in enumerate(zip(centres, tangents, normals, strict=False)):
         rel = points - c
         inside = np.abs(rel @ t) <= pitch / 4
         if inside.sum() >= 3:

@@ -126,7 +126,7 @@ def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
 
     try:
         loaded = trimesh.load(path, force=None, process=False)
-    except Exception as exc:  # noqa: BLE001 - any parser failure is a file that is not a scan
+    except Exception as exc:  # any parser failure is a file that is not a scan
         raise ScanError(f"scan {path}: not a readable mesh or point cloud ({type(exc).__name__}: {exc})") from None
     if isinstance(loaded, trimesh.Scene):
         geometries = list(loaded.geometry.values())

@@ -65,12 +65,12 @@ __all__ = [
     "make_objective",
     "mirror_response",
     "plot_study",
-    "smooth_curve",
     "population_study",
     "profile_target",
     "run_design",
     "run_exhaustive",
     "run_ga",
     "score",
+    "smooth_curve",
     "tip_goal",
 ]

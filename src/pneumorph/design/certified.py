@@ -413,7 +413,8 @@ def chain_geometry(chain: ChainModel) -> ChainGeometry:
     ths: list[FloatArray] = []
     rs: list[FloatArray] = []
     with np.errstate(all="ignore"):
-        for p, _, bits, st, centres in _depths(chain, *_seed_prefixes(chain, polar=True), polar=True):
+        # the last depth's designs and state are the complete designs' (used after the loop)
+        for p, _, bits, st, centres in _depths(chain, *_seed_prefixes(chain, polar=True), polar=True):  # noqa: B007
             for _, x, y in centres:
                 depth.append(p)
                 xs.append(x)
@@ -794,7 +795,7 @@ def certified_search(
         "could_beat": could_beat,
         "certified": could_beat == 0 and not beat_floor,
         "verified": list(verified),
-        "designs_scored": int(len(designs)),
+        "designs_scored": len(designs),
         "complete": scores.complete,
         "floor": None if scores.complete else sign * scores.floor,
         "margin": margin,
@@ -804,5 +805,17 @@ def certified_search(
                            solves=book.solves, wall_time=time.perf_counter() - start)
 
 
-__all__ = ["CertifiedResult", "ChainGeometry", "ChainScores", "best_scores", "chain_geometry", "grow_designs", "certified_search", "chain_candidate", "chain_errors",
-           "chain_scores", "objective_bounds", "score_designs"]
+__all__ = [
+    "CertifiedResult",
+    "ChainGeometry",
+    "ChainScores",
+    "best_scores",
+    "certified_search",
+    "chain_candidate",
+    "chain_errors",
+    "chain_geometry",
+    "chain_scores",
+    "grow_designs",
+    "objective_bounds",
+    "score_designs",
+]

@@ -128,7 +128,8 @@ class DesignConfig:
             given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
                                     ("chain_table", self.chain_table), ("margin", self.margin != 1.0)) if v]
             if given:
-                raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} to the "
+                raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} "
+                                        "to the "
                                         "certified search, not to "
                                         f"search = {self.search!r}; leave them out or set search = \"certified\"")
         if self.verify is not None:
@@ -197,7 +198,8 @@ class DesignConfig:
         known_exec = {"executor", "workers", "scheduler", "cache"}
         tables = {"design": known_design, "ga": known_ga, "execution": known_exec}
         for table in set(data) - {*tables, "model", "provenance"}:
-            raise SearchConfigError(f"unknown table [{table}] in the design config; known: design, ga, execution, model")
+            raise SearchConfigError(f"unknown table [{table}] in the design config; "
+                                    "known: design, ga, execution, model")
         for table in ("design", "ga", "execution", "model"):
             if not isinstance(data.get(table, {}), dict):
                 raise SearchConfigError(f"[{table}] must be a table of settings, got {data[table]!r}")

@@ -284,7 +284,8 @@ def parse_expression(
     >>> parse_expression("x.__class__")
     Traceback (most recent call last):
     ...
-    pneumorph.errors.TargetExpressionError: in expression 'x.__class__': attribute access is not allowed: 'x.__class__' (column 1)
+    pneumorph.errors.TargetExpressionError: in expression 'x.__class__': attribute access is not allowed:
+    'x.__class__' (column 1)
     """
     if not isinstance(text, str) or not text.strip():
         raise TargetExpressionError("the target expression is empty; give e.g. 'A*sin(2*pi*x/L)'")

@@ -234,7 +234,8 @@ def _design(ind: Sequence[int]) -> str:
     return "".join(str(int(b)) for b in ind)
 
 
-def _stats(gen: int, population: Sequence, book: ScoreBook, counts: tuple[int, int, int], wall: float) -> GenerationStats:
+def _stats(gen: int, population: Sequence, book: ScoreBook, counts: tuple[int, int, int],
+           wall: float) -> GenerationStats:
     values = np.array([ind.fitness.values[0] for ind in population], dtype=float)
     finite = values[np.isfinite(values)]
     best_ind = max(population, key=lambda ind: ind.fitness)
@@ -338,6 +339,6 @@ def _keep_elites(population: list, offspring: list, k: int, toolbox: base.Toolbo
         if len(elites) == k:
             break
     worst_first = sorted(range(len(offspring)), key=lambda i: offspring[i].fitness)
-    for i, elite in zip(worst_first, elites):
+    for i, elite in zip(worst_first, elites, strict=False):
         if elite.fitness > offspring[i].fitness:
             offspring[i] = elite

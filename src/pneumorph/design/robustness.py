@@ -32,7 +32,7 @@ def _stats(values: np.ndarray, sense: str) -> dict[str, float]:
     worse = v if sense == "min" else -v
     sign = 1.0 if sense == "min" else -1.0
     return {"mean": float(v.mean()), "worst": float(sign * worse.max()), "p95": float(sign * np.percentile(worse, 95)),
-            "best": float(sign * worse.min()), "samples": int(len(v))}
+            "best": float(sign * worse.min()), "samples": len(v)}
 
 
 def chain_robustness(config: Any, chain: Any, tables: Any, objective: Any, winner: Candidate) -> dict[str, Any]:

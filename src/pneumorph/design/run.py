@@ -350,7 +350,8 @@ def _remove_run_files(folder: Path) -> None:
         except FileNotFoundError:
             continue
         except OSError as exc:
-            raise RunFolderError(f"{folder}: cannot remove {path.name} of the old run ({exc.strerror or exc})") from None
+            raise RunFolderError(f"{folder}: cannot remove {path.name} of the old run "
+                                 f"({exc.strerror or exc})") from None
         parents.update(p for p in path.parents if p != folder and p.is_relative_to(folder))
     for parent in sorted(parents, key=lambda p: len(p.parts), reverse=True):
         try:
@@ -516,7 +517,7 @@ def run_design(
                 hof = cert.hall_of_fame
                 order = cert.scores.order()[:1000]
                 names = design_strings(cert.scores.bits[order])
-                ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order)]
+                ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order, strict=False)]
             else:
                 ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame,
                                     on_progress=on_progress)
@@ -790,8 +791,9 @@ def _robustness_lines(rob: dict[str, Any], o: Objective) -> list[str]:
     """The report's section on mould tolerances."""
     u = o.unit
     lines = ["## Robustness to mould tolerances", "",
-             f"Every thickness of Fig E.4 (side walls, Mold Star wall, Smooth-Sil layer) within +-{rob['tolerance_mm']:g} "
-             f"mm, {rob['samples']} seeded samples (seed {rob['seed']}); {rob['method']}.", ""]
+             f"Every thickness of Fig E.4 (side walls, Mold Star wall, Smooth-Sil layer) within "
+             f"+-{rob['tolerance_mm']:g} mm, {rob['samples']} seeded samples (seed {rob['seed']}); "
+             f"{rob['method']}.", ""]
 
     def row(label: str, w: dict[str, Any]) -> str:
         p = "-" if w.get("pressure_kPa") is None else f"{w['pressure_kPa']:.4g}"

@@ -222,7 +222,8 @@ class ProfileTarget:
         >>> profile_target("y = 1/x").check(157.5)
         Traceback (most recent call last):
         ...
-        pneumorph.errors.TargetExpressionError: the target y = 1/x is not finite at x = 0 (inf); it must be finite for 0 <= x <= L = 157.5 mm
+        pneumorph.errors.TargetExpressionError: the target y = 1/x is not finite at x = 0 (inf); it must be
+        finite for 0 <= x <= L = 157.5 mm
         """
         polar = self.coordinates == "polar"
         s = np.linspace(0.0, np.pi if polar else float(length), 201)
@@ -402,7 +403,8 @@ def make_objective(
     >>> make_objective("max-z")
     Traceback (most recent call last):
     ...
-    pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y, min-y, min-distance, max-curl, reach, sin, cos, or a profile 'y = f(x)' / 'r = f(theta)'
+    pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y,
+    min-y, min-distance, max-curl, reach, sin, cos, or a profile 'y = f(x)' / 'r = f(theta)'
     """
     key = _ALIASES.get(_normalise(spec), _normalise(spec))
     if (key == "curve") != (curve is not None):

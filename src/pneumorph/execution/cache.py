@@ -451,8 +451,10 @@ class CachedEvaluator:
         yield from self._answer(keys, lambda key: self.cache.get(*key),
                                 lambda todo: self.inner.iter_cases([first[key] for key in todo]))
 
-    def _answer(self, keys: list[tuple[str, str]], lookup: Callable[[tuple[str, str]], Outcome | None],
-                solve: Callable[[list[tuple[str, str]]], Iterator[tuple[int, Outcome]]]) -> Iterator[tuple[int, Outcome]]:
+    def _answer(
+        self, keys: list[tuple[str, str]], lookup: Callable[[tuple[str, str]], Outcome | None],
+        solve: Callable[[list[tuple[str, str]]], Iterator[tuple[int, Outcome]]],
+    ) -> Iterator[tuple[int, Outcome]]:
         """Yield ``(index, Outcome)`` of every ``(fingerprint, design)`` key: the cache's first, then each key
         solved once (``solve(unique keys)``), stored the moment it arrives."""
         todo: dict[tuple[str, str], list[int]] = {}

@@ -70,7 +70,8 @@ def solve(model: ActuatorModel, design: str) -> Outcome:
     except SimulationFailed as exc:
         p_max = exc.pressure if exc.pressure is not None else float(model.pressures()[-1])
         partial = exc.partial if isinstance(exc.partial, Response) else None  # the levels it did converge
-        return Outcome(design, partial, exc.cause or str(exc), exc.reached * p_max, wall_time=time.perf_counter() - start)
+        return Outcome(design, partial, exc.cause or str(exc), exc.reached * p_max,
+                       wall_time=time.perf_counter() - start)
     except Exception as exc:
         raise EvaluationError(f"design {design}: the model raised {type(exc).__name__}: {exc}") from exc
     wall = time.perf_counter() - start

@@ -53,7 +53,8 @@ Solver controls
     derivatives divided by their differences elsewhere. Measured on the 15-unit
     benchmark design: from the unloaded state (C = I) its first iteration's largest
     displacement is 2.3 times the converged solution's (0.154 against 0.068 mm at
-    0.28 kPa), and a first increment of 4.5 kPa diverges, and at small loads the residual stalls at 10-100 micronewtons, which
+    0.28 kPa), and a first increment of 4.5 kPa diverges, and at small loads the residual
+    stalls at 10-100 micronewtons, which
     CalculiX's default criterion (0.5 % of the running average nodal force, itself tiny
     in the first increments) never accepts. The deck therefore starts with a twentieth of
     the first level (``*STATIC``; the increments grow to one level, never beyond) and
@@ -314,7 +315,7 @@ def _ogden_line(material: Any, role: str) -> list[str]:
         raise MaterialDataError(f"{role} material {material.name!r}: no bulk modulus; the deck needs one")
     k = material.bulk_modulus.value
     values = []
-    for mu, alpha in zip(model.mu, model.alpha):
+    for mu, alpha in zip(model.mu, model.alpha, strict=False):
         values += [mu * alpha / 2.0 * PA_PER_MPA, alpha]
     d = [2.0 / (k * PA_PER_MPA)] + [HUGE_D] * (model.terms - 1)
     values += d
@@ -460,7 +461,7 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True, residual
         "** follower pressure on the cavity walls: element, face (C3D20 numbering), Pa",
         "*DLOAD, AMPLITUDE=RAMP",
     ]
-    out += [f"{e + 1}, P{f}, {_num(pressure_pa)}" for e, f in zip(elements, faces)]
+    out += [f"{e + 1}, P{f}, {_num(pressure_pa)}" for e, f in zip(elements, faces, strict=False)]
     out += ["*NODE PRINT, NSET=TIP, TIME POINTS=LEVELS", "U"]
     if full_output:
         out += ["*NODE FILE, TIME POINTS=LEVELS", "U"]

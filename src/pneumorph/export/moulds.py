@@ -147,7 +147,8 @@ class MouldSpec:
     >>> MouldSpec(clearance=2.0)
     Traceback (most recent call last):
     ...
-    pneumorph.errors.GeometryError: mould clearance 2 mm is too large: a pin hole of 3 + 2 x 2 mm leaves less than 0.5 mm of the 6 mm wall on each side (clearance, pin_diameter, wall)
+    pneumorph.errors.GeometryError: mould clearance 2 mm is too large: a pin hole of 3 + 2 x 2 mm leaves less
+    than 0.5 mm of the 6 mm wall on each side (clearance, pin_diameter, wall)
     """
 
     clearance: float = 0.2
@@ -209,7 +210,8 @@ class MouldSpec:
         >>> MouldSpec(draft=8.0).check(UnitSpec(), "01")
         Traceback (most recent call last):
         ...
-        pneumorph.errors.GeometryError: mould draft 8 degrees narrows each side of the 12 mm deep cores by 1.69 mm, more than a quarter of the cavity's smaller side (4.5 mm); use at most 5.36 degrees
+        pneumorph.errors.GeometryError: mould draft 8 degrees narrows each side of the 12 mm deep cores by
+        1.69 mm, more than a quarter of the cavity's smaller side (4.5 mm); use at most 5.36 degrees
         """
         _check_fit(spec, self)
         _hole_centres(spec, parse_orientation(orientation), self)
@@ -383,7 +385,8 @@ def _check_fit(spec: UnitSpec, mould: MouldSpec) -> tuple[float, float]:
     tip = depth * math.tan(math.radians(mould.draft))
     if tip > smaller / 4:
         raise GeometryError(
-            f"mould draft {mould.draft:g} degrees narrows each side of the {depth:g} mm deep cores by {tip:.3g} mm, more "
+            f"mould draft {mould.draft:g} degrees narrows each side of the {depth:g} mm deep cores by {tip:.3g} mm, "
+            f"more "
             f"than a quarter of the cavity's smaller side ({smaller:g} mm); use at most "
             f"{math.degrees(math.atan(smaller / 4 / depth)):.3g} degrees"
         )
@@ -425,7 +428,8 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     >>> casting_mould(UnitSpec(), "0", MouldSpec(clearance=1.2, wall=8.0))
     Traceback (most recent call last):
     ...
-    pneumorph.errors.GeometryError: mould clearance 1.2 mm is not smaller than the core tenon's setback 1.125 mm (a quarter of the cavity's smaller side, 4.5 mm): silicone would run into the tenon pockets
+    pneumorph.errors.GeometryError: mould clearance 1.2 mm is not smaller than the core tenon's setback 1.125
+    mm (a quarter of the cavity's smaller side, 4.5 mm): silicone would run into the tenon pockets
     """
     import manifold3d as m3
 
@@ -491,8 +495,8 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     explode.update({name: (0.0, 0.0, e) for name in solids if name.startswith("pin_")})
 
     if check:
-        gaps = [hole - pin for hole, pin in zip(pin_holes, pins)]
-        gaps += [(pocket ^ box((X0, X1, Y0, Y1, Z0, s))) - core for pocket, core in zip(pockets, cores)]
+        gaps = [hole - pin for hole, pin in zip(pin_holes, pins, strict=False)]
+        gaps += [(pocket ^ box((X0, X1, Y0, Y1, Z0, s))) - core for pocket, core in zip(pockets, cores, strict=False)]
         body = actuator_solids(spec, orientation, base_block=None)["body"]
         core_tops = m3.Manifold.batch_boolean(cores, m3.OpType.Add) ^ box((X0, X1, Y0, Y1, s, W))
         as_cast = outline_solid(spec, orientation, 0.0, W) - core_tops

@@ -93,7 +93,8 @@ __all__ = [
     "write_stl",
 ]
 
-#: A box ``(x0, x1, y0, y1, z0, z1)`` in mm.
+#: the base block the parts get unless told otherwise (frozen: safe as a default)
+DEFAULT_BLOCK = BaseBlock()
 
 # The 12 outward triangles of a box whose 8 corners are numbered by bits (x, y, z).
 _BOX_FACES = np.array(
@@ -290,7 +291,7 @@ def outline_solid(spec: UnitSpec, orientation: str, z0: float, z1: float) -> man
 
 
 def actuator_solids(
-    spec: UnitSpec, orientation: str, base_block: BaseBlock | None = BaseBlock()
+    spec: UnitSpec, orientation: str, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, manifold3d.Manifold]:
     """The actuator's parts as manifold3d solids (see :func:`actuator_parts`)."""
     import manifold3d as m3
@@ -310,7 +311,7 @@ def actuator_solids(
 
 
 def actuator_parts(
-    spec: UnitSpec, orientation: str, base_block: BaseBlock | None = BaseBlock()
+    spec: UnitSpec, orientation: str, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, trimesh.Trimesh]:
     """Watertight meshes of the body, the layer pieces and the base block.
 

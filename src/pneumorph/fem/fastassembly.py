@@ -230,7 +230,7 @@ class PlaneStrainSystem:
     def tangent_data(self) -> FloatArray:
         """CSR ``data`` of ``K[dof1, dof1]`` at the state of the last :meth:`residual`."""
         blocks = []
-        for grp, AdV in zip(self.groups, self._cache):
+        for grp, AdV in zip(self.groups, self._cache, strict=False):
             c, q, n, _ = grp.g.shape
             # D[cq, (i, J, k), b] = sum_L A[i, J, k, L, cq] dV g[cq, b, L]
             At = np.ascontiguousarray(AdV.reshape(16, c * q).T).reshape(c * q, 8, 2)

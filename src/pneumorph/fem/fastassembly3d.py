@@ -249,7 +249,7 @@ class SolidSystem3D:
         self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows_u, minlength=n1))]).astype(np.int32)
         self.indices = (unique - rows_u * n1).astype(np.int32)
         start = 0
-        for owner, k in zip(owners, keys_all):
+        for owner, k in zip(owners, keys_all, strict=False):
             owner.scatter = position[start : start + k.size]
             start += k.size
         self._edofs = [(3 * o.cells[:, :, None] + np.arange(3)).ravel() for o in owners]
@@ -267,7 +267,7 @@ class SolidSystem3D:
         r = np.zeros(self.ndof)
         self._state = []
         jmin = np.inf
-        for s, edofs in zip(self.solids, self._edofs):
+        for s, edofs in zip(self.solids, self._edofs, strict=False):
             c, q = s.dV.shape
             # F[c, i, (q, J)] = sum_a u[c, a, i] g[c, q, a, J], then as [i, J, (c, q)]
             F = np.matmul(U[s.cells].transpose(0, 2, 1), s.G).reshape(c, 3, q, 3)
@@ -282,7 +282,7 @@ class SolidSystem3D:
             PdV = (P * s.dV.reshape(-1)).reshape(3, 3, c, q).transpose(2, 3, 1, 0).reshape(c, 3 * q, 3)
             r += np.bincount(edofs, weights=np.matmul(s.G, PdV).ravel(), minlength=self.ndof)
             self._state.append((Fp, principal))
-        for w, edofs in zip(self.walls, self._edofs[len(self.solids):]):
+        for w, edofs in zip(self.walls, self._edofs[len(self.solids):], strict=False):
             p = float(w.item.results.pressure)
             F = _deformation(w.g, w.cells, U)
             cofN = _cof_normal(F, w.ndA)  # (f, q, 3)
@@ -294,7 +294,7 @@ class SolidSystem3D:
     def tangent_data(self) -> FloatArray:
         """CSR ``data`` of the upper triangle of ``K[dof1, dof1]`` (state of the last residual)."""
         data = np.zeros(self.nnz)
-        for s, (Fp, principal) in zip(self.solids, self._state):
+        for s, (Fp, principal) in zip(self.solids, self._state, strict=False):
             c, q, n, _ = s.g.shape
             _, A, _ = s.kernel(Fp, True, principal)
             assert A is not None

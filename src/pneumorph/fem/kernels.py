@@ -326,7 +326,7 @@ def ogden_3d(
             for j in range(3):
                 row = Ab[m, j]
                 np.multiply(left[0][i, j], right[0][k], out=row)
-                for L, R in zip(left[1:], right[1:]):
+                for L, R in zip(left[1:], right[1:], strict=False):
                     row += L[i, j] * R[k]
                 if i == k:
                     row += S_mat[j]
@@ -336,7 +336,7 @@ def ogden_3d(
         for j in range(3):
             row = A[i, j]
             np.multiply(left[0][i, j], right[0], out=row)
-            for L, R in zip(left[1:], right[1:]):
+            for L, R in zip(left[1:], right[1:], strict=False):
                 row += L[i, j] * R
             row[i] += S_mat[j]
     return P, A, J

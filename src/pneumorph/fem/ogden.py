@@ -166,7 +166,7 @@ class OgdenCompressible:
             right.append(diag[a, 0] * Gd[0] + diag[a, 1] * Gd[1] + diag[a, 2] * Gd[2])
         for a, b in ((0, 1), (0, 2), (1, 2)):
             dd = common / (cp[a] * cp[b])  # divided difference of -common / c
-            for mu_n, a_n, J_n in zip(self.mu, self.alpha, Jn):
+            for mu_n, a_n, J_n in zip(self.mu, self.alpha, Jn, strict=False):
                 dd += mu_n * J_n * _power_divided_difference(cp[b], cp[a], a_n / 2 - 1.0)
             Gs = f[:, a][:, None] * Np[:, b][None, :] + f[:, b][:, None] * Np[:, a][None, :]
             left.append(Gs)

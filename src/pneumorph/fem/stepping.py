@@ -148,7 +148,7 @@ def _extrapolate(
             if m != j:
                 w *= (t - tm) / (tj - tm)
         weights.append(w)
-    return [sum(w * s[1][i] for w, s in zip(weights, states)) for i in range(len(states[0][1]))]
+    return [sum(w * s[1][i] for w, s in zip(weights, states, strict=False)) for i in range(len(states[0][1]))]
 
 
 def _values(fields: Any) -> list[NDArray[np.float64]]:
@@ -156,7 +156,7 @@ def _values(fields: Any) -> list[NDArray[np.float64]]:
 
 
 def _restore(fields: Any, values: Sequence[NDArray[np.float64]]) -> None:
-    for f, v in zip(fields.fields, values):
+    for f, v in zip(fields.fields, values, strict=False):
         f.values[:] = v
 
 

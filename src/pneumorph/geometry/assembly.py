@@ -14,6 +14,7 @@ regions and fields.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 from numpy.typing import NDArray
@@ -104,7 +105,7 @@ def grid_lines(breaks: list[float], size: float) -> FloatArray:
     """
     b = np.unique(np.round(np.asarray(breaks, dtype=float), 6))
     out = [b[0]]
-    for lo, hi in zip(b[:-1], b[1:]):
+    for lo, hi in pairwise(b):
         n = max(1, int(np.ceil((hi - lo) / size - 1e-9)))
         out.extend(np.linspace(lo, hi, n + 1)[1:])
     return np.asarray(out)

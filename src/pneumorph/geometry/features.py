@@ -123,7 +123,9 @@ def check_passage(spec: UnitSpec, diameter: float) -> float:
     >>> check_passage(UnitSpec(), 4.0)
     Traceback (most recent call last):
     ...
-    pneumorph.errors.GeometryError: a passage of 4 mm (a 3.54 mm square channel) is wider than the walls between cavities allow: at most 3.385 mm for this unit (the common height of two cavities facing either way, cavity_height 6 mm - layer 3 mm, and the cavity's width)
+    pneumorph.errors.GeometryError: a passage of 4 mm (a 3.54 mm square channel) is wider than the walls
+    between cavities allow: at most 3.385 mm for this unit (the common height of two cavities facing either
+    way, cavity_height 6 mm - layer 3 mm, and the cavity's width)
     """
     check_length("passage diameter", diameter, positive=False)
     if diameter == 0:

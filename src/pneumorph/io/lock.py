@@ -72,7 +72,7 @@ def _pid_alive(pid: int) -> bool | None:
                 return code.value == 259  # STILL_ACTIVE
             finally:
                 kernel32.CloseHandle(handle)
-        except Exception:  # noqa: BLE001 - cannot tell: treated as running
+        except Exception:  # cannot tell: treated as running
             return None
     try:
         os.kill(pid, 0)

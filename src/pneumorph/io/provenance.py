@@ -32,7 +32,7 @@ def provenance(**extra: Any) -> dict[str, Any]:
         "pneumorph": __version__,
         "python": sys.version.split()[0],
         "platform": platform.platform(),
-        "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "created_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "dependencies": deps,
         **extra,
     }

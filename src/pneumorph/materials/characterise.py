@@ -47,14 +47,14 @@ ModulusKind = Literal["secant", "tangent"]
 def _columns(*arrays: ArrayLike, names: tuple[str, ...]) -> tuple[FloatArray, ...]:
     """1-D float arrays of equal length without NaN/inf (DataFormatError otherwise)."""
     out = tuple(np.asarray(a, dtype=float) for a in arrays)
-    for a, name in zip(out, names):
+    for a, name in zip(out, names, strict=False):
         if a.ndim != 1:
             raise DataFormatError(f"{name} must be a 1-D sequence, got shape {a.shape}")
-    lengths = {name: a.size for a, name in zip(out, names)}
+    lengths = {name: a.size for a, name in zip(out, names, strict=False)}
     if len(set(lengths.values())) > 1:
         got = ", ".join(f"{k} {v}" for k, v in lengths.items())
         raise DataFormatError(f"columns must have the same length, got {got}")
-    for a, name in zip(out, names):
+    for a, name in zip(out, names, strict=False):
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
             raise DataFormatError(f"{name} has a non-finite value at index {bad[0]}: {a[bad[0]]}")

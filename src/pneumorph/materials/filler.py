@@ -18,7 +18,8 @@ Examples
 >>> law.modulus(0.060)
 Traceback (most recent call last):
     ...
-pneumorph.errors.PressureRangeError: pressure 60 kPa is outside the calibrated range 0-45 kPa of the filler law 'eq5_2'; recalibrate the law for this range instead of extrapolating
+pneumorph.errors.PressureRangeError: pressure 60 kPa is outside the calibrated range 0-45 kPa of the filler
+law 'eq5_2'; recalibrate the law for this range instead of extrapolating
 """
 
 from __future__ import annotations
@@ -82,7 +83,8 @@ class FillerLaw:
         lower, upper = (float(x) for x in self.pressure_range)
         object.__setattr__(self, "pressure_range", (lower, upper))
         if not self.coefficients or not all(math.isfinite(c) for c in self.coefficients):
-            raise MaterialDataError(f"filler law {self.name!r}: coefficients must be finite numbers, got {self.coefficients}")
+            raise MaterialDataError(f"filler law {self.name!r}: coefficients must be finite numbers, "
+                                    f"got {self.coefficients}")
         if not (0.0 <= lower < upper and math.isfinite(upper)):
             raise MaterialDataError(
                 f"filler law {self.name!r}: calibrated range must satisfy 0 <= lower < upper, "
@@ -176,7 +178,7 @@ class FillerLaw:
             "coefficients_internal_units": "c_k in MPa^(1-k), P in MPa",
             "calibrated_range_MPa": list(self.pressure_range),
             "calibrated_range_kPa": [x * 1e3 for x in self.pressure_range],
-            "minimum_in_range": dict(zip(("pressure_MPa", "modulus_MPa"), self.minimum())),
+            "minimum_in_range": dict(zip(("pressure_MPa", "modulus_MPa"), self.minimum(), strict=False)),
             "source": self.source,
             "range_source": self.range_source,
             "poisson_ratio": {

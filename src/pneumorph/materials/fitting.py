@@ -471,10 +471,11 @@ def fit(
         model=model,
         parameters=MappingProxyType(dict(params)),
         mu0=float(model.shear_modulus),
-        r2=MappingProxyType({c.mode: r_squared(c.stress, q) for c, q in zip(curves, pred)}),
+        r2=MappingProxyType({c.mode: r_squared(c.stress, q) for c, q in zip(curves, pred, strict=False)}),
         r2_overall=r_squared(y, np.concatenate(pred)),
         residual_norm=float(np.linalg.norm(y - np.concatenate(pred))),
-        rmse=MappingProxyType({c.mode: float(np.sqrt(np.mean((c.stress - q) ** 2))) for c, q in zip(curves, pred)}),
+        rmse=MappingProxyType({c.mode: float(np.sqrt(np.mean((c.stress - q) ** 2)))
+                               for c, q in zip(curves, pred, strict=True)}),
         n_points=MappingProxyType({c.mode: len(c) for c in curves}),
         stretch_range=MappingProxyType({c.mode: (float(c.stretch[0]), float(c.stretch[-1])) for c in curves}),
         stability=drucker_stability(model, stretch_range=srange),
@@ -527,7 +528,7 @@ class FitComparison:
 
     def to_text(self) -> str:
         head, body = self._cells()
-        widths = [max(len(x) for x in col) for col in zip(head, *body)]
+        widths = [max(len(x) for x in col) for col in zip(head, *body, strict=False)]
         fmt = "  ".join(f"{{:{w}s}}" for w in widths)
         rows = [head, ["-" * w for w in widths], *body]
         return "\n".join(fmt.format(*r).rstrip() for r in rows)

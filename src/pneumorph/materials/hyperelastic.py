@@ -313,12 +313,12 @@ class Ogden(_Base):
 
     @property
     def shear_modulus(self) -> float:
-        return float(sum(m * a for m, a in zip(self.mu, self.alpha)) / 2.0)
+        return float(sum(m * a for m, a in zip(self.mu, self.alpha, strict=False)) / 2.0)
 
     @property
     def parameters(self) -> dict[str, float]:
         out: dict[str, float] = {}
-        for i, (m, a) in enumerate(zip(self.mu, self.alpha), start=1):
+        for i, (m, a) in enumerate(zip(self.mu, self.alpha, strict=False), start=1):
             out[f"mu{i}"] = m
             out[f"alpha{i}"] = a
         return out
@@ -327,7 +327,7 @@ class Ogden(_Base):
         s = (np.asarray(x, dtype=float) for x in (l1, l2, l3))
         a1, a2, a3 = s
         return np.asarray(
-            sum(m / a * (a1**a + a2**a + a3**a - 3.0) for m, a in zip(self.mu, self.alpha)),
+            sum(m / a * (a1**a + a2**a + a3**a - 3.0) for m, a in zip(self.mu, self.alpha, strict=False)),
             dtype=float,
         )
 
@@ -337,7 +337,7 @@ class Ogden(_Base):
         out = []
         for s in (l1, l2, l3):
             s = np.asarray(s, dtype=float)
-            out.append(np.asarray(sum(m * s**a for m, a in zip(self.mu, self.alpha)), dtype=float))
+            out.append(np.asarray(sum(m * s**a for m, a in zip(self.mu, self.alpha, strict=False)), dtype=float))
         return out[0], out[1], out[2]
 
 
@@ -352,7 +352,7 @@ def ogden_marc_to_felupe(mu: tuple[float, ...], alpha: tuple[float, ...]) -> tup
     >>> ogden_marc_to_felupe((0.2169,), (1.18,))
     (0.127971,)
     """
-    return tuple(round(m * a / 2.0, 15) for m, a in zip(mu, alpha))
+    return tuple(round(m * a / 2.0, 15) for m, a in zip(mu, alpha, strict=False))
 
 
 @dataclass(frozen=True)
@@ -453,7 +453,7 @@ def drucker_stability(
     h = 1e-5
     stable = {}
     for mode in MODES:
-        l1, l2, l3 = mode_stretches(mode, lam)
+        l1, l2, _l3 = mode_stretches(mode, lam)
         e = np.stack([np.log(l1), np.log(l2)])
 
         def grad(e1: FloatArray, e2: FloatArray) -> FloatArray:

@@ -17,8 +17,8 @@ from pneumorph.materials.hyperelastic import (
 )
 from pneumorph.materials.material import (
     KINDS,
-    PROPERTIES,
     POSITIVE_PROPERTIES,
+    PROPERTIES,
     Library,
     Material,
     ModelRecord,

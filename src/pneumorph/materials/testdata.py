@@ -207,7 +207,7 @@ class TestData:
             if keep.any():
                 note = f"restricted to stretch {lo:g}-{hi:g} ({int(keep.sum())} of {len(c)} points)"
                 out.append(TestCurve(c.mode, c.stretch[keep], c.stress[keep], c.source,
-                                     c.description, c.metadata, c.notes + (note,)))
+                                     c.description, c.metadata, (*c.notes, note)))
         if not out:
             raise DataFormatError(f"no data point has a stretch between {lo:g} and {hi:g}",
                                   path=self.name or None)
@@ -238,11 +238,13 @@ def column_roles(columns: str | Sequence[str], path: str | None = None) -> list[
     >>> column_roles("stress")
     Traceback (most recent call last):
     ...
-    pneumorph.errors.DataFormatError: columns ['stress'] must name one of stretch/strain/true-strain, one stress and otherwise 'skip' (roles: stretch, strain, true-strain, stress, skip)
+    pneumorph.errors.DataFormatError: columns ['stress'] must name one of stretch/strain/true-strain, one
+    stress and otherwise 'skip' (roles: stretch, strain, true-strain, stress, skip)
     """
     roles = [c.strip().lower() for c in (columns.split(",") if isinstance(columns, str) else columns)]
     bad = [r for r in roles if r not in COLUMN_ROLES]
-    if bad or sum(r == "stress" for r in roles) != 1 or sum(r in ("stretch", "strain", "true-strain") for r in roles) != 1:
+    strains = sum(r in ("stretch", "strain", "true-strain") for r in roles)
+    if bad or sum(r == "stress" for r in roles) != 1 or strains != 1:
         raise DataFormatError(
             f"columns {roles} must name one of stretch/strain/true-strain, one stress and "
             f"otherwise 'skip' (roles: {', '.join(COLUMN_ROLES)})", path=path)
@@ -503,7 +505,7 @@ def read_curve(
 def _soro_metadata(body: list[tuple[int, str]], src: str) -> tuple[list[tuple[int, str]], dict[str, str]]:
     """Split the database's ``PARAMETER;INFO;URL`` block from the table."""
     meta: dict[str, str] = {}
-    for k, (n, line) in enumerate(body[1:], start=1):
+    for k, (_n, line) in enumerate(body[1:], start=1):
         cells = _split(line, ";")
         if not cells:  # a line of empty cells ends the block
             continue

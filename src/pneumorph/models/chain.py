@@ -422,7 +422,7 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     tip_y = float(ref.reference_tip[1])
     heights: dict[int, list[float]] = {0: [], 1: []}
     for r in responses:
-        for o, y in zip(r.orientation, r.reference_centres[:, 1]):
+        for o, y in zip(r.orientation, r.reference_centres[:, 1], strict=False):
             heights[int(o)].append(float(y))
             if mirror:
                 heights[1 - int(o)].append(2 * tip_y - float(y))
@@ -555,7 +555,7 @@ def build_table(
         todo = [d for d in designs if d not in solved]
         t0 = time.perf_counter()
         done = 0
-        for i, outcome in evaluator.iter_evaluate(model, todo):
+        for _i, outcome in evaluator.iter_evaluate(model, todo):
             done += 1
             if not outcome.ok:
                 raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "

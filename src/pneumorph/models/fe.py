@@ -355,7 +355,8 @@ class FEModel:
             System = PlaneStrainSystem if self.dim == 2 else SolidSystem3D
             system = System(model["items"], field, model["dof1"], model["dof0"])
             substep = FastSubstep(system, reuse=self.tangent_reuse, depth=self.anderson_depth)
-            monitor = lambda: system.cavity_volume(field[0].values.ravel())
+            def monitor() -> float:
+                return system.cavity_volume(field[0].values.ravel())
         gravity_iterations = 0
         if self.gravity is not None:
             gravity_iterations = self._apply_gravity(model, substep, follow, design)

@@ -80,7 +80,7 @@ def plot_fits(
     FigureCanvasAgg(fig)
     fig.get_layout_engine().set(rect=(0.0, 0.03 * nlines, 1.0, 1.0 - 0.03 * nlines))
     axes = fig.subplots(1, len(modes), squeeze=False)[0]
-    for ax, mode in zip(axes, modes):
+    for ax, mode in zip(axes, modes, strict=False):
         c = data.curve(mode)
         every = max(1, len(c) // 60)
         ax.plot(c.stretch, c.stress, "o", ms=4, mfc="none", color="k", markevery=every,

@@ -50,7 +50,8 @@ def _surface(ax: Any, solution: Any, level: int | None) -> None:
     lo, hi = x.min(axis=0), x.max(axis=0)
     span = (hi - lo).max() / 2
     mid = (hi + lo) / 2
-    ax.set(xlim=(mid[0] - span, mid[0] + span), ylim=(mid[1] - span, mid[1] + span), zlim=(mid[2] - span, mid[2] + span))
+    ax.set(xlim=(mid[0] - span, mid[0] + span), ylim=(mid[1] - span, mid[1] + span),
+           zlim=(mid[2] - span, mid[2] + span))
     ax.view_init(elev=20, azim=-60)
 
 

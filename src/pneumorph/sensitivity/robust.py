@@ -115,7 +115,8 @@ class ToleranceTables:
                 lo, hi = np.asarray(getattr(self.minus[i], name)), np.asarray(getattr(self.plus[i], name))
                 v += (hi - lo) / (2 * t) * d + (hi + lo - 2 * n0) / (2 * t * t) * d * d
             scalars[name] = tuple(float(x) for x in v)
-        source = {**table.source, "tolerance_offsets_mm": dict(zip(self.tolerance.fields, offsets.tolist(), strict=True))}
+        given = dict(zip(self.tolerance.fields, offsets.tolist(), strict=True))
+        source = {**table.source, "tolerance_offsets_mm": given}
         return replace(table, **out, **scalars, source=source)
 
     # -- persistence --------------------------------------------------------------------------
@@ -160,7 +161,8 @@ def _variants(model: Any, tolerance: Tolerance) -> list[tuple[str, Any]]:
         for i, f in enumerate(tolerance.fields):
             o = np.zeros(len(tolerance.fields))
             o[i] = sign * tolerance.tolerance
-            out.append((f"{f} {sign * tolerance.tolerance:+g}", model.variant(unit=perturbed(unit, tolerance.fields, o))))
+            variant = model.variant(unit=perturbed(unit, tolerance.fields, o))
+            out.append((f"{f} {sign * tolerance.tolerance:+g}", variant))
     return out
 
 
@@ -273,7 +275,7 @@ class Robustness:
         return {"mean": float(self.statistic("mean")[i]), "worst": float(self.statistic("worst")[i]),
                 "p95": float(self.statistic("p95")[i]), "best": float(
                     self.values[:, i].min() if self.sense == "min" else self.values[:, i].max()),
-                "samples": int(len(self.values))}
+                "samples": len(self.values)}
 
 
 def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any, bits: NDArray[np.integer],

@@ -230,7 +230,8 @@ def bulk_modulus(model: FEModel, design: str | None = None, factors: Sequence[fl
     """Appendix E.1.2: the body silicone's bulk modulus raised by each factor."""
     body = model.body
     cases = tuple(
-        Case(f"bulk modulus x{f:g}", model.variant(materials={**model.materials, body.name: scaled_bulk_modulus(body, f)}),
+        Case(f"bulk modulus x{f:g}",
+             model.variant(materials={**model.materials, body.name: scaled_bulk_modulus(body, f)}),
              {"bulk_modulus_kpa": body.bulk_modulus.value * f * 1e3})  # type: ignore[union-attr]
         for f in factors
     )
@@ -250,7 +251,7 @@ def calibration(model: FEModel, design: str | None = None, reach: float = 2.0, s
     body = model.body
     soft, fitted = tension_only(body, seed=seed)
     steps = model.ramp.steps
-    increments = int(round(steps.increments * reach))
+    increments = round(steps.increments * reach)
     ramp = RampSpec(pressure=model.ramp.pressure * increments / steps.increments,
                     steps=replace(steps, increments=increments))
     variant = model.variant(materials={**model.materials, body.name: soft}, ramp_spec=ramp)
@@ -295,7 +296,8 @@ def _matching(reference: Any, response: Any, level: int) -> tuple[float, float]:
     return float(p[k]), float(d[k])
 
 
-def run_study(study: Study, evaluator: Any, on_case: Callable[[int, int, CaseResult], None] | None = None) -> StudyResult:
+def run_study(study: Study, evaluator: Any,
+              on_case: Callable[[int, int, CaseResult], None] | None = None) -> StudyResult:
     """Solve every case of ``study`` with ``evaluator`` (``iter_cases``) and measure the variants.
 
     ``on_case(done, total, result)`` is called as each case finishes (progress). Cases come
