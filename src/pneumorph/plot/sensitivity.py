@@ -40,8 +40,8 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
         lo, hi = (int(np.argmin(curls)), int(np.argmax(curls))) if len(curls) else (-1, -1)
         for i, c in enumerate(ok):
             line = c.outcome.response.centreline(level)
-            style = {"color": "tab:blue" if i == lo else "tab:red" if i == hi else "0.55",
-                     "lw": 1.4 if i in (lo, hi) else 0.5}
+            style: dict[str, Any] = {"color": "tab:blue" if i == lo else "tab:red" if i == hi else "0.55",
+                                     "lw": 1.4 if i in (lo, hi) else 0.5}
             label = "minimum curl" if i == lo else "maximum curl" if i == hi else None
             ax.plot(line[:, 0], line[:, 1], "-", label=label, **style)
     else:
@@ -65,13 +65,13 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
     if tolerances and ok:
         bx = fig.add_subplot(1, 2, 2)
         labels = [c.case.label for c in ok]
-        curls = [c.difference.curl_deg if c.difference is not None else np.nan for c in ok]
+        bars = [c.difference.curl_deg if c.difference is not None else np.nan for c in ok]
         colours = ["tab:orange" if not lab.startswith("sample") else "tab:gray" for lab in labels]
-        bx.barh(range(len(ok)), curls, color=colours)
+        bx.barh(range(len(ok)), bars, color=colours)
         if result.reference.outcome.ok:
             bx.axvline(float(ref.curl[level]), color="k", lw=1.2, label="nominal")
         bx.set_yticks(range(len(ok)), labels, fontsize=5)
-        finite = np.array(curls, dtype=float)
+        finite = np.array(bars, dtype=float)
         finite = finite[np.isfinite(finite)]
         if finite.size:
             pad = max(1.0, 0.1 * float(np.ptp(finite)))

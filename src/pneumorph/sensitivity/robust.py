@@ -251,8 +251,8 @@ class Robustness:
     sense : {"min", "max"}
     """
 
-    bits: NDArray[np.uint8]
-    level: NDArray[np.int64]
+    bits: NDArray[np.integer]
+    level: NDArray[np.integer]
     values: FloatArray
     offsets: FloatArray
     sense: str

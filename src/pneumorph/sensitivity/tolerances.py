@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from itertools import product
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -130,7 +131,8 @@ def perturbed(unit: UnitSpec, fields: tuple[str, ...], offsets: FloatArray) -> U
     >>> perturbed(UnitSpec(), FIELDS, np.array([0.1, -0.1, 0.05])).layer
     3.05
     """
-    values = {f: round(float(getattr(unit, f)) + float(d), 12) for f, d in zip(fields, offsets, strict=True)}
+    values: dict[str, Any] = {f: round(float(getattr(unit, f)) + float(d), 12)
+                              for f, d in zip(fields, offsets, strict=True)}
     return replace(unit, **values)
 
 
