@@ -1,4 +1,4 @@
-"""The code style the project holds itself to: ruff's checks (pyproject.toml [tool.ruff]) pass everywhere."""
+"""The code checks the project holds itself to ([tool.ruff] and [tool.mypy] in pyproject.toml)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,15 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 
 
+def _run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", *args], cwd=REPO, capture_output=True, text=True)
+
+
 def test_ruff_finds_nothing() -> None:
-    done = subprocess.run([sys.executable, "-m", "ruff", "check", "--output-format", "concise", "src", "tests",
-                           "benchmarks", "docs/scripts"], cwd=REPO, capture_output=True, text=True)
+    done = _run("ruff", "check", "--output-format", "concise", "src", "tests", "benchmarks", "docs/scripts")
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_mypy_finds_nothing_in_the_package() -> None:
+    done = _run("mypy", "--no-incremental")  # the files and settings of [tool.mypy]
     assert done.returncode == 0, done.stdout + done.stderr

@@ -22,13 +22,14 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 FIGURES = ROOT / "docs" / "figures"
-STUDIES = [
-    ("simplifications", []),
-    ("simplifications", ["--design", "001111010001001"]),
-    ("temperature", []),
-    ("bulk-modulus", []),
-    ("calibration", []),
-    ("tolerances", []),
+STUDIES = [  # (figure tag, study, options)
+    ("simplifications", "simplifications", []),
+    ("simplifications-mixed", "simplifications", ["--design", "001111010001001"]),
+    ("temperature", "temperature", []),
+    ("bulk-modulus", "bulk-modulus", []),
+    ("calibration", "calibration", []),
+    ("tolerances", "tolerances", ["--corners"]),
+    ("tolerances-machined", "tolerances", ["--tolerance", "0.02"]),
 ]
 
 
@@ -84,8 +85,7 @@ def main() -> None:
     solve = "--solve" in sys.argv
     FIGURES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        for name, extra in STUDIES:
-            tag = name + ("-mixed" if extra else "")
+        for tag, name, extra in STUDIES:
             data = run(name, extra, Path(tmp) / tag, solve)
             shutil.copy(Path(tmp) / tag / "study.png", FIGURES / f"sensitivity-{tag}.png")
             r = data["reference"]

@@ -142,7 +142,7 @@ def gamma(d2: np.ndarray, d3: np.ndarray) -> float:
 
 
 def fit_law(pressures: Sequence[float], moduli: Sequence[float], degree: int,
-            pressure_range: tuple[float, float], weights: Sequence[float] | None = None,
+            pressure_range: tuple[float, float], weights: Sequence[float] | np.ndarray | None = None,
             weighting: str = "uniform") -> LawFit:
     """Weighted least-squares polynomial E(P) of a degree, with R^2 (Eqs A.1-A.3) and checks.
 
@@ -469,7 +469,7 @@ def cached_3d_solver(cache: Any) -> Callable[[Full3D, str], Response]:
         outcome = hit if hit is not None else solve(model, design)
         if hit is None:
             cache.put(key, outcome)
-        if not outcome.ok:
+        if not outcome.ok or outcome.response is None:
             raise SimulationFailed(reached=0.0, cause=f"3D reference failed: {outcome.failure}", design=design)
         return outcome.response
 

@@ -12,7 +12,7 @@ from pneumorph.bench.query import Query, QueryError, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 
 
-def create_app(*args, **kwargs):  # type: ignore[no-untyped-def]
+def create_app(*args, **kwargs):
     """The bench's ASGI application (:func:`pneumorph.bench.app.create_app`; needs the ``web`` extra)."""
     from pneumorph.bench.app import create_app as make
 

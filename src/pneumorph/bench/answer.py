@@ -24,7 +24,7 @@ import numpy as np
 from pneumorph.bench.query import MODELS, Query, QueryError, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import best_scores
-from pneumorph.design.targets import ProfileTarget
+from pneumorph.design.targets import ProfileTarget, TipGoal
 from pneumorph.geometry.assembly import assemble
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
@@ -251,7 +251,7 @@ class Bench:
                      "pressure_kpa": float(kpa[int(scores.level[j])]), "optimistic": sign * float(scores.optimistic[j])}
                     for i, (d, j) in enumerate(zip(designs, top, strict=False))],
             "target": _target_samples(objective, length),
-            "point": list(objective.point) if getattr(objective, "point", None) is not None else None,
+            "point": list(objective.point) if isinstance(objective, TipGoal) and objective.point is not None else None,
             "profiles": profiles(response),
         }
 

@@ -230,7 +230,7 @@ class JobBoard:
         with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
                                  initializer=prepare_worker) as pool:
             response, shape, wall = pool.submit(fe_solve_shape, model, design).result()
-        if response is None:
+        if response is None or shape is None:
             return  # the design run solves it again and reports the failure
         self.bench.add_fe_shape(design, shape, unit)
         with EvaluationCache(self.cache) as cache:

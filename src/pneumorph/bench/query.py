@@ -188,7 +188,7 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
         blame = "point" if goal == "reach" else "goal"
     else:
         try:
-            knots = smooth_curve(target.get("points"), length)
+            knots = smooth_curve(target.get("points", []), length)
         except PneumorphError as exc:
             raise QueryError("points", str(exc)) from None
         fields.update(spec="curve", curve=tuple((float(x), float(y)) for x, y in np.round(knots, 6)))

@@ -39,6 +39,7 @@ from pneumorph.bimodal.geometry import (
 from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.materials import get
+from pneumorph.materials.hyperelastic import Ogden
 
 FloatArray = np.ndarray
 
@@ -197,7 +198,7 @@ class BimodalModel:
         if names["bilinear"] is None:
             raise ValueError("give a crimp ratio or a bilinear material")
         self.names = names
-        self.materials = {k: get(v) for k, v in names.items()}
+        self.materials = {k: get(v) for k, v in names.items() if v is not None}
         self.bilinear_bulk = bilinear_bulk
         self.increments = increments
         self.step = float(step)
@@ -211,7 +212,9 @@ class BimodalModel:
         """Bulk modulus (MPa) used for a layer."""
         if layer == "bilinear" and self.bilinear_bulk is not None:
             return float(self.bilinear_bulk)
-        return float(self.materials[layer].bulk_modulus.value)
+        bulk = self.materials[layer].bulk_modulus
+        assert bulk is not None, f"{layer}: a silicone without a bulk modulus"
+        return float(bulk.value)
 
     def describe(self) -> dict[str, Any]:
         return {
@@ -243,6 +246,7 @@ class BimodalModel:
         for code in (BILINEAR, SEAL, BODY, STRIP):
             name = LABELS[code]
             m = self.materials[name].model
+            assert isinstance(m, Ogden), f"{name}: the bimodal model takes Ogden silicones"
             umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name))
             bodies.append(linked_solid(umat, mesh.points, mesh.cells[mesh.label == code], mesh.cell_type,
                                        Region, fem.Field, 3, field_))

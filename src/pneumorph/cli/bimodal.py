@@ -71,7 +71,8 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     for option, field, value in (("--voids", "voids", voids), ("--element-size", "element_size", element_size),
                                  ("--end-cap", "end_cap", end_cap)):
         with P.blame(option):
-            BimodalSpec(**{field: value})
+            # one field at a time, so that an error names its option
+            BimodalSpec(**{field: value})  # type: ignore[arg-type]
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations)

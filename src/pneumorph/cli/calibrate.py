@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
@@ -61,7 +63,7 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
         store.close()
         return
 
-    def on_point(p) -> None:  # type: ignore[no-untyped-def]
+    def on_point(p) -> None:
         click.echo(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
                    f"(Eq 5.1 = {p.gamma:.4g} mm^2, {p.evaluations} 2D solves)", err=True)
 
@@ -100,14 +102,14 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
     if result.chosen is None:
         click.echo("no acceptable law: nothing written to unit.toml", err=True)
     if "validation" in summary:
-        v = summary["validation"]
+        v: Any = summary["validation"]
         for p, m, x in zip(v["pressures_kpa"], v["mean_mm"], v["max_mm"], strict=False):
             click.echo(f"  {p:5.1f} kPa: 2D-3D unit-centre distance mean {m:.3f} mm, max {x:.3f} mm")
     written = "calibration.json, calibration.png" + (", unit.toml" if result.chosen is not None else "")
     click.echo(f"written to {folder}/ ({written})")
 
 
-def _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d) -> None:  # type: ignore[no-untyped-def]
+def _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d) -> None:
     """Solve the 3D references into the cache, one by one, with their wall time."""
     import time
 
@@ -131,7 +133,7 @@ def _solve_references(unit, n_units, levels, runs, seed, n_validate, solve_3d) -
                    f"{time.perf_counter() - t0:.0f} s", err=True)
 
 
-def _validation_figures(result, unit, n_units, design, p_max, solve_3d, folder):  # type: ignore[no-untyped-def]
+def _validation_figures(result, unit, n_units, design, p_max, solve_3d, folder):
     """Fig 5.4 (each run's law, the chosen law, 3D) and Fig 5.7 (constant filler against E(P))."""
     from dataclasses import replace
 

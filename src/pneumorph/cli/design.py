@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import re
 import sys
+from typing import Any
 
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli import params as P
 
-_NOT_CERTIFIED = {"certify": False, "verify": None, "margin": 1.0, "chain_table": None}  # a fallback to the GA
+# a fallback to the GA
+_NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "chain_table": None}
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
 
 
@@ -111,7 +113,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         with P.blame("--unit"):
             UnitSpec.from_toml(unit_file)
     config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
-    changes: dict = {}
+    changes: dict[str, Any] = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
                        ("point", point), ("units", units), ("search", search), ("seed", seed),
                        ("certify", certify), ("verify", verify), ("margin", margin), ("chain_table", chain_table),
@@ -119,7 +121,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
         if value is not None:
             changes[key] = value
-    ga_changes = {k: v for k, v in (("population", population), ("generations", generations)) if v is not None}
+    ga_changes: dict[str, Any] = {k: v for k, v in (("population", population), ("generations", generations))
+                                  if v is not None}
     model_settings = dict(config.model)
     for key, value in (("fidelity", fidelity), ("pressure_kpa", pressure), ("unit_file", unit_file)):
         if value is not None:
@@ -153,7 +156,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             click.echo(f"designing {config.units} units for {label} ({model.fidelity} model, {config.search}, "
                        f"executor {config.executor}) -> {folder}", err=True)
 
-    def on_generation(stats) -> None:  # type: ignore[no-untyped-def]
+    def on_generation(stats) -> None:
         announce()
         total = config.ga.generations
         done = stats.generation
@@ -236,7 +239,7 @@ def _check_options_apply(search: str, owner: str, options: dict) -> None:
                                f"{'/'.join(given)} out")
 
 
-def _certified_json(result) -> dict:  # type: ignore[no-untyped-def]
+def _certified_json(result) -> dict:
     """The certificate and the top designs of a certified run (empty otherwise)."""
     if result.certified is None:
         return {}

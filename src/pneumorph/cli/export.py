@@ -149,6 +149,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     for path, (name, mesh) in zip(paths, parts.items(), strict=False):
         click.echo(f"  {path.name:<{width}}  {float(mesh.volume):10.2f} mm^3  {describe[name]}")
     if mould is not None:
+        assert mould_spec is not None
         c = mould.check
         click.echo(f"mould: {len(mould.parts)} parts (clearance {mould_spec.clearance:g} mm, draft "
                    f"{mould_spec.draft:g} deg) in {folder / 'mould'}/, drawing mould.png")

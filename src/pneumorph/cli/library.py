@@ -114,7 +114,8 @@ def _material_text(m: Material) -> str:
         lines.append(f"  parameters as printed ({rec.source}), mu in {rec.unit}:")
         lines.append(f"  {'n':>3} {'mu_n (Marc)':>14} {'alpha_n':>10} {'mu_n FElupe [MPa]':>19}")
         mu, alpha = params["mu"], params["alpha"]
-        for i, (a, b, c) in enumerate(zip(mu, alpha, m.ogden_felupe_mu, strict=False), start=1):  # type: ignore[call-overload]
+        assert isinstance(mu, tuple) and isinstance(alpha, tuple)  # an Ogden record's parameters are lists
+        for i, (a, b, c) in enumerate(zip(mu, alpha, m.ogden_felupe_mu, strict=True), start=1):
             lines.append(f"  {i:>3} {a:>14g} {b:>10g} {c:>19.6g}")
         lines.append("  FElupe convention psi = sum 2 mu_i/alpha_i^2 (...): mu_i = mu_n alpha_n / 2")
         mu0_felupe = sum(m.ogden_felupe_mu)

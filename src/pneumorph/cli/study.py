@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_STARTS
@@ -54,7 +56,7 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
         with P.blame("--target"):
             make_objective(target, length=(units or DesignConfig.units) * UnitSpec.pitch)
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
-    changes = {k: v for k, v in (("units", units), ("objective", target)) if v is not None}
+    changes: dict[str, Any] = {k: v for k, v in (("units", units), ("objective", target)) if v is not None}
     model_settings = dict(config.model)
     if pressure is not None:
         model_settings["pressure_kpa"] = pressure
@@ -66,7 +68,7 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     click.echo(f"population study: {objective.label}, populations {pops}, {seeds} seeds, "
                f"{generations} generations, {config.units} units", err=True)
 
-    def on_run(pop: int, seed: int, result) -> None:  # type: ignore[no-untyped-def]
+    def on_run(pop: int, seed: int, result) -> None:
         best = result.best
         click.echo(f"  population {pop:3d}, seed {seed}: best {best.value:.4g} ({best.design})", err=True)
 

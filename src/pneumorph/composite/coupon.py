@@ -201,7 +201,7 @@ class CouponResult:
             "dofs": int(self.points.size),
         }
         for kind in ("engineering", "surface"):
-            t = self.transition(kind)  # type: ignore[arg-type]
+            t = self.transition(kind)
             out[f"transition_{kind}"] = t.transition_strain
             out[f"primary_modulus_{kind}"] = t.primary_modulus
             out[f"secondary_modulus_{kind}"] = t.secondary_modulus

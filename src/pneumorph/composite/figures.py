@@ -9,12 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
+from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from pneumorph import __version__
 from pneumorph.composite.coupon import CouponResult
@@ -22,7 +23,7 @@ from pneumorph.composite.coupon import CouponResult
 
 def _caption(fig: Figure, text: str) -> None:
     """Provenance line under the axes (space for it is kept free by the layout)."""
-    fig.get_layout_engine().set(rect=(0.0, 0.035, 1.0, 0.965))
+    cast(ConstrainedLayoutEngine, fig.get_layout_engine()).set(rect=(0.0, 0.035, 1.0, 0.965))
     fig.text(0.005, 0.005, f"pneumorph {__version__} | {text}", fontsize=6, color="0.4", va="bottom")
 
 

@@ -110,7 +110,7 @@ def _columns(crimp: Crimp, per_flute: int) -> tuple[FloatArray, FloatArray]:
     for a, b in itertools.pairwise(edges):
         n = max(1, math.ceil((b - a) / half * per_flute - 1e-6))
         xs.extend(np.linspace(a, b, n + 1)[1:])
-    return np.asarray(xs), kinks
+    return np.asarray(xs, dtype=np.float64), np.asarray(kinks, dtype=np.float64)
 
 
 def coupon_mesh(crimp: Crimp, thickness: float = 5.0, per_flute: int = 4, rows: int = 4) -> CouponMesh:

@@ -36,7 +36,7 @@ def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | 
     ax = fig.add_subplot()
     if photo is not None:
         _photo(ax, result, photo, photo_scale or 1.0)
-    ax.add_collection(LineCollection(shape.outline, colors="k", linewidths=0.8, label="model outline"))
+    ax.add_collection(LineCollection(list(shape.outline), colors="k", linewidths=0.8, label="model outline"))
     ax.plot(shape.centres[:, 0], shape.centres[:, 1], "k.--", lw=0.6, ms=3, label="model unit centres")
     pts = result.outline_points
     ax.plot(pts[:, 0], pts[:, 1], ".", color="tab:red", ms=1.5, alpha=0.6, label="scan (aligned)")

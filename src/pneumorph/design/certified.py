@@ -31,14 +31,14 @@ import time
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.design.fitness import profile_error_array, score, tip_value_array
 from pneumorph.design.scoring import Candidate, ScoreBook
-from pneumorph.design.targets import Objective, ProfileTarget
+from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.chain import ChainModel, design_strings, window_codes
@@ -151,7 +151,7 @@ class ChainScores:
         The optimistic cost of every design *not* in the set (``inf`` when the set is all).
     """
 
-    bits: NDArray[np.uint8]
+    bits: NDArray[np.integer]
     per_level: FloatArray
     cost: FloatArray
     level: NDArray[np.int64]
@@ -183,7 +183,8 @@ def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integ
     return values, centres, ref_c
 
 
-def _costs(values: FloatArray, beta: FloatArray, sense: str) -> tuple[FloatArray, ...]:
+def _costs(values: FloatArray, beta: FloatArray, sense: str) -> tuple[FloatArray, NDArray[np.int64], FloatArray,
+                                                                      FloatArray]:
     c = values * -1.0 if sense == "max" else values.copy()
     c[~np.isfinite(c)] = np.inf
     level = np.argmin(c, axis=1)
@@ -202,7 +203,7 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
                   errors: dict[str, FloatArray]) -> ChainScores:
     """Chain scores of the given designs (chunked)."""
     bits = np.asarray(bits, dtype=np.uint8)
-    parts: list[tuple[FloatArray, ...]] = []
+    parts: list[tuple[Any, ...]] = []
     for lo in range(0, len(bits), CHUNK):
         b = bits[lo : lo + CHUNK]
         values, centres, ref_c = level_values(chain, objective, b)
@@ -434,8 +435,9 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
     n = chain.n_units
     e = errors["centre"]
     profile = isinstance(objective, ProfileTarget)
-    polar = profile and objective.coordinates == "polar"
-    slope = _target_slope(chain, objective, errors) if profile else 0.0
+    prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
+    polar = profile and prof.coordinates == "polar"
+    slope = _target_slope(chain, prof, errors) if profile else 0.0
     length = chain.length
     with np.errstate(all="ignore"):
         if profile:
@@ -448,11 +450,11 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
                     bsum = None if bsum is None else np.repeat(bsum, 2 ** (p - at), axis=0)
                     at = p
                 if polar:
-                    d = objective.curve(g.theta[j], length)
+                    d = prof.curve(g.theta[j], length)
                     d -= g.r[j]
                     bsum += _polar_term(g.r[j], e, slope) ** 2  # type: ignore[operator]
                 else:
-                    d = objective.curve(g.x[j], length)
+                    d = prof.curve(g.x[j], length)
                     d -= g.y[j]
                 d *= d
                 total += d
@@ -461,7 +463,7 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
                 bsum = None if bsum is None else np.repeat(bsum, 2 ** (n - at), axis=0)
             values = np.sqrt(total, out=total)
         else:
-            values = tip_value_array(g.tip, np.asarray(chain.table.tip_ref), g.curl, objective.name, objective.point)
+            values = tip_value_array(g.tip, np.asarray(chain.table.tip_ref), g.curl, goal.name, goal.point)
         if polar:
             beta = e[None, :] * np.sqrt(bsum)  # type: ignore[arg-type]
         else:
@@ -574,10 +576,11 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     table = chain.table
     n, k = chain.n_units, table.n_levels
     profile = isinstance(objective, ProfileTarget)
-    polar = profile and objective.coordinates == "polar"
+    prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
+    polar = profile and prof.coordinates == "polar"
     length = chain.length
     e = errors["centre"]
-    slope = _target_slope(chain, objective, errors) if profile else 0.0
+    slope = _target_slope(chain, prof, errors) if profile else 0.0
     bits, st = _seed_prefixes(chain, polar)
     if profile:
         st["sum"] = np.zeros((2, k))
@@ -589,9 +592,9 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
             for _, x, y in centres:
                 if profile:
                     if not polar:
-                        st["sum"] = st["sum"] + (objective.curve(x, length) - y) ** 2
+                        st["sum"] = st["sum"] + (prof.curve(x, length) - y) ** 2
                     else:
-                        st["sum"] = st["sum"] + (objective.curve(st["theta"], length) - st["r"]) ** 2
+                        st["sum"] = st["sum"] + (prof.curve(st["theta"], length) - st["r"]) ** 2
                         st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
@@ -611,7 +614,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
             values = np.sqrt(st["sum"])
         else:
             tip, curl = _tip_and_curl(chain, bits, st)
-            values = tip_value_array(tip, np.asarray(table.tip_ref), curl, objective.name, objective.point)
+            values = tip_value_array(tip, np.asarray(table.tip_ref), curl, goal.name, goal.point)
         if polar:
             beta = e[None, :] * np.sqrt(st["bsum"])
         else:

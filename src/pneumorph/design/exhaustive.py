@@ -226,6 +226,7 @@ def _verify(book: ScoreBook, design: str) -> None:
             f"mirror {b.design} {'converged' if b.ok else 'failed'}; search with symmetry=False"
         )
     if a.ok and b.ok:
+        assert a.response is not None and b.response is not None
         length = float(a.response.reference_tip[0])
         dev = symmetry_deviation(a.response, b.response)
         if dev > 1e-6 * max(1.0, length):

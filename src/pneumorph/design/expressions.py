@@ -144,7 +144,7 @@ class Expression:
         missing = sorted(self.used - set(values))
         if missing:
             raise TargetExpressionError(f"expression {self.text!r} needs a value for {', '.join(missing)}")
-        env = {k: np.asarray(v, dtype=float) for k, v in values.items()}
+        env: dict[str, Any] = {k: np.asarray(v, dtype=float) for k, v in values.items()}
         env.update(CONSTANTS)
         with np.errstate(all="ignore"):
             out = self.root(env)

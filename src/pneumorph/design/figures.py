@@ -21,7 +21,7 @@ def _pyplot():
     return plt
 
 
-def save_figure(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+def save_figure(fig, path: str | Path) -> Path:
     """Lay out, write (PNG/SVG by extension, 150 dpi) and close a pyplot figure."""
     path = Path(path)
     fig.tight_layout()
@@ -60,6 +60,7 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     """
     plt = _pyplot()
     r = candidate.response
+    assert r is not None, "a candidate without a response has no profile"
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
     fig, ax = plt.subplots(figsize=(6.4, 4.2))

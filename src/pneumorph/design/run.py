@@ -343,7 +343,7 @@ def run_files(folder: str | Path) -> list[Path]:
 
 def _remove_run_files(folder: Path) -> None:
     """Remove the old run's files (``config.toml`` last: a removal cut short still reads as that run)."""
-    parents = set()
+    parents: set[Path] = set()
     for path in run_files(folder):
         try:
             path.unlink()
@@ -502,8 +502,13 @@ def run_design(
             if on_generation:
                 on_generation(stats)
 
-        status, hof, history, ranking, cert = "finished", (), (), None, None
-        robustness, robust_best = None, None
+        status = "finished"
+        hof: tuple[Candidate, ...] = ()
+        history: tuple[GenerationStats, ...] = ()
+        ranking: list[tuple[str, Score]] | None = None
+        cert: CertifiedResult | None = None
+        robustness: dict[str, Any] | None = None
+        robust_best: Candidate | None = None
         try:
             if config.search == "ga":
                 ga = run_ga(model, objective, config.ga, cached, on_gen)
@@ -755,18 +760,19 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
         lines.append("")
     cert = result.certified
     if cert is not None:
-        c = cert.certificate
+        sure = cert.certificate
         u = o.unit
-        verdict = ("**certified**: no unverified design can beat the winner" if c["certified"] else
-                   f"not certified: {c['could_beat']} unverified design(s) could beat the winner by up to "
-                   f"{c['gap']:.3g} {u}; run with --certify to verify them")
+        verdict = ("**certified**: no unverified design can beat the winner" if sure["certified"] else
+                   f"not certified: {sure['could_beat']} unverified design(s) could beat the winner by up to "
+                   f"{sure['gap']:.3g} {u}; run with --certify to verify them")
         lines += [
             "## Certificate",
             "",
-            f"- designs scored by the chain model: {c['designs_scored']:,}"
-            + ("" if c["complete"] else " (branch-and-bound; every other design is worse by the chain)"),
-            f"- verified by FE ({getattr(model, 'fidelity', '?')}): {', '.join(f'`{d}`' for d in c['verified'])}",
-            f"- bound on the chain's objective error: {c['bound']:.3g} {u} (validated centre errors x {c['margin']:g})",
+            f"- designs scored by the chain model: {sure['designs_scored']:,}"
+            + ("" if sure["complete"] else " (branch-and-bound; every other design is worse by the chain)"),
+            f"- verified by FE ({getattr(model, 'fidelity', '?')}): {', '.join(f'`{d}`' for d in sure['verified'])}",
+            f"- bound on the chain's objective error: {sure['bound']:.3g} {u} "
+            f"(validated centre errors x {sure['margin']:g})",
             f"- {verdict}",
             "",
             f"| chain rank | design | chain ({u}) | FE ({u}) | 2D chain ({u}) | pressure (kPa) |",

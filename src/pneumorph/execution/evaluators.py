@@ -121,7 +121,7 @@ def prepare_worker() -> None:
     _watch_parent(os.getppid())
 
 
-def _init_worker(model: ActuatorModel) -> None:
+def _init_worker(model: ActuatorModel | None) -> None:
     global _WORKER_MODEL
     prepare_worker()
     _WORKER_MODEL = model
@@ -328,7 +328,8 @@ class ProcessPoolEvaluator(_Base):
                 while source and len(flight) < window and not broken:
                     i = source.popleft()
                     try:
-                        flight[pool.submit(*tasks[i])] = i
+                        fn, arg = tasks[i]
+                        flight[pool.submit(fn, arg)] = i
                     except BrokenProcessPool:
                         source.appendleft(i)
                         broken = True

@@ -502,7 +502,7 @@ def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *
     >>> write_calculix_deck(Full3D(1, ramp_spec=RampSpec(pressure=0.01)), "1", p).name
     'a.inp'
     """
-    target = check_writable_file(path, "deck")
+    target = check_writable_file(Path(path), "deck")
     text = calculix_deck(model, design, full_output=full_output, residual_force=residual_force)
     target.parent.mkdir(parents=True, exist_ok=True)
     return atomic_write_text(target, text)

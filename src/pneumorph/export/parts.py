@@ -387,5 +387,6 @@ def write_stl(parts: Mapping[str, trimesh.Trimesh], folder: str | Path) -> list[
     written = []
     for name, mesh in parts.items():
         data = mesh.export(file_type="stl")
+        assert isinstance(data, bytes)  # binary STL
         written.append(atomic_write_bytes(folder / f"{name}.stl", data))
     return written

@@ -36,7 +36,7 @@ def nodal_volumes(region: Any, npoints: int) -> FloatArray:
         h = h[:, :, None]
     dV = np.asarray(region.dV)  # (q, c)
     per_cell = np.einsum("aqc,qc->ca", np.broadcast_to(h, (*h.shape[:2], dV.shape[1])), dV)
-    return np.bincount(cells.ravel(), weights=per_cell.ravel(), minlength=npoints)
+    return np.asarray(np.bincount(cells.ravel(), weights=per_cell.ravel(), minlength=npoints), dtype=np.float64)
 
 
 class DeadLoads:

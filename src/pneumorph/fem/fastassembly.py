@@ -147,7 +147,7 @@ class PlaneStrainSystem:
         self.dead = DeadLoads(forces, self.npoints, 2)
         self._build_pattern()
         self.points = np.asarray(field[0].region.mesh.points[:, :2], dtype=float)
-        self._cache: list[tuple[FloatArray, ...]] = []
+        self._cache: list[FloatArray] = []
 
     # -- pattern ------------------------------------------------------------------------
     def _element_dofs(self, cells: IntArray) -> IntArray:
@@ -214,7 +214,7 @@ class PlaneStrainSystem:
             # r[f, a, i] = p sum_q h[q, a] cof(F)_iJ N_J dA
             vectors.append((p * np.matmul(h.T[None], cofN)).ravel())
         weights = np.concatenate(vectors)
-        r = np.bincount(self._edofs, weights=weights, minlength=self.ndof)
+        r = np.asarray(np.bincount(self._edofs, weights=weights, minlength=self.ndof), dtype=np.float64)
         if self.dead:
             r -= self.dead.vector()
         return r, jmin
@@ -244,7 +244,7 @@ class PlaneStrainSystem:
             M = p * np.matmul(h.T[None], t)  # (f, n, n)
             blocks.append((_EPS[None, None, :, :, None] * M[:, :, None, None, :]).ravel())
         data = np.bincount(self._scatter, weights=np.concatenate(blocks), minlength=self.nnz + 1)
-        return data[: self.nnz]
+        return np.asarray(data[: self.nnz], dtype=np.float64)
 
     def tangent(self) -> Any:
         """``K[dof1, dof1]`` as a ``scipy.sparse.csr_matrix`` (state of the last residual)."""

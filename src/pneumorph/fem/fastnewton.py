@@ -247,7 +247,7 @@ class FastSubstep:
                 done, cause = _verdict(fnorm_new, jmin, u_new, values, settings.tolerance)
                 if done:
                     return iteration, cause
-                if fnorm_new > self.reuse * fnorm:
+                if self.reuse is not None and fnorm_new > self.reuse * fnorm:
                     self._factorised = False  # refresh at u_new
                     f = None
                 else:

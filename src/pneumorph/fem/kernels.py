@@ -32,7 +32,7 @@ def _outer(a: FloatArray, b: FloatArray) -> FloatArray:
 
 
 def ogden_plane_strain(
-    F: FloatArray, mu: Sequence[float], alpha: Sequence[float], bulk: float
+    F: FloatArray, mu: Sequence[float] | FloatArray, alpha: Sequence[float] | FloatArray, bulk: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Stress and tangent of the compressible Ogden model (Eq 2.12) in plane strain.
 
@@ -223,8 +223,8 @@ def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
 
 def ogden_3d(
     F: FloatArray,
-    mu: Sequence[float],
-    alpha: Sequence[float],
+    mu: Sequence[float] | FloatArray,
+    alpha: Sequence[float] | FloatArray,
     bulk: float,
     tangent: bool = True,
     principal: tuple[FloatArray, FloatArray] | None = None,
@@ -322,9 +322,9 @@ def ogden_3d(
         S_mat += S[a] * Nv[a][:, None] * Nv[a][None, :]
     if pairs is not None:  # only the blocks A[i, :, k, :] asked for, as [pair, J, L]
         Ab = np.empty((len(pairs), 3, 3, n))
-        for m, (i, k) in enumerate(pairs):
+        for q, (i, k) in enumerate(pairs):
             for j in range(3):
-                row = Ab[m, j]
+                row = Ab[q, j]
                 np.multiply(left[0][i, j], right[0][k], out=row)
                 for L, R in zip(left[1:], right[1:], strict=False):
                     row += L[i, j] * R[k]

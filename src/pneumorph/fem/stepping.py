@@ -148,7 +148,8 @@ def _extrapolate(
             if m != j:
                 w *= (t - tm) / (tj - tm)
         weights.append(w)
-    return [sum(w * s[1][i] for w, s in zip(weights, states, strict=False)) for i in range(len(states[0][1]))]
+    return [sum((w * s[1][i] for w, s in zip(weights, states, strict=True)), start=np.zeros_like(states[0][1][i]))
+            for i in range(len(states[0][1]))]
 
 
 def _values(fields: Any) -> list[NDArray[np.float64]]:
@@ -242,6 +243,7 @@ def ramp(
             if substep is not None:
                 iterations, cause = substep(fields, settings)
             else:
+                assert solver is not None
                 iterations, cause = _solve_substep(items, fields, dof1, dof0, settings, solver)
             stats.newton_iterations += iterations
             value = watched

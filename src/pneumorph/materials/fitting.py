@@ -261,7 +261,7 @@ def _linear_columns(spec: ModelSpec, curves: Sequence[TestCurve]) -> FloatArray:
     """Nominal stress of the model with each parameter 1 and the others 0 (it is linear)."""
     eye = np.eye(spec.n_parameters)
     return np.column_stack([
-        np.concatenate([spec.build(e).nominal_stress(c.mode, c.stretch) for c in curves]) for e in eye
+        np.concatenate([spec.build(e.tolist()).nominal_stress(c.mode, c.stretch) for c in curves]) for e in eye
     ])
 
 
@@ -280,7 +280,7 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
     return np.concatenate(w)
 
 
-def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):  # type: ignore[no-untyped-def]
+def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):
     """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
 
     The exponents are parametrised as ``alpha_1`` and the gaps ``alpha_(k+1) - alpha_k >=

@@ -453,7 +453,7 @@ def drucker_stability(
     lam = np.geomspace(lo, hi, num)
     lam = np.unique(np.concatenate([lam, [1.0]]))
     h = 1e-5
-    stable = {}
+    stable: dict[str, NDArray[np.bool_]] = {}
     for mode in MODES:
         l1, l2, _l3 = mode_stretches(mode, lam)
         e = np.stack([np.log(l1), np.log(l2)])

@@ -299,6 +299,7 @@ class Material:
                 f"{self.name}: no bulk modulus in the library entry ({self.origin}); "
                 "an FE model needs one - add [materials.<key>.bulk_modulus]"
             )
+        assert self.model is not None  # a hyperelastic material (checked on construction)
         return felupe_models.build_umat(
             self.model, self.bulk_modulus.value, formulation=formulation
         )

@@ -147,7 +147,9 @@ class Response:
         """JSON-ready dictionary (pressures in MPa, lengths in mm, NaN as null)."""
 
         def clean(a: FloatArray) -> Any:
-            return np.where(np.isnan(a), None, a).tolist()
+            out = np.asarray(a).astype(object)
+            out[np.isnan(a)] = None
+            return out.tolist()
 
         out: dict[str, Any] = {"orientation": self.orientation}
         out.update({name: clean(getattr(self, name)) for name in self._ARRAYS})

@@ -15,10 +15,12 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Sequence
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from pneumorph import __version__
 from pneumorph.materials.fitting import FitResult
@@ -78,7 +80,7 @@ def plot_fits(
     nlines = caption.count("\n") + 1
     fig = Figure(figsize=(width, 4.4), layout="constrained")
     FigureCanvasAgg(fig)
-    fig.get_layout_engine().set(rect=(0.0, 0.03 * nlines, 1.0, 1.0 - 0.03 * nlines))
+    cast(ConstrainedLayoutEngine, fig.get_layout_engine()).set(rect=(0.0, 0.03 * nlines, 1.0, 1.0 - 0.03 * nlines))
     axes = fig.subplots(1, len(modes), squeeze=False)[0]
     for ax, mode in zip(axes, modes, strict=False):
         c = data.curve(mode)
