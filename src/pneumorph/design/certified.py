@@ -531,7 +531,9 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     length = chain.length
     slope = _target_slope(chain, objective, errors)
     beta = np.asarray(_uniform_bound(chain, objective, errors, slope), dtype=float)
-    optimistic = lambda total: np.min(np.sqrt(total) - beta, axis=1)  # noqa: E731
+    def optimistic(total: FloatArray) -> FloatArray:
+        return np.min(np.sqrt(total) - beta, axis=1)
+
     cut = n - 2
     early = range(sum(1 for p in g.depth if p <= cut))
     with np.errstate(all="ignore"):

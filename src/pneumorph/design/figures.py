@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -12,7 +13,7 @@ from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
 
 
-def _pyplot():
+def _pyplot() -> Any:
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -21,7 +22,7 @@ def _pyplot():
     return plt
 
 
-def save_figure(fig, path: str | Path) -> Path:
+def save_figure(fig: Any, path: str | Path) -> Path:
     """Lay out, write (PNG/SVG by extension, 150 dpi) and close a pyplot figure."""
     path = Path(path)
     fig.tight_layout()

@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import partial
+from typing import Any
 
 import numpy as np
 from deap import base, creator, tools
@@ -199,12 +200,13 @@ def mut_flip_bit(individual: list[int], indpb: float, rng: random.Random) -> tup
     return (individual,)
 
 
-def sel_tournament(individuals: Sequence, k: int, tournsize: int, rng: random.Random) -> list:
+def sel_tournament(individuals: Sequence[Any], k: int, tournsize: int, rng: random.Random) -> list[Any]:
     """``k`` tournaments of ``tournsize`` random picks, as ``deap.tools.selTournament``."""
     return [max((rng.choice(individuals) for _ in range(tournsize)), key=lambda ind: ind.fitness) for _ in range(k)]
 
 
-def var_and(population: Sequence, toolbox: base.Toolbox, cxpb: float, mutpb: float, rng: random.Random) -> list:
+def var_and(population: Sequence[Any], toolbox: base.Toolbox, cxpb: float, mutpb: float,
+            rng: random.Random) -> list[Any]:
     """Crossover then mutation on clones, as ``deap.algorithms.varAnd``."""
     offspring = [toolbox.clone(ind) for ind in population]
     for i in range(1, len(offspring), 2):
@@ -234,7 +236,7 @@ def _design(ind: Sequence[int]) -> str:
     return "".join(str(int(b)) for b in ind)
 
 
-def _stats(gen: int, population: Sequence, book: ScoreBook, counts: tuple[int, int, int],
+def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[int, int, int],
            wall: float) -> GenerationStats:
     values = np.array([ind.fitness.values[0] for ind in population], dtype=float)
     finite = values[np.isfinite(values)]
@@ -249,7 +251,7 @@ def _stats(gen: int, population: Sequence, book: ScoreBook, counts: tuple[int, i
     )
 
 
-def _evaluate(population: Sequence, book: ScoreBook) -> tuple[int, int, int]:
+def _evaluate(population: Sequence[Any], book: ScoreBook) -> tuple[int, int, int]:
     invalid = [ind for ind in population if not ind.fitness.valid]
     before = book.solves
     scores = book.score_many([_design(ind) for ind in invalid])
@@ -329,7 +331,7 @@ def run_ga(
     )
 
 
-def _keep_elites(population: list, offspring: list, k: int, toolbox: base.Toolbox) -> None:
+def _keep_elites(population: list[Any], offspring: list[Any], k: int, toolbox: base.Toolbox) -> None:
     """Replace the ``k`` worst offspring by the ``k`` best distinct parents (no random draws)."""
     elites, seen = [], set()
     for ind in sorted(population, key=lambda ind: ind.fitness, reverse=True):

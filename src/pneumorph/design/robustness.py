@@ -48,7 +48,8 @@ def chain_robustness(config: Any, chain: Any, tables: Any, objective: Any, winne
             "offsets_mm": rob.offsets.tolist(), "winner_values": rob.values[:, 0].tolist()}
 
 
-def robust_ranking(config: Any, chain: Any, tables: Any, objective: Any, bits: np.ndarray) -> tuple[list[dict], Any]:
+def robust_ranking(config: Any, chain: Any, tables: Any, objective: Any,
+                   bits: np.ndarray) -> tuple[list[dict[str, Any]], Any]:
     """All ``bits`` ranked by ``config.robust`` under the tolerance samples (best first), and the Robustness."""
     rob = design_robustness(chain.table, tables, objective, bits, samples=config.samples(chain=True),
                             seed=config.seed, choose=config.robust)
@@ -62,7 +63,7 @@ def robust_ranking(config: Any, chain: Any, tables: Any, objective: Any, bits: n
     return rows, rob
 
 
-def robust_winner(config: Any, model: Any, objective: Any, evaluator: Any, rows: list[dict]) -> Candidate:
+def robust_winner(config: Any, model: Any, objective: Any, evaluator: Any, rows: list[dict[str, Any]]) -> Candidate:
     """The best design by the robust statistic, verified by the FE model (its nominal value)."""
     book = ScoreBook(model, objective, evaluator)
     book.score_many([rows[0]["design"]])

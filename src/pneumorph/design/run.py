@@ -271,7 +271,7 @@ class _GenerationLog:
         return kept, clean
 
     @staticmethod
-    def _lines(records: list) -> str:
+    def _lines(records: list[Any]) -> str:
         buffer = io.StringIO()
         csv.writer(buffer).writerows(records)
         return buffer.getvalue()

@@ -281,7 +281,7 @@ class EvaluationCache:
             return CacheError(f"cache {p} is closed ({why}): open it again")
         return CacheError(f"cache {p} failed ({why}): {_WAY_OUT}")
 
-    def _execute(self, sql: str, params: tuple = (), doing: str = "") -> sqlite3.Cursor:
+    def _execute(self, sql: str, params: tuple[Any, ...] = (), doing: str = "") -> sqlite3.Cursor:
         """``self._db.execute`` with sqlite3 errors turned into CacheError (caller holds the lock)."""
         try:
             return self._db.execute(sql, params)
@@ -290,7 +290,7 @@ class EvaluationCache:
 
     # -- reading ----------------------------------------------------------------------
     @staticmethod
-    def _row_to_outcome(fingerprint: str, design: str, row: tuple) -> Outcome | None:
+    def _row_to_outcome(fingerprint: str, design: str, row: tuple[Any, ...]) -> Outcome | None:
         """The outcome of a stored row, or None if the row is damaged."""
         status, response, cause, reached, wall, checksum = row
         if checksum != _checksum(fingerprint, design, status, response, cause, reached):
@@ -420,7 +420,7 @@ class CachedEvaluator:
     damaged entries are solved again and counted in ``cache.rejected``.
     """
 
-    def __init__(self, inner, cache: EvaluationCache) -> None:
+    def __init__(self, inner: Any, cache: EvaluationCache) -> None:
         self.inner = inner
         self.cache = cache
         self.solves = 0

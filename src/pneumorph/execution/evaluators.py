@@ -320,7 +320,7 @@ class ProcessPoolEvaluator(_Base):
         finish. Returns ``(broken, lost)``: whether a worker died, and the designs it took along
         (those in flight then; the others stay in ``source``)."""
         pool = self._ensure_pool(model)
-        flight: dict[Future, int] = {}
+        flight: dict[Future[Outcome], int] = {}
         lost: set[int] = set()
         broken = False
         try:

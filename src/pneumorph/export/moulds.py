@@ -82,7 +82,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -267,7 +267,7 @@ class MouldCheck:
                 and self.cavity_error <= self.tolerance and self.reassembly_error <= self.tolerance
                 and self.gap_distance > 0)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """Plain values, for JSON."""
         return {
             "ok": self.ok,
@@ -328,7 +328,7 @@ def _cylinder(cx: float, cy: float, z0: float, z1: float, radius: float, segment
     return m3.Manifold.cylinder(z1 - z0, radius, -1.0, segments).translate((cx, cy, z0))
 
 
-def _core(cavity: tuple, tip_inset: float, tenon_inset: float, tenon_depth: float) -> manifold3d.Manifold:
+def _core(cavity: tuple[float, ...], tip_inset: float, tenon_inset: float, tenon_depth: float) -> manifold3d.Manifold:
     """The core of one cavity: the cavity (tapered by ``tip_inset`` at its tip) on a tenon."""
     import manifold3d as m3
 
@@ -530,8 +530,8 @@ def _xor_volume(a: manifold3d.Manifold, b: manifold3d.Manifold) -> float:
     return (a - b).volume() + (b - a).volume()
 
 
-def _measure(solids: dict, cast: dict, opening, gaps, body, as_cast, sheet_offset: tuple,
-             outer: tuple) -> MouldCheck:
+def _measure(solids: dict[str, Any], cast: dict[str, Any], opening: Any, gaps: Any, body: Any, as_cast: Any,
+             sheet_offset: tuple[float, ...], outer: tuple[float, ...]) -> MouldCheck:
     """The checks of :class:`MouldCheck`, on manifold3d solids."""
     import manifold3d as m3
 

@@ -21,6 +21,7 @@ Ogden and gives the same stress and tangent to rounding.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -114,7 +115,7 @@ class OgdenCompressible:
         self._cache = (F.copy(), result)
         return result
 
-    def gradient(self, x: list, **kwargs: object) -> list:
+    def gradient(self, x: list[Any], **kwargs: object) -> list[Any]:
         """First Piola-Kirchhoff stress ``P = F S`` and (no) state variables."""
         F, statevars = x[0], x[-1]
         theta = self.thermal_stretch
@@ -125,7 +126,7 @@ class OgdenCompressible:
         P = np.einsum("iI...,IJ...->iJ...", F, S_mat)
         return [P * theta**2 if theta != 1.0 else P, statevars]
 
-    def hessian(self, x: list, **kwargs: object) -> list:
+    def hessian(self, x: list[Any], **kwargs: object) -> list[Any]:
         """Fourth-order tangent ``A_iJkL = dP_iJ / dF_kL``."""
         F = x[0]
         theta = self.thermal_stretch

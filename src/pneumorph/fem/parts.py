@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 
-def linked_solid(umat: Any, points: NDArray, cells: NDArray, cell_type: str, region: Any, field_type: Any,
+def linked_solid(umat: Any, points: NDArray[Any], cells: NDArray[Any], cell_type: str, region: Any, field_type: Any,
                  dim: int, field: Any) -> Any:
     """A ``SolidBody`` of ``umat`` on some cells, its field linked to the global ``field``.
 
@@ -24,7 +24,7 @@ def linked_solid(umat: Any, points: NDArray, cells: NDArray, cell_type: str, reg
 
 
 def clamped_dofs(field: Any, base_points: NDArray[np.bool_],
-                 symmetry_points: NDArray[np.bool_] | None = None) -> tuple[NDArray, NDArray]:
+                 symmetry_points: NDArray[np.bool_] | None = None) -> tuple[NDArray[Any], NDArray[Any]]:
     """``(dof0, dof1)``: the base clamped, and u_z = 0 on a mid-width symmetry plane if given."""
     import felupe as fem
 

@@ -12,7 +12,8 @@ import numpy as np
 _REGION_IDS = {"body": 0, "layer": 1, "filler": 2}
 
 
-def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator", meta: dict | None = None) -> Path:
+def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
+                     meta: dict[str, Any] | None = None) -> Path:
     """Write ``<stem>_<k>.vtu`` for every converged level and ``<stem>.pvd`` to open them all.
 
     Each VTU holds the undeformed points with the point data ``displacement`` (use

@@ -16,6 +16,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 from pneumorph.errors import DataFormatError, UnknownDatasetError
 from pneumorph.materials.testdata import TestCurve, TestData, read_curve
@@ -36,7 +37,7 @@ def _dataset_root() -> Path:
     return Path(str(resources.files("pneumorph.materials") / "data" / "datasets"))
 
 
-def _manifest(name: str) -> tuple[Path, dict]:
+def _manifest(name: str) -> tuple[Path, dict[str, Any]]:
     folder = _dataset_root() / name
     with open(folder / "dataset.toml", "rb") as fh:
         return folder, tomllib.load(fh)

@@ -280,7 +280,8 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
     return np.concatenate(w)
 
 
-def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):
+def _fit_ogden(curves: Sequence[TestCurve], y: FloatArray, w: FloatArray, n: int, starts: int,
+               rng: np.random.Generator, alpha_bound: float, gap: float, stable: bool) -> FloatArray:
     """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
 
     The exponents are parametrised as ``alpha_1`` and the gaps ``alpha_(k+1) - alpha_k >=
@@ -303,7 +304,7 @@ def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):
     def mu_for(alpha: FloatArray) -> FloatArray:
         a, _ = _ogden_columns(curves, alpha)
         if not stable:
-            return np.linalg.lstsq(a * w[:, None], yw, rcond=None)[0]
+            return np.asarray(np.linalg.lstsq(a * w[:, None], yw, rcond=None)[0], dtype=np.float64)
         pos = alpha > 0
         return lsq_linear(a * w[:, None], yw, bounds=(np.where(pos, 0.0, -np.inf), np.where(pos, np.inf, 0.0)),
                           method="bvls").x
@@ -345,7 +346,7 @@ def _fit_ogden(curves, y, w, n, starts, rng, alpha_bound, gap, stable):
         if np.all(np.isfinite(res.x)) and (best is None or res.cost < best.cost):
             best = res
             best_alpha = res.x[n:] if stable else alphas(res.x[n:])
-    if best is None:
+    if best is None or best_alpha is None:
         raise FitError("the Ogden fit failed from every start (non-finite parameters)")
     order = np.argsort(best_alpha)
     return np.concatenate([best.x[:n][order], best_alpha[order]])
@@ -458,7 +459,7 @@ def fit(
         else:
             p = least_squares(lambda q: aw @ q - y * w, p0, jac=lambda q: aw, method="lm").x
         nstarts, used_seed = 1, None
-    model = spec.build(p)
+    model = spec.build(p.tolist())
     pred = [model.nominal_stress(c.mode, c.stretch) for c in curves]
     lo = min(float(c.stretch.min()) for c in curves)
     hi = max(float(c.stretch.max()) for c in curves)
