@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Literal
 
 import numpy as np
@@ -34,8 +35,8 @@ from numpy.typing import NDArray
 
 from pneumorph.composite.crimp import Crimp
 from pneumorph.composite.mesh import CouponMesh, coupon_mesh
-from pneumorph.errors import CrimpError, SimulationFailed
-from pneumorph.fem.stepping import StepSettings
+from pneumorph.errors import CrimpError
+from pneumorph.fem.stepping import StepSettings, newton_check, ramp
 
 FloatArray = NDArray[np.float64]
 StrainKind = Literal["engineering", "surface"]
@@ -311,8 +312,11 @@ def simulate_coupon(
             snaps[k + 1] = u.copy()
 
     start = time.perf_counter()
-    stats = _displacement_ramp([matrix, paper], fields, dof1, dof0, lambda t: np.where(pulled, t * d_max, 0.0),
-                               settings, record)
+    def pull(t: float) -> None:  # the loaded node's x-displacement, a prescribed value of the field
+        fields[0].values.ravel()[dof0[pulled]] = t * d_max
+
+    stats = ramp([matrix, paper], fields, pull, dof1, dof0, settings, on_level=record,
+                 check=partial(newton_check, still=UPDATE_TOLERANCE))
     return CouponResult(
         spec=spec,
         engineering_strain=np.asarray(eng),
@@ -326,99 +330,12 @@ def simulate_coupon(
         paper_nodes=mesh.paper,
         snapshots=snaps,
         seconds=time.perf_counter() - start,
-        newton_iterations=stats[0],
-        cutbacks=stats[1],
+        newton_iterations=stats.newton_iterations,
+        cutbacks=stats.cutbacks,
     )
 
 
 #: Newton updates below this norm (mm) count as converged: near the unloaded state the
-#: reaction forces that scale FElupe's residual criterion are ~1e-4 N, while the round-off
+#: reaction forces that scale the residual criterion are ~1e-4 N, while the round-off
 #: of the paper's internal forces (EA ~ 700 N) leaves residuals of ~1e-11 N.
 UPDATE_TOLERANCE = 1e-9
-
-
-def _check(dx: Any, x: Any, f: Any, xtol: float, ftol: float, dof1: Any = None, dof0: Any = None,
-           items: Any = None, eps: float = 1e-3) -> tuple[float, float, bool]:
-    """FElupe's residual criterion, or a vanishing Newton update with a residual below 1e-4."""
-    from felupe.tools._newton import check
-
-    xnorm, fnorm, success = check(dx, x, f, xtol, ftol, dof1=dof1, dof0=dof0, items=items, eps=eps)
-    return xnorm, fnorm, bool(success or (xnorm < UPDATE_TOLERANCE and fnorm < 1e-4))
-
-
-def _displacement_ramp(
-    items: list[Any],
-    fields: Any,
-    dof1: NDArray[np.int64],
-    dof0: NDArray[np.int64],
-    prescribed: Any,
-    settings: StepSettings,
-    on_level: Any,
-) -> tuple[int, int]:
-    """Ramp prescribed displacements ``prescribed(t)`` (values of ``dof0``) from 0 to 1.
-
-    Equal reported levels, ``substeps`` solves between them, halving cut-backs and a
-    linear-extrapolation predictor, as :func:`pneumorph.fem.ramp` does for loads; here
-    the prescribed values reach FElupe's Newton solver as ``ext0``.
-    Returns (Newton iterations, cut-backs).
-    """
-    import warnings
-
-    import felupe as fem
-    from scipy.sparse.linalg import MatrixRankWarning
-
-    def values() -> list[FloatArray]:
-        return [f.values.copy() for f in fields.fields]
-
-    def restore(vals: list[FloatArray]) -> None:
-        for f, v in zip(fields.fields, vals, strict=False):
-            f.values[:] = v
-
-    iterations = cutbacks = 0
-    current, prev = values(), None
-    t_now = t_prev = 0.0
-    nominal = 1.0 / (settings.increments * settings.substeps)
-    for k, level in enumerate(settings.levels()):
-        dt, cut_here = nominal, 0
-        while t_now < level - 1e-12:
-            t_try = min(t_now + dt, level)
-            if settings.predictor and prev is not None and t_now > t_prev:
-                s = (t_try - t_now) / (t_now - t_prev)
-                restore([c + s * (c - p) for c, p in zip(current, prev, strict=False)])
-            cause = None
-            try:
-                with warnings.catch_warnings(), np.errstate(all="ignore"):
-                    warnings.simplefilter("ignore", MatrixRankWarning)
-                    warnings.simplefilter("ignore", RuntimeWarning)
-                    res = fem.newtonraphson(items=items, x0=fields, dof1=dof1, dof0=dof0, ext0=prescribed(t_try),
-                                            tol=settings.tolerance, maxiter=settings.max_iterations, verbose=0,
-                                            check=_check)
-                iterations += int(res.iterations)
-                if not all(np.all(np.isfinite(f.values)) for f in fields.fields):
-                    cause = "the solution is not finite"
-                else:
-                    F = fields[0].extract(grad=True, sym=False, add_identity=True)
-                    jmin = float(np.min(fem.math.det(F)))
-                    if not jmin > 0.0:
-                        cause = f"an element inverted (det F = {jmin:.3g})"
-            except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError) as exc:
-                iterations += settings.max_iterations
-                cause = f"{type(exc).__name__}: {exc}".strip()
-            if cause is None:
-                prev, t_prev = current, t_now
-                current, t_now = values(), t_try
-                cut_here = 0
-                dt = min(2 * dt, nominal)
-                continue
-            restore(current)
-            cutbacks += 1
-            cut_here += 1
-            if cut_here > settings.max_cutbacks:
-                raise SimulationFailed(
-                    reached=t_now,
-                    cause=f"no convergence at load factor {t_try:.4g} after {settings.max_cutbacks} cut-backs "
-                          f"({cause})",
-                )
-            dt /= 2.0
-        on_level(k, level)
-    return iterations, cutbacks

@@ -1,8 +1,9 @@
 """Newton's method on a fast system (:class:`~pneumorph.fem.fastassembly.PlaneStrainSystem`,
 :class:`~pneumorph.fem.fastassembly3d.SolidSystem3D`).
 
-The convergence test is FElupe's (``felupe.tools._newton.check``): the norm of the
-residual of the active dofs over ``1e-3`` plus the norm of the reaction forces,
+The convergence test is the residual criterion of
+:func:`pneumorph.fem.stepping.newton_check` (FElupe's): the norm of the residual of the
+active dofs over ``1e-3`` plus the norm of the reaction forces,
 
     ||r[dof1]|| / (1e-3 + ||r[dof0]||) < tol,
 
