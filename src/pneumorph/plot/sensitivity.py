@@ -55,6 +55,19 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
                 line = r.centreline(j)
                 ax.plot(line[:, 0], line[:, 1], "--", lw=1.2,
                         label=f"{c.case.label} at {r.pressures[j] * 1e3:.4g} kPa (closest {c.matching_kpa:.1f} kPa)")
+    for c in result.cases:  # a ramp that failed: its closest converged shape, and the reference at that pressure
+        r = c.outcome.response
+        if c.outcome.ok or r is None or c.matching_kpa is None or ref is None:
+            continue
+        j = int(np.argmin(np.abs(r.pressures * 1e3 - c.matching_kpa)))
+        line = r.centreline(j)
+        p = r.pressures[j] * 1e3
+        ax.plot(line[:, 0], line[:, 1], "--", color="tab:red", lw=1.4,
+                label=f"{c.case.label} at {p:.4g} kPa (failed at {(c.outcome.reached or 0) * 1e3:.4g} kPa)")
+        same = np.flatnonzero(np.isclose(ref.pressures * 1e3, p))
+        if same.size:
+            line = ref.centreline(int(same[0]))
+            ax.plot(line[:, 0], line[:, 1], ":", color="k", lw=1.2, label=f"{study.reference.label} at {p:.4g} kPa")
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
@@ -76,7 +89,7 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
         if finite.size:
             pad = max(1.0, 0.1 * float(np.ptp(finite)))
             bx.set_xlim(float(finite.min()) - pad, float(finite.max()) + pad)
-        bx.set_xlabel("curl [deg] (orange: one thickness at its extreme; grey: random combinations)")
+        bx.set_xlabel("curl [deg]; orange: extremes and corners, grey: random samples")
         bx.legend(loc="lower right", fontsize=7)
     fig.text(0.01, 0.005, f"pneumorph {__version__} | {study.reference.model.fingerprint()}", fontsize=6, color="0.4")
     if path is not None:
