@@ -12,7 +12,11 @@ Folder contents:
   verified, how much better at most an unverified design could be; ``top.csv`` - the best
   designs by chain value with their FE and 2D values; ``chain-vs-fe.png`` - the winner's
   shape from the chain against its FE verification.
-- ``report.md`` - the winning design, its pressure (kPa) and error, the settings.
+- ``robustness.json`` - the winner's objective under seeded samples of the mould tolerance
+  (``tolerance``, by the chain with tolerance tables or by FE solves) and, with ``robust``,
+  the designs ranked by their worst or mean error under it.
+- ``report.md`` - the winning design, its pressure (kPa) and error, the settings, its
+  robustness.
 - ``profile.png`` - the winner at its pressure against the target (Figs 6.6-6.11);
   ``convergence.png`` - best and mean fitness per generation.
 - whatever the model's optional hook ``write_deformed(response, level, folder) -> list[Path]``
