@@ -50,14 +50,11 @@ from __future__ import annotations
 import csv
 import io
 import os
-import platform
 import re
 import time
 import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from datetime import UTC, datetime
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -94,6 +91,7 @@ from pneumorph.io.files import (
 )
 from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 from pneumorph.io.lock import RunLock
+from pneumorph.io.provenance import provenance as make_provenance
 from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.chaintables import find_table, table_for
 from pneumorph.models.factory import make_model
@@ -101,7 +99,6 @@ from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import tolerance_tables_for
 from pneumorph.sensitivity.tolerances import Tolerance
 
-DEPENDENCIES = ("numpy", "scipy", "felupe", "tensortrax", "deap", "matplotlib", "distributed")
 _COMPARED = ("design", "ga", "model")
 
 #: The files a run writes into its folder (glob patterns, relative to it): what ``overwrite`` removes,
@@ -125,27 +122,15 @@ RUN_FILES = (
 )
 
 
-def _version(name: str) -> str | None:
-    try:
-        return metadata.version(name)
-    except metadata.PackageNotFoundError:
-        return None
-
-
 def provenance(config: DesignConfig, model: ActuatorModel) -> dict[str, Any]:
-    """Where a run comes from: versions, date, seed, model identity."""
-    return {
-        "pneumorph": _version("pneumorph") or "unknown",
-        "created": datetime.now(UTC).isoformat(timespec="seconds"),
-        "seed": config.seed,
-        "model_fidelity": str(getattr(model, "fidelity", "unknown")),
-        "model_fingerprint": model.fingerprint(),
-        "model_units": int(model.n_units),
-        "pressures_kPa": [round(float(p) * 1e3, 9) for p in model.pressures()],
-        "python": platform.python_version(),
-        "platform": platform.platform(),
-        "dependencies": {name: v for name in DEPENDENCIES if (v := _version(name)) is not None},
-    }
+    """Where a run comes from: the common record (:func:`pneumorph.io.provenance`), seed, model identity."""
+    return make_provenance(
+        seed=config.seed,
+        model_fidelity=str(getattr(model, "fidelity", "unknown")),
+        model_fingerprint=model.fingerprint(),
+        model_units=int(model.n_units),
+        pressures_kPa=[round(float(p) * 1e3, 9) for p in model.pressures()],
+    )
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,9 @@ from typing import Any
 
 from pneumorph import __version__
 
-_PACKAGES = ("numpy", "scipy", "felupe", "tensortrax", "matplotlib", "deap", "pypardiso", "meshio")
+#: every package a result can depend on: the solver (PARDISO included), the search, the meshes, the figures
+_PACKAGES = ("numpy", "scipy", "felupe", "tensortrax", "pypardiso", "deap", "distributed", "meshio", "trimesh",
+             "manifold3d", "matplotlib")
 
 
 def provenance(**extra: Any) -> dict[str, Any]:
