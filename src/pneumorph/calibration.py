@@ -478,11 +478,9 @@ def cached_3d_solver(cache: Any) -> Callable[[Full3D, str], Response]:
 
 def plot_calibration(cal: Calibration, path: Any) -> Any:
     """Fig 5.3: the best modulus per pressure for each run, and both fitted laws."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from pneumorph.plot.figure import new_figure, save_figure
 
-    fig = Figure(figsize=(6.0, 4.2), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(6.0, 4.2)
     ax = fig.add_subplot()
     for run in sorted({p.run for p in cal.points}):
         pts = [p for p in cal.points if p.run == run]
@@ -495,5 +493,4 @@ def plot_calibration(cal: Calibration, path: Any) -> Any:
     ax.set(xlabel="pressure [kPa]", ylabel="filler modulus E [MPa]", title="Filler law calibration (Eq 5.1)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=150)
-    return path
+    return save_figure(fig, path, "filler law calibration (Fig 5.3)")

@@ -10,16 +10,15 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from pneumorph import __version__
 from pneumorph.bimodal.model import BimodalResult
+from pneumorph.plot.figure import new_figure, save_figure
 
 
 def _save(fig: Figure, path: str | Path | None, dpi: int) -> None:
     if path is not None:
-        fig.savefig(path, dpi=dpi, metadata={"Creator": f"pneumorph {__version__}"})
+        save_figure(fig, path, dpi=dpi)
 
 
 def plot_tip_paths(
@@ -39,8 +38,7 @@ def plot_tip_paths(
     >>> len(plot_tip_paths([("a", r)]).axes)
     2
     """
-    fig = Figure(figsize=(11, 5.0), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(11, 5.0)
     ax, ax2 = fig.subplots(1, 2)
     for i, (label, r) in enumerate(runs):
         c = f"C{i}"
@@ -92,8 +90,7 @@ def plot_outlines(
     >>> len(plot_outlines(r).axes)
     1
     """
-    fig = Figure(figsize=(9, 4.5), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(9, 4.5)
     ax = fig.subplots()
     p = 1e3 * result.pressures
     if pressures_kpa is None:

@@ -12,13 +12,13 @@ from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from pneumorph import __version__
 from pneumorph.composite.coupon import CouponResult
+from pneumorph.plot.figure import new_figure, save_figure
 
 
 def _caption(fig: Figure, text: str) -> None:
@@ -29,7 +29,7 @@ def _caption(fig: Figure, text: str) -> None:
 
 def _save(fig: Figure, path: str | Path | None, dpi: int) -> None:
     if path is not None:
-        fig.savefig(path, dpi=dpi, metadata={"Creator": f"pneumorph {__version__}"})
+        save_figure(fig, path, dpi=dpi)
 
 
 def _label(r: CouponResult) -> str:
@@ -46,8 +46,7 @@ def plot_load_strain(results: Sequence[CouponResult], path: str | Path | None = 
     >>> len(plot_load_strain([r]).axes)
     4
     """
-    fig = Figure(figsize=(10, 7.0), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(10, 7.0)
     grid = fig.subplots(2, 2, sharex="col")
     knee = 0.0
     for row, zoom in ((grid[0], False), (grid[1], True)):
@@ -117,8 +116,7 @@ def plot_deformed(
     x0, x = result.points, result.points + u
     crimp = result.spec.crimp
     window = 4 * crimp.wavelength if window is None else window
-    fig = Figure(figsize=(11, 4.6), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(11, 4.6)
     ax_all, ax_zoom = fig.subplots(2, 1, height_ratios=(1, 2))
     edges = np.concatenate([result.quads[:, [0, 1]], result.quads[:, [1, 2]], result.quads[:, [2, 3]],
                             result.quads[:, [3, 0]]])
@@ -177,8 +175,7 @@ def plot_surface_strain(
     """Surface strain along half a wavelength, peak to valley of the paper (cf. Fig 3.5)."""
     level = _level_at(result, strain)
     d, e = half_wave_profile(result, strain)
-    fig = Figure(figsize=(6.4, 4.0), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(6.4, 4.0)
     ax = fig.subplots()
     ax.plot(d, 100 * e, "o-", ms=3)
     ax.axhline(100 * result.surface_strain[level], color="0.5", ls="--", lw=0.8,
@@ -201,8 +198,7 @@ def plot_transitions(rows: Sequence[dict[str, Any]], path: str | Path | None = N
     """
     from pneumorph.composite.crimp import Crimp
 
-    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(6.4, 4.4)
     ax = fig.subplots()
     cr = np.array([r["crimp_ratio"] for r in rows])
     first = rows[0]

@@ -6,13 +6,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 
 from pneumorph import __version__
 from pneumorph.correlation.compare import Correlation, ModelShape
-from pneumorph.io.files import save_figure
+from pneumorph.plot.figure import new_figure, save_figure
 
 
 def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | None = None,
@@ -31,8 +30,7 @@ def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | 
     photo_scale : float, optional
         mm per pixel of the photo (the scan's ``--scale``).
     """
-    fig = Figure(figsize=(8, 4.5))
-    FigureCanvasAgg(fig)
+    fig = new_figure(8, 4.5, layout=None)
     ax = fig.add_subplot()
     if photo is not None:
         _photo(ax, result, photo, photo_scale or 1.0)

@@ -4,31 +4,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from pneumorph.design.ga import GenerationStats
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
-
-
-def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def save_figure(fig: Any, path: str | Path) -> Path:
-    """Lay out, write (PNG/SVG by extension, 150 dpi) and close a pyplot figure."""
-    path = Path(path)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    _pyplot().close(fig)
-    return path
+from pneumorph.plot.figure import new_figure, save_figure
 
 
 def profile_points(candidate: Candidate) -> np.ndarray:
@@ -59,12 +41,12 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     -------
     Path
     """
-    plt = _pyplot()
     r = candidate.response
     assert r is not None, "a candidate without a response has no profile"
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig = new_figure(6.4, 4.2, layout="tight")
+    ax = fig.add_subplot()
     ax.axhline(0.0, color="0.8", lw=0.8, ls="--", label="undeformed axis")
     if isinstance(objective, ProfileTarget):
         if objective.coordinates == "cartesian":
@@ -101,9 +83,9 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
 
 def plot_convergence(history: Sequence[GenerationStats], path: str | Path, unit: str = "mm") -> Path:
     """Best and mean fitness of the population over the generations."""
-    plt = _pyplot()
     gens = [h.generation for h in history]
-    fig, ax = plt.subplots(figsize=(5.6, 3.6))
+    fig = new_figure(5.6, 3.6, layout="tight")
+    ax = fig.add_subplot()
     ax.plot(gens, [h.best for h in history], "o-", label="best")
     ax.plot(gens, [h.mean for h in history], "s--", label="mean")
     ax.set_xlabel("generation")

@@ -147,11 +147,11 @@ def population_study(
 
 def plot_study(result: StudyResult, path: str | Path) -> Path:
     """Lowest, largest and mean best fitness against the population size (Fig 6.1)."""
-    from pneumorph.design.figures import _pyplot, save_figure
+    from pneumorph.plot.figure import new_figure, save_figure
 
-    plt = _pyplot()
     pops = [r.population for r in result.rows]
-    fig, ax = plt.subplots(figsize=(5.6, 3.8))
+    fig = new_figure(5.6, 3.8, layout="tight")
+    ax = fig.add_subplot()
     ax.plot(pops, [r.lowest for r in result.rows], "v-", label="Lowest")
     ax.plot(pops, [r.largest for r in result.rows], "^-", label="Largest")
     ax.plot(pops, [r.mean for r in result.rows], "o--", label="Mean")

@@ -5,12 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from pneumorph import __version__
 from pneumorph.export.moulds import Mould
-from pneumorph.io.files import save_figure
+from pneumorph.plot.figure import new_figure, save_figure
 
 __all__ = ["plot_mould"]
 
@@ -60,8 +59,7 @@ def plot_mould(mould: Mould, path: str | Path | None = None, cast: bool = True, 
     """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    fig = Figure(figsize=(9, 6))
-    FigureCanvasAgg(fig)
+    fig = new_figure(9, 6, layout=None)
     ax = fig.add_subplot(projection="3d")
     items = [(name, mesh, mould.explode.get(name, (0.0, 0.0, 0.0))) for name, mesh in mould.parts.items()]
     if cast:

@@ -17,15 +17,11 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials.filler import FillerLaw
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response
+from pneumorph.plot.figure import new_figure, save_figure
 
 
 def _figure(size: tuple[float, float]) -> Any:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=size, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
+    return new_figure(*size)
 
 
 def _finish(fig: Any, ax: Any, title: str, path: str | Path) -> Path:
@@ -33,9 +29,7 @@ def _finish(fig: Any, ax: Any, title: str, path: str | Path) -> Path:
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    path = Path(path)
-    fig.savefig(path, dpi=150)
-    return path
+    return save_figure(fig, path, title)
 
 
 def centre_distances(r2: Response, r3: Response) -> np.ndarray:

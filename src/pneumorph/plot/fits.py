@@ -18,13 +18,13 @@ from pathlib import Path
 from typing import cast
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from pneumorph import __version__
 from pneumorph.materials.fitting import FitResult
 from pneumorph.materials.testdata import TestData
+from pneumorph.plot.figure import new_figure, save_figure
 
 _TITLES = {"uniaxial": "Uniaxial", "equibiaxial": "Equibiaxial", "planar": "Planar (pure shear)"}
 
@@ -78,8 +78,7 @@ def plot_fits(
     caption = textwrap.fill(f"{meta['Creator']} | data: {meta['Source']} | {meta['Description']}",
                             width=int(width * 24))
     nlines = caption.count("\n") + 1
-    fig = Figure(figsize=(width, 4.4), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(width, 4.4)
     cast(ConstrainedLayoutEngine, fig.get_layout_engine()).set(rect=(0.0, 0.03 * nlines, 1.0, 1.0 - 0.03 * nlines))
     axes = fig.subplots(1, len(modes), squeeze=False)[0]
     for ax, mode in zip(axes, modes, strict=False):
@@ -101,5 +100,5 @@ def plot_fits(
     fig.suptitle(title or data.name)
     fig.text(0.005, 0.005, caption, fontsize=5.5, color="0.4", ha="left", va="bottom")
     if path is not None:
-        fig.savefig(path, dpi=dpi, metadata=meta)
+        save_figure(fig, path, meta["Description"], dpi=dpi, fields={"Title": meta["Title"], "Source": meta["Source"]})
     return fig

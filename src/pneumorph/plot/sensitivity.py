@@ -7,10 +7,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from pneumorph import __version__
+from pneumorph.plot.figure import new_figure, save_figure
 
 
 def plot_study(result: Any, path: str | Path | None = None) -> Figure:
@@ -24,8 +24,7 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
     """
     study = result.study
     tolerances = study.name == "tolerances"
-    fig = Figure(figsize=(11.0 if tolerances else 6.5, 5.0), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(11.0 if tolerances else 6.5, 5.0)
     ax = fig.add_subplot(1, 2 if tolerances else 1, 1)
     ref = result.reference.outcome.response
     level = study.level
@@ -93,8 +92,7 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
         bx.legend(loc="lower right", fontsize=7)
     fig.text(0.01, 0.005, f"pneumorph {__version__} | {study.reference.model.fingerprint()}", fontsize=6, color="0.4")
     if path is not None:
-        fig.savefig(path, dpi=150, metadata={"Software": f"pneumorph {__version__}",
-                                             "Description": f"{study.name} study of design {study.design}"})
+        save_figure(fig, path, f"{study.name} study of design {study.design}")
     return fig
 
 

@@ -7,12 +7,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
 from pneumorph import __version__
 from pneumorph.geometry.boundary import boundary_facets
+from pneumorph.plot.figure import new_figure, save_figure
 
 COLOURS = {"body": "#4daf4a", "layer": "#377eb8", "filler": "#d9d9d9", "base": "#a6d96a"}
 LABELS = {"body": "body", "layer": "stiff layer", "filler": "filler (2D model)", "base": "base block"}
@@ -81,8 +81,7 @@ def plot_shape(
     done = [k for k in range(resp.n_levels) if not np.isnan(solution.displacements[k]).any()]
     levels = list(levels) if levels is not None else done[-1:]
     dim = solution.mesh.dim
-    fig = Figure(figsize=(5.5 * max(1, len(levels)), 5.0), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(5.5 * max(1, len(levels)), 5.0)
     for i, k in enumerate(levels):
         if dim == 2:
             ax = fig.add_subplot(1, len(levels), i + 1)
@@ -104,6 +103,5 @@ def plot_shape(
     fig.suptitle(title or f"design {resp.orientation} ({resp.metadata.get('fidelity', '')} model)")
     fig.text(0.01, 0.005, f"pneumorph {__version__} | {resp.metadata.get('fingerprint', '')}", fontsize=6, color="0.4")
     if path is not None:
-        fig.savefig(path, dpi=150, metadata={"Software": f"pneumorph {__version__}",
-                                             "Description": f"design {resp.orientation}"})
+        save_figure(fig, path, f"design {resp.orientation}")
     return fig
