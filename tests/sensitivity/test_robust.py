@@ -112,3 +112,23 @@ def test_fe_robustness_of_another_search_and_bad_input(tmp_path: Path, capsys: p
         assert main([*args[:-2], *bad]) == 2
         assert message in capsys.readouterr().err
     assert shipped_tolerance_path("3d").is_file()
+
+
+def test_the_interpolation_is_exact_for_any_quadratic_with_interactions() -> None:
+    tables = shipped_tolerance_tables("2d")  # its tolerance and the corner order only
+    t = tables.tolerance.tolerance
+    rng = np.random.default_rng(7)
+    g, c = rng.normal(size=3), rng.normal(size=3)
+    b = rng.normal(size=(3, 3))
+    b3 = rng.normal()
+
+    def f(d: np.ndarray) -> float:
+        return float(1.5 + g @ d + c @ d**2 + d[0] * d[1] * b[0, 1] + d[0] * d[2] * b[0, 2] + d[1] * d[2] * b[1, 2]
+                     + b3 * d.prod())
+
+    axis = [f(s * t * np.eye(3)[i]) for s in (-1, 1) for i in range(3)]
+    values = [np.array(f(np.zeros(3))), *map(np.array, axis), *(np.array(f(o)) for o in tables.tolerance.corners())]
+    for d in rng.uniform(-t, t, size=(20, 3)):
+        assert float(tables._change(values, d)) == pytest.approx(f(d) - f(np.zeros(3)), abs=1e-12)
+    # without the corners the interactions are missing
+    assert abs(float(tables._change(values[:7], np.full(3, t))) - (f(np.full(3, t)) - f(np.zeros(3)))) > 1e-6

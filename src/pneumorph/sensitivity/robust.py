@@ -4,17 +4,15 @@ A chain table (:mod:`pneumorph.models.chain`) holds the chord turns and lengths 
 window of units. Under a mould tolerance each of these moves smoothly with the three
 thicknesses of Fig E.4, and the change is local again (a unit's response depends on its
 neighbourhood), so it is tabulated the same way, with a narrower window: a
-:class:`ToleranceTables` holds window-1 tables of the unit at its nominal thicknesses and
-at ``-t`` and ``+t`` of each thickness alone (7 tables, 2 FE solves each for 15 units).
+:class:`ToleranceTables` holds window-1 tables of the unit at its nominal thicknesses, at
+``-t`` and ``+t`` of each thickness alone, and at the corners of the tolerance box (15
+tables for three thicknesses, 2 FE solves each for 15 units).
 :meth:`ToleranceTables.perturbed` then gives the chain table of *any* offsets within the
-class, second order in each thickness:
-
-    T(d) = T0 + sum_f [ (T+_f - T-_f) / (2 t) d_f + (T+_f + T-_f - 2 T0_f) / (2 t^2) d_f^2 ]
-
-with ``T0`` the full nominal table and the differences read at each window's inner three
-units. Scoring every design under ``S`` seeded samples of the class costs ``S`` chain
-scorings (:func:`design_robustness`). The tolerance study's FE solves of a design check it
-(``docs/sensitivity.md``).
+class: the full nominal table plus, read at each window's inner three units, a polynomial
+in the offsets that is exact for any quadratic with all products of the thicknesses
+(:meth:`ToleranceTables._change`). Scoring every design under ``S`` seeded samples of the
+class costs ``S`` chain scorings (:func:`design_robustness`). The tolerance study's FE
+solves of a design check it (``docs/sensitivity.md``).
 """
 
 from __future__ import annotations
@@ -22,6 +20,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from itertools import combinations
 from pathlib import Path
 from typing import Any
 
@@ -64,6 +63,9 @@ class ToleranceTables:
     nominal : ChainTable
     minus, plus : tuple of ChainTable
         One per field of the tolerance, in its order.
+    corners : tuple of ChainTable
+        One per corner of the tolerance box, in :meth:`Tolerance.corners` order (empty: no
+        interactions between the thicknesses).
     source : dict
         ``key`` (the chain source key of the nominal model), ``element_size`` (the matched
         mesh size of every table), ``fingerprints`` of the FE models solved.
@@ -74,6 +76,7 @@ class ToleranceTables:
     minus: tuple[ChainTable, ...]
     plus: tuple[ChainTable, ...]
     source: dict[str, Any]
+    corners: tuple[ChainTable, ...] = ()
 
     def perturbed(self, table: ChainTable, offsets: FloatArray) -> ChainTable:
         """``table`` (the nominal unit's, any window >= 1) moved to thickness ``offsets`` (mm, per field).
@@ -96,34 +99,58 @@ class ToleranceTables:
         if table.window < TOLERANCE_WINDOW:
             raise ChainTableError(f"a chain table of window +-{table.window} is narrower than the tolerance tables'")
         inner, inner_end = inner_codes(table.codes, table.window), inner_codes(table.end_codes, table.window)
-        rows = [x.lookup(inner) for x in (self.nominal, *self.minus, *self.plus)]
-        erows = [x.lookup(inner_end, end=True) for x in (self.nominal, *self.minus, *self.plus)]
-        m = len(self.tolerance.fields)
+        parts = (self.nominal, *self.minus, *self.plus, *self.corners)
+        rows = [x.lookup(inner) for x in parts]
+        erows = [x.lookup(inner_end, end=True) for x in parts]
         out: dict[str, Any] = {}
         for name, rr in (("turn", rows), ("length", rows), ("end", erows)):
-            base = getattr(table, name).copy()
-            n0 = getattr(self.nominal, name)[rr[0]]
-            for i, d in enumerate(offsets):
-                lo, hi = getattr(self.minus[i], name)[rr[1 + i]], getattr(self.plus[i], name)[rr[1 + m + i]]
-                base += (hi - lo) / (2 * t) * d + (hi + lo - 2 * n0) / (2 * t * t) * d * d
-            out[name] = base
+            values = [getattr(x, name)[r] for x, r in zip(parts, rr, strict=True)]
+            out[name] = getattr(table, name) + self._change(values, offsets)
         scalars: dict[str, Any] = {}
         for name in ("centre_y", "tip_ref"):
-            v = np.asarray(getattr(table, name), dtype=float).copy()
-            n0 = np.asarray(getattr(self.nominal, name), dtype=float)
-            for i, d in enumerate(offsets):
-                lo, hi = np.asarray(getattr(self.minus[i], name)), np.asarray(getattr(self.plus[i], name))
-                v += (hi - lo) / (2 * t) * d + (hi + lo - 2 * n0) / (2 * t * t) * d * d
+            values = [np.asarray(getattr(x, name), dtype=float) for x in parts]
+            v = np.asarray(getattr(table, name), dtype=float) + self._change(values, offsets)
             scalars[name] = tuple(float(x) for x in v)
         given = dict(zip(self.tolerance.fields, offsets.tolist(), strict=True))
         source = {**table.source, "tolerance_offsets_mm": given}
         return replace(table, **out, **scalars, source=source)
 
+    def _change(self, values: list[Any], d: FloatArray) -> Any:
+        """The change from the nominal of one tabulated quantity at offsets ``d``.
+
+        ``values`` holds the quantity in the nominal table, the ``-t`` and the ``+t`` tables of
+        each field and, if there are any, the corner tables. The model is the polynomial
+
+            sum_f (g_f d_f + c_f d_f^2) + sum_S b_S prod_(f in S) d_f   (S: 2 or more fields)
+
+        with ``g_f``, ``c_f`` from the central differences along each axis (exact at the
+        nominal and at the axis points) and the interactions ``b_S`` from the corners,
+        ``b_S = sum_corners (prod_(f in S) s_f) value / (2^m t^|S|)``: exact for any
+        quadratic in the thicknesses with all their products, as the FE response is to second
+        order.
+        """
+        t, m = self.tolerance.tolerance, len(self.tolerance.fields)
+        n0, minus, plus = values[0], values[1:1 + m], values[1 + m:1 + 2 * m]
+        total = np.zeros_like(n0)
+        for i in range(m):
+            lo, hi = minus[i], plus[i]
+            total = total + (hi - lo) / (2 * t) * d[i] + (hi + lo - 2 * n0) / (2 * t * t) * d[i] ** 2
+        corners = values[1 + 2 * m:]
+        if corners:
+            signs = np.sign(self.tolerance.corners())  # (2^m, m), the order the corner tables were built in
+            for size in range(2, m + 1):
+                for subset in combinations(range(m), size):
+                    weight = np.prod(signs[:, subset], axis=1)
+                    b = sum(w * c for w, c in zip(weight, corners, strict=True)) / (2**m * t**size)
+                    total = total + b * np.prod(d[list(subset)])
+        return total
+
     # -- persistence --------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         return {"kind": "pneumorph tolerance tables", "tolerance_mm": self.tolerance.tolerance,
                 "fields": list(self.tolerance.fields), "source": self.source, "nominal": self.nominal.to_dict(),
-                "minus": [x.to_dict() for x in self.minus], "plus": [x.to_dict() for x in self.plus]}
+                "minus": [x.to_dict() for x in self.minus], "plus": [x.to_dict() for x in self.plus],
+                "corners": [x.to_dict() for x in self.corners]}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], where: str = "tolerance tables") -> ToleranceTables:
@@ -133,7 +160,8 @@ class ToleranceTables:
             tolerance = Tolerance(float(data["tolerance_mm"]), tuple(data["fields"]))
             return cls(tolerance, ChainTable.from_dict(data["nominal"], where),
                        tuple(ChainTable.from_dict(x, where) for x in data["minus"]),
-                       tuple(ChainTable.from_dict(x, where) for x in data["plus"]), dict(data["source"]))
+                       tuple(ChainTable.from_dict(x, where) for x in data["plus"]), dict(data["source"]),
+                       tuple(ChainTable.from_dict(x, where) for x in data.get("corners", [])))
         except (KeyError, TypeError, ValueError) as exc:
             raise ChainTableError(f"{where}: not a tolerance table file ({exc})") from None
 
@@ -152,8 +180,9 @@ class ToleranceTables:
         return cls.from_dict(data, str(p))
 
 
-def _variants(model: Any, tolerance: Tolerance) -> list[tuple[str, Any]]:
-    """The 7 FE models of the tables: nominal, then -t and +t of each field, at the matched element size."""
+def _variants(model: Any, tolerance: Tolerance, corners: bool = True) -> list[tuple[str, Any]]:
+    """The FE models of the tables at the matched element size: nominal, -t and +t of each field, and
+    (``corners``) every corner of the box in :meth:`Tolerance.corners` order."""
     size = matched_element_size(model.unit, tolerance)
     unit = replace(model.unit, element_size=size)
     out = [("nominal", model.variant(unit=unit))]
@@ -163,11 +192,15 @@ def _variants(model: Any, tolerance: Tolerance) -> list[tuple[str, Any]]:
             o[i] = sign * tolerance.tolerance
             variant = model.variant(unit=perturbed(unit, tolerance.fields, o))
             out.append((f"{f} {sign * tolerance.tolerance:+g}", variant))
+    if corners:
+        for o in tolerance.corners():
+            label = "corner " + " ".join("-" if v < 0 else "+" for v in o)
+            out.append((label, model.variant(unit=perturbed(unit, tolerance.fields, o))))
     return out
 
 
 def build_tolerance_tables(model: Any, tolerance: Tolerance | None = None, evaluator: Any = None, n_units: int = 15,
-                           on_progress: Callable[[str], None] | None = None) -> ToleranceTables:
+                           on_progress: Callable[[str], None] | None = None, corners: bool = True) -> ToleranceTables:
     """Solve the covering designs of the 7 variants of ``model``'s unit and fit their window-1 tables.
 
     ``model`` is any FE model of the nominal unit (its number of units is replaced by
@@ -180,7 +213,7 @@ def build_tolerance_tables(model: Any, tolerance: Tolerance | None = None, evalu
     evaluator = evaluator or SerialEvaluator()
     say = on_progress or (lambda text: None)
     training = model.with_units(n_units)
-    variants = _variants(training, tolerance)
+    variants = _variants(training, tolerance, corners)
     designs = covering_designs(n_units, TOLERANCE_WINDOW)
     cases = [(m, d) for _, m in variants for d in designs]
     responses: list[Any] = [None] * len(cases)
@@ -198,7 +231,8 @@ def build_tolerance_tables(model: Any, tolerance: Tolerance | None = None, evalu
     k = len(tolerance.fields)
     source = {"key": source_key(model), "element_size": variants[0][1].unit.element_size,
               "fingerprints": [m.fingerprint() for _, m in variants], "n_units": n_units}
-    return ToleranceTables(tolerance, tables[0], tuple(tables[1:1 + k]), tuple(tables[1 + k:]), source)
+    return ToleranceTables(tolerance, tables[0], tuple(tables[1:1 + k]), tuple(tables[1 + k:1 + 2 * k]), source,
+                           tuple(tables[1 + 2 * k:]))
 
 
 def shipped_tolerance_path(fidelity: str = "3d", tolerance: float = 0.1) -> Path:
