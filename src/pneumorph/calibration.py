@@ -460,15 +460,14 @@ def validate(
 
 
 def cached_3d_solver(cache: Any) -> Callable[[Full3D, str], Response]:
-    """A ``solve_3d`` that answers from an :class:`~pneumorph.execution.EvaluationCache`."""
-    from pneumorph.execution.outcome import solve
+    """A ``solve_3d`` that answers from an :class:`~pneumorph.execution.EvaluationCache` and stores
+    what it solves (a :class:`~pneumorph.execution.CachedEvaluator` over the serial evaluator)."""
+    from pneumorph.execution import CachedEvaluator, SerialEvaluator
+
+    cached = CachedEvaluator(SerialEvaluator(), cache)
 
     def solve_3d(model: Full3D, design: str) -> Response:
-        key = model.fingerprint()
-        hit = cache.get(key, design)
-        outcome = hit if hit is not None else solve(model, design)
-        if hit is None:
-            cache.put(key, outcome)
+        (outcome,) = cached.evaluate_many(model, [design])
         if not outcome.ok or outcome.response is None:
             raise SimulationFailed(reached=0.0, cause=f"3D reference failed: {outcome.failure}", design=design)
         return outcome.response
