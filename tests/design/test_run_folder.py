@@ -35,18 +35,6 @@ class Terminated(KeyboardInterrupt):
     """Stands for the CLI's SIGTERM (a KeyboardInterrupt subclass)."""
 
 
-class HookedToy(ToyModel):
-    """A toy with the ``write_deformed`` hook of the FE models (and one file of its own)."""
-
-    def write_deformed(self, response, level, folder):
-        vtk = Path(folder) / "vtk"
-        vtk.mkdir(parents=True, exist_ok=True)
-        files = [Path(folder) / "deformed.png", vtk / "winner.pvd", vtk / "winner_00.vtu", Path(folder) / "extra.dat"]
-        for f in files:
-            f.write_text(f"{response.orientation} {level}")
-        return files
-
-
 class BrokenPressures(ToyModel):
     """A model that fails only when its pressures are asked for (the provenance, after the checks)."""
 
@@ -179,11 +167,14 @@ def test_generation_log_rules(tmp_path: Path) -> None:
 
 # -- overwrite --------------------------------------------------------------------------------------------
 def test_overwrite_removes_the_old_runs_files_only(tmp_path: Path) -> None:
+    from pneumorph.models.fe import RampSpec, Reduced2D
+
     folder = tmp_path / "run"
-    run_design(config(tmp_path), HookedToy(), folder)
+    small = config(tmp_path, units=2, ga=GAConfig(population=4, generations=1, hall_of_fame=2))
+    run_design(small, Reduced2D(2, ramp_spec=RampSpec(pressure=0.01)), folder)  # an FE model: its winner's fields
     names = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
     assert {"report.md", "profile.png", "convergence.png", "winner/deformed.png", "winner/vtk/winner.pvd",
-            "winner/vtk/winner_00.vtu", "winner/extra.dat"} <= names
+            "winner/vtk/winner_01.vtu"} <= names
     assert {p.relative_to(folder).as_posix() for p in run_files(folder)} == names
     (folder / "notes.txt").write_text("mine")
     (folder / "photo.png").write_bytes(b"not a run figure")

@@ -19,8 +19,8 @@ Folder contents:
   robustness.
 - ``profile.png`` - the winner at its pressure against the target (Figs 6.6-6.11);
   ``convergence.png`` - best and mean fitness per generation.
-- whatever the model's optional hook ``write_deformed(response, level, folder) -> list[Path]``
-  writes (the deformed shape, VTK of the winner).
+- ``winner/deformed.png`` and ``winner/vtk/`` - an FE model's winner solved again with its
+  fields (``model.solve``): the deformed shape at the winning pressure and its VTK series.
 
 Running the same settings into the same folder again resumes: the GA replays with the same
 seed and the evaluation cache answers every design solved before. Ctrl-C (or any
@@ -115,7 +115,7 @@ RUN_FILES = (
     "profile.png",
     "chain-vs-fe.png",
     "convergence.png",
-    "winner/deformed.png",  # the FE models' write_deformed hook
+    "winner/deformed.png",  # an FE model's winner, solved again with its fields
     "winner/vtk/winner.pvd",
     "winner/vtk/winner_*.vtu",
     "report.md",
@@ -389,7 +389,7 @@ def run_design(
         Start afresh in a folder that holds another run: once every check has passed, the
         old run's files are removed (:func:`run_files`); other files in the folder stay.
     figures : bool
-        Draw the figures (and call the model's ``write_deformed`` hook).
+        Draw the figures (and, for an FE model, solve the winner again for its shape and VTK).
 
     Returns
     -------
@@ -655,13 +655,27 @@ def _write_outputs(
         if cert is not None:
             files.append(_atomic_figure(folder / "chain-vs-fe.png", lambda p: plot_profile(
                 best, result.objective, p, compare=[("chain model", cert.winner_chain)])))
-        hook = getattr(model, "write_deformed", None)
-        if callable(hook) and cert is None:  # a certified run does not solve its winner a second time
-            files.extend(Path(p) for p in hook(best.response, best.level, folder / "winner"))
+        if callable(getattr(model, "solve", None)) and cert is None:  # a certified run solves no winner again
+            files.extend(_write_winner(model, best.response.orientation, best.level, folder / "winner"))
     if figures and result.history:
         files.append(_atomic_figure(folder / "convergence.png",
                                     lambda p: plot_convergence(result.history, p, result.objective.unit)))
     files.append(_write_report(result, config, model, files))
+
+
+def _write_winner(model: Any, design: str, level: int, folder: Path) -> list[Path]:
+    """Solve the winner again with its fields (``model.solve``, an FE model) and write its deformed
+    shape at the winning level and its VTK series (for ParaView) into ``folder``."""
+    from pneumorph.io import provenance as record
+    from pneumorph.io import write_vtk_series
+    from pneumorph.plot.shape import plot_shape
+
+    folder.mkdir(parents=True, exist_ok=True)
+    solution = model.solve(design)
+    shape = folder / "deformed.png"
+    plot_shape(solution, shape, levels=[level])
+    meta = record(model=model.describe(), fingerprint=model.fingerprint(), design=design)
+    return [shape, write_vtk_series(solution, folder / "vtk", stem="winner", meta=meta)]
 
 
 def _write_report(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[Path]) -> Path:

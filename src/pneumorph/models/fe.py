@@ -421,26 +421,6 @@ class FEModel:
         return replace(self.ramp.steps, increments=1, substeps=2)
 
 
-    def write_deformed(self, response: Response, level: int, folder: Any) -> list[Any]:
-        """Re-solve a design and write its shape figure and VTK series into ``folder``.
-
-        The hook a design run calls for its winner (``level`` is the winning pressure).
-        """
-        from pathlib import Path
-
-        from pneumorph.io import provenance, write_vtk_series
-        from pneumorph.plot.shape import plot_shape
-
-        out = Path(folder)
-        out.mkdir(parents=True, exist_ok=True)
-        solution = self.solve(response.orientation)
-        shape = out / "deformed.png"
-        plot_shape(solution, shape, levels=[level])
-        meta = provenance(model=self.describe(), fingerprint=self.fingerprint(), design=response.orientation)
-        pvd = write_vtk_series(solution, out / "vtk", stem="winner", meta=meta)
-        return [shape, pvd]
-
-
 class Reduced2D(FEModel):
     """The 2D plane-strain reduced-order model with a pressure-dependent filler (chapter 5).
 
