@@ -4,7 +4,7 @@
 # Results: results/<name>.json (+ .npz with the final displacement field) and logs/<name>.log
 set -u
 cd "$(dirname "$0")"
-PY=${PY:-/work/venv/bin/python}
+PY=${PY:-../../.venv/bin/python}  # the repository's venv (README quick start)
 export OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 mkdir -p results logs
 run() {  # name, args...
