@@ -132,3 +132,15 @@ def test_the_interpolation_is_exact_for_any_quadratic_with_interactions() -> Non
         assert float(tables._change(values, d)) == pytest.approx(f(d) - f(np.zeros(3)), abs=1e-12)
     # without the corners the interactions are missing
     assert abs(float(tables._change(values[:7], np.full(3, t))) - (f(np.full(3, t)) - f(np.zeros(3)))) > 1e-6
+
+
+def test_every_design_grown_unit_by_unit_equals_them_scored_one_by_one() -> None:
+    from pneumorph.design.targets import make_objective
+
+    nominal, tables = ChainTable.load(shipped_path("2d")), shipped_tolerance_tables("2d")
+    every = ((np.arange(2**15)[:, None] >> np.arange(14, -1, -1)) & 1).astype(np.uint8)
+    for objective in (make_objective("sin", 10.0, 1.0, length=157.5), make_objective("max-x", 10.0)):
+        grown = design_robustness(nominal, tables, objective, every, samples=3, seed=1, choose="worst")
+        one_by_one = design_robustness(nominal, tables, objective, every[:-1], samples=3, seed=1, choose="worst")
+        assert np.abs(grown.values[:, :-1] - one_by_one.values).max() < 1e-9
+        assert np.array_equal(grown.level[:-1], one_by_one.level)

@@ -323,17 +323,30 @@ def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any
         The level each design is judged at (its nominal best level, say); with ``choose``
         instead, the level of each design that minimises that statistic (``"worst"`` or
         ``"mean"``: the pressure at which it is most robust).
+
+    Every design of an actuator short enough to keep its prefix geometry is scored by
+    growing the designs unit by unit (:func:`~pneumorph.design.certified.chain_scores`, the
+    certified search's scoring, twice as fast); other sets of designs one by one.
     """
-    from pneumorph.design.certified import level_values
+    from pneumorph.design.certified import KEEP_GEOMETRY_UNITS, chain_scores, level_values
 
     samples = checks.integer(samples, "samples", 1, 10_000)
     bits = np.atleast_2d(np.asarray(bits, dtype=np.uint8))
     offsets = tables.tolerance.samples(samples, seed)
     n = bits.shape[1]
+    codes = bits.astype(np.int64) @ (1 << np.arange(n - 1, -1, -1))
+    every = n <= KEEP_GEOMETRY_UNITS and len(bits) == 2**n and len(np.unique(codes)) == 2**n
     per = []  # (samples, m, k)
     for o in offsets:
         chain = ChainModel(tables.perturbed(table, o), n)
-        values, _, _ = level_values(chain, objective, bits)
+        if every:
+            scores = chain_scores(chain, objective)
+            grown = scores.bits.astype(np.int64) @ (1 << np.arange(n - 1, -1, -1))
+            where = np.empty(2**n, dtype=np.int64)
+            where[grown] = np.arange(len(grown))
+            values = scores.per_level[where[codes]]
+        else:
+            values, _, _ = level_values(chain, objective, bits)
         per.append(np.where(np.isfinite(values), values, np.inf if objective.sense == "min" else -np.inf))
     stack = np.stack(per)
     if level is None:
