@@ -32,6 +32,7 @@ from pneumorph.io.files import atomic_write_text
 from pneumorph.models.chain import ChainModel, design_strings
 from pneumorph.models.chaintables import find_table
 from pneumorph.models.factory import make_model
+from pneumorph.models.windows import design_numbers
 
 TARGET_SAMPLES = 201
 BUILTIN = "builtin"
@@ -213,8 +214,7 @@ class Bench:
         sign = 1.0 if objective.sense == "min" else -1.0
         k = min(query.top, len(scores.cost))
         top = np.argpartition(scores.cost, k - 1)[:k]
-        as_int = (scores.bits[top].astype(np.int64) << np.arange(self.units - 1, -1, -1)).sum(axis=1)
-        top = top[np.lexsort((as_int, scores.cost[top]))]  # ties: the smaller design first
+        top = top[np.lexsort((design_numbers(scores.bits[top]), scores.cost[top]))]  # ties: the smaller design first
         designs = design_strings(scores.bits[top])
         kpa = chain.pressures() * 1e3
         best = int(top[0])

@@ -43,6 +43,7 @@ from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.chain import ChainModel, design_strings, window_codes
 from pneumorph.models.response import ActuatorModel
+from pneumorph.models.windows import design_numbers
 
 FloatArray = NDArray[np.float64]
 
@@ -168,8 +169,7 @@ class ChainScores:
         return np.lexsort((self._as_int(), self.cost))
 
     def _as_int(self) -> NDArray[np.int64]:
-        n = self.bits.shape[1]
-        return (self.bits.astype(np.int64) << np.arange(n - 1, -1, -1)).sum(axis=1)
+        return design_numbers(self.bits)
 
 
 def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integer]) -> tuple[FloatArray, ...]:

@@ -20,19 +20,11 @@ import numpy as np
 from pneumorph.design.fitness import score
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.models.chain import design_array, design_strings
-from pneumorph.sensitivity.robust import design_robustness
+from pneumorph.sensitivity.robust import design_robustness, spread
 from pneumorph.sensitivity.tolerances import Tolerance, matched_element_size, perturbed
 
 #: designs listed by their robust statistic
 TOP = 10
-
-
-def _stats(values: np.ndarray, sense: str) -> dict[str, float]:
-    v = np.asarray(values, dtype=float)
-    worse = v if sense == "min" else -v
-    sign = 1.0 if sense == "min" else -1.0
-    return {"mean": float(v.mean()), "worst": float(sign * worse.max()), "p95": float(sign * np.percentile(worse, 95)),
-            "best": float(sign * worse.min()), "samples": len(v)}
 
 
 def chain_robustness(config: Any, chain: Any, tables: Any, objective: Any, winner: Candidate) -> dict[str, Any]:
@@ -44,7 +36,7 @@ def chain_robustness(config: Any, chain: Any, tables: Any, objective: Any, winne
             "samples": config.samples(chain=True), "seed": config.seed,
             "winner": {"design": winner.design, "level": level,
                        "pressure_kPa": None if winner.pressure is None else winner.pressure * 1e3,
-                       "nominal_fe": winner.value, **_stats(rob.values[:, 0], objective.sense)},
+                       "nominal_fe": winner.value, **rob.summary(0)},
             "offsets_mm": rob.offsets.tolist(), "winner_values": rob.values[:, 0].tolist()}
 
 
@@ -59,7 +51,7 @@ def robust_ranking(config: Any, chain: Any, tables: Any, objective: Any,
     names = design_strings(rob.bits[order])
     pressures = chain.pressures()
     rows = [{"rank": r + 1, "design": d, "pressure_kPa": float(pressures[rob.level[i]] * 1e3),
-             **_stats(rob.values[:, i], objective.sense)} for r, (d, i) in enumerate(zip(names, order, strict=True))]
+             **rob.summary(i)} for r, (d, i) in enumerate(zip(names, order, strict=True))]
     return rows, rob
 
 
@@ -92,7 +84,7 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
     out["winner"] = {"design": winner.design, "level": int(winner.level),
                      "pressure_kPa": None if winner.pressure is None else winner.pressure * 1e3,
                      "nominal_fe": winner.value, "nominal_matched_mesh": float(values[0]),
-                     **(_stats(values[1:][ok], objective.sense) if ok.any() else {})}
+                     **(spread(values[1:][ok], objective.sense) if ok.any() else {})}
     return out
 
 

@@ -42,6 +42,17 @@ def design_array(designs: Sequence[str] | str, n_units: int | None = None) -> ND
     return (np.frombuffer("".join(rows).encode(), dtype=np.uint8) - ord("0")).reshape(len(rows), n)
 
 
+def design_numbers(bits: NDArray[np.integer]) -> IntArray:
+    """Each design (a row of 0/1, base first) as the integer its digits spell, base most significant.
+
+    >>> design_numbers(np.array([[0, 1, 1], [1, 0, 0]])).tolist()
+    [3, 4]
+    """
+    bits = np.atleast_2d(np.asarray(bits))
+    n = bits.shape[1]
+    return bits.astype(np.int64) @ (np.int64(1) << np.arange(n - 1, -1, -1, dtype=np.int64))
+
+
 def design_strings(bits: NDArray[np.integer]) -> list[str]:
     """The inverse of :func:`design_array`.
 

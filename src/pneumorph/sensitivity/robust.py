@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from pneumorph import checks
 from pneumorph.errors import ChainTableError
 from pneumorph.models.chain import ChainModel, ChainTable, covering_designs, fit_table, source_description, source_key
+from pneumorph.models.windows import design_numbers
 from pneumorph.sensitivity.tolerances import Tolerance, matched_element_size, perturbed
 
 FloatArray = NDArray[np.float64]
@@ -305,11 +306,22 @@ class Robustness:
         return out if self.sense == "min" else -out
 
     def summary(self, i: int = 0) -> dict[str, float]:
-        """Mean, worst and 95th percentile of design ``i``, and the spread of its values."""
-        return {"mean": float(self.statistic("mean")[i]), "worst": float(self.statistic("worst")[i]),
-                "p95": float(self.statistic("p95")[i]), "best": float(
-                    self.values[:, i].min() if self.sense == "min" else self.values[:, i].max()),
-                "samples": len(self.values)}
+        """:func:`spread` of design ``i``."""
+        return spread(self.values[:, i], self.sense)
+
+
+def spread(values: Any, sense: str) -> dict[str, float]:
+    """Mean, worst, 95th percentile toward the worse side, best, and number of the ``values`` of one
+    design under the samples (``sense`` "min": larger is worse).
+
+    >>> spread([1.0, 2.0, 4.0], "min")["worst"], spread([1.0, 2.0, 4.0], "max")["worst"]
+    (4.0, 1.0)
+    """
+    v = np.asarray(values, dtype=float)
+    sign = 1.0 if sense == "min" else -1.0
+    worse = sign * v
+    return {"mean": float(v.mean()), "worst": float(sign * worse.max()), "p95": float(sign * np.percentile(worse, 95)),
+            "best": float(sign * worse.min()), "samples": len(v)}
 
 
 def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any, bits: NDArray[np.integer],
@@ -334,14 +346,14 @@ def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any
     bits = np.atleast_2d(np.asarray(bits, dtype=np.uint8))
     offsets = tables.tolerance.samples(samples, seed)
     n = bits.shape[1]
-    codes = bits.astype(np.int64) @ (1 << np.arange(n - 1, -1, -1))
+    codes = design_numbers(bits)
     every = n <= KEEP_GEOMETRY_UNITS and len(bits) == 2**n and len(np.unique(codes)) == 2**n
     per = []  # (samples, m, k)
     for o in offsets:
         chain = ChainModel(tables.perturbed(table, o), n)
         if every:
             scores = chain_scores(chain, objective)
-            grown = scores.bits.astype(np.int64) @ (1 << np.arange(n - 1, -1, -1))
+            grown = design_numbers(scores.bits)
             where = np.empty(2**n, dtype=np.int64)
             where[grown] = np.arange(len(grown))
             values = scores.per_level[where[codes]]
@@ -361,5 +373,5 @@ def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any
 
 
 __all__ = ["STATISTICS", "TOLERANCE_WINDOW", "Robustness", "ToleranceTables", "build_tolerance_tables",
-           "design_robustness", "inner_codes", "shipped_tolerance_path", "shipped_tolerance_tables",
+           "design_robustness", "inner_codes", "shipped_tolerance_path", "shipped_tolerance_tables", "spread",
            "tolerance_tables_for"]
