@@ -12,7 +12,6 @@ design at the pressure where its statistic is best.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -21,7 +20,7 @@ from pneumorph.design.fitness import score
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.models.chain import design_array, design_strings
 from pneumorph.sensitivity.robust import design_robustness, spread
-from pneumorph.sensitivity.tolerances import Tolerance, matched_element_size, perturbed
+from pneumorph.sensitivity.tolerances import Tolerance, box_units
 
 #: designs listed by their robust statistic
 TOP = 10
@@ -67,11 +66,9 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
     if not hasattr(model, "variant") or not hasattr(model, "unit") or winner.level is None:
         return None
     tolerance = Tolerance(config.tolerance)
-    size = matched_element_size(model.unit, tolerance)
-    unit = replace(model.unit, element_size=size)
     offsets = tolerance.samples(config.samples(chain=False), config.seed)
-    cases = [(model.variant(unit=unit), winner.design)]
-    cases += [(model.variant(unit=perturbed(unit, tolerance.fields, o)), winner.design) for o in offsets]
+    nominal, units = box_units(model.unit, tolerance, offsets)
+    cases = [(model.variant(unit=u), winner.design) for u in (nominal, *units)]
     values = np.full(len(cases), np.nan)
     for i, outcome in evaluator.iter_cases(cases):
         if outcome.ok:
@@ -79,7 +76,7 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
     ok = np.isfinite(values[1:])
     out: dict[str, Any] = {"method": "FE model, one solve per sample", "tolerance_mm": config.tolerance,
                            "samples": config.samples(chain=False), "seed": config.seed, "failed": int((~ok).sum()),
-                           "element_size_mm": size, "offsets_mm": offsets.tolist(),
+                           "element_size_mm": nominal.element_size, "offsets_mm": offsets.tolist(),
                            "winner_values": [None if not np.isfinite(v) else float(v) for v in values[1:]]}
     out["winner"] = {"design": winner.design, "level": int(winner.level),
                      "pressure_kPa": None if winner.pressure is None else winner.pressure * 1e3,

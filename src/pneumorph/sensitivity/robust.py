@@ -31,7 +31,7 @@ from pneumorph import checks
 from pneumorph.errors import ChainTableError
 from pneumorph.models.chain import ChainModel, ChainTable, covering_designs, fit_table, source_description, source_key
 from pneumorph.models.windows import design_numbers
-from pneumorph.sensitivity.tolerances import Tolerance, matched_element_size, perturbed
+from pneumorph.sensitivity.tolerances import Tolerance, box_units, corner_label
 
 FloatArray = NDArray[np.float64]
 
@@ -184,25 +184,19 @@ class ToleranceTables:
 def _variants(model: Any, tolerance: Tolerance, corners: bool = True) -> list[tuple[str, Any]]:
     """The FE models of the tables at the matched element size: nominal, -t and +t of each field, and
     (``corners``) every corner of the box in :meth:`Tolerance.corners` order."""
-    size = matched_element_size(model.unit, tolerance)
-    unit = replace(model.unit, element_size=size)
-    out = [("nominal", model.variant(unit=unit))]
-    for sign in (-1.0, 1.0):
-        for i, f in enumerate(tolerance.fields):
-            o = np.zeros(len(tolerance.fields))
-            o[i] = sign * tolerance.tolerance
-            variant = model.variant(unit=perturbed(unit, tolerance.fields, o))
-            out.append((f"{f} {sign * tolerance.tolerance:+g}", variant))
-    if corners:
-        for o in tolerance.corners():
-            label = "corner " + " ".join("-" if v < 0 else "+" for v in o)
-            out.append((label, model.variant(unit=perturbed(unit, tolerance.fields, o))))
-    return out
+    m, t = len(tolerance.fields), tolerance.tolerance
+    axis = [(f"{f} {sign * t:+g}", sign * t * np.eye(m)[i])
+            for sign in (-1.0, 1.0) for i, f in enumerate(tolerance.fields)]
+    points = axis + ([(corner_label(o), o) for o in tolerance.corners()] if corners else [])
+    nominal, units = box_units(model.unit, tolerance, [o for _, o in points])
+    return [("nominal", model.variant(unit=nominal))] + [
+        (label, model.variant(unit=unit)) for (label, _), unit in zip(points, units, strict=True)]
 
 
 def build_tolerance_tables(model: Any, tolerance: Tolerance | None = None, evaluator: Any = None, n_units: int = 15,
                            on_progress: Callable[[str], None] | None = None, corners: bool = True) -> ToleranceTables:
-    """Solve the covering designs of the 7 variants of ``model``'s unit and fit their window-1 tables.
+    """Solve the covering designs of the variants of ``model``'s unit (nominal, each thickness at -t and
+    +t, and with ``corners`` the 8 corners) and fit their window-1 tables.
 
     ``model`` is any FE model of the nominal unit (its number of units is replaced by
     ``n_units``, the training actuator). The solves go through ``evaluator.iter_cases``

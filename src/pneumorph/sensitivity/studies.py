@@ -34,7 +34,7 @@ from pneumorph.geometry.features import PHYSICAL_PASSAGE, BaseBlock
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.models.fe import FEModel, RampSpec
 from pneumorph.sensitivity.compare import ShapeDifference, shape_difference
-from pneumorph.sensitivity.tolerances import FIELDS, Tolerance, matched_element_size, perturbed
+from pneumorph.sensitivity.tolerances import FIELDS, Tolerance, box_units, corner_label
 from pneumorph.sensitivity.variants import scaled_bulk_modulus, tension_only
 
 STUDIES = ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature")
@@ -206,23 +206,21 @@ def tolerances(model: FEModel, design: str | None = None, tolerance: Tolerance |
     """
     tolerance = tolerance or Tolerance()
     samples = checks.integer(samples, "samples", 0, 10_000)
-    # every case on the nominal mesh's cell counts: a change of mesh would be as large as the tolerance's effect
-    size = matched_element_size(model.unit, tolerance)
-    nominal_unit = replace(model.unit, element_size=size)
-    cases = []
-    extremes = tolerance.extremes()
     labels = [f"{f} {s}{tolerance.tolerance:g}" for f in tolerance.fields for s in ("-", "+")]
-    offsets = [*zip(labels, extremes, strict=True)]
+    offsets = [*zip(labels, tolerance.extremes(), strict=True)]
     if corners:  # every thickness at an end: these bracket any combination's curl when it is monotone in each
-        offsets += [("corner " + " ".join(f"{'-' if v < 0 else '+'}" for v in o), o) for o in tolerance.corners()]
+        offsets += [(corner_label(o), o) for o in tolerance.corners()]
     if samples:
         offsets += [(f"sample {k + 1}", o) for k, o in enumerate(tolerance.samples(samples, seed))]
-    for label, o in offsets:
-        unit = perturbed(nominal_unit, tolerance.fields, o)
+    # every case on the nominal mesh's cell counts: a change of mesh would be as large as the tolerance's effect
+    nominal_unit, units = box_units(model.unit, tolerance, [o for _, o in offsets])
+    cases = []
+    for (label, _), unit in zip(offsets, units, strict=True):
         inputs = {f: round(float(getattr(unit, f)), 6) for f in tolerance.fields}
         cases.append(Case(label, model.variant(unit=unit), inputs))
     nominal = {f: float(getattr(model.unit, f)) for f in tolerance.fields}
-    reference = Case("nominal", model.variant(unit=nominal_unit), {**nominal, "element_size": size})
+    reference = Case("nominal", model.variant(unit=nominal_unit),
+                     {**nominal, "element_size": nominal_unit.element_size})
     return Study("tolerances", _design(model, design), reference, tuple(cases))
 
 

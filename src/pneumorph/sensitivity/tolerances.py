@@ -118,6 +118,31 @@ def matched_element_size(unit: UnitSpec, tolerance: Tolerance, steps: int = 40) 
                         "tolerance or an element size that is not a divisor of its thicknesses")
 
 
+def box_units(unit: UnitSpec, tolerance: Tolerance, offsets: Any) -> tuple[UnitSpec, list[UnitSpec]]:
+    """The nominal ``unit`` at :func:`matched_element_size`, and it moved to each row of ``offsets``.
+
+    Every unit of a tolerance study, a table or a robustness check is built here, so all share
+    the nominal mesh's cell counts.
+
+    Examples
+    --------
+    >>> nominal, (thin,) = box_units(UnitSpec(), Tolerance(0.1), [[-0.1, 0.0, 0.0]])
+    >>> nominal.element_size, thin.side_wall, thin.element_size
+    (1.71, 1.4, 1.71)
+    """
+    nominal = replace(unit, element_size=matched_element_size(unit, tolerance))
+    return nominal, [perturbed(nominal, tolerance.fields, np.asarray(o, dtype=float)) for o in offsets]
+
+
+def corner_label(offsets: Any) -> str:
+    """``"corner - + +"``: which end of each thickness a corner of the tolerance box takes.
+
+    >>> corner_label([-0.1, 0.1, 0.1])
+    'corner - + +'
+    """
+    return "corner " + " ".join("-" if v < 0 else "+" for v in offsets)
+
+
 def perturbed(unit: UnitSpec, fields: tuple[str, ...], offsets: FloatArray) -> UnitSpec:
     """``unit`` with ``offsets`` (mm) added to its ``fields``.
 
@@ -136,4 +161,5 @@ def perturbed(unit: UnitSpec, fields: tuple[str, ...], offsets: FloatArray) -> U
     return replace(unit, **values)
 
 
-__all__ = ["FIELDS", "MACHINED", "PRINTED", "Tolerance", "matched_element_size", "perturbed"]
+__all__ = ["FIELDS", "MACHINED", "PRINTED", "Tolerance", "box_units", "corner_label", "matched_element_size",
+           "perturbed"]
