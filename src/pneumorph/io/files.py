@@ -145,13 +145,6 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     return Path(path)
 
 
-def save_figure(fig: Any, path: str | Path, dpi: int = 150, **options: Any) -> Path:
-    """Save a matplotlib figure to ``path`` atomically (format from the suffix)."""
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, **options)
-    return Path(path)
-
-
 def atomic_write_text(path: str | Path, text: str) -> Path:
     """Write UTF-8 ``text`` to ``path`` atomically (see :func:`atomic_write_bytes`)."""
     return atomic_write_bytes(path, text.encode("utf-8"))

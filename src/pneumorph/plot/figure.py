@@ -15,7 +15,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from pneumorph import __version__
-from pneumorph.io.files import save_figure as _save_atomically
+from pneumorph.io.files import atomic_path
 
 
 def new_figure(width: float, height: float,
@@ -62,7 +62,9 @@ def save_figure(fig: Figure, path: str | Path, description: str = "", dpi: int =
     ``fields`` are further metadata (``Title``, ``Source``); ``options`` go to
     :meth:`matplotlib.figure.Figure.savefig` (e.g. ``bbox_inches``).
     """
-    return _save_atomically(fig, path, dpi=dpi, metadata=metadata(path, description, **(fields or {})), **options)
+    with atomic_path(path) as tmp:  # the temporary file keeps the suffix, so the format
+        fig.savefig(tmp, dpi=dpi, metadata=metadata(path, description, **(fields or {})), **options)
+    return Path(path)
 
 
 __all__ = ["metadata", "new_figure", "save_figure"]
