@@ -92,7 +92,9 @@ def test_dask_local_cluster_matches_serial(model: ToyModel, serial: list) -> Non
     with DaskEvaluator(workers=1, processes=False) as ev:
         out = ev.evaluate_many(model, DESIGNS)
         streamed = sorted(i for i, _ in ev.iter_evaluate(model, DESIGNS[:3]))
+        cases = dict(ev.iter_cases([(model, d) for d in DESIGNS]))  # pairs, each with its model
     same(out, serial)
+    same([cases[i] for i in range(len(DESIGNS))], serial)
     assert streamed == [0, 1, 2]
 
 

@@ -433,15 +433,21 @@ class DaskEvaluator(_Base):
         return self._model_future
 
     def iter_evaluate(self, model: ActuatorModel, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
-        from distributed import KilledWorker, as_completed
-
         designs = list(designs)
         if not designs:
             return
         remote = self._model_on_workers(model)
-        futures = [
-self.client.submit(_solve_on_dask_worker, remote, d, pure=False) for d in designs
-        ]
+        yield from self._collect([(remote, d) for d in designs])
+
+    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]:
+        """Solve ``(model, design)`` pairs of different models, each sent with its case."""
+        yield from self._collect(list(cases))
+
+    def _collect(self, cases: list[tuple[Any, str]]) -> Iterator[tuple[int, Outcome]]:
+        """Submit ``(model or its scattered future, design)`` pairs and yield ``(index, Outcome)`` as they finish."""
+        from distributed import KilledWorker, as_completed
+
+        futures = [self.client.submit(_solve_on_dask_worker, m, d, pure=False) for m, d in cases]
         index = {f.key: i for i, f in enumerate(futures)}
         try:
             for f in as_completed(futures):
@@ -449,22 +455,9 @@ self.client.submit(_solve_on_dask_worker, remote, d, pure=False) for d in design
                 try:
                     outcome = f.result()
                 except KilledWorker:  # every worker that tried it died (distributed's allowed-failures)
-                    outcome = Outcome(designs[i], None, transient=True,
+                    outcome = Outcome(cases[i][1], None, transient=True,
                                       failure="worker died: every Dask worker that solved it died (KilledWorker)")
                 yield i, outcome
-        finally:
-            self.client.cancel([f for f in futures if not f.done()])
-
-    def iter_cases(self, cases: Iterable[tuple[ActuatorModel, str]]) -> Iterator[tuple[int, Outcome]]:
-        """Solve ``(model, design)`` pairs of different models, each sent with its case."""
-        from distributed import as_completed
-
-        cases = list(cases)
-        futures = [self.client.submit(_solve_on_dask_worker, m, d, pure=False) for m, d in cases]
-        index = {f.key: i for i, f in enumerate(futures)}
-        try:
-            for f in as_completed(futures):
-                yield index[f.key], f.result()
         finally:
             self.client.cancel([f for f in futures if not f.done()])
 
