@@ -478,7 +478,6 @@ class Reduced2D(FEModel):
         materials: Mapping[str, Material] | None = None,
     ) -> None:
         unit = unit or UnitSpec()
-        self._given_filler = filler
         super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity,
                          base_block=base_block, materials=materials)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
