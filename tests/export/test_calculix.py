@@ -139,8 +139,7 @@ def test_cavity_faces_of_one_element() -> None:
 
 def test_mesh_nodes_and_elements_equal_the_models(one_unit) -> None:
     model, _, blocks = one_unit
-    built = model.build("0")
-    mesh = built["mesh"]
+    mesh, _, _ = model.build("0")
     node_lines = next(data for key, data in blocks if key == "*NODE")
     nodes = np.array([[float(v) for v in line.split(",")] for line in node_lines])
     assert len(nodes) == len(mesh.points) == 1438
@@ -173,9 +172,8 @@ def test_boundary_sets_and_tip(one_unit) -> None:
 def test_loaded_faces_are_pneumorphs_pressure_faces(one_unit) -> None:
     """Every (element, Pn) face holds the nodes of one face FElupe's pressure acts on, and all of them."""
     model, _, blocks = one_unit
-    built = model.build("0")
-    mesh = built["mesh"]
-    felupe_faces = {frozenset(f.tolist()) for f in built["wall_field"][0].region.mesh.cells_faces}
+    mesh, body, _ = model.build("0")
+    felupe_faces = {frozenset(f.tolist()) for f in body.walls[0].region.mesh.cells_faces}
     conn = elements(block(blocks, "*ELEMENT, TYPE=C3D20"), 20)[:, 1:] - 1
     loads = block(blocks, "*DLOAD")
     deck_faces = set()

@@ -66,22 +66,21 @@ def test_neo_hooke_kernel_is_felupes(gradients: np.ndarray) -> None:
 @pytest.fixture(scope="module")
 def deformed_actuator():
     model = Reduced2D(2)
-    parts = model.build("01")
-    field = parts["field"]
+    mesh, body, set_pressure = model.build("01")
+    field = body.field
     X = field[0].region.mesh.points
     rng = np.random.default_rng(1)
     u = np.column_stack([0.05 * np.sin(X[:, 1] / 3.0) + 0.02 * X[:, 0] / 10, 0.08 * np.cos(X[:, 0] / 7.0)])
     u += 0.004 * rng.standard_normal(u.shape)
-    u[parts["mesh"].base_points] = 0.0
+    u[mesh.base_points] = 0.0
     field[0].values[:] = u
-    parts["pressure"].update(0.03)  # 30 kPa, filler at E(30 kPa)
-    parts["set_extra"](0.03)
-    return parts
+    set_pressure(0.03)  # 30 kPa, filler at E(30 kPa)
+    return mesh, body
 
 
 def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
-    parts = deformed_actuator
-    field, items, dof1, dof0 = parts["field"], parts["items"], parts["dof1"], parts["dof0"]
+    mesh, body = deformed_actuator
+    field, items, dof1, dof0 = body.field, body.items, body.dof1, body.dof0
     system = PlaneStrainSystem(items, field, dof1, dof0)
     r, jmin = system.residual(field[0].values.ravel().copy())
     K_fast = system.tangent()
@@ -92,11 +91,11 @@ def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
     assert abs(K_fast - K_fe).max() <= 1e-12 * abs(K_fe).max()
     # each wall element's follower-load stiffness is not symmetric, but the walls of a
     # closed cavity make the load conservative (potential -p V): the sum is symmetric
-    K_p = jac_items([parts["pressure"]], field).tocsr()
-    walls = parts["pressure"].field[0].region.mesh.cells[:1]
+    K_p = jac_items([body.pressure], field).tocsr()
+    walls = body.pressure.field[0].region.mesh.cells[:1]
     one = fem.SolidBodyPressure(fem.FieldContainer([fem.FieldPlaneStrain(
         fem.RegionQuadraticQuadBoundary(fem.Mesh(field[0].region.mesh.points, walls, "quad8"),
-                                        mask=parts["mesh"].cavity_points, ensure_3d=True), dim=2)]), pressure=0.03)
+                                        mask=mesh.cavity_points, ensure_3d=True), dim=2)]), pressure=0.03)
     one.field.link(field)
     K_one = one.assemble.matrix()
     assert abs(K_one - K_one.T).max() > 1e-3 * abs(K_one).max()
@@ -104,7 +103,7 @@ def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
     F = field[0].extract(grad=True, sym=False, add_identity=True)
     assert jmin == pytest.approx(float(np.min(fem.math.det(F))), rel=1e-13)
     area = system.cavity_volume(field[0].values.ravel())
-    assert area == pytest.approx(cavity_volume(parts["wall_field"]), rel=1e-13)
+    assert area == pytest.approx(cavity_volume(body.walls), rel=1e-13)
 
 
 def test_unsupported_items_are_refused() -> None:

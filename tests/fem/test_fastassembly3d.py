@@ -69,24 +69,24 @@ def test_closed_form_eigen_decomposition_of_C() -> None:
 @pytest.fixture(scope="module")
 def deformed_actuator():
     model = Full3D(1, unit=UnitSpec(element_size=3.0))
-    parts = model.build("1")
-    field = parts["field"]
+    mesh, body, _ = model.build("1")
+    field = body.field
     X = field[0].region.mesh.points
     rng = np.random.default_rng(1)
     u = np.column_stack(
         [0.05 * np.sin(X[:, 1] / 3.0), 0.08 * np.cos(X[:, 0] / 7.0), 0.03 * np.sin(X[:, 0] / 5.0)]
     )
     u += 0.004 * rng.standard_normal(u.shape)
-    u[parts["mesh"].base_points] = 0.0
-    u[parts["mesh"].symmetry_points, 2] = 0.0  # the state satisfies the boundary conditions
+    u[mesh.base_points] = 0.0
+    u[mesh.symmetry_points, 2] = 0.0  # the state satisfies the boundary conditions
     field[0].values[:] = u
-    parts["pressure"].update(0.03)
-    return parts
+    body.pressure.update(0.03)
+    return mesh, body
 
 
 def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
-    parts = deformed_actuator
-    field, items, dof1, dof0 = parts["field"], parts["items"], parts["dof1"], parts["dof0"]
+    mesh, body = deformed_actuator
+    field, items, dof1, dof0 = body.field, body.items, body.dof1, body.dof0
     system = SolidSystem3D(items, field, dof1, dof0)
     r, jmin = system.residual(field[0].values.ravel().copy())
     upper = system.tangent_data()
@@ -100,7 +100,7 @@ def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
     F = field[0].extract(grad=True, sym=False, add_identity=True)
     assert jmin == pytest.approx(float(np.min(fem.math.det(F))), rel=1e-13)
     volume = system.cavity_volume(field[0].values.ravel())
-    assert volume == pytest.approx(cavity_volume(parts["wall_field"]), rel=1e-13)
+    assert volume == pytest.approx(cavity_volume(body.walls), rel=1e-13)
 
 
 def test_pressure_stiffness_is_symmetric_on_the_active_dofs(deformed_actuator) -> None:
@@ -110,16 +110,16 @@ def test_pressure_stiffness_is_symmetric_on_the_active_dofs(deformed_actuator) -
     restricted to the active dofs of a state with the rim on the symmetry plane, is
     symmetric to rounding.
     """
-    parts = deformed_actuator
-    field, dof1 = parts["field"], parts["dof1"]
-    pressure = parts["pressure"]
+    mesh, body = deformed_actuator
+    field, dof1 = body.field, body.dof1
+    pressure = body.pressure
     fun_items([pressure], field)
     K_p = jac_items([pressure], field).tocsr()[dof1][:, dof1]
     assert abs(K_p - K_p.T).max() < 1e-12 * abs(K_p).max()
     walls = pressure.field[0].region
     one = fem.SolidBodyPressure(
         fem.FieldContainer([fem.Field(type(walls)(fem.Mesh(walls.mesh.points, walls.mesh.cells[:1], "hexahedron20"),
-                                                  mask=parts["mesh"].cavity_points), dim=3)]),
+                                                  mask=mesh.cavity_points), dim=3)]),
         pressure=0.03,
     )
     one.field.link(field)
@@ -171,13 +171,13 @@ def test_kept_tangent_reaches_newtons_equilibrium() -> None:
     settings = StepSettings(increments=1, substeps=1, max_iterations=40)
     results = []
     for options in ({}, {"reuse": 0.3, "depth": 4}):
-        parts = Full3D(1, unit=UnitSpec(element_size=3.0)).build("0")
-        parts["pressure"].update(0.02)
-        system = SolidSystem3D(parts["items"], parts["field"], parts["dof1"], parts["dof0"])
+        _, body, set_pressure = Full3D(1, unit=UnitSpec(element_size=3.0)).build("0")
+        set_pressure(0.02)
+        system = SolidSystem3D(body.items, body.field, body.dof1, body.dof0)
         substep = FastSubstep(system, **options)
-        iterations, cause = substep(parts["field"], settings)
+        iterations, cause = substep(body.field, settings)
         assert cause is None
-        results.append((parts["field"][0].values.copy(), iterations, substep.factorisations))
+        results.append((body.displacement.copy(), iterations, substep.factorisations))
     (u_newton, it_newton, fact_newton), (u_chord, _, fact_chord) = results
     assert fact_newton == it_newton and fact_chord < fact_newton
     assert abs(u_newton).max() > 0.5  # mm: a real inflation

@@ -88,13 +88,12 @@ def test_3d_bar_hangs_like_the_closed_form() -> None:
 
 def test_dead_loads_equal_felupes_body_force_and_the_weight() -> None:
     model = Reduced2D(2, gravity="horizontal")
-    parts = model.build("01")
-    field, mesh = parts["field"], parts["mesh"]
-    for force in parts["forces"]:
-        force.update(np.asarray(model.gravity))
-    system = PlaneStrainSystem(parts["items"], field, parts["dof1"], parts["dof0"])
+    mesh, body, _ = model.build("01")
+    field = body.field
+    body.set_gravity(np.asarray(model.gravity))
+    system = PlaneStrainSystem(body.items, field, body.dof1, body.dof0)
     r_fast, _ = system.residual(np.zeros(field[0].values.size))
-    r_fe = fun_items(parts["items"], field)
+    r_fe = fun_items(body.items, field)
     np.testing.assert_allclose(r_fast, r_fe, rtol=0, atol=1e-12 * np.abs(r_fe).max())
     # the weight: density times the area of each silicone's (straight-sided) cells by the shoelace rule
     weight = 0.0
@@ -103,7 +102,7 @@ def test_dead_loads_equal_felupes_body_force_and_the_weight() -> None:
         x, y = corners[..., 0], corners[..., 1]
         area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)).sum()
         weight += material.density.value * STANDARD_GRAVITY * area
-    loads = DeadLoads(parts["forces"], system.npoints, 2).vector().reshape(-1, 2)
+    loads = DeadLoads(list(body.forces.values()), system.npoints, 2).vector().reshape(-1, 2)
     assert loads[:, 1].sum() == pytest.approx(-weight, rel=1e-12)
     assert loads[:, 0].sum() == 0.0
     assert 1e-3 < weight < 1e-2  # N per mm of depth: about 1.1e-9 tonne/mm^3 * 9.8e3 mm/s^2 * ~500 mm^2

@@ -42,7 +42,7 @@ def test_the_pressurised_surface_encloses_cavities_and_passages(design: str) -> 
     u = UnitSpec()
     s = passage_side(PHYSICAL_PASSAGE)
     model = Full3D(3, half=False, passage=PHYSICAL_PASSAGE)
-    enclosed = cavity_volume(model.build(design)["wall_field"])
+    enclosed = cavity_volume(model.build(design)[1].walls)
     cavities = 3 * u.cavity_length * u.cavity_height * (u.width - 2 * u.side_wall)
     assert enclosed == pytest.approx(cavities + 2 * s * s * 2 * u.end_wall, rel=1e-6)
 

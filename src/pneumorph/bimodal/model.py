@@ -38,8 +38,11 @@ from pneumorph.bimodal.geometry import (
 )
 from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
+from pneumorph.fem import OgdenCompressible, StepSettings, ramp
+from pneumorph.fem.body import BACKENDS, PressurisedBody, pressurised_body
 from pneumorph.materials import get
 from pneumorph.materials.hyperelastic import Ogden
+from pneumorph.models.fe import Full3D
 
 FloatArray = np.ndarray
 
@@ -151,6 +154,10 @@ class BimodalModel:
         (a limit point) every trial that fails costs ``max_iterations`` tangent solves.
     half : bool
         Half model across the width (u_z = 0 on the mid-plane), the default.
+    backend : {"fast", "felupe"}
+        ``"fast"`` (default): the fast 3D system and its Newton method keeping factorised
+        tangents, as :class:`pneumorph.models.fe.Full3D`; ``"felupe"``: FElupe's assembly
+        and ``newtonraphson`` (the reference path). Both stop at the same criterion.
 
     Examples
     --------
@@ -159,6 +166,12 @@ class BimodalModel:
     >>> r.completed, r.pressures.tolist(), bool(r.tip[0, 1] > 0)
     (True, [0.005], True)
     """
+
+    #: the 3D actuator model's tuned Newton method (quadratic predictor, kept tangents with
+    #: Anderson acceleration), on the same hexahedra
+    predictor_order = Full3D.predictor_order
+    tangent_reuse = Full3D.tangent_reuse
+    anderson_depth = Full3D.anderson_depth
 
     def __init__(
         self,
@@ -172,6 +185,7 @@ class BimodalModel:
         max_cutbacks: int = 4,
         max_iterations: int = 12,
         half: bool = True,
+        backend: str = "fast",
     ) -> None:
         pmax = checks.real(pmax, "pmax", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                            limit="MAX_PRESSURE_KPA")
@@ -207,6 +221,9 @@ class BimodalModel:
         self.max_cutbacks = int(max_cutbacks)
         self.max_iterations = int(max_iterations)
         self.half = bool(half)
+        if backend not in BACKENDS:
+            raise SettingsError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+        self.backend = backend
 
     def bulk(self, layer: str) -> float:
         """Bulk modulus (MPa) used for a layer."""
@@ -231,32 +248,18 @@ class BimodalModel:
             "element": "hexahedron20",
         }
 
-    def build(self) -> dict[str, Any]:
-        """FElupe objects: mesh, global field, layer bodies, void pressure, boundaries."""
-        import felupe as fem
-
-        from pneumorph.fem import OgdenCompressible
-        from pneumorph.fem.parts import clamped_dofs, linked_solid
-
-        mesh: BimodalMesh = mesh_actuator(self.spec, half=self.half)
-        Region, Boundary = fem.RegionQuadraticHexahedron, fem.RegionQuadraticHexahedronBoundary
-        fmesh = fem.Mesh(mesh.points, mesh.cells, mesh.cell_type)
-        field_ = fem.FieldContainer([fem.Field(Region(fmesh), dim=3)])
-        bodies = []
+    def build(self) -> tuple[BimodalMesh, PressurisedBody]:
+        """The layered mesh and its pressurised body (one Ogden solid per layer, void walls)."""
+        mesh = mesh_actuator(self.spec, half=self.half)
+        regions = []
         for code in (BILINEAR, SEAL, BODY, STRIP):
             name = LABELS[code]
             m = self.materials[name].model
             assert isinstance(m, Ogden), f"{name}: the bimodal model takes Ogden silicones"
-            umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name))
-            bodies.append(linked_solid(umat, mesh.points, mesh.cells[mesh.label == code], mesh.cell_type,
-                                       Region, fem.Field, 3, field_))
-        walls = Boundary(fmesh, mask=mesh.void_points)
-        wall_field = fem.FieldContainer([fem.Field(walls, dim=3)])
-        wall_field.link(field_)
-        pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
-        dof0, dof1 = clamped_dofs(field_, mesh.base_points, mesh.symmetry_points)
-        return {"mesh": mesh, "field": field_, "items": [*bodies, pressure], "pressure": pressure,
-                "wall_field": wall_field, "dof0": dof0, "dof1": dof1}
+            regions.append((name, mesh.label == code, OgdenCompressible(m.mu, m.alpha, self.bulk(name))))
+        body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
+                                mesh.symmetry_points)
+        return mesh, body
 
     def solve(self, on_level: Any = None) -> BimodalResult:
         """Ramp the pressure; stop at the top pressure or where the solve stops converging.
@@ -266,12 +269,8 @@ class BimodalModel:
         on_level : callable, optional
             ``on_level(k, pressure_mpa, tip_uy_mm)`` after each converged step (progress).
         """
-        from pneumorph.fem import StepSettings, cavity_volume, ramp
-
         t0 = time.perf_counter()
-        model = self.build()
-        mesh: BimodalMesh = model["mesh"]
-        field_ = model["field"]
+        mesh, body = self.build()
         outline_ids = _outline(mesh)
         x0 = mesh.points[outline_ids][:, :2]
         pressures: list[float] = []
@@ -282,10 +281,10 @@ class BimodalModel:
                                 max_iterations=self.max_iterations)
 
         def apply(t: float) -> None:
-            model["pressure"].update(t * self.pmax)
+            body.pressure.update(t * self.pmax)
 
         def record(k: int, t: float) -> None:
-            u = field_[0].values
+            u = body.displacement
             pressures.append(t * self.pmax)
             tips.append(u[mesh.tip, :2].mean(axis=0))
             stations.append(u[mesh.station, :2].mean(axis=0))
@@ -293,10 +292,11 @@ class BimodalModel:
             if on_level is not None:
                 on_level(k, pressures[-1], float(tips[-1][1]))
 
+        substep, monitor, _ = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
         cause, stats = "", None
         try:
-            stats = ramp(model["items"], field_, apply, model["dof1"], model["dof0"], settings,
-                         on_level=record, monitor=lambda: cavity_volume(model["wall_field"]))
+            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, settings, on_level=record,
+                         monitor=monitor, substep=substep, predictor_order=self.predictor_order)
         except SimulationFailed as exc:
             cause = f"stopped after {1e3 * (pressures[-1] if pressures else 0.0):g} kPa: {exc.cause}"
         p = np.asarray(pressures, dtype=float)
@@ -304,13 +304,15 @@ class BimodalModel:
         station = np.asarray(stations, dtype=float).reshape(-1, 2)
         meta = {
             "model": self.describe(),
-            "dofs": int(field_[0].values.size),
+            "dofs": int(body.displacement.size),
             "cells": len(mesh.cells),
             "wall_time_s": round(time.perf_counter() - t0, 2),
+            "backend": self.backend,
             "pneumorph": __version__,
         }
         if stats is not None:
-            meta.update(newton_iterations=stats.newton_iterations, substeps=stats.substeps, cutbacks=stats.cutbacks)
+            meta.update(newton_iterations=stats.newton_iterations, substeps=stats.substeps, cutbacks=stats.cutbacks,
+                        factorisations=getattr(substep, "factorisations", stats.newton_iterations))
         return BimodalResult(
             crimp_ratio=self.crimp_ratio, pressures=p, tip=tip, outline=np.asarray(outlines), pmax=self.pmax,
             completed=not cause, cause=cause, switch=find_switch(p, tip[:, 1]), metadata=meta,

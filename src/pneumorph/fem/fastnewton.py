@@ -1,9 +1,9 @@
 """Newton's method on a fast system (:class:`~pneumorph.fem.fastassembly.PlaneStrainSystem`,
 :class:`~pneumorph.fem.fastassembly3d.SolidSystem3D`).
 
-The convergence test is the residual criterion of
-:func:`pneumorph.fem.stepping.newton_check` (FElupe's): the norm of the residual of the
-active dofs over ``1e-3`` plus the norm of the reaction forces,
+The convergence test is the one of the FElupe path,
+:func:`pneumorph.fem.stepping.relative_residual` below the tolerance: the norm of the
+residual of the active dofs over ``1e-3`` plus the norm of the reaction forces,
 
     ||r[dof1]|| / (1e-3 + ||r[dof0]||) < tol,
 
@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from pneumorph.fem.stepping import relative_residual
 
 FloatArray = NDArray[np.float64]
 
@@ -50,11 +52,6 @@ def pattern_solver(
         return PardisoPattern(indptr, indices, symmetric=symmetric, ordering=ordering, single=single)
     except ImportError:
         return SuperLUPattern(indptr, indices, symmetric=symmetric)
-
-
-def residual_norm(r: FloatArray, dof1: NDArray[np.int64], dof0: NDArray[np.int64]) -> float:
-    """FElupe's relative residual norm ``||r1|| / (1e-3 + ||r0||)``."""
-    return float(np.linalg.norm(r[dof1]) / (1e-3 + np.linalg.norm(r[dof0])))
 
 
 def _inadmissible(r: FloatArray, jmin: float) -> str | None:
@@ -191,7 +188,7 @@ class FastSubstep:
                     return iteration, "the linear solve gave a non-finite increment"
                 u[dof1] += dx
                 r, jmin = system.residual(u)
-                fnorm = residual_norm(r, dof1, dof0)
+                fnorm = relative_residual(r, dof1, dof0)
                 if self.trace is not None:
                     self.trace.append((fnorm, True))
                 done, cause = _verdict(fnorm, jmin, u, values, settings.tolerance)
@@ -211,7 +208,7 @@ class FastSubstep:
             r, jmin = system.residual(u)
             if (cause := _inadmissible(r, jmin)) is not None:
                 return 0, cause
-            fnorm = residual_norm(r, dof1, dof0)
+            fnorm = relative_residual(r, dof1, dof0)
             if self.trace is not None:
                 self.trace.append((fnorm, False))
             f: FloatArray | None = None  # chord step -K0^-1 r at u
@@ -237,7 +234,7 @@ class FastSubstep:
                 u_new = u.copy()
                 u_new[dof1] += step
                 r_new, jmin = system.residual(u_new)
-                fnorm_new = residual_norm(r_new, dof1, dof0)
+                fnorm_new = relative_residual(r_new, dof1, dof0)
                 if self.trace is not None:
                     self.trace.append((fnorm_new, fresh))
                 if not fresh and not (fnorm_new < fnorm and jmin > 0.0):

@@ -87,14 +87,29 @@ def _sumnorm(x: Any) -> float:
     return float(np.linalg.norm(np.asarray(x)))
 
 
+def relative_residual(r: Any, dof1: Any = None, dof0: Any = None, eps: float = 1e-3) -> float:
+    """The residual norm every Newton method here converges on.
+
+    The norm of the residual of the active degrees of freedom over ``eps`` plus the norm
+    of the reaction forces of the prescribed ones, ``|r[dof1]| / (eps + |r[dof0]|)``
+    (FElupe's measure, so that both backends stop at the same equilibrium).
+
+    >>> relative_residual(np.array([3e-9, 4e-9, 2.0]), dof1=[0, 1], dof0=[2])
+    2.4987...e-09
+    """
+    r = np.asarray(r)
+    active = r[slice(None) if dof1 is None else dof1]
+    reactions = r[slice(0, 0) if dof0 is None else dof0]
+    return _sumnorm(active) / (eps + _sumnorm(reactions))
+
+
 def newton_check(dx: Any, x: Any, f: Any, xtol: float, ftol: float, dof1: Any = None, dof0: Any = None,
                  items: Any = None, eps: float = 1e-3, still: float = 0.0,
                  still_residual: float = 1e-4) -> tuple[float, float, bool]:
     """The convergence test of a Newton iteration (FElupe's ``check`` signature).
 
-    Converged when the residual of the active degrees of freedom, relative to the reaction
-    forces of the prescribed ones (``|f[dof1]| / (eps + |f[dof0]|)``), is below ``ftol``
-    and the update ``|dx|`` below ``xtol`` - FElupe's criterion. With ``still > 0``, an
+    Converged when the :func:`relative_residual` is below ``ftol`` and the update ``|dx|``
+    below ``xtol`` - FElupe's criterion. With ``still > 0``, an
     update below ``still`` with a relative residual below ``still_residual`` converges as
     well: near an unloaded state the reaction forces that scale the residual are tiny, and
     round-off alone can keep it above ``ftol`` (the paper-silicone coupon).
@@ -111,11 +126,8 @@ def newton_check(dx: Any, x: Any, f: Any, xtol: float, ftol: float, dof1: Any = 
     >>> newton_check(np.array([1e-12]), None, np.array([1e-9, 1e-4]), 1e-3, 1e-8, dof1=[0], dof0=[1], still=1e-9)[2]
     True
     """
-    f = np.asarray(f)
-    active = f[slice(None) if dof1 is None else dof1]
-    reactions = f[slice(0, 0) if dof0 is None else dof0]
     xnorm = _sumnorm(dx)
-    fnorm = _sumnorm(active) / (eps + _sumnorm(reactions))
+    fnorm = relative_residual(f, dof1, dof0, eps)
     success = (fnorm < ftol and xnorm < xtol) or (still > 0.0 and xnorm < still and fnorm < still_residual)
     return xnorm, fnorm, bool(success)
 
@@ -128,54 +140,74 @@ def _min_jacobian(fields: Any) -> float:
     return float(np.min(fem.math.det(F)))
 
 
-def _solve_substep(
-    items: Sequence[Any],
-    fields: Any,
-    dof1: NDArray[np.int64],
-    dof0: NDArray[np.int64],
-    settings: StepSettings,
-    solver: Callable[[Any, Any], NDArray[np.float64]],
-    check: Callable[..., tuple[float, float, bool]] | None = None,
-) -> tuple[int, str | None]:
-    """One Newton solve; returns (iterations, cause of failure or None).
+class FElupeSubstep:
+    """Solve one substep of :func:`ramp` with FElupe's assembly and ``newtonraphson``.
+
+    The reference strategy (the other is :class:`pneumorph.fem.fastnewton.FastSubstep`):
+    called as ``substep(fields, settings)``, it iterates from the values in ``fields``
+    (the ramp's prediction; prescribed values as ``apply`` left them, which carries an
+    enforced displacement) and returns ``(iterations, cause of failure or None)``.
+
+    Parameters
+    ----------
+    items : sequence
+        FElupe items (solid bodies, pressure bodies) whose sum is the residual.
+    dof1, dof0 : ndarray
+        Active and prescribed degrees of freedom.
+    solver : callable, optional
+        ``solver(A, b)`` for the linear systems (default:
+        :func:`pneumorph.fem.linear.default_solver`).
+    check : callable, optional
+        The convergence test of each iteration (default :func:`newton_check`).
 
     A trial that fails is cut back, so the numerical warnings of its divergence (singular
     matrix, powers of negative volume ratios) are expected and not shown.
     """
-    import felupe as fem
-    from scipy.sparse.linalg import MatrixRankWarning
 
-    # prescribed values as ``apply`` left them in the fields (enforced displacements)
-    ext0 = np.concatenate([f.values.ravel() for f in fields.fields])[dof0]
-    try:
-        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            warnings.simplefilter("ignore", MatrixRankWarning)
-            res = fem.newtonraphson(
-                items=list(items),
-                x0=fields,
-                dof1=dof1,
-                dof0=dof0,
-                ext0=ext0,
-                tol=settings.tolerance,
-                maxiter=settings.max_iterations,
-                solver=solver,
-                verbose=0,
-                check=check or newton_check,
-            )
-    except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
-        return settings.max_iterations, f"{type(exc).__name__}: {exc}"
-    # FElupe iterates on copies of the unknowns and re-links the items' fields to them:
-    # point the caller's container (and so every field linked to it) at the result.
-    fields.link(res.x)
-    iterations = int(res.iterations)
-    if not res.success:
-        return iterations, "Newton iterations did not reach the tolerance"
-    if not all(np.all(np.isfinite(f.values)) for f in fields.fields):
-        return iterations, "the solution is not finite"
-    jmin = _min_jacobian(fields)
-    if not jmin > 0.0:
-        return iterations, f"an element inverted (det F = {jmin:.3g})"
-    return iterations, None
+    def __init__(self, items: Sequence[Any], dof1: NDArray[np.int64], dof0: NDArray[np.int64],
+                 solver: Callable[[Any, Any], NDArray[np.float64]] | None = None,
+                 check: Callable[..., tuple[float, float, bool]] | None = None) -> None:
+        from pneumorph.fem.linear import default_solver
+
+        self.items = list(items)
+        self.dof1, self.dof0 = dof1, dof0
+        self.solver = solver or default_solver()
+        self.check = check or newton_check
+
+    def __call__(self, fields: Any, settings: StepSettings) -> tuple[int, str | None]:
+        import felupe as fem
+        from scipy.sparse.linalg import MatrixRankWarning
+
+        ext0 = np.concatenate([f.values.ravel() for f in fields.fields])[self.dof0]
+        try:
+            with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                warnings.simplefilter("ignore", MatrixRankWarning)
+                res = fem.newtonraphson(
+                    items=self.items,
+                    x0=fields,
+                    dof1=self.dof1,
+                    dof0=self.dof0,
+                    ext0=ext0,
+                    tol=settings.tolerance,
+                    maxiter=settings.max_iterations,
+                    solver=self.solver,
+                    verbose=0,
+                    check=self.check,
+                )
+        except (fem.NewtonConvergenceError, ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
+            return settings.max_iterations, f"{type(exc).__name__}: {exc}"
+        # FElupe iterates on copies of the unknowns and re-links the items' fields to them:
+        # point the caller's container (and so every field linked to it) at the result.
+        fields.link(res.x)
+        iterations = int(res.iterations)
+        if not res.success:
+            return iterations, "Newton iterations did not reach the tolerance"
+        if not all(np.all(np.isfinite(f.values)) for f in fields.fields):
+            return iterations, "the solution is not finite"
+        jmin = _min_jacobian(fields)
+        if not jmin > 0.0:
+            return iterations, f"an element inverted (det F = {jmin:.3g})"
+        return iterations, None
 
 
 def _extrapolate(
@@ -248,9 +280,11 @@ def ramp(
         ``on_substep(t)`` after every converged substep (before ``on_level``), e.g. to
         follow a rotation continuously.
     substep : callable, optional
-        ``substep(fields, settings)`` solves one substep in place of FElupe's Newton
-        method and returns ``(iterations, cause of failure or None)``, e.g. a
-        :class:`pneumorph.fem.fastnewton.FastSubstep` (``solver`` is then not used).
+        The substep strategy: ``substep(fields, settings)`` solves one substep and returns
+        ``(iterations, cause of failure or None)``. Default: :class:`FElupeSubstep` on
+        ``items`` with ``solver`` and ``check``; the fast path is a
+        :class:`pneumorph.fem.fastnewton.FastSubstep` (``items``, ``solver`` and ``check``
+        are then not used).
     predictor_order : int
         Degree of the polynomial through the last converged states that predicts the
         start of a substep (1: linear, 2: quadratic once three states are known).
@@ -267,10 +301,7 @@ def ramp(
         If a substep still fails after ``max_cutbacks`` halvings; ``reached`` is the last
         converged load factor and the fields hold that state.
     """
-    from pneumorph.fem.linear import default_solver
-
-    if substep is None:
-        solver = solver or default_solver()
+    strategy = substep or FElupeSubstep(items, dof1, dof0, solver, check)
     stats = RampStatistics()
     current = _values(fields)
     history: list[tuple[float, list[NDArray[np.float64]]]] = [(0.0, current)]  # converged states
@@ -285,11 +316,7 @@ def ramp(
             if settings.predictor and len(history) > 1:
                 _restore(fields, _extrapolate(history[-1 - predictor_order:], t_try))
             apply(t_try)
-            if substep is not None:
-                iterations, cause = substep(fields, settings)
-            else:
-                assert solver is not None
-                iterations, cause = _solve_substep(items, fields, dof1, dof0, settings, solver, check)
+            iterations, cause = strategy(fields, settings)
             stats.newton_iterations += iterations
             value = watched
             if cause is None and monitor is not None:

@@ -26,11 +26,8 @@ import numpy as np
 
 from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
-from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume, ramp
-from pneumorph.fem.fastassembly import PlaneStrainSystem
-from pneumorph.fem.fastassembly3d import SolidSystem3D
-from pneumorph.fem.fastnewton import FastSubstep
-from pneumorph.fem.parts import clamped_dofs, linked_solid
+from pneumorph.fem import OgdenCompressible, StepSettings, ramp
+from pneumorph.fem.body import PressurisedBody, pressurised_body
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.orientation import parse_orientation
@@ -232,10 +229,6 @@ class FEModel:
         return self.ramp.pressures()
 
     # -- building -------------------------------------------------------------------------
-    def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
-        """(Region class, boundary region class, field class) for this dimension."""
-        raise NotImplementedError  # pragma: no cover
-
     def thermal_stretch(self, material: Any) -> float:
         """``1 + a dT``: the free stretch of ``material`` under the model's temperature change."""
         if self.temperature_change == 0.0:
@@ -246,46 +239,32 @@ class FEModel:
         return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value,
                                  self.thermal_stretch(material))
 
-    def _extra_bodies(self, mesh: ActuatorMesh, field: Any) -> tuple[list[Any], Any]:
-        """Further items (the 2D filler) and a callback ``set_pressure(p)`` for them."""
+    def _extra_regions(self, mesh: ActuatorMesh) -> tuple[list[tuple[str, Any, Any]], Any]:
+        """Further material regions (the 2D filler) and a callback ``set_pressure(p)`` for them."""
         return [], lambda p: None
 
-    def build(self, orientation: str) -> dict[str, Any]:
-        """FElupe objects for one design (mesh, fields, bodies, boundary conditions)."""
-        import felupe as fem
+    def build(self, orientation: str) -> tuple[ActuatorMesh, PressurisedBody, Any]:
+        """The meshed design, its pressurised body and ``set_pressure(p)`` for a load level.
 
+        ``set_pressure`` sets the cavity pressure and everything that follows it (the 2D
+        filler's modulus).
+        """
         mesh = assemble(self.unit, orientation, self.dim, half=self.half, passage=self.passage, base=self.base_block)
-        Region, BoundaryRegion, Field = self._regions(mesh)
-        fmesh = fem.Mesh(mesh.points, mesh.cells, mesh.cell_type)
-        field = fem.FieldContainer([Field(Region(fmesh), dim=self.dim)])
-        bodies = []
-        for name, material in self.silicones.items():
-            bodies.append(linked_solid(self._silicone_umat(material), mesh.points, mesh.cells[mesh.regions[name]],
-                                       mesh.cell_type, Region, Field, self.dim, field))
-        extra, set_extra = self._extra_bodies(mesh, field)
-        silicone = np.concatenate([mesh.regions[name] for name in self.silicones])
-        walls_mesh = fem.Mesh(mesh.points, mesh.cells[silicone], mesh.cell_type)
-        kwargs = {"ensure_3d": True} if self.dim == 2 else {}
-        walls = BoundaryRegion(walls_mesh, mask=mesh.cavity_points, **kwargs)
-        wall_field = fem.FieldContainer([Field(walls, dim=self.dim)])
-        wall_field.link(field)
-        pressure = fem.SolidBodyPressure(wall_field, pressure=0.0)
-        forces = []
+        regions = [(name, mesh.regions[name], self._silicone_umat(material))
+                   for name, material in self.silicones.items()]
+        extra, set_extra = self._extra_regions(mesh)
+        densities = None
         if self.gravity is not None:  # dead loads rho g on the silicones, switched on by the gravity stage
-            forces = [fem.SolidBodyForce(body.field, values=np.zeros(self.dim), scale=material.density.value)
-                      for body, material in zip(bodies, self.silicones.values(), strict=True)]
-        dof0, dof1 = clamped_dofs(field, mesh.base_points, mesh.symmetry_points)
-        return {
-            "mesh": mesh,
-            "field": field,
-            "items": [*bodies, *extra, pressure, *forces],
-            "forces": forces,
-            "pressure": pressure,
-            "set_extra": set_extra,
-            "wall_field": wall_field,
-            "dof0": dof0,
-            "dof1": dof1,
-        }
+            densities = {name: material.density.value for name, material in self.silicones.items()}
+        body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, [*regions, *extra], mesh.cavity_points,
+                                mesh.base_points, mesh.symmetry_points, walls_of=list(self.silicones),
+                                densities=densities)
+
+        def set_pressure(p: float) -> None:
+            body.pressure.update(p)
+            set_extra(p)
+
+        return mesh, body, set_pressure
 
     # -- solving --------------------------------------------------------------------------
     def evaluate(self, orientation: str, on_level: Any = None) -> Response:
@@ -312,9 +291,7 @@ class FEModel:
         """
         design = parse_orientation(orientation, self.n_units)
         t0 = time.perf_counter()
-        model = self.build(design)
-        mesh: ActuatorMesh = model["mesh"]
-        field = model["field"]
+        mesh, body, set_pressure = self.build(design)
         pressures = self.pressures()
         x_end0 = mesh.points[mesh.end_points][:, :2]
         response = Response.empty(
@@ -329,52 +306,33 @@ class FEModel:
         displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
 
         def apply(t: float) -> None:
-            p = t * self.ramp.pressure
-            model["pressure"].update(p)
-            model["set_extra"](p)
+            set_pressure(t * self.ramp.pressure)
 
         def follow(t: float) -> None:
-            angle = _end_face_angle(x_end0 + field[0].values[:, :2][mesh.end_points])
+            angle = _end_face_angle(x_end0 + body.displacement[:, :2][mesh.end_points])
             step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
             turned["total"] += step
             turned["last"] = angle
 
-        def tip_of(u: FloatArray) -> FloatArray:
-            return (x_end0 + u[mesh.end_points][:, :2]).mean(axis=0)
+        def tip_of(v: FloatArray) -> FloatArray:
+            return (x_end0 + v[mesh.end_points][:, :2]).mean(axis=0)
 
         def record(k: int, t: float) -> None:
-            displacements[k] = field[0].values[:, : self.dim]
+            displacements[k] = body.displacement[:, : self.dim]
             response.centres[k] = mesh.unit_centres(displacements[k])
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
             if on_level is not None:
                 on_level(k, pressures[k])
 
-        substep, monitor = None, lambda: cavity_volume(model["wall_field"])
-        if self.backend == "fast":
-            System = PlaneStrainSystem if self.dim == 2 else SolidSystem3D
-            system = System(model["items"], field, model["dof1"], model["dof0"])
-            substep = FastSubstep(system, reuse=self.tangent_reuse, depth=self.anderson_depth)
-            def monitor() -> float:
-                return system.cavity_volume(field[0].values.ravel())
+        substep, monitor, _ = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
         gravity_iterations = 0
         if self.gravity is not None:
-            gravity_iterations = self._apply_gravity(model, substep, follow, design)
-            response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(field[0].values).tolist())
+            gravity_iterations = self._apply_gravity(body, substep, follow, design)
+            response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(body.displacement).tolist())
         try:
-            stats = ramp(
-                model["items"],
-                field,
-                apply,
-                model["dof1"],
-                model["dof0"],
-                self.ramp.steps,
-                on_level=record,
-                monitor=monitor,
-                on_substep=follow,
-                substep=substep,
-                predictor_order=self.predictor_order,
-            )
+            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
+                         monitor=monitor, on_substep=follow, substep=substep, predictor_order=self.predictor_order)
         except SimulationFailed as exc:
             partial = replace(response, converged=False, reached=exc.reached * self.ramp.pressure,
                               failure=exc.cause)
@@ -384,18 +342,18 @@ class FEModel:
         meta = dict(response.metadata)
         meta.update(
             newton_iterations=stats.newton_iterations + gravity_iterations,
-            factorisations=substep.factorisations if substep is not None else stats.newton_iterations,
+            factorisations=getattr(substep, "factorisations", stats.newton_iterations),
             substeps=stats.substeps,
             cutbacks=stats.cutbacks,
             wall_time_s=time.perf_counter() - t0,
-            dofs=int(field[0].values.size),
+            dofs=int(body.displacement.size),
             backend=self.backend,
             pneumorph=__version__,
         )
         final = replace(response, converged=True, reached=float(pressures[-1]), metadata=meta)
         return Solution(final, mesh, displacements)
 
-    def _apply_gravity(self, model: dict[str, Any], substep: Any, follow: Any, design: str) -> int:
+    def _apply_gravity(self, body: PressurisedBody, substep: Any, follow: Any, design: str) -> int:
         """Load the unpressurised actuator with its weight; returns the Newton iterations.
 
         Gravity rises to its full value in :attr:`gravity_steps`; the pressure ramp then
@@ -404,11 +362,10 @@ class FEModel:
         g = np.asarray(self.gravity, dtype=float)
 
         def apply(t: float) -> None:
-            for force in model["forces"]:
-                force.update(t * g)
+            body.set_gravity(t * g)
 
         try:
-            stats = ramp(model["items"], model["field"], apply, model["dof1"], model["dof0"], self.gravity_steps,
+            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.gravity_steps,
                          on_substep=follow, substep=substep, predictor_order=self.predictor_order)
         except SimulationFailed as exc:
             raise SimulationFailed(reached=0.0, cause=f"under its own weight, before any pressure: {exc.cause}",
@@ -489,22 +446,13 @@ class Reduced2D(FEModel):
         # the law in use, given or the unit's: a variant of another unit (a mould tolerance) keeps it
         return {**super().options(), "filler": self.filler}
 
-    def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
-        import felupe as fem
-
-        if mesh.cell_type == "quad":
-            return fem.RegionQuad, fem.RegionQuadBoundary, fem.FieldPlaneStrain
-        return fem.RegionQuadraticQuad, fem.RegionQuadraticQuadBoundary, fem.FieldPlaneStrain
-
-    def _extra_bodies(self, mesh: ActuatorMesh, field: Any) -> tuple[list[Any], Any]:
+    def _extra_regions(self, mesh: ActuatorMesh) -> tuple[list[tuple[str, Any, Any]], Any]:
         import felupe as fem
 
         law = self.filler
         assert law is not None
         nu = law.poisson_ratio
         umat = fem.NeoHookeCompressible(mu=1.0, lmbda=1.0)
-        body = linked_solid(umat, mesh.points, mesh.cells[mesh.regions["filler"]], mesh.cell_type,
-                            self._regions(mesh)[0], fem.FieldPlaneStrain, 2, field)
 
         def set_pressure(p: float) -> None:
             # linear-elastic filler at large strain: compressible neo-Hooke with the Lame
@@ -514,7 +462,7 @@ class Reduced2D(FEModel):
             umat.lmbda = e * nu / ((1 + nu) * (1 - 2 * nu))
 
         set_pressure(0.0)
-        return [body], set_pressure
+        return [("filler", mesh.regions["filler"], umat)], set_pressure
 
 
 class Full3D(FEModel):
@@ -594,10 +542,3 @@ class Full3D(FEModel):
     def options(self) -> dict[str, Any]:
         return {**super().options(), "half": self.half, "temperature_change": self.temperature_change,
                 "passage": self.passage}
-
-    def _regions(self, mesh: ActuatorMesh) -> tuple[Any, Any, Any]:
-        import felupe as fem
-
-        if mesh.cell_type == "hexahedron":
-            return fem.RegionHexahedron, fem.RegionHexahedronBoundary, fem.Field
-        return fem.RegionQuadraticHexahedron, fem.RegionQuadraticHexahedronBoundary, fem.Field

@@ -1,0 +1,233 @@
+"""The pressurised body: the one builder of every FE model's FElupe objects.
+
+An actuator (2D section or 3D hexahedra), the bimodal actuator and any body like them is
+a mesh whose cells fall into material regions, one displacement field shared by one
+``felupe.SolidBody`` per region, a follower pressure on the walls of its closed cavities,
+optional dead loads, a clamped base and, for a half model, a plane of symmetry.
+:func:`pressurised_body` builds that from plain arrays; :meth:`PressurisedBody.stepper`
+gives the substep strategy and the cavity-volume monitor of
+:func:`pneumorph.fem.stepping.ramp` for the chosen backend (FElupe's assembly and
+``newtonraphson``, or the fast system and its Newton method), so that every model solves
+its ramp the same way.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.errors import SettingsError
+from pneumorph.fem.cavity import cavity_volume
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+#: FElupe's (region, boundary region, field) classes by cell type, by name so that FElupe
+#: is imported only when a body is built.
+_REGIONS = {
+    "quad": ("RegionQuad", "RegionQuadBoundary", "FieldPlaneStrain"),
+    "quad8": ("RegionQuadraticQuad", "RegionQuadraticQuadBoundary", "FieldPlaneStrain"),
+    "hexahedron": ("RegionHexahedron", "RegionHexahedronBoundary", "Field"),
+    "hexahedron20": ("RegionQuadraticHexahedron", "RegionQuadraticHexahedronBoundary", "Field"),
+}
+
+#: The backends that solve a body's ramp.
+BACKENDS = ("fast", "felupe")
+
+
+def regions_of(cell_type: str) -> tuple[Any, Any, Any]:
+    """FElupe's region, boundary-region and field classes for a cell type.
+
+    >>> [c.__name__ for c in regions_of("hexahedron20")]
+    ['RegionQuadraticHexahedron', 'RegionQuadraticHexahedronBoundary', 'Field']
+    """
+    import felupe as fem
+
+    try:
+        names = _REGIONS[cell_type]
+    except KeyError:
+        raise SettingsError(f"no pressurised body on {cell_type!r} cells; cell types: {', '.join(_REGIONS)}") from None
+    return tuple(getattr(fem, name) for name in names)  # type: ignore[return-value]
+
+
+@dataclass
+class PressurisedBody:
+    """FElupe objects of a pressurised body (built by :func:`pressurised_body`).
+
+    Attributes
+    ----------
+    points : ndarray, shape (p, dim)
+    cells : ndarray, shape (c, n)
+    cell_type : str
+    dim : int
+    field : felupe.FieldContainer
+        The global displacement field every item is linked to.
+    solids : dict of str to felupe.SolidBody
+        One body per material region, in the order given.
+    walls : felupe.FieldContainer
+        The field on the pressurised cavity walls.
+    pressure : felupe.SolidBodyPressure
+        The follower pressure on the walls (``pressure.update(p)``).
+    forces : dict of str to felupe.SolidBodyForce
+        Dead loads per region (``force.update(g)``), for the regions given a density.
+    dof0, dof1 : ndarray
+        Prescribed (clamped base, symmetry plane) and active degrees of freedom.
+    """
+
+    points: FloatArray
+    cells: IntArray
+    cell_type: str
+    dim: int
+    field: Any
+    solids: dict[str, Any]
+    walls: Any
+    pressure: Any
+    forces: dict[str, Any] = field(default_factory=dict)
+    dof0: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    dof1: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    @property
+    def items(self) -> list[Any]:
+        """Every FElupe item whose sum is the residual."""
+        return [*self.solids.values(), self.pressure, *self.forces.values()]
+
+    @property
+    def displacement(self) -> FloatArray:
+        """The current nodal displacements, shape (p, dim).
+
+        Read it anew after a solve: the FElupe path re-links the field to new arrays.
+        """
+        return self.field[0].values  # type: ignore[no-any-return]
+
+    def set_gravity(self, acceleration: FloatArray) -> None:
+        """Set the acceleration of every dead load (mm/s^2)."""
+        for force in self.forces.values():
+            force.update(np.asarray(acceleration, dtype=float))
+
+    def stepper(self, backend: str = "fast", reuse: float | None = None,
+                depth: int = 0) -> tuple[Any, Callable[[], float], Any]:
+        """The ramp's substep strategy and monitor for a backend.
+
+        Parameters
+        ----------
+        backend : {"fast", "felupe"}
+            ``"fast"``: :class:`~pneumorph.fem.fastassembly.PlaneStrainSystem` (2D) or
+            :class:`~pneumorph.fem.fastassembly3d.SolidSystem3D` (3D) with
+            :class:`~pneumorph.fem.fastnewton.FastSubstep`; ``"felupe"``: FElupe's
+            assembly and ``newtonraphson`` (:class:`~pneumorph.fem.stepping.FElupeSubstep`).
+        reuse, depth
+            The fast Newton method's tangent reuse and Anderson depth (see
+            :class:`~pneumorph.fem.fastnewton.FastSubstep`).
+
+        Returns
+        -------
+        substep : callable
+            ``substep(fields, settings) -> (iterations, cause)`` for
+            :func:`~pneumorph.fem.stepping.ramp`.
+        monitor : callable
+            The current enclosed cavity volume (area in 2D).
+        system : PlaneStrainSystem, SolidSystem3D or None
+            The fast system (None on the FElupe path).
+        """
+        from pneumorph.fem.stepping import FElupeSubstep
+
+        if backend not in BACKENDS:
+            raise SettingsError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+        if backend == "felupe":
+            return FElupeSubstep(self.items, self.dof1, self.dof0), lambda: cavity_volume(self.walls), None
+        from pneumorph.fem.fastassembly import PlaneStrainSystem
+        from pneumorph.fem.fastassembly3d import SolidSystem3D
+        from pneumorph.fem.fastnewton import FastSubstep
+
+        system = (PlaneStrainSystem if self.dim == 2 else SolidSystem3D)(self.items, self.field, self.dof1, self.dof0)
+        def monitor() -> float:
+            return float(system.cavity_volume(self.displacement.ravel()))
+
+        return FastSubstep(system, reuse=reuse, depth=depth), monitor, system
+
+
+def pressurised_body(
+    points: FloatArray,
+    cells: IntArray,
+    cell_type: str,
+    materials: Sequence[tuple[str, BoolArray | IntArray, Any]],
+    cavity_points: BoolArray,
+    base_points: BoolArray,
+    symmetry_points: BoolArray | None = None,
+    walls_of: Sequence[str] | None = None,
+    densities: Mapping[str, float] | None = None,
+) -> PressurisedBody:
+    """Build the FElupe objects of a pressurised body.
+
+    Parameters
+    ----------
+    points : ndarray, shape (p, dim)
+        Mesh points (2D: a plane-strain section; 3D: hexahedra).
+    cells : ndarray, shape (c, n)
+    cell_type : {"quad", "quad8", "hexahedron", "hexahedron20"}
+    materials : sequence of (name, cells, umat)
+        Every material region: its name, its cells (a mask or indices into ``cells``) and
+        its FElupe material.
+    cavity_points : ndarray of bool
+        The points of the cavity walls; the pressure acts on every face of a
+        ``walls_of`` cell whose points all lie there.
+    base_points : ndarray of bool
+        Clamped points.
+    symmetry_points : ndarray of bool, optional
+        Points on a mid-width plane of symmetry (u_z = 0; 3D half models).
+    walls_of : sequence of str, optional
+        The regions whose faces carry the pressure (default: all). A 2D filler that fills
+        the cavities is left out, so that the walls are the silicone's.
+    densities : mapping of str to float, optional
+        Mass densities (t/mm^3) of the regions that carry their weight (dead loads that
+        :meth:`PressurisedBody.set_gravity` switches on); default none.
+
+    Examples
+    --------
+    >>> import felupe as fem
+    >>> from pneumorph.fem import OgdenCompressible
+    >>> cube = fem.Cube(n=3)
+    >>> inner = np.all(np.isclose(cube.points, 0.5), axis=1)   # no closed cavity here
+    >>> body = pressurised_body(cube.points, cube.cells, "hexahedron",
+    ...                         [("silicone", np.ones(len(cube.cells), bool), OgdenCompressible([0.1], [2.0], 10.0))],
+    ...                         inner, cube.points[:, 0] == 0.0)
+    >>> len(body.items), body.dof0.size, body.dof1.size
+    (2, 27, 54)
+    """
+    import felupe as fem
+
+    from pneumorph.fem.parts import clamped_dofs, linked_solid
+
+    points = np.asarray(points, dtype=float)
+    cells = np.asarray(cells)
+    dim = points.shape[1]
+    Region, BoundaryRegion, Field = regions_of(cell_type)
+    mesh = fem.Mesh(points, cells, cell_type)
+    global_field = fem.FieldContainer([Field(Region(mesh), dim=dim)])
+    solids: dict[str, Any] = {}
+    selected: dict[str, IntArray] = {}
+    for name, which, umat in materials:
+        if name in solids:
+            raise SettingsError(f"material region {name!r} given twice")
+        index = np.flatnonzero(which) if np.asarray(which).dtype == bool else np.asarray(which, dtype=np.int64)
+        selected[name] = index
+        solids[name] = linked_solid(umat, points, cells[index], cell_type, Region, Field, dim, global_field)
+    walled = list(solids) if walls_of is None else list(walls_of)
+    wall_cells = cells[np.concatenate([selected[name] for name in walled])]
+    kwargs = {"ensure_3d": True} if dim == 2 else {}
+    walls_region = BoundaryRegion(fem.Mesh(points, wall_cells, cell_type), mask=cavity_points, **kwargs)
+    walls = fem.FieldContainer([Field(walls_region, dim=dim)])
+    walls.link(global_field)
+    pressure = fem.SolidBodyPressure(walls, pressure=0.0)
+    forces = {name: fem.SolidBodyForce(solids[name].field, values=np.zeros(dim), scale=float(rho))
+              for name, rho in (densities or {}).items()}
+    dof0, dof1 = clamped_dofs(global_field, base_points, symmetry_points)
+    return PressurisedBody(points, cells, cell_type, dim, global_field, solids, walls, pressure, forces, dof0, dof1)
+
+
+__all__ = ["BACKENDS", "PressurisedBody", "pressurised_body", "regions_of"]
