@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.fem.bodyforce import DeadLoads
-from pneumorph.fem.kernels import ogden_3d, principal_3d
+from pneumorph.fem.kernels import principal_3d
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -68,18 +68,7 @@ def _kernel_of(umat: Any) -> Kernel:
     from pneumorph.fem.ogden import OgdenCompressible
 
     if isinstance(umat, OgdenCompressible):
-        theta = umat.thermal_stretch
-        if theta == 1.0:
-            return lambda F, tangent, principal: ogden_3d(F, umat.mu, umat.alpha, umat.bulk, tangent, principal,
-                                                          _UPPER)
-
-        def thermal(F: FloatArray, tangent: bool, principal: Any) -> Any:
-            # W(F) = theta^3 W_e(F / theta): C / theta^2 has the same eigenvectors
-            c, N = principal if principal is not None else principal_3d(F)
-            P, A, J = ogden_3d(F / theta, umat.mu, umat.alpha, umat.bulk, tangent, (c / theta**2, N), _UPPER)
-            return P * theta**2, None if A is None else A * theta, J
-
-        return thermal
+        return lambda F, tangent, principal: umat.kernel(F, tangent, principal, _UPPER)
     raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
 

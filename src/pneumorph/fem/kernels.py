@@ -1,4 +1,4 @@
-"""Plane-strain constitutive kernels with the quadrature points leading (fast assembly).
+"""Constitutive kernels with the quadrature points last (plane strain and 3D).
 
 Each kernel maps in-plane deformation gradients ``F`` of shape ``(2, 2, n)`` (``F33 = 1``)
 to the in-plane first Piola-Kirchhoff stress ``P`` ``(2, 2, n)`` and the in-plane block of
@@ -12,6 +12,9 @@ axis, so that NumPy's elementwise loops run over long rows rather than 2x2 block
   closed-form 2x2 eigen-decomposition of ``C`` (the third stretch is 1).
 * :func:`neo_hooke_plane_strain` - FElupe's ``NeoHookeCompressible``,
   ``W = mu/2 (tr C - 3) - mu ln J + lambda/2 (ln J)^2``.
+* :func:`ogden_3d` - the one 3D Ogden kernel: the fast 3D assembly calls it directly and
+  :class:`~pneumorph.fem.ogden.OgdenCompressible` adapts it to FElupe; with
+  :func:`principal_3d`, the closed-form eigen-decomposition of ``C``.
 """
 
 from __future__ import annotations
@@ -21,9 +24,22 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.fem.ogden import _power_divided_difference
-
 FloatArray = NDArray[np.float64]
+
+
+def _power_divided_difference(cb: FloatArray, ca: FloatArray, k: float) -> FloatArray:
+    """``(cb^k - ca^k) / (cb - ca)``, exact also for ``cb == ca`` (limit ``k ca^(k-1)``).
+
+    The divided differences ``(S_b - S_a) / (c_b - c_a)`` of the principal-frame tangent are
+    divided differences of powers of ``c``; in closed form with ``expm1`` equal stretches
+    (the undeformed state, uniaxial and equibiaxial states) are exact, without perturbing
+    the eigenvalues.
+    """
+    x = np.log(cb / ca)
+    small = np.abs(x) < 1e-13
+    xs = np.where(small, 1.0, x)
+    ratio = np.where(small, k, np.expm1(k * xs) / np.expm1(xs))
+    return ca ** (k - 1.0) * ratio
 
 
 def _outer(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -183,7 +199,7 @@ def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
     lo = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
     mid = 3.0 * q - hi - lo
 
-    def vector(lam: FloatArray) -> list[FloatArray]:
+    def vector(lam: FloatArray) -> list[FloatArray]:  # (called where NaNs are expected)
         m11, m22, m33 = C11 - lam, C22 - lam, C33 - lam
         cands = [  # cross products of the rows of C - lam I: (1, 2), (1, 3), (2, 3)
             (C12 * C23 - C13 * m22, C13 * C12 - m11 * C23, m11 * m22 - C12 * C12),
@@ -197,17 +213,19 @@ def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
         scale = 1.0 / np.sqrt(np.where(first, norms[0], np.where(second, norms[1], norms[2])))
         return [vj * scale for vj in v]
 
-    v_lo = vector(lo)
-    v_hi = vector(hi)
-    dot = v_hi[0] * v_lo[0] + v_hi[1] * v_lo[1] + v_hi[2] * v_lo[2]
-    v_hi = [v_hi[j] - dot * v_lo[j] for j in range(3)]
-    scale = 1.0 / np.sqrt(v_hi[0] * v_hi[0] + v_hi[1] * v_hi[1] + v_hi[2] * v_hi[2])
-    v_hi = [vj * scale for vj in v_hi]
-    v_mid = [
-        v_hi[1] * v_lo[2] - v_hi[2] * v_lo[1],
-        v_hi[2] * v_lo[0] - v_hi[0] * v_lo[2],
-        v_hi[0] * v_lo[1] - v_hi[1] * v_lo[0],
-    ]
+    # equal eigenvalues give zero cross products: the NaNs go to LAPACK below
+    with np.errstate(invalid="ignore", divide="ignore"):
+        v_lo = vector(lo)
+        v_hi = vector(hi)
+        dot = v_hi[0] * v_lo[0] + v_hi[1] * v_lo[1] + v_hi[2] * v_lo[2]
+        v_hi = [v_hi[j] - dot * v_lo[j] for j in range(3)]
+        scale = 1.0 / np.sqrt(v_hi[0] * v_hi[0] + v_hi[1] * v_hi[1] + v_hi[2] * v_hi[2])
+        v_hi = [vj * scale for vj in v_hi]
+        v_mid = [
+            v_hi[1] * v_lo[2] - v_hi[2] * v_lo[1],
+            v_hi[2] * v_lo[0] - v_hi[0] * v_lo[2],
+            v_hi[0] * v_lo[1] - v_hi[1] * v_lo[0],
+        ]
     c = np.stack([lo, mid, hi])
     N = np.array([v_lo, v_mid, v_hi])
     close = ~((np.minimum(mid - lo, hi - mid) > _GAP * q) & np.all(np.isfinite(N), axis=(0, 1)))
