@@ -23,10 +23,9 @@ from felupe.tools._newton import fun_items
 
 from pneumorph.errors import MaterialDataError, SearchConfigError
 from pneumorph.fem import StepSettings, ramp
-from pneumorph.fem.bodyforce import DeadLoads
-from pneumorph.fem.fastassembly import PlaneStrainSystem
-from pneumorph.fem.fastassembly3d import SolidSystem3D
-from pneumorph.fem.fastnewton import FastSubstep
+from pneumorph.fem.fast.loads import DeadLoads
+from pneumorph.fem.fast.newton import FastSubstep
+from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
 from pneumorph.fem.ogden import OgdenCompressible
 from pneumorph.models.factory import make_model
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D

@@ -52,7 +52,7 @@ def regions_of(cell_type: str) -> tuple[Any, Any, Any]:
         names = _REGIONS[cell_type]
     except KeyError:
         raise SettingsError(f"no pressurised body on {cell_type!r} cells; cell types: {', '.join(_REGIONS)}") from None
-    return tuple(getattr(fem, name) for name in names)  # type: ignore[return-value]
+    return tuple(getattr(fem, name) for name in names)
 
 
 @dataclass
@@ -102,7 +102,7 @@ class PressurisedBody:
 
         Read it anew after a solve: the FElupe path re-links the field to new arrays.
         """
-        return self.field[0].values  # type: ignore[no-any-return]
+        return self.field[0].values
 
     def set_gravity(self, acceleration: FloatArray) -> None:
         """Set the acceleration of every dead load (mm/s^2)."""
@@ -116,13 +116,13 @@ class PressurisedBody:
         Parameters
         ----------
         backend : {"fast", "felupe"}
-            ``"fast"``: :class:`~pneumorph.fem.fastassembly.PlaneStrainSystem` (2D) or
-            :class:`~pneumorph.fem.fastassembly3d.SolidSystem3D` (3D) with
-            :class:`~pneumorph.fem.fastnewton.FastSubstep`; ``"felupe"``: FElupe's
+            ``"fast"``: :class:`~pneumorph.fem.fast.system.PlaneStrainSystem` (2D) or
+            :class:`~pneumorph.fem.fast.system.SolidSystem3D` (3D) with
+            :class:`~pneumorph.fem.fast.newton.FastSubstep`; ``"felupe"``: FElupe's
             assembly and ``newtonraphson`` (:class:`~pneumorph.fem.stepping.FElupeSubstep`).
         reuse, depth
             The fast Newton method's tangent reuse and Anderson depth (see
-            :class:`~pneumorph.fem.fastnewton.FastSubstep`).
+            :class:`~pneumorph.fem.fast.newton.FastSubstep`).
 
         Returns
         -------
@@ -140,9 +140,8 @@ class PressurisedBody:
             raise SettingsError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
         if backend == "felupe":
             return FElupeSubstep(self.items, self.dof1, self.dof0), lambda: cavity_volume(self.walls), None
-        from pneumorph.fem.fastassembly import PlaneStrainSystem
-        from pneumorph.fem.fastassembly3d import SolidSystem3D
-        from pneumorph.fem.fastnewton import FastSubstep
+        from pneumorph.fem.fast.newton import FastSubstep
+        from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
 
         system = (PlaneStrainSystem if self.dim == 2 else SolidSystem3D)(self.items, self.field, self.dof1, self.dof0)
         def monitor() -> float:

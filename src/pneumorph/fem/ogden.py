@@ -5,7 +5,7 @@ The dissertation's silicone model (Eq 2.12) in the published (MSC Marc) conventi
     W = sum_n mu_n / alpha_n (lb1^a_n + lb2^a_n + lb3^a_n - 3) + 9/2 K (J^(1/3) - 1)^2,
 
 with ``lb_a = J^(-1/3) l_a`` the isochoric principal stretches. Its stress and exact
-tangent are computed in one place, :func:`pneumorph.fem.kernels.ogden_3d` (principal
+tangent are computed in one place, :func:`pneumorph.fem.fast.kernels.ogden_3d` (principal
 form, divided differences exact at equal stretches); :class:`OgdenCompressible` hands
 FElupe's ``(3, 3, q, c)`` arrays to it (the FElupe path) and gives the fast assemblers
 the same kernel with the thermal stretch applied (:meth:`OgdenCompressible.kernel`).
@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.fem.kernels import ogden_3d, principal_3d
+from pneumorph.fem.fast.kernels import ogden_3d, principal_3d
 
 FloatArray = NDArray[np.float64]
 
@@ -78,8 +78,8 @@ class OgdenCompressible:
                pairs: Sequence[tuple[int, int]] | None = None) -> tuple[FloatArray, FloatArray | None, FloatArray]:
         """Stress, tangent and ``det F`` of deformation gradients stored points last, (3, 3, n).
 
-        :func:`~pneumorph.fem.kernels.ogden_3d` with this material's parameters and its
-        thermal stretch (``principal`` is :func:`~pneumorph.fem.kernels.principal_3d` of
+        :func:`~pneumorph.fem.fast.kernels.ogden_3d` with this material's parameters and its
+        thermal stretch (``principal`` is :func:`~pneumorph.fem.fast.kernels.principal_3d` of
         ``F`` itself; ``J`` is that of the elastic part).
 
         >>> P, A, J = OgdenCompressible([0.1], [2.0], 10.0, thermal_stretch=1.1).kernel(1.1 * np.eye(3)[..., None])

@@ -143,7 +143,7 @@ def _min_jacobian(fields: Any) -> float:
 class FElupeSubstep:
     """Solve one substep of :func:`ramp` with FElupe's assembly and ``newtonraphson``.
 
-    The reference strategy (the other is :class:`pneumorph.fem.fastnewton.FastSubstep`):
+    The reference strategy (the other is :class:`pneumorph.fem.fast.newton.FastSubstep`):
     called as ``substep(fields, settings)``, it iterates from the values in ``fields``
     (the ramp's prediction; prescribed values as ``apply`` left them, which carries an
     enforced displacement) and returns ``(iterations, cause of failure or None)``.
@@ -283,7 +283,7 @@ def ramp(
         The substep strategy: ``substep(fields, settings)`` solves one substep and returns
         ``(iterations, cause of failure or None)``. Default: :class:`FElupeSubstep` on
         ``items`` with ``solver`` and ``check``; the fast path is a
-        :class:`pneumorph.fem.fastnewton.FastSubstep` (``items``, ``solver`` and ``check``
+        :class:`pneumorph.fem.fast.newton.FastSubstep` (``items``, ``solver`` and ``check``
         are then not used).
     predictor_order : int
         Degree of the polynomial through the last converged states that predicts the

@@ -13,8 +13,8 @@ import pytest
 from felupe.tools._newton import fun_items, jac_items
 
 from pneumorph.fem import OgdenCompressible, cavity_volume
-from pneumorph.fem.fastassembly import PlaneStrainSystem
-from pneumorph.fem.kernels import neo_hooke_plane_strain, ogden_plane_strain
+from pneumorph.fem.fast.kernels import neo_hooke_plane_strain, ogden_plane_strain
+from pneumorph.fem.fast.system import PlaneStrainSystem
 from pneumorph.models.fe import Reduced2D
 
 # Table A.4 Mold Star 15 (Marc convention), Table A.5 bulk modulus

@@ -15,9 +15,9 @@ import pytest
 from felupe.tools._newton import fun_items, jac_items
 
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume
-from pneumorph.fem.fastassembly3d import SolidSystem3D
-from pneumorph.fem.fastnewton import FastSubstep
-from pneumorph.fem.kernels import ogden_3d, principal_3d
+from pneumorph.fem.fast.kernels import ogden_3d, principal_3d
+from pneumorph.fem.fast.newton import FastSubstep
+from pneumorph.fem.fast.system import SolidSystem3D
 from pneumorph.fem.linear import PardisoPattern, SuperLUPattern
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Full3D
@@ -85,7 +85,7 @@ def deformed_actuator():
 
 
 def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
-    mesh, body = deformed_actuator
+    _, body = deformed_actuator
     field, items, dof1, dof0 = body.field, body.items, body.dof1, body.dof0
     system = SolidSystem3D(items, field, dof1, dof0)
     r, jmin = system.residual(field[0].values.ravel().copy())

@@ -1,5 +1,5 @@
-"""Newton's method on a fast system (:class:`~pneumorph.fem.fastassembly.PlaneStrainSystem`,
-:class:`~pneumorph.fem.fastassembly3d.SolidSystem3D`).
+"""Newton's method on a fast system (:class:`~pneumorph.fem.fast.system.PlaneStrainSystem`,
+:class:`~pneumorph.fem.fast.system.SolidSystem3D`).
 
 The convergence test is the one of the FElupe path,
 :func:`pneumorph.fem.stepping.relative_residual` below the tolerance: the norm of the

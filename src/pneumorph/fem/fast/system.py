@@ -1,0 +1,499 @@
+"""The fast assembler: residual and tangent of FElupe items on a fixed mesh, any dimension.
+
+FElupe assembles every item into its own sparse matrix (COO to CSR), sums them and slices
+the active block at every Newton iteration; on an actuator that bookkeeping costs far more
+than the quadrature points' arithmetic. :class:`FastSystem` does the bookkeeping once per
+design: the shape-function gradients ``dN/dX`` and volume elements of every material
+region (taken from the FElupe regions), the CSR pattern of the active block
+``K[dof1, dof1]`` and, for every element-matrix entry, its position in the CSR ``data``
+array. Each evaluation computes ``F``, the stress ``P`` and tangent ``A`` with the
+points-last kernels of :mod:`pneumorph.fem.fast.kernels`, contracts them with batched
+products and scatters them with ``np.bincount``. The model's parameters (pressure, the 2D
+filler's Lame constants, dead loads) are read from the FElupe items at every evaluation,
+so the same ``apply(t)`` drives both paths.
+
+What depends on the dimension are the hooks of two small subclasses:
+
+* :class:`PlaneStrainSystem` (quad4/quad8, ``FieldPlaneStrain``): the full active block,
+  non-symmetric, for PARDISO's LU; the follower pressure ``p cof(F) N dA`` with
+  ``cof(F)_iJ = e_ik e_JL F_kL`` (2D permutation symbol ``e``), whose stiffness is
+  ``p h_a e_ik (N_1 dN_b/dX_2 - N_2 dN_b/dX_1) dA``.
+* :class:`SolidSystem3D` (hex8/hex20, ``Field``): only the upper triangle. The material
+  part is the Hessian of a strain energy, and the follower pressure on the walls of closed
+  cavities is conservative (its load is the derivative of ``-p V``): each face's load
+  stiffness ``p h_a e_ikm [F (N dA x dN_b/dX)]_m`` is not symmetric, but their sum over a
+  closed surface is, up to terms on the surface's rim, which lies on the plane of symmetry
+  where the normal displacement is held. The 27-point rule integrates the face terms of
+  quadratic elements exactly, so the sum is symmetric to rounding, for PARDISO's symmetric
+  indefinite solver (``mtype=-2``). Of the element matrices only the blocks ``i <= k`` of
+  the component pairs are computed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.fem.fast.kernels import neo_hooke_plane_strain, ogden_plane_strain, principal_3d
+from pneumorph.fem.fast.loads import DeadLoads
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: component pairs (i, k) of the 3D element blocks that are computed
+_UPPER = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
+#: cells per chunk of the 3D tangent (keeps the temporaries in the tens of MB)
+_CHUNK = 256
+_EPS = np.array([[0.0, 1.0], [-1.0, 0.0]])  # 2D permutation symbol e_ik
+
+
+@dataclass
+class _Solid:
+    """One material on some cells: gradients in the layouts the products need."""
+
+    cells: IntArray  # (c, n)
+    g: FloatArray  # (c, q, n, d) dN_a/dX_J
+    dV: FloatArray  # (c, q)
+    kernel: Any
+    layouts: dict[str, FloatArray] = field(default_factory=dict)
+    take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # assembled entries
+    scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # their CSR positions
+    edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+
+@dataclass
+class _Walls:
+    """The pressurised faces of one ``SolidBodyPressure``."""
+
+    item: Any
+    cells: IntArray  # (f, n) of the volume cells the faces belong to
+    g: FloatArray  # (f, q, n, d)
+    h: FloatArray  # (q, n)
+    ndA: FloatArray  # (f, q, d)
+    take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+
+def _deformation(g: FloatArray, cells: IntArray, U: FloatArray) -> FloatArray:
+    """``F = I + grad u`` at every quadrature point, (c, q, d, d)."""
+    F = np.matmul(U[cells].transpose(0, 2, 1)[:, None], g)  # (c, q, i, J)
+    for i in range(U.shape[1]):
+        F[..., i, i] += 1.0
+    return F
+
+
+class FastSystem:
+    """Residual and active-block tangent of FElupe items, assembled fast.
+
+    Use the dimension's subclass (:class:`PlaneStrainSystem`, :class:`SolidSystem3D`);
+    this class holds what they share: the items' data, the CSR pattern, the scatter,
+    dead loads, the tangent matrix and the enclosed cavity volume.
+
+    Parameters
+    ----------
+    items : sequence
+        ``felupe.SolidBody`` items with materials the dimension has a kernel for,
+        ``felupe.SolidBodyPressure`` items on boundary regions of closed cavities and
+        ``felupe.SolidBodyForce`` dead loads (all linked to one global field).
+    field : felupe.FieldContainer
+        The global field; only its size and mesh points are read here.
+    dof1, dof0 : ndarray
+        Active and prescribed degrees of freedom (FElupe numbering ``dim * point + component``).
+
+    Attributes
+    ----------
+    indptr, indices : ndarray
+        CSR pattern of ``K[dof1, dof1]`` (its upper triangle if :attr:`symmetric`).
+    """
+
+    dim: ClassVar[int]
+    #: the tangent is symmetric and only its upper triangle is assembled
+    symmetric: ClassVar[bool] = False
+    #: PARDISO's fill-reducing ordering for this dimension's tangents
+    ordering: ClassVar[int] = 0
+    #: a Newton method that keeps its tangents may factorise in single precision
+    single_precision: ClassVar[bool] = False
+
+    def __init__(self, items: Sequence[Any], field: Any, dof1: IntArray, dof0: IntArray) -> None:
+        import felupe as fem
+
+        d = self.dim
+        self.ndof = int(field[0].values.size)
+        self.npoints = self.ndof // d
+        self.dof1 = np.asarray(dof1, dtype=np.int64)
+        self.dof0 = np.asarray(dof0, dtype=np.int64)
+        self.points = np.asarray(field[0].region.mesh.points[:, :d], dtype=float)
+        self.solids: list[_Solid] = []
+        self.walls: list[_Walls] = []
+        forces = []
+        for item in items:
+            self._check_field(item.field[0])
+            if isinstance(item, fem.SolidBodyForce):
+                forces.append(item)
+                continue
+            region = item.field[0].region
+            cells = np.asarray(region.mesh.cells, dtype=np.int64)
+            g = np.ascontiguousarray(np.transpose(region.dhdX[:, :d], (3, 2, 0, 1)))  # (c, q, n, d)
+            if isinstance(item, fem.SolidBodyPressure):
+                h = np.ascontiguousarray(region.h[:, :, 0].T)  # (n, q) -> (q, n)
+                ndA = np.ascontiguousarray(np.transpose(region.dA[:d], (2, 1, 0)))  # (f, q, d)
+                self.walls.append(_Walls(item, cells, g, h, ndA))
+            elif isinstance(item, fem.SolidBody):
+                solid = _Solid(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
+                solid.layouts = self._layouts(g)
+                self.solids.append(solid)
+            else:
+                raise TypeError(f"no fast assembly for {type(item).__name__}; use the FElupe backend")
+        self.dead = DeadLoads(forces, self.npoints, d)
+        self._build_pattern()
+        self._state: list[Any] = []
+        self._U = np.zeros((self.npoints, d))
+
+    # -- dimension hooks ---------------------------------------------------------------
+    def _check_field(self, sub: Any) -> None:
+        raise NotImplementedError  # pragma: no cover
+
+    def _kernel_of(self, umat: Any) -> Any:
+        raise NotImplementedError  # pragma: no cover
+
+    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+        """The gradients in the layouts this dimension's products need."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+        """Active (row, column) of every element-matrix entry as it is computed, and which
+        of them are assembled (``act``: the active index of each cell's dofs, (c, n, d))."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+        """The element vectors ``(c, n, d)`` of a solid, its smallest det F and the state
+        :meth:`_solid_tangent` needs."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
+        """The element matrices of a solid, entries in :meth:`_entries` order."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
+        """The follower-pressure stiffness of some walls, entries in :meth:`_entries` order."""
+        raise NotImplementedError  # pragma: no cover
+
+    @staticmethod
+    def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
+        """``cof(F) N dA`` at the boundary points, (f, q, d)."""
+        raise NotImplementedError  # pragma: no cover
+
+    # -- pattern ------------------------------------------------------------------------
+    def _build_pattern(self) -> None:
+        """CSR pattern and every element entry's position in it.
+
+        Entries are keyed ``row * n1 + column`` (active numbering); one argsort of all
+        keys gives both the pattern (row-major, sorted columns) and the scatter positions.
+        """
+        d = self.dim
+        active = np.full(self.ndof, -1, dtype=np.int64)
+        active[self.dof1] = np.arange(self.dof1.size)
+        n1 = self.dof1.size
+        owners: list[_Solid | _Walls] = [*self.solids, *self.walls]
+        keys_all = []
+        for owner in owners:
+            owner.edofs = (d * owner.cells[:, :, None] + np.arange(d)).ravel()
+            rows, cols, valid = self._entries(owner, active[d * owner.cells[:, :, None] + np.arange(d)])
+            owner.take = np.flatnonzero(valid)
+            keys_all.append((rows * n1 + cols).ravel()[owner.take])
+        keys = np.concatenate(keys_all)
+        if n1 * n1 < 2**32:
+            keys = keys.astype(np.uint32)  # sorts faster
+        order = np.argsort(keys)
+        sorted_keys = keys[order]
+        first = np.empty(keys.size, dtype=bool)
+        first[:1] = True
+        np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=first[1:])
+        starts = np.flatnonzero(first)
+        position = np.empty(keys.size, dtype=np.int64)
+        position[order] = np.repeat(np.arange(starts.size), np.diff(np.append(starts, keys.size)))
+        unique = sorted_keys[first].astype(np.int64)
+        self.nnz = int(unique.size)
+        rows_u = unique // n1
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows_u, minlength=n1))]).astype(np.int32)
+        self.indices = (unique - rows_u * n1).astype(np.int32)
+        start = 0
+        for owner, k in zip(owners, keys_all, strict=True):
+            owner.scatter = position[start : start + k.size]
+            start += k.size
+
+    # -- evaluation -----------------------------------------------------------------------
+    def residual(self, u: FloatArray) -> tuple[FloatArray, float]:
+        """Residual over all dofs at the displacement vector ``u`` and the smallest det F.
+
+        What the tangent needs is kept for :meth:`tangent_data` at the same state.
+        """
+        U = u.reshape(-1, self.dim)
+        self._U = U.copy()
+        r = np.zeros(self.ndof)
+        self._state = []
+        jmin = np.inf
+        for s in self.solids:
+            vectors, j, state = self._solid_residual(s, U)
+            jmin = min(jmin, j)
+            r += np.bincount(s.edofs, weights=vectors.ravel(), minlength=self.ndof)
+            self._state.append(state)
+        for w in self.walls:
+            p = float(w.item.results.pressure)
+            cofN = self._cof_normal(_deformation(w.g, w.cells, U), w.ndA)  # (f, q, d)
+            # r[f, a, i] = p sum_q h[q, a] cof(F)_iJ N_J dA
+            r += np.bincount(w.edofs, weights=(p * np.matmul(w.h.T[None], cofN)).ravel(), minlength=self.ndof)
+        if self.dead:
+            r -= self.dead.vector()
+        return r, jmin
+
+    def tangent_data(self) -> FloatArray:
+        """CSR ``data`` of ``K[dof1, dof1]`` (its upper triangle if symmetric), state of the last residual."""
+        data = np.zeros(self.nnz)
+        for s, state in zip(self.solids, self._state, strict=True):
+            blocks = self._solid_tangent(s, state)
+            data += np.bincount(s.scatter, weights=blocks.ravel()[s.take], minlength=self.nnz)
+        for w in self.walls:
+            K = self._wall_tangent(w, float(w.item.results.pressure), self._U)
+            data += np.bincount(w.scatter, weights=K.ravel()[w.take], minlength=self.nnz)
+        return data
+
+    def tangent(self) -> Any:
+        """``K[dof1, dof1]`` as ``scipy.sparse.csr_matrix`` (state of the last residual)."""
+        import scipy.sparse as sp
+
+        n1 = self.dof1.size
+        matrix = sp.csr_matrix((self.tangent_data(), self.indices, self.indptr), shape=(n1, n1))
+        if self.symmetric:
+            matrix = (matrix + sp.triu(matrix, k=1).T).tocsr()
+        return matrix
+
+    def cavity_volume(self, u: FloatArray) -> float:
+        """Volume (area in 2D) enclosed by the pressurised walls, as :func:`pneumorph.fem.cavity_volume`."""
+        U = u.reshape(-1, self.dim)
+        total = 0.0
+        for w in self.walls:
+            F = _deformation(w.g, w.cells, U)
+            x = np.matmul(w.h[None], (self.points + U)[w.cells])  # (f, q, d)
+            total += float(np.sum(x * self._cof_normal(F, w.ndA)))
+        return -total / self.dim
+
+
+class PlaneStrainSystem(FastSystem):
+    """The fast assembler's plane-strain hooks (quad4/quad8 on ``FieldPlaneStrain``).
+
+    Materials: :class:`~pneumorph.fem.ogden.OgdenCompressible` and
+    ``felupe.NeoHookeCompressible``; pressure walls built with ``ensure_3d=True``.
+
+    Examples
+    --------
+    >>> import felupe as fem, numpy as np
+    >>> mesh = fem.Rectangle(n=3).add_midpoints_edges()
+    >>> field = fem.FieldContainer([fem.FieldPlaneStrain(fem.RegionQuadraticQuad(mesh), dim=2)])
+    >>> solid = fem.SolidBody(fem.NeoHookeCompressible(mu=1.0, lmbda=2.0), field)
+    >>> dof0, dof1 = fem.dof.partition(field, {"x0": fem.Boundary(field[0], fx=0.0)})
+    >>> system = PlaneStrainSystem([solid], field, dof1, dof0)
+    >>> r, jmin = system.residual(np.zeros(field[0].values.size))
+    >>> float(abs(r).max()), float(jmin), system.tangent().shape == (dof1.size, dof1.size)
+    (0.0, 1.0, True)
+    """
+
+    dim = 2
+
+    def _check_field(self, sub: Any) -> None:
+        import felupe as fem
+
+        if not isinstance(sub, fem.FieldPlaneStrain):
+            raise TypeError(f"the fast assembly needs FieldPlaneStrain fields, got {type(sub).__name__}")
+
+    def _kernel_of(self, umat: Any) -> Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]:
+        """The plane-strain kernel of a material, reading its parameters at every call."""
+        import felupe as fem
+
+        from pneumorph.fem.ogden import OgdenCompressible
+
+        if isinstance(umat, OgdenCompressible):
+            return lambda F: ogden_plane_strain(F, umat.mu, umat.alpha, umat.bulk)
+        if isinstance(umat, fem.NeoHookeCompressible) and umat.lmbda is not None:
+            return lambda F: neo_hooke_plane_strain(F, float(umat.mu), float(umat.lmbda))
+        raise TypeError(f"no fast plane-strain kernel for {type(umat).__name__}; use the FElupe backend")
+
+    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+        c, q, n, _ = g.shape
+        return {
+            "g_res": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 2 * q)),  # [c, a, (q, J)]
+            "gT": np.ascontiguousarray(g.transpose(0, 1, 3, 2).reshape(c * q, 2, n)),  # [(c, q), L, b]
+            # d_ii' g[c, q, a, J] as [c, (a, i), (q, i', J)]
+            "B": np.ascontiguousarray(np.einsum("cqaJ,ij->caiqjJ", g, np.eye(2)).reshape(c, 2 * n, 4 * q)),
+        }
+
+    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+        # the full element matrix, entries (c, a, i, k, b)
+        c, n, _ = act.shape
+        rows = np.broadcast_to(act[:, :, :, None, None], (c, n, 2, 2, n))
+        cols = np.broadcast_to(act.transpose(0, 2, 1)[:, None, None, :, :], (c, n, 2, 2, n))
+        return rows, cols, (rows >= 0) & (cols >= 0)
+
+    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+        c, q = s.dV.shape
+        F = _deformation(s.g, s.cells, U)
+        P, A, J = s.kernel(np.ascontiguousarray(F.transpose(2, 3, 0, 1)).reshape(2, 2, c * q))
+        dV = s.dV.reshape(-1)
+        PdV = (P * dV).reshape(2, 2, c, q)
+        # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV
+        return np.matmul(s.layouts["g_res"], PdV.transpose(2, 3, 1, 0).reshape(c, 2 * q, 2)), float(J.min()), A * dV
+
+    def _solid_tangent(self, s: _Solid, AdV: FloatArray) -> FloatArray:
+        c, q, n, _ = s.g.shape
+        # D[cq, (i, J, k), b] = sum_L A[i, J, k, L, cq] dV g[cq, b, L]
+        At = np.ascontiguousarray(AdV.reshape(16, c * q).T).reshape(c * q, 8, 2)
+        D = np.matmul(At, s.layouts["gT"]).reshape(c, 4 * q, 2 * n)  # [c, (q, i, J), (k, b)]
+        # K[c, (a, i), (k, b)] = sum_(q, J) g[c, q, a, J] D[c, (q, i, J), (k, b)]
+        return np.matmul(s.layouts["B"], D)
+
+    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
+        # t[f, q, b] = N_1 dN_b/dX_2 - N_2 dN_b/dX_1 (with dA); M[f, a, b] = p sum_q h_a t_b
+        t = w.ndA[..., 0:1] * w.g[..., 1] - w.ndA[..., 1:2] * w.g[..., 0]
+        M = p * np.matmul(w.h.T[None], t)  # (f, n, n)
+        return _EPS[None, None, :, :, None] * M[:, :, None, None, :]  # (f, a, i, k, b)
+
+    @staticmethod
+    def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
+        out = np.empty_like(ndA)
+        out[..., 0] = F[..., 1, 1] * ndA[..., 0] - F[..., 1, 0] * ndA[..., 1]
+        out[..., 1] = -F[..., 0, 1] * ndA[..., 0] + F[..., 0, 0] * ndA[..., 1]
+        return out
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Cross products along the last axis (faster than ``numpy.cross`` on small shapes)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+class SolidSystem3D(FastSystem):
+    """The fast assembler's 3D hooks (hex8/hex20 on ``Field``): the upper triangle.
+
+    Materials: :class:`~pneumorph.fem.ogden.OgdenCompressible` (its thermal stretch too).
+    The material tangent is only computed in :meth:`tangent_data`: a Newton method that
+    reuses its factorisation needs many residuals and few tangents.
+
+    Examples
+    --------
+    >>> import felupe as fem, numpy as np
+    >>> from pneumorph.fem import OgdenCompressible
+    >>> mesh = fem.Cube(n=2)
+    >>> field = fem.FieldContainer([fem.Field(fem.RegionHexahedron(mesh), dim=3)])
+    >>> solid = fem.SolidBody(OgdenCompressible([0.1], [2.0], 10.0), field)
+    >>> dof0, dof1 = fem.dof.partition(field, {"x0": fem.Boundary(field[0], fx=0.0)})
+    >>> system = SolidSystem3D([solid], field, dof1, dof0)
+    >>> r, jmin = system.residual(np.zeros(field[0].values.size))
+    >>> float(abs(r).max()), float(jmin), system.tangent().shape == (dof1.size, dof1.size)
+    (0.0, 1.0, True)
+    """
+
+    dim = 3
+    symmetric = True
+    #: METIS nested dissection suits the 3D pattern
+    ordering = 2
+    single_precision = True
+
+    def _check_field(self, sub: Any) -> None:
+        import felupe as fem
+
+        if type(sub) is not fem.Field or sub.dim != 3:
+            raise TypeError(f"the fast 3D assembly needs 3D felupe.Field fields, got {type(sub).__name__}")
+
+    def _kernel_of(self, umat: Any) -> Any:
+        from pneumorph.fem.ogden import OgdenCompressible
+
+        if isinstance(umat, OgdenCompressible):
+            return lambda F, tangent, principal: umat.kernel(F, tangent, principal, _UPPER)
+        raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
+
+    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+        c, q, n, _ = g.shape
+        return {
+            "G": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 3 * q)),  # [c, a, (q, J)]
+            "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
+        }
+
+    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+        ik = np.array(_UPPER)
+        if isinstance(owner, _Solid):
+            # entry (c, a, ik, b) at (row of (a, i), column of (b, k)); blocks i < k
+            # stand for themselves and their transposes, blocks i == k hold both
+            off = (ik[:, 0] != ik[:, 1])[None, None, :, None]
+            rows = act[:, :, ik[:, 0]][:, :, :, None]
+            cols = act[:, :, ik[:, 1]].transpose(0, 2, 1)[:, None]
+            lo, hi = np.minimum(rows, cols), np.maximum(rows, cols)
+            return lo, hi, (lo >= 0) & (off | (rows <= cols))
+        # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries
+        rows = act[:, :, :, None, None]
+        cols = act[:, None, None, :, :]
+        return np.broadcast_to(rows, np.broadcast_shapes(rows.shape, cols.shape)), \
+            np.broadcast_to(cols, np.broadcast_shapes(rows.shape, cols.shape)), (rows >= 0) & (rows <= cols)
+
+    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+        c, q = s.dV.shape
+        # F[c, i, (q, J)] = sum_a u[c, a, i] g[c, q, a, J], then as [i, J, (c, q)]
+        F = np.matmul(U[s.cells].transpose(0, 2, 1), s.layouts["G"]).reshape(c, 3, q, 3)
+        Fp = np.ascontiguousarray(F.transpose(1, 3, 0, 2)).reshape(3, 3, c * q)
+        Fp[0, 0] += 1.0
+        Fp[1, 1] += 1.0
+        Fp[2, 2] += 1.0
+        principal = principal_3d(Fp)
+        P, _, J = s.kernel(Fp, False, principal)
+        # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV
+        PdV = (P * s.dV.reshape(-1)).reshape(3, 3, c, q).transpose(2, 3, 1, 0).reshape(c, 3 * q, 3)
+        return np.matmul(s.layouts["G"], PdV), float(J.min()), (Fp, principal)
+
+    def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
+        Fp, principal = state
+        c, q, n, _ = s.g.shape
+        _, A, _ = s.kernel(Fp, True, principal)
+        assert A is not None
+        # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
+        Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).reshape(c, q, 3, 6, 3)
+        if "blocks" not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
+            s.layouts["blocks"] = np.empty((c, n, 6, n))
+        blocks = s.layouts["blocks"]
+        G, gt = s.layouts["G"], s.layouts["gt"]
+        for start in range(0, c, _CHUNK):
+            sl = slice(start, min(start + _CHUNK, c))
+            m = sl.stop - sl.start
+            # E[c, q, J, ik, b] = sum_L A dV g[c, q, b, L]
+            # (optimize=True: a batched matrix product, 3x faster than the plain loop)
+            E = np.einsum("pmL,pLb->pmb", Ap[sl].reshape(m * q, 18, 3), gt[sl].reshape(m * q, 3, n), optimize=True)
+            # K[c, a, (ik, b)] = sum_(q, J) g[c, q, a, J] E[c, (q, J), (ik, b)]
+            blocks[sl] = np.matmul(G[sl], E.reshape(m, 3 * q, 6 * n)).reshape(m, n, 6, n)
+        return blocks
+
+    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
+        F = _deformation(w.g, w.cells, U)
+        # v[f, q, b, m] = [F (N dA x dN_b/dX)]_m; M[f, a, b, m] = p sum_q h_a v_bm
+        t = _cross(w.ndA[:, :, None, :], w.g)  # (f, q, n, 3)
+        v = np.matmul(t, F.transpose(0, 1, 3, 2))  # (f, q, n, m)
+        f, q, n, _ = v.shape
+        M = p * np.matmul(w.h.T[None], v.reshape(f, q, 3 * n)).reshape(f, n, n, 3)
+        K = np.zeros((f, n, 3, n, 3))  # K[a, i, b, k] = e_ikm M[a, b, m]
+        for i, k, m_, sign in ((0, 1, 2, 1), (1, 2, 0, 1), (2, 0, 1, 1), (1, 0, 2, -1), (2, 1, 0, -1), (0, 2, 1, -1)):
+            K[:, :, i, :, k] = sign * M[..., m_]
+        return K
+
+    @staticmethod
+    def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
+        """``cof(F) N dA = N_1 F_2 x F_3 + N_2 F_3 x F_1 + N_3 F_1 x F_2`` (columns F_J), (f, q, 3)."""
+        c1, c2, c3 = F[..., :, 0], F[..., :, 1], F[..., :, 2]
+        return ndA[..., 0:1] * _cross(c2, c3) + ndA[..., 1:2] * _cross(c3, c1) + ndA[..., 2:3] * _cross(c1, c2)
+
+
+__all__ = ["FastSystem", "PlaneStrainSystem", "SolidSystem3D"]
