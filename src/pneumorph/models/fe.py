@@ -396,7 +396,7 @@ class Reduced2D(FEModel):
         :class:`pneumorph.errors.PressureRangeError` is raised at once.
     backend : {"fast", "felupe"}
         ``"fast"`` (default): the vectorised assembly of
-        :class:`pneumorph.fem.fastassembly.PlaneStrainSystem` and its Newton method;
+        :class:`pneumorph.fem.fast.system.PlaneStrainSystem` and its Newton method;
         ``"felupe"``: FElupe's assembly and ``newtonraphson``. Both solve the same
         equations to the same tolerance (the fingerprint does not depend on it).
     gravity : str or sequence of float, optional
@@ -475,9 +475,9 @@ class Full3D(FEModel):
         Model half the width with u_z = 0 on the mid-plane (default): the same solution
         as the full model for this symmetric actuator, with half the unknowns.
     backend : {"fast", "felupe"}
-        ``"fast"`` (default): :class:`pneumorph.fem.fastassembly3d.SolidSystem3D` (the
+        ``"fast"`` (default): :class:`pneumorph.fem.fast.system.SolidSystem3D` (the
         upper triangle of the symmetric tangent, PARDISO's symmetric indefinite solver in
-        single precision) and :class:`pneumorph.fem.fastnewton.FastSubstep` keeping its
+        single precision) and :class:`pneumorph.fem.fast.newton.FastSubstep` keeping its
         factorised tangent while it converges well; ``"felupe"``: FElupe's assembly and ``newtonraphson``.
         Both stop at the same criterion.
     gravity : str or sequence of float, optional
