@@ -6,7 +6,7 @@ run after the other; every run's result is kept as JSON in ``--out`` and reused 
 script is started again (delete the file to re-run it). Figures go to docs/figures/.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/bimodal_table.py [--voids 15]
-        [--element-size 2.5] [--pmax 60] [--end-cap 0] [--max-cutbacks 2] [--max-iterations 10]
+        [--element-size 2.5] [--pmax 60] [--end-cap 0] [--max-cutbacks N] [--max-iterations N]
         [--out /tmp/bimodal-runs] [--only 0.2] [--tag=-v5]
 """
 
@@ -73,8 +73,8 @@ def main() -> None:
     ap.add_argument("--element-size", type=float, default=2.5)
     ap.add_argument("--pmax", type=float, default=60.0)
     ap.add_argument("--end-cap", type=float, default=0.0)
-    ap.add_argument("--max-cutbacks", type=int, default=2)
-    ap.add_argument("--max-iterations", type=int, default=10)
+    ap.add_argument("--max-cutbacks", type=int, default=BimodalModel.default_max_cutbacks)
+    ap.add_argument("--max-iterations", type=int, default=BimodalModel.default_max_iterations)
     ap.add_argument("--out", type=Path, default=Path("/tmp/bimodal-runs"))
     ap.add_argument("--only", type=float, nargs="*", default=None, help="crimp ratios to run")
     ap.add_argument("--variants", nargs="*", default=list(VARIANTS), choices=list(VARIANTS),

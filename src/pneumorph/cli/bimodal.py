@@ -40,17 +40,18 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
 @click.option("--bilinear-nu", type=P.Real(-1.0, 0.5, low_open=True, high_open=True), default=None,
               help="Small-strain Poisson's ratio of the composite, sets its bulk modulus "
                    "[default: the library's assumed bulk modulus].")
-@click.option("--max-cutbacks", type=P.Count(0, 60), default=2, show_default=True,
-              help="Halvings of a step that does not converge before the ramp ends there.")
-@click.option("--max-iterations", type=P.Count(1, 1000), default=10, show_default=True,
-              help="Newton iterations per trial.")
+@click.option("--max-cutbacks", type=P.Count(0, 60), default=None,
+              help="Halvings of a step that does not converge before the ramp ends there "
+                   "[default: the model's own, shown in the --json metadata].")
+@click.option("--max-iterations", type=P.Count(1, 1000), default=None,
+              help="Newton iterations per trial [default: the model's own, shown in --json metadata].")
 @click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
 def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
-            bilinear_nu: float | None, max_cutbacks: int, max_iterations: int, out: Path | None, as_json: bool,
-            quiet: bool) -> None:
+            bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
+            as_json: bool, quiet: bool) -> None:
     """3D FE of the bimodal actuator: tip displacement in pressure steps, switch pressure.
 
     The ramp ends at --pmax or at the last pressure that converges (where a wall balloons).
@@ -75,7 +76,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
             BimodalSpec(**{field: value})  # type: ignore[arg-type]
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
-                         max_cutbacks=max_cutbacks, max_iterations=max_iterations)
+                         max_cutbacks=max_cutbacks, max_iterations=max_iterations)  # None: the model's own
 
     def progress(k: int, p: float, v: float) -> None:
         if not quiet and not as_json:

@@ -134,6 +134,9 @@ class FastSubstep:
             getattr(system, "ordering", 0),
             single=reuse is not None and getattr(system, "single_precision", False),
         )
+        if getattr(self.solver, "dtype", None) == np.float32:
+            # a tangent factorised in single precision may as well be assembled in it
+            system.tangent_dtype = np.float32
         if reuse is not None and not (0.0 < reuse < 1.0 and hasattr(self.solver, "factorize")):
             raise ValueError(f"reuse must lie in (0, 1) with a solver that factorises once, got {reuse}")
         self.reuse = reuse

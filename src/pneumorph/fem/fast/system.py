@@ -118,6 +118,9 @@ class FastSystem:
     ordering: ClassVar[int] = 0
     #: a Newton method that keeps its tangents may factorise in single precision
     single_precision: ClassVar[bool] = False
+    #: the precision the element matrices are computed in (:class:`~pneumorph.fem.fast.newton.FastSubstep`
+    #: sets float32 where it factorises in single precision; the residual is always double)
+    tangent_dtype: type = np.float64
 
     def __init__(self, items: Sequence[Any], field: Any, dof1: IntArray, dof0: IntArray) -> None:
         import felupe as fem
@@ -461,12 +464,16 @@ class SolidSystem3D(FastSystem):
         c, q, n, _ = s.g.shape
         _, A, _ = s.kernel(Fp, True, principal)
         assert A is not None
+        dtype = self.tangent_dtype
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
-        Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).reshape(c, q, 3, 6, 3)
-        if "blocks" not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
-            s.layouts["blocks"] = np.empty((c, n, 6, n))
-        blocks = s.layouts["blocks"]
-        G, gt = s.layouts["G"], s.layouts["gt"]
+        Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
+        key = f"blocks-{np.dtype(dtype).name}"
+        if key not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
+            s.layouts[key] = np.empty((c, n, 6, n), dtype=dtype)
+            s.layouts[f"G-{np.dtype(dtype).name}"] = s.layouts["G"].astype(dtype)
+            s.layouts[f"gt-{np.dtype(dtype).name}"] = s.layouts["gt"].astype(dtype)
+        blocks = s.layouts[key]
+        G, gt = s.layouts[f"G-{np.dtype(dtype).name}"], s.layouts[f"gt-{np.dtype(dtype).name}"]
         for start in range(0, c, _CHUNK):
             sl = slice(start, min(start + _CHUNK, c))
             m = sl.stop - sl.start
