@@ -1,21 +1,30 @@
-"""Figures of a filler-law validation: profiles per law (Fig 5.4), constant against E(P) (Fig 5.7).
+"""Figures of a filler-law calibration: the points and laws (Fig 5.3), profiles per law
+(Fig 5.4), constant filler against E(P) (Fig 5.7).
 
-Both compare the 2D model with a 3D reference of the same design, so they take the 3D
-:class:`~pneumorph.models.response.Response` and solve the 2D model as needed.
+They only draw what they are given: the responses are solved by the workflow
+(:func:`~pneumorph.calibration.compare_laws`).
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> from pneumorph.calibration import FillerPoint, fit_law
+>>> pts = tuple(FillerPoint(0, p, "01", 0.05 - p, 0.0, 0.03, 1) for p in (0.01, 0.02, 0.03))
+>>> fit = fit_law([p.pressure for p in pts], [p.modulus for p in pts], 1, (0.0, 0.03))
+>>> cal = Calibration(pts, fit, fit, fit, (0.0, 0.03), 0.3)
+>>> plot_calibration(cal, pathlib.Path(tempfile.mkdtemp()) / "c.png").is_file()
+True
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from pneumorph.geometry.unit import UnitSpec
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.models.fe import RampSpec, Reduced2D
+from pneumorph.calibration.method import Calibration
+from pneumorph.calibration.validation import centre_distances
 from pneumorph.models.response import Response
 from pneumorph.plot.figure import new_figure, save_figure
 
@@ -32,15 +41,22 @@ def _finish(fig: Any, ax: Any, title: str, path: str | Path) -> Path:
     return save_figure(fig, path, title)
 
 
-def centre_distances(r2: Response, r3: Response) -> np.ndarray:
-    """(levels, units) distances between matching unit centres of two responses, mm."""
-    return np.linalg.norm(r2.centres - r3.centres, axis=-1)
-
-
-def law_responses(unit: UnitSpec, n_units: int, design: str, ramp: RampSpec,
-                  laws: Mapping[str, FillerLaw]) -> dict[str, Response]:
-    """The 2D response of one design under each named filler law."""
-    return {name: Reduced2D(n_units, unit, ramp, law).evaluate(design) for name, law in laws.items()}
+def plot_calibration(cal: Calibration, path: str | Path) -> Path:
+    """Fig 5.3: the best modulus per pressure for each run, and both fitted laws."""
+    fig = new_figure(6.0, 4.2)
+    ax = fig.add_subplot()
+    for run in sorted({p.run for p in cal.points}):
+        pts = [p for p in cal.points if p.run == run]
+        ax.plot([p.pressure * 1e3 for p in pts], [p.modulus for p in pts], "o", label=f"run {run + 1}")
+    grid = np.linspace(*cal.pressure_range, 100)
+    for fit, style in ((cal.linear, "--"), (cal.quadratic, "-")):
+        if fit.coefficients:
+            ax.plot(grid * 1e3, np.polynomial.polynomial.polyval(grid, fit.coefficients), style,
+                    label=f"degree {fit.degree}, {fit.weighting} weighting, R$^2$ = {fit.r_squared:.4f}")
+    ax.set(xlabel="pressure [kPa]", ylabel="filler modulus E [MPa]", title="Filler law calibration (Eq 5.1)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return save_figure(fig, path, "filler law calibration (Fig 5.3)")
 
 
 def plot_law_profiles(responses: Mapping[str, Response], reference: Response, path: str | Path,
@@ -92,8 +108,3 @@ def plot_filler_paths(responses: Mapping[str, Response], reference: Response, pa
         ax.plot(p, d.max(axis=1), "^:", color=colour, label=f"{name}: max")
     ax.set(xlabel="pressure [kPa]", ylabel="2D-3D unit-centre distance [mm]")
     return _finish(fig, ax, f"Constant vs pressure-dependent filler, {reference.orientation}", path)
-
-
-def constant_law(law: FillerLaw, pressure: float, name: str) -> FillerLaw:
-    """A constant filler law equal to ``law`` at ``pressure`` (MPa), over the same range."""
-    return replace(law, name=name, display_name=name, coefficients=(float(law.modulus(pressure)),))
