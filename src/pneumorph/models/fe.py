@@ -515,8 +515,11 @@ class Full3D(FEModel):
     # the kept tangents are factorised in single precision, SolidSystem3D.single_precision).
     # 15-unit benchmark design, double-precision factorisations: 17 factorisations and 69
     # iterations where Newton's method took 37 of each; a threshold of 0.3 took 21 and 60,
-    # 0.7 took 15 and 74. Single precision: 15 and 74 at 0.5.
-    tangent_reuse = 0.5
+    # 0.7 took 15 and 74. Single precision with element matrices in single precision too
+    # (issue 13, one thread): at 0.5 17 factorisations and 76 iterations, 16.5 s, at 0.7 14 and
+    # 84, 15.8 s (0.8: 14 and 86, 17.8 s); the all-aligned design 69 and 178, 52.9 s at 0.5,
+    # 60 and 174, 47.9 s at 0.7 (0.8: 61, 49.8 s); curls equal to 1e-4 degrees.
+    tangent_reuse = 0.7
     anderson_depth = 6
 
     def __init__(
