@@ -39,7 +39,7 @@ from pneumorph.bimodal.geometry import (
 from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
-from pneumorph.fem.body import BACKENDS, PressurisedBody, pressurised_body
+from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.materials import get
 from pneumorph.materials.hyperelastic import Ogden
 from pneumorph.models.fe import Full3D
@@ -233,9 +233,7 @@ class BimodalModel:
         self.max_cutbacks = int(max_cutbacks)
         self.max_iterations = int(max_iterations)
         self.half = bool(half)
-        if backend not in BACKENDS:
-            raise SettingsError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
-        self.backend = backend
+        self.backend = check_backend(backend)
 
     def bulk(self, layer: str) -> float:
         """Bulk modulus (MPa) used for a layer."""
@@ -304,7 +302,7 @@ class BimodalModel:
             if on_level is not None:
                 on_level(k, pressures[-1], float(tips[-1][1]))
 
-        substep, monitor, _ = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
+        substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
         cause, stats = "", None
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, settings, on_level=record,

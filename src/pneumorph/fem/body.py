@@ -14,7 +14,7 @@ its ramp the same way.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -38,6 +38,17 @@ _REGIONS = {
 
 #: The backends that solve a body's ramp.
 BACKENDS = ("fast", "felupe")
+
+
+def check_backend(backend: str, allowed: Sequence[str] = BACKENDS) -> str:
+    """``backend`` if it is one of ``allowed``, else :class:`SettingsError` naming them.
+
+    >>> check_backend("fast")
+    'fast'
+    """
+    if backend not in allowed:
+        raise SettingsError(f"backend must be one of {', '.join(allowed)}, got {backend!r}")
+    return backend
 
 
 def regions_of(cell_type: str) -> tuple[Any, Any, Any]:
@@ -87,9 +98,9 @@ class PressurisedBody:
     solids: dict[str, Any]
     walls: Any
     pressure: Any
-    forces: dict[str, Any] = field(default_factory=dict)
-    dof0: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    dof1: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    forces: dict[str, Any]
+    dof0: IntArray
+    dof1: IntArray
 
     @property
     def items(self) -> list[Any]:
@@ -110,7 +121,7 @@ class PressurisedBody:
             force.update(np.asarray(acceleration, dtype=float))
 
     def stepper(self, backend: str = "fast", reuse: float | None = None,
-                depth: int = 0) -> tuple[Any, Callable[[], float], Any]:
+                depth: int = 0) -> tuple[Any, Callable[[], float]]:
         """The ramp's substep strategy and monitor for a backend.
 
         Parameters
@@ -131,15 +142,11 @@ class PressurisedBody:
             :func:`~pneumorph.fem.stepping.ramp`.
         monitor : callable
             The current enclosed cavity volume (area in 2D).
-        system : PlaneStrainSystem, SolidSystem3D or None
-            The fast system (None on the FElupe path).
         """
         from pneumorph.fem.stepping import FElupeSubstep
 
-        if backend not in BACKENDS:
-            raise SettingsError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
-        if backend == "felupe":
-            return FElupeSubstep(self.items, self.dof1, self.dof0), lambda: cavity_volume(self.walls), None
+        if check_backend(backend) == "felupe":
+            return FElupeSubstep(self.items, self.dof1, self.dof0), lambda: cavity_volume(self.walls)
         from pneumorph.fem.fast.newton import FastSubstep
         from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
 
@@ -147,7 +154,7 @@ class PressurisedBody:
         def monitor() -> float:
             return float(system.cavity_volume(self.displacement.ravel()))
 
-        return FastSubstep(system, reuse=reuse, depth=depth), monitor, system
+        return FastSubstep(system, reuse=reuse, depth=depth), monitor
 
 
 def pressurised_body(
@@ -229,4 +236,4 @@ def pressurised_body(
     return PressurisedBody(points, cells, cell_type, dim, global_field, solids, walls, pressure, forces, dof0, dof1)
 
 
-__all__ = ["BACKENDS", "PressurisedBody", "pressurised_body", "regions_of"]
+__all__ = ["BACKENDS", "PressurisedBody", "check_backend", "pressurised_body", "regions_of"]

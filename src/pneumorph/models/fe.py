@@ -27,7 +27,7 @@ import numpy as np
 from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
-from pneumorph.fem.body import PressurisedBody, pressurised_body
+from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.orientation import parse_orientation
@@ -119,10 +119,7 @@ class FEModel:
         base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None,
     ) -> None:
-        backend = backend or self.backends[0]
-        if backend not in self.backends:
-            raise SettingsError(f"backend must be one of {', '.join(self.backends)}, got {backend!r}")
-        self.backend = backend
+        self.backend = check_backend(backend or self.backends[0], self.backends)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.unit = unit or UnitSpec()
         self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
@@ -143,7 +140,7 @@ class FEModel:
             raise SettingsError(f"base_block must be a BaseBlock or None, got {base_block!r}")
         self.base_block = base_block
         self.base = self._material(base_block.material) if base_block is not None else None
-        if self.temperature_change != 0.0 and backend != "fast":
+        if self.temperature_change != 0.0 and self.backend != "fast":
             # the thermal strain loads the body before any pressure; FElupe's Newton check on that first
             # state does not converge (seen on a 1-unit actuator), the fast path's does
             raise SettingsError("a temperature change needs the fast backend (the 3D model's default)")
@@ -325,7 +322,7 @@ class FEModel:
             if on_level is not None:
                 on_level(k, pressures[k])
 
-        substep, monitor, _ = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
+        substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
         gravity_iterations = 0
         if self.gravity is not None:
             gravity_iterations = self._apply_gravity(body, substep, follow, design)

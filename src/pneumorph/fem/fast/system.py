@@ -205,8 +205,9 @@ class FastSystem:
         owners: list[_Solid | _Walls] = [*self.solids, *self.walls]
         keys_all = []
         for owner in owners:
-            owner.edofs = (d * owner.cells[:, :, None] + np.arange(d)).ravel()
-            rows, cols, valid = self._entries(owner, active[d * owner.cells[:, :, None] + np.arange(d)])
+            dofs = d * owner.cells[:, :, None] + np.arange(d)  # (c, n, d)
+            owner.edofs = dofs.ravel()
+            rows, cols, valid = self._entries(owner, active[dofs])
             owner.take = np.flatnonzero(valid)
             keys_all.append((rows * n1 + cols).ravel()[owner.take])
         keys = np.concatenate(keys_all)
@@ -442,8 +443,8 @@ class SolidSystem3D(FastSystem):
         # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries
         rows = act[:, :, :, None, None]
         cols = act[:, None, None, :, :]
-        return np.broadcast_to(rows, np.broadcast_shapes(rows.shape, cols.shape)), \
-            np.broadcast_to(cols, np.broadcast_shapes(rows.shape, cols.shape)), (rows >= 0) & (rows <= cols)
+        rows, cols = np.broadcast_arrays(rows, cols)
+        return rows, cols, (rows >= 0) & (rows <= cols)
 
     def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
