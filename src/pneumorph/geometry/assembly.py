@@ -14,13 +14,13 @@ regions and fields.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import pairwise
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError
 from pneumorph.geometry.features import BaseBlock, check_passage
+from pneumorph.geometry.grid import grid_lines, section_breaks
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 
@@ -91,35 +91,6 @@ class ActuatorMesh:
     def submesh(self, region: str) -> tuple[FloatArray, IntArray]:
         """Points (all of them, shared) and the cells of one region."""
         return self.points, self.cells[self.regions[region]]
-
-
-def grid_lines(breaks: list[float], size: float) -> FloatArray:
-    """Coordinates through every break, no gap wider than ``size``.
-
-    Breaks closer than 1e-6 mm are merged.
-
-    Examples
-    --------
-    >>> grid_lines([0.0, 1.5, 4.5], 1.5).tolist()
-    [0.0, 1.5, 3.0, 4.5]
-    """
-    b = np.unique(np.round(np.asarray(breaks, dtype=float), 6))
-    out = [b[0]]
-    for lo, hi in pairwise(b):
-        n = max(1, int(np.ceil((hi - lo) / size - 1e-9)))
-        out.extend(np.linspace(lo, hi, n + 1)[1:])
-    return np.asarray(out)
-
-
-def _section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
-    """Local x breaks of one unit and y breaks of both orientations."""
-    x0, x1, y0, y1 = spec.cavity
-    xb = [0.0, x0, x1, x1 + spec.end_wall, spec.pitch]
-    yb = [0.0, y0, y1, spec.height - spec.layer, spec.height]
-    if spec.slit is not None:
-        yb.append(spec.slit_depth)
-    yb += [spec.height - y for y in yb]
-    return xb, yb
 
 
 def _label(spec: UnitSpec, orientation: str, centres: FloatArray, passage: float = 0.0,
@@ -213,7 +184,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
     side = check_passage(spec, passage)
     n, P, H, W = len(orientation), spec.pitch, spec.height, spec.width
     h = spec.element_size
-    xb_local, yb = _section_breaks(spec)
+    xb_local, yb = section_breaks(spec)
     xb = [i * P + x for i in range(n) for x in xb_local] + [n * P + spec.end_cap]
     zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
     if side:
@@ -295,3 +266,6 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
         spec=spec,
         symmetry_points=np.isclose(points[:, 2], W / 2) if (dim == 3 and half) else None,
     )
+
+
+__all__ = ["BASE", "BODY", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "grid_lines"]

@@ -133,6 +133,8 @@ def check_passage(spec: UnitSpec, diameter: float) -> float:
     if spec.slit is not None:
         raise GeometryError("a passage cannot run through a unit with a slit: it would open the cavities to the "
                             "outside")
+    if spec.solid:
+        raise GeometryError(f"a passage cannot run through the solid unit {spec.name!r}: it has no cavity to join")
     side = passage_side(diameter)
     room = min(spec.cavity_height - spec.layer, spec.width - 2 * spec.side_wall)
     if side >= room:

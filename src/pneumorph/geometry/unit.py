@@ -22,11 +22,27 @@ soft wall. In 3D the cavity stops ``side_wall`` short of both sides; the slit go
 the whole width. Orientation 1 is the unit turned 180 degrees about the long axis: its
 section is mirrored, y -> height - y.
 
+Unit types
+----------
+The same parameters describe the deformation modes of a library of units (section 8.4,
+``docs/unit-library.md``):
+
+- *bending* (the default): the stiff layer on one side bends the unit towards it;
+- *extending*: no stiff layer (``layer = 0``) and equal walls on both sides of the cavity,
+  so the section is symmetric and the unit lengthens instead of bending;
+- *near-rigid*: ``solid = True``, the cavity filled with the body material: no pressure
+  acts in it, its box is still meshed and tracked (for the unit's centre);
+- *short-pitch* (section 8.3.1): a shorter ``pitch`` with thinner end walls, so more units
+  fit in the same length.
+
 Examples
 --------
 >>> u = UnitSpec()
 >>> u.height, u.cavity_length
 (12.0, 4.5)
+>>> extending = UnitSpec(wall=3.0, layer=0.0)
+>>> extending.height, extending.cavity
+(12.0, (3.0, 7.5, 3.0, 9.0))
 """
 
 from __future__ import annotations
@@ -73,7 +89,8 @@ class UnitSpec:
         Thickness of each end wall of the cavity.
 
     layer : float
-        Thickness of the stiff layer that gives the preferential bending direction.
+        Thickness of the stiff layer that gives the preferential bending direction; 0: no
+        stiff layer (an extending unit when the walls are equal).
     cavity_height : float
         Height of the cavity.
     slit_width, slit_depth : float
@@ -100,11 +117,20 @@ class UnitSpec:
         Poisson's ratio of the filler.
     filler_source : str
         Where the law comes from (provenance of the calibration).
+    solid : bool
+        True: the cavity is filled with the body material (a near-rigid unit). Its box is
+        still meshed with the same lines, and its vertices are still tracked.
 
     Raises
     ------
     GeometryError
         Non-positive dimensions, walls that leave no cavity, a slit that cuts the unit in two.
+
+    Notes
+    -----
+    Fields added after the unit's first release (:data:`OPTIONAL_FIELDS`: ``solid``) are
+    left out of :meth:`to_dict` while they hold their default, so the description of every
+    earlier unit, and the fingerprints of models and chain tables built on it, stay the same.
 
     Notes
     -----
@@ -132,8 +158,11 @@ class UnitSpec:
     filler_range_kpa: tuple[float, float] = (0.0, 45.0)
     filler_poisson_ratio: float = 0.3
     filler_source: str = ""
+    solid: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.solid, bool):
+            raise GeometryError(f"unit solid must be true or false, got {self.solid!r}")
         object.__setattr__(self, "filler_coefficients", tuple(float(c) for c in self.filler_coefficients))
         object.__setattr__(self, "filler_range_kpa", tuple(float(c) for c in self.filler_range_kpa))
         if self.filler_coefficients:
@@ -147,13 +176,13 @@ class UnitSpec:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise GeometryError(f"unit {key} must be a finite number of mm, got {value!r}")
-        for key in ("pitch", "width", "wall", "side_wall", "end_wall", "layer", "cavity_height", "element_size"):
+        for key in ("pitch", "width", "wall", "side_wall", "end_wall", "cavity_height", "element_size"):
             if getattr(self, key) <= 0:
                 raise GeometryError(f"unit {key} must be positive, got {getattr(self, key)} mm")
-        for key in ("slit_width", "slit_depth", "end_cap"):
+        for key in ("layer", "slit_width", "slit_depth", "end_cap"):
             if getattr(self, key) < 0:
                 raise GeometryError(f"unit {key} must be >= 0, got {getattr(self, key)} mm")
-        thinnest = min(self.wall, self.side_wall, self.end_wall, self.layer)
+        thinnest = min(self.wall, self.side_wall, self.end_wall, *([self.layer] if self.layer > 0 else []))
         if self.element_size < MIN_ELEMENT_FRACTION * thinnest:
             raise GeometryError(
                 f"unit element_size {self.element_size:g} mm is below {MIN_ELEMENT_FRACTION:g} x the thinnest wall "
@@ -252,10 +281,22 @@ class UnitSpec:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """All parameters, for TOML files and provenance."""
+        """All parameters, for TOML files, provenance and model fingerprints.
+
+        The fields of :data:`OPTIONAL_FIELDS` appear only when they differ from their
+        default, so that a unit described before they existed is described the same now.
+
+        Examples
+        --------
+        >>> "solid" in UnitSpec().to_dict(), UnitSpec(solid=True).to_dict()["solid"]
+        (False, True)
+        """
         out = asdict(self)
         out["filler_coefficients"] = list(self.filler_coefficients)
         out["filler_range_kpa"] = list(self.filler_range_kpa)
+        for key, default in OPTIONAL_FIELDS.items():
+            if out[key] == default:
+                del out[key]
         return out
 
     @classmethod
@@ -298,6 +339,10 @@ class UnitSpec:
             raise GeometryError(f"{p}: expected a [unit] table with the unit's dimensions in mm")
         return cls.from_dict(data["unit"], source=str(p))
 
+
+#: Fields added after the first release, with their defaults: :meth:`UnitSpec.to_dict` leaves
+#: them out while they hold these values (earlier descriptions and fingerprints stay valid).
+OPTIONAL_FIELDS: dict[str, Any] = {"solid": False}
 
 #: The filler law of the built-in unit: ``pneumorph calibrate`` (defaults: 15 units, 5-45 kPa
 #: in 5 kPa steps, three runs, seed 0, relative weighting) against the 3D model; the

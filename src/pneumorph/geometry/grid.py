@@ -1,0 +1,90 @@
+"""Grid lines of the structured actuator mesh: where they must fall, and how they fill the gaps.
+
+The assembly (:mod:`pneumorph.geometry.assembly`) meshes a whole actuator as one tensor grid;
+its lines go through every interface of every unit (the breaks of :func:`section_breaks`),
+and :func:`grid_lines` fills the gaps between breaks with lines no further apart than the
+element size. Units of a library share their cross-section lines
+(:func:`cross_section_lines`), so that any mix of them meshes as one conforming grid.
+"""
+
+from __future__ import annotations
+
+from itertools import pairwise
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.geometry.unit import UnitSpec
+
+FloatArray = NDArray[np.float64]
+
+
+def grid_lines(breaks: list[float], size: float) -> FloatArray:
+    """Coordinates through every break, no gap wider than ``size``.
+
+    Breaks closer than 1e-6 mm are merged.
+
+    Examples
+    --------
+    >>> grid_lines([0.0, 1.5, 4.5], 1.5).tolist()
+    [0.0, 1.5, 3.0, 4.5]
+    """
+    b = np.unique(np.round(np.asarray(breaks, dtype=float), 6))
+    out = [b[0]]
+    for lo, hi in pairwise(b):
+        n = max(1, int(np.ceil((hi - lo) / size - 1e-9)))
+        out.extend(np.linspace(lo, hi, n + 1)[1:])
+    return np.asarray(out)
+
+
+def section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
+    """The x breaks of one unit (its own frame) and the y breaks of both its orientations.
+
+    Examples
+    --------
+    >>> xb, yb = section_breaks(UnitSpec())
+    >>> xb
+    [0.0, 3.0, 7.5, 10.5, 10.5]
+    >>> sorted(set(yb))
+    [0.0, 1.5, 3.0, 4.5, 7.5, 9.0, 10.5, 12.0]
+    """
+    x0, x1, y0, y1 = spec.cavity
+    xb = [0.0, x0, x1, x1 + spec.end_wall, spec.pitch]
+    yb = [0.0, y0, y1, spec.height - spec.layer, spec.height]
+    if spec.slit is not None:
+        yb.append(spec.slit_depth)
+    yb += [spec.height - y for y in yb]
+    return xb, yb
+
+
+def width_breaks(spec: UnitSpec, half: bool = False) -> list[float]:
+    """The z breaks across the width: the side walls and the mid-plane (3D).
+
+    Examples
+    --------
+    >>> width_breaks(UnitSpec(), half=True)
+    [0.0, 1.5, 7.5]
+    """
+    W = spec.width
+    return [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+
+
+def cross_section_lines(spec: UnitSpec) -> tuple[FloatArray, FloatArray]:
+    """The y lines (height, both orientations) and z lines (full width) of a unit meshed alone.
+
+    Two units can follow each other in one actuator only if these are the same: then the
+    faces they share carry the same nodes, and each unit is meshed as it would be alone.
+
+    Examples
+    --------
+    >>> y, z = cross_section_lines(UnitSpec())
+    >>> y.tolist()
+    [0.0, 1.5, 3.0, 4.5, 6.0, 7.5, 9.0, 10.5, 12.0]
+    >>> len(z)
+    11
+    """
+    h = spec.element_size
+    return grid_lines(section_breaks(spec)[1], h), grid_lines(width_breaks(spec), h)
+
+
+__all__ = ["cross_section_lines", "grid_lines", "section_breaks", "width_breaks"]
