@@ -89,6 +89,8 @@ def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
     assert np.abs(r_fe).max() > 1e-3  # a real, unbalanced state
     np.testing.assert_allclose(r, r_fe, rtol=0, atol=1e-12 * np.abs(r_fe).max())
     assert abs(K_fast - K_fe).max() <= 1e-12 * abs(K_fe).max()
+    K_fe.sort_indices()  # the pattern is FElupe's, entry for entry: none missing, none extra
+    assert np.array_equal(system.indptr, K_fe.indptr) and np.array_equal(system.indices, K_fe.indices)
     # each wall element's follower-load stiffness is not symmetric, but the walls of a
     # closed cavity make the load conservative (potential -p V): the sum is symmetric
     K_p = jac_items([body.pressure], field).tocsr()

@@ -12,6 +12,7 @@ from __future__ import annotations
 import felupe as fem
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from felupe.tools._newton import fun_items, jac_items
 
 from pneumorph.fem import OgdenCompressible, StepSettings, cavity_volume
@@ -97,6 +98,9 @@ def test_residual_and_tangent_equal_felupes(deformed_actuator) -> None:
     np.testing.assert_allclose(r, r_fe, rtol=0, atol=1e-12 * np.abs(r_fe).max())
     assert abs(K_fast - K_fe).max() <= 1e-12 * abs(K_fe).max()
     assert upper.size == system.nnz and system.nnz < 0.6 * K_fe.nnz  # the upper triangle only
+    triu = sp.triu(K_fe).tocsr()  # ... of FElupe's pattern, entry for entry: none missing, none extra
+    triu.sort_indices()
+    assert np.array_equal(system.indptr, triu.indptr) and np.array_equal(system.indices, triu.indices)
     F = field[0].extract(grad=True, sym=False, add_identity=True)
     assert jmin == pytest.approx(float(np.min(fem.math.det(F))), rel=1e-13)
     volume = system.cavity_volume(field[0].values.ravel())

@@ -173,6 +173,11 @@ class FastSystem:
         of them are assembled (``act``: the active index of each cell's dofs, (c, n, d))."""
         raise NotImplementedError  # pragma: no cover
 
+    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+        """The local nodes ``a``, ``b`` that each entry of :meth:`_entries` couples, as index
+        arrays that broadcast to its shape without the cell axis."""
+        raise NotImplementedError  # pragma: no cover
+
     def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
         """The element vectors ``(c, n, d)`` of a solid, its smallest det F and the state
         :meth:`_solid_tangent` needs."""
@@ -195,41 +200,78 @@ class FastSystem:
     def _build_pattern(self) -> None:
         """CSR pattern and every element entry's position in it.
 
-        Entries are keyed ``row * n1 + column`` (active numbering); one argsort of all
-        keys gives both the pattern (row-major, sorted columns) and the scatter positions.
+        No sort of the element entries: the nodes a cell couples are paired once
+        (``np.unique`` of the cells' node pairs, unordered where the tangent is
+        symmetric), the pattern follows from the pairs - in a row of node ``P``'s
+        component ``i`` the columns are the active components of ``P``'s partners ``Q``
+        in ascending order, since the active numbering keeps the order of the dofs - and
+        an entry's position is its pair's row start, the columns of the partners before
+        ``Q`` and the components before its own. Only the entries some element assembles
+        are kept, so the pattern is exactly theirs.
         """
-        d = self.dim
+        d, npts = self.dim, self.npoints
         active = np.full(self.ndof, -1, dtype=np.int64)
         active[self.dof1] = np.arange(self.dof1.size)
         n1 = self.dof1.size
         owners: list[_Solid | _Walls] = [*self.solids, *self.walls]
-        keys_all = []
+        # 1. the node pairs every owner's cells couple, numbered
+        pair_keys = []
         for owner in owners:
+            a, b = owner.cells[:, :, None], owner.cells[:, None, :]
+            if self.symmetric:
+                a, b = np.minimum(a, b), np.maximum(a, b)
+            pair_keys.append((a * npts + b).ravel())
+        every = np.concatenate(pair_keys)
+        if npts * npts < 2**32:
+            every = every.astype(np.uint32)  # sorts faster
+        keys, inverse = np.unique(every, return_inverse=True)
+        keys = keys.astype(np.int64)
+        first, second = keys // npts, keys % npts
+        # 2. the dof entries (pair, i, k) of every pair: position if all were assembled
+        comp = np.arange(d)
+        rows = active[d * first[:, None] + comp]  # (pairs, d)
+        cols = active[d * second[:, None] + comp]
+        exists = (rows[:, :, None] >= 0) & (cols[:, None, :] >= 0)
+        if self.symmetric:  # a node with itself: the upper triangle of its block
+            exists &= (first != second)[:, None, None] | (comp[:, None] <= comp[None, :])
+        per_row = exists.sum(axis=2)  # (pairs, d): columns each pair adds to the rows of first
+        before = np.cumsum(per_row, axis=0) - per_row  # columns of earlier pairs (all nodes)
+        starts = np.flatnonzero(np.r_[True, first[1:] != first[:-1]])
+        group = np.repeat(starts, np.diff(np.r_[starts, first.size]))
+        before -= before[group]  # ... of earlier pairs of the same first node
+        live = rows >= 0
+        indptr = np.r_[0, np.cumsum(np.bincount(rows[live], weights=per_row[live], minlength=n1))].astype(np.int64)
+        full = indptr[np.maximum(rows, 0)][:, :, None] + before[:, :, None] + (np.cumsum(exists, axis=2) - exists)
+        # 3. every element entry's (pair, i, k), of the assembled ones
+        offsets = np.cumsum([0, *(k.size for k in pair_keys)])
+        component = (self.dof1 % d).astype(np.int32)  # of each active dof
+        full_flat = full.reshape(-1)
+        positions = []
+        used = np.zeros(int(indptr[-1]), dtype=bool)
+        for o, owner in enumerate(owners):
             dofs = d * owner.cells[:, :, None] + np.arange(d)  # (c, n, d)
             owner.edofs = dofs.ravel()
-            rows, cols, valid = self._entries(owner, active[dofs])
+            erows, ecols, valid = self._entries(owner, active[dofs])
             owner.take = np.flatnonzero(valid)
-            keys_all.append((rows * n1 + cols).ravel()[owner.take])
-        keys = np.concatenate(keys_all)
-        if n1 * n1 < 2**32:
-            keys = keys.astype(np.uint32)  # sorts faster
-        order = np.argsort(keys)
-        sorted_keys = keys[order]
-        first = np.empty(keys.size, dtype=bool)
-        first[:1] = True
-        np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=first[1:])
-        starts = np.flatnonzero(first)
-        position = np.empty(keys.size, dtype=np.int64)
-        position[order] = np.repeat(np.arange(starts.size), np.diff(np.append(starts, keys.size)))
-        unique = sorted_keys[first].astype(np.int64)
-        self.nnz = int(unique.size)
-        rows_u = unique // n1
-        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows_u, minlength=n1))]).astype(np.int32)
-        self.indices = (unique - rows_u * n1).astype(np.int32)
-        start = 0
-        for owner, k in zip(owners, keys_all, strict=True):
-            owner.scatter = position[start : start + k.size]
-            start += k.size
+            n = owner.cells.shape[1]
+            pair = inverse[offsets[o] : offsets[o + 1]].reshape(-1, n, n).astype(np.int32)
+            ia, ib = self._entry_nodes(owner)
+            index = np.broadcast_to(pair[:, ia, ib] * (d * d), erows.shape).ravel()[owner.take]
+            index += component[np.ravel(erows)[owner.take]] * d
+            index += component[np.ravel(ecols)[owner.take]]
+            pos = full_flat[index]
+            used[pos] = True
+            positions.append(pos)
+        # 4. keep the entries some element assembles
+        renumber = np.cumsum(used) - 1
+        self.nnz = int(used.sum())
+        kept_rows = np.repeat(np.arange(n1), np.diff(indptr))[used]
+        self.indptr = np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32)
+        columns = np.empty(int(indptr[-1]), dtype=np.int64)
+        columns[full[exists]] = np.broadcast_to(cols[:, None, :], exists.shape)[exists]
+        self.indices = columns[used].astype(np.int32)
+        for owner, pos in zip(owners, positions, strict=True):
+            owner.scatter = renumber[pos]
 
     # -- evaluation -----------------------------------------------------------------------
     def residual(self, u: FloatArray) -> tuple[FloatArray, float]:
@@ -343,6 +385,10 @@ class PlaneStrainSystem(FastSystem):
         cols = np.broadcast_to(act.transpose(0, 2, 1)[:, None, None, :, :], (c, n, 2, 2, n))
         return rows, cols, (rows >= 0) & (cols >= 0)
 
+    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+        n = np.arange(owner.cells.shape[1])
+        return n[:, None, None, None], n  # entries (a, i, k, b)
+
     def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
         F = _deformation(s.g, s.cells, U)
@@ -445,6 +491,12 @@ class SolidSystem3D(FastSystem):
         cols = act[:, None, None, :, :]
         rows, cols = np.broadcast_arrays(rows, cols)
         return rows, cols, (rows >= 0) & (rows <= cols)
+
+    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+        n = np.arange(owner.cells.shape[1])
+        if isinstance(owner, _Solid):
+            return n[:, None, None], n  # entries (a, ik, b)
+        return n[:, None, None, None], n[:, None]  # entries (a, i, b, k)
 
     def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
