@@ -157,6 +157,11 @@ class GeometryError(PneumorphError, ValueError):
     """A unit or actuator geometry that cannot be built (non-positive sizes, no cavity, ...)."""
 
 
+class UnitLibraryError(GeometryError):
+    """A unit library that cannot serve: a bad or repeated symbol, an unknown key, a unit that
+    does not validate, or two units whose sections cannot be joined in one mesh."""
+
+
 class CrimpError(PneumorphError, ValueError):
     """A crimp or composite coupon that cannot exist (non-positive amplitude, wavelength
     longer than the coupon, crimp deeper than the matrix, ...)."""
