@@ -1,8 +1,11 @@
-"""Assemble an actuator mesh from a unit and an orientation vector.
+"""Assemble an actuator mesh from a unit (or a unit library) and a design.
 
 One structured grid whose lines fall on every interface of every unit in either
 orientation; each cell is labelled (body, stiff layer, cavity, slit) from its unit's
-section, mirrored for orientation 1; cavity cells become the filler of the 2D
+section, mirrored for orientation 1; the units of a mixed design (a design over a
+:class:`~pneumorph.geometry.library.UnitLibrary`) follow each other with their own pitch
+and section, on the cross-section lines that all units of a library share, so the mesh
+conforms at every interface; cavity cells become the filler of the 2D
 reduced-order model (section 5.2) and are removed in 3D; slit cells are removed. The
 linear grid is then made quadratic (quad8 in 2D, hex20 in 3D) so that all materials share
 one set of points.
@@ -13,15 +16,18 @@ regions and fields.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError
+from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.features import BaseBlock, check_passage
-from pneumorph.geometry.grid import grid_lines, section_breaks
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.grid import grid_lines, section_breaks, width_breaks
+from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 
 IntArray = NDArray[np.int64]
@@ -54,9 +60,17 @@ class ActuatorMesh:
     base_points : ndarray of bool, shape (p,)
         The clamped points: the base face x = 0, or the jaw faces of the base block.
     orientation : str
+        ``0``/``1`` per unit, base first.
     spec : UnitSpec
+        The unit (of a mixed design: the library's first unit, whose cross-section,
+        width, height and element size all its units share).
     symmetry_points : ndarray of bool, shape (p,)
         3D half models: points on the mid-plane z = width / 2, where u_z = 0.
+    units : tuple of UnitSpec
+        The unit of every unit, base first (empty: every unit is ``spec``).
+    design : str
+        The design's canonical text (:mod:`pneumorph.geometry.alphabet`): the 0/1 string
+        for one unit type, else the library's symbols (empty: ``orientation``).
     """
 
     points: FloatArray
@@ -70,6 +84,8 @@ class ActuatorMesh:
     orientation: str
     spec: UnitSpec
     symmetry_points: BoolArray | None = None
+    units: tuple[UnitSpec, ...] = ()
+    design: str = ""
 
     @property
     def dim(self) -> int:
@@ -80,8 +96,22 @@ class ActuatorMesh:
         return len(self.orientation)
 
     @property
+    def unit_specs(self) -> tuple[UnitSpec, ...]:
+        """The unit of every unit, base first."""
+        return self.units or (self.spec,) * self.n_units
+
+    @property
+    def unit_bounds(self) -> FloatArray:
+        """Where each unit starts along the actuator, and where the last one ends: shape (n + 1,).
+
+        >>> assemble(UnitSpec(), "01").unit_bounds.tolist()
+        [0.0, 10.5, 21.0]
+        """
+        return unit_starts(self.unit_specs)
+
+    @property
     def length(self) -> float:
-        return self.n_units * self.spec.pitch + self.spec.end_cap
+        return float(self.unit_bounds[-1]) + self.spec.end_cap
 
     def unit_centres(self, displacement: FloatArray | None = None) -> FloatArray:
         """Mean (x, y) of each unit's four tracked points, shape (n, 2)."""
@@ -93,54 +123,79 @@ class ActuatorMesh:
         return self.points, self.cells[self.regions[region]]
 
 
-def _label(spec: UnitSpec, orientation: str, centres: FloatArray, passage: float = 0.0,
-           base: BaseBlock | None = None) -> IntArray:
+def unit_starts(units: Sequence[UnitSpec]) -> FloatArray:
+    """Where each unit starts along the actuator, and where the last one ends (mm).
+
+    Exact sums (``math.fsum``): for units of one pitch ``P`` they are ``i * P`` to the last bit.
+
+    >>> unit_starts([UnitSpec(), UnitSpec(pitch=7.0, end_wall=1.5), UnitSpec()]).tolist()
+    [0.0, 10.5, 17.5, 28.0]
+    """
+    pitches = [u.pitch for u in units]
+    return np.array([math.fsum(pitches[:i]) for i in range(len(pitches) + 1)], dtype=float)
+
+
+def _label(units: Sequence[UnitSpec], orientation: str, starts: FloatArray, centres: FloatArray,
+           passage: float = 0.0, base: BaseBlock | None = None) -> IntArray:
     """Label of each linear cell from its centroid: BODY, LAYER, CAVITY, SLIT, BASE or VOID.
 
-    ``passage`` is the side of the square channels between adjacent cavities (labelled
-    CAVITY); cells outside the actuator's section (beside a base block with a margin) are VOID.
+    Each cell belongs to the unit whose span holds its centroid (the end cap: to no unit,
+    solid); ``units`` share height and width. ``passage`` is the side of the square channels
+    between adjacent cavities (labelled CAVITY); cells outside the actuator's section (beside
+    a base block with a margin) are VOID.
     """
-    n, P, H = len(orientation), spec.pitch, spec.height
-    unit = np.clip(np.floor(centres[:, 0] / P).astype(int), 0, n - 1)
-    lx = centres[:, 0] - unit * P
-    cap = centres[:, 0] > n * P  # the end cap: solid, body or layer by height
+    n, ref = len(orientation), units[0]
+    H, W = ref.height, ref.width
+
+    def per_unit(values: Iterable[float]) -> FloatArray:
+        return np.asarray(list(values))
+
+    cx = centres[:, 0]
+    unit = np.searchsorted(starts[1:n], cx, side="right")  # 0 .. n - 1; the base block and the cap clip
+    lx = cx - starts[unit]
+    cap = cx > starts[n]  # the end cap: solid, body or layer by height
     flipped = np.array([c == "1" for c in orientation])[unit]
     ly = np.where(flipped, H - centres[:, 1], centres[:, 1])
-    x0, x1, y0, y1 = spec.cavity
-    cavity = (lx > x0) & (lx < x1) & (ly > y0) & (ly < y1) & ~cap
+    box = per_unit(c for u in units for c in u.cavity).reshape(n, 4)[unit]
+    x0, x1, y0, y1 = box.T
+    filled = np.array([u.solid for u in units], dtype=bool)[unit]
+    cavity = (lx > x0) & (lx < x1) & (ly > y0) & (ly < y1) & ~cap & ~filled
     if centres.shape[1] == 3:
         z = centres[:, 2]
-        cavity &= (z > spec.side_wall) & (z < spec.width - spec.side_wall)
-    label = np.where(ly > H - spec.layer, LAYER, BODY)
+        cavity &= (z > ref.side_wall) & (z < W - ref.side_wall)
+    label = np.where(ly > H - per_unit(u.layer for u in units)[unit], LAYER, BODY)
     label = np.where(cavity, CAVITY, label)
-    if spec.slit is not None:
-        sx0, _, _, sy1 = spec.slit
-        label = np.where((lx > sx0) & (ly < sy1) & ~cap, SLIT, label)
+    if any(u.slit is not None for u in units):
+        slit = np.array([u.slit is not None for u in units], dtype=bool)[unit]
+        sx0 = per_unit(u.pitch - u.slit_width for u in units)[unit]
+        sy1 = per_unit(u.slit_depth for u in units)[unit]
+        label = np.where(slit & (lx > sx0) & (ly < sy1) & ~cap, SLIT, label)
     if passage > 0:  # the wall between cavity i and cavity i + 1, at mid-height and mid-width
         between = ((lx > x1) & (unit < n - 1)) | ((lx < x0) & (unit > 0))
-        through = between & ~cap & (centres[:, 0] > 0) & (np.abs(centres[:, 1] - H / 2) < passage / 2)
+        through = between & ~cap & (cx > 0) & (np.abs(centres[:, 1] - H / 2) < passage / 2)
         if centres.shape[1] == 3:
-            through &= np.abs(centres[:, 2] - spec.width / 2) < passage / 2
+            through &= np.abs(centres[:, 2] - W / 2) < passage / 2
         label = np.where(through, CAVITY, label)
     outside = (centres[:, 1] < 0) | (centres[:, 1] > H)
     if centres.shape[1] == 3:
-        outside |= (centres[:, 2] < 0) | (centres[:, 2] > spec.width)
+        outside |= (centres[:, 2] < 0) | (centres[:, 2] > W)
     label = np.where(outside, VOID, label)
     if base is not None:
-        label = np.where(centres[:, 0] < 0, BASE, label)
+        label = np.where(cx < 0, BASE, label)
     return label
 
 
-def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False, passage: float = 0.0,
-             base: BaseBlock | None = None) -> ActuatorMesh:
+def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[int], dim: int = 2,
+             half: bool = False, passage: float = 0.0, base: BaseBlock | None = None) -> ActuatorMesh:
     """Mesh an actuator of ``len(orientation)`` units.
 
     Parameters
     ----------
-    spec : UnitSpec
-        The articulating unit.
-    orientation : str
-        The design, base first: one digit per unit, 1 = turned 180 degrees.
+    spec : UnitSpec or UnitLibrary
+        The articulating unit, or a library of unit types for a mixed design.
+    orientation : str or Design
+        The design, base first: one digit per unit, 1 = turned 180 degrees; over a library
+        also its symbols, upper case = turned (:func:`~pneumorph.geometry.alphabet.parse_design`).
     dim : {2, 3}
         2 = plane-strain longitudinal section with filled cavities; 3 = solid with empty
         cavities.
@@ -169,24 +224,43 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
     >>> np.round(m.unit_centres(), 3).tolist()
     [[5.25, 4.5], [15.75, 7.5]]
 
+    A mixed design over the built-in library: a bending unit turned over, a short one,
+    a near-rigid one (no filler in it):
+
+    >>> from pneumorph.geometry.library import builtin_library
+    >>> m = assemble(builtin_library(), "Asr", dim=2)
+    >>> m.design, m.orientation, m.unit_bounds.tolist(), m.length
+    ('Asr', '100', [0.0, 10.5, 17.5, 28.0], 28.0)
+
     Raises
     ------
     GeometryError
-        A bad ``dim`` or design, a passage in 2D or one that does not fit the walls.
+        A bad ``dim`` or design, a passage in 2D or one that does not fit the walls (or
+        meets a solid unit).
+    OrientationError
+        A design that is not one over ``spec``'s symbols (0/1 for one unit).
     """
     import felupe as fem
 
     if dim not in (2, 3):
         raise GeometryError(f"dim must be 2 or 3, got {dim!r}")
-    orientation = parse_orientation(orientation)
+    library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
+    design = parse_design(orientation, library)
+    orientation = design.orientation
     if passage and dim != 3:
         raise GeometryError("a passage between cavities is a 3D feature: the 2D section would be cut in two")
-    side = check_passage(spec, passage)
-    n, P, H, W = len(orientation), spec.pitch, spec.height, spec.width
-    h = spec.element_size
-    xb_local, yb = section_breaks(spec)
-    xb = [i * P + x for i in range(n) for x in xb_local] + [n * P + spec.end_cap]
-    zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+    units = design.units(library)
+    ref = library[library.default]  # the cross-section, mesh size and end cap all units share
+    side = 0.0
+    for unit in dict.fromkeys(units):
+        side = check_passage(unit, passage)
+    n, H, W = len(orientation), ref.height, ref.width
+    starts = unit_starts(units)
+    h = ref.element_size
+    xb = [float(starts[i]) + x for i, unit in enumerate(units) for x in section_breaks(unit)[0]]
+    xb.append(float(starts[n]) + ref.end_cap)
+    yb = [y for unit in library.units for y in section_breaks(unit)[1]]
+    zb = width_breaks(ref, half)
     if side:
         yb += [H / 2 - side / 2, H / 2 + side / 2]
         zb += [W / 2 - side / 2] if half else [W / 2 - side / 2, W / 2 + side / 2]
@@ -197,7 +271,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
         zb += [-m] if half else [-m, W + m]
     xs, ys = grid_lines(xb, h), grid_lines(yb, h)
     grid = fem.Grid(xs, ys, grid_lines(zb, h)) if dim == 3 else fem.Grid(xs, ys)
-    label = _label(spec, orientation, grid.points[grid.cells].mean(axis=1), side, base)
+    label = _label(units, orientation, starts, grid.points[grid.cells].mean(axis=1), side, base)
     solid = (label == BODY) | (label == LAYER) | (label == BASE)
     keep = solid | (label == CAVITY) if dim == 2 else solid
     cells, label = grid.cells[keep], label[keep]
@@ -205,7 +279,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
     renumber = np.full(len(grid.points), -1)
     renumber[used] = np.arange(len(used))
     linear = fem.Mesh(grid.points[used], renumber[cells], grid.cell_type)
-    mesh = linear.add_midpoints_edges() if spec.element_order == 2 else linear
+    mesh = linear.add_midpoints_edges() if ref.element_order == 2 else linear
     points = np.asarray(mesh.points, dtype=float)
     regions = {"body": np.flatnonzero(label == BODY), "layer": np.flatnonzero(label == LAYER)}
     if dim == 2:
@@ -214,21 +288,23 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
         regions["base"] = np.flatnonzero(label == BASE)
 
     tol = 1e-6
-    x0, x1, y0, y1 = spec.cavity
     cavity_points = np.zeros(len(points), dtype=bool)
     tracked = np.zeros((n, 4), dtype=np.int64)
-    for i, o in enumerate(orientation):
+    for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
+        s = float(starts[i])
+        x0, x1, y0, y1 = unit.cavity
         cy0, cy1 = (y0, y1) if o == "0" else (H - y1, H - y0)
-        inside = (
-            (points[:, 0] > i * P + x0 - tol)
-            & (points[:, 0] < i * P + x1 + tol)
-            & (points[:, 1] > cy0 - tol)
-            & (points[:, 1] < cy1 + tol)
-        )
-        if dim == 3:
-            inside &= (points[:, 2] > spec.side_wall - tol) & (points[:, 2] < W - spec.side_wall + tol)
-        cavity_points |= inside
-        corners = [(i * P + x0, cy0), (i * P + x1, cy0), (i * P + x1, cy1), (i * P + x0, cy1)]
+        if not unit.solid:
+            inside = (
+                (points[:, 0] > s + x0 - tol)
+                & (points[:, 0] < s + x1 + tol)
+                & (points[:, 1] > cy0 - tol)
+                & (points[:, 1] < cy1 + tol)
+            )
+            if dim == 3:
+                inside &= (points[:, 2] > ref.side_wall - tol) & (points[:, 2] < W - ref.side_wall + tol)
+            cavity_points |= inside
+        corners = [(s + x0, cy0), (s + x1, cy0), (s + x1, cy1), (s + x0, cy1)]  # a solid unit's box too
         for k, (cx, cy) in enumerate(corners):
             d = (points[:, 0] - cx) ** 2 + (points[:, 1] - cy) ** 2
             if dim == 3:
@@ -238,7 +314,8 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
                 raise GeometryError(f"no mesh point at cavity vertex {k} of unit {i}")
     if side:  # the passages' walls are loaded by the pressure too
         for i in range(n - 1):
-            inside = ((points[:, 0] > i * P + x1 - tol) & (points[:, 0] < (i + 1) * P + x0 + tol)
+            inside = ((points[:, 0] > float(starts[i]) + units[i].cavity[1] - tol)
+                      & (points[:, 0] < float(starts[i + 1]) + units[i + 1].cavity[0] + tol)
                       & (np.abs(points[:, 1] - H / 2) < side / 2 + tol))
             if dim == 3:
                 inside &= np.abs(points[:, 2] - W / 2) < side / 2 + tol
@@ -248,7 +325,7 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
     else:  # the jaws of the clamp hold the block's bottom and top faces
         jaws = np.isclose(points[:, 1], -base.margin) | np.isclose(points[:, 1], H + base.margin)
         clamped = jaws & (points[:, 0] < tol)
-    on_end = np.isclose(points[:, 0], n * P + spec.end_cap)
+    on_end = np.isclose(points[:, 0], float(starts[n]) + ref.end_cap)
     if dim == 3:
         on_end &= np.isclose(points[:, 2], W / 2)
     end_points = np.flatnonzero(on_end)
@@ -263,9 +340,11 @@ def assemble(spec: UnitSpec, orientation: str, dim: int = 2, half: bool = False,
         end_points=end_points,
         base_points=clamped,
         orientation=orientation,
-        spec=spec,
+        spec=ref,
         symmetry_points=np.isclose(points[:, 2], W / 2) if (dim == 3 and half) else None,
+        units=units,
+        design=design.text,
     )
 
 
-__all__ = ["BASE", "BODY", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "grid_lines"]
+__all__ = ["BASE", "BODY", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "grid_lines", "unit_starts"]
