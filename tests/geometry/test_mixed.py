@@ -188,3 +188,21 @@ def test_bad_mixed_designs_are_refused() -> None:
         assemble(lib, "ara", dim=3, passage=PHYSICAL_PASSAGE)
     m = assemble(lib, "aea", dim=3, passage=PHYSICAL_PASSAGE)  # the extending unit's cavity takes a passage
     assert m.cavity_points.sum() > assemble(lib, "aea", dim=3).cavity_points.sum()
+
+
+def test_a_mixed_2d_mesh_solves_and_each_type_does_its_part(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Before the models take a library: Reduced2D's own build, given the mixed mesh, solves 2 units at 10 kPa.
+
+    The extending and the near-rigid unit bend less than the bending one (the curl is then mostly
+    the first unit's), and the extending unit lengthens more than the near-rigid one.
+    """
+    from pneumorph.models import fe
+
+    lib, responses = builtin_library(), {}
+    for design in ("aa", "ae", "ar"):
+        monkeypatch.setattr(fe, "assemble", lambda spec, orientation, *a, _d=design, **k: assemble(lib, _d, *a, **k))
+        responses[design] = fe.Reduced2D(2, ramp_spec=fe.RampSpec(pressure=0.01)).evaluate("00")
+    assert all(r.converged for r in responses.values())
+    curl = {d: r.curl[-1] for d, r in responses.items()}
+    assert 0 < curl["ae"] < curl["aa"] and 0 < curl["ar"] < curl["aa"]
+    assert responses["ae"].tip[-1][0] > responses["ar"].tip[-1][0]
