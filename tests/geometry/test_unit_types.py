@@ -64,3 +64,16 @@ def test_bad_unit_types_are_refused() -> None:
         UnitSpec(solid=1)  # type: ignore[arg-type]
     with pytest.raises(GeometryError, match="solid unit"):
         check_passage(UnitSpec(solid=True), 1.5)
+
+
+@pytest.mark.parametrize("fidelity", ["2d", "3d"])
+def test_the_shipped_chain_tables_describe_the_default_unit_as_it_is_described_now(fidelity: str) -> None:
+    import json
+
+    from pneumorph.models.chaintables import shipped_path
+
+    source = json.loads(shipped_path(fidelity).read_text(encoding="utf-8"))["source"]
+    now = UnitSpec().to_dict()
+    if fidelity == "3d":  # the 3D model has no filler: its description leaves the filler's fields out
+        now = {k: v for k, v in now.items() if not k.startswith("filler_")}
+    assert source["description"]["unit"] == now

@@ -119,7 +119,7 @@ def check_joinable(units: Mapping[str, UnitSpec], where: str = "unit library") -
     (12 mm and 11 mm); the units of a library share one cross-section
     """
     items = list(units.items())
-    if not items:
+    if len(items) < 2:
         return
     first, ref = items[0]
     ref_y, ref_z = cross_section_lines(ref)
