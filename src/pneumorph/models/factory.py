@@ -8,14 +8,43 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
-from pneumorph.errors import GeometryError, SearchConfigError
+from pneumorph.errors import GeometryError, SearchConfigError, SettingsError
 from pneumorph.geometry.features import BaseBlock
+from pneumorph.geometry.library import UnitLibrary, builtin_library
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
-              "temperature_change", "passage", "base_block")
+              "temperature_change", "passage", "base_block", "library")
+
+
+def load_library(value: Any, where: str = "[model] library",
+                 error: type[SettingsError] = SearchConfigError) -> UnitLibrary:
+    """A unit library named by a setting: ``"builtin"`` or the path of a library TOML file.
+
+    Raises
+    ------
+    SearchConfigError (or ``error``)
+        Not a text, or the file is unreadable or no valid library (duplicate symbols, units
+        that cannot be joined, ...): one line naming ``where`` and the file's problem.
+
+    Examples
+    --------
+    >>> load_library("builtin").symbols
+    ('a', 'e', 'r', 's')
+    >>> load_library("no-such-library.toml")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: [model] library: ...no-such-library.toml...
+    """
+    name = checks.text(value, where, error=error)
+    if name == "builtin":
+        return builtin_library()
+    try:
+        return UnitLibrary.from_toml(Path(name))
+    except GeometryError as exc:
+        raise error(f"{where}: {exc}") from None
 
 
 def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel:
@@ -33,13 +62,17 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         the features of appendix D: ``temperature_change`` (degC, 3D), ``passage`` (the
         diameter of the holes between cavities, mm, 3D) and ``base_block`` (a table of
         :class:`~pneumorph.geometry.features.BaseBlock` parameters: ``length``, ``margin``,
-        ``material``).
+        ``material``); or, instead of the unit, ``library``: ``"builtin"`` or the path of a
+        unit library TOML file (:func:`load_library`): designs over its symbols, the
+        model's fingerprint then holding the library (unless it has one type only).
 
     Examples
     --------
     >>> m = make_model(4, {"pressure_kpa": 30, "unit": {"slit_width": 1.0, "slit_depth": 5.0}})
     >>> m.fidelity, m.n_units, round(m.ramp.pressure, 6), m.unit.slit_width
     ('2d', 4, 0.03, 1.0)
+    >>> make_model(4, {"library": "builtin"}).library.symbols
+    ('a', 'e', 'r', 's')
     """
     checks.integer(units, "units", 1, checks.MAX_UNITS, limit="MAX_UNITS", error=SearchConfigError)
     s = dict(settings or {})
@@ -48,7 +81,15 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         raise SearchConfigError(f"unknown model setting(s) {', '.join(unknown)}; known: {', '.join(MODEL_KEYS)}")
     if "unit" in s and "unit_file" in s:
         raise SearchConfigError("give the unit either inline ([model.unit]) or as unit_file, not both")
-    if "unit_file" in s:
+    library = None
+    unit: UnitSpec | None
+    if "library" in s:
+        if "unit" in s or "unit_file" in s:
+            raise SearchConfigError("give either a unit ([model.unit] or unit_file) or a unit library ([model] "
+                                    "library), not both: the library names its units")
+        library = load_library(s["library"])
+        unit = None  # the library's first type
+    elif "unit_file" in s:
         try:
             unit = UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file", error=SearchConfigError)))
         except GeometryError as exc:
@@ -89,6 +130,8 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         except GeometryError as exc:
             raise SearchConfigError(f"[model.base_block] {exc}") from None
     extra: dict[str, Any] = {"base_block": block} if block is not None else {}
+    if library is not None:
+        extra["library"] = library
     if change != 0.0 or passage != 0.0:
         if Model is not Full3D:
             what = "temperature_change" if change != 0.0 else "passage"

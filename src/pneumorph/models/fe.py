@@ -28,9 +28,10 @@ from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
+from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.features import BaseBlock, check_passage
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get, get_filler
 from pneumorph.materials.filler import FillerLaw
@@ -90,6 +91,34 @@ def _end_face_angle(x: FloatArray) -> float:
     return float(np.arctan2(-d[0], d[1]))
 
 
+def model_library(unit: UnitSpec | None, library: UnitLibrary | None) -> UnitLibrary:
+    """The unit library of a model: ``library``, else the one-type library of ``unit`` (default unit).
+
+    Raises
+    ------
+    SettingsError
+        ``library`` is no :class:`UnitLibrary`, or a unit is given too that is not the
+        library's first type.
+
+    Examples
+    --------
+    >>> model_library(None, None).is_single
+    True
+    >>> model_library(UnitSpec(pitch=9.0), None)["a"].pitch
+    9.0
+    """
+    if library is None:
+        if unit is not None and not isinstance(unit, UnitSpec):
+            raise SettingsError(f"unit must be a UnitSpec, got {type(unit).__name__}; a unit library goes to library=")
+        return UnitLibrary.single(unit or UnitSpec())
+    if not isinstance(library, UnitLibrary):
+        raise SettingsError(f"library must be a UnitLibrary, got {type(library).__name__}")
+    if unit is not None and unit != library[library.default]:
+        raise SettingsError("give the model a unit or a unit library, not both (the library's first type is its "
+                            "unit)")
+    return library
+
+
 class FEModel:
     """Common machinery of the 2D and 3D models (build once per design, solve the ramp)."""
 
@@ -118,10 +147,12 @@ class FEModel:
         passage: float = 0.0,
         base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None,
+        library: UnitLibrary | None = None,
     ) -> None:
         self.backend = check_backend(backend or self.backends[0], self.backends)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
-        self.unit = unit or UnitSpec()
+        self.library = model_library(unit, library)
+        self.unit = self.library[self.library.default]
         self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
         self.filler = filler
         self.materials = dict(materials or {})
@@ -129,13 +160,17 @@ class FEModel:
             if not isinstance(material, Material) or material.kind != "hyperelastic":
                 raise SettingsError(f"materials[{name!r}] must be a hyperelastic Material, got {material!r}")
         self.body = self._material(self.unit.body_material)
-        self.layer = self._material(self.unit.layer_material)
+        # the units of a library share the body material and the layer's (check_joinable)
+        layered = [u for u in self.library.units if u.layer > 0] or [self.unit]
+        self.layer = self._material(layered[0].layer_material)
         self.gravity = gravity_vector(gravity, self.dim)
         self.temperature_change = checks.real(temperature_change, "temperature_change", -100.0, 100.0, unit="degC")
         if passage and self.dim != 3:
             raise SettingsError("a passage between cavities is a 3D model option: the 2D section would be cut in two")
         self.passage = float(passage)
-        check_passage(self.unit, self.passage)
+        for spec in dict.fromkeys(self.library.units):
+            if not spec.solid:  # assemble refuses a passage through a solid unit
+                check_passage(spec, self.passage)
         if base_block is not None and not isinstance(base_block, BaseBlock):
             raise SettingsError(f"base_block must be a BaseBlock or None, got {base_block!r}")
         self.base_block = base_block
@@ -165,7 +200,14 @@ class FEModel:
         out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
                                "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
                                "base_block": self.base_block, "materials": dict(self.materials)}
+        if not self.library.is_single:
+            out["library"] = self.library
         return out
+
+    @property
+    def mixed(self) -> bool:
+        """True for a model over a library of several unit types (designs may mix them)."""
+        return not self.library.is_single
 
     def variant(self, **changes: Any) -> FEModel:
         """The same model with some constructor arguments changed (a sensitivity study's variant).
@@ -206,6 +248,8 @@ class FEModel:
         if self.base_block is not None:  # likewise
             assert self.base is not None
             out["base_block"] = {**self.base_block.to_dict(), "material_data": self.base.to_dict()}
+        if self.mixed:  # likewise: a one-type library is described by its unit alone
+            out["library"] = self.library.to_dict()
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -240,21 +284,41 @@ class FEModel:
         """Further material regions (the 2D filler) and a callback ``set_pressure(p)`` for them."""
         return [], lambda p: None
 
-    def build(self, orientation: str) -> tuple[ActuatorMesh, PressurisedBody, Any]:
+    def parse(self, design: str | Design) -> Design:
+        """A design of this model's length over its library (0/1 text or the library's symbols).
+
+        Raises
+        ------
+        OrientationError
+            The wrong length, or a character that is no symbol of the library.
+
+        >>> from pneumorph.geometry.library import builtin_library
+        >>> Reduced2D(3, library=builtin_library()).parse("aEr").text
+        'aEr'
+        """
+        return parse_design(design, self.library, self.n_units)
+
+    def build(self, orientation: str | Design) -> tuple[ActuatorMesh, PressurisedBody, Any]:
         """The meshed design, its pressurised body and ``set_pressure(p)`` for a load level.
 
         ``set_pressure`` sets the cavity pressure and everything that follows it (the 2D
-        filler's modulus).
+        filler's modulus). ``orientation`` is a design over the model's library.
         """
-        mesh = assemble(self.unit, orientation, self.dim, half=self.half, passage=self.passage, base=self.base_block)
-        regions = [(name, mesh.regions[name], self._silicone_umat(material))
-                   for name, material in self.silicones.items()]
+        if self.mixed:
+            mesh = assemble(self.library, self.parse(orientation), self.dim, half=self.half, passage=self.passage,
+                            base=self.base_block)
+        else:  # today's call, to the last bit
+            mesh = assemble(self.unit, orientation if isinstance(orientation, str) else orientation.orientation,
+                            self.dim, half=self.half, passage=self.passage, base=self.base_block)
+        # a design of extending units has no layer cells: the empty region is left out
+        silicones = {name: material for name, material in self.silicones.items() if len(mesh.regions[name])}
+        regions = [(name, mesh.regions[name], self._silicone_umat(material)) for name, material in silicones.items()]
         extra, set_extra = self._extra_regions(mesh)
         densities = None
         if self.gravity is not None:  # dead loads rho g on the silicones, switched on by the gravity stage
-            densities = {name: material.density.value for name, material in self.silicones.items()}
+            densities = {name: material.density.value for name, material in silicones.items()}
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, [*regions, *extra], mesh.cavity_points,
-                                mesh.base_points, mesh.symmetry_points, walls_of=list(self.silicones),
+                                mesh.base_points, mesh.symmetry_points, walls_of=list(silicones),
                                 densities=densities)
 
         def set_pressure(p: float) -> None:
@@ -264,20 +328,22 @@ class FEModel:
         return mesh, body, set_pressure
 
     # -- solving --------------------------------------------------------------------------
-    def evaluate(self, orientation: str, on_level: Any = None) -> Response:
+    def evaluate(self, orientation: str | Design, on_level: Any = None) -> Response:
         """Solve the pressure ramp of one design and return its :class:`Response`.
 
         See :meth:`solve` for the parameters and errors.
         """
         return self.solve(orientation, on_level).response
 
-    def solve(self, orientation: str, on_level: Any = None) -> Solution:
+    def solve(self, orientation: str | Design, on_level: Any = None) -> Solution:
         """Solve the pressure ramp of one design, keeping the displacement fields.
 
         Parameters
         ----------
-        orientation : str
-            The design, one digit per unit (``"0101..."``).
+        orientation : str or Design
+            The design, one digit per unit (``"0101..."``), or over the model's library
+            (``"aAer..."``, :mod:`pneumorph.geometry.alphabet`); the response keeps its
+            canonical text (0/1 digits for a one-type library).
         on_level : callable, optional
             ``on_level(k, pressure_mpa)`` after each reported level (progress).
 
@@ -285,10 +351,13 @@ class FEModel:
         ------
         SimulationFailed
             If the ramp cannot be completed; ``reached`` and ``pressure`` name how far it got.
+        OrientationError
+            A design of the wrong length or with symbols the library does not have.
         """
-        design = parse_orientation(orientation, self.n_units)
+        parsed = self.parse(orientation)
+        design = parsed.text
         t0 = time.perf_counter()
-        mesh, body, set_pressure = self.build(design)
+        mesh, body, set_pressure = self.build(parsed if self.mixed else design)
         pressures = self.pressures()
         x_end0 = mesh.points[mesh.end_points][:, :2]
         response = Response.empty(
@@ -430,36 +499,68 @@ class Reduced2D(FEModel):
         gravity: str | Sequence[float] | None = None,
         base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None,
+        library: UnitLibrary | None = None,
     ) -> None:
-        unit = unit or UnitSpec()
-        super().__init__(n_units, unit, ramp_spec, filler or unit.filler_law() or get_filler(), backend, gravity,
-                         base_block=base_block, materials=materials)
+        lib = model_library(unit, library)
+        first = lib[lib.default]
+        super().__init__(n_units, unit, ramp_spec, filler or first.filler_law() or get_filler(), backend, gravity,
+                         base_block=base_block, materials=materials, library=library)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
+        #: the filler law of every unit type: the given one for all, else each unit's calibrated law, else
+        #: Eq 5.2 (the extending and short units of the built-in library have none calibrated yet)
+        self.fillers = {s: filler or spec.filler_law() or get_filler() for s, spec in zip(
+            self.library.symbols, self.library.units, strict=True)}
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
-        self.filler.modulus(self.ramp.pressure)
+        for law in dict.fromkeys([self.filler, *self.fillers.values()]):
+            law.modulus(self.ramp.pressure)
 
     def options(self) -> dict[str, Any]:
         # the law in use, given or the unit's: a variant of another unit (a mould tolerance) keeps it
-        return {**super().options(), "filler": self.filler}
+        # (a library model's given law; else each type's own)
+        given = self.filler if not self.mixed or len(set(self.fillers.values())) == 1 else None
+        return {**super().options(), "filler": given}
+
+    def describe(self) -> dict[str, Any]:
+        out = super().describe()
+        if self.mixed:  # absent for one unit type: earlier fingerprints stay valid
+            out["fillers"] = {s: law.to_dict() for s, law in self.fillers.items()}
+        return out
 
     def _extra_regions(self, mesh: ActuatorMesh) -> tuple[list[tuple[str, Any, Any]], Any]:
         import felupe as fem
 
-        law = self.filler
-        assert law is not None
-        nu = law.poisson_ratio
-        umat = fem.NeoHookeCompressible(mu=1.0, lmbda=1.0)
+        cells = mesh.regions["filler"]
+        groups: dict[FillerLaw, Any] = {}
+        if not self.mixed:  # today's one region
+            assert self.filler is not None
+            groups[self.filler] = cells
+        else:  # the filler of each unit's cavity follows its type's law
+            centres = mesh.points[mesh.cells[cells]].mean(axis=1)[:, 0]
+            unit = np.clip(np.searchsorted(mesh.unit_bounds, centres, side="right") - 1, 0, mesh.n_units - 1)
+            symbols = np.array(list(self.parse(mesh.design).symbols))[unit]
+            for symbol in dict.fromkeys(symbols.tolist()):
+                law = self.fillers[symbol]
+                groups[law] = np.concatenate([groups.get(law, np.zeros(0, dtype=np.int64)),
+                                              cells[symbols == symbol]])
+        items: list[tuple[str, Any, Any]] = []
+        setters: list[tuple[FillerLaw, Any]] = []
+        for i, (law, members) in enumerate(groups.items()):
+            umat = fem.NeoHookeCompressible(mu=1.0, lmbda=1.0)
+            items.append(("filler" if i == 0 else f"filler_{i + 1}", members, umat))
+            setters.append((law, umat))
 
         def set_pressure(p: float) -> None:
             # linear-elastic filler at large strain: compressible neo-Hooke with the Lame
             # constants of E(P) and nu (small-strain limit = Hooke's law)
-            e = float(law.modulus(p))
-            umat.mu = e / (2 * (1 + nu))
-            umat.lmbda = e * nu / ((1 + nu) * (1 - 2 * nu))
+            for law, umat in setters:
+                nu = law.poisson_ratio
+                e = float(law.modulus(p))
+                umat.mu = e / (2 * (1 + nu))
+                umat.lmbda = e * nu / ((1 + nu) * (1 - 2 * nu))
 
         set_pressure(0.0)
-        return [("filler", mesh.regions["filler"], umat)], set_pressure
+        return items, set_pressure
 
 
 class Full3D(FEModel):
@@ -523,9 +624,10 @@ class Full3D(FEModel):
         self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
         backend: str | None = None, gravity: str | Sequence[float] | None = None, temperature_change: float = 0.0,
         passage: float = 0.0, base_block: BaseBlock | None = None, materials: Mapping[str, Material] | None = None,
+        library: UnitLibrary | None = None,
     ) -> None:
         super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block,
-                         materials)
+                         materials, library)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
@@ -535,6 +637,10 @@ class Full3D(FEModel):
         out = {**super().describe(), "half_model": self.half}
         # the 3D model has no filler: a unit's filler law must not change its fingerprint
         out["unit"] = {k: v for k, v in out["unit"].items() if not k.startswith("filler_")}
+        if "library" in out:  # nor the filler laws of a library's units
+            out["library"]["units"] = [{**entry, "unit": {k: v for k, v in entry["unit"].items()
+                                                          if not k.startswith("filler_")}}
+                                       for entry in out["library"]["units"]]
         steps = self.ramp.steps
         out["steps"] = {"increments": steps.increments, "tolerance": steps.tolerance}
         return out
