@@ -22,6 +22,13 @@ Mirror symmetry (every unit inverted mirrors the actuator) gives the window with
 exchanged the negated turns and the same lengths, so a training design teaches two
 windows at once and the covering set needs half as many FE solves.
 
+Over a unit library of several types (:mod:`pneumorph.geometry.library`) the windows are
+those of the types and orientations (``a``, ``A``, ``e``, ``E``, ... : codes ``2t + o``,
+:mod:`pneumorph.models.windows`), and the table keeps the types' symbols (its *alphabet*)
+and each type's pitch, centre offset and centre heights; a design with a type the table
+has not seen is refused ("unit type 'x' has no table"). A table of one unit type is
+today's 0/1 table, file and fingerprint unchanged.
+
 The table is fitted from FE solves of a *covering set* of designs in which every window
 occurs (:func:`covering_designs`), and validated on held-out random designs
 (:func:`build_table`): the window half-width grows until the worst unit-centre error of
@@ -41,8 +48,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.errors import ChainTableError, LocalityError
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.errors import ChainTableError, LocalityError, UnitLibraryError
+from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.models.windows import (
@@ -53,6 +60,8 @@ from pneumorph.models.windows import (
     design_strings,
     mirror_codes,
     possible_codes,
+    random_designs,
+    window_code,
     window_codes,
     window_symbols,
     window_text,
@@ -65,8 +74,10 @@ __all__ = ["BASE", "TIP", "ChainModel", "ChainTable", "build_table", "check_sour
 
 IntArray = NDArray[np.int64]
 
-#: format of the table file (bumped when its layout changes)
+#: format of the table file (bumped when its layout changes); a table over several unit types
+#: is written in :data:`ALPHABET_FORMAT` (older readers refuse it instead of misreading it)
 TABLE_FORMAT = 1
+ALPHABET_FORMAT = 2
 #: a level's worst held-out centre error above this is refused (mm, default)
 DEFAULT_TOLERANCE = 0.2
 #: widest window tried by :func:`build_table`
@@ -135,6 +146,13 @@ class ChainTable:
     spread : float
         The largest deviation of one training element from its window's mean (rad or mm):
         how well a window determines its element.
+    alphabet : tuple of str
+        The unit types' symbols of a table over a library of several types (the library's
+        order: code ``2t + o``); empty for a table of one unit (0/1 designs).
+    type_pitch, type_offset : tuple of float
+        Per type: its pitch and the x of its centre from its start (mm); empty for one unit.
+    type_centre_y : tuple of float
+        Per code ``2t + o``: the undeformed height of the unit's centre; empty for one unit.
     """
 
     window: int
@@ -153,17 +171,49 @@ class ChainTable:
     validation: dict[str, Any] = field(default_factory=dict)
     spread: float = 0.0
     metadata: dict[str, Any] = field(default_factory=dict)
+    alphabet: tuple[str, ...] = ()
+    type_pitch: tuple[float, ...] = ()
+    type_offset: tuple[float, ...] = ()
+    type_centre_y: tuple[float, ...] = ()
 
     @property
     def n_levels(self) -> int:
         return len(self.pressures)
 
+    @property
+    def n_types(self) -> int:
+        """Unit types of the table: 1 for a 0/1 table."""
+        return max(1, len(self.alphabet))
+
+    @property
+    def heights(self) -> FloatArray:
+        """The undeformed centre height of every unit code (``2t + o``)."""
+        return np.asarray(self.type_centre_y if self.alphabet else self.centre_y, dtype=float)
+
+    def designs(self, texts: Sequence[str] | str, n_units: int | None = None) -> NDArray[np.uint8]:
+        """Designs as unit codes over the table's types (:func:`~pneumorph.models.windows.design_array`).
+
+        Raises
+        ------
+        ChainTableError
+            A unit type the table does not cover ("unit type 'x' has no table").
+        """
+        return design_array(texts, n_units, self.alphabet)
+
+    def texts(self, codes: NDArray[np.integer]) -> list[str]:
+        """The canonical texts of designs given as unit codes (0/1 digits for one type)."""
+        return design_strings(codes, self.alphabet)
+
     def fingerprint(self) -> str:
         """Hash of everything that changes a prediction."""
         h = hashlib.sha256()
-        h.update(json.dumps({"window": self.window, "source": self.source.get("key"),
-                             "pitch": self.pitch, "centre_y": list(self.centre_y),
-                             "first": self.first_offset, "tip": list(self.tip_ref)}, sort_keys=True).encode())
+        head: dict[str, Any] = {"window": self.window, "source": self.source.get("key"), "pitch": self.pitch,
+                                "centre_y": list(self.centre_y), "first": self.first_offset,
+                                "tip": list(self.tip_ref)}
+        if self.alphabet:  # absent for one unit type: the fingerprints of 0/1 tables stay the same
+            head.update(alphabet=list(self.alphabet), type_pitch=list(self.type_pitch),
+                        type_offset=list(self.type_offset), type_centre_y=list(self.type_centre_y))
+        h.update(json.dumps(head, sort_keys=True).encode())
         for a in (self.pressures, self.codes, self.turn, self.length, self.end_codes, self.end):
             h.update(np.ascontiguousarray(a).tobytes())
         return h.hexdigest()[:16]
@@ -182,7 +232,7 @@ class ChainTable:
         idx = np.clip(idx, 0, len(table) - 1)
         missing = table[idx] != codes
         if missing.any():
-            bad = window_text(int(np.asarray(codes)[missing].ravel()[0]), self.window)
+            bad = window_text(int(np.asarray(codes)[missing].ravel()[0]), self.window, self.alphabet)
             raise ChainTableError(
                 f"the chain table has no entry for the {what} window {bad!r} (window +-{self.window}, trained on "
                 f"{self.source.get('n_units')} units); designs with fewer than {2 * self.window + 1} units or "
@@ -203,9 +253,23 @@ class ChainTable:
             )
 
     def reference(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray]:
-        """Undeformed unit centres (m, n, 2) and tip (2,) of designs (m, n)."""
+        """Undeformed unit centres (m, n, 2) and tip (2,) of designs (m, n).
+
+        Over several unit types the tip depends on the design (the units' pitches): then it
+        is (m, 2).
+        """
         bits = np.atleast_2d(np.asarray(bits))
         m, n = bits.shape
+        if self.alphabet:
+            types = bits.astype(np.int64) // 2
+            pitch = np.asarray(self.type_pitch)[types]
+            starts = np.cumsum(pitch, axis=1) - pitch
+            x = starts + np.asarray(self.type_offset)[types]
+            centres = np.stack([x, self.heights[bits]], axis=-1)
+            # the end cap (shared by all types) beyond the last unit's end
+            cap = self.tip_ref[0] - self.type_pitch[0] + self.type_offset[0]
+            tips = np.stack([starts[:, -1] + pitch[:, -1] + cap, np.full(m, self.tip_ref[1])], axis=-1)
+            return centres, tips
         x = self.first_offset + self.pitch * np.arange(n)
         y = np.asarray(self.centre_y)[bits]
         centres = np.stack([np.broadcast_to(x, (m, n)), y], axis=-1)
@@ -222,13 +286,13 @@ class ChainTable:
         bits = np.atleast_2d(np.asarray(bits))
         m, n = bits.shape
         self.check_units(n)
-        codes = window_codes(bits, self.window)  # (m, n + 1)
+        codes = window_codes(bits, self.window, n_types=self.n_types)  # (m, n + 1)
         rows = self.lookup(codes)
         erows = self.lookup(codes[:, -1], end=True)
         angle = np.cumsum(self.turn[rows], axis=1)  # (m, n + 1, k)
         length = self.length[rows]
         steps = np.stack([length * np.cos(angle), length * np.sin(angle)], axis=-1)  # (m, n + 1, k, 2)
-        base = np.stack([np.zeros(m), np.asarray(self.centre_y)[bits[:, 0]]], axis=-1)  # (m, 2)
+        base = np.stack([np.zeros(m), self.heights[bits[:, 0]]], axis=-1)  # (m, 2)
         pts = np.cumsum(steps, axis=1) + base[:, None, None, :]
         pts = pts.transpose(0, 2, 1, 3)  # (m, k, n + 1, 2)
         centres, tip = pts[:, :, :-1], pts[:, :, -1]
@@ -237,16 +301,29 @@ class ChainTable:
 
     # -- persistence ----------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form (arrays as lists; codes also as window text for readers)."""
+        """JSON-ready form (arrays as lists; codes also as window text for readers).
+
+        A table over several unit types (format :data:`ALPHABET_FORMAT`) adds ``alphabet``
+        and ``types`` (per symbol: ``pitch_mm``, ``centre_offset_mm``, ``centre_y_mm`` of
+        both orientations), and writes its windows in the types' letters with ``<`` and ``>``
+        for the base and the tip.
+        """
+        extra: dict[str, Any] = {}
+        if self.alphabet:
+            extra = {"alphabet": list(self.alphabet),
+                     "types": {s: {"pitch_mm": self.type_pitch[t], "centre_offset_mm": self.type_offset[t],
+                                   "centre_y_mm": list(self.type_centre_y[2 * t : 2 * t + 2])}
+                               for t, s in enumerate(self.alphabet)}}
         return {
-            "format": TABLE_FORMAT,
+            "format": ALPHABET_FORMAT if self.alphabet else TABLE_FORMAT,
             "kind": "pneumorph chain table",
+            **extra,
             "window": self.window,
             "pressures_mpa": self.pressures.tolist(),
-            "windows": [window_text(c, self.window) for c in self.codes],
+            "windows": [window_text(c, self.window, self.alphabet) for c in self.codes],
             "turn_rad": self.turn.tolist(),
             "length_mm": self.length.tolist(),
-            "end_windows": [window_text(c, self.window) for c in self.end_codes],
+            "end_windows": [window_text(c, self.window, self.alphabet) for c in self.end_codes],
             "end_turn_rad": self.end.tolist(),
             "pitch_mm": self.pitch,
             "centre_y_mm": list(self.centre_y),
@@ -264,16 +341,33 @@ class ChainTable:
     def from_dict(cls, data: dict[str, Any], where: str = "chain table") -> ChainTable:
         """Read :meth:`to_dict`'s form, checking its layout and its fingerprint."""
         try:
-            if data.get("kind") != "pneumorph chain table" or data.get("format") != TABLE_FORMAT:
-                raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT}")
+            fmt = data.get("format")
+            if data.get("kind") != "pneumorph chain table" or fmt not in (TABLE_FORMAT, ALPHABET_FORMAT):
+                raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT} or "
+                                      f"{ALPHABET_FORMAT}")
             w = int(data["window"])
+            alphabet: tuple[str, ...] = ()
+            geometry: dict[str, tuple[float, ...]] = {}
+            if fmt == ALPHABET_FORMAT:
+                from pneumorph.geometry.library import check_symbol
+
+                alphabet = tuple(check_symbol(a, where) for a in data["alphabet"])
+                if len(alphabet) < 2 or len(set(alphabet)) != len(alphabet):
+                    raise ChainTableError(f"{where}: a table over unit types needs two or more distinct symbols, "
+                                          f"got {list(alphabet)}")
+                types = data["types"]
+                geometry = {
+                    "type_pitch": tuple(float(types[a]["pitch_mm"]) for a in alphabet),
+                    "type_offset": tuple(float(types[a]["centre_offset_mm"]) for a in alphabet),
+                    "type_centre_y": tuple(float(y) for a in alphabet for y in types[a]["centre_y_mm"][:2]),
+                }
 
             def codes_of(texts: list[str]) -> IntArray:
                 out = []
                 for t in texts:
-                    if len(t) != 2 * w + 1 or set(t) - set("01BT"):
+                    if not isinstance(t, str) or len(t) != 2 * w + 1:
                         raise ChainTableError(f"{where}: bad window {t!r}")
-                    out.append(sum("01BT".index(ch) * 4**i for i, ch in enumerate(t)))
+                    out.append(window_code(t, alphabet))
                 return np.array(out, dtype=np.int64)
 
             table = cls(
@@ -293,15 +387,24 @@ class ChainTable:
                 validation=dict(data.get("validation", {})),
                 spread=float(data.get("spread", 0.0)),
                 metadata=dict(data.get("metadata", {})),
+                alphabet=alphabet,
+                **geometry,
             )
-        except ChainTableError:
-            raise
+        except ChainTableError as exc:
+            message = str(exc)
+            if message.startswith(where):
+                raise
+            raise ChainTableError(f"{where}: {message}") from None
+        except UnitLibraryError as exc:
+            raise ChainTableError(f"{where}: bad alphabet: {exc}") from None
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise ChainTableError(f"{where}: damaged chain table ({type(exc).__name__}: {exc})") from None
         k, K, E = table.n_levels, len(table.codes), len(table.end_codes)
         shapes_ok = (table.turn.shape == (K, k) and table.length.shape == (K, k) and table.end.shape == (E, k))
         if not shapes_ok or not (np.all(np.diff(table.codes) > 0) and np.all(np.diff(table.end_codes) > 0)):
             raise ChainTableError(f"{where}: damaged chain table (array shapes or window order do not match)")
+        if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
+            raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
         if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures)):
             raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
         if data.get("fingerprint") != table.fingerprint():
@@ -361,16 +464,26 @@ def check_source(table: ChainTable, model: Any) -> None:
 
 
 # -- fitting --------------------------------------------------------------------------------
-def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True) -> ChainTable:
+def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
+              library: UnitLibrary | None = None) -> ChainTable:
     """Fit a table to converged training responses (all of the same length).
 
     Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
     mirrored occurrences with negated turns).
 
+    Parameters
+    ----------
+    library : UnitLibrary, optional
+        The unit library of designs over several types (responses keyed by its letters); the
+        table then covers its types (:attr:`ChainTable.alphabet`), and each type's pitch and
+        centre offset are the library's units', checked against the training actuators.
+        None or a one-type library: a 0/1 table.
+
     Raises
     ------
     ChainTableError
-        No responses, a failed one, mixed lengths or levels.
+        No responses, a failed one, mixed lengths or levels; over a library, training
+        actuators whose undeformed centres are not where the library's units put them.
     """
     if not responses:
         raise ChainTableError("a chain table needs at least one training response")
@@ -383,11 +496,13 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         if r.n_units != n or not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
             raise ChainTableError("training responses of different lengths or pressure levels")
     w = int(window)
+    alphabet = library.symbols if library is not None and not library.is_single else ()
+    k = max(1, len(alphabet))
     all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
     for r in responses:
         turn, length, end = response_elements(r)
-        codes = window_codes(design_array(r.orientation), w)[0]
-        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w), -1.0)] if mirror else [])
+        codes = window_codes(design_array(r.orientation, alphabet=alphabet), w, n_types=k)[0]
+        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k), -1.0)] if mirror else [])
         for c, sign in variants:
             all_codes.append(c)
             all_turn.append(sign * turn.T)
@@ -418,6 +533,12 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     xs = ref.reference_centres[:, 0]
     if n < 2:
         raise ChainTableError("a chain table needs training designs of at least 2 units")
+    if alphabet:
+        assert library is not None
+        return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
+            window=w, pressures=np.asarray(pressures, dtype=float), codes=uniq, turn=mean_turn, length=mean_len,
+            end_codes=euniq, end=mean_end, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0),
+            source=dict(source), training=tuple(r.orientation for r in responses), spread=spread))
     pitch = float(np.mean(np.diff(xs)))
     tip_y = float(ref.reference_tip[1])
     heights: dict[int, list[float]] = {0: [], 1: []}
@@ -450,17 +571,68 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     )
 
 
+def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], library: UnitLibrary, mirror: bool,
+                  table: ChainTable) -> ChainTable:
+    """The undeformed geometry of a table over several unit types, checked against the training actuators."""
+    k = len(alphabet)
+    pitch = tuple(float(library[a].pitch) for a in alphabet)
+    offset = tuple(float(sum(library[a].cavity[:2]) / 2) for a in alphabet)  # the tracked cavity's middle
+    tip_y = float(responses[0].reference_tip[1])
+    heights: dict[int, list[float]] = {c: [] for c in range(2 * k)}
+    for r in responses:
+        codes = design_array(r.orientation, alphabet=alphabet)[0]
+        for c, y in zip(codes, r.reference_centres[:, 1], strict=True):
+            heights[int(c)].append(float(y))
+            if mirror:
+                heights[int(c) ^ 1].append(2 * tip_y - float(y))
+    missing = [design_strings(np.array([[c]], dtype=np.uint8), alphabet)[0] for c, ys in heights.items() if not ys]
+    if missing:
+        raise ChainTableError(f"the training designs do not show the unit(s) {', '.join(missing)}; every type and "
+                              "orientation must occur")
+    if max(np.ptp(ys) for ys in heights.values()) > 1e-9:
+        raise ChainTableError("the training designs show a unit type's centre at different heights")
+    first = responses[0]
+    cap = float(first.reference_tip[0]) - float(np.sum([library[a].pitch for a in
+                                                         first_symbols(first.orientation, alphabet)]))
+    geometry = {"type_pitch": pitch, "type_offset": offset,
+                "type_centre_y": tuple(heights[c][0] for c in range(2 * k))}
+    fitted = ChainTable(**{**table.__dict__, "alphabet": alphabet, **geometry, "pitch": pitch[0],
+                           "centre_y": (heights[0][0], heights[1][0]), "first_offset": offset[0],
+                           "tip_ref": (cap + pitch[0] - offset[0], tip_y)})
+    for r in responses:
+        centres, tip = fitted.reference(fitted.designs(r.orientation))
+        if not (np.allclose(centres[0], r.reference_centres, atol=1e-9, rtol=0)
+                and np.allclose(tip[0], r.reference_tip, atol=1e-9, rtol=0)):
+            raise ChainTableError(f"the undeformed centres of training design {r.orientation} are not where the "
+                                  "library's units put them (pitch, cavity middle); a table of another library?")
+    return fitted
+
+
+def first_symbols(design: str, alphabet: Sequence[str]) -> str:
+    """The type symbol of every unit of a design over ``alphabet`` (lower case; digits: the first type).
+
+    >>> first_symbols("aE1", ("a", "e"))
+    'aea'
+    """
+    return "".join(alphabet[int(c) // 2] for c in design_array(design, alphabet=alphabet)[0])
+
+
 def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[str, Any]:
     """Centre, tip and curl errors of the table's predictions against FE responses.
 
     Returns a dict with per-level lists ``centre_mean_mm``, ``centre_worst_mm``,
     ``tip_worst_mm``, ``curl_worst_deg``, ``norm_worst_mm`` (the worst root of the summed
-    squared centre errors of one design), and ``designs``.
+    squared centre errors of one design), and ``designs``. A table over several unit
+    types adds ``per_type``: per symbol the ``centre_worst_mm``, ``centre_mean_mm`` (per
+    level) and ``centres`` (how many) of the centres of the units of that type.
     """
     k = table.n_levels
     centre_err, tip_err, curl_err, norm_err = [], [], [], []
+    types = []
     for r in responses:
-        c, t, cu = table.predict(design_array(r.orientation))
+        bits = table.designs(r.orientation)
+        types.append(bits[0] // 2)
+        c, t, cu = table.predict(bits)
         e = np.hypot(*(c[0] - r.centres).transpose(2, 0, 1))  # (k, n)
         centre_err.append(e)
         norm_err.append(np.sqrt((e**2).sum(axis=1)))
@@ -471,7 +643,7 @@ def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[
         return {"designs": [], "centre_mean_mm": nan, "centre_worst_mm": nan, "tip_worst_mm": nan,
                 "curl_worst_deg": nan, "norm_worst_mm": nan}
     all_c = np.concatenate(centre_err, axis=1)
-    return {
+    out: dict[str, Any] = {
         "designs": [r.orientation for r in responses],
         "centre_mean_mm": all_c.mean(axis=1).tolist(),
         "centre_worst_mm": all_c.max(axis=1).tolist(),
@@ -479,16 +651,32 @@ def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[
         "curl_worst_deg": np.max(curl_err, axis=0).tolist(),
         "norm_worst_mm": np.max(norm_err, axis=0).tolist(),
     }
+    if table.alphabet:
+        of_type = np.concatenate(types)
+        out["per_type"] = {}
+        for code, symbol in enumerate(table.alphabet):
+            mine = all_c[:, of_type == code]
+            out["per_type"][symbol] = {"centres": int(mine.shape[1])}
+            if mine.size:
+                out["per_type"][symbol].update(centre_mean_mm=mine.mean(axis=1).tolist(),
+                                               centre_worst_mm=mine.max(axis=1).tolist())
+    return out
 
 
-def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed: int = 1) -> list[str]:
-    """``count`` random designs of ``n_units`` units, none of them in ``exclude`` (seeded)."""
+def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed: int = 1,
+                    alphabet: Sequence[str] = ()) -> list[str]:
+    """``count`` random designs of ``n_units`` units, none of them in ``exclude`` (seeded).
+
+    Over several unit types (``alphabet``) every unit is a random type and orientation.
+    """
     rng = np.random.default_rng(seed)
     out: list[str] = []
     taken = set(exclude)
-    limit = 2**n_units - len(taken)
+    k = max(1, len(alphabet))
+    limit = (2 * k) ** n_units - len(taken)
     while len(out) < min(count, limit):
-        d = design_strings(rng.integers(0, 2, size=(1, n_units), dtype=np.uint8))[0]
+        d = design_strings(random_designs(1, n_units, rng, k) if k > 1 else
+                           rng.integers(0, 2, size=(1, n_units), dtype=np.uint8), alphabet)[0]
         if d not in taken:
             taken.add(d)
             out.append(d)
@@ -549,6 +737,8 @@ def build_table(
                               f"{2 * windows[-1] + 1} units; the model has {n}")
     src = {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
            "n_units": n, "description": source_description(model)}
+    library = getattr(model, "library", None)
+    alphabet = library.symbols if library is not None and not library.is_single else ()
     solved: dict[str, Response] = {}
 
     def solve(designs: list[str], what: str) -> list[Response]:
@@ -568,15 +758,19 @@ def build_table(
     start = time.perf_counter()
     best: ChainTable | None = None
     for w in windows:
-        train = covering_designs(n, w)
+        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet)
         say(f"window +-{w}: {len(train)} covering designs")
-        table = fit_table(solve(train, "covering"), w, src)
-        tests = heldout_designs(n, heldout, exclude=train, seed=seed)
+        table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
+        tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet)
         val = prediction_errors(table, solve(tests, "held-out"))
         val.update(tolerance_mm=tolerance, seed=seed)
         worst = max(val["centre_worst_mm"])
         say(f"window +-{w}: worst held-out centre error {worst:.4f} mm, mean at the last level "
             f"{val['centre_mean_mm'][-1]:.4f} mm")
+        for symbol, errs in val.get("per_type", {}).items():
+            if errs["centres"]:
+                say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
+                    f"({errs['centres']} centres)")
         meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - start)
         table = ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})
         best = table
@@ -631,8 +825,18 @@ class ChainModel:
 
     @property
     def length(self) -> float:
-        """The undeformed length of the actuator, base to tip (mm): the ``L`` of a profile target."""
-        return float(self.table.reference(np.zeros((1, self.n_units), dtype=np.uint8))[1][0])
+        """The undeformed length of the actuator, base to tip (mm): the ``L`` of a profile target.
+
+        Over several unit types: that of the actuator of the first type only (the designs'
+        lengths differ with their units' pitches).
+        """
+        tip = self.table.reference(np.zeros((1, self.n_units), dtype=np.uint8))[1]
+        return float(np.atleast_2d(tip)[0, 0])
+
+    @property
+    def alphabet(self) -> tuple[str, ...]:
+        """The unit types of the table (empty: one type, 0/1 designs)."""
+        return self.table.alphabet
 
     def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Centres (m, k, n, 2), tip (m, k, 2), curl (m, k) of many designs at once."""
@@ -642,10 +846,20 @@ class ChainModel:
         return self.table.predict(bits)
 
     def evaluate(self, orientation: str) -> Response:
-        design = parse_orientation(orientation, self.n_units)
-        bits = design_array(design)
+        """The chained response of one design (0/1, or over the table's unit types).
+
+        Raises
+        ------
+        ChainTableError
+            A unit type the table has no entries for ("unit type 'x' has no table").
+        OrientationError
+            A design of the wrong length or with characters that are no symbols.
+        """
+        bits = self.table.designs(orientation, self.n_units)
+        design = self.table.texts(bits)[0]
         c, t, cu = self.predict(bits)
         ref_c, ref_t = self.table.reference(bits)
+        ref_t = np.atleast_2d(ref_t)[0]
         return Response(design, self.pressures(), c[0], ref_c[0], t[0], ref_t, cu[0], converged=True,
                         reached=float(self.table.pressures[-1]),
                         metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()})

@@ -1,12 +1,25 @@
 """Windows of an actuator design and covering sets of designs, for the chain model.
 
-A design is a row of 0/1 unit orientations. Element ``j`` of the chain model (chord ``j``,
-which starts at point ``j``: the base for ``j = 0``, the centre of unit ``j`` otherwise)
-sees the *window* of units ``j - w .. j + w`` (1-based); positions before the first unit
-read as the base symbol ``B`` (2), after the last as the tip symbol ``T`` (3). A window is
-stored as one integer, base 4, first unit least significant. Exchanging 0 and 1 mirrors a
+A design is a row of unit codes. For one unit type (today's actuators) the codes are the
+0/1 orientations. Over a unit library of ``k`` types (an *alphabet*, the types' symbols in
+the library's order, :mod:`pneumorph.geometry.alphabet`) unit type ``t`` in orientation
+``o`` is code ``2 t + o``: ``a`` 0, ``A`` 1, ``e`` 2, ``E`` 3, ... (so a one-type design's
+codes are its 0/1 digits). Element ``j`` of the chain model (chord ``j``, which starts at
+point ``j``: the base for ``j = 0``, the centre of unit ``j`` otherwise) sees the *window*
+of units ``j - w .. j + w`` (1-based); positions before the first unit read as the base
+symbol ``B`` (code ``2k``), after the last as the tip symbol ``T`` (``2k + 1``). A window is
+stored as one integer in base ``2k + 2``, first unit least significant: base 4 with ``B`` = 2
+and ``T`` = 3 for one type, as always. Turning every unit over (``2t <-> 2t + 1``) mirrors a
 window (:func:`mirror_codes`). A *covering set* is a small set of designs in which every
 window of an actuator occurs (:func:`covering_designs`).
+
+Examples
+--------
+>>> codes = design_array(["aEr", "AAs"], alphabet=("a", "e", "r", "s"))
+>>> codes.tolist(), design_strings(codes, ("a", "e", "r", "s"))
+([[0, 3, 4], [1, 1, 6]], ['aEr', 'AAs'])
+>>> window_text(int(window_codes(codes[:1], 1, n_types=4)[0, 0]), 1, ("a", "e", "r", "s"))
+'<<a'
 """
 
 from __future__ import annotations
@@ -21,18 +34,94 @@ from pneumorph.geometry.orientation import parse_orientation
 
 IntArray = NDArray[np.int64]
 
-#: symbols of a window besides the two orientations: the base and the tip
+#: symbols of a window besides the two orientations of one unit type: the base and the tip
 BASE, TIP = 2, 3
+#: characters of the base and the tip in the window text of a table over several unit types
+#: (``B`` and ``T`` would read as units ``b`` and ``t`` turned over)
+BASE_CHAR, TIP_CHAR = "<", ">"
 
 
-def design_array(designs: Sequence[str] | str, n_units: int | None = None) -> NDArray[np.uint8]:
-    """Designs as a (m, n) array of 0/1 (one row per design).
+def ends(n_types: int = 1) -> tuple[int, int]:
+    """The codes of the base and the tip symbols for ``n_types`` unit types: ``2k`` and ``2k + 1``.
+
+    >>> ends(), ends(4)
+    ((2, 3), (8, 9))
+    """
+    return 2 * int(n_types), 2 * int(n_types) + 1
+
+
+def symbol_chars(alphabet: Sequence[str] = ()) -> str:
+    """The character of every window symbol, by code: ``"01BT"`` for one type, else ``"aAeE...<>"``.
+
+    >>> symbol_chars(), symbol_chars(("a", "r"))
+    ('01BT', 'aArR<>')
+    """
+    if len(alphabet) <= 1:
+        return "01BT"
+    return "".join(s + s.upper() for s in alphabet) + BASE_CHAR + TIP_CHAR
+
+
+def _parse_alphabet(design: str, alphabet: Sequence[str], n_units: int | None) -> str:
+    """``design`` checked against the types of a table: the canonical letters (digits: the first type)."""
+    from pneumorph.errors import OrientationError
+
+    text = "".join(ch for ch in design if ch not in " ,_\t")
+    bad = sorted({ch for ch in text if ch not in "01" and ch.lower() not in alphabet})
+    if bad:
+        letters = [b for b in bad if b.isalpha()]
+        if letters:
+            which = ", ".join(repr(b.lower()) for b in dict.fromkeys(letters))
+            raise ChainTableError(
+                f"unit type {which} has no table: the chain table covers the unit types "
+                f"{', '.join(alphabet)} (design {design!r}); build a table over a library with "
+                f"{'that type' if len(letters) == 1 else 'those types'} (`pneumorph chain build --library`)")
+        raise OrientationError(f"design {design!r} contains {', '.join(repr(b) for b in bad)}; allowed: the unit "
+                               f"types {', '.join(alphabet)} (upper case: turned over) and 0/1 for {alphabet[0]}")
+    if not text:
+        raise OrientationError("empty design: give one symbol per unit")
+    if n_units is not None and len(text) != n_units:
+        raise OrientationError(f"design {text!r} has {len(text)} units, expected {n_units}")
+    first = alphabet[0]
+    return "".join(first if ch == "0" else first.upper() if ch == "1" else ch for ch in text)
+
+
+def design_array(designs: Sequence[str] | str, n_units: int | None = None,
+                 alphabet: Sequence[str] = ()) -> NDArray[np.uint8]:
+    """Designs as a (m, n) array of unit codes (one row per design): 0/1 for one unit type.
+
+    ``alphabet`` names the unit types of a table over several (module docstring); a design
+    with a letter of another type raises a :class:`ChainTableError` ("unit type 'x' has no
+    table").
 
     >>> design_array(["010", "110"]).tolist()
     [[0, 1, 0], [1, 1, 0]]
+    >>> design_array("a1R", alphabet=("a", "r")).tolist()
+    [[0, 1, 3]]
+    >>> design_array("aEa", alphabet=("a", "r"))
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.ChainTableError: unit type 'e' has no table: the chain table covers the unit types a, r
+    (design 'aEa'); build a table over a library with that type (`pneumorph chain build --library`)
     """
     if isinstance(designs, str):
         designs = [designs]
+    if len(alphabet) > 1:
+        chars = symbol_chars(alphabet)
+        texts = [_parse_alphabet(d, alphabet, n_units) for d in designs]
+        if not texts:
+            return np.zeros((0, n_units or 0), dtype=np.uint8)
+        if any(len(t) != len(texts[0]) for t in texts):
+            raise ChainTableError("designs of different lengths cannot be scored together")
+        lookup = np.zeros(128, dtype=np.uint8)
+        lookup[[ord(c) for c in chars[:-2]]] = np.arange(len(chars) - 2, dtype=np.uint8)
+        return lookup[np.frombuffer("".join(texts).encode(), dtype=np.uint8)].reshape(len(texts), -1)
+    for d in designs:
+        if isinstance(d, str) and any(ch.isalpha() for ch in d):
+            letters = sorted({ch.lower() for ch in d if ch.isalpha()})
+            raise ChainTableError(
+                f"unit type {', '.join(repr(x) for x in letters)} has no table: the chain table is of one unit "
+                f"type, written 0/1 (design {d!r}); build a table over a library with "
+                f"{'that type' if len(letters) == 1 else 'those types'} (`pneumorph chain build --library`)")
     rows = [parse_orientation(d, n_units) for d in designs]
     if not rows:
         return np.zeros((0, n_units or 0), dtype=np.uint8)
@@ -53,27 +142,32 @@ def design_numbers(bits: NDArray[np.integer]) -> IntArray:
     return bits.astype(np.int64) @ (np.int64(1) << np.arange(n - 1, -1, -1, dtype=np.int64))
 
 
-def design_strings(bits: NDArray[np.integer]) -> list[str]:
-    """The inverse of :func:`design_array`.
+def design_strings(bits: NDArray[np.integer], alphabet: Sequence[str] = ()) -> list[str]:
+    """The inverse of :func:`design_array`: canonical texts (letters for several unit types).
 
-    >>> design_strings(np.array([[0, 1, 1]]))
-    ['011']
+    >>> design_strings(np.array([[0, 1, 1]])), design_strings(np.array([[0, 3]]), ("a", "r"))
+    (['011'], ['aR'])
     """
     bits = np.asarray(bits, dtype=np.uint8)
     if bits.ndim == 1:
         bits = bits[None]
-    text = (bits + ord("0")).astype(np.uint8).tobytes().decode()
+    if len(alphabet) > 1:
+        chars = np.frombuffer(symbol_chars(alphabet).encode(), dtype=np.uint8)
+        text = chars[bits].astype(np.uint8).tobytes().decode()
+    else:
+        text = (bits + ord("0")).astype(np.uint8).tobytes().decode()
     n = bits.shape[1]
     return [text[i * n : (i + 1) * n] for i in range(bits.shape[0])]
 
 
-def window_symbols(bits: NDArray[np.integer], window: int, chords: Sequence[int] | None = None) -> NDArray[np.int64]:
+def window_symbols(bits: NDArray[np.integer], window: int, chords: Sequence[int] | None = None,
+                   n_types: int = 1) -> NDArray[np.int64]:
     """The windows of the elements (chords) of every design, shape (m, chords, 2w + 1).
 
     Element ``j`` sees the units ``j - w .. j + w`` (1-based); outside the actuator the
-    base symbol 2 and the tip symbol 3 stand in. ``chords`` picks elements (default all
-    ``n + 1``); for the first ``p`` units of longer designs, the elements ``j <= p - w``
-    are those of the whole designs.
+    base symbol (2, or ``2k`` for ``n_types = k``) and the tip symbol (3, ``2k + 1``) stand
+    in. ``chords`` picks elements (default all ``n + 1``); for the first ``p`` units of
+    longer designs, the elements ``j <= p - w`` are those of the whole designs.
 
     >>> window_symbols(np.array([[0, 1]]), 1)[0].tolist()
     [[2, 2, 0], [2, 0, 1], [0, 1, 3]]
@@ -87,56 +181,81 @@ def window_symbols(bits: NDArray[np.integer], window: int, chords: Sequence[int]
     lo, hi = int(units.min()), int(units.max())
     span = np.arange(lo, hi + 1)
     seen = bits[:, np.clip(span, 0, n - 1)].astype(np.int64)  # only the columns the elements see
-    seen[:, span < 0] = BASE
-    seen[:, span >= n] = TIP
+    base, tip = ends(n_types)
+    seen[:, span < 0] = base
+    seen[:, span >= n] = tip
     return seen[:, units - lo]
 
 
-def window_codes(bits: NDArray[np.integer], window: int, chords: Sequence[int] | None = None) -> IntArray:
-    """Integer codes (base 4, first unit least significant) of the elements' windows, (m, chords).
+def window_codes(bits: NDArray[np.integer], window: int, chords: Sequence[int] | None = None,
+                 n_types: int = 1) -> IntArray:
+    """Integer codes (base ``2k + 2``: 4 for one type; first unit least significant) of the windows, (m, chords).
 
     ``chords`` as for :func:`window_symbols`.
     """
-    sym = window_symbols(bits, window, chords)
-    weights = 4 ** np.arange(sym.shape[-1], dtype=np.int64)
+    sym = window_symbols(bits, window, chords, n_types)
+    weights = (2 * int(n_types) + 2) ** np.arange(sym.shape[-1], dtype=np.int64)
     return sym @ weights
 
 
-def mirror_codes(codes: IntArray, window: int) -> IntArray:
-    """Codes of the mirrored windows (0 and 1 exchanged; base and tip kept)."""
+def mirror_codes(codes: IntArray, window: int, n_types: int = 1) -> IntArray:
+    """Codes of the mirrored windows (every unit turned over: ``2t <-> 2t + 1``; base and tip kept)."""
     codes = np.asarray(codes, dtype=np.int64)
+    radix, k2 = 2 * int(n_types) + 2, 2 * int(n_types)
     out = np.zeros_like(codes)
     for t in range(2 * window + 1):
-        s = (codes // 4**t) % 4
-        s = np.where(s < 2, 1 - s, s)
-        out += s * 4**t
+        s = (codes // radix**t) % radix
+        s = np.where(s < k2, s ^ 1, s)
+        out += s * radix**t
     return out
 
 
-def window_text(code: int, window: int) -> str:
-    """A window code as text, e.g. ``'BB01'``.
+def window_text(code: int, window: int, alphabet: Sequence[str] = ()) -> str:
+    """A window code as text, e.g. ``'BB01'`` (one unit type) or ``'<aE'`` (a table over ``alphabet``).
 
     >>> window_text(int(window_codes(np.array([[0, 1]]), 1)[0, 0]), 1)
     'BB0'
     """
-    return "".join("01BT"[(int(code) // 4**t) % 4] for t in range(2 * window + 1))
+    chars = symbol_chars(alphabet)
+    radix = len(chars)
+    return "".join(chars[(int(code) // radix**t) % radix] for t in range(2 * window + 1))
 
 
-def possible_codes(n_units: int, window: int) -> IntArray:
+def window_code(text: str, alphabet: Sequence[str] = ()) -> int:
+    """The inverse of :func:`window_text`; a :class:`ChainTableError` for a character of no symbol.
+
+    >>> window_code("<aE", ("a", "e")), window_code("BB0")
+    (112, 10)
+    """
+    chars = symbol_chars(alphabet)
+    if set(text) - set(chars):
+        raise ChainTableError(f"bad window {text!r}: its characters must be among {chars!r}")
+    return sum(chars.index(ch) * len(chars) ** i for i, ch in enumerate(text))
+
+
+def possible_codes(n_units: int, window: int, n_types: int = 1) -> IntArray:
     """Every window code that occurs in some design of ``n_units`` units, sorted."""
-    n, w = int(n_units), int(window)
+    n, w, k2 = int(n_units), int(window), 2 * int(n_types)
+    radix = k2 + 2
+    base, tip = ends(n_types)
     width = 2 * w + 1
     found: set[int] = set()
     for j in range(n + 1):
         units = [j - w + t for t in range(width)]  # 1-based unit numbers
         inside = [t for t, u in enumerate(units) if 1 <= u <= n]
-        fixed = sum((BASE if u < 1 else TIP) * 4**t for t, u in enumerate(units) if not 1 <= u <= n)
-        for k in range(2 ** len(inside)):
-            found.add(fixed + sum(((k >> i) & 1) * 4**t for i, t in enumerate(inside)))
+        fixed = sum((base if u < 1 else tip) * radix**t for t, u in enumerate(units) if not 1 <= u <= n)
+        for k in range(k2 ** len(inside)):
+            found.add(fixed + sum(((k // k2**i) % k2) * radix**t for i, t in enumerate(inside)))
     return np.array(sorted(found), dtype=np.int64)
 
 
-def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -> list[str]:
+def random_designs(count: int, n_units: int, rng: np.random.Generator, n_types: int = 1) -> NDArray[np.uint8]:
+    """``count`` random designs of ``n_units`` unit codes (0/1 for one type, ``0 .. 2k - 1`` for ``k``)."""
+    return rng.integers(0, 2 * int(n_types), size=(count, n_units), dtype=np.uint8)
+
+
+def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0, n_types: int = 1,
+                     alphabet: Sequence[str] = ()) -> list[str]:
     """A small set of designs in which every window of ``n_units`` units occurs.
 
     Greedy set cover: each pick is the design that shows the most windows not yet seen
@@ -152,25 +271,42 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     mirror : bool
         A design also teaches its mirror's windows (valid for a mirror-symmetric model).
     seed : int
-        Seed of the candidate pool (all designs up to 16 units, else 20,000 random ones).
+        Seed of the candidate pool (all designs up to 16 units, else 20,000 random ones; over
+        ``k > 1`` types all designs up to 2^16 of them, else ``max(20000, 8 K / n)`` random
+        ones for ``K`` windows).
+    n_types : int
+        Unit types ``k`` (codes ``0 .. 2k - 1`` per unit); 1: today's 0/1 designs.
+    alphabet : sequence of str
+        The types' symbols, for the designs' text (letters) when ``n_types > 1``.
 
     Examples
     --------
     >>> designs = covering_designs(6, 1)
     >>> len(designs)
     2
+    >>> designs = covering_designs(6, 1, n_types=2, alphabet=("a", "r"))
+    >>> len(designs) >= 8, designs[0]   # at least one design per base window "<<u1u2", up to the mirror
+    (True, ...)
     """
-    n, w = int(n_units), int(window)
+    n, w, k = int(n_units), int(window), int(n_types)
     if n < 1 or w < 0:
         raise ChainTableError(f"a covering set needs at least 1 unit and a window >= 0, got {n} and {w}")
+    if k > 1 and len(alphabet) != k:
+        raise ChainTableError(f"a covering set over {k} unit types needs their {k} symbols, got {alphabet!r}")
     rng = np.random.default_rng(seed)
-    if n <= 16:
+    if k == 1 and n <= 16:
         pool = ((np.arange(2**n)[:, None] >> np.arange(n)[None, ::-1]) & 1).astype(np.uint8)
         pool = pool[rng.permutation(len(pool))]
-    else:
+    elif k == 1:
         pool = rng.integers(0, 2, size=(20000, n), dtype=np.uint8)
-    codes = window_codes(pool, w)
-    canon = np.minimum(codes, mirror_codes(codes, w)) if mirror else codes
+    elif (2 * k) ** n <= 2**16:
+        every = np.arange((2 * k) ** n)[:, None] // (2 * k) ** np.arange(n - 1, -1, -1)[None, :] % (2 * k)
+        pool = every.astype(np.uint8)[rng.permutation(len(every))]
+    else:
+        windows = len(possible_codes(n, w, k))
+        pool = random_designs(max(20000, 8 * windows // max(n, 1)), n, rng, k)
+    codes = window_codes(pool, w, n_types=k)
+    canon = np.minimum(codes, mirror_codes(codes, w, k)) if mirror else codes
     needed = np.unique(canon)
     index = np.searchsorted(needed, canon)
     seen = np.zeros(len(needed), dtype=bool)
@@ -182,7 +318,7 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
             raise ChainTableError(f"no design of the pool shows the remaining windows of {n} units")
         chosen.append(best)
         seen[index[best]] = True
-    return design_strings(pool[chosen])
+    return design_strings(pool[chosen], alphabet if k > 1 else ())
 
 
 def _distinct_counts(index: IntArray, new: NDArray[np.bool_], n_keys: int) -> IntArray:
