@@ -3,7 +3,8 @@
 A ramp from load factor 0 to 1 is reported at ``increments`` equally spaced levels (the
 dissertation's "method 2", section 4.3: one solve gives the response at ten pressures).
 Between two reported levels the solver takes ``substeps`` Newton solves; a substep that
-fails is halved (cut-back) without changing the reported levels. Each substep starts from
+fails is halved (cut-back) without changing the reported levels, and the level after one
+that needed a cut-back starts at the substep that converged last. Each substep starts from
 the linear extrapolation of the last two converged states, which keeps the very soft
 bending mode of a long actuator from costing hundreds of Newton iterations.
 
@@ -308,8 +309,12 @@ def ramp(
     t_now = 0.0
     apply(0.0)
     watched = monitor() if monitor is not None else 0.0
+    nominal = 1.0 / (settings.increments * settings.substeps)
+    dt, last, cut_back = nominal, nominal, False
     for k, level in enumerate(settings.levels()):
-        dt = 1.0 / (settings.increments * settings.substeps)
+        # a level after one that needed a cut-back starts at the substep that converged last
+        dt = last if cut_back else nominal
+        cut_back = False
         cutbacks_here = 0
         while t_now < level - 1e-12:
             t_try = min(t_now + dt, level)
@@ -325,6 +330,7 @@ def ramp(
                     cause = f"the monitored quantity fell from {watched:.6g} to {value:.6g}"
             if cause is None:
                 watched = value
+                last = t_try - t_now
                 current, t_now = _values(fields), t_try
                 history = [*history[-max(2, predictor_order):], (t_now, current)]
                 stats.substeps += 1
@@ -333,10 +339,11 @@ def ramp(
                     on_substep(t_now)
                 cutbacks_here = 0
                 # grow back towards the nominal substep after a successful cut-back
-                dt = min(2 * dt, 1.0 / (settings.increments * settings.substeps))
+                dt = min(2 * dt, nominal)
                 continue
             _restore(fields, current)
             apply(t_now)
+            cut_back = True
             cutbacks_here += 1
             stats.cutbacks += 1
             if cutbacks_here > settings.max_cutbacks:
@@ -346,7 +353,7 @@ def ramp(
                     cause=f"no convergence at load factor {t_try:.4g} after "
                     f"{settings.max_cutbacks} cut-backs ({cause})",
                 )
-            dt /= 2.0
+            dt = (t_try - t_now) / 2.0  # the step that failed, halved (dt may reach past the level)
         stats.reached = t_now
         if on_level is not None:
             on_level(k, level)

@@ -466,7 +466,7 @@ class SolidSystem3D(FastSystem):
         from pneumorph.fem.ogden import OgdenCompressible
 
         if isinstance(umat, OgdenCompressible):
-            return lambda F, tangent, principal: umat.kernel(F, tangent, principal, _UPPER)
+            return lambda F, tangent, principal, dtype=np.float64: umat.kernel(F, tangent, principal, _UPPER, dtype)
         raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
     def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
@@ -515,11 +515,11 @@ class SolidSystem3D(FastSystem):
     def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
         Fp, principal = state
         c, q, n, _ = s.g.shape
-        _, A, _ = s.kernel(Fp, True, principal)
-        assert A is not None
         dtype = self.tangent_dtype
+        _, A, _ = s.kernel(Fp, True, principal, dtype)
+        assert A is not None
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
-        Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
+        Ap = (A * s.dV.reshape(-1).astype(dtype)).transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
         key = f"blocks-{np.dtype(dtype).name}"
         if key not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
             s.layouts[key] = np.empty((c, n, 6, n), dtype=dtype)

@@ -1,0 +1,61 @@
+"""The load stepping's step control, on a substep strategy that fails by rule.
+
+The strategy converges or fails by the load factor it is asked for and the size of the
+step that leads there, so the sequence of attempts the ramp makes is known exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pneumorph.fem import StepSettings, ramp
+
+
+@dataclass
+class _Field:
+    values: np.ndarray = field(default_factory=lambda: np.zeros(1))
+
+
+@dataclass
+class _Fields:
+    fields: list[_Field] = field(default_factory=lambda: [_Field()])
+
+
+class _Hard:
+    """Converges unless the step is too large for where it ends: beyond t = 0.7 steps
+    over 0.05 fail, beyond t = 0.95 steps over 0.025."""
+
+    def __init__(self) -> None:
+        self.t_now = 0.0
+        self.t_try = 0.0
+        self.attempts: list[tuple[float, float, bool]] = []
+
+    def apply(self, t: float) -> None:
+        self.t_try = t
+
+    def __call__(self, fields: Any, settings: StepSettings) -> tuple[int, str | None]:
+        size = self.t_try - self.t_now
+        eps = 1e-9
+        ok = not ((self.t_try > 0.7 + eps and size > 0.05 + eps) or (self.t_try > 0.95 + eps and size > 0.025 + eps))
+        self.attempts.append((round(self.t_now, 6), round(self.t_try, 6), ok))
+        if ok:
+            self.t_now = self.t_try
+        return 1, None if ok else "too large a step"
+
+
+def test_cut_back_halves_the_failed_step_and_carries_into_the_next_level() -> None:
+    hard = _Hard()
+    stats = ramp([], _Fields(), hard.apply, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                 StepSettings(increments=10, substeps=1), substep=hard)
+    late = [a for a in hard.attempts if a[0] >= 0.7 - 1e-9]
+    assert late == [
+        (0.7, 0.8, False), (0.7, 0.75, True), (0.75, 0.8, True),  # level 8: one cut-back
+        (0.8, 0.85, True), (0.85, 0.9, True),  # level 9 starts at the substep that converged last
+        (0.9, 1.0, False), (0.9, 0.95, True),  # level 10 at the nominal substep again
+        (0.95, 1.0, False), (0.95, 0.975, True), (0.975, 1.0, True),  # the failed 0.05 step halved
+    ]
+    assert len(set(hard.attempts)) == len(hard.attempts)  # no trial repeated
+    assert (stats.substeps, stats.cutbacks, stats.reached) == (14, 3, 1.0)
