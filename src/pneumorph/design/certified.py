@@ -22,6 +22,11 @@ Up to :data:`MAX_ENUMERATE` units every design is scored, grown unit by unit ove
 prefixes; above, a branch-and-bound over the same growth (the partial sums of Eq 4.1 only
 grow; the tip stays in the box its remaining chords can reach) returns every design whose
 chain value is within reach of the best, and a floor under all others.
+
+Over a unit library of ``k`` types (a chain table with an alphabet) every unit has ``2k``
+choices (type and orientation, codes ``2t + o``) instead of 2: the same growth with ``2k``
+children per prefix, all ``(2k)^n`` designs scored while there are at most
+``2^MAX_ENUMERATE`` of them, branch-and-bound above.
 """
 
 from __future__ import annotations
@@ -41,14 +46,15 @@ from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
-from pneumorph.models.chain import ChainModel, design_strings, window_codes
+from pneumorph.models.chain import ChainModel, window_codes
 from pneumorph.models.response import ActuatorModel
 from pneumorph.models.windows import design_numbers
 
 FloatArray = NDArray[np.float64]
 
 MAX_ENUMERATE = 20
-"""Longest actuator whose 2^n designs are all scored; longer ones go through branch-and-bound."""
+"""Longest actuator whose 2^n designs are all scored; longer ones go through branch-and-bound
+(over ``2k`` choices per unit: while ``(2k)^n <= 2^MAX_ENUMERATE``)."""
 CHUNK = 8192
 """Designs scored at once (memory: about 2 kB per design and level)."""
 MAX_NODES = 500_000
@@ -75,6 +81,21 @@ def chain_errors(chain: ChainModel, margin: float = 1.0) -> dict[str, FloatArray
     trained = int(chain.table.source.get("n_units", chain.n_units))
     scale = margin * max(1.0, chain.n_units / max(trained, 1))
     return {k: v * scale for k, v in errs.items()}
+
+
+def choices(chain: ChainModel) -> int:
+    """The choices per unit: 2 orientations of each of the table's unit types."""
+    return 2 * chain.table.n_types
+
+
+def designs_of(chain: ChainModel) -> float:
+    """How many designs the chain model has: ``(2k)^n``."""
+    return float(choices(chain)) ** chain.n_units
+
+
+def _enumerable(chain: ChainModel, units: int) -> bool:
+    """At most as many designs as ``2^units`` (every design's geometry fits)."""
+    return designs_of(chain) <= 2.0**units
 
 
 def _max_slope(f: Callable[[FloatArray], FloatArray], lo: float, hi: float, samples: int = 20001) -> float:
@@ -159,6 +180,7 @@ class ChainScores:
     optimistic: FloatArray
     bound: FloatArray
     floor: float = float("inf")
+    choices: int = 2
 
     @property
     def complete(self) -> bool:
@@ -169,17 +191,19 @@ class ChainScores:
         return np.lexsort((self._as_int(), self.cost))
 
     def _as_int(self) -> NDArray[np.int64]:
-        return design_numbers(self.bits)
+        return design_numbers(self.bits, self.choices)
 
 
 def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integer]) -> tuple[FloatArray, ...]:
     """Objective per design and level (m, k), with the predicted centres and references."""
     centres, tip, curl = chain.predict(bits)
-    ref_c, ref_t = chain.table.reference(bits)
+    ref_c, _ = chain.table.reference(bits)
+    # L: the actuator of the first unit type (over a library the designs' lengths differ), and the
+    # tip's undeformed height, which every design shares
     if isinstance(objective, ProfileTarget):
-        values = profile_error_array(centres, ref_c[:, None], objective, float(ref_t[0]))
+        values = profile_error_array(centres, ref_c[:, None], objective, chain.length)
     else:
-        values = tip_value_array(tip, ref_t, curl, objective.name, objective.point)
+        values = tip_value_array(tip, np.asarray(chain.table.tip_ref), curl, objective.name, objective.point)
     return values, centres, ref_c
 
 
@@ -210,7 +234,7 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
         beta = objective_bounds(chain, objective, centres, ref_c, errors)
         parts.append((values, *_costs(values, beta, objective.sense)))
     values, cost, level, optimistic, bound = (np.concatenate([p[i] for p in parts]) for i in range(5))
-    return ChainScores(bits, values, cost, level, optimistic, bound)
+    return ChainScores(bits, values, cost, level, optimistic, bound, choices=choices(chain))
 
 
 # -- growing designs unit by unit: enumeration and branch-and-bound ---------------------------
@@ -291,21 +315,21 @@ def _prefix_bound(chain: ChainModel, objective: Objective, state: dict[str, Any]
 
 # -- the prefix tree: chords placed unit by unit ---------------------------------------------
 def _seed_prefixes(chain: ChainModel, polar: bool = False) -> tuple[NDArray[np.uint8], dict[str, Any]]:
-    """The two one-unit prefixes and their state: base point, angle (and polar angle, radius)."""
-    k = chain.table.n_levels
-    bits = np.array([[0], [1]], dtype=np.uint8)
-    st: dict[str, Any] = {"point": np.zeros((2, k, 2)), "angle": np.zeros((2, k))}
-    st["point"][..., 1] = np.asarray(chain.table.centre_y)[bits[:, 0]][:, None]
+    """The one-unit prefixes (2; ``2k`` over ``k`` types) and their state: base point, angle (polar angle, radius)."""
+    k, c = chain.table.n_levels, choices(chain)
+    bits = np.arange(c, dtype=np.uint8)[:, None]
+    st: dict[str, Any] = {"point": np.zeros((c, k, 2)), "angle": np.zeros((c, k))}
+    st["point"][..., 1] = chain.table.heights[bits[:, 0]][:, None]
     if polar:
-        st.update(theta=np.zeros((2, k)), r=np.zeros((2, k)))
+        st.update(theta=np.zeros((c, k)), r=np.zeros((c, k)))
     return bits, st
 
 
-def _grow(bits: NDArray[np.uint8], st: dict[str, Any]) -> tuple[NDArray[np.uint8], dict[str, Any]]:
-    """Every prefix extended by a 0 and a 1 unit (child ``2 i + b`` of prefix ``i``)."""
-    bits = np.concatenate([np.repeat(bits, 2, axis=0),
-                           np.tile(np.array([[0], [1]], dtype=np.uint8), (len(bits), 1))], axis=1)
-    return bits, {key: np.repeat(v, 2, axis=0) for key, v in st.items()}
+def _grow(bits: NDArray[np.uint8], st: dict[str, Any], c: int = 2) -> tuple[NDArray[np.uint8], dict[str, Any]]:
+    """Every prefix extended by each of the ``c`` unit codes (child ``c i + b`` of prefix ``i``)."""
+    bits = np.concatenate([np.repeat(bits, c, axis=0),
+                           np.tile(np.arange(c, dtype=np.uint8)[:, None], (len(bits), 1))], axis=1)
+    return bits, {key: np.repeat(v, c, axis=0) for key, v in st.items()}
 
 
 def _place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], placed: int, upto: int,
@@ -320,8 +344,8 @@ def _place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any]
     n, w = chain.n_units, table.window
     if upto <= placed:
         return
-    cy = np.asarray(table.centre_y)
-    codes = window_codes(bits, w, range(placed, upto))
+    cy = table.heights
+    codes = window_codes(bits, w, range(placed, upto), n_types=table.n_types)
     for j in range(placed, upto):
         rows = table.lookup(codes[:, j - placed])
         st["angle"] = st["angle"] + table.turn[rows]
@@ -347,7 +371,7 @@ def _depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], pola
     placed = 0
     for p in range(1, n + 1):
         if p > 1:
-            bits, st = _grow(bits, st)
+            bits, st = _grow(bits, st, choices(chain))
         upto = n + 1 if p == n else max(p - w + 1, 0)
         pruned = yield p, max(placed, upto), bits, st, _place_chords(chain, bits, st, placed, upto, polar)
         placed = max(placed, upto)
@@ -359,7 +383,7 @@ def _depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], pola
 def _tip_and_curl(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
     """Tip point and curl (degrees) of whole designs from their final state."""
     table = chain.table
-    erows = table.lookup(window_codes(bits, table.window, [chain.n_units])[:, 0], end=True)
+    erows = table.lookup(window_codes(bits, table.window, [chain.n_units], n_types=table.n_types)[:, 0], end=True)
     return st["point"], np.degrees(st["angle"] + table.end[erows])
 
 
@@ -368,10 +392,11 @@ class ChainGeometry:
     """The centres, tip and curl of every design of a chain model, by prefix depth.
 
     Centre ``j`` is fixed once the prefix covers its windows, at depth ``depth[j]`` (then
-    ``2**depth[j]`` prefixes); ``x[j]``, ``y[j]`` (and ``theta[j]``, ``r[j]``) hold it for
-    every prefix at every level, so an objective is evaluated once per prefix, not per
-    design. ``tip`` and ``curl`` are those of all ``2**n`` designs, in the order of
-    :attr:`bits` (the first unit most significant).
+    ``c**depth[j]`` prefixes, ``c`` = 2 choices per unit, ``2k`` over ``k`` unit types);
+    ``x[j]``, ``y[j]`` (and ``theta[j]``, ``r[j]``) hold it for every prefix at every level,
+    so an objective is evaluated once per prefix, not per design. ``tip`` and ``curl`` are
+    those of all ``c**n`` designs, in the order of :attr:`bits` (the first unit most
+    significant).
     """
 
     bits: NDArray[np.uint8]
@@ -439,15 +464,16 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
     polar = profile and prof.coordinates == "polar"
     slope = _target_slope(chain, prof, errors) if profile else 0.0
     length = chain.length
+    c = choices(chain)
     with np.errstate(all="ignore"):
         if profile:
-            total = np.zeros((2, chain.table.n_levels))
+            total = np.zeros((c, chain.table.n_levels))
             bsum = np.zeros_like(total) if polar else None
             at = 1
             for j, p in enumerate(g.depth):
                 if p > at:
-                    total = np.repeat(total, 2 ** (p - at), axis=0)
-                    bsum = None if bsum is None else np.repeat(bsum, 2 ** (p - at), axis=0)
+                    total = np.repeat(total, c ** (p - at), axis=0)
+                    bsum = None if bsum is None else np.repeat(bsum, c ** (p - at), axis=0)
                     at = p
                 if polar:
                     d = prof.curve(g.theta[j], length)
@@ -459,8 +485,8 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
                 d *= d
                 total += d
             if at < n:
-                total = np.repeat(total, 2 ** (n - at), axis=0)
-                bsum = None if bsum is None else np.repeat(bsum, 2 ** (n - at), axis=0)
+                total = np.repeat(total, c ** (n - at), axis=0)
+                bsum = None if bsum is None else np.repeat(bsum, c ** (n - at), axis=0)
             values = np.sqrt(total, out=total)
         else:
             values = tip_value_array(g.tip, np.asarray(chain.table.tip_ref), g.curl, goal.name, goal.point)
@@ -469,25 +495,26 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
         else:
             beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
-    return ChainScores(g.bits, values, cost, level, optimistic, bound)
+    return ChainScores(g.bits, values, cost, level, optimistic, bound, choices=c)
 
 
-def _children(alive: NDArray[np.int64], steps: int) -> NDArray[np.int64]:
-    """Indices of the prefixes ``steps`` units longer than the prefixes ``alive`` (child ``2 i + b``)."""
-    return (alive[:, None] * 2**steps + np.arange(2**steps)).ravel()
+def _children(alive: NDArray[np.int64], steps: int, c: int = 2) -> NDArray[np.int64]:
+    """Indices of the prefixes ``steps`` units longer than the prefixes ``alive`` (child ``c i + b``)."""
+    return (alive[:, None] * c**steps + np.arange(c**steps)).ravel()
 
 
 def _accumulate(g: ChainGeometry, objective: ProfileTarget, length: float, alive: NDArray[np.int64],
-                total: FloatArray, at: int, centres: range, prune: Callable[[FloatArray], NDArray[np.bool_]] | None
-                ) -> tuple[NDArray[np.int64], FloatArray, int]:
+                total: FloatArray, at: int, centres: range, prune: Callable[[FloatArray], NDArray[np.bool_]] | None,
+                c: int = 2) -> tuple[NDArray[np.int64], FloatArray, int]:
     """Add the squared Eq 4.1 terms of ``centres`` for the prefixes ``alive`` (at depth ``at``).
 
-    With ``prune``, prefixes whose partial sums it flags are dropped after every centre.
+    With ``prune``, prefixes whose partial sums it flags are dropped after every centre;
+    ``c`` is the number of choices per unit.
     """
     for j in centres:
         p = g.depth[j]
         if p > at:
-            alive, total, at = _children(alive, p - at), np.repeat(total, 2 ** (p - at), axis=0), p
+            alive, total, at = _children(alive, p - at, c), np.repeat(total, c ** (p - at), axis=0), p
         d = objective.curve(g.x[j][alive], length)
         d -= g.y[j][alive]
         d *= d
@@ -525,9 +552,10 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     errors = chain_errors(chain, margin)
     n = chain.n_units
     if (not isinstance(objective, ProfileTarget) or objective.coordinates != "cartesian"
-            or n > KEEP_GEOMETRY_UNITS or n < 4):
+            or not _enumerable(chain, KEEP_GEOMETRY_UNITS) or n < 4):
         return chain_scores(chain, objective, margin)
     g = chain_geometry(chain)
+    c = choices(chain)
     length = chain.length
     slope = _target_slope(chain, objective, errors)
     beta = np.asarray(_uniform_bound(chain, objective, errors, slope), dtype=float)
@@ -537,22 +565,23 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     cut = n - 2
     early = range(sum(1 for p in g.depth if p <= cut))
     with np.errstate(all="ignore"):
-        alive, total, at = _accumulate(g, objective, length, np.arange(2), np.zeros((2, len(beta))), 1, early, None)
+        alive, total, at = _accumulate(g, objective, length, np.arange(c), np.zeros((c, len(beta))), 1, early, None,
+                                       c)
         lb = optimistic(total)
         few = np.argsort(lb, kind="stable")[:probe]
         _, probe_total, _ = _accumulate(g, objective, length, alive[few], total[few], at,
-                                        range(len(early), len(g.depth)), None)
+                                        range(len(early), len(g.depth)), None, c)
         costs = np.sort(np.sqrt(probe_total).min(axis=1))
         k = min(top, len(costs)) - 1
         threshold = max(float(costs[k]), float(costs[0] + beta.max())) + 1e-9
         keep = lb < threshold
         alive, total = _accumulate(g, objective, length, alive[keep], total[keep], at,
-                                   range(len(early), len(g.depth)), lambda t: optimistic(t) >= threshold)[:2]
+                                   range(len(early), len(g.depth)), lambda t: optimistic(t) >= threshold, c)[:2]
         if (at := max(g.depth)) < n:  # pragma: no cover - the last centres are fixed by the whole design
-            alive, total = _children(alive, n - at), np.repeat(total, 2 ** (n - at), axis=0)
+            alive, total = _children(alive, n - at, c), np.repeat(total, c ** (n - at), axis=0)
         values = np.sqrt(total)
     cost, level, opt, bound = _costs(values, np.broadcast_to(beta, values.shape), objective.sense)
-    return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold)
+    return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold, choices=c)
 
 
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
@@ -573,7 +602,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     SearchConfigError
         More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose).
     """
-    if not np.isfinite(threshold) and beam is None and chain.n_units <= KEEP_GEOMETRY_UNITS:
+    if not np.isfinite(threshold) and beam is None and _enumerable(chain, KEEP_GEOMETRY_UNITS):
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
     n, k = chain.n_units, table.n_levels
@@ -585,9 +614,9 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     slope = _target_slope(chain, prof, errors) if profile else 0.0
     bits, st = _seed_prefixes(chain, polar)
     if profile:
-        st["sum"] = np.zeros((2, k))
+        st["sum"] = np.zeros((len(bits), k))
     if polar:
-        st["bsum"] = np.zeros((2, k))
+        st["bsum"] = np.zeros((len(bits), k))
     with np.errstate(all="ignore"):
         growth = _depths(chain, bits, st, polar)
         for p, placed, bits, st, centres in growth:
@@ -622,7 +651,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         else:
             beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
-    return ChainScores(bits, values, cost, level, optimistic, bound)
+    return ChainScores(bits, values, cost, level, optimistic, bound, choices=choices(chain))
 
 
 def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
@@ -638,7 +667,7 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     """
     errors = chain_errors(chain, margin)
     n = chain.n_units
-    if n <= max_enumerate:
+    if _enumerable(chain, max_enumerate):
         return grow_designs(chain, objective, errors)
     c0 = float(grow_designs(chain, objective, errors, beam=4096).cost.min())
     probe = score_designs(chain, objective, np.zeros((1, n), dtype=np.uint8), errors)
@@ -647,7 +676,7 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     scores = grow_designs(chain, objective, errors, threshold)
     keep = scores.cost < threshold
     return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
-                       scores.optimistic[keep], scores.bound[keep], floor=threshold - beta)
+                       scores.optimistic[keep], scores.bound[keep], floor=threshold - beta, choices=scores.choices)
 
 
 # -- the search -------------------------------------------------------------------------------
@@ -748,7 +777,7 @@ def certified_search(
         raise SearchConfigError(f"the bound's margin must be a positive number, got {margin!r}")
     scores = chain_scores(chain, objective, margin)
     order = scores.order()
-    designs = design_strings(scores.bits[order])
+    designs = chain.table.texts(scores.bits[order])
     say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "
         f"{time.perf_counter() - start:.2f} s; best {designs[0]}")
     book = ScoreBook(fe_model, objective, evaluator)

@@ -131,15 +131,22 @@ def design_array(designs: Sequence[str] | str, n_units: int | None = None,
     return (np.frombuffer("".join(rows).encode(), dtype=np.uint8) - ord("0")).reshape(len(rows), n)
 
 
-def design_numbers(bits: NDArray[np.integer]) -> IntArray:
-    """Each design (a row of 0/1, base first) as the integer its digits spell, base most significant.
+def design_numbers(bits: NDArray[np.integer], choices: int = 2) -> IntArray:
+    """Each design (a row of unit codes, base first) as the integer its digits spell in base ``choices``.
+
+    The base is most significant; ``choices`` is 2 for 0/1 designs, ``2k`` over ``k`` unit types.
 
     >>> design_numbers(np.array([[0, 1, 1], [1, 0, 0]])).tolist()
     [3, 4]
+    >>> design_numbers(np.array([[0, 3, 1]]), choices=4).tolist()
+    [13]
     """
     bits = np.atleast_2d(np.asarray(bits))
     n = bits.shape[1]
-    return bits.astype(np.int64) @ (np.int64(1) << np.arange(n - 1, -1, -1, dtype=np.int64))
+    if choices == 2:
+        return bits.astype(np.int64) @ (np.int64(1) << np.arange(n - 1, -1, -1, dtype=np.int64))
+    weights = np.array([int(choices) ** i for i in range(n - 1, -1, -1)], dtype=np.int64)
+    return np.asarray(bits.astype(np.int64) @ weights, dtype=np.int64)
 
 
 def design_strings(bits: NDArray[np.integer], alphabet: Sequence[str] = ()) -> list[str]:
