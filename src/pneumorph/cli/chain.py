@@ -18,6 +18,9 @@ def chain() -> None:
               help="The FE model the table is fitted to.")
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
+@click.option("--library", metavar="builtin|FILE", type=P.Text(),
+              help="A unit library ('builtin' or a library TOML file): the table covers its unit types "
+                   "(docs/unit-library.md); instead of --unit.")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,
               help="Units of the training designs.")
@@ -32,8 +35,9 @@ def chain() -> None:
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", required=True, metavar="FILE", type=P.OutputFile((".json",)), help="Table file to write (JSON).")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
-def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units: int, window: int | None,
-          tolerance: float, heldout: int, workers: int | None, cache: str | None, out: str, as_json: bool) -> None:
+def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
+          window: int | None, tolerance: float, heldout: int, workers: int | None, cache: str | None, out: str,
+          as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with
@@ -50,17 +54,27 @@ def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units:
     )
     from pneumorph.io import strict_json
     from pneumorph.models.chain import build_table
-    from pneumorph.models.factory import make_model
+    from pneumorph.models.factory import load_library, make_model
 
     settings: dict = {"fidelity": fidelity}
     if unit_file:
         settings["unit_file"] = unit_file
+    if library is not None:
+        if unit_file:
+            raise click.UsageError("give either --unit or --library, not both")
+        with P.blame("--library"):
+            load_library(library, "unit library")
+        settings["library"] = library
     if pressure is not None:
         settings["pressure_kpa"] = pressure
     target = Path(out)
     if window is not None and (window < 1 or 2 * window + 1 > n_units):
         raise ChainTableError(f"--window {window} needs 1 <= window and 2 window + 1 <= --units ({n_units})")
     model = make_model(n_units, settings)
+    if getattr(model, "mixed", False):
+        from pneumorph.models.chain import check_training_size
+
+        check_training_size(len(model.library), window or 1)  # before any solve
     evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))
     try:
         table = build_table(model, evaluator, window=window, tolerance=tolerance, heldout=heldout,
@@ -77,3 +91,8 @@ def build(fidelity: str, unit_file: str | None, pressure: float | None, n_units:
         click.echo(f"{target}: window +-{table.window}, {len(table.training)} covering designs, "
                    f"{len(v['designs'])} held-out: worst centre error {max(v['centre_worst_mm']):.4f} mm, "
                    f"mean at {table.pressures[-1] * 1e3:g} kPa {v['centre_mean_mm'][-1]:.4f} mm")
+        for symbol, errs in v.get("per_type", {}).items():
+            if errs["centres"]:
+                click.echo(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} "
+                           f"mm, mean at the last level {errs['centre_mean_mm'][-1]:.4f} mm ({errs['centres']} "
+                           "centres)")

@@ -70,6 +70,9 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
               help="Model fidelity (default: 3d for the certified search, 2d for ga and exhaustive).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file.")
+@click.option("--library", metavar="builtin|FILE", type=P.Text(),
+              help="Designs over a unit library ('builtin' or a library TOML file; docs/unit-library.md): "
+                   "certified search over every type and orientation per unit; instead of --unit.")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
 @click.option("--out", metavar="DIR", type=P.OutputDir(),
@@ -82,7 +85,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
            verify: int | None, margin: float | None, chain_table: str | None, tolerance: float | None,
            robust: str | None, robust_samples: int | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
-           unit_file: str | None, cache: str | None, out: str | None, overwrite: bool, as_json: bool) -> None:
+           unit_file: str | None, library: str | None, cache: str | None, out: str | None, overwrite: bool,
+           as_json: bool) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
 
     Without options: a 15-unit actuator for the target "sin, amplitude 10 mm, one period":
@@ -112,6 +116,13 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
 
         with P.blame("--unit"):
             UnitSpec.from_toml(unit_file)
+    if library is not None:
+        from pneumorph.models.factory import load_library
+
+        if unit_file is not None:
+            raise click.UsageError("give either --unit or --library, not both")
+        with P.blame("--library"):
+            load_library(library, "unit library")
     config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
     changes: dict[str, Any] = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
@@ -129,6 +140,11 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             model_settings[key] = value
     if unit_file:
         model_settings.pop("unit", None)
+        model_settings.pop("library", None)
+    if library is not None:
+        model_settings["library"] = library
+        model_settings.pop("unit", None)
+        model_settings.pop("unit_file", None)
     # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
     _check_options_apply(search or config.search, "certified",
                          {"--certify": certify, "--verify": verify, "--margin": margin, "--chain-table": chain_table})
@@ -142,6 +158,9 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     config = DesignConfig.from_dict(config.to_dict())  # validate the combination
     folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
     model = make_model(config.units, config.model)
+    mixed = bool(getattr(model, "mixed", False))
+    if mixed:
+        _check_library_run(config, model, tolerance)
     config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
 
     if fallback:  # said once every setting has been checked
@@ -177,7 +196,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
                             overwrite=overwrite, on_message=on_message)
     except LocalityError as exc:  # the chain cannot represent this model: nothing was written
-        if config.search != "certified":
+        if config.search != "certified" or mixed:  # (no GA over a unit library yet)
             raise
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
         settings = dict(config.model) if fidelity_given else {**config.model, "fidelity": "2d"}
@@ -247,3 +266,30 @@ def _certified_json(result) -> dict:
 
     return {"certificate": result.certified.certificate, "top": _top_rows(result),
             "opinion_2d": result.opinion_2d}
+
+
+def _check_library_run(config: Any, model: Any, tolerance: float | None) -> None:
+    """Refuse, before any computation, what a run over a unit library of several types cannot do yet.
+
+    Only the certified search covers every type and orientation per unit (the GA and the exhaustive
+    search still choose orientations of the first type); a given chain table must cover every unit
+    type of the library ("unit type 'x' has no table"); the mould tolerance report is of one unit.
+    """
+    from pneumorph.errors import ChainTableError, SearchConfigError
+
+    if config.search != "certified":
+        raise SearchConfigError(f"--search {config.search} over a unit library is not available yet: only the "
+                                "certified search chooses among the unit types (use --search certified)")
+    if tolerance or config.robust is not None:
+        raise SearchConfigError(f"{'--robust' if config.robust else '--tolerance'}: the mould tolerance report is of "
+                                "one unit type; over a unit library leave it out")
+    if config.chain_table is not None:
+        from pneumorph.models.chain import ChainTable
+
+        table = ChainTable.load(config.chain_table)
+        missing = [s for s in model.library.symbols if s not in table.alphabet]
+        if missing:
+            covers = ", ".join(table.alphabet) if table.alphabet else "one unit type, written 0/1"
+            raise ChainTableError(f"--chain-table {config.chain_table}: unit type "
+                                  f"{', '.join(repr(m) for m in missing)} has no table (it covers {covers}); "
+                                  "build one with `pneumorph chain build --library`")

@@ -35,7 +35,7 @@ import threading
 import time
 import weakref
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, cast
 
 import numpy as np
@@ -546,7 +546,7 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     >>> from pneumorph.design.targets import make_objective
     >>> chain = ChainModel(find_table(make_model(15, {"fidelity": "3d"})), 15)
     >>> s = best_scores(chain, make_objective("sin", 10.0, length=chain.length))
-    >>> design_strings(s.bits[s.order()[:1]]), bool(len(s.bits) < 2**15), s.complete
+    >>> chain.table.texts(s.bits[s.order()[:1]]), bool(len(s.bits) < 2**15), s.complete
     (['001111010001001'], True, False)
     """
     errors = chain_errors(chain, margin)
@@ -775,6 +775,10 @@ def certified_search(
         raise SearchConfigError("the FE model and the chain model report different pressure levels")
     if not (np.isfinite(margin) and margin > 0):
         raise SearchConfigError(f"the bound's margin must be a positive number, got {margin!r}")
+    if chain.table.alphabet and isinstance(objective, ProfileTarget) and objective.length is None:
+        # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
+        # and the FE verifications alike
+        objective = replace(objective, length=chain.length)
     scores = chain_scores(chain, objective, margin)
     order = scores.order()
     designs = chain.table.texts(scores.bits[order])

@@ -92,7 +92,7 @@ from pneumorph.io.files import (
 from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 from pneumorph.io.lock import RunLock
 from pneumorph.io.provenance import provenance as make_provenance
-from pneumorph.models.chain import ChainModel, design_strings
+from pneumorph.models.chain import ChainModel
 from pneumorph.models.chaintables import find_table, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
@@ -464,7 +464,8 @@ def run_design(
             table = table_for(model, _training(model), folder=table_dir, path=config.chain_table,
                               evaluator=cached, on_progress=say)
             chain = ChainModel(table, config.units)
-            if config.tolerance > 0 and hasattr(model, "variant"):  # the unit's tolerance tables, likewise
+            # the unit's tolerance tables, likewise (of one unit type: none over a library of several yet)
+            if config.tolerance > 0 and hasattr(model, "variant") and not getattr(model, "mixed", False):
                 tol_tables = tolerance_tables_for(model, Tolerance(config.tolerance), folder=table_dir,
                                                   evaluator=cached, on_progress=say)
         made = _created_top(folder)
@@ -510,7 +511,7 @@ def run_design(
                                         on_progress=say)
                 hof = cert.hall_of_fame
                 order = cert.scores.order()[:1000]
-                names = design_strings(cert.scores.bits[order])
+                names = chain.table.texts(cert.scores.bits[order])
                 ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order, strict=False)]
             else:
                 ex = run_exhaustive(model, objective, cached, hall_of_fame=config.ga.hall_of_fame,
@@ -551,8 +552,11 @@ def run_design(
 def _robustness(config: DesignConfig, model: ActuatorModel, objective: Objective, evaluator: Any,
                 cert: CertifiedResult | None, chain: ChainModel | None, tables: Any, hof: Any,
                 say: Callable[[str], None]) -> tuple[dict[str, Any] | None, Candidate | None]:
-    """The winner's spread under the mould tolerance and, with ``robust``, the most robust design."""
-    if config.tolerance == 0:
+    """The winner's spread under the mould tolerance and, with ``robust``, the most robust design.
+
+    None for a model over a unit library of several types (the tolerances are those of one unit).
+    """
+    if config.tolerance == 0 or getattr(model, "mixed", False):
         return None, None
     if cert is not None and tables is not None:
         assert chain is not None

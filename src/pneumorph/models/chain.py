@@ -82,6 +82,26 @@ ALPHABET_FORMAT = 2
 DEFAULT_TOLERANCE = 0.2
 #: widest window tried by :func:`build_table`
 MAX_WINDOW = 3
+#: most covering designs a table over several unit types may ask for (the base windows alone need
+#: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
+MAX_TRAINING = 200
+
+
+def check_training_size(n_types: int, window: int) -> None:
+    """Refuse, before any solve, a window whose base windows alone need more than :data:`MAX_TRAINING` designs.
+
+    >>> check_training_size(2, 2)
+    >>> check_training_size(4, 2)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use fewer unit types or a window of +-1
+    """
+    need = (2 * int(n_types)) ** (int(window) + 1) // 2
+    if n_types > 1 and need > MAX_TRAINING:
+        raise LocalityError(f"a chain table over {n_types} unit types at window +-{window} needs at least {need} FE "
+                            f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use fewer "
+                            "unit types or a window of +-1")
 
 
 # -- elements of a response -----------------------------------------------------------------
@@ -758,6 +778,7 @@ def build_table(
     start = time.perf_counter()
     best: ChainTable | None = None
     for w in windows:
+        check_training_size(max(1, len(alphabet)), w)
         train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet)
         say(f"window +-{w}: {len(train)} covering designs")
         table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
