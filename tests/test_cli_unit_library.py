@@ -65,13 +65,28 @@ def test_design_over_a_library_verifies_a_mixed_winner(built, tmp_path: Path,
     assert abs(float(rows[0]["chain"]) - float(rows[0]["fe"])) <= cert["bound_worst"]
 
 
+def test_ga_over_a_library_writes_letter_designs(built, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    lib, _, cache = built
+    out = tmp_path / "ga"
+    args = ["design", "--library", str(lib), "--model", "2d", "--units", "4", "--pressure", "15", "--search", "ga",
+            "--pop", "6", "--gen", "2", "--executor", "serial", "--cache", str(cache), "--out", str(out), "--json"]
+    assert main(args) == 0
+    winner = json.loads(capsys.readouterr().out)["best"]["design"]
+    fame = json.loads((out / "hall_of_fame.json").read_text())
+    designs = [entry["design"] for entry in fame["designs"]]
+    assert winner == designs[0] and all(len(d) == 4 and set(d) <= set("aArR") for d in designs)
+    rows = list(csv.DictReader((out / "generations.csv").open()))
+    assert len(rows) == 3 and all(set(r["best_design"]) <= set("aArR") for r in rows)
+
+
 @pytest.mark.parametrize(("args", "message"), [
     (["design", "--library", "{twice}", "--model", "2d"], "symbol 'a' is given twice"),
     (["chain", "build", "--model", "2d", "--library", "{twice}", "--out", "{out}"], "symbol 'a' is given twice"),
     (["design", "--library", "{missing}", "--model", "2d"], "missing.toml"),
     (["design", "--library", "builtin", "--model", "2d", "--units", "7", "--pressure", "25", "--chain-table",
       "{table}", "--tolerance", "0"], "unit type 'e', 's' has no table (it covers a, r)"),
-    (["design", "--library", "{lib}", "--model", "2d", "--search", "ga"], "--search ga over a unit library"),
+    (["design", "--library", "{lib}", "--model", "2d", "--search", "exhaustive"],
+     "--search exhaustive over a unit library"),
     (["design", "--library", "{lib}", "--model", "2d", "--tolerance", "0.1", "--out", "{run}"],
      "--tolerance: the mould tolerance report"),
     (["chain", "build", "--model", "2d", "--library", "builtin", "--window", "2", "--out", "{out}"],

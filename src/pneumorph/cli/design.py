@@ -196,7 +196,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
                             overwrite=overwrite, on_message=on_message)
     except LocalityError as exc:  # the chain cannot represent this model: nothing was written
-        if config.search != "certified" or mixed:  # (no GA over a unit library yet)
+        if config.search != "certified":
             raise
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
         settings = dict(config.model) if fidelity_given else {**config.model, "fidelity": "2d"}
@@ -271,15 +271,15 @@ def _certified_json(result) -> dict:
 def _check_library_run(config: Any, model: Any, tolerance: float | None) -> None:
     """Refuse, before any computation, what a run over a unit library of several types cannot do yet.
 
-    Only the certified search covers every type and orientation per unit (the GA and the exhaustive
-    search still choose orientations of the first type); a given chain table must cover every unit
-    type of the library ("unit type 'x' has no table"); the mould tolerance report is of one unit.
+    The certified search and the GA choose among every type and orientation per unit; the FE
+    exhaustive search lists orientations of one type only; a given chain table must cover every
+    unit type of the library ("unit type 'x' has no table"); the mould tolerance report is of one unit.
     """
     from pneumorph.errors import ChainTableError, SearchConfigError
 
-    if config.search != "certified":
-        raise SearchConfigError(f"--search {config.search} over a unit library is not available yet: only the "
-                                "certified search chooses among the unit types (use --search certified)")
+    if config.search == "exhaustive":
+        raise SearchConfigError("--search exhaustive over a unit library is not available: it lists the 2^n "
+                                "orientations of one type (use --search certified or ga)")
     if tolerance or config.robust is not None:
         raise SearchConfigError(f"{'--robust' if config.robust else '--tolerance'}: the mould tolerance report is of "
                                 "one unit type; over a unit library leave it out")

@@ -1,5 +1,9 @@
 """Genetic algorithm over orientation vectors: DEAP's ``eaSimple`` (section 4.5).
 
+Over a unit library of several types (``docs/unit-library.md``) a gene is a unit code,
+type ``t`` in orientation ``o`` being ``2t + o``, mutated to another code at random; over
+one type it is the 0/1 orientation, flipped, as in the dissertation.
+
 This is the only module that touches DEAP's global ``creator``. The generational loop
 follows ``deap.algorithms.eaSimple`` step for step (tournament selection, ``varAnd`` with
 two-point crossover and bit-flip mutation, evaluation of the individuals whose fitness was
@@ -200,6 +204,22 @@ def mut_flip_bit(individual: list[int], indpb: float, rng: random.Random) -> tup
     return (individual,)
 
 
+def mut_other_code(individual: list[int], indpb: float, codes: int, rng: random.Random) -> tuple[list[int]]:
+    """Give each unit, with probability ``indpb``, another of the ``codes`` unit codes (each equally likely).
+
+    Over two codes this is :func:`mut_flip_bit` (the only other code is the flipped one); over a unit
+    library of ``k`` types there are ``2k`` codes, type ``t`` in orientation ``o`` being ``2t + o``.
+
+    >>> mut_other_code([0, 3, 5], 1.0, 6, random.Random(1))[0] != [0, 3, 5]
+    True
+    """
+    for i in range(len(individual)):
+        if rng.random() < indpb:
+            other = rng.randrange(codes - 1)
+            individual[i] = other + (other >= individual[i])
+    return (individual,)
+
+
 def sel_tournament(individuals: Sequence[Any], k: int, tournsize: int, rng: random.Random) -> list[Any]:
     """``k`` tournaments of ``tournsize`` random picks, as ``deap.tools.selTournament``."""
     return [max((rng.choice(individuals) for _ in range(tournsize)), key=lambda ind: ind.fitness) for _ in range(k)]
@@ -220,24 +240,32 @@ def var_and(population: Sequence[Any], toolbox: base.Toolbox, cxpb: float, mutpb
     return offspring
 
 
-def make_toolbox(n_units: int, sense: Sense, config: GAConfig, rng: random.Random) -> base.Toolbox:
-    """A DEAP toolbox whose random operators all draw from ``rng``."""
+def make_toolbox(n_units: int, sense: Sense, config: GAConfig, rng: random.Random, codes: int = 2) -> base.Toolbox:
+    """A DEAP toolbox whose random operators all draw from ``rng``; genes are unit codes ``0 .. codes - 1``
+    (0/1 orientations, or ``2t + o`` over a unit library of several types)."""
     toolbox = base.Toolbox()
-    toolbox.register("attr_bool", rng.randint, 0, 1)
-    toolbox.register("individual", tools.initRepeat, getattr(creator, _INDIVIDUAL[sense]), toolbox.attr_bool, n_units)
+    toolbox.register("attr_code", rng.randint, 0, codes - 1)
+    toolbox.register("individual", tools.initRepeat, getattr(creator, _INDIVIDUAL[sense]), toolbox.attr_code, n_units)
     toolbox.register("population", tools.initRepeat, list, toolbox.individual)
     toolbox.register("mate", cx_two_point, rng=rng)
-    toolbox.register("mutate", mut_flip_bit, indpb=config.indpb, rng=rng)
+    if codes == 2:  # eaSimple's bit flip, draw for draw
+        toolbox.register("mutate", mut_flip_bit, indpb=config.indpb, rng=rng)
+    else:
+        toolbox.register("mutate", mut_other_code, indpb=config.indpb, codes=codes, rng=rng)
     toolbox.register("select", sel_tournament, tournsize=config.tournsize, rng=rng)
     return toolbox
 
 
-def _design(ind: Sequence[int]) -> str:
-    return "".join(str(int(b)) for b in ind)
+def _design(ind: Sequence[int], symbols: Sequence[str] = ()) -> str:
+    """A genome as design text: 0/1 digits, or over a library's ``symbols`` the letter of the type,
+    upper case for orientation 1 (code ``2t + o``)."""
+    if not symbols:
+        return "".join(str(int(b)) for b in ind)
+    return "".join(symbols[int(b) // 2].upper() if int(b) % 2 else symbols[int(b) // 2] for b in ind)
 
 
 def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[int, int, int],
-           wall: float) -> GenerationStats:
+           wall: float, symbols: Sequence[str] = ()) -> GenerationStats:
     values = np.array([ind.fitness.values[0] for ind in population], dtype=float)
     finite = values[np.isfinite(values)]
     best_ind = max(population, key=lambda ind: ind.fitness)
@@ -247,14 +275,15 @@ def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[i
     else:
         best = worst_ = mean = std = math.nan
     return GenerationStats(
-        gen, float(best), mean, float(worst_), std, *counts, int(values.size - finite.size), wall, _design(best_ind)
+        gen, float(best), mean, float(worst_), std, *counts, int(values.size - finite.size), wall,
+        _design(best_ind, symbols)
     )
 
 
-def _evaluate(population: Sequence[Any], book: ScoreBook) -> tuple[int, int, int]:
+def _evaluate(population: Sequence[Any], book: ScoreBook, symbols: Sequence[str] = ()) -> tuple[int, int, int]:
     invalid = [ind for ind in population if not ind.fitness.valid]
     before = book.solves
-    scores = book.score_many([_design(ind) for ind in invalid])
+    scores = book.score_many([_design(ind, symbols) for ind in invalid])
     for ind, s in zip(invalid, scores, strict=True):
         ind.fitness.values = (s.value,)
     solves = book.solves - before
@@ -294,13 +323,15 @@ def run_ga(
     """
     book = ScoreBook(model, objective, evaluator)
     rng = random.Random(config.seed)
-    toolbox = make_toolbox(model.n_units, objective.sense, config, rng)
+    library = getattr(model, "library", None)  # the FE models' unit library; designs over several types
+    symbols: tuple[str, ...] = tuple(library.symbols) if library is not None and not library.is_single else ()
+    toolbox = make_toolbox(model.n_units, objective.sense, config, rng, codes=2 * max(len(symbols), 1))
     history: list[GenerationStats] = []
 
     start = time.perf_counter()
     population = toolbox.population(n=config.population)
-    counts = _evaluate(population, book)
-    history.append(_stats(0, population, book, counts, time.perf_counter() - start))
+    counts = _evaluate(population, book, symbols)
+    history.append(_stats(0, population, book, counts, time.perf_counter() - start, symbols))
     if on_generation:
         on_generation(history[-1])
     stopped = "generations"
@@ -308,15 +339,15 @@ def run_ga(
         start = time.perf_counter()
         offspring = var_and(toolbox.select(population, len(population)), toolbox, config.cxpb, config.mutpb, rng)
         if config.budget is not None:
-            new = {_design(ind) for ind in offspring if not ind.fitness.valid} - book.scores.keys()
+            new = {_design(ind, symbols) for ind in offspring if not ind.fitness.valid} - book.scores.keys()
             if len(book.scores) + len(new) > config.budget:
                 stopped = "budget"
                 break
-        counts = _evaluate(offspring, book)
+        counts = _evaluate(offspring, book, symbols)
         if config.elitism:
             _keep_elites(population, offspring, config.elitism, toolbox)
         population[:] = offspring
-        history.append(_stats(gen, population, book, counts, time.perf_counter() - start))
+        history.append(_stats(gen, population, book, counts, time.perf_counter() - start, symbols))
         if on_generation:
             on_generation(history[-1])
     return GAResult(
@@ -324,7 +355,7 @@ def run_ga(
         objective.sense,
         tuple(history),
         book.hall_of_fame(config.hall_of_fame),
-        tuple(_design(ind) for ind in population),
+        tuple(_design(ind, symbols) for ind in population),
         book.solves,
         dict(book.scores),
         stopped,
@@ -335,8 +366,8 @@ def _keep_elites(population: list[Any], offspring: list[Any], k: int, toolbox: b
     """Replace the ``k`` worst offspring by the ``k`` best distinct parents (no random draws)."""
     elites, seen = [], set()
     for ind in sorted(population, key=lambda ind: ind.fitness, reverse=True):
-        if _design(ind) not in seen:
-            seen.add(_design(ind))
+        if tuple(ind) not in seen:
+            seen.add(tuple(ind))
             elites.append(toolbox.clone(ind))
         if len(elites) == k:
             break
