@@ -96,6 +96,7 @@ BASE = {
     "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--scale", "0.2", "--out", "run"],
     "list": ["materials", "list"],
     "serve": ["serve", "--port", "18765", "--state", "run"],
+    "optimise": ["unit", "optimise", "--out", "run", "--executor", "serial", "--pop", "4", "--gen", "1"],
     **{study: ["sensitivity", study, "--units", "2", "--executor", "serial", "--out", "run"]
        for study in ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature")},
 }
@@ -174,6 +175,12 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
            ("calibration", {"--reach": ["0.5", "11", *REAL]}),
            ("temperature", {"--change": [*REAL, "-101"]}),
        )},
+    "optimise": {"--var": ["", "height=1:2", "wall=2:1", "wall", "wall=a:b", "end_wall=2:6", "pitch=5:12"],
+                 "--strain-limit": POSITIVE, "--pressure": [*POSITIVE, "1e9"], "--units": ["2", *POS_COUNT, *HUGE],
+                 "--pop": ["3", *POS_COUNT, *HUGE], "--gen": POS_COUNT + HUGE, "--seed": COUNT,
+                 "--resolution": ["-1", "11", *REAL], "--element-size": [*POSITIVE, "1e-4"],
+                 "--unit": ["binary.bin", "folder", "missing.toml", ""], "--workers": POS_COUNT,
+                 "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }

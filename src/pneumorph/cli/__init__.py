@@ -55,6 +55,10 @@ from pneumorph.cli.bimodal import bimodal  # noqa: E402
 
 cli.add_command(bimodal)
 
+from pneumorph.cli.unit import unit  # noqa: E402
+
+cli.add_command(unit)
+
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised in the main thread so that a run stops as on Ctrl-C (exit 143)."""

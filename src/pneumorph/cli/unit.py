@@ -1,0 +1,123 @@
+"""``pneumorph unit optimise``: the unit geometry optimisation of section 8.3.2 (docs/unit-library.md)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import Any
+
+import click
+
+from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_UNITS
+from pneumorph.cli import params as P
+
+
+@click.group("unit")
+def unit() -> None:
+    """The articulating unit: geometry optimisation (docs/unit-library.md)."""
+
+
+@unit.command("optimise")
+@click.option("--var", "variables", multiple=True, metavar="NAME=LOW:HIGH", type=P.Text(max_length=200),
+              help="A varied dimension and its bounds, mm (repeatable; default cavity_height=3:9, end_wall=1.5:4, "
+                   "wall=1:2.5, layer=1.5:4.5). Names: cavity_height, end_wall, wall, layer, side_wall, pitch.")
+@click.option("--strain-limit", type=P.Real(0.0, 1e3, low_open=True), default=4.4, show_default=True,
+              help="Largest principal nominal strain allowed in the body (Mold Star 15: 440 % at break, Smooth-On).")
+@click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Design pressure, kPa.")
+@click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=3, show_default=True,
+              help="Units of the 3D probe actuator (Omega is its middle unit's turn).")
+@click.option("--pop", "pop_size", type=P.Count(4, MAX_POPULATION, limit="MAX_POPULATION"), default=16,
+              show_default=True, help="NSGA-II population.")
+@click.option("--gen", "generations", type=P.Count(1, MAX_GENERATIONS, limit="MAX_GENERATIONS"), default=8,
+              show_default=True, help="NSGA-II generations after the initial population.")
+@click.option("--seed", type=P.SEED, default=0, show_default=True, help="Seed of the start and of NSGA-II.")
+@click.option("--resolution", type=P.Real(0.0, 10.0, unit="mm"), default=0.1, show_default=True,
+              help="Dimensions are rounded to this, mm (0: not rounded).")
+@click.option("--element-size", type=P.POSITIVE_MM, help="Element size of the candidates' mesh, mm (default: "
+              "the base unit's, 1.5).")
+@click.option("--unit", "unit_file", type=P.InputFile(), help="Base unit TOML file (default: the built-in unit).")
+@click.option("--executor", type=click.Choice(["serial", "processes"]), default="processes", show_default=True,
+              help="Solve the candidates one after another, or in parallel processes.")
+@click.option("--workers", type=P.WORKERS, help="Processes (default: all cores).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes.")
+@click.option("--out", required=True, type=P.OutputDir(),
+              help="Folder for candidates.csv, pareto.csv/.json, front.png and units/*.toml.")
+@click.option("--json", "as_json", is_flag=True, help="Print the front as JSON.")
+def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n_units: int, pop_size: int,
+             generations: int, seed: int, resolution: float, element_size: float | None, unit_file: str | None,
+             executor: str, workers: int | None, cache: str | None, out: str, as_json: bool) -> None:
+    """Maximise the bending angle per unit (Omega) and minimise the ballooning height (h_b) within a
+    strain limit (Ellis 2020, 8.3.2), NSGA-II on a 3-unit 3D actuator; resumable through the cache."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.io import strict_json
+    from pneumorph.io.lock import RunLock
+    from pneumorph.unitopt.run import OptimiseSettings, check_settings, optimise, write_outputs
+    from pneumorph.unitopt.space import DesignSpace, parse_variable
+
+    with P.blame("--unit"):
+        base = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
+    base = replace(base, name="unitopt")
+    if element_size is not None:
+        with P.blame("--element-size"):
+            base = replace(base, element_size=element_size)
+    with P.blame("--var"):
+        space = (DesignSpace(tuple(parse_variable(v) for v in variables), base, resolution) if variables
+                 else replace(DesignSpace.default(base), resolution=resolution))
+        check_settings(space, strain_limit)
+    settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
+                                pop_size=pop_size, generations=generations, seed=seed)
+    click.echo(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
+               f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
+               f"{generations} generations, seed {seed}", err=True)
+    evaluator = CachedEvaluator(make_evaluator(executor, workers), EvaluationCache(cache or default_cache_path()))
+    t0 = time.perf_counter()
+    count = {"n": 0}
+
+    def on_candidate(c: Any) -> None:
+        count["n"] += 1
+        dims = ", ".join(f"{v:g}" for v in c.values.values())
+        if c.measures is None:
+            state = f"failed at {c.reached * 1e3:.1f} kPa: {c.failure}"
+        else:
+            m = c.measures
+            state = (f"Omega {m.omega_deg:.2f} deg, h_b {m.balloon_mm:.2f} mm, strain {m.strain:.2f}"
+                     + (" (cached)" if c.cached else ""))
+        click.echo(f"  [{count['n']}] ({dims}): {state}  [{time.perf_counter() - t0:.0f} s]", err=True)
+
+    def on_generation(g: int, front: list[Any]) -> None:
+        click.echo(f"generation {g}: front of {len(front)}", err=True)
+
+    Path(out).mkdir(parents=True, exist_ok=True)
+    with RunLock(out):
+        try:
+            result = optimise(settings, evaluator, on_candidate, on_generation)
+        finally:
+            evaluator.close()
+        write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
+    rows = [c.row(strain_limit) for c in result.front]
+    better = result.better()
+    if as_json:
+        click.echo(strict_json({"front": rows, "base": result.base.row(strain_limit),
+                                "better_than_base": [c.row(strain_limit) for c in better]}))
+        return
+    names = space.names
+    click.echo(" ".join(f"{n:>13}" for n in names) + f" {'Omega [deg]':>11} {'h_b [mm]':>8} {'strain':>7}")
+    for c in [result.base, *result.front]:
+        m = c.measures
+        tail = "failed" if m is None else f"{m.omega_deg:11.2f} {m.balloon_mm:8.2f} {m.strain:7.2f}"
+        click.echo(" ".join(f"{c.values[n]:13.2f}" for n in names) + f" {tail}"
+                   + ("  <- base unit" if c is result.base else ""))
+    if better:
+        m = better[0].measures
+        assert m is not None
+        click.echo(f"{len(better)} unit(s) bend more than the base unit at the same or a lower h_b; best: Omega "
+                   f"{m.omega_deg:.2f} deg, h_b {m.balloon_mm:.2f} mm")
+    else:
+        click.echo("no unit bends more than the base unit at the same or a lower h_b within the strain limit")
+    click.echo(f"{len(result.candidates)} candidates ({result.solves} solved, {result.hits} from the cache) in "
+               f"{time.perf_counter() - t0:.0f} s; written to {out}/")

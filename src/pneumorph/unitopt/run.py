@@ -1,0 +1,310 @@
+"""The driver of the unit optimisation: NSGA-II over the design space, and what it writes.
+
+:func:`optimise` runs pymoo's NSGA-II (Deb et al. 2002) on a
+:class:`~pneumorph.unitopt.problem.UnitProblem`: a seeded Latin hypercube start that
+holds the base unit (the built-in one) when it lies in the box, the space's rounding as
+the repair, ``pop_size`` offspring per generation. Every candidate goes through the given
+evaluator; with the package's cache (``CachedEvaluator``) a run that was stopped resumes:
+the same seed asks for the same candidates, and those solved before are read back.
+
+:func:`write_outputs` writes a folder:
+
+- ``candidates.csv``: every candidate solved (dimensions, Omega, h_b and its parts, strain,
+  feasibility, generation);
+- ``pareto.csv`` and ``pareto.json``: the feasible non-dominated candidates (the front),
+  the base unit and the settings, with provenance;
+- ``front.png``: the front beside every candidate (:func:`pneumorph.unitopt.figures.plot_front`);
+- ``units/*.toml``: unit files (``[unit]`` table, :meth:`UnitSpec.from_toml`) of the chosen
+  points: the largest Omega, the smallest h_b, the knee of the front, and ``better.toml``,
+  the largest Omega of the units that bend more than the base unit at the same or a lower
+  h_b within the strain limit (if any).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pneumorph import checks
+from pneumorph.errors import SettingsError
+from pneumorph.unitopt.probe import DEFAULT_UNITS
+from pneumorph.unitopt.problem import (
+    Candidate,
+    CandidateEvaluator,
+    SnapRepair,
+    UnitProblem,
+    check_strain_limit,
+)
+from pneumorph.unitopt.space import DesignSpace, FloatArray
+
+#: largest principal nominal strain of Mold Star 15 at break: 440 % elongation at break (ASTM D-412), Smooth-On,
+#: "Mold Star 15 SLOW" technical bulletin. The dissertation did not test to failure ("not concerned with material
+#: failure", appendix A.2); its actuators held 45 kPa with 1.5 mm walls (section 4.2)
+DEFAULT_STRAIN_LIMIT = 4.40
+STRAIN_LIMIT_SOURCE = ("Smooth-On, Mold Star 15 SLOW technical bulletin: elongation at break 440 % (ASTM D-412); "
+                       "nominal strain = largest principal stretch - 1")
+
+
+@dataclass(frozen=True)
+class OptimiseSettings:
+    """What :func:`optimise` runs.
+
+    Parameters
+    ----------
+    space : DesignSpace
+        The varied dimensions and their bounds.
+    strain_limit : float
+        Largest principal nominal strain allowed in the body material (:data:`DEFAULT_STRAIN_LIMIT`).
+    pressure : float
+        Design pressure, MPa.
+    n_units : int
+        Units of the probe actuator (at least 3).
+    pop_size, generations : int
+        NSGA-II's population and generations (the initial population is generation 0).
+    seed : int
+        Seeds the start and pymoo.
+
+    Raises
+    ------
+    SettingsError
+        A non-positive strain limit, a population below 4, a count out of range.
+    """
+
+    space: DesignSpace = field(default_factory=DesignSpace.default)
+    strain_limit: float = DEFAULT_STRAIN_LIMIT
+    pressure: float = 0.045
+    n_units: int = DEFAULT_UNITS
+    pop_size: int = 16
+    generations: int = 8
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        check_strain_limit(self.strain_limit)
+        checks.real(self.pressure, "pressure", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
+                    limit="MAX_PRESSURE_KPA")
+        checks.integer(self.n_units, "probe units", 3, checks.MAX_UNITS, limit="MAX_UNITS")
+        checks.integer(self.pop_size, "population", 4, checks.MAX_POPULATION, limit="MAX_POPULATION")
+        checks.integer(self.generations, "generations", 1, checks.MAX_GENERATIONS, limit="MAX_GENERATIONS")
+        checks.integer(self.seed, "seed", 0, 2**32 - 1)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"space": self.space.to_dict(), "strain_limit": self.strain_limit,
+                "strain_limit_source": STRAIN_LIMIT_SOURCE if self.strain_limit == DEFAULT_STRAIN_LIMIT else "user",
+                "pressure_kpa": self.pressure * 1e3, "n_units": self.n_units, "pop_size": self.pop_size,
+                "generations": self.generations, "seed": self.seed, "algorithm": "pymoo NSGA2"}
+
+
+@dataclass(frozen=True)
+class UnitOptimisation:
+    """The outcome of :func:`optimise`.
+
+    Attributes
+    ----------
+    settings : OptimiseSettings
+    candidates : list of Candidate
+        Every candidate solved, in the order first asked for.
+    front : list of Candidate
+        The feasible non-dominated candidates, by increasing h_b.
+    base : Candidate
+        The base unit (the built-in one), solved with the same probe.
+    solves, hits : int
+        Candidates solved in this run and answered from the cache.
+    """
+
+    settings: OptimiseSettings
+    candidates: list[Candidate]
+    front: list[Candidate]
+    base: Candidate
+    solves: int = 0
+    hits: int = 0
+
+    def better(self) -> list[Candidate]:
+        """Feasible candidates that turn more than the base unit at the same or a lower h_b, best Omega first."""
+        b = self.base.measures
+        if b is None:
+            return []
+        limit = self.settings.strain_limit
+        out = [c for c in self.candidates if c.feasible(limit) and c.measures is not None
+               and c.measures.omega_deg > b.omega_deg and c.measures.balloon_mm <= b.balloon_mm]
+        return sorted(out, key=lambda c: -c.measures.omega_deg)  # type: ignore[union-attr]
+
+    def chosen(self) -> dict[str, Candidate]:
+        """The points written as unit files: ``max-omega``, ``min-balloon``, ``knee`` and ``better``."""
+        if not self.front:
+            return {}
+        f = np.array([c.objectives() for c in self.front])
+        span = np.where(np.ptp(f, axis=0) > 0, np.ptp(f, axis=0), 1.0)
+        knee = int(np.argmin(np.linalg.norm((f - f.min(axis=0)) / span, axis=1)))
+        out = {"max-omega": self.front[int(np.argmin(f[:, 0]))], "min-balloon": self.front[int(np.argmin(f[:, 1]))],
+               "knee": self.front[knee]}
+        better = self.better()
+        if better:
+            out["better"] = better[0]
+        return out
+
+
+def latin_hypercube(space: DesignSpace, n: int, seed: int) -> FloatArray:
+    """``n`` snapped points of a Latin hypercube over the space (seeded); row 0 is the base unit if inside.
+
+    >>> x = latin_hypercube(DesignSpace.default(), 8, seed=1)
+    >>> x.shape, x[0].tolist()
+    ((8, 4), [6.0, 3.0, 1.5, 3.0])
+    """
+    rng = np.random.default_rng(seed)
+    k = len(space.variables)
+    strata = np.array([rng.permutation(n) for _ in range(k)]).T
+    u = (strata + rng.random((n, k))) / n
+    x = space.lower + u * (space.upper - space.lower)
+    base = space.base_point()
+    if np.all((base >= space.lower) & (base <= space.upper)):
+        x[0] = base
+    return np.array([space.snap(row) for row in x])
+
+
+def front_of(candidates: list[Candidate], strain_limit: float) -> list[Candidate]:
+    """The feasible candidates no other feasible one dominates (in ``-Omega``, h_b), by increasing h_b."""
+    from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+    feasible = [c for c in candidates if c.feasible(strain_limit)]
+    if not feasible:
+        return []
+    f = np.array([c.objectives() for c in feasible])
+    first = NonDominatedSorting().do(f, only_non_dominated_front=True)
+    return sorted((feasible[i] for i in first), key=lambda c: c.objectives()[1])
+
+
+def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[[Candidate], None] | None = None,
+             on_generation: Callable[[int, list[Candidate]], None] | None = None) -> UnitOptimisation:
+    """Run NSGA-II on the unit (see the module docstring).
+
+    Parameters
+    ----------
+    settings : OptimiseSettings
+    evaluator : Evaluator
+        Solves the probes (``iter_cases``); a ``CachedEvaluator`` makes the run resumable.
+    on_candidate : callable, optional
+        ``on_candidate(candidate)`` as each candidate is solved.
+    on_generation : callable, optional
+        ``on_generation(generation, front)`` after each generation.
+
+    Raises
+    ------
+    GeometryError
+        The space's bounds do not always make a unit (checked before any solve).
+    """
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.core.callback import Callback
+    from pymoo.optimize import minimize
+
+    settings.space.check()
+    candidates = CandidateEvaluator(settings.space, evaluator, settings.n_units, settings.pressure, on_candidate)
+    problem = UnitProblem(candidates, settings.strain_limit)
+    base = candidates.evaluate(settings.space.base_point()[None])[0]  # in or outside the box: the reference
+
+    class Progress(Callback):  # type: ignore[misc]
+        def notify(self, algorithm: Any) -> None:
+            candidates.generation = algorithm.n_gen  # the offspring asked for next belong to this generation
+            if on_generation is not None:
+                on_generation(algorithm.n_gen - 1, front_of(list(candidates.history.values()),
+                                                            settings.strain_limit))
+
+    algorithm = NSGA2(pop_size=settings.pop_size, sampling=latin_hypercube(settings.space, settings.pop_size,
+                                                                           settings.seed),
+                      repair=SnapRepair(settings.space), eliminate_duplicates=True)
+    minimize(problem, algorithm, ("n_gen", settings.generations + 1), seed=settings.seed, callback=Progress(),
+             verbose=False, save_history=False)
+    everything = list(candidates.history.values())
+    return UnitOptimisation(settings, everything, front_of(everything, settings.strain_limit), base,
+                            solves=int(getattr(evaluator, "solves", 0)), hits=int(getattr(evaluator, "hits", 0)))
+
+
+_COLUMNS = ("omega_deg", "balloon_mm", "balloon_bottom_mm", "balloon_end_mm", "balloon_side_mm", "strain",
+            "layer_strain", "curl_per_unit_deg", "feasible", "failure", "reached_kpa", "generation", "cached",
+            "wall_time_s")
+
+
+def table_csv(result: UnitOptimisation, candidates: list[Candidate]) -> str:
+    """CSV text of ``candidates``: the varied dimensions, then the measures (see :class:`Candidate.row`)."""
+    out = io.StringIO()
+    writer = csv.DictWriter(out, fieldnames=[*result.settings.space.names, *_COLUMNS], lineterminator="\n")
+    writer.writeheader()
+    for c in candidates:
+        row = c.row(result.settings.strain_limit)
+        writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) and not isinstance(v, bool) and math.isfinite(v)
+                             else ("" if v is None else v)) for k, v in row.items()})
+    return out.getvalue()
+
+
+def unit_file(candidate: Candidate, label: str, result: UnitOptimisation, prov: dict[str, Any]) -> str:
+    """TOML text of a chosen unit: its ``[unit]`` table (what differs from the built-in unit, and its name),
+    then ``[unitopt]`` with its measures and where it comes from (ignored by :meth:`UnitSpec.from_toml`)."""
+    from dataclasses import replace
+
+    from pneumorph.design.config import to_toml
+    from pneumorph.geometry.unit import UnitSpec
+
+    unit = replace(candidate.unit, name=f"unitopt_{label.replace('-', '_')}")
+    default = UnitSpec().to_dict()
+    table = {k: v for k, v in unit.to_dict().items() if k == "name" or v != default.get(k)}
+    measures = candidate.measures.to_dict() if candidate.measures is not None else {}
+    meta = {"label": label, **measures, "strain_limit": result.settings.strain_limit,
+            "pressure_kpa": result.settings.pressure * 1e3, "probe_units": result.settings.n_units,
+            "pneumorph": prov.get("pneumorph"), "created_utc": prov.get("created_utc"),
+            "command": prov.get("command")}
+    return to_toml({"unit": table, "unitopt": meta})
+
+
+def write_outputs(result: UnitOptimisation, folder: str | Path, **provenance_extra: Any) -> list[Path]:
+    """Write the tables, the figure and the chosen units' files into ``folder`` (see the module docstring)."""
+    from pneumorph.io import provenance
+    from pneumorph.io.files import atomic_write_text, write_json
+    from pneumorph.unitopt.figures import plot_front
+
+    out = Path(folder)
+    (out / "units").mkdir(parents=True, exist_ok=True)
+    prov = provenance(settings=result.settings.to_dict(), **provenance_extra)
+    limit = result.settings.strain_limit
+    written = [atomic_write_text(out / "candidates.csv", table_csv(result, result.candidates)),
+               atomic_write_text(out / "pareto.csv", table_csv(result, result.front))]
+    chosen = result.chosen()
+    data = {
+        "front": [c.row(limit) for c in result.front],
+        "base": result.base.row(limit),
+        "better_than_base": [c.row(limit) for c in result.better()],
+        "chosen": {label: c.values for label, c in chosen.items()},
+        "candidates": len(result.candidates),
+        "feasible": sum(c.feasible(limit) for c in result.candidates),
+        "failed": sum(c.measures is None for c in result.candidates),
+        "solves": result.solves,
+        "cache_hits": result.hits,
+        "provenance": prov,
+    }
+    written.append(write_json(out / "pareto.json", data))
+    written.append(plot_front(result, out / "front.png"))
+    for label, c in chosen.items():
+        written.append(atomic_write_text(out / "units" / f"{label}.toml", unit_file(c, label, result, prov)))
+    return written
+
+
+def check_settings(space: DesignSpace, strain_limit: float) -> None:
+    """The checks of :func:`optimise` that need no solve (for the command line, before anything is written).
+
+    Raises
+    ------
+    SettingsError, GeometryError
+    """
+    check_strain_limit(strain_limit)
+    if not isinstance(space, DesignSpace):
+        raise SettingsError(f"expected a DesignSpace, got {type(space).__name__}")
+    space.check()
+
+
+__all__ = ["DEFAULT_STRAIN_LIMIT", "STRAIN_LIMIT_SOURCE", "OptimiseSettings", "UnitOptimisation", "check_settings",
+           "front_of", "latin_hypercube", "optimise", "table_csv", "unit_file", "write_outputs"]

@@ -1,0 +1,54 @@
+"""``pneumorph unit optimise``: bad input is one line and exit 2 before anything is solved or written; a tiny run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from pneumorph.cli import main
+
+TINY = ["unit", "optimise", "--var", "cavity_height=4.5:7.5", "--var", "end_wall=2:3.5", "--element-size", "3",
+        "--pressure", "10", "--pop", "4", "--gen", "1", "--resolution", "0.5", "--executor", "serial"]
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    (["--var", "height=1:2"], "unknown unit variable 'height'"),
+    (["--var", "wall=2.5:1"], "0 < low < high"),
+    (["--var", "wall"], "NAME=LOW:HIGH"),
+    (["--var", "wall=a:b"], "must be numbers"),
+    (["--var", "wall=1:2", "--var", "wall=1:3"], "given twice"),
+    (["--var", "end_wall=2:5.5"], "do not always make a unit"),
+    (["--var", "pitch=5:12"], "do not always make a unit"),
+    (["--strain-limit", "0"], "--strain-limit"),
+    (["--strain-limit", "-1"], "--strain-limit"),
+    (["--strain-limit", "nan"], "--strain-limit"),
+    (["--units", "2"], "--units"),
+    (["--pop", "3"], "--pop"),
+])
+def test_bad_input_is_one_line_and_exit_2_before_any_solve(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                          monkeypatch: pytest.MonkeyPatch, args: list[str],
+                                                          says: str) -> None:
+    import pneumorph.models.fe as fe
+
+    def tripwire(*a: object, **k: object) -> None:
+        raise AssertionError("a solve was reached")
+
+    monkeypatch.setattr(fe.FEModel, "solve", tripwire)
+    out = tmp_path / "run"
+    code = main(["unit", "optimise", *args, "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"),
+                 "--out", str(out)])
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert code == 2 and len(lines) == 1 and lines[0].startswith("error: ") and says in lines[0], err
+    assert not out.exists() and not (tmp_path / "c.sqlite").exists()
+
+
+def test_a_tiny_run_prints_the_front_and_writes_its_folder(tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "run"
+    assert main([*TINY, "--cache", str(tmp_path / "c.sqlite"), "--out", str(out), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["front"] and data["base"]["cavity_height"] == 6.0
+    assert (out / "front.png").stat().st_size > 0 and (out / "units" / "knee.toml").exists()
