@@ -117,6 +117,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')"], "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""], "--chain-table": ["binary.bin", "folder", "missing.json", ""],
+        "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
     },
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
@@ -136,6 +137,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--pressure": POSITIVE, "--units": POS_COUNT + HUGE, "--window": [*POS_COUNT, "50"],
         "--tolerance": POSITIVE, "--heldout": COUNT + HUGE, "--workers": POS_COUNT, "--unit": ["binary.bin", ""],
         "--cache": ["folder", ""], "--out": ["folder", "a-file/t.json", ""],
+        "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
     },
     "bimodal": {
         "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE,
