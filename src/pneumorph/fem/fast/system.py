@@ -210,7 +210,7 @@ class FastSystem:
         are kept, so the pattern is exactly theirs.
         """
         d, npts = self.dim, self.npoints
-        active = np.full(self.ndof, -1, dtype=np.int64)
+        active = np.full(self.ndof, -1, dtype=np.int32)  # (int32: half the memory traffic of the gathers)
         active[self.dof1] = np.arange(self.dof1.size)
         n1 = self.dof1.size
         owners: list[_Solid | _Walls] = [*self.solids, *self.walls]
@@ -267,12 +267,16 @@ class FastSystem:
         self.nnz = int(used.sum())
         kept_rows = np.repeat(np.arange(n1), np.diff(indptr))[used]
         self.indptr = np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32)
-        columns = np.empty(int(indptr[-1]), dtype=np.int64)
+        columns = np.empty(int(indptr[-1]), dtype=np.int32)
         columns[full[exists]] = np.broadcast_to(cols[:, None, :], exists.shape)[exists]
-        self.indices = columns[used].astype(np.int32)
+        self.indices = columns[used]
+        # every owner's CSR positions side by side (each owner's scatter is its slice)
+        self._scatter = np.empty(sum(pos.size for pos in positions), dtype=np.int64)
+        start = 0
         for owner, pos in zip(owners, positions, strict=True):
-            owner.scatter = renumber[pos]
-        self._scatter = np.concatenate([owner.scatter for owner in owners])
+            owner.scatter = self._scatter[start : start + pos.size]
+            np.take(renumber, pos, out=owner.scatter)
+            start += pos.size
         self._values = np.empty(self._scatter.size)  # kept: a tangent fills it anew
 
     # -- evaluation -----------------------------------------------------------------------
