@@ -46,10 +46,15 @@ class _Hard:
         return 1, None if ok else "too large a step"
 
 
-def test_cut_back_halves_the_failed_step_and_carries_into_the_next_level() -> None:
+def _attempts(carry: bool) -> tuple[_Hard, Any]:
     hard = _Hard()
     stats = ramp([], _Fields(), hard.apply, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
-                 StepSettings(increments=10, substeps=1), substep=hard)
+                 StepSettings(increments=10, substeps=1), substep=hard, carry=carry)
+    return hard, stats
+
+
+def test_cut_back_halves_the_failed_step_and_carries_into_the_next_level() -> None:
+    hard, stats = _attempts(carry=True)
     late = [a for a in hard.attempts if a[0] >= 0.7 - 1e-9]
     assert late == [
         (0.7, 0.8, False), (0.7, 0.75, True), (0.75, 0.8, True),  # level 8: one cut-back
@@ -59,3 +64,11 @@ def test_cut_back_halves_the_failed_step_and_carries_into_the_next_level() -> No
     ]
     assert len(set(hard.attempts)) == len(hard.attempts)  # no trial repeated
     assert (stats.substeps, stats.cutbacks, stats.reached) == (14, 3, 1.0)
+
+
+def test_without_carry_every_level_starts_at_the_nominal_substep() -> None:
+    hard, stats = _attempts(carry=False)
+    late = [a for a in hard.attempts if a[0] >= 0.8 - 1e-9]
+    assert late[:3] == [(0.8, 0.9, False), (0.8, 0.85, True), (0.85, 0.9, True)]
+    assert len(set(hard.attempts)) == len(hard.attempts)
+    assert (stats.substeps, stats.cutbacks, stats.reached) == (14, 4, 1.0)

@@ -3,8 +3,8 @@
 A ramp from load factor 0 to 1 is reported at ``increments`` equally spaced levels (the
 dissertation's "method 2", section 4.3: one solve gives the response at ten pressures).
 Between two reported levels the solver takes ``substeps`` Newton solves; a substep that
-fails is halved (cut-back) without changing the reported levels, and the level after one
-that needed a cut-back starts at the substep that converged last. Each substep starts from
+fails is halved (cut-back) without changing the reported levels (optionally, the level
+after one that needed a cut-back starts at the substep that converged last). Each substep starts from
 the linear extrapolation of the last two converged states, which keeps the very soft
 bending mode of a long actuator from costing hundreds of Newton iterations.
 
@@ -250,6 +250,7 @@ def ramp(
     substep: Callable[[Any, StepSettings], tuple[int, str | None]] | None = None,
     predictor_order: int = 1,
     check: Callable[..., tuple[float, float, bool]] | None = None,
+    carry: bool = False,
 ) -> RampStatistics:
     """Ramp a FElupe model from load factor 0 to 1.
 
@@ -291,6 +292,11 @@ def ramp(
         start of a substep (1: linear, 2: quadratic once three states are known).
     check : callable, optional
         The convergence test of each Newton iteration (default :func:`newton_check`).
+    carry : bool
+        Start a level that follows one that needed a cut-back at the substep that converged
+        last, instead of the nominal one: where the load gets harder level by level (a long
+        actuator curling up) this saves the failed attempts; where a ramp ends at a load it
+        cannot reach, it creeps on in small substeps before it gives up.
 
     Returns
     -------
@@ -312,8 +318,8 @@ def ramp(
     nominal = 1.0 / (settings.increments * settings.substeps)
     dt, last, cut_back = nominal, nominal, False
     for k, level in enumerate(settings.levels()):
-        # a level after one that needed a cut-back starts at the substep that converged last
-        dt = last if cut_back else nominal
+        # with ``carry``, a level after one that needed a cut-back starts at the substep that converged last
+        dt = last if carry and cut_back else nominal
         cut_back = False
         cutbacks_here = 0
         while t_now < level - 1e-12:
