@@ -167,7 +167,7 @@ class CandidateEvaluator:
                          outcome.cached, outcome.wall_time, self.generation)
 
 
-class SnapRepair(Repair):  # type: ignore[misc]
+class SnapRepair(Repair):
     """Rounds offspring to the design space's resolution (pymoo's repair operator)."""
 
     def __init__(self, space: DesignSpace) -> None:
@@ -178,7 +178,7 @@ class SnapRepair(Repair):  # type: ignore[misc]
         return np.array([self.space.snap(x) for x in X])
 
 
-class UnitProblem(Problem):  # type: ignore[misc]
+class UnitProblem(Problem):
     """Maximise Omega and minimise h_b within a strain limit (see the module docstring).
 
     Parameters

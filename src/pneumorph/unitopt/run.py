@@ -131,9 +131,9 @@ class UnitOptimisation:
         if b is None:
             return []
         limit = self.settings.strain_limit
-        out = [c for c in self.candidates if c.feasible(limit) and c.measures is not None
+        out = [(c.measures.omega_deg, c) for c in self.candidates if c.feasible(limit) and c.measures is not None
                and c.measures.omega_deg > b.omega_deg and c.measures.balloon_mm <= b.balloon_mm]
-        return sorted(out, key=lambda c: -c.measures.omega_deg)  # type: ignore[union-attr]
+        return [c for _, c in sorted(out, key=lambda pair: -pair[0])]
 
     def chosen(self) -> dict[str, Candidate]:
         """The points written as unit files: ``max-omega``, ``min-balloon``, ``knee`` and ``better``."""
@@ -208,7 +208,7 @@ def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[
     problem = UnitProblem(candidates, settings.strain_limit)
     base = candidates.evaluate(settings.space.base_point()[None])[0]  # in or outside the box: the reference
 
-    class Progress(Callback):  # type: ignore[misc]
+    class Progress(Callback):
         def notify(self, algorithm: Any) -> None:
             candidates.generation = algorithm.n_gen  # the offspring asked for next belong to this generation
             if on_generation is not None:

@@ -28,6 +28,7 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -189,10 +190,10 @@ class DesignSpace:
         GeometryError
             The dimensions make no unit (see :class:`UnitSpec`).
         """
-        changes: dict[str, object] = dict(self.values(x))
+        changes: dict[str, Any] = dict(self.values(x))
         if name is not None:
             changes["name"] = name
-        return replace(self.base, **changes)  # type: ignore[arg-type]
+        return replace(self.base, **changes)
 
     def base_point(self) -> FloatArray:
         """The base unit's values of the variables (may lie outside the bounds)."""
@@ -219,7 +220,8 @@ class DesignSpace:
         for corner in itertools.product(*[(v.low, v.high) for v in self.variables]):
             where = ", ".join(f"{n}={value:g}" for n, value in zip(self.names, corner, strict=True))
             try:
-                spec = replace(self.base, **dict(zip(self.names, corner, strict=True)))  # type: ignore[arg-type]
+                corner_values: dict[str, Any] = dict(zip(self.names, corner, strict=True))
+                spec = replace(self.base, **corner_values)
                 assemble(spec, "0", dim=3, half=True)
             except GeometryError as exc:
                 raise GeometryError(f"the bounds do not always make a unit: at {where} mm: {exc}") from None
