@@ -122,6 +122,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
+        "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
     },
     "study": {
         "--populations": ["", "0", "1", "20,,40", "abc", "1.5", "-20"], "--seeds": POS_COUNT + HUGE,

@@ -79,6 +79,26 @@ def test_ga_over_a_library_writes_letter_designs(built, tmp_path: Path, capsys: 
     assert len(rows) == 3 and all(set(r["best_design"]) <= set("aArR") for r in rows)
 
 
+def test_simulate_solves_a_mixed_design_as_design_and_the_api_build_it(built, tmp_path: Path,
+                                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    from pneumorph.models.factory import make_model
+
+    lib, _, _ = built
+    out = tmp_path / "sim"
+    assert main(["simulate", "-o", "aRa", "--library", str(lib), "--pressure", "10", "--increments", "2",
+                 "--out", str(out), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["orientation"] == "aRa" and len(result["levels"]) == 2
+    written = json.loads((out / "provenance.json").read_text())["fingerprint"]
+    model = make_model(3, {"fidelity": "2d", "pressure_kpa": 10, "increments": 2, "library": str(lib)})
+    assert written == model.fingerprint() and model.mixed
+    # a near-rigid unit in the middle: the actuator curls less than with three bending units
+    assert main(["simulate", "-o", "aaa", "--library", str(lib), "--pressure", "10", "--increments", "2",
+                 "--json"]) == 0
+    bending = json.loads(capsys.readouterr().out)
+    assert 0 < result["levels"][-1]["curl_deg"] < 0.9 * bending["levels"][-1]["curl_deg"]
+
+
 @pytest.mark.parametrize(("args", "message"), [
     (["design", "--library", "{twice}", "--model", "2d"], "symbol 'a' is given twice"),
     (["chain", "build", "--model", "2d", "--library", "{twice}", "--out", "{out}"], "symbol 'a' is given twice"),

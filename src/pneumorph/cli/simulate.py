@@ -12,13 +12,17 @@ from pneumorph.cli import params as P
 
 @click.command("simulate")
 @click.option("--orientation", "-o", required=True, metavar="DIGITS", type=P.Text(max_length=1000),
-              help="The design, base first: one digit per unit, 1 = unit turned 180 degrees (e.g. 010011).")
+              help="The design, base first: one digit per unit, 1 = unit turned 180 degrees (e.g. 010011); "
+                   "over a --library, one letter per unit, upper case = turned (e.g. aRRa).")
 @click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure in kPa.")
 @click.option("--increments", type=P.INCREMENTS, default=10, show_default=True, help="Reported pressure levels.")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="2d", show_default=True,
               help="2D reduced-order (plane strain with filler) or 3D model.")
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
+@click.option("--library", metavar="builtin|FILE", type=P.Text(),
+              help="A unit library ('builtin' or a library TOML file; docs/unit-library.md): the design's "
+                   "letters name its unit types; instead of --unit.")
 @click.option("--gravity", type=click.Choice(["none", "hanging", "horizontal"]), default="none", show_default=True,
               help="Weight of the silicones, applied before the pressure: hanging from the clamped base "
                    "(appendix A.2.2) or lying horizontal with gravity across the height.")
@@ -30,6 +34,7 @@ def simulate(
     increments: int,
     fidelity: str,
     unit_file: str | None,
+    library: str | None,
     gravity: str,
     out: str | None,
     as_json: bool,
@@ -42,8 +47,19 @@ def simulate(
     from pneumorph.io.files import strict_json, write_json
     from pneumorph.models import make_model
 
-    with P.blame("--orientation"):
-        design = parse_orientation(orientation)
+    if library is not None:
+        from pneumorph.geometry.alphabet import parse_design
+        from pneumorph.models.factory import load_library
+
+        if unit_file is not None:
+            raise click.UsageError("give either --unit or --library, not both")
+        with P.blame("--library"):
+            units = load_library(library, "unit library")
+        with P.blame("--orientation"):
+            design = parse_design(orientation, units).text
+    else:
+        with P.blame("--orientation"):
+            design = parse_orientation(orientation)
     if unit_file is not None:
         from pneumorph.geometry.unit import UnitSpec
 
@@ -53,6 +69,8 @@ def simulate(
     settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure, "increments": increments, "gravity": gravity}
     if unit_file is not None:
         settings["unit_file"] = unit_file
+    if library is not None:
+        settings["library"] = library
     model = make_model(len(design), settings)
     t0 = time.perf_counter()
 
