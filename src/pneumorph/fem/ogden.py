@@ -75,13 +75,12 @@ class OgdenCompressible:
         self._principal: tuple[FloatArray, tuple[FloatArray, FloatArray]] | None = None
 
     def kernel(self, F: FloatArray, tangent: bool = True, principal: tuple[FloatArray, FloatArray] | None = None,
-               pairs: Sequence[tuple[int, int]] | None = None,
-               dtype: type = np.float64) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+               pairs: Sequence[tuple[int, int]] | None = None) -> tuple[FloatArray, FloatArray | None, FloatArray]:
         """Stress, tangent and ``det F`` of deformation gradients stored points last, (3, 3, n).
 
         :func:`~pneumorph.fem.fast.kernels.ogden_3d` with this material's parameters and its
         thermal stretch (``principal`` is :func:`~pneumorph.fem.fast.kernels.principal_3d` of
-        ``F`` itself; ``J`` is that of the elastic part; ``dtype`` is the blocks' precision).
+        ``F`` itself; ``J`` is that of the elastic part).
 
         >>> P, A, J = OgdenCompressible([0.1], [2.0], 10.0, thermal_stretch=1.1).kernel(1.1 * np.eye(3)[..., None])
         >>> float(abs(P).max()) < 1e-12, round(float(J[0]), 12)   # free thermal expansion: no stress
@@ -89,12 +88,12 @@ class OgdenCompressible:
         """
         theta = self.thermal_stretch
         if theta == 1.0:
-            return ogden_3d(F, self.mu, self.alpha, self.bulk, tangent, principal, pairs, dtype)
+            return ogden_3d(F, self.mu, self.alpha, self.bulk, tangent, principal, pairs)
         # W(F) = theta^3 W_e(F / theta): C / theta^2 has the same eigenvectors
         scaled = None
         if principal is not None:
             scaled = (principal[0] / theta**2, principal[1])
-        P, A, J = ogden_3d(F / theta, self.mu, self.alpha, self.bulk, tangent, scaled, pairs, dtype)
+        P, A, J = ogden_3d(F / theta, self.mu, self.alpha, self.bulk, tangent, scaled, pairs)
         return P * theta**2, None if A is None else A * theta, J
 
     def _evaluate(self, F: FloatArray, tangent: bool) -> tuple[FloatArray, FloatArray | None]:

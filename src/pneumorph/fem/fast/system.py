@@ -474,7 +474,7 @@ class SolidSystem3D(FastSystem):
         from pneumorph.fem.ogden import OgdenCompressible
 
         if isinstance(umat, OgdenCompressible):
-            return lambda F, tangent, principal, dtype=np.float64: umat.kernel(F, tangent, principal, _UPPER, dtype)
+            return lambda F, tangent, principal: umat.kernel(F, tangent, principal, _UPPER)
         raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
     def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
@@ -523,9 +523,9 @@ class SolidSystem3D(FastSystem):
     def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
         Fp, principal = state
         c, q, n, _ = s.g.shape
-        dtype = self.tangent_dtype
         _, A, _ = s.kernel(Fp, True, principal)
         assert A is not None
+        dtype = self.tangent_dtype
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
         Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
         key = f"blocks-{np.dtype(dtype).name}"
