@@ -54,16 +54,13 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     )
     from pneumorph.io import strict_json
     from pneumorph.models.chain import build_table
-    from pneumorph.models.factory import load_library, make_model
+    from pneumorph.models.factory import make_model
 
     settings: dict = {"fidelity": fidelity}
     if unit_file:
         settings["unit_file"] = unit_file
     if library is not None:
-        if unit_file:
-            raise click.UsageError("give either --unit or --library, not both")
-        with P.blame("--library"):
-            load_library(library, "unit library")
+        P.library_option(library, unit_file)
         settings["library"] = library
     if pressure is not None:
         settings["pressure_kpa"] = pressure

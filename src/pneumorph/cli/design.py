@@ -117,12 +117,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         with P.blame("--unit"):
             UnitSpec.from_toml(unit_file)
     if library is not None:
-        from pneumorph.models.factory import load_library
-
-        if unit_file is not None:
-            raise click.UsageError("give either --unit or --library, not both")
-        with P.blame("--library"):
-            load_library(library, "unit library")
+        P.library_option(library, unit_file)
     config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
     changes: dict[str, Any] = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),

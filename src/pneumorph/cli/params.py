@@ -10,13 +10,16 @@ import contextlib
 import os
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from pneumorph import checks
 from pneumorph.errors import OutputPathError, PneumorphError, SettingsError
 from pneumorph.io.files import check_writable_dir, check_writable_file
+
+if TYPE_CHECKING:
+    from pneumorph.geometry.library import UnitLibrary
 
 
 def _name(param: click.Parameter | None) -> str:
@@ -232,3 +235,14 @@ def blame(option: str) -> Iterator[None]:
         yield
     except PneumorphError as exc:
         raise click.BadParameter(" ".join(str(exc).split()), param_hint=f"'{option}'") from None
+
+
+def library_option(library: str, unit_file: str | None) -> UnitLibrary:
+    """The :class:`~pneumorph.geometry.library.UnitLibrary` that ``--library`` names (``builtin`` or a
+    library file), refused as a usage error beside ``--unit`` or when it is no valid library."""
+    from pneumorph.models.factory import load_library
+
+    if unit_file is not None:
+        raise click.UsageError("give either --unit or --library, not both")
+    with blame("--library"):
+        return load_library(library, "unit library")

@@ -49,12 +49,8 @@ def simulate(
 
     if library is not None:
         from pneumorph.geometry.alphabet import parse_design
-        from pneumorph.models.factory import load_library
 
-        if unit_file is not None:
-            raise click.UsageError("give either --unit or --library, not both")
-        with P.blame("--library"):
-            units = load_library(library, "unit library")
+        units = P.library_option(library, unit_file)
         with P.blame("--orientation"):
             design = parse_design(orientation, units).text
     else:
