@@ -37,8 +37,6 @@ Examples
 
 from __future__ import annotations
 
-import hashlib
-import json
 import string
 import tomllib
 from collections.abc import Iterator, Mapping
@@ -52,6 +50,7 @@ import numpy as np
 from pneumorph.errors import GeometryError, UnitLibraryError
 from pneumorph.geometry.grid import cross_section_lines
 from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.provenance import digest
 
 #: the characters a unit type may be named by
 SYMBOLS = string.ascii_lowercase
@@ -274,8 +273,7 @@ class UnitLibrary:
         >>> len(builtin_library().fingerprint())
         16
         """
-        text = json.dumps(self.to_dict(), sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
+        return digest(self.to_dict())
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "unit library", base: Path | None = None) -> UnitLibrary:

@@ -11,7 +11,7 @@ from pneumorph.io.files import (
     write_json,
 )
 from pneumorph.io.lock import RunLock
-from pneumorph.io.provenance import provenance
+from pneumorph.io.provenance import digest, provenance
 from pneumorph.io.vtk import write_vtk_series
 
 __all__ = [
@@ -20,6 +20,7 @@ __all__ = [
     "atomic_write_text",
     "check_writable_dir",
     "check_writable_file",
+    "digest",
     "json_safe",
     "provenance",
     "strict_json",

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import datetime as _dt
+import hashlib
+import json
 import platform
 import sys
 from importlib.metadata import PackageNotFoundError, version
@@ -38,3 +40,16 @@ def provenance(**extra: Any) -> dict[str, Any]:
         "dependencies": deps,
         **extra,
     }
+
+
+def digest(description: Any) -> str:
+    """A short stable hash of a JSON-able description: what identifies a model, a unit library
+    or a table's source in fingerprints and cache keys (sorted keys; anything else as its text).
+
+    >>> digest({"b": 1, "a": [1.5, None]}) == digest({"a": [1.5, None], "b": 1})
+    True
+    >>> len(digest({}))
+    16
+    """
+    text = json.dumps(description, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]

@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError, LocalityError, UnitLibraryError
 from pneumorph.geometry.library import UnitLibrary
-from pneumorph.io.provenance import provenance
+from pneumorph.io.provenance import digest, provenance
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.models.windows import (
     BASE,
@@ -467,8 +467,7 @@ def source_description(model: Any) -> dict[str, Any]:
 
 def source_key(model: Any) -> str:
     """Hash of :func:`source_description`: equal for the same unit, materials, ramp, fidelity."""
-    text = json.dumps(source_description(model), sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return digest(source_description(model))
 
 
 def check_source(table: ChainTable, model: Any) -> None:

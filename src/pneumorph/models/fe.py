@@ -15,8 +15,6 @@ pressure is ramped (the hanging test of appendix A.2.2).
 from __future__ import annotations
 
 import copy
-import hashlib
-import json
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field, replace
@@ -33,6 +31,7 @@ from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.provenance import digest
 from pneumorph.materials import get, get_filler
 from pneumorph.materials.filler import FillerLaw
 from pneumorph.materials.material import Material
@@ -265,8 +264,7 @@ class FEModel:
         return other
 
     def fingerprint(self) -> str:
-        text = json.dumps(self.describe(), sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
+        return digest(self.describe())
 
     def pressures(self) -> FloatArray:
         return self.ramp.pressures()

@@ -16,13 +16,12 @@ validation of the optimised units).
 
 from __future__ import annotations
 
-import hashlib
-import json
 from dataclasses import replace
 from typing import Any
 
 from pneumorph import checks
 from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.provenance import digest
 from pneumorph.models.fe import Full3D, RampSpec
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.unitopt.measures import MEASURES_REVISION, UnitMeasures, measure
@@ -75,8 +74,7 @@ class UnitProbe:
         return {"probe": "unitopt", "measures_revision": MEASURES_REVISION, "model": self.model.describe()}
 
     def fingerprint(self) -> str:
-        text = json.dumps(self.describe(), sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
+        return digest(self.describe())
 
     def pressures(self) -> FloatArray:
         return self.model.pressures()
