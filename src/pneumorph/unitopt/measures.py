@@ -221,15 +221,13 @@ def principal_strains(mesh: ActuatorMesh, displacement: FloatArray, region: str)
     """
     import felupe as fem
 
+    from pneumorph.fem.body import regions_of
+
     cells = mesh.cells[mesh.regions[region]]
     if not len(cells):
         return 0.0
-    if mesh.dim == 3:
-        fmesh = fem.Mesh(mesh.points, cells, "hexahedron20" if cells.shape[1] == 20 else "hexahedron")
-        fe_region = (fem.RegionQuadraticHexahedron(fmesh) if cells.shape[1] == 20 else fem.RegionHexahedron(fmesh))
-    else:
-        fmesh = fem.Mesh(mesh.points, cells, "quad8" if cells.shape[1] == 8 else "quad")
-        fe_region = fem.RegionQuadraticQuad(fmesh) if cells.shape[1] == 8 else fem.RegionQuad(fmesh)
+    Region = regions_of(mesh.cell_type)[0]  # the models' region of this cell type
+    fe_region = Region(fem.Mesh(mesh.points, cells, mesh.cell_type))
     field = fem.FieldContainer([fem.Field(fe_region, dim=mesh.dim, values=np.asarray(displacement, dtype=float))])
     grad = field.extract(grad=True, sym=False, add_identity=True)[0]  # (dim, dim, q, c)
     f = np.moveaxis(np.asarray(grad), (0, 1), (-2, -1))
