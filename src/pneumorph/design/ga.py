@@ -37,6 +37,7 @@ from pneumorph.design.targets import Objective, Sense
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.response import ActuatorModel
+from pneumorph.models.windows import design_strings
 
 _FITNESS = {"min": "PneumorphFitnessMin", "max": "PneumorphFitnessMax"}
 _INDIVIDUAL = {"min": "PneumorphIndividualMin", "max": "PneumorphIndividualMax"}
@@ -258,10 +259,8 @@ def make_toolbox(n_units: int, sense: Sense, config: GAConfig, rng: random.Rando
 
 def _design(ind: Sequence[int], symbols: Sequence[str] = ()) -> str:
     """A genome as design text: 0/1 digits, or over a library's ``symbols`` the letter of the type,
-    upper case for orientation 1 (code ``2t + o``)."""
-    if not symbols:
-        return "".join(str(int(b)) for b in ind)
-    return "".join(symbols[int(b) // 2].upper() if int(b) % 2 else symbols[int(b) // 2] for b in ind)
+    upper case for orientation 1 (code ``2t + o``), as the chain tables write designs."""
+    return design_strings(np.asarray([ind], dtype=np.uint8), symbols)[0]
 
 
 def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[int, int, int],
