@@ -10,11 +10,12 @@ from pneumorph.io.files import (
     strict_json,
     write_json,
 )
-from pneumorph.io.lock import RunLock
+from pneumorph.io.lock import FileLock, RunLock
 from pneumorph.io.provenance import digest, provenance
 from pneumorph.io.vtk import write_vtk_series
 
 __all__ = [
+    "FileLock",
     "RunLock",
     "atomic_write_bytes",
     "atomic_write_text",

@@ -1,16 +1,20 @@
-"""A lock on a run folder, so that two runs never write into the same folder at once.
+"""Locks on files, so that two processes never write the same thing at once.
 
-The lock is a file ``.pneumorph.lock`` in the folder holding the process id, the host and
-the start time (UTC) of the run that holds it, one ``key=value`` a line. Where the
-operating system offers ``fcntl.flock`` (Linux, macOS, the BSDs) the file is locked with
-``LOCK_EX | LOCK_NB``: the lock belongs to the open file, so the operating system releases
-it when the process ends in any way (even ``kill -9``) and a lock file left behind by a
-dead run is no obstacle - the next run takes it over. Elsewhere the lock is the exclusive
-creation of the file; a lock file of a process that no longer runs on this host is then
-recognised by its process id and removed.
+A lock is a file (a run folder's ``.pneumorph.lock``, a chain table's ``<table>.lock``)
+holding the process id, the host and the start time (UTC) of the process that holds it, one
+``key=value`` a line. Where the operating system offers ``fcntl.flock`` (Linux, macOS, the
+BSDs) the file is locked with ``LOCK_EX | LOCK_NB``: the lock belongs to the open file, so
+the operating system releases it when the process ends in any way (even ``kill -9``) and a
+lock file left behind by a dead process is no obstacle - the next one takes it over.
+Elsewhere the lock is the exclusive creation of the file; a lock file of a process that no
+longer runs on this host is then recognised by its process id and removed.
 
-Releasing the lock removes the file (while still holding it: a run that opened the old
+Releasing the lock removes the file (while still holding it: a process that opened the old
 file in that instant sees that it was replaced and tries again).
+
+:class:`FileLock` is the mechanism; it either refuses a lock that another process holds or,
+with ``wait=True``, waits for it (saying once whom it waits for). :class:`RunLock` holds a
+run folder for one run and refuses a second one.
 
 Examples
 --------
@@ -21,6 +25,10 @@ Examples
 (True, True)
 >>> (folder / ".pneumorph.lock").exists()
 False
+>>> table = FileLock(folder / "table.json.lock", "chain table table.json")
+>>> table.acquire(wait=True).held, FileLock.read(table.path)["pid"] == str(os.getpid())
+(True, True)
+>>> table.release()
 """
 
 from __future__ import annotations
@@ -30,11 +38,13 @@ import errno
 import os
 import socket
 import sys
+import time
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Self
 
-from pneumorph.errors import RunFolderError
+from pneumorph.errors import OutputPathError, PneumorphError, RunFolderError
 
 try:
     import fcntl
@@ -43,9 +53,16 @@ except ImportError:  # pragma: no cover - Windows
 
 LOCK_NAME = ".pneumorph.lock"
 _BUSY = {errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK}
+#: seconds between two looks at a lock that a waiting process wants
+POLL_SECONDS = 0.25
 
 
-def _describe(info: dict[str, str]) -> str:
+def describe_holder(info: dict[str, str]) -> str:
+    """The holder of a lock as text: ``pid 12 on host, started 2026-...`` (from :meth:`FileLock.read`).
+
+    >>> describe_holder({"pid": "1", "host": "h", "started": "s"})
+    'pid 1 on h, started s'
+    """
     pid = info.get("pid", "?")
     host = info.get("host", "?")
     started = info.get("started", "?")
@@ -85,25 +102,29 @@ def _pid_alive(pid: int) -> bool | None:
     return True
 
 
-class RunLock:
-    """Hold a run folder for one run: a context manager (or :meth:`acquire` / :meth:`release`).
+class FileLock:
+    """An exclusive lock held as the file ``path``: a context manager (or :meth:`acquire` / :meth:`release`).
 
     Parameters
     ----------
-    folder : str or Path
-        The run folder; it must exist.
+    path : str or Path
+        The lock file; its folder must exist.
+    what : str, optional
+        What the lock guards, for messages (default: the lock file).
 
     Raises
     ------
-    RunFolderError
-        On entering, if another run (of this or another process) holds the folder, naming
-        the folder and the holder's pid, host and start; or if the lock file cannot be
-        written.
+    OutputPathError
+        On acquiring without waiting, if another process holds the lock (naming its pid,
+        host and start); or if the lock file cannot be written.
     """
 
-    def __init__(self, folder: str | Path) -> None:
-        self.folder = Path(folder)
-        self.path = self.folder / LOCK_NAME
+    #: the error of a lock that is busy or cannot be written
+    error: type[PneumorphError] = OutputPathError
+
+    def __init__(self, path: str | Path, what: str | None = None) -> None:
+        self.path = Path(path)
+        self.what = what or str(self.path)
         self._fd: int | None = None
         self._created = False
 
@@ -113,10 +134,10 @@ class RunLock:
         return self._fd is not None or self._created
 
     @staticmethod
-    def holder(folder: str | Path) -> dict[str, str]:
-        """What the lock file of ``folder`` says (pid, host, started); empty if none or unreadable."""
+    def read(path: str | Path) -> dict[str, str]:
+        """What the lock file ``path`` says (pid, host, started); empty if none or unreadable."""
         try:
-            text = (Path(folder) / LOCK_NAME).read_text(encoding="utf-8", errors="replace")
+            text = Path(path).read_text(encoding="utf-8", errors="replace")
         except OSError:
             return {}
         info = {}
@@ -126,30 +147,49 @@ class RunLock:
                 info[key.strip()] = value.strip()
         return info
 
-    def _busy(self) -> RunFolderError:
-        info = self.holder(self.folder)
-        who = _describe(info) if info else "its pid is not written yet"
-        return RunFolderError(f"run folder {self.folder} is in use by another run ({who}); wait for it to end "
-                              "or choose another output folder")
+    def holder_text(self) -> str:
+        """Who holds the lock now, as text (or that its pid is not written yet)."""
+        info = self.read(self.path)
+        return describe_holder(info) if info else "its pid is not written yet"
+
+    def _busy(self, exclusive: bool = False) -> PneumorphError:
+        return self.error(f"{self.what} is locked by another process ({self.holder_text()})")
+
+    def _cannot(self, exc: OSError) -> PneumorphError:
+        return self.error(f"{self.what}: cannot write its lock file {self.path} ({exc.strerror or exc})")
 
     def _content(self) -> bytes:
         started = datetime.now(UTC).isoformat(timespec="seconds")
         return f"pid={os.getpid()}\nhost={socket.gethostname()}\nstarted={started}\n".encode()
 
-    def _cannot(self, exc: OSError) -> RunFolderError:
-        return RunFolderError(f"run folder {self.folder}: cannot write its lock file ({exc.strerror or exc})")
+    def acquire(self, wait: bool = False, on_wait: Callable[[str], None] | None = None) -> Self:
+        """Take the lock; returns self.
 
-    def acquire(self) -> RunLock:
-        """Take the lock (see the class); returns self."""
+        Parameters
+        ----------
+        wait : bool
+            If another process holds the lock, wait until it gives it back (looking every
+            :data:`POLL_SECONDS`) instead of refusing it.
+        on_wait : callable, optional
+            Called once, with the holder as text (:func:`describe_holder`), when the lock has
+            to be waited for.
+        """
         if self.held:
-            raise RunFolderError(f"run folder {self.folder} is already held by this lock")
-        if fcntl is not None:
-            self._acquire_flock()
-        else:  # pragma: no cover - exercised on Linux by a test that hides fcntl
-            self._acquire_exclusive()
-        return self
+            raise self.error(f"{self.what} is already held by this lock")
+        told = False
+        while True:
+            taken = self._try_flock() if fcntl is not None else self._try_exclusive()
+            if taken:
+                return self
+            if not wait:
+                raise self._busy(exclusive=fcntl is None)
+            if on_wait is not None and not told:
+                on_wait(self.holder_text())
+                told = True
+            time.sleep(POLL_SECONDS)
 
-    def _acquire_flock(self) -> None:
+    def _try_flock(self) -> bool:
+        """Take the lock if it is free (True); False if another process holds it."""
         for _ in range(100):
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -160,7 +200,7 @@ class RunLock:
             except OSError as exc:
                 os.close(fd)
                 if exc.errno in _BUSY:
-                    raise self._busy() from None
+                    return False
                 raise self._cannot(exc) from None
             try:
                 same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
@@ -177,23 +217,21 @@ class RunLock:
                 os.close(fd)
                 raise self._cannot(exc) from None
             self._fd = fd
-            return
-        raise RunFolderError(f"run folder {self.folder}: its lock file keeps being replaced; try again")
+            return True
+        raise self.error(f"{self.what}: its lock file {self.path} keeps being replaced; try again")
 
-    def _acquire_exclusive(self) -> None:
+    def _try_exclusive(self) -> bool:
+        """As :meth:`_try_flock`, by the exclusive creation of the file (a stale file of a dead process is removed)."""
         for _ in range(2):
             try:
                 fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
             except FileExistsError:
-                info = self.holder(self.folder)
+                info = self.read(self.path)
                 stale = False
                 if info.get("host") == socket.gethostname() and info.get("pid", "").isdigit():
                     stale = _pid_alive(int(info["pid"])) is False
                 if not stale:
-                    raise RunFolderError(
-                        f"run folder {self.folder} is in use by another run ({_describe(info) if info else '?'}); "
-                        f"wait for it to end, or remove {self.path} if that run is over"
-                    ) from None
+                    return False
                 self.path.unlink(missing_ok=True)  # its process is gone
                 continue
             except OSError as exc:
@@ -203,8 +241,8 @@ class RunLock:
             finally:
                 os.close(fd)
             self._created = True
-            return
-        raise self._busy()
+            return True
+        return False
 
     def release(self) -> None:
         """Give the lock back and remove the lock file (nothing if not held)."""
@@ -231,3 +269,44 @@ class RunLock:
     def __del__(self) -> None:  # pragma: no cover - a lock object dropped without release
         with contextlib.suppress(Exception):  # nothing to release at interpreter shutdown
             self.release()
+
+
+class RunLock(FileLock):
+    """Hold a run folder for one run: a context manager (or :meth:`acquire` / :meth:`release`).
+
+    Parameters
+    ----------
+    folder : str or Path
+        The run folder; it must exist.
+
+    Raises
+    ------
+    RunFolderError
+        On entering, if another run (of this or another process) holds the folder, naming
+        the folder and the holder's pid, host and start; or if the lock file cannot be
+        written.
+    """
+
+    error = RunFolderError
+
+    def __init__(self, folder: str | Path) -> None:
+        self.folder = Path(folder)
+        super().__init__(self.folder / LOCK_NAME, f"run folder {self.folder}")
+
+    @staticmethod
+    def holder(folder: str | Path) -> dict[str, str]:
+        """What the lock file of ``folder`` says (pid, host, started); empty if none or unreadable."""
+        return FileLock.read(Path(folder) / LOCK_NAME)
+
+    def _busy(self, exclusive: bool = False) -> PneumorphError:
+        info = self.holder(self.folder)
+        if exclusive:
+            return RunFolderError(
+                f"run folder {self.folder} is in use by another run ({describe_holder(info) if info else '?'}); "
+                f"wait for it to end, or remove {self.path} if that run is over")
+        who = describe_holder(info) if info else "its pid is not written yet"
+        return RunFolderError(f"run folder {self.folder} is in use by another run ({who}); wait for it to end "
+                              "or choose another output folder")
+
+    def _cannot(self, exc: OSError) -> PneumorphError:
+        return RunFolderError(f"run folder {self.folder}: cannot write its lock file ({exc.strerror or exc})")
