@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.design.fitness import profile_error_array, score, tip_value_array
+from pneumorph.design.reach import CurveRange, profile_rest, reach_of, tip_goal_rest
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
@@ -59,6 +60,9 @@ CHUNK = 8192
 """Designs scored at once (memory: about 2 kB per design and level)."""
 MAX_NODES = 500_000
 """Most open prefixes the branch-and-bound keeps at one depth."""
+REFINE_AT = 20_000
+"""Open prefixes of a profile target above which the bound on the centres still to place is added
+(below, the partial sums of Eq 4.1 prune well enough, and the support functions cost more than they save)."""
 KEEP_GEOMETRY_UNITS = 15
 """Longest actuator whose prefix geometry is kept between queries (15 units: about 50 MB;
 the memory doubles with every unit)."""
@@ -284,33 +288,63 @@ def _reach_box(table: Any, state: dict[str, Any], remaining: int, axes: str = "x
     return xlo, xhi, ylo, yhi
 
 
-def _prefix_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], remaining: int) -> FloatArray:
-    """A lower bound on the cost of every completion of each prefix, shape (m,)."""
+def _box_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], remaining: int) -> FloatArray:
+    """Per level, a lower bound on the cost of every completion from the chords' heading intervals (m, k)."""
     table = chain.table
-    if isinstance(objective, ProfileTarget):
-        return np.sqrt(state["sum"].min(axis=1))
     name = objective.name
     if name == "max-curl":  # the rest of the turns and the end turn at their largest
         turns = np.degrees(remaining * table.turn.max(axis=0) + table.end.max(axis=0))
-        return (-(np.degrees(state["angle"]) + turns)).min(axis=1)
+        return -(np.degrees(state["angle"]) + turns)
     axes = {"max-x": "x", "min-x": "x", "max-y": "y", "min-y": "y"}.get(name, "xy")
     xlo, xhi, ylo, yhi = _reach_box(table, state, remaining, axes)
     ylo, yhi = ylo - table.tip_ref[1], yhi - table.tip_ref[1]
     if name == "max-x":
-        c = -xhi
-    elif name == "min-x":
-        c = xlo
-    elif name == "max-y":
-        c = -yhi
-    elif name == "min-y":
-        c = ylo
-    else:  # distance to the base or to a point: from the point to the box
-        q = (0.0, 0.0) if name == "min-distance" else objective.point
-        assert q is not None
-        dx = np.maximum(np.maximum(xlo - q[0], q[0] - xhi), 0.0)
-        dy = np.maximum(np.maximum(ylo - q[1], q[1] - yhi), 0.0)
-        c = np.hypot(dx, dy)
-    return c.min(axis=1)
+        return -xhi
+    if name == "min-x":
+        return xlo
+    if name == "max-y":
+        return -yhi
+    if name == "min-y":
+        return ylo
+    # distance to the base or to a point: from the point to the box
+    q = (0.0, 0.0) if name == "min-distance" else cast(TipGoal, objective).point
+    assert q is not None
+    dx = np.maximum(np.maximum(xlo - q[0], q[0] - xhi), 0.0)
+    dy = np.maximum(np.maximum(ylo - q[1], q[1] - yhi), 0.0)
+    return np.hypot(dx, dy)
+
+
+def _uses_reach(chain: ChainModel, p: int) -> bool:
+    """Whether the support functions bound a prefix of ``p`` units: its next window holds no base symbol."""
+    return 2 * chain.table.window <= p < chain.n_units and _reach_enabled(chain)
+
+
+def _reach_enabled(chain: ChainModel) -> bool:
+    return chain.n_units >= 2 * chain.table.window + 2
+
+
+def _prefix_bound(chain: ChainModel, objective: Objective, bits: NDArray[np.uint8], state: dict[str, Any],
+                  placed: int, curve: CurveRange | None = None) -> FloatArray:
+    """A lower bound on the cost of every completion of each prefix, shape (m,).
+
+    The partial sums of Eq 4.1 (profiles) or the box of the remaining chords' heading intervals
+    (tip goals), and, once the prefix's next window holds no base symbol, the bound on the
+    units still to place from the support functions of their displacements
+    (:mod:`pneumorph.design.reach`).
+    """
+    n = chain.n_units
+    p = bits.shape[1]
+    use = _uses_reach(chain, p)
+    if isinstance(objective, ProfileTarget):
+        total = state["sum"]
+        if use and curve is not None and objective.coordinates == "cartesian":
+            total = total + profile_rest(reach_of(chain, "centre"), chain.table.heights, curve, bits, state["point"],
+                                         state["angle"], placed, n, chain.table.window)
+        return np.sqrt(total.min(axis=1))
+    if not use:
+        return _box_bound(chain, objective, state, n + 1 - placed).min(axis=1)
+    return tip_goal_rest(reach_of(chain, "tip"), objective.name, objective.point, float(chain.table.tip_ref[1]), bits,
+                         state["point"], state["angle"], n).min(axis=1)
 
 
 # -- the prefix tree: chords placed unit by unit ---------------------------------------------
@@ -613,6 +647,10 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     e = errors["centre"]
     slope = _target_slope(chain, prof, errors) if profile else 0.0
     bits, st = _seed_prefixes(chain, polar)
+    curve, refine = None, False
+    if profile and not polar and np.isfinite(slope) and (np.isfinite(threshold) or beam is not None):
+        reach = float(table.length.max()) * (n + 1) + float(e.max())
+        curve = CurveRange.of(lambda x: prof.curve(x, length), -reach, reach, slope)
     if profile:
         st["sum"] = np.zeros((len(bits), k))
     if polar:
@@ -629,8 +667,14 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                         st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
-            bound = _prefix_bound(chain, objective, st, n + 1 - placed)
+            bound = _prefix_bound(chain, objective, bits, st, placed)
             keep = bound < threshold
+            if curve is not None and (refine or keep.sum() > REFINE_AT) and _uses_reach(chain, p):
+                # the partial sums leave too many prefixes open: add the bound on the centres still to place
+                refine = True
+                bound[keep] = _prefix_bound(chain, objective, bits[keep], {key: v[keep] for key, v in st.items()},
+                                            placed, curve)
+                keep = bound < threshold
             if beam is not None and keep.sum() > beam:
                 keep = np.zeros(len(bits), dtype=bool)
                 keep[np.argpartition(bound, beam)[:beam]] = True
