@@ -112,12 +112,16 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     unit = tmp_path / "coarse.toml"
     unit.write_text("[unit]\nelement_size = 3.0\n")
     cache = tmp_path / "cache" / "c.sqlite"
-    args = ["design", "--model", "2d", "--unit", str(unit), "--pressure", "20", "--units", "6", "--executor", "serial",
+    args = ["design", "--model", "2d", "--unit", str(unit), "--pressure", "20", "--units", "7", "--executor", "serial",
             "--target", "cos", "--amplitude", "4", "--cache", str(cache), "--out", str(tmp_path / "run"), "--json"]
     assert main(args) == 0
     captured = capsys.readouterr()
     first = json.loads(captured.out)
-    assert "covering designs" in captured.err and "held-out" in captured.err  # progress of the build
+    # the plan and its estimate before the first solve, then the build's progress
+    plan = captured.err.index("building the chain table of the 2d model (unit with element_size 3, 2-20 kPa in 10 "
+                              "levels)")
+    assert "22-59 FE solves, estimated" in captured.err and plan < captured.err.index("covering: 1/")
+    assert "held-out" in captured.err and "building the tolerance tables" in captured.err
     kept = sorted((tmp_path / "cache" / "chain-tables").glob("chain-2d-*.json"))
     tables = [p for p in kept if "tolerance" not in p.name]
     assert len(tables) == 1 and [p.name for p in kept if "tolerance" in p.name] == [
@@ -145,7 +149,7 @@ def test_a_model_the_chain_cannot_represent_falls_back_to_the_ga(tmp_path: Path,
     monkeypatch.setattr(chaintables, "build_table", no_locality)
     unit = tmp_path / "coarse.toml"
     unit.write_text("[unit]\nelement_size = 3.0\n")
-    args = ["design", "--unit", str(unit), "--pressure", "10", "--units", "3", "--pop", "4", "--gen", "1",
+    args = ["design", "--unit", str(unit), "--pressure", "10", "--units", "7", "--pop", "4", "--gen", "1",
             "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"), "--json"]
     monkeypatch.chdir(tmp_path)
     assert main(args) == 0

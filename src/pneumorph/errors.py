@@ -220,6 +220,13 @@ class ChainTableError(PneumorphError, ValueError):
     """A chain table that cannot serve: damaged, of another model, or too wide a window."""
 
 
+class MissingTableError(ChainTableError):
+    """A table a run needs is neither shipped nor kept, and the run may not build it (``--no-build``).
+
+    The message names the table and how to build it.
+    """
+
+
 class LocalityError(SearchConfigError):
     """The chain model cannot represent this model (gravity, or units that interact further)."""
 

@@ -78,6 +78,9 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--out", metavar="DIR", type=P.OutputDir(),
               help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
 @click.option("--overwrite", is_flag=True, help="Start afresh in a folder that holds another run.")
+@click.option("--no-build", "no_build", is_flag=True,
+              help="Certified search: stop with a message instead of building a chain table (or tolerance tables) "
+                   "that no shipped or kept table serves.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
            periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
@@ -86,7 +89,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
            robust: str | None, robust_samples: int | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
            unit_file: str | None, library: str | None, cache: str | None, out: str | None, overwrite: bool,
-           as_json: bool) -> None:
+           no_build: bool, as_json: bool) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
 
     Without options: a 15-unit actuator for the target "sin, amplitude 10 mm, one period":
@@ -189,7 +192,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
 
     try:
         result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
-                            overwrite=overwrite, on_message=on_message)
+                            overwrite=overwrite, on_message=on_message, build=not no_build)
     except LocalityError as exc:  # the chain cannot represent this model: nothing was written
         if config.search != "certified":
             raise
@@ -215,6 +218,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             },
             "hall_of_fame": [{"design": c.design, "pressure_kpa": _kpa(c.pressure), "fitness": c.value,
                               "failure": c.failure} for c in result.hall_of_fame],
+            "search": result.search, "search_note": result.search_note,
             "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
             "cache_entries_rejected": result.rejected,
             "robustness": None if result.robustness is None else

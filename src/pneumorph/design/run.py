@@ -32,11 +32,15 @@ Nothing a run writes is lost or mixed up:
 
 - one run at a time: the folder is held by a :class:`~pneumorph.io.RunLock`
   (``.pneumorph.lock``, naming the pid, host and start of its run) from before anything
-  is written to the end; a second run into it is refused with :class:`RunFolderError`.
-  A lock left by a killed run is released by the operating system.
-- a start that fails (settings, model, chain table, cache, executor, another run in the
-  folder) leaves the folder as it was: it is created, and anything written, only once every
-  check has passed (and removed again if the run created it and then failed at once).
+  is written or built (a chain table built on first use) to the end; a second run into it
+  is refused with :class:`RunFolderError` before it solves anything. A lock left by a
+  killed run is released by the operating system.
+- a start that fails (settings, model, chain table, a table it may not build, cache,
+  executor, another run in the folder) leaves the folder as it was: the checks that need no
+  solve come before the folder is touched; the folder is then created (if missing) and
+  claimed, and a start that still fails (a table build the chain cannot represent, say)
+  releases it and removes the lock file and the folders it created; a result is written
+  only once every check has passed.
 - every result file is written to a temporary file and renamed over the old one
   (``config.toml``, ``report.md``, the JSON and CSV files, the figures); JSON is strict.
 - ``generations.csv`` is appended to, never truncated by a resumed run (see
@@ -58,6 +62,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from pneumorph.design.certified import (
     CertifiedResult,
     certified_search,
@@ -68,10 +74,12 @@ from pneumorph.design.exhaustive import run_exhaustive
 from pneumorph.design.figures import plot_convergence, plot_profile
 from pneumorph.design.fitness import Score
 from pneumorph.design.ga import GenerationStats, run_ga
+from pneumorph.design.planning import plan_search, planned_workers
 from pneumorph.design.robustness import chain_robustness, fe_robustness, robust_ranking, robust_winner
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import (
+    MissingTableError,
     OutputPathError,
     PneumorphError,
     RunFolderError,
@@ -93,10 +101,10 @@ from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 from pneumorph.io.lock import RunLock
 from pneumorph.io.provenance import provenance as make_provenance
 from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table, table_for
+from pneumorph.models.chaintables import evaluator_workers, serve_table, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
-from pneumorph.sensitivity.robust import tolerance_tables_for
+from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for
 from pneumorph.sensitivity.tolerances import Tolerance
 
 _COMPARED = ("design", "ga", "model")
@@ -152,6 +160,12 @@ class RunResult:
     rejected : int
         Cache entries that failed their checksum and were solved again instead of used.
     files : tuple of Path
+    search : str
+        The search that ran: the config's, or for a certified run of an actuator shorter
+        than its chain table needs, ``"exhaustive"``.
+    search_note : str
+        A certified run's choice: its table and the levels it scores, or why it searched
+        exhaustively (and the estimated cost).
     """
 
     status: str
@@ -168,6 +182,8 @@ class RunResult:
     rejected: int = 0
     robustness: dict[str, Any] | None = None
     robust_winner: Candidate | None = None
+    search: str = ""
+    search_note: str = ""
 
     @property
     def best(self) -> Candidate | None:
@@ -367,6 +383,7 @@ def run_design(
     overwrite: bool = False,
     figures: bool = True,
     on_message: Any = None,
+    build: bool = True,
 ) -> RunResult:
     """Run a design search and write its folder.
 
@@ -390,6 +407,18 @@ def run_design(
         old run's files are removed (:func:`run_files`); other files in the folder stay.
     figures : bool
         Draw the figures (and, for an FE model, solve the winner again for its shape and VTK).
+    build : bool
+        Whether a certified search may build a chain table (or tolerance tables) that no
+        shipped or kept table serves; a build first says what it builds and its estimated
+        time. False: such a run stops with :class:`MissingTableError` before anything is
+        written.
+
+    A certified search picks its table and its search before the folder is touched
+    (:func:`pneumorph.design.planning.plan_search`): a table of the model's source, or of a
+    longer ramp of the same step restricted to the levels at or below the model's pressure
+    (the FE verifications then use the model remade with those levels); for an actuator
+    shorter than the table needs, the FE exhaustive search of all its designs instead
+    (:attr:`RunResult.search` and :attr:`RunResult.search_note` say which and why).
 
     Returns
     -------
@@ -404,6 +433,8 @@ def run_design(
         cannot be read, or another run is writing into it now (its pid, host and start).
     OutputPathError
         The folder cannot be created or written.
+    MissingTableError
+        ``build`` is False and the run needs a table that no shipped or kept table serves.
 
     Any error raised before the run starts leaves the folder as it was. A
     ``KeyboardInterrupt`` (or a subclass) during the search or while the results are
@@ -413,21 +444,31 @@ def run_design(
     if int(model.n_units) != config.units:
         raise SearchConfigError(f"the model has {model.n_units} units but the config asks for {config.units}")
     objective = config.make_objective()
-    fingerprint = model.fingerprint()
-    _check_folder(folder, config, fingerprint, overwrite)  # checked again under the lock
     say = on_message or (lambda text: None)
+    table_dir = _table_dir(config, cache)
+    search, plan = config.search, None
     if config.search == "certified":
         if getattr(model, "gravity", None) is not None:
             from pneumorph.errors import LocalityError
 
             raise LocalityError("the certified search needs a free actuator (its chain model does not hold under "
                                 "gravity); search with --search ga or exhaustive")
-        if config.units < 3:
-            raise SearchConfigError(f"the certified search needs at least 3 units (a window of +-1), got "
-                                    f"{config.units}; use --search exhaustive")
-        if config.chain_table is not None:  # check a given table before anything is written
-            table = table_for(model, _training(model), path=config.chain_table)
-            ChainModel(table, config.units)
+        # which table serves the model (and the model remade with its levels), or the FE exhaustive search of a
+        # short actuator, or a build (refused here with build=False): decided before anything is written
+        workers = evaluator_workers(evaluator) if evaluator is not None else planned_workers(config)
+        plan = plan_search(config, model, table_dir, build=build, workers=workers)
+        search = plan.search
+        if plan.served is not None:
+            model = plan.served.model  # the FE verifications report the chain's levels
+            tolerance = Tolerance(config.tolerance) if _tolerance_tables_wanted(config, model) else None
+            if not build and tolerance is not None and find_tolerance_tables(model, tolerance, table_dir) is None:
+                raise MissingTableError(
+                    f"--no-build: the mould tolerance tables of this unit (+-{config.tolerance:g} mm) are neither "
+                    f"shipped nor kept in {table_dir}; run without --no-build to build them "
+                    f"({tolerance_plan_text(model, tolerance, workers, what=False)}), or leave the robustness "
+                    "report out with --tolerance 0")
+    fingerprint = model.fingerprint()
+    _check_folder(folder, config, fingerprint, overwrite)  # checked again under the lock
 
     own_evaluator, own_cache = evaluator is None, cache is None
     inner: Evaluator | None = evaluator
@@ -454,20 +495,9 @@ def run_design(
     try:
         inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
         cache = cache or EvaluationCache(config.cache or default_cache_path())
-        table_dir = None if cache.path == ":memory:" else Path(cache.path).parent / "chain-tables"
         cached = CachedEvaluator(inner, cache)
-        chain = None
-        tol_tables = None
-        if config.search == "certified":
-            # the table (built on first use, through the cache) before the folder is claimed: a model the
-            # chain cannot represent leaves nothing behind
-            table = table_for(model, _training(model), folder=table_dir, path=config.chain_table,
-                              evaluator=cached, on_progress=say)
-            chain = ChainModel(table, config.units)
-            # the unit's tolerance tables, likewise (of one unit type: none over a library of several yet)
-            if config.tolerance > 0 and hasattr(model, "variant") and not getattr(model, "mixed", False):
-                tol_tables = tolerance_tables_for(model, Tolerance(config.tolerance), folder=table_dir,
-                                                  evaluator=cached, on_progress=say)
+        # the folder is claimed before any table is built: a second run into it is refused at once; a start that
+        # fails from here on releases it and removes what this run created (the lock file, a new folder)
         made = _created_top(folder)
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -476,16 +506,36 @@ def run_design(
         lock = RunLock(folder).acquire()
         # under the lock, no other run can have written the folder since the first look
         resumed = _check_folder(folder, config, fingerprint, overwrite)
+        chain = None
+        tol_tables = None
+        if plan is not None:
+            say(plan.note)
+        if search == "certified":
+            assert plan is not None
+            if plan.served is not None:
+                table = plan.served.table
+            else:  # built now (its plan and estimate said first), under the table's lock; a model the chain
+                # cannot represent raises LocalityError and leaves nothing behind
+                table = table_for(model, _training(model), folder=table_dir, evaluator=cached, on_progress=say)
+            chain = ChainModel(table, config.units)
+            # the unit's tolerance tables, likewise (of one unit type: none over a library of several yet)
+            if _tolerance_tables_wanted(config, model):
+                tol_tables = tolerance_tables_for(model, Tolerance(config.tolerance), folder=table_dir,
+                                                  evaluator=cached, on_progress=say)
         if overwrite:
             _remove_run_files(folder)
         prov = provenance(config, model)
         prov["resumed"] = resumed
+        if search != config.search:
+            prov["search"] = search
         if chain is not None:
             prov["chain_table"] = chain.table.fingerprint()
+            if "restricted_from" in chain.table.source:
+                prov["chain_table_restricted_from"] = chain.table.source["restricted_from"]
         atomic_write_text(folder / "config.toml", to_toml({**config.to_dict(), "provenance": prov}))
         started = True
         start = time.perf_counter()
-        log = _GenerationLog(folder / "generations.csv", resume=resumed) if config.search == "ga" else None
+        log = _GenerationLog(folder / "generations.csv", resume=resumed) if search == "ga" else None
 
         def on_gen(stats: GenerationStats) -> None:
             log(stats)  # type: ignore[misc]
@@ -500,10 +550,10 @@ def run_design(
         robustness: dict[str, Any] | None = None
         robust_best: Candidate | None = None
         try:
-            if config.search == "ga":
+            if search == "ga":
                 ga = run_ga(model, objective, config.ga, cached, on_gen)
                 hof, history = ga.hall_of_fame, ga.history
-            elif config.search == "certified":
+            elif search == "certified":
                 assert chain is not None
                 verify = config.verify or int(getattr(inner, "workers", 1) or 1)
                 cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
@@ -528,7 +578,8 @@ def run_design(
             release()
         result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
                            time.perf_counter() - start, certified=cert, rejected=int(getattr(cache, "rejected", 0)),
-                           robustness=robustness, robust_winner=robust_best)
+                           robustness=robustness, robust_winner=robust_best, search=search,
+                           search_note=plan.note if plan is not None else "")
         files: list[Path] = []
         try:
             if cert is not None:
@@ -580,6 +631,17 @@ def _robustness(config: DesignConfig, model: ActuatorModel, objective: Objective
     return fe_robustness(config, model, objective, best_candidate, evaluator), None
 
 
+def _tolerance_tables_wanted(config: DesignConfig, model: ActuatorModel) -> bool:
+    """Whether a certified run scores its winner's robustness with the unit's tolerance tables (one unit type)."""
+    return config.tolerance > 0 and hasattr(model, "variant") and not getattr(model, "mixed", False)
+
+
+def _table_dir(config: DesignConfig, cache: EvaluationCache | None) -> Path | None:
+    """The chain tables' folder beside the evaluation cache (None for a cache in memory)."""
+    path = cache.path if cache is not None else str(config.cache or default_cache_path())
+    return None if path == ":memory:" else Path(path).parent / "chain-tables"
+
+
 def _training(model: ActuatorModel) -> Any:
     """``n -> the same model with n units`` (the training actuator of a new chain table)."""
     with_units = getattr(model, "with_units", None)
@@ -603,17 +665,18 @@ def _chain_score(cert: CertifiedResult, i: int) -> Score:
 
 def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective,
                 cert: CertifiedResult) -> dict[str, float]:
-    """The 2D reduced-order model's values of the listed designs (its shipped chain table), if it has one."""
+    """The 2D reduced-order model's values of the listed designs (its shipped chain table, at the levels the
+    chain scored), if it has one."""
     if getattr(model, "fidelity", None) != "3d":
         return {}
     try:
         model2d = make_model(config.units, {**config.model, "fidelity": "2d"})
-        table = find_table(model2d)
+        served = serve_table(model2d)
+        if served is None or not np.allclose(served.table.pressures, model.pressures(), rtol=0, atol=1e-12):
+            return {}
+        chain = ChainModel(served.table, config.units)
     except PneumorphError:
         return {}
-    if table is None:
-        return {}
-    chain = ChainModel(table, config.units)
     designs = dict.fromkeys([cert.winner.design, *(c.design for c in cert.hall_of_fame)])
     return {d: chain_candidate(chain, objective, d).value for d in designs}
 
@@ -733,7 +796,9 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
               f"seed {config.seed})",
         "exhaustive": "exhaustive search",
         "certified": "certified search (every design scored by the chain model, the best verified by FE)",
-    }[config.search]
+    }[result.search or config.search]
+    if result.search_note:
+        search += f"; {result.search_note}"
     lines += [
         f"- objective: {o.label} ({'minimised' if o.sense == 'min' else 'maximised'})",
         f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",

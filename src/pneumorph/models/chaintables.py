@@ -188,13 +188,25 @@ def ramp_variant(model: Any, pressure: float, increments: int) -> Any:
         return None
 
 
+def same_source(table: ChainTable, model: Any) -> bool:
+    """Whether ``table`` was fitted to ``model``'s unit, materials and solver settings with any ramp of the same
+    kind: ``model`` remade with the table's ramp (:func:`ramp_variant`) has the table's source key and levels.
+
+    >>> from pneumorph.models.factory import make_model
+    >>> table = ChainTable.load(shipped_path("3d"))
+    >>> same_source(table, make_model(6, {"fidelity": "3d", "pressure_kpa": 3})), same_source(table, make_model(6))
+    (True, False)
+    """
+    k = table.n_levels
+    wide = ramp_variant(model, level_pressure(table, k), k) if k else None
+    return (wide is not None and source_key(wide) == table.source.get("key")
+            and bool(np.allclose(wide.pressures(), table.pressures, rtol=0, atol=1e-12)))
+
+
 def restriction_levels(table: ChainTable, model: Any) -> int | None:
     """How many of ``table``'s levels serve ``model``: those at or below its top pressure, if the table is of
-    the model's source with a ramp of the same step that reaches at least as far; else None.
-
-    The table serves the model when the model remade with the table's whole ramp
-    (:func:`ramp_variant`) has the table's source key, the table's levels are that ramp's, and
-    at least its first level lies at or below the model's top pressure.
+    the model's source (:func:`same_source`) with a ramp that reaches at least as far; else None (also when
+    the model's pressure lies below the table's first level).
 
     >>> from pneumorph.models.factory import make_model
     >>> table = ChainTable.load(shipped_path("3d"))
@@ -206,12 +218,7 @@ def restriction_levels(table: ChainTable, model: Any) -> int | None:
         return None
     levels = np.asarray(table.pressures, dtype=float)
     m = int(np.sum(levels <= float(ramp.pressure) * (1 + 1e-9)))
-    if m == 0 or float(ramp.pressure) > float(levels[-1]) * (1 + 1e-9):
-        return None
-    wide = ramp_variant(model, level_pressure(table, len(levels)), len(levels))
-    if wide is None or source_key(wide) != table.source.get("key"):
-        return None
-    if not np.allclose(wide.pressures(), levels, rtol=0, atol=1e-12):
+    if m == 0 or float(ramp.pressure) > float(levels[-1]) * (1 + 1e-9) or not same_source(table, model):
         return None
     return m
 
@@ -342,7 +349,7 @@ def estimate_text(solves: int, fidelity: str, n_units: int, workers: int) -> str
     """The estimated wall time of ``solves`` FE solves of ``n_units`` units among ``workers`` workers, as text.
 
     >>> estimate_text(33, "3d", 6, 2)
-    'estimated 1.7 min with 2 workers (about 6 s a solve of 6 units on one core, from BENCHMARKS.md; an estimate)'
+    'estimated 1.7 min with 2 workers (about 6 s a 3d solve of 6 units on one core, from BENCHMARKS.md; an estimate)'
     """
     per = solve_seconds(fidelity, n_units)
     if per is None:
@@ -350,7 +357,7 @@ def estimate_text(solves: int, fidelity: str, n_units: int, workers: int) -> str
     workers = max(1, int(workers))
     wall = per * math.ceil(solves / min(workers, max(solves, 1))) if solves else 0.0
     return (f"estimated {duration_text(wall)} with {workers} worker{'s' if workers > 1 else ''} (about "
-            f"{per:.2g} s a solve of {n_units} units on one core, from BENCHMARKS.md; an estimate)")
+            f"{per:.2g} s a {fidelity} solve of {n_units} units on one core, from BENCHMARKS.md; an estimate)")
 
 
 @dataclass(frozen=True)
@@ -392,54 +399,83 @@ class BuildPlan:
     cached: int = 0
     workers: int = 1
 
+    def cost_text(self) -> str:
+        """The FE solves (fewest to most, those cached not counted) and their estimated wall time."""
+        lo, hi = (max(s - self.cached, 0) for s in (self.solves[0], self.solves[-1]))
+        count = f"{lo} FE solves" if lo == hi else f"{lo}-{hi} FE solves"
+        per = solve_seconds(self.fidelity, self.n_units)
+        if per is None:
+            return f"{count} (no measured solve time of the {self.fidelity} model to estimate the time from)"
+        w = max(1, self.workers)
+        lo_s, hi_s = (per * math.ceil(s / w) for s in (lo, hi))
+        when = duration_text(lo_s) if lo == hi else f"{duration_text(lo_s)} to {duration_text(hi_s)}"
+        return (f"{count}, estimated {when} with {w} worker{'s' if w > 1 else ''} (about {per:.2g} s a {self.fidelity} "
+                f"solve of {self.n_units} units on one core, from BENCHMARKS.md; an estimate)")
+
     def text(self) -> str:
-        """The plan as one paragraph (what, how many solves, the estimate)."""
+        """The plan as one paragraph: what is built, the windows tried, the solves and the estimate."""
         p = np.asarray(self.pressures) * 1e3
         ramp = f"{p[0]:.4g}-{p[-1]:.4g} kPa in {len(p)} levels" if len(p) > 1 else f"{p[0]:.4g} kPa"
-        tries = ", ".join(f"+-{w} ({c} covering)" for w, c in zip(self.windows, self.covering, strict=True))
-        first, last = self.solves[0] - self.cached, self.solves[-1] - self.cached
-        fewest = max(first, 0)
-        count = (f"{fewest} FE solves" if len(self.solves) == 1 else
-                 f"{fewest} FE solves if window +-{self.windows[0]} is enough, {max(last, 0)} if it needs "
-                 f"+-{self.windows[-1]}")
-        cached = f" ({self.cached} of them already in the evaluation cache, not counted)" if self.cached else ""
-        low = estimate_text(fewest, self.fidelity, self.n_units, self.workers)
-        high = estimate_text(max(last, 0), self.fidelity, self.n_units, self.workers)
-        span = low if fewest == max(last, 0) or "estimated" not in low else (
-            f"{low.split(' with ')[0]} to {high.removeprefix('estimated ')}")
+        tries = ", ".join(f"+-{w} ({c} covering designs)" for w, c in zip(self.windows, self.covering, strict=True))
+        grow = (f"windows {tries} tried in turn until" if len(self.windows) > 1 else f"window {tries}, checked that")
+        cached = f" ({self.cached} designs already in the evaluation cache)" if self.cached else ""
         return (f"building the chain table of the {self.fidelity} model ({self.unit}, {ramp}) on {self.n_units}-unit "
-                f"designs: windows {tries} tried in turn until the worst held-out centre error of {self.heldout} "
-                f"designs is within {self.tolerance:g} mm; {count}{cached}; {span}")
+                f"designs: {grow} the worst centre error of {self.heldout} held-out designs is within "
+                f"{self.tolerance:g} mm; {self.cost_text()}{cached}")
 
 
 def unit_text(model: Any) -> str:
-    """The unit of a model as text: ``the built-in unit``, ``unit 'name'`` or ``unit types a, r``.
+    """The unit of a model as text: ``the built-in unit``, ``unit 'name' with wall 2, ...`` or ``unit types a, r``.
 
+    A unit other than the built-in one is named with the dimensions in which it differs from it.
+
+    >>> from pneumorph.geometry.unit import UnitSpec
     >>> from pneumorph.models.factory import make_model
     >>> unit_text(make_model(3)), unit_text(make_model(3, {"library": "builtin"}))
     ('the built-in unit', 'unit types a, e, r, s')
+    >>> unit_text(make_model(3, {"unit": {"element_size": 3.0, "layer": 2.5}}))
+    'unit with layer 2.5, element_size 3'
     """
+    from dataclasses import fields
+
     from pneumorph.geometry.unit import UnitSpec
 
     library = getattr(model, "library", None)
     if library is not None and not library.is_single:
         return f"unit types {', '.join(library.symbols)}"
     unit = getattr(model, "unit", None)
-    if unit is None or unit == UnitSpec():
+    default = UnitSpec()
+    if unit is None or unit == default:
         return "the built-in unit"
-    return f"unit {unit.name!r}"
+    differ = []
+    for f in fields(UnitSpec):
+        value = getattr(unit, f.name)
+        if f.name != "name" and not f.name.startswith("filler_") and value != getattr(default, f.name):
+            differ.append(f"{f.name} {value:g}" if isinstance(value, float) else f"{f.name} {value}")
+    name = "unit" if unit.name == default.name else f"unit {unit.name!r}"
+    return f"{name} with {', '.join(differ[:4])}{', ...' if len(differ) > 4 else ''}" if differ else name
 
 
-def build_plan(model: Any, n_units: int = TRAINING_UNITS, heldout: int = HELDOUT, workers: int = 1,
-               cached: Callable[[list[str]], int] | None = None) -> BuildPlan:
-    """What :func:`~pneumorph.models.chain.build_table` will solve to fit ``model``'s table on ``n_units``-unit
-    designs (its defaults: windows 1, 2, ... up to :data:`~pneumorph.models.chain.MAX_WINDOW`, those a library
-    allows; ``heldout`` held-out designs), counted without a solve.
+def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
+               window: int | None = None, tolerance: float = DEFAULT_TOLERANCE) -> BuildPlan:
+    """What :func:`~pneumorph.models.chain.build_table` will solve to fit a table to ``model`` (the training
+    actuator: its designs have ``model.n_units`` units), counted without a solve.
 
     Parameters
     ----------
+    model : ActuatorModel
+        The training model.
+    heldout : int
+        Held-out designs of each window.
+    workers : int
+        The evaluator's workers, for the estimate.
     cached : callable, optional
         ``cached(designs)``: how many of the designs the evaluation cache holds already.
+    window : int, optional
+        A fixed window; by default ``build_table``'s: 1, 2, ... up to
+        :data:`~pneumorph.models.chain.MAX_WINDOW` (those a library of several types allows).
+    tolerance : float
+        The worst held-out centre error the build accepts (mm).
 
     Examples
     --------
@@ -447,13 +483,19 @@ def build_plan(model: Any, n_units: int = TRAINING_UNITS, heldout: int = HELDOUT
     >>> plan = build_plan(make_model(15, {"fidelity": "3d", "pressure_kpa": 50}), workers=2)
     >>> plan.windows, plan.covering, plan.solves
     ((1, 2, 3), (2, 8, 32), (22, 29, 59))
+    >>> print(plan.text())  # doctest: +NORMALIZE_WHITESPACE
+    building the chain table of the 3d model (the built-in unit, 5-50 kPa in 10 levels) on 15-unit designs: windows
+    +-1 (2 covering designs), +-2 (8 covering designs), +-3 (32 covering designs) tried in turn until the worst
+    centre error of 20 held-out designs is within 0.2 mm; 22-59 FE solves, estimated 2.8 min to 7.5 min with 2
+    workers (about 15 s a 3d solve of 15 units on one core, from BENCHMARKS.md; an estimate)
     """
+    n_units = int(model.n_units)
     library = getattr(model, "library", None)
     alphabet = library.symbols if library is not None and not library.is_single else ()
     types = max(1, len(alphabet))
     windows, covering, solves = [], [], []
     seen: set[str] = set()
-    for w in range(1, min(MAX_WINDOW, (n_units - 1) // 2) + 1):
+    for w in [int(window)] if window is not None else range(1, min(MAX_WINDOW, (n_units - 1) // 2) + 1):
         try:
             check_training_size(types, w)
         except PneumorphError:
@@ -467,7 +509,7 @@ def build_plan(model: Any, n_units: int = TRAINING_UNITS, heldout: int = HELDOUT
     held = int(cached(sorted(seen))) if cached is not None and seen else 0
     return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
                      tuple(float(p) for p in model.pressures()), int(n_units), tuple(windows), tuple(covering),
-                     tuple(solves), heldout, DEFAULT_TOLERANCE, held, max(1, int(workers)))
+                     tuple(solves), heldout, float(tolerance), held, max(1, int(workers)))
 
 
 def evaluator_workers(evaluator: Any) -> int:

@@ -245,24 +245,140 @@ def shipped_tolerance_tables(fidelity: str = "3d", tolerance: float = 0.1) -> To
     return ToleranceTables.load(path)
 
 
+def tolerance_file(folder: str | Path, model: Any, tolerance: Tolerance) -> Path:
+    """Where the tolerance tables of ``model``'s unit are kept in a table folder."""
+    key = source_key(model)
+    return Path(folder) / f"chain-{getattr(model, 'fidelity', 'model')}-{key}-tolerance-{tolerance.tolerance:g}.json"
+
+
+def restrict_tolerance_tables(tables: ToleranceTables, levels: int, key: str) -> ToleranceTables:
+    """``tables`` restricted to their first ``levels`` levels (each table by
+    :func:`~pneumorph.models.chaintables.restrict_table`), for the model of source key ``key`` (the
+    model remade with the ramp of those levels). A pure function.
+
+    >>> tables = shipped_tolerance_tables("2d")
+    >>> short = restrict_tolerance_tables(tables, 3, "k")
+    >>> short.nominal.n_levels, len(short.plus), short.source["key"], short.source["restricted_from"]["levels"]
+    (3, 3, 'k', 10)
+    """
+    from pneumorph.models.chaintables import restrict_table
+
+    def cut(group: tuple[ChainTable, ...]) -> tuple[ChainTable, ...]:
+        return tuple(restrict_table(t, levels) for t in group)
+
+    source = {**tables.source, "key": key,
+              "restricted_from": {"key": tables.source.get("key"), "levels": tables.nominal.n_levels}}
+    return ToleranceTables(tables.tolerance, restrict_table(tables.nominal, levels), cut(tables.minus),
+                           cut(tables.plus), source, cut(tables.corners))
+
+
+def _serving_levels(tables: ToleranceTables, model: Any) -> int | None:
+    """How many of the tables' levels are ``model``'s levels, if the tables are of ``model``'s unit with a longer
+    ramp of the same step (``model`` reports exactly their first levels); else None."""
+    from pneumorph.models.chaintables import level_pressure, ramp_variant
+
+    nominal = tables.nominal
+    k = nominal.n_levels
+    p = np.asarray(model.pressures(), dtype=float)
+    m = len(p)
+    if not 1 <= m <= k or not np.allclose(p, nominal.pressures[:m], rtol=0, atol=1e-12):
+        return None
+    wide = ramp_variant(model, level_pressure(nominal, k), k)
+    if wide is None or source_key(wide) != tables.source.get("key"):
+        return None
+    return m
+
+
+def find_tolerance_tables(model: Any, tolerance: Tolerance, folder: str | Path | None = None) -> ToleranceTables | None:
+    """The shipped or kept tolerance tables of ``model``'s unit and ramp, or None.
+
+    Tables of a longer ramp of the same step serve a model whose levels are their first ones
+    (a model remade by :func:`~pneumorph.models.chaintables.ramp_variant` for a restricted
+    chain table): they are restricted to those levels (:func:`restrict_tolerance_tables`).
+
+    >>> from pneumorph.models.chaintables import serve_table
+    >>> from pneumorph.models.factory import make_model
+    >>> served = serve_table(make_model(10, {"fidelity": "3d", "pressure_kpa": 25}))
+    >>> find_tolerance_tables(served.model, Tolerance(0.1)).nominal.n_levels
+    5
+    """
+    key = source_key(model)
+    fidelity = str(getattr(model, "fidelity", ""))
+    candidates = [shipped_tolerance_path(fidelity, tolerance.tolerance)]
+    if folder is not None:
+        candidates.append(tolerance_file(folder, model, tolerance))
+        if Path(folder).is_dir():
+            candidates += sorted(Path(folder).glob(f"chain-{fidelity}-*-tolerance-{tolerance.tolerance:g}.json"))
+    for path in dict.fromkeys(candidates):
+        if not path.is_file():
+            continue
+        try:
+            tables = ToleranceTables.load(path)
+        except ChainTableError:
+            continue
+        if tables.tolerance != tolerance:
+            continue
+        if tables.source.get("key") == key:
+            return tables
+        levels = _serving_levels(tables, model)
+        if levels is not None:
+            return restrict_tolerance_tables(tables, levels, key)
+    return None
+
+
+def tolerance_plan_text(model: Any, tolerance: Tolerance, workers: int = 1, n_units: int = 15,
+                        corners: bool = True, what: bool = True) -> str:
+    """What building the tolerance tables of ``model``'s unit solves, and the estimated time (before any solve);
+    without ``what``, only the tables, solves and estimate.
+
+    >>> from pneumorph.models.factory import make_model
+    >>> tolerance_plan_text(make_model(15, {"fidelity": "2d"}), Tolerance(0.1), workers=2)  # doctest: +ELLIPSIS
+    'building the tolerance tables of the 2d model (the built-in unit, +-0.1 mm): 15 window-1 tables, 30 FE ...'
+    >>> tolerance_plan_text(make_model(15, {"fidelity": "3d"}), Tolerance(0.1), 2, what=False)  # doctest: +ELLIPSIS
+    '15 window-1 tables, 30 FE solves of 15-unit designs; estimated 3.8 min with 2 workers (about 15 s a 3d solve ...'
+    """
+    from pneumorph.models.chaintables import estimate_text, unit_text
+
+    m = len(tolerance.fields)
+    tables = 1 + 2 * m + (2**m if corners else 0)
+    solves = tables * len(covering_designs(n_units, TOLERANCE_WINDOW))
+    fidelity = str(getattr(model, "fidelity", "?"))
+    cost = (f"{tables} window-1 tables, {solves} FE solves of {n_units}-unit designs; "
+            f"{estimate_text(solves, fidelity, n_units, workers)}")
+    if not what:
+        return cost
+    return (f"building the tolerance tables of the {fidelity} model ({unit_text(model)}, +-{tolerance.tolerance:g} "
+            f"mm): {cost}")
+
+
 def tolerance_tables_for(model: Any, tolerance: Tolerance, folder: str | Path | None = None, evaluator: Any = None,
                          on_progress: Callable[[str], None] | None = None) -> ToleranceTables:
-    """The tolerance tables of ``model``'s unit: shipped, kept in ``folder``, or built now (cached) and kept."""
-    key = source_key(model)
-    candidates = [shipped_tolerance_path(str(getattr(model, "fidelity", "")), tolerance.tolerance)]
-    name = f"chain-{getattr(model, 'fidelity', 'model')}-{key}-tolerance-{tolerance.tolerance:g}.json"
-    if folder is not None:
-        candidates.append(Path(folder) / name)
-    for path in candidates:
-        if path.is_file():
-            tables = ToleranceTables.load(path)
-            if tables.source.get("key") == key and tables.tolerance == tolerance:
-                return tables
-    tables = build_tolerance_tables(model, tolerance, evaluator, on_progress=on_progress)
-    if folder is not None:
-        Path(folder).mkdir(parents=True, exist_ok=True)
-        tables.save(Path(folder) / name)
-    return tables
+    """The tolerance tables of ``model``'s unit: shipped, kept in ``folder`` (also of a longer ramp of the same
+    step, restricted: :func:`find_tolerance_tables`), or built now (cached) and kept.
+
+    A build first says what it will build and its estimated time (:func:`tolerance_plan_text`),
+    and holds a lock on its file (:func:`~pneumorph.models.chaintables.build_once`): another
+    process that needs the same tables waits for them and reuses them.
+    """
+    from pneumorph.models.chaintables import build_once, evaluator_workers
+
+    found = find_tolerance_tables(model, tolerance, folder)
+    if found is not None:
+        return found
+    say = on_progress or (lambda text: None)
+
+    def build() -> ToleranceTables:
+        say(tolerance_plan_text(model, tolerance, evaluator_workers(evaluator)))
+        tables = build_tolerance_tables(model, tolerance, evaluator, on_progress=on_progress)
+        if folder is not None:
+            tables.save(tolerance_file(folder, model, tolerance))
+        return tables
+
+    if folder is None:
+        return build()
+    target = tolerance_file(folder, model, tolerance)
+    return build_once(target, lambda: find_tolerance_tables(model, tolerance, folder), build, say,
+                      f"tolerance tables {target.name}")
 
 
 @dataclass(frozen=True)
@@ -367,5 +483,6 @@ def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any
 
 
 __all__ = ["STATISTICS", "TOLERANCE_WINDOW", "Robustness", "ToleranceTables", "build_tolerance_tables",
-           "design_robustness", "inner_codes", "shipped_tolerance_path", "shipped_tolerance_tables", "spread",
+           "design_robustness", "find_tolerance_tables", "inner_codes", "restrict_tolerance_tables",
+           "shipped_tolerance_path", "shipped_tolerance_tables", "spread", "tolerance_file", "tolerance_plan_text",
            "tolerance_tables_for"]
