@@ -23,7 +23,7 @@ Examples
 >>> config = DesignConfig(units=6)
 >>> plan = plan_search(config, make_model(6, {"fidelity": "3d"}), None, workers=2)
 >>> plan.search, plan.note  # doctest: +ELLIPSIS
-('exhaustive', 'FE exhaustive search over all 64 designs: the chain table of window +-3 needs at least 7 units; ...')
+('exhaustive', 'FE exhaustive search over all 64 designs instead of the certified search: the chain table of window ...')
 """
 
 from __future__ import annotations
@@ -64,7 +64,8 @@ class SearchPlan:
     build : bool
         A certified search whose table is built first (announced, under the table's lock).
     note : str
-        Why this search, and which levels the chain scores: said at the start and in the report.
+        The search as a sentence: which table and levels the chain scores, or why the FE
+        exhaustive search and what it costs; said at the start and in the report.
     """
 
     search: str
@@ -89,13 +90,14 @@ def exhaustive_note(n_units: int, fidelity: str, workers: int, why: str) -> str:
     """The note of an FE exhaustive search chosen for a short actuator: designs, solves, estimated time, why.
 
     >>> print(exhaustive_note(6, "3d", 2, "the reason"))  # doctest: +NORMALIZE_WHITESPACE
-    FE exhaustive search over all 64 designs: the reason; 33 FE solves (the mirror designs by symmetry), estimated
-    1.7 min with 2 workers (about 6 s a 3d solve of 6 units on one core, from BENCHMARKS.md; an estimate)
+    FE exhaustive search over all 64 designs instead of the certified search: the reason; 33 FE solves (the mirror
+    designs by symmetry), estimated 1.7 min with 2 workers (about 6 s a 3d solve of 6 units on one core, from BENCHMARKS.md; an estimate)
     """
     solves = exhaustive_solves(n_units)
     plural = "s" if solves > 1 else ""
-    return (f"FE exhaustive search over all {2**n_units:,} designs: {why}; {solves} FE solve{plural} (the mirror "
-            f"designs by symmetry), {estimate_text(solves, fidelity, n_units, workers)}")
+    return (f"FE exhaustive search over all {2**n_units:,} designs instead of the certified search: {why}; "
+            f"{solves} FE solve{plural} (the mirror designs by symmetry), "
+            f"{estimate_text(solves, fidelity, n_units, workers)}")
 
 
 def exhaustive_solves(n_units: int) -> int:
@@ -183,7 +185,7 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
         return SearchPlan("exhaustive", note=exhaustive_note(n, fidelity, workers, why))
     if not build:
         raise MissingTableError(missing_table_message(config, model, table_dir, workers))
-    return SearchPlan("certified", build=True, note="certified search with a chain table built first (see its plan)")
+    return SearchPlan("certified", build=True, note="certified search with a chain table built first (its plan follows)")
 
 
 def missing_table_message(config: Any, model: Any, table_dir: str | Path | None, workers: int = 1) -> str:

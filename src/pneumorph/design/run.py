@@ -797,8 +797,8 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
         "exhaustive": "exhaustive search",
         "certified": "certified search (every design scored by the chain model, the best verified by FE)",
     }[result.search or config.search]
-    if result.search_note:
-        search += f"; {result.search_note}"
+    if result.search_note:  # a certified run's choice: its table and levels, or why it searched exhaustively
+        search = result.search_note
     lines += [
         f"- objective: {o.label} ({'minimised' if o.sense == 'min' else 'maximised'})",
         f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",

@@ -176,16 +176,19 @@ class FileLock:
         """
         if self.held:
             raise self.error(f"{self.what} is already held by this lock")
-        told = False
+        looks = 0
         while True:
             taken = self._try_flock() if fcntl is not None else self._try_exclusive()
             if taken:
                 return self
             if not wait:
                 raise self._busy(exclusive=fcntl is None)
-            if on_wait is not None and not told:
+            # said once, as soon as the holder has written its name (or after a second without it)
+            if on_wait is not None and looks >= 0 and (self.read(self.path) or looks >= 4):
                 on_wait(self.holder_text())
-                told = True
+                looks = -1
+            elif looks >= 0:
+                looks += 1
             time.sleep(POLL_SECONDS)
 
     def _try_flock(self) -> bool:
