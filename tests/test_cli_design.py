@@ -176,3 +176,65 @@ def test_a_tampered_cache_entry_is_solved_again_and_reported(tmp_path: Path,
     assert second["cache_entries_rejected"] == 1 and second["solves"] == 1
     assert second["best"] == first["best"]  # the tampered value was never used
     assert "1 damaged cache entries were solved again" in (tmp_path / "run" / "report.md").read_text()
+
+
+# -- short actuators, pressures served by a table's levels, no silent builds ---------------------------
+def _short(tmp_path: Path, units: int, *extra: str) -> list[str]:
+    return ["design", "--model", "2d", "--units", str(units), "--executor", "serial", "--tolerance", "0",
+            "--cache", str(tmp_path / "cache" / "c.sqlite"), "--out", str(tmp_path / f"run{units}"), "--json", *extra]
+
+
+@pytest.mark.parametrize(("units", "search", "solves"), [(1, "exhaustive", 1), (4, "exhaustive", 9),
+                                                          (5, "certified", 1)])
+def test_an_actuator_shorter_than_its_table_needs_is_searched_exhaustively(
+        units: int, search: str, solves: int, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the shipped 2D table (window +-2) needs 5 units; below, every design is solved (2^(n-1) + 1 with the mirror)
+    assert main(_short(tmp_path, units)) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert out["search"] == search and out["solves"] == solves and len(out["best"]["design"]) == units
+    report = (tmp_path / f"run{units}" / "report.md").read_text()
+    if search == "exhaustive":
+        assert out["search_note"].startswith(f"FE exhaustive search over all {2**units} designs instead of the "
+                                             "certified search: the chain table of window +-2 needs at least 5 units")
+        assert out["search_note"] in captured.err and out["search_note"] in report
+        ranking = (tmp_path / f"run{units}" / "ranking.csv").read_text().splitlines()
+        assert len(ranking) == 1 + 2**units and "certificate" not in out
+        best = float(ranking[1].split(",")[2])
+        assert best == out["best"]["fitness"] == min(float(r.split(",")[2]) for r in ranking[1:])
+    else:
+        assert out["certificate"]["designs_scored"] == 32 and out["certificate"]["complete"]
+
+
+def test_a_pressure_between_the_tables_levels_is_served_by_the_levels_below_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    args = _short(tmp_path, 6, "--pressure", "25", "--target", "cos", "--amplitude", "5", "--certify", "--no-build")
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    note = ("certified search with the chain table of window +-2 fitted to 10 levels, scored at the table's levels "
+            "4.5-22.5 kPa (5 levels) at or below 25 kPa")
+    assert out["search"] == "certified" and out["search_note"] == note and note in captured.err
+    cert = out["certificate"]
+    assert cert["certified"] and cert["designs_scored"] == 64 and out["solves"] == len(cert["verified"])
+    assert out["best"]["pressure_kpa"] in {4.5, 9.0, 13.5, 18.0, 22.5}
+    top = out["top"][0]
+    assert top["fe"] is not None and abs(top["fe"] - top["chain"]) <= cert["bound"]
+    assert not (tmp_path / "cache" / "chain-tables").exists()  # nothing built, nothing kept
+    config = (tmp_path / "run6" / "config.toml").read_text()
+    assert "pressures_kPa = [4.5, 9.0, 13.5, 18.0, 22.5]" in config and "pressure_kpa = 25.0" in config
+    assert note in (tmp_path / "run6" / "report.md").read_text()
+
+
+def test_no_build_stops_a_run_that_needs_a_table_with_one_line(tmp_path: Path,
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
+    args = _short(tmp_path, 8, "--pressure", "3", "--no-build")
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    tables = tmp_path / "cache" / "chain-tables"
+    assert "--no-build: no chain table serves the 2d model (the built-in unit, 0.3-3 kPa in 10 levels" in err
+    assert "(the shipped table's levels start at 4.5 kPa)" in err
+    assert f"`pneumorph chain build --model 2d --pressure 3 --out {tables}/chain-2d-" in err
+    assert "22-59 FE solves, estimated" in err
+    assert not (tmp_path / "run8").exists() and not tables.exists()

@@ -197,6 +197,56 @@ def test_overwrite_removes_the_old_runs_files_only(tmp_path: Path) -> None:
     assert "amplitude = 15.0" in (folder / "config.toml").read_text()
 
 
+def _needs_a_table(tmp_path: Path) -> tuple[DesignConfig, object]:
+    """A certified run of a unit no shipped table serves (2D, coarse mesh, 7 units): it would build a table."""
+    from pneumorph.models.factory import make_model
+
+    settings = {"fidelity": "2d", "unit": {"element_size": 3.0}, "pressure_kpa": 10}
+    cfg = DesignConfig(objective="cos", units=7, search="certified", tolerance=0.0,
+                       cache=str(tmp_path / "cache" / "c.sqlite"), model=settings)
+    return cfg, make_model(7, settings)
+
+
+def test_a_second_run_is_refused_before_it_builds_a_table(tmp_path: Path) -> None:
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    cfg, model = _needs_a_table(tmp_path)
+    with RunLock(folder):  # the same run, started before, holds the folder
+        before = snapshot(folder)
+        said: list[str] = []
+        with pytest.raises(RunFolderError, match="in use by another run"):
+            run_design(cfg, model, folder, on_message=said.append)
+        assert snapshot(folder) == before
+    assert not any("building" in line for line in said)  # refused before the table build began
+    tables = tmp_path / "cache" / "chain-tables"
+    assert not tables.exists() or not list(tables.iterdir())
+    with EvaluationCache(cfg.cache) as cache:
+        assert cache.count() == 0  # not one design solved
+
+
+def test_a_failed_table_build_releases_the_folder_it_claimed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from pneumorph.errors import LocalityError
+    from pneumorph.models import chaintables
+
+    def no_locality(*args, **kwargs):  # type: ignore[no-untyped-def]
+        assert (folder / LOCK).exists() or (tmp_path / "new" / LOCK).exists()  # built with the folder claimed
+        raise LocalityError("the chain model does not reproduce this model within 0.2 mm")
+
+    monkeypatch.setattr(chaintables, "build_table", no_locality)
+    cfg, model = _needs_a_table(tmp_path)
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    before = snapshot(folder)
+    with pytest.raises(LocalityError):
+        run_design(cfg, model, folder)
+    assert snapshot(folder) == before  # its lock file removed again
+    with pytest.raises(LocalityError):
+        run_design(cfg, model, tmp_path / "new")
+    assert not (tmp_path / "new").exists()  # the folder it created, removed again
+
+
 def test_run_files_are_listed_in_one_place() -> None:
     assert "config.toml" in RUN_FILES and "report.md" in RUN_FILES and LOCK not in RUN_FILES
 

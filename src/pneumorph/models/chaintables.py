@@ -335,9 +335,11 @@ def solve_seconds(fidelity: str, n_units: int) -> float | None:
 def duration_text(seconds: float) -> str:
     """A duration for people: ``45 s``, ``3.5 min``, ``1.2 h``.
 
-    >>> duration_text(44.6), duration_text(210), duration_text(9000)
-    ('45 s', '3.5 min', '2.5 h')
+    >>> duration_text(0.37), duration_text(44.6), duration_text(210), duration_text(9000)
+    ('0.4 s', '45 s', '3.5 min', '2.5 h')
     """
+    if seconds < 9.95:
+        return f"{seconds:.1f} s"
     if seconds < 90:
         return f"{seconds:.0f} s"
     if seconds < 5400:
@@ -357,7 +359,8 @@ def estimate_text(solves: int, fidelity: str, n_units: int, workers: int) -> str
     workers = max(1, int(workers))
     wall = per * math.ceil(solves / min(workers, max(solves, 1))) if solves else 0.0
     return (f"estimated {duration_text(wall)} with {workers} worker{'s' if workers > 1 else ''} (about "
-            f"{per:.2g} s a {fidelity} solve of {n_units} units on one core, from BENCHMARKS.md; an estimate)")
+            f"{per:.2g} s a {fidelity} solve of {n_units} unit{'s' if n_units != 1 else ''} on one core, from "
+            "BENCHMARKS.md; an estimate)")
 
 
 @dataclass(frozen=True)
