@@ -88,7 +88,12 @@ def chain_errors(chain: ChainModel, margin: float = 1.0) -> dict[str, FloatArray
 
 
 def choices(chain: ChainModel) -> int:
-    """The choices per unit: 2 orientations of each of the table's unit types."""
+    """The choices per unit: 2 orientations of each of the table's unit types, 1 of a symmetric type."""
+    return len(chain.table.unit_codes)
+
+
+def _radix(chain: ChainModel) -> int:
+    """The base in which designs are numbered (:func:`design_numbers`): the unit codes ``0 .. 2k - 1``."""
     return 2 * chain.table.n_types
 
 
@@ -175,6 +180,8 @@ class ChainScores:
         ``max_k beta_k`` per design.
     floor : float
         The optimistic cost of every design *not* in the set (``inf`` when the set is all).
+    choices : int
+        The base in which the designs are numbered for ordering ties: the unit codes ``2k``.
     """
 
     bits: NDArray[np.integer]
@@ -238,7 +245,7 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
         beta = objective_bounds(chain, objective, centres, ref_c, errors)
         parts.append((values, *_costs(values, beta, objective.sense)))
     values, cost, level, optimistic, bound = (np.concatenate([p[i] for p in parts]) for i in range(5))
-    return ChainScores(bits, values, cost, level, optimistic, bound, choices=choices(chain))
+    return ChainScores(bits, values, cost, level, optimistic, bound, choices=_radix(chain))
 
 
 # -- growing designs unit by unit: enumeration and branch-and-bound ---------------------------
@@ -351,7 +358,7 @@ def _prefix_bound(chain: ChainModel, objective: Objective, bits: NDArray[np.uint
 def _seed_prefixes(chain: ChainModel, polar: bool = False) -> tuple[NDArray[np.uint8], dict[str, Any]]:
     """The one-unit prefixes (2; ``2k`` over ``k`` types) and their state: base point, angle (polar angle, radius)."""
     k, c = chain.table.n_levels, choices(chain)
-    bits = np.arange(c, dtype=np.uint8)[:, None]
+    bits = chain.table.unit_codes[:, None].copy()
     st: dict[str, Any] = {"point": np.zeros((c, k, 2)), "angle": np.zeros((c, k))}
     st["point"][..., 1] = chain.table.heights[bits[:, 0]][:, None]
     if polar:
@@ -359,10 +366,11 @@ def _seed_prefixes(chain: ChainModel, polar: bool = False) -> tuple[NDArray[np.u
     return bits, st
 
 
-def _grow(bits: NDArray[np.uint8], st: dict[str, Any], c: int = 2) -> tuple[NDArray[np.uint8], dict[str, Any]]:
-    """Every prefix extended by each of the ``c`` unit codes (child ``c i + b`` of prefix ``i``)."""
-    bits = np.concatenate([np.repeat(bits, c, axis=0),
-                           np.tile(np.arange(c, dtype=np.uint8)[:, None], (len(bits), 1))], axis=1)
+def _grow(bits: NDArray[np.uint8], st: dict[str, Any], codes: NDArray[np.uint8]) -> tuple[NDArray[np.uint8],
+                                                                                        dict[str, Any]]:
+    """Every prefix extended by each of the unit ``codes`` (child ``c i + b`` of prefix ``i``: code ``codes[b]``)."""
+    c = len(codes)
+    bits = np.concatenate([np.repeat(bits, c, axis=0), np.tile(codes[:, None], (len(bits), 1))], axis=1)
     return bits, {key: np.repeat(v, c, axis=0) for key, v in st.items()}
 
 
@@ -405,7 +413,7 @@ def _depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], pola
     placed = 0
     for p in range(1, n + 1):
         if p > 1:
-            bits, st = _grow(bits, st, choices(chain))
+            bits, st = _grow(bits, st, chain.table.unit_codes)
         upto = n + 1 if p == n else max(p - w + 1, 0)
         pruned = yield p, max(placed, upto), bits, st, _place_chords(chain, bits, st, placed, upto, polar)
         placed = max(placed, upto)
@@ -529,7 +537,7 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
         else:
             beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
-    return ChainScores(g.bits, values, cost, level, optimistic, bound, choices=c)
+    return ChainScores(g.bits, values, cost, level, optimistic, bound, choices=_radix(chain))
 
 
 def _children(alive: NDArray[np.int64], steps: int, c: int = 2) -> NDArray[np.int64]:
@@ -615,7 +623,7 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
             alive, total = _children(alive, n - at, c), np.repeat(total, c ** (n - at), axis=0)
         values = np.sqrt(total)
     cost, level, opt, bound = _costs(values, np.broadcast_to(beta, values.shape), objective.sense)
-    return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold, choices=c)
+    return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold, choices=_radix(chain))
 
 
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
@@ -695,7 +703,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         else:
             beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
-    return ChainScores(bits, values, cost, level, optimistic, bound, choices=choices(chain))
+    return ChainScores(bits, values, cost, level, optimistic, bound, choices=_radix(chain))
 
 
 def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,

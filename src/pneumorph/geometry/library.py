@@ -243,6 +243,17 @@ class UnitLibrary:
         return self.symbols[0]
 
     @property
+    def symmetric(self) -> tuple[str, ...]:
+        """The symbols of the types whose turned-over unit is the same body (:attr:`UnitSpec.symmetric`).
+
+        They have one orientation: one letter in designs, one set of windows in chain tables.
+
+        >>> builtin_library().symmetric
+        ('e',)
+        """
+        return tuple(s for s, u in zip(self.symbols, self.units, strict=True) if u.symmetric)
+
+    @property
     def is_single(self) -> bool:
         """One type only: its designs are written as 0/1 digits."""
         return len(self.symbols) == 1

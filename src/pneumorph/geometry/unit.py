@@ -231,6 +231,24 @@ class UnitSpec:
             return None
         return (self.pitch - self.slit_width, self.pitch, 0.0, self.slit_depth)
 
+    @property
+    def symmetric(self) -> bool:
+        """True if the unit turned over is the same body: no stiff layer and no slit.
+
+        The walls above and below the cavity are both ``wall`` thick, so with ``layer = 0``
+        and no slit (cut from the soft face) the section is its own mirror about the unit's
+        mid-height, the tracked cavity corners map onto each other, and the two orientations
+        of the unit are one: a design over a library writes it in one letter.
+
+        Examples
+        --------
+        >>> UnitSpec().symmetric, UnitSpec(wall=3.0, layer=0.0).symmetric
+        (False, True)
+        >>> UnitSpec(wall=3.0, layer=0.0, slit_width=0.5, slit_depth=2.0).symmetric
+        False
+        """
+        return self.layer == 0.0 and self.slit is None
+
     def is_builtin_shape(self) -> bool:
         """True if the unit's dimensions and materials are the built-in unit's.
 

@@ -61,6 +61,7 @@ from pneumorph.models.windows import (
     mirror_codes,
     possible_codes,
     random_designs,
+    unit_codes,
     window_code,
     window_codes,
     window_symbols,
@@ -87,7 +88,7 @@ MAX_WINDOW = 3
 MAX_TRAINING = 200
 
 
-def check_training_size(n_types: int, window: int) -> None:
+def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
     """Refuse, before any solve, a window whose base windows alone need more than :data:`MAX_TRAINING` designs.
 
     >>> check_training_size(2, 2)
@@ -97,7 +98,7 @@ def check_training_size(n_types: int, window: int) -> None:
     pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
     its base windows alone (at most 200, MAX_TRAINING); use fewer unit types or a window of +-1
     """
-    need = (2 * int(n_types)) ** (int(window) + 1) // 2
+    need = (2 * int(n_types) - int(symmetric)) ** (int(window) + 1) // 2
     if n_types > 1 and need > MAX_TRAINING:
         raise LocalityError(f"a chain table over {n_types} unit types at window +-{window} needs at least {need} FE "
                             f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use fewer "
@@ -173,6 +174,9 @@ class ChainTable:
         Per type: its pitch and the x of its centre from its start (mm); empty for one unit.
     type_centre_y : tuple of float
         Per code ``2t + o``: the undeformed height of the unit's centre; empty for one unit.
+    symmetric : tuple of str
+        The types whose unit turned over is the same body (:attr:`UnitSpec.symmetric`): one
+        orientation, one letter (lower case) in designs, one set of windows; empty for none.
     """
 
     window: int
@@ -195,6 +199,7 @@ class ChainTable:
     type_pitch: tuple[float, ...] = ()
     type_offset: tuple[float, ...] = ()
     type_centre_y: tuple[float, ...] = ()
+    symmetric: tuple[str, ...] = ()
 
     @property
     def n_levels(self) -> int:
@@ -204,6 +209,16 @@ class ChainTable:
     def n_types(self) -> int:
         """Unit types of the table: 1 for a 0/1 table."""
         return max(1, len(self.alphabet))
+
+    @property
+    def symmetric_types(self) -> tuple[int, ...]:
+        """Indices of the :attr:`symmetric` types in the alphabet."""
+        return tuple(self.alphabet.index(s) for s in self.symmetric)
+
+    @property
+    def unit_codes(self) -> NDArray[np.uint8]:
+        """The unit codes a design may hold (both orientations of a type, one of a symmetric type)."""
+        return unit_codes(self.n_types, self.symmetric_types)
 
     @property
     def heights(self) -> FloatArray:
@@ -218,7 +233,7 @@ class ChainTable:
         ChainTableError
             A unit type the table does not cover ("unit type 'x' has no table").
         """
-        return design_array(texts, n_units, self.alphabet)
+        return design_array(texts, n_units, self.alphabet, self.symmetric_types)
 
     def texts(self, codes: NDArray[np.integer]) -> list[str]:
         """The canonical texts of designs given as unit codes (0/1 digits for one type)."""
@@ -233,6 +248,8 @@ class ChainTable:
         if self.alphabet:  # absent for one unit type: the fingerprints of 0/1 tables stay the same
             head.update(alphabet=list(self.alphabet), type_pitch=list(self.type_pitch),
                         type_offset=list(self.type_offset), type_centre_y=list(self.type_centre_y))
+        if self.symmetric:  # likewise absent without symmetric types
+            head["symmetric"] = list(self.symmetric)
         h.update(json.dumps(head, sort_keys=True).encode())
         for a in (self.pressures, self.codes, self.turn, self.length, self.end_codes, self.end):
             h.update(np.ascontiguousarray(a).tobytes())
@@ -334,6 +351,8 @@ class ChainTable:
                      "types": {s: {"pitch_mm": self.type_pitch[t], "centre_offset_mm": self.type_offset[t],
                                    "centre_y_mm": list(self.type_centre_y[2 * t : 2 * t + 2])}
                                for t, s in enumerate(self.alphabet)}}
+            if self.symmetric:
+                extra["symmetric"] = list(self.symmetric)
         return {
             "format": ALPHABET_FORMAT if self.alphabet else TABLE_FORMAT,
             "kind": "pneumorph chain table",
@@ -367,6 +386,7 @@ class ChainTable:
                                       f"{ALPHABET_FORMAT}")
             w = int(data["window"])
             alphabet: tuple[str, ...] = ()
+            symmetric: tuple[str, ...] = ()
             geometry: dict[str, tuple[float, ...]] = {}
             if fmt == ALPHABET_FORMAT:
                 from pneumorph.geometry.library import check_symbol
@@ -376,6 +396,7 @@ class ChainTable:
                     raise ChainTableError(f"{where}: a table over unit types needs two or more distinct symbols, "
                                           f"got {list(alphabet)}")
                 types = data["types"]
+                symmetric = tuple(check_symbol(a, where) for a in data.get("symmetric", []))
                 geometry = {
                     "type_pitch": tuple(float(types[a]["pitch_mm"]) for a in alphabet),
                     "type_offset": tuple(float(types[a]["centre_offset_mm"]) for a in alphabet),
@@ -408,6 +429,7 @@ class ChainTable:
                 spread=float(data.get("spread", 0.0)),
                 metadata=dict(data.get("metadata", {})),
                 alphabet=alphabet,
+                symmetric=symmetric,
                 **geometry,
             )
         except ChainTableError as exc:
@@ -423,6 +445,8 @@ class ChainTable:
         shapes_ok = (table.turn.shape == (K, k) and table.length.shape == (K, k) and table.end.shape == (E, k))
         if not shapes_ok or not (np.all(np.diff(table.codes) > 0) and np.all(np.diff(table.end_codes) > 0)):
             raise ChainTableError(f"{where}: damaged chain table (array shapes or window order do not match)")
+        if set(table.symmetric) - set(table.alphabet):
+            raise ChainTableError(f"{where}: symmetric unit types {list(table.symmetric)} outside the alphabet")
         if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
             raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
         if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures)):
@@ -516,12 +540,13 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
             raise ChainTableError("training responses of different lengths or pressure levels")
     w = int(window)
     alphabet = library.symbols if library is not None and not library.is_single else ()
+    symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
     k = max(1, len(alphabet))
     all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
     for r in responses:
         turn, length, end = response_elements(r)
-        codes = window_codes(design_array(r.orientation, alphabet=alphabet), w, n_types=k)[0]
-        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k), -1.0)] if mirror else [])
+        codes = window_codes(design_array(r.orientation, alphabet=alphabet, symmetric=symmetric), w, n_types=k)[0]
+        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k, symmetric), -1.0)] if mirror else [])
         for c, sign in variants:
             all_codes.append(c)
             all_turn.append(sign * turn.T)
@@ -598,12 +623,15 @@ def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], libr
     offset = tuple(float(sum(library[a].cavity[:2]) / 2) for a in alphabet)  # the tracked cavity's middle
     tip_y = float(responses[0].reference_tip[1])
     heights: dict[int, list[float]] = {c: [] for c in range(2 * k)}
+    symmetric = {alphabet.index(t) for t in library.symmetric}
     for r in responses:
         codes = design_array(r.orientation, alphabet=alphabet)[0]
         for c, y in zip(codes, r.reference_centres[:, 1], strict=True):
             heights[int(c)].append(float(y))
             if mirror:
                 heights[int(c) ^ 1].append(2 * tip_y - float(y))
+            if int(c) // 2 in symmetric:  # turned over, the same body: its centre where it was
+                heights[int(c) ^ 1].append(float(y))
     missing = [design_strings(np.array([[c]], dtype=np.uint8), alphabet)[0] for c, ys in heights.items() if not ys]
     if missing:
         raise ChainTableError(f"the training designs do not show the unit(s) {', '.join(missing)}; every type and "
@@ -616,6 +644,7 @@ def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], libr
     geometry = {"type_pitch": pitch, "type_offset": offset,
                 "type_centre_y": tuple(heights[c][0] for c in range(2 * k))}
     fitted = ChainTable(**{**table.__dict__, "alphabet": alphabet, **geometry, "pitch": pitch[0],
+                           "symmetric": library.symmetric,
                            "centre_y": (heights[0][0], heights[1][0]), "first_offset": offset[0],
                            "tip_ref": (cap + pitch[0] - offset[0], tip_y)})
     for r in responses:
@@ -683,18 +712,19 @@ def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[
 
 
 def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed: int = 1,
-                    alphabet: Sequence[str] = ()) -> list[str]:
+                    alphabet: Sequence[str] = (), symmetric: Sequence[int] = ()) -> list[str]:
     """``count`` random designs of ``n_units`` units, none of them in ``exclude`` (seeded).
 
-    Over several unit types (``alphabet``) every unit is a random type and orientation.
+    Over several unit types (``alphabet``) every unit is a random type and orientation (one
+    orientation for the ``symmetric`` types' indices).
     """
     rng = np.random.default_rng(seed)
     out: list[str] = []
     taken = set(exclude)
     k = max(1, len(alphabet))
-    limit = (2 * k) ** n_units - len(taken)
+    limit = len(unit_codes(k, symmetric)) ** n_units - len(taken)
     while len(out) < min(count, limit):
-        d = design_strings(random_designs(1, n_units, rng, k) if k > 1 else
+        d = design_strings(random_designs(1, n_units, rng, k, symmetric) if k > 1 else
                            rng.integers(0, 2, size=(1, n_units), dtype=np.uint8), alphabet)[0]
         if d not in taken:
             taken.add(d)
@@ -758,6 +788,7 @@ def build_table(
            "n_units": n, "description": source_description(model)}
     library = getattr(model, "library", None)
     alphabet = library.symbols if library is not None and not library.is_single else ()
+    symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
     solved: dict[str, Response] = {}
 
     def solve(designs: list[str], what: str) -> list[Response]:
@@ -777,11 +808,11 @@ def build_table(
     start = time.perf_counter()
     best: ChainTable | None = None
     for w in windows:
-        check_training_size(max(1, len(alphabet)), w)
-        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet)
+        check_training_size(max(1, len(alphabet)), w, len(symmetric))
+        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric)
         say(f"window +-{w}: {len(train)} covering designs")
         table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
-        tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet)
+        tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet, symmetric=symmetric)
         val = prediction_errors(table, solve(tests, "held-out"))
         val.update(tolerance_mm=tolerance, seed=seed)
         worst = max(val["centre_worst_mm"])

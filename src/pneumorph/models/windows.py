@@ -50,6 +50,34 @@ def ends(n_types: int = 1) -> tuple[int, int]:
     return 2 * int(n_types), 2 * int(n_types) + 1
 
 
+def unit_codes(n_types: int = 1, symmetric: Sequence[int] = ()) -> NDArray[np.uint8]:
+    """The unit codes a design may hold: ``2t + o``, one code (``2t``) for a symmetric type ``t``.
+
+    A type whose unit turned over is the same body (``symmetric``: type indices) has one
+    orientation, written in lower case.
+
+    >>> unit_codes(2).tolist(), unit_codes(4, symmetric=(1,)).tolist()
+    ([0, 1, 2, 3], [0, 1, 2, 4, 5, 6, 7])
+    """
+    sym = set(int(t) for t in symmetric)
+    return np.array([c for c in range(2 * int(n_types)) if not (c % 2 and c // 2 in sym)], dtype=np.uint8)
+
+
+def canonical_codes(codes: NDArray[np.integer], symmetric: Sequence[int] = ()) -> NDArray[np.integer]:
+    """Unit codes with every turned-over symmetric unit (``2t + 1``, ``t`` in ``symmetric``) written as ``2t``.
+
+    Base and tip symbols (``2k``, ``2k + 1``) and the codes of other types are kept.
+
+    >>> canonical_codes(np.array([[0, 3, 1, 2]]), symmetric=(1,)).tolist()
+    [[0, 2, 1, 2]]
+    """
+    if not len(symmetric):
+        return codes
+    codes = np.asarray(codes)
+    flip = np.isin(codes // 2, np.asarray(symmetric, dtype=np.int64)) & (codes % 2 == 1)
+    return np.where(flip, codes - 1, codes).astype(codes.dtype)
+
+
 def symbol_chars(alphabet: Sequence[str] = ()) -> str:
     """The character of every window symbol, by code: ``"01BT"`` for one type, else ``"aAeE...<>"``.
 
@@ -86,12 +114,12 @@ def _parse_alphabet(design: str, alphabet: Sequence[str], n_units: int | None) -
 
 
 def design_array(designs: Sequence[str] | str, n_units: int | None = None,
-                 alphabet: Sequence[str] = ()) -> NDArray[np.uint8]:
+                 alphabet: Sequence[str] = (), symmetric: Sequence[int] = ()) -> NDArray[np.uint8]:
     """Designs as a (m, n) array of unit codes (one row per design): 0/1 for one unit type.
 
     ``alphabet`` names the unit types of a table over several (module docstring); a design
     with a letter of another type raises a :class:`ChainTableError` ("unit type 'x' has no
-    table").
+    table"). The turned-over units of ``symmetric`` types (indices) are read as the unit itself.
 
     >>> design_array(["010", "110"]).tolist()
     [[0, 1, 0], [1, 1, 0]]
@@ -114,7 +142,8 @@ def design_array(designs: Sequence[str] | str, n_units: int | None = None,
             raise ChainTableError("designs of different lengths cannot be scored together")
         lookup = np.zeros(128, dtype=np.uint8)
         lookup[[ord(c) for c in chars[:-2]]] = np.arange(len(chars) - 2, dtype=np.uint8)
-        return lookup[np.frombuffer("".join(texts).encode(), dtype=np.uint8)].reshape(len(texts), -1)
+        out = lookup[np.frombuffer("".join(texts).encode(), dtype=np.uint8)].reshape(len(texts), -1)
+        return np.asarray(canonical_codes(out, symmetric), dtype=np.uint8)
     for d in designs:
         if isinstance(d, str) and any(ch.isalpha() for ch in d):
             letters = sorted({ch.lower() for ch in d if ch.isalpha()})
@@ -205,14 +234,17 @@ def window_codes(bits: NDArray[np.integer], window: int, chords: Sequence[int] |
     return sym @ weights
 
 
-def mirror_codes(codes: IntArray, window: int, n_types: int = 1) -> IntArray:
-    """Codes of the mirrored windows (every unit turned over: ``2t <-> 2t + 1``; base and tip kept)."""
+def mirror_codes(codes: IntArray, window: int, n_types: int = 1, symmetric: Sequence[int] = ()) -> IntArray:
+    """Codes of the mirrored windows (every unit turned over: ``2t <-> 2t + 1``; base and tip kept).
+
+    A unit of a ``symmetric`` type turned over is itself (code ``2t``).
+    """
     codes = np.asarray(codes, dtype=np.int64)
     radix, k2 = 2 * int(n_types) + 2, 2 * int(n_types)
     out = np.zeros_like(codes)
     for t in range(2 * window + 1):
         s = (codes // radix**t) % radix
-        s = np.where(s < k2, s ^ 1, s)
+        s = canonical_codes(np.where(s < k2, s ^ 1, s), symmetric)
         out += s * radix**t
     return out
 
@@ -256,13 +288,20 @@ def possible_codes(n_units: int, window: int, n_types: int = 1) -> IntArray:
     return np.array(sorted(found), dtype=np.int64)
 
 
-def random_designs(count: int, n_units: int, rng: np.random.Generator, n_types: int = 1) -> NDArray[np.uint8]:
-    """``count`` random designs of ``n_units`` unit codes (0/1 for one type, ``0 .. 2k - 1`` for ``k``)."""
+def random_designs(count: int, n_units: int, rng: np.random.Generator, n_types: int = 1,
+                   symmetric: Sequence[int] = ()) -> NDArray[np.uint8]:
+    """``count`` random designs of ``n_units`` unit codes (0/1 for one type, ``0 .. 2k - 1`` for ``k``).
+
+    With ``symmetric`` types, each unit is one of :func:`unit_codes` (equally likely).
+    """
+    if len(symmetric):
+        allowed = unit_codes(n_types, symmetric)
+        return allowed[rng.integers(0, len(allowed), size=(count, n_units))]
     return rng.integers(0, 2 * int(n_types), size=(count, n_units), dtype=np.uint8)
 
 
 def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0, n_types: int = 1,
-                     alphabet: Sequence[str] = ()) -> list[str]:
+                     alphabet: Sequence[str] = (), symmetric: Sequence[int] = ()) -> list[str]:
     """A small set of designs in which every window of ``n_units`` units occurs.
 
     Greedy set cover: each pick is the design that shows the most windows not yet seen
@@ -285,6 +324,8 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
         Unit types ``k`` (codes ``0 .. 2k - 1`` per unit); 1: today's 0/1 designs.
     alphabet : sequence of str
         The types' symbols, for the designs' text (letters) when ``n_types > 1``.
+    symmetric : sequence of int
+        Types whose unit turned over is the same body: one orientation (:func:`unit_codes`).
 
     Examples
     --------
@@ -306,14 +347,15 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
         pool = pool[rng.permutation(len(pool))]
     elif k == 1:
         pool = rng.integers(0, 2, size=(20000, n), dtype=np.uint8)
-    elif (2 * k) ** n <= 2**16:
-        every = np.arange((2 * k) ** n)[:, None] // (2 * k) ** np.arange(n - 1, -1, -1)[None, :] % (2 * k)
-        pool = every.astype(np.uint8)[rng.permutation(len(every))]
+    elif len(allowed := unit_codes(k, symmetric)) ** n <= 2**16:
+        c = len(allowed)
+        every = np.arange(c**n)[:, None] // c ** np.arange(n - 1, -1, -1)[None, :] % c
+        pool = allowed[every][rng.permutation(len(every))]
     else:
         windows = len(possible_codes(n, w, k))
-        pool = random_designs(max(20000, 8 * windows // max(n, 1)), n, rng, k)
+        pool = random_designs(max(20000, 8 * windows // max(n, 1)), n, rng, k, symmetric)
     codes = window_codes(pool, w, n_types=k)
-    canon = np.minimum(codes, mirror_codes(codes, w, k)) if mirror else codes
+    canon = np.minimum(codes, mirror_codes(codes, w, k, symmetric)) if mirror else codes
     needed = np.unique(canon)
     index = np.searchsorted(needed, canon)
     seen = np.zeros(len(needed), dtype=bool)
