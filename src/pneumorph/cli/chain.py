@@ -54,6 +54,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     )
     from pneumorph.io import strict_json
     from pneumorph.models.chain import build_table
+    from pneumorph.models.chaintables import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.factory import make_model
 
     settings: dict = {"fidelity": fidelity}
@@ -74,6 +75,9 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         check_training_size(len(model.library), window or 1)  # before any solve
     evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))
     try:
+        plan = build_plan(model, heldout=heldout, workers=evaluator_workers(evaluator), window=window,
+                          tolerance=tolerance, cached=cached_counter(evaluator, model))
+        click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve
         table = build_table(model, evaluator, window=window, tolerance=tolerance, heldout=heldout,
                             on_progress=lambda text: click.echo(text, err=True))
     finally:
