@@ -16,6 +16,7 @@ from pneumorph.design.certified import (
     objective_bounds,
     score_designs,
 )
+from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror
 from pneumorph.geometry.unit import UnitSpec
@@ -73,6 +74,24 @@ def test_without_certify_one_batch_is_verified_and_the_gap_is_reported(setup) ->
     assert len(c["verified"]) == 1 and c["verified"][0] == result.hall_of_fame[0].design
     assert c["certified"] == (c["could_beat"] == 0)
     assert c["gap"] >= 0.0
+
+
+def test_a_certificate_within_epsilon_counts_the_ties_and_solves_less(setup) -> None:
+    """Within epsilon: no design can beat the winner by more than epsilon, and the truth (every design by FE)
+    agrees; the designs that could beat it by less are counted as ties instead of verified."""
+    model, chain, evaluator = setup
+    objective = make_objective("cos", amplitude=8.0)
+    exact = certified_search(model, chain, objective, evaluator, verify=1, certify=True)
+    eps = 0.15  # mm: a third of the bound (0.44 mm)
+    loose = certified_search(model, chain, objective, evaluator, verify=1, certify=True, epsilon=eps)
+    c = loose.certificate
+    assert c["certified"] and c["epsilon"] == eps and c["could_beat"] == 0
+    assert 0.0 <= c["gap"] <= eps + 1e-12
+    assert c["tied"] > 0 and len(c["verified"]) < len(exact.certificate["verified"])
+    truth = run_exhaustive(model, objective, evaluator)
+    assert loose.winner.value <= truth.best.value + eps + 1e-9
+    with pytest.raises(SearchConfigError, match="epsilon"):
+        certified_search(model, chain, objective, evaluator, epsilon=-1.0)
 
 
 def test_the_cartesian_bound_is_the_closed_form() -> None:

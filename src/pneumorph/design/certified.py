@@ -748,9 +748,11 @@ class CertifiedResult:
         FE candidates of every verified design.
     certificate : dict
         ``bound`` (largest objective bound), ``gap`` (how much better at most an unverified
-        design could be than the winner; 0 when certified), ``could_beat`` (unverified designs
-        whose optimistic value beats the winner), ``certified``, ``designs_scored``,
-        ``complete`` (all 2^n scored) and ``floor``.
+        design could be than the winner; 0 when certified exactly, at most ``epsilon`` when
+        certified within it), ``could_beat`` (unverified designs whose optimistic value beats
+        the winner by more than ``epsilon``), ``epsilon``, ``tied`` (unverified designs that
+        could beat it by at most ``epsilon``), ``certified``, ``designs_scored``, ``complete``
+        (all 2^n scored) and ``floor``.
     scores : ChainScores
     solves : int
         New FE solves.
@@ -786,6 +788,7 @@ def certified_search(
     max_verify: int = 200,
     on_progress: Callable[[str], None] | None = None,
     max_failures: int = 4,
+    epsilon: float = 0.0,
 ) -> CertifiedResult:
     """Score every design with the chain, verify the best with FE, and bound the rest.
 
@@ -810,6 +813,10 @@ def certified_search(
     max_failures : int
         Give up when this many verified designs in a row failed to converge in the FE model
         before any converged (each failure can cost minutes).
+    epsilon : float
+        Certify within ``epsilon`` (the objective's units): designs that could beat the winner
+        by at most ``epsilon`` are *tied* - counted in the certificate, not verified - and
+        the winner is certified when no other design can beat it by more.
 
     Raises
     ------
@@ -827,6 +834,8 @@ def certified_search(
         raise SearchConfigError("the FE model and the chain model report different pressure levels")
     if not (np.isfinite(margin) and margin > 0):
         raise SearchConfigError(f"the bound's margin must be a positive number, got {margin!r}")
+    if not (np.isfinite(epsilon) and epsilon >= 0):
+        raise SearchConfigError(f"the certificate's epsilon must be a number >= 0, got {epsilon!r}")
     if chain.table.alphabet and isinstance(objective, ProfileTarget) and objective.length is None:
         # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
         # and the FE verifications alike
@@ -850,7 +859,8 @@ def certified_search(
         best = winner_cost()
         if np.isfinite(best) and not certify:
             break  # one batch that converged
-        pending = np.flatnonzero(~done & (optimistic < best)) if np.isfinite(best) else np.flatnonzero(~done)
+        pending = np.flatnonzero(~done & (optimistic < best - epsilon)) if np.isfinite(best) else \
+            np.flatnonzero(~done)
         if not len(pending):
             break
         if len(verified) >= max_verify:
@@ -870,8 +880,9 @@ def certified_search(
         raise SearchConfigError("no design converged in the FE model")
     best_cost = winner_cost()
     rest = optimistic[~done]
-    could_beat = int((rest < best_cost).sum())
-    beat_floor = scores.floor < best_cost
+    could_beat = int((rest < best_cost - epsilon).sum())
+    tied = int(((rest < best_cost) & (rest >= best_cost - epsilon)).sum())
+    beat_floor = scores.floor < best_cost - epsilon
     gap = max(0.0, best_cost - min(float(rest.min()) if len(rest) else float("inf"), scores.floor))
     winner = min((book.candidate(d) for d in verified if not book.scores[d].failed),
                  key=lambda c: (sign * c.value, c.design))
@@ -883,6 +894,8 @@ def certified_search(
         "bound_worst": float(np.max(scores.bound)),
         "gap": gap,
         "could_beat": could_beat,
+        "epsilon": epsilon,
+        "tied": tied,
         "certified": could_beat == 0 and not beat_floor,
         "verified": list(verified),
         "designs_scored": len(designs),
