@@ -2,6 +2,7 @@
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/chain.py score      # all 2^n designs, n = 15, 20
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/chain.py search     # chain part of the search, n = 15, 30
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/chain.py search --table T.json --units 15  # a library's table
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/chain.py build      # 2D table from a fresh cache
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/chain.py search30   # n = 30 with 2D FE verification
 
@@ -51,22 +52,26 @@ def score() -> None:
             print(f"score all 2^{n} = {2**n:,} designs, {spec}: {t:.3f} s CPU")
 
 
-def search() -> None:
-    table = ChainTable.load(shipped_path("3d"))
-    for n in (15, 30):
-        chain = ChainModel(table, n)
-        for spec, a in TARGETS:
-            objective = make_objective(spec, amplitude=a)
-            t0 = time.process_time()
-            try:
-                s = chain_scores(chain, objective)
-            except SearchConfigError as exc:
-                print(f"n = {n}, {spec} A = {a:g}: refused after {time.process_time() - t0:.1f} s CPU: "
-                      f"{exc}", flush=True)
-                continue
-            t = time.process_time() - t0
-            print(f"n = {n}, {spec} A = {a:g}: {t:.2f} s CPU, {len(s.cost):,} designs kept"
-                  f"{'' if s.complete else ' (branch-and-bound)'}", flush=True)
+def search(tables: list[str], units: list[int]) -> None:
+    for src in tables or ["3d", "2d"]:
+        table = ChainTable.load(shipped_path(src) if src in ("2d", "3d") else src)
+        name = src if src in ("2d", "3d") else "+".join(table.alphabet) or src
+        for n in units:
+            chain = ChainModel(table, n)
+            for spec, a in TARGETS:
+                objective = make_objective(spec, amplitude=a, length=chain.length if spec in ("sin", "cos") else None)
+                t0 = time.process_time()
+                try:
+                    s = chain_scores(chain, objective)
+                except SearchConfigError as exc:
+                    print(f"{name} n = {n}, {spec} A = {a:g}: refused after {time.process_time() - t0:.1f} s CPU: "
+                          f"{exc}", flush=True)
+                    continue
+                t = time.process_time() - t0
+                best = table.texts(s.bits[s.order()[:1]])[0]
+                print(f"{name} n = {n}, {spec} A = {a:g}: {t:.2f} s CPU, {len(s.cost):,} designs kept"
+                      f"{'' if s.complete else ' (branch-and-bound)'}, best {best} {abs(float(s.cost.min())):.4g}",
+                      flush=True)
 
 
 def build() -> None:
@@ -101,9 +106,14 @@ def search30() -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("what", choices=["score", "search", "build", "search30"])
+    parser.add_argument("--table", action="append", default=[], help="search: a table file or 2d/3d (repeatable)")
+    parser.add_argument("--units", type=int, nargs="+", default=[15, 30], help="search: actuator lengths")
     args = parser.parse_args()
     print(f"# {platform.node()} {platform.machine()} python {platform.python_version()} numpy {np.__version__}")
-    {"score": score, "search": search, "build": build, "search30": search30}[args.what]()
+    if args.what == "search":
+        search(args.table, args.units)
+    else:
+        {"score": score, "build": build, "search30": search30}[args.what]()
 
 
 if __name__ == "__main__":

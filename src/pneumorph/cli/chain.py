@@ -72,7 +72,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     if getattr(model, "mixed", False):
         from pneumorph.models.chain import check_training_size
 
-        check_training_size(len(model.library), window or 1)  # before any solve
+        check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
     evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))
     try:
         plan = build_plan(model, heldout=heldout, workers=evaluator_workers(evaluator), window=window,
