@@ -238,3 +238,15 @@ def test_no_build_stops_a_run_that_needs_a_table_with_one_line(tmp_path: Path,
     assert f"`pneumorph chain build --model 2d --pressure 3 --out {tables}/chain-2d-" in err
     assert "22-59 FE solves, estimated" in err
     assert not (tmp_path / "run8").exists() and not tables.exists()
+
+
+def test_no_build_stops_a_run_whose_tolerance_tables_are_missing(tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    args = _short(tmp_path, 6, "--no-build")
+    args[args.index("--tolerance") + 1] = "0.05"  # tolerance tables are shipped for +-0.1 mm only
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "--no-build: the mould tolerance tables of this unit (+-0.05 mm) are neither shipped nor kept" in err
+    assert "30 FE solves of 15-unit designs; estimated" in err and "--tolerance 0" in err
+    assert not (tmp_path / "run6").exists()
