@@ -509,7 +509,7 @@ def check_source(table: ChainTable, model: Any) -> None:
 # -- fitting --------------------------------------------------------------------------------
 def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
               library: UnitLibrary | None = None) -> ChainTable:
-    """Fit a table to converged training responses (all of the same length).
+    """Fit a table to converged training responses (of one ramp; of any lengths).
 
     Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
     mirrored occurrences with negated turns).
@@ -530,14 +530,15 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     """
     if not responses:
         raise ChainTableError("a chain table needs at least one training response")
-    n = responses[0].n_units
+    longest = max(responses, key=lambda r: r.n_units)
+    n = longest.n_units
     pressures = responses[0].pressures
     for r in responses:
         if not r.converged or not np.isfinite(r.centres).all():
             raise ChainTableError(f"training design {r.orientation} did not converge; the chain table needs "
                                   "every training design solved to the last level")
-        if r.n_units != n or not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
-            raise ChainTableError("training responses of different lengths or pressure levels")
+        if not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
+            raise ChainTableError("training responses of different pressure levels")
     w = int(window)
     alphabet = library.symbols if library is not None and not library.is_single else ()
     symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
@@ -573,7 +574,7 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     np.add.at(mean_end, einv, end)
     mean_end /= np.bincount(einv)[:, None]
 
-    ref = responses[0]
+    ref = longest
     xs = ref.reference_centres[:, 0]
     if n < 2:
         raise ChainTableError("a chain table needs training designs of at least 2 units")
@@ -741,6 +742,7 @@ def build_table(
     seed: int = 1,
     max_window: int = MAX_WINDOW,
     on_progress: Callable[[str], None] | None = None,
+    short: bool = False,
 ) -> ChainTable:
     """Fit and validate a chain table to an FE model by solving covering and held-out designs.
 
@@ -761,6 +763,11 @@ def build_table(
         Random held-out designs (seeded by ``seed``) solved to validate the table.
     on_progress : callable, optional
         Called with a line of text after each stage.
+    short : bool
+        Learn the windows that hold the base or the tip from actuators of ``2w`` units
+        (:func:`~pneumorph.models.windows.covering_designs` with ``short``; the model must have
+        ``with_units``), the interior ones from actuators of the model's length. The held-out
+        designs are of the model's length, as always.
 
     Raises
     ------
@@ -795,21 +802,24 @@ def build_table(
         todo = [d for d in designs if d not in solved]
         t0 = time.perf_counter()
         done = 0
-        for _i, outcome in evaluator.iter_evaluate(model, todo):
-            done += 1
-            if not outcome.ok:
-                raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
-                                      f"({outcome.failure}); the chain table needs every design solved")
-            solved[outcome.design] = outcome.response
-            say(f"  {what}: {done}/{len(todo)} solved ({'cached' if outcome.cached else 'solved'} "
-                f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
+        for length in sorted({len(d) for d in todo}):  # a model per length (short training designs)
+            actuator = model if length == n else model.with_units(length)
+            for _i, outcome in evaluator.iter_evaluate(actuator, [d for d in todo if len(d) == length]):
+                done += 1
+                if not outcome.ok:
+                    raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
+                                          f"({outcome.failure}); the chain table needs every design solved")
+                solved[outcome.design] = outcome.response
+                say(f"  {what}: {done}/{len(todo)} solved ({'cached' if outcome.cached else 'solved'} "
+                    f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
         return [solved[d] for d in designs]
 
     start = time.perf_counter()
     best: ChainTable | None = None
     for w in windows:
         check_training_size(max(1, len(alphabet)), w, len(symmetric))
-        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric)
+        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric,
+                                 short=short)
         say(f"window +-{w}: {len(train)} covering designs")
         table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
         tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet, symmetric=symmetric)

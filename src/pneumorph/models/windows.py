@@ -301,7 +301,7 @@ def random_designs(count: int, n_units: int, rng: np.random.Generator, n_types: 
 
 
 def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0, n_types: int = 1,
-                     alphabet: Sequence[str] = (), symmetric: Sequence[int] = ()) -> list[str]:
+                     alphabet: Sequence[str] = (), symmetric: Sequence[int] = (), short: bool = False) -> list[str]:
     """A small set of designs in which every window of ``n_units`` units occurs.
 
     Greedy set cover: each pick is the design that shows the most windows not yet seen
@@ -326,6 +326,10 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
         The types' symbols, for the designs' text (letters) when ``n_types > 1``.
     symmetric : sequence of int
         Types whose unit turned over is the same body: one orientation (:func:`unit_codes`).
+    short : bool
+        Cover the windows that hold the base or the tip with the designs of :func:`end_designs`
+        (``2w`` units each, every end window of ``n_units`` units in one of them), and only the
+        interior windows with designs of ``n_units`` units; first the short designs.
 
     Examples
     --------
@@ -335,6 +339,9 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     >>> designs = covering_designs(6, 1, n_types=2, alphabet=("a", "r"))
     >>> len(designs) >= 8, designs[0]   # at least one design per base window "<<u1u2", up to the mirror
     (True, ...)
+    >>> short = covering_designs(15, 3, short=True)
+    >>> [len(d) for d in short].count(6), len(short) - 32   # 2^6 / 2 end designs, then 15-unit ones
+    (32, 9)
     """
     n, w, k = int(n_units), int(window), int(n_types)
     if n < 1 or w < 0:
@@ -354,7 +361,11 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     else:
         windows = len(possible_codes(n, w, k))
         pool = random_designs(max(20000, 8 * windows // max(n, 1)), n, rng, k, symmetric)
+    ends_first: list[str] = []
     codes = window_codes(pool, w, n_types=k)
+    if short and n > 2 * w:
+        ends_first = end_designs(w, mirror, k, alphabet, symmetric)
+        codes = codes[:, w + 1 : n - w + 1]  # the chords whose windows hold neither the base nor the tip
     canon = np.minimum(codes, mirror_codes(codes, w, k, symmetric)) if mirror else codes
     needed = np.unique(canon)
     index = np.searchsorted(needed, canon)
@@ -367,7 +378,30 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
             raise ChainTableError(f"no design of the pool shows the remaining windows of {n} units")
         chosen.append(best)
         seen[index[best]] = True
-    return design_strings(pool[chosen], alphabet if k > 1 else ())
+    return ends_first + design_strings(pool[chosen], alphabet if k > 1 else ())
+
+
+def end_designs(window: int, mirror: bool = True, n_types: int = 1, alphabet: Sequence[str] = (),
+                symmetric: Sequence[int] = ()) -> list[str]:
+    """Designs of ``2w`` units that together show every window holding the base or the tip.
+
+    Chord ``w`` of a ``2w``-unit design sees the base and all its units, chord ``w + 1`` all its
+    units and the tip; the chords before and after see fewer units. Every sequence of ``2w``
+    unit codes (up to the mirror) therefore shows every end window of any longer actuator: by
+    locality a window's element does not depend on what lies beyond it.
+
+    >>> end_designs(1), len(end_designs(3))
+    (['00', '01'], 32)
+    """
+    w, k = int(window), int(n_types)
+    allowed = unit_codes(k, symmetric)
+    c = len(allowed)
+    every = allowed[np.arange(c ** (2 * w))[:, None] // c ** np.arange(2 * w - 1, -1, -1)[None, :] % c]
+    if mirror:
+        flipped = np.asarray(canonical_codes(every ^ 1, symmetric))
+        keys, mirrored = design_numbers(every, 2 * k), design_numbers(flipped, 2 * k)
+        every = every[keys <= mirrored]
+    return design_strings(every, alphabet if k > 1 else ())
 
 
 def _distinct_counts(index: IntArray, new: NDArray[np.bool_], n_keys: int) -> IntArray:
