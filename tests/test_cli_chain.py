@@ -33,6 +33,24 @@ def test_chain_build_writes_a_validated_table(tmp_path: Path, capsys: pytest.Cap
     assert table.metadata["pneumorph"] and table.metadata["created_utc"]
 
 
+def test_chain_build_short_learns_the_ends_from_short_actuators(tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    unit = tmp_path / "coarse.toml"
+    unit.write_text("[unit]\nelement_size = 3.0\n")
+    out = tmp_path / "t.json"
+    args = ["chain", "build", "--model", "2d", "--unit", str(unit), "--pressure", "20", "--units", "12",
+            "--window", "2", "--short", "--heldout", "4", "--workers", "1", "--cache", str(tmp_path / "c.sqlite"),
+            "--out", str(out)]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    table = ChainTable.load(out)
+    assert {len(d) for d in table.training} == {4, 12} and table.source["n_units"] == 12
+    assert all(len(d) == 12 for d in table.validation["designs"])
+    # the plan counted the short designs the build solved
+    assert f"window +-2 ({len(table.training)} covering designs)" in err.splitlines()[0]
+    assert max(table.validation["centre_worst_mm"]) <= 0.2
+
+
 @pytest.mark.parametrize(
     ("extra", "message"),
     [

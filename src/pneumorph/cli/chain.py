@@ -34,10 +34,13 @@ def chain() -> None:
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", required=True, metavar="FILE", type=P.OutputFile((".json",)), help="Table file to write (JSON).")
+@click.option("--short", is_flag=True,
+              help="Learn the windows at the base and the tip from actuators of 2w units (docs/chain-model.md); "
+                   "the held-out designs keep --units.")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
           window: int | None, tolerance: float, heldout: int, workers: int | None, cache: str | None, out: str,
-          as_json: bool) -> None:
+          short: bool, as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with
@@ -76,10 +79,10 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))
     try:
         plan = build_plan(model, heldout=heldout, workers=evaluator_workers(evaluator), window=window,
-                          tolerance=tolerance, cached=cached_counter(evaluator, model))
+                          tolerance=tolerance, cached=cached_counter(evaluator, model), short=short)
         click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve
         table = build_table(model, evaluator, window=window, tolerance=tolerance, heldout=heldout,
-                            on_progress=lambda text: click.echo(text, err=True))
+                            on_progress=lambda text: click.echo(text, err=True), short=short)
     finally:
         evaluator.close()
     target.parent.mkdir(parents=True, exist_ok=True)

@@ -460,7 +460,7 @@ def unit_text(model: Any) -> str:
 
 
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
-               window: int | None = None, tolerance: float = DEFAULT_TOLERANCE) -> BuildPlan:
+               window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False) -> BuildPlan:
     """What :func:`~pneumorph.models.chain.build_table` will solve to fit a table to ``model`` (the training
     actuator: its designs have ``model.n_units`` units), counted without a solve.
 
@@ -479,6 +479,9 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         :data:`~pneumorph.models.chain.MAX_WINDOW` (those a library of several types allows).
     tolerance : float
         The worst held-out centre error the build accepts (mm).
+    short : bool
+        The build learns the end windows from short actuators (``build_table(short=True)``); each
+        short design counts as one solve (the estimate takes it at the full length's time).
 
     Examples
     --------
@@ -496,16 +499,17 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     library = getattr(model, "library", None)
     alphabet = library.symbols if library is not None and not library.is_single else ()
     types = max(1, len(alphabet))
+    symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
     windows, covering, solves = [], [], []
     seen: set[str] = set()
     for w in [int(window)] if window is not None else range(1, min(MAX_WINDOW, (n_units - 1) // 2) + 1):
         try:
-            check_training_size(types, w)
+            check_training_size(types, w, len(symmetric))
         except PneumorphError:
             break
-        train = covering_designs(n_units, w, n_types=types, alphabet=alphabet)
+        train = covering_designs(n_units, w, n_types=types, alphabet=alphabet, symmetric=symmetric, short=short)
         seen.update(train)
-        seen.update(heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet))
+        seen.update(heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet, symmetric=symmetric))
         windows.append(w)
         covering.append(len(train))
         solves.append(len(seen))
