@@ -170,7 +170,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     def announce() -> None:  # the run's first line, once it has started: an error before it stays one line
         if not said:
             said.append(folder)
-            click.echo(f"designing {config.units} unit{'s' if config.units != 1 else ''} for {label} ({model.fidelity} model, {config.search}, "
+            units = f"{config.units} unit{'s' if config.units != 1 else ''}"
+            click.echo(f"designing {units} for {label} ({model.fidelity} model, {config.search}, "
                        f"executor {config.executor}) -> {folder}", err=True)
 
     def on_generation(stats) -> None:

@@ -23,7 +23,7 @@ Examples
 >>> config = DesignConfig(units=6)
 >>> plan = plan_search(config, make_model(6, {"fidelity": "3d"}), None, workers=2)
 >>> plan.search, plan.note  # doctest: +ELLIPSIS
-('exhaustive', 'FE exhaustive search over all 64 designs instead of the certified search: the chain table of window ...')
+('exhaustive', 'FE exhaustive search over all 64 designs instead of the certified search: the chain table ...')
 """
 
 from __future__ import annotations
@@ -91,7 +91,8 @@ def exhaustive_note(n_units: int, fidelity: str, workers: int, why: str) -> str:
 
     >>> print(exhaustive_note(6, "3d", 2, "the reason"))  # doctest: +NORMALIZE_WHITESPACE
     FE exhaustive search over all 64 designs instead of the certified search: the reason; 33 FE solves (the mirror
-    designs by symmetry), estimated 1.7 min with 2 workers (about 6 s a 3d solve of 6 units on one core, from BENCHMARKS.md; an estimate)
+    designs by symmetry), estimated 1.7 min with 2 workers (about 6 s a 3d solve of 6 units on one core, from
+    BENCHMARKS.md; an estimate)
     """
     solves = exhaustive_solves(n_units)
     plural = "s" if solves > 1 else ""
@@ -185,7 +186,8 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
         return SearchPlan("exhaustive", note=exhaustive_note(n, fidelity, workers, why))
     if not build:
         raise MissingTableError(missing_table_message(config, model, table_dir, workers))
-    return SearchPlan("certified", build=True, note="certified search with a chain table built first (its plan follows)")
+    return SearchPlan("certified", build=True,
+                      note="certified search with a chain table built first (its plan follows)")
 
 
 def missing_table_message(config: Any, model: Any, table_dir: str | Path | None, workers: int = 1) -> str:
