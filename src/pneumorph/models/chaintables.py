@@ -22,7 +22,6 @@ built on first use through the evaluation cache (resumable) and kept in a table 
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -659,15 +658,3 @@ def table_for(
     target = table_file(folder, model)
     return build_once(target, lambda: find_table(model, folder), build, say, f"chain table {target.name}")
 
-
-def table_summary(table: ChainTable) -> dict[str, Any]:
-    """A few facts of a table for reports: window, levels (kPa), source key, what it was restricted from.
-
-    >>> table_summary(restrict_table(ChainTable.load(shipped_path("3d")), 2))["levels_kPa"]
-    [4.5, 9.0]
-    """
-    out: dict[str, Any] = {"window": table.window, "levels_kPa": [round(float(p) * 1e3, 9) for p in table.pressures],
-                           "source": table.source.get("key"), "fingerprint": table.fingerprint()}
-    if "restricted_from" in table.source:
-        out["restricted_from"] = json.loads(json.dumps(table.source["restricted_from"]))
-    return out
