@@ -69,6 +69,10 @@ def test_the_source_check_passes_for_the_model_remade_with_the_tables_levels(tab
         check_source(short, make_model(10, {"fidelity": "3d"}))
     served = serve_table(asked)
     assert served is not None and served.restricted and served.model.fingerprint() == remade.fingerprint()
+    given = serve_table(asked, path=shipped_path("3d"))  # a table given by its file is restricted alike
+    assert given is not None and given.table.fingerprint() == served.table.fingerprint()
+    with pytest.raises(ChainTableError, match="another model"):
+        serve_table(make_model(10, {"fidelity": "2d", "pressure_kpa": 25}), path=shipped_path("3d"))
     assert served.levels_text() == "scored at the table's levels 4.5-22.5 kPa (5 levels) at or below 25 kPa"
     # the chain of the served table is the full table's chain at its first five levels
     design = "0111100001"
