@@ -166,3 +166,15 @@ def test_an_fe_model_that_never_converges_is_given_up_early(setup) -> None:
     other = Reduced2D(N, UnitSpec(element_size=3.0), RampSpec(pressure=0.03))
     with pytest.raises(SearchConfigError, match="different pressure levels"):
         certified_search(other, chain, make_objective("sin"), evaluator)
+
+
+def test_epsilon_is_a_setting_of_the_certified_search_only() -> None:
+    from pneumorph.design.config import DesignConfig
+
+    config = DesignConfig(epsilon=0.05)
+    assert DesignConfig.from_dict(config.to_dict()).epsilon == 0.05
+    assert "epsilon" not in DesignConfig().to_dict()["design"]  # absent by default: run folders of before match
+    with pytest.raises(SearchConfigError, match="epsilon"):
+        DesignConfig(search="ga", epsilon=0.05)
+    with pytest.raises(SearchConfigError, match="epsilon"):
+        DesignConfig(epsilon=-1.0)

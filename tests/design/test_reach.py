@@ -139,3 +139,22 @@ def test_thirty_units_tip_goals_certify_by_branch_and_bound() -> None:
         whole = cs.score_designs(chain, tip_goal(name), s.bits, cs.chain_errors(chain))
         assert np.allclose(whole.cost, s.cost, rtol=0, atol=1e-9)
     assert table.texts(s.bits[s.order()[:1]])[0].count("1") > 15  # min-distance: the tip curls back to the base
+
+
+def test_too_many_open_prefixes_answer_with_a_sound_floor() -> None:
+    """Past max_nodes the search answers with the beam's designs and a floor that no unlisted design beats.
+
+    16 units through branch-and-bound (2^16 designs, checked against all of them) with room for 50 open prefixes.
+    """
+    table = find_table(make_model(15, {"fidelity": "2d"}))
+    assert table is not None
+    chain = ChainModel(table, 16)
+    for objective in (make_objective("sin", 10.0, length=chain.length), tip_goal("min-distance")):
+        every = cs.grow_designs(chain, objective, cs.chain_errors(chain))
+        partial = cs.chain_scores(chain, objective, max_enumerate=10, max_nodes=50)
+        assert not partial.complete and np.isfinite(partial.floor)
+        listed = {tuple(b) for b in partial.bits.tolist()}
+        unlisted = np.array([tuple(b) not in listed for b in every.bits.tolist()])
+        assert unlisted.sum() > 2**15
+        assert np.all(every.optimistic[unlisted] >= partial.floor - 1e-9)
+        assert partial.cost.min() >= every.cost.min() - 1e-12

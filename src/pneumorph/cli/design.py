@@ -12,7 +12,7 @@ from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli import params as P
 
 # a fallback to the GA
-_NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "chain_table": None}
+_NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "chain_table": None}
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
 
 
@@ -51,6 +51,9 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
               help="Certified search: designs verified by FE per batch (default: one per worker).")
 @click.option("--margin", type=P.Real(0.0, 1e3, low_open=True),
               help="Certified search: factor on the chain's validated errors in the bound (default 1).")
+@click.option("--epsilon", type=P.Real(0.0, 1e3),
+              help="Certified search: certify within this much (the objective's units): designs that could beat the "
+                   "winner by less are counted as ties, not verified (default 0).")
 @click.option("--chain-table", metavar="FILE", type=P.InputFile(),
               help="Certified search: a chain table file (default: the shipped one, or built on first use).")
 @click.option("--tolerance", type=P.Real(0.0, 1.0, unit="mm"),
@@ -85,7 +88,8 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
            periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
            generations: int | None, seed: int | None, search: str | None, certify: bool | None,
-           verify: int | None, margin: float | None, chain_table: str | None, tolerance: float | None,
+           verify: int | None, margin: float | None, epsilon: float | None, chain_table: str | None,
+           tolerance: float | None,
            robust: str | None, robust_samples: int | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
            unit_file: str | None, library: str | None, cache: str | None, out: str | None, overwrite: bool,
@@ -125,7 +129,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     changes: dict[str, Any] = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
                        ("point", point), ("units", units), ("search", search), ("seed", seed),
-                       ("certify", certify), ("verify", verify), ("margin", margin), ("chain_table", chain_table),
+                       ("certify", certify), ("verify", verify), ("margin", margin), ("epsilon", epsilon),
+                       ("chain_table", chain_table),
                        ("tolerance", tolerance), ("robust", robust), ("robust_samples", robust_samples),
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
         if value is not None:
@@ -145,7 +150,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         model_settings.pop("unit_file", None)
     # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
     _check_options_apply(search or config.search, "certified",
-                         {"--certify": certify, "--verify": verify, "--margin": margin, "--chain-table": chain_table})
+                         {"--certify": certify, "--verify": verify, "--margin": margin, "--epsilon": epsilon,
+                          "--chain-table": chain_table})
     config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
     fidelity_given = "fidelity" in config.model
     fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")

@@ -68,6 +68,18 @@ KEEP_GEOMETRY_UNITS = 15
 the memory doubles with every unit)."""
 
 
+class BranchOverflow(SearchConfigError):
+    """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`).
+
+    ``lower`` is the least bound among the open prefixes: no design that was not listed has a
+    chain cost below ``min(lower, threshold)``.
+    """
+
+    def __init__(self, message: str, lower: float) -> None:
+        super().__init__(message)
+        self.lower = lower
+
+
 # -- errors of the chain and the bound on the objective --------------------------------------
 def chain_errors(chain: ChainModel, margin: float = 1.0) -> dict[str, FloatArray]:
     """The chain's validated worst errors per level: ``centre``, ``tip`` (mm), ``curl`` (deg).
@@ -686,13 +698,13 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
             if beam is not None and keep.sum() > beam:
                 keep = np.zeros(len(bits), dtype=bool)
                 keep[np.argpartition(bound, beam)[:beam]] = True
+            if keep.sum() > max_nodes:
+                raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too "
+                                     "many designs come within the chain's error bound of the best to list them all "
+                                     "- use --search ga", float(bound[keep].min()))
             bits = bits[keep]
             st = {key: v[keep] for key, v in st.items()}
             growth.send((bits, st))
-            if len(bits) > max_nodes:
-                raise SearchConfigError(f"branch-and-bound: {len(bits):,} open prefixes at unit {p} of {n}: too "
-                                        "many designs come within the chain's error bound of the best to list "
-                                        "them all - use --search ga")
         if profile:
             values = np.sqrt(st["sum"])
         else:
@@ -707,7 +719,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
 
 
 def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
-                 max_enumerate: int = MAX_ENUMERATE) -> ChainScores:
+                 max_enumerate: int = MAX_ENUMERATE, max_nodes: int = MAX_NODES) -> ChainScores:
     """Chain scores of every design that can matter, with a floor under the rest.
 
     Up to ``max_enumerate`` units: all ``2^n`` designs. Above: a beam search (the 4096
@@ -716,16 +728,25 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     bound), the only ones whose FE value can beat a design of chain cost ``c0``; all others
     are at least ``c0 + 2 beta`` by the chain, so their optimistic value is at least
     ``c0 + beta``.
+
+    Where more than ``max_nodes`` prefixes stay open, the answer is the beam's designs with
+    the floor that the open prefixes' least bound gives (``lower - beta``): an answer whose
+    certificate states how much better an unlisted design could be, not a failure.
     """
     errors = chain_errors(chain, margin)
     n = chain.n_units
     if _enumerable(chain, max_enumerate):
         return grow_designs(chain, objective, errors)
-    c0 = float(grow_designs(chain, objective, errors, beam=4096).cost.min())
+    beamed = grow_designs(chain, objective, errors, beam=4096)
+    c0 = float(beamed.cost.min())
     probe = score_designs(chain, objective, np.zeros((1, n), dtype=np.uint8), errors)
     beta = float(probe.bound.max()) if np.isfinite(probe.bound).all() else float(errors["centre"].max())
     threshold = c0 + 2 * beta + 1e-9
-    scores = grow_designs(chain, objective, errors, threshold)
+    try:
+        scores = grow_designs(chain, objective, errors, threshold, max_nodes=max_nodes)
+    except BranchOverflow as exc:
+        floor = min(exc.lower, threshold) - beta
+        return replace(beamed, floor=floor)
     keep = scores.cost < threshold
     return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
                        scores.optimistic[keep], scores.bound[keep], floor=threshold - beta, choices=scores.choices)

@@ -70,6 +70,8 @@ IntArray = NDArray[np.int64]
 DIRECTIONS = 360
 #: most states (``(2k)^memory``) the programme keeps per step
 MAX_STATES = 128
+#: centres ahead of a prefix whose terms the profile bound adds
+AHEAD = 12
 #: what a kept float32 value may lie below the float64 it rounds (mm): added back at every query
 _ROUND = 1e-4
 _EMPTY = -1e30
@@ -362,13 +364,14 @@ def profile_rest(reach: Reach, heights: FloatArray, curve: CurveRange, bits: NDA
     ``i - placed`` chords from the prefixes' point; its term ``f(x) - (y - y_ref)`` is at least
     the gap between the box's heights (less the unit's undeformed centre height, known for the
     prefix's units, else its least and greatest) and the target's values over the box's x
-    range. The last ``w - 1`` centres add nothing.
+    range. The last ``w - 1`` centres add nothing, nor do those more than :data:`AHEAD` chords
+    ahead (their boxes are wide: they would cost more than they add).
     """
     state = reach.state(bits)
     p = bits.shape[1]
     total = np.zeros(heading.shape)
     h_lo, h_hi = float(np.min(heights)), float(np.max(heights))
-    for i in range(placed + 1, n_units - window + 2):
+    for i in range(placed + 1, min(n_units - window + 2, placed + 1 + AHEAD)):
         x_lo, x_hi, y_lo, y_hi = reach.box("centre", i - placed, state, point, heading)
         lo_ref: FloatArray | float = h_lo
         hi_ref: FloatArray | float = h_hi

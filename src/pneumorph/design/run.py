@@ -558,7 +558,7 @@ def run_design(
                 verify = config.verify or int(getattr(inner, "workers", 1) or 1)
                 cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
                                         hall_of_fame=config.ga.hall_of_fame, margin=config.margin,
-                                        on_progress=say)
+                                        on_progress=say, epsilon=config.epsilon)
                 hof = cert.hall_of_fame
                 order = cert.scores.order()[:1000]
                 names = chain.table.texts(cert.scores.bits[order])
@@ -834,9 +834,13 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
     if cert is not None:
         sure = cert.certificate
         u = o.unit
-        verdict = ("**certified**: no unverified design can beat the winner" if sure["certified"] else
+        eps = float(sure.get("epsilon", 0.0))
+        within = (f" by more than {eps:g} {u} ({sure['tied']:,} unverified design(s) could beat it by less: tied)"
+                  if eps > 0 else "")
+        verdict = (f"**certified**: no unverified design can beat the winner{within}" if sure["certified"] else
                    f"not certified: {sure['could_beat']} unverified design(s) could beat the winner by up to "
-                   f"{sure['gap']:.3g} {u}; run with --certify to verify them")
+                   f"{sure['gap']:.3g} {u}" + (f" (by more than epsilon = {eps:g} {u})" if eps > 0 else "")
+                   + "; run with --certify to verify them")
         lines += [
             "## Certificate",
             "",
