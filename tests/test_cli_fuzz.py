@@ -111,6 +111,7 @@ HUGE = ["100000", "1000000000"]
 OPTIONS: dict[str, dict[str, list[str]]] = {
     "design": {
         "--pressure": [*POSITIVE, "1e9"], "--amplitude": POSITIVE, "--periods": POSITIVE, "--margin": POSITIVE,
+        "--epsilon": [*NONNEG, "1e9"],
         "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
         "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
