@@ -286,7 +286,8 @@ class ChainTable:
         if int(n_units) < need and int(n_units) != trained:
             raise ChainTableError(
                 f"a chain table of window +-{self.window} needs at least {need} units (every window then holds "
-                f"at most one end); got {n_units}. Use the FE model for so short an actuator"
+                f"at most one end); got {n_units}. Search so short an actuator with the FE model (--search exhaustive; "
+                "pneumorph design chooses it by itself)"
             )
 
     def reference(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray]:
