@@ -71,7 +71,7 @@ DIRECTIONS = 360
 #: most states (``(2k)^memory``) the programme keeps per step
 MAX_STATES = 128
 #: centres ahead of a prefix whose terms the profile bound adds
-AHEAD = 12
+AHEAD = 6
 #: what a kept float32 value may lie below the float64 it rounds (mm): added back at every query
 _ROUND = 1e-4
 _EMPTY = -1e30
