@@ -63,6 +63,20 @@ def test_codes_are_written_in_the_librarys_letters() -> None:
     assert counts.min() > 250  # every code reached (2000 draws over 6 codes: about 333 each)
 
 
+def test_a_symmetric_unit_is_written_in_one_letter() -> None:
+    """The extending unit turned over is itself: a genome's E is written e, so it is solved once."""
+    assert _design([0, 3, 2, 1], ("a", "e"), symmetric=(1,)) == "aeeA"
+    library = UnitLibrary(("a", "e"), (UnitSpec(), UnitSpec(wall=3.0, layer=0.0)), ("bending", "extending"),
+                          name="toy-ae")
+    model = LibraryToy()
+    model.library = library
+    objective = make_objective("sin", 6.0, length=model.n_units * model.unit_length)
+    result = run_ga(model, objective, GAConfig(seed=0, population=20, generations=5, indpb=1 / 6))
+    assert model.calls and not any("E" in d for d in model.calls)
+    assert len(model.calls) == len(set(model.calls))  # no design solved twice under two names
+    assert "E" not in result.best.design
+
+
 def test_ga_over_a_library_finds_the_brute_force_optimum() -> None:
     model = LibraryToy()
     objective = make_objective("sin", 6.0, length=model.n_units * model.unit_length)

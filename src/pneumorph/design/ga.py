@@ -37,7 +37,7 @@ from pneumorph.design.targets import Objective, Sense
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.response import ActuatorModel
-from pneumorph.models.windows import design_strings
+from pneumorph.models.windows import canonical_codes, design_strings
 
 _FITNESS = {"min": "PneumorphFitnessMin", "max": "PneumorphFitnessMax"}
 _INDIVIDUAL = {"min": "PneumorphIndividualMin", "max": "PneumorphIndividualMax"}
@@ -257,14 +257,15 @@ def make_toolbox(n_units: int, sense: Sense, config: GAConfig, rng: random.Rando
     return toolbox
 
 
-def _design(ind: Sequence[int], symbols: Sequence[str] = ()) -> str:
+def _design(ind: Sequence[int], symbols: Sequence[str] = (), symmetric: Sequence[int] = ()) -> str:
     """A genome as design text: 0/1 digits, or over a library's ``symbols`` the letter of the type,
-    upper case for orientation 1 (code ``2t + o``), as the chain tables write designs."""
-    return design_strings(np.asarray([ind], dtype=np.uint8), symbols)[0]
+    upper case for orientation 1 (code ``2t + o``), as the chain tables write designs; a turned-over
+    unit of a ``symmetric`` type (indices) is the unit itself, written in lower case."""
+    return design_strings(np.asarray(canonical_codes(np.asarray([ind], dtype=np.uint8), symmetric)), symbols)[0]
 
 
 def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[int, int, int],
-           wall: float, symbols: Sequence[str] = ()) -> GenerationStats:
+           wall: float, symbols: Sequence[str] = (), symmetric: Sequence[int] = ()) -> GenerationStats:
     values = np.array([ind.fitness.values[0] for ind in population], dtype=float)
     finite = values[np.isfinite(values)]
     best_ind = max(population, key=lambda ind: ind.fitness)
@@ -275,14 +276,15 @@ def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[i
         best = worst_ = mean = std = math.nan
     return GenerationStats(
         gen, float(best), mean, float(worst_), std, *counts, int(values.size - finite.size), wall,
-        _design(best_ind, symbols)
+        _design(best_ind, symbols, symmetric)
     )
 
 
-def _evaluate(population: Sequence[Any], book: ScoreBook, symbols: Sequence[str] = ()) -> tuple[int, int, int]:
+def _evaluate(population: Sequence[Any], book: ScoreBook, symbols: Sequence[str] = (),
+              symmetric: Sequence[int] = ()) -> tuple[int, int, int]:
     invalid = [ind for ind in population if not ind.fitness.valid]
     before = book.solves
-    scores = book.score_many([_design(ind, symbols) for ind in invalid])
+    scores = book.score_many([_design(ind, symbols, symmetric) for ind in invalid])
     for ind, s in zip(invalid, scores, strict=True):
         ind.fitness.values = (s.value,)
     solves = book.solves - before
@@ -324,13 +326,14 @@ def run_ga(
     rng = random.Random(config.seed)
     library = getattr(model, "library", None)  # the FE models' unit library; designs over several types
     symbols: tuple[str, ...] = tuple(library.symbols) if library is not None and not library.is_single else ()
+    symmetric = tuple(symbols.index(t) for t in library.symmetric) if symbols and library is not None else ()
     toolbox = make_toolbox(model.n_units, objective.sense, config, rng, codes=2 * max(len(symbols), 1))
     history: list[GenerationStats] = []
 
     start = time.perf_counter()
     population = toolbox.population(n=config.population)
-    counts = _evaluate(population, book, symbols)
-    history.append(_stats(0, population, book, counts, time.perf_counter() - start, symbols))
+    counts = _evaluate(population, book, symbols, symmetric)
+    history.append(_stats(0, population, book, counts, time.perf_counter() - start, symbols, symmetric))
     if on_generation:
         on_generation(history[-1])
     stopped = "generations"
@@ -338,15 +341,15 @@ def run_ga(
         start = time.perf_counter()
         offspring = var_and(toolbox.select(population, len(population)), toolbox, config.cxpb, config.mutpb, rng)
         if config.budget is not None:
-            new = {_design(ind, symbols) for ind in offspring if not ind.fitness.valid} - book.scores.keys()
+            new = {_design(ind, symbols, symmetric) for ind in offspring if not ind.fitness.valid} - book.scores.keys()
             if len(book.scores) + len(new) > config.budget:
                 stopped = "budget"
                 break
-        counts = _evaluate(offspring, book, symbols)
+        counts = _evaluate(offspring, book, symbols, symmetric)
         if config.elitism:
             _keep_elites(population, offspring, config.elitism, toolbox)
         population[:] = offspring
-        history.append(_stats(gen, population, book, counts, time.perf_counter() - start, symbols))
+        history.append(_stats(gen, population, book, counts, time.perf_counter() - start, symbols, symmetric))
         if on_generation:
             on_generation(history[-1])
     return GAResult(
@@ -354,7 +357,7 @@ def run_ga(
         objective.sense,
         tuple(history),
         book.hall_of_fame(config.hall_of_fame),
-        tuple(_design(ind, symbols) for ind in population),
+        tuple(_design(ind, symbols, symmetric) for ind in population),
         book.solves,
         dict(book.scores),
         stopped,
