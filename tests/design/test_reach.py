@@ -40,9 +40,7 @@ def _slack(chain: ChainModel, objective) -> list[tuple[int, np.ndarray]]:
     cost[(full.bits.astype(np.int64) * c ** np.arange(n - 1, -1, -1)).sum(axis=1)] = full.cost
     curve = None
     if isinstance(objective, cs.ProfileTarget):
-        reach = float(chain.table.length.max()) * (n + 1) + float(errors["centre"].max())
-        slope = cs._target_slope(chain, objective, errors)
-        curve = CurveRange.of(lambda x: objective.curve(x, chain.length), -reach, reach, slope)
+        curve = cs._curve_range(chain, objective, errors, cs._target_slope(chain, objective, errors))
     seeds, state = cs._seed_prefixes(chain)
     state["sum"] = np.zeros((len(seeds), chain.table.n_levels))
     out = []

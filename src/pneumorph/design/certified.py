@@ -139,8 +139,20 @@ def _target_slope(chain: ChainModel, objective: ProfileTarget, errors: dict[str,
     length = chain.length
     if objective.coordinates == "polar":
         return _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
-    reach = float(chain.table.length.max()) * (chain.n_units + 1) + float(errors["centre"].max())
+    reach = _x_reach(chain, errors)
     return _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+
+
+def _x_reach(chain: ChainModel, errors: dict[str, FloatArray]) -> float:
+    """How far from the base any centre can be (mm): the chords' summed greatest length plus the chain's error."""
+    return float(chain.table.length.max()) * (chain.n_units + 1) + float(errors["centre"].max())
+
+
+def _curve_range(chain: ChainModel, objective: ProfileTarget, errors: dict[str, FloatArray],
+                 slope: float) -> CurveRange:
+    """The range of a Cartesian profile target over x intervals wherever the actuator can reach."""
+    reach = _x_reach(chain, errors)
+    return CurveRange.of(lambda x: objective.curve(x, chain.length), -reach, reach, slope)
 
 
 def _polar_term(r: FloatArray, e: FloatArray, slope: float) -> FloatArray:
@@ -334,12 +346,10 @@ def _box_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], r
 
 
 def _uses_reach(chain: ChainModel, p: int) -> bool:
-    """Whether the support functions bound a prefix of ``p`` units: its next window holds no base symbol."""
-    return 2 * chain.table.window <= p < chain.n_units and _reach_enabled(chain)
-
-
-def _reach_enabled(chain: ChainModel) -> bool:
-    return chain.n_units >= 2 * chain.table.window + 2
+    """Whether the support functions bound a prefix of ``p`` units: its next window holds no base symbol (and
+    the actuator is longer than one full window)."""
+    w = chain.table.window
+    return 2 * w <= p < chain.n_units and chain.n_units >= 2 * w + 2
 
 
 def _prefix_bound(chain: ChainModel, objective: Objective, bits: NDArray[np.uint8], state: dict[str, Any],
@@ -669,8 +679,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     bits, st = _seed_prefixes(chain, polar)
     curve, refine = None, False
     if profile and not polar and np.isfinite(slope) and (np.isfinite(threshold) or beam is not None):
-        reach = float(table.length.max()) * (n + 1) + float(e.max())
-        curve = CurveRange.of(lambda x: prof.curve(x, length), -reach, reach, slope)
+        curve = _curve_range(chain, prof, errors, slope)
     if profile:
         st["sum"] = np.zeros((len(bits), k))
     if polar:

@@ -325,8 +325,8 @@ def run_ga(
     book = ScoreBook(model, objective, evaluator)
     rng = random.Random(config.seed)
     library = getattr(model, "library", None)  # the FE models' unit library; designs over several types
-    symbols: tuple[str, ...] = tuple(library.symbols) if library is not None and not library.is_single else ()
-    symmetric = tuple(symbols.index(t) for t in library.symmetric) if symbols and library is not None else ()
+    symbols: tuple[str, ...] = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
     toolbox = make_toolbox(model.n_units, objective.sense, config, rng, codes=2 * max(len(symbols), 1))
     history: list[GenerationStats] = []
 

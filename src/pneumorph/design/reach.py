@@ -185,11 +185,7 @@ def _shifted(prev: NDArray[np.float64], rows_next: IntArray, turn: FloatArray, d
     weights per row and level.
     """
     n = prev.shape[-1]
-    cells = -turn / delta
-    shift = np.floor(cells)
-    f = cells - shift
-    wa, wb = np.sin((1.0 - f) * delta) / np.sin(delta), np.sin(f * delta) / np.sin(delta)
-    start = shift.astype(np.int64) % n
+    start, wa, wb = _wedge(prev, -turn, delta)
     doubled = np.concatenate([prev, prev[..., :1 + n]], axis=-1)  # (S, k, 2n + 1): any run of n + 1 is a slice
     runs = np.lib.stride_tricks.sliding_window_view(doubled, n + 1, axis=-1)  # (S, k, n + 1, n + 1)
     block = runs[rows_next[:, None], np.arange(prev.shape[1])[None, :], start]  # (R, k, n + 1)
@@ -264,14 +260,14 @@ def build_reach(table: ChainTable, units: int, memory: int | None = None, direct
         last = window
         for _ in range(w):
             window = window + tip_sym * b ** (2 * w)
-            rows = np.searchsorted(table.codes, window).clip(0, len(table.codes) - 1)
-            ok &= table.codes[rows] == window
+            rows, found = table.find(window)
+            ok &= found
             angle = angle + table.turn[rows]
             disp += table.length[rows][..., None] * np.stack([np.cos(angle), np.sin(angle)], -1)
             last = window
             window = window // b
-        erows = np.searchsorted(table.end_codes, last).clip(0, len(table.end_codes) - 1)
-        ok &= table.end_codes[erows] == last
+        erows, found = table.find(last, end=True)
+        ok &= found
         angle = angle + table.end[erows]
         fstate = _state_code(_digits(full, b, 2 * w)[:, 2 * w - m:], c)
         tip0 = disp[..., 0][..., None] * np.cos(grid) + disp[..., 1][..., None] * np.sin(grid)

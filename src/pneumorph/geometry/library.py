@@ -254,6 +254,24 @@ class UnitLibrary:
         return tuple(s for s, u in zip(self.symbols, self.units, strict=True) if u.symmetric)
 
     @property
+    def alphabet(self) -> tuple[str, ...]:
+        """The symbols designs over several types are written in; empty for one type (0/1 designs).
+
+        >>> builtin_library().alphabet, UnitLibrary.single().alphabet
+        (('a', 'e', 'r', 's'), ())
+        """
+        return () if self.is_single else self.symbols
+
+    @property
+    def symmetric_types(self) -> tuple[int, ...]:
+        """Indices in :attr:`alphabet` of the :attr:`symmetric` types (empty for one type).
+
+        >>> builtin_library().symmetric_types
+        (1,)
+        """
+        return tuple(self.alphabet.index(t) for t in self.symmetric) if self.alphabet else ()
+
+    @property
     def is_single(self) -> bool:
         """One type only: its designs are written as 0/1 digits."""
         return len(self.symbols) == 1

@@ -256,6 +256,15 @@ class ChainTable:
         return h.hexdigest()[:16]
 
     # -- lookup and prediction ----------------------------------------------------------
+    def find(self, codes: IntArray, end: bool = False) -> tuple[IntArray, NDArray[np.bool_]]:
+        """Rows of the chord (or end-turn) entries of window ``codes``, and whether each was found.
+
+        Where a window is missing its row is that of a neighbouring window: read ``found``.
+        """
+        table = self.end_codes if end else self.codes
+        idx = np.clip(np.searchsorted(table, codes), 0, len(table) - 1)
+        return idx, table[idx] == codes
+
     def lookup(self, codes: IntArray, end: bool = False) -> IntArray:
         """Rows of the chord (or end-turn) entries of window ``codes``.
 
@@ -264,10 +273,9 @@ class ChainTable:
         ChainTableError
             A window the table has never seen (too short an actuator, another model).
         """
-        table, what = (self.end_codes, "end") if end else (self.codes, "chord")
-        idx = np.searchsorted(table, codes)
-        idx = np.clip(idx, 0, len(table) - 1)
-        missing = table[idx] != codes
+        what = "end" if end else "chord"
+        idx, found = self.find(codes, end)
+        missing = ~found
         if missing.any():
             bad = window_text(int(np.asarray(codes)[missing].ravel()[0]), self.window, self.alphabet)
             raise ChainTableError(
@@ -541,8 +549,8 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         if not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
             raise ChainTableError("training responses of different pressure levels")
     w = int(window)
-    alphabet = library.symbols if library is not None and not library.is_single else ()
-    symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
     k = max(1, len(alphabet))
     all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
     for r in responses:
@@ -625,7 +633,7 @@ def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], libr
     offset = tuple(float(sum(library[a].cavity[:2]) / 2) for a in alphabet)  # the tracked cavity's middle
     tip_y = float(responses[0].reference_tip[1])
     heights: dict[int, list[float]] = {c: [] for c in range(2 * k)}
-    symmetric = {alphabet.index(t) for t in library.symmetric}
+    symmetric = set(library.symmetric_types)
     for r in responses:
         codes = design_array(r.orientation, alphabet=alphabet)[0]
         for c, y in zip(codes, r.reference_centres[:, 1], strict=True):
@@ -795,8 +803,8 @@ def build_table(
     src = {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
            "n_units": n, "description": source_description(model)}
     library = getattr(model, "library", None)
-    alphabet = library.symbols if library is not None and not library.is_single else ()
-    symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
     solved: dict[str, Response] = {}
 
     def solve(designs: list[str], what: str) -> list[Response]:

@@ -496,9 +496,9 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     """
     n_units = int(model.n_units)
     library = getattr(model, "library", None)
-    alphabet = library.symbols if library is not None and not library.is_single else ()
+    alphabet = library.alphabet if library is not None else ()
     types = max(1, len(alphabet))
-    symmetric = tuple(alphabet.index(t) for t in library.symmetric) if library is not None and alphabet else ()
+    symmetric = library.symmetric_types if library is not None else ()
     windows, covering, solves = [], [], []
     seen: set[str] = set()
     for w in [int(window)] if window is not None else range(1, min(MAX_WINDOW, (n_units - 1) // 2) + 1):

@@ -349,15 +349,11 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     if k > 1 and len(alphabet) != k:
         raise ChainTableError(f"a covering set over {k} unit types needs their {k} symbols, got {alphabet!r}")
     rng = np.random.default_rng(seed)
-    if k == 1 and n <= 16:
-        pool = ((np.arange(2**n)[:, None] >> np.arange(n)[None, ::-1]) & 1).astype(np.uint8)
+    if len(allowed := unit_codes(k, symmetric)) ** n <= 2**16:
+        pool = every_design(n, allowed)
         pool = pool[rng.permutation(len(pool))]
     elif k == 1:
         pool = rng.integers(0, 2, size=(20000, n), dtype=np.uint8)
-    elif len(allowed := unit_codes(k, symmetric)) ** n <= 2**16:
-        c = len(allowed)
-        every = np.arange(c**n)[:, None] // c ** np.arange(n - 1, -1, -1)[None, :] % c
-        pool = allowed[every][rng.permutation(len(every))]
     else:
         windows = len(possible_codes(n, w, k))
         pool = random_designs(max(20000, 8 * windows // max(n, 1)), n, rng, k, symmetric)
@@ -381,6 +377,16 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     return ends_first + design_strings(pool[chosen], alphabet if k > 1 else ())
 
 
+def every_design(n_units: int, codes: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """Every design of ``n_units`` units over the unit ``codes``, counting up with the first unit most significant.
+
+    >>> every_design(2, np.array([0, 1], dtype=np.uint8)).tolist()
+    [[0, 0], [0, 1], [1, 0], [1, 1]]
+    """
+    c, n = len(codes), int(n_units)
+    return np.asarray(codes, dtype=np.uint8)[np.arange(c**n)[:, None] // c ** np.arange(n - 1, -1, -1)[None, :] % c]
+
+
 def end_designs(window: int, mirror: bool = True, n_types: int = 1, alphabet: Sequence[str] = (),
                 symmetric: Sequence[int] = ()) -> list[str]:
     """Designs of ``2w`` units that together show every window holding the base or the tip.
@@ -394,9 +400,7 @@ def end_designs(window: int, mirror: bool = True, n_types: int = 1, alphabet: Se
     (['00', '01'], 32)
     """
     w, k = int(window), int(n_types)
-    allowed = unit_codes(k, symmetric)
-    c = len(allowed)
-    every = allowed[np.arange(c ** (2 * w))[:, None] // c ** np.arange(2 * w - 1, -1, -1)[None, :] % c]
+    every = every_design(2 * w, unit_codes(k, symmetric))
     if mirror:
         flipped = np.asarray(canonical_codes(every ^ 1, symmetric))
         keys, mirrored = design_numbers(every, 2 * k), design_numbers(flipped, 2 * k)
