@@ -7,8 +7,6 @@ import pytest
 
 from pneumorph.design import make_objective, run_exhaustive
 from pneumorph.design.certified import (
-    _cos_range,
-    _sin_range,
     certified_search,
     chain_errors,
     chain_scores,
@@ -16,6 +14,7 @@ from pneumorph.design.certified import (
     objective_bounds,
     score_designs,
 )
+from pneumorph.design.reach import _cos_range, _sin_range
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror

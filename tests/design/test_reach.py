@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from pneumorph.design import certified as cs
+from pneumorph.design.prefixes import depths, seed_prefixes
 from pneumorph.design.reach import CurveRange, build_reach
 from pneumorph.design.targets import make_objective, tip_goal
 from pneumorph.models.chain import ChainModel, ChainTable
@@ -41,10 +42,10 @@ def _slack(chain: ChainModel, objective) -> list[tuple[int, np.ndarray]]:
     curve = None
     if isinstance(objective, cs.ProfileTarget):
         curve = cs._curve_range(chain, objective, errors, cs._target_slope(chain, objective, errors))
-    seeds, state = cs._seed_prefixes(chain)
+    seeds, state = seed_prefixes(chain)
     state["sum"] = np.zeros((len(seeds), chain.table.n_levels))
     out = []
-    for p, placed, bits, st, centres in cs._depths(chain, seeds, state):
+    for p, placed, bits, st, centres in depths(chain, seeds, state):
         for _, x, y in centres:
             if curve is not None:
                 st["sum"] = st["sum"] + (objective.curve(x, chain.length) - y) ** 2

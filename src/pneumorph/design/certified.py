@@ -31,9 +31,7 @@ children per prefix, all ``(2k)^n`` designs scored while there are at most
 
 from __future__ import annotations
 
-import threading
 import time
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any, cast
@@ -42,12 +40,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.design.fitness import profile_error_array, score, tip_value_array
-from pneumorph.design.reach import CurveRange, profile_rest, reach_of, tip_goal_rest
+from pneumorph.design.prefixes import ChainGeometry, chain_geometry, depths, seed_prefixes, tip_and_curl
+from pneumorph.design.reach import CurveRange, box_bound, profile_rest, reach_of, tip_goal_rest
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
-from pneumorph.models.chain import ChainModel, window_codes
+from pneumorph.models.chain import ChainModel
 from pneumorph.models.response import ActuatorModel
 from pneumorph.models.windows import design_numbers
 
@@ -273,78 +272,6 @@ def score_designs(chain: ChainModel, objective: Objective, bits: NDArray[np.inte
 
 
 # -- growing designs unit by unit: enumeration and branch-and-bound ---------------------------
-def _contains(lo: FloatArray, hi: FloatArray, phase: float) -> NDArray[np.bool_]:
-    """True where [lo, hi] contains ``phase + 2 pi m`` for some integer m."""
-    return 2 * np.pi * np.ceil((lo - phase) / (2 * np.pi)) + phase <= hi
-
-
-def _cos_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Least and greatest cosine over the angle intervals [lo, hi]."""
-    c_lo, c_hi = np.cos(lo), np.cos(hi)
-    top = np.where(_contains(lo, hi, 0.0), 1.0, np.maximum(c_lo, c_hi))
-    bottom = np.where(_contains(lo, hi, np.pi), -1.0, np.minimum(c_lo, c_hi))
-    return bottom, top
-
-
-def _sin_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Least and greatest sine over the angle intervals [lo, hi]."""
-    s_lo, s_hi = np.sin(lo), np.sin(hi)
-    top = np.where(_contains(lo, hi, np.pi / 2), 1.0, np.maximum(s_lo, s_hi))
-    bottom = np.where(_contains(lo, hi, -np.pi / 2), -1.0, np.minimum(s_lo, s_hi))
-    return bottom, top
-
-
-def _reach_box(table: Any, state: dict[str, Any], remaining: int, axes: str = "xy") -> tuple[FloatArray, ...]:
-    """A box (per prefix and level) holding every tip its remaining chords can reach.
-
-    Chord ``i`` of the remaining ones turns by ``i`` tabulated turns at most, so its angle
-    lies in ``[a + i t_min, a + i t_max]``; its length in ``[L_min, L_max]``. Only the
-    ``axes`` asked for are bounded (the others stay at the current point).
-    """
-    tmin, tmax = table.turn.min(axis=0), table.turn.max(axis=0)
-    lmin, lmax = table.length.min(axis=0), table.length.max(axis=0)
-    a = state["angle"]
-    x, y = state["point"][..., 0], state["point"][..., 1]
-    xlo, xhi, ylo, yhi = x.copy(), x.copy(), y.copy(), y.copy()
-    for i in range(1, remaining + 1):
-        lo, hi = a + i * tmin, a + i * tmax
-        if "x" in axes:
-            cmin, cmax = _cos_range(lo, hi)
-            xhi += np.where(cmax >= 0, lmax * cmax, lmin * cmax)
-            xlo += np.where(cmin <= 0, lmax * cmin, lmin * cmin)
-        if "y" in axes:
-            smin, smax = _sin_range(lo, hi)
-            yhi += np.where(smax >= 0, lmax * smax, lmin * smax)
-            ylo += np.where(smin <= 0, lmax * smin, lmin * smin)
-    return xlo, xhi, ylo, yhi
-
-
-def _box_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], remaining: int) -> FloatArray:
-    """Per level, a lower bound on the cost of every completion from the chords' heading intervals (m, k)."""
-    table = chain.table
-    name = objective.name
-    if name == "max-curl":  # the rest of the turns and the end turn at their largest
-        turns = np.degrees(remaining * table.turn.max(axis=0) + table.end.max(axis=0))
-        return -(np.degrees(state["angle"]) + turns)
-    axes = {"max-x": "x", "min-x": "x", "max-y": "y", "min-y": "y"}.get(name, "xy")
-    xlo, xhi, ylo, yhi = _reach_box(table, state, remaining, axes)
-    ylo, yhi = ylo - table.tip_ref[1], yhi - table.tip_ref[1]
-    if name == "max-x":
-        return -xhi
-    if name == "min-x":
-        return xlo
-    if name == "max-y":
-        return -yhi
-    if name == "min-y":
-        return ylo
-    # distance to the base or to a point: from the point to the box
-    q = (0.0, 0.0) if name == "min-distance" else cast(TipGoal, objective).point
-    assert q is not None
-    dx = np.maximum(np.maximum(xlo - q[0], q[0] - xhi), 0.0)
-    dy = np.maximum(np.maximum(ylo - q[1], q[1] - yhi), 0.0)
-    return np.hypot(dx, dy)
-
-
 def _uses_reach(chain: ChainModel, p: int) -> bool:
     """Whether the support functions bound a prefix of ``p`` units: its next window holds no base symbol (and
     the actuator is longer than one full window)."""
@@ -371,151 +298,9 @@ def _prefix_bound(chain: ChainModel, objective: Objective, bits: NDArray[np.uint
                                          state["angle"], placed, n, chain.table.window)
         return np.sqrt(total.min(axis=1))
     if not use:
-        return _box_bound(chain, objective, state, n + 1 - placed).min(axis=1)
+        return box_bound(chain, objective, state, n + 1 - placed).min(axis=1)
     return tip_goal_rest(reach_of(chain, "tip"), objective.name, objective.point, float(chain.table.tip_ref[1]), bits,
                          state["point"], state["angle"], n).min(axis=1)
-
-
-# -- the prefix tree: chords placed unit by unit ---------------------------------------------
-def _seed_prefixes(chain: ChainModel, polar: bool = False) -> tuple[NDArray[np.uint8], dict[str, Any]]:
-    """The one-unit prefixes (2; ``2k`` over ``k`` types) and their state: base point, angle (polar angle, radius)."""
-    k, c = chain.table.n_levels, choices(chain)
-    bits = chain.table.unit_codes[:, None].copy()
-    st: dict[str, Any] = {"point": np.zeros((c, k, 2)), "angle": np.zeros((c, k))}
-    st["point"][..., 1] = chain.table.heights[bits[:, 0]][:, None]
-    if polar:
-        st.update(theta=np.zeros((c, k)), r=np.zeros((c, k)))
-    return bits, st
-
-
-def _grow(bits: NDArray[np.uint8], st: dict[str, Any], codes: NDArray[np.uint8]) -> tuple[NDArray[np.uint8],
-                                                                                        dict[str, Any]]:
-    """Every prefix extended by each of the unit ``codes`` (child ``c i + b`` of prefix ``i``: code ``codes[b]``)."""
-    c = len(codes)
-    bits = np.concatenate([np.repeat(bits, c, axis=0), np.tile(codes[:, None], (len(bits), 1))], axis=1)
-    return bits, {key: np.repeat(v, c, axis=0) for key, v in st.items()}
-
-
-def _place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], placed: int, upto: int,
-                  polar: bool = False) -> Any:
-    """Place chords ``placed .. upto - 1`` of every prefix (their windows are covered), updating ``st``.
-
-    Yields ``(j, x, y)`` after chord ``j`` with the centre ``j + 1`` it fixes (heights above
-    the undeformed axis), for ``j + 1 <= n``; with ``polar``, ``st["theta"]`` (unwrapped)
-    and ``st["r"]`` of that centre too.
-    """
-    table = chain.table
-    n, w = chain.n_units, table.window
-    if upto <= placed:
-        return
-    cy = table.heights
-    codes = window_codes(bits, w, range(placed, upto), n_types=table.n_types)
-    for j in range(placed, upto):
-        rows = table.lookup(codes[:, j - placed])
-        st["angle"] = st["angle"] + table.turn[rows]
-        step = table.length[rows]
-        st["point"] = st["point"] + np.stack([step * np.cos(st["angle"]), step * np.sin(st["angle"])], -1)
-        if j + 1 <= n:  # centre j + 1 is now known
-            x = st["point"][..., 0]
-            y = st["point"][..., 1] - cy[bits[:, j]][:, None]
-            if polar:
-                raw = np.arctan2(y, x)
-                st["theta"] = raw if j == 0 else st["theta"] + (raw - st["theta"] + np.pi) % (2 * np.pi) - np.pi
-                st["r"] = np.hypot(x, y)
-            yield j, x, y
-
-
-def _depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], polar: bool = False) -> Any:
-    """Grow the prefixes unit by unit: yields ``(p, placed, bits, st, centres)`` at every depth ``p``.
-
-    ``centres`` iterates over the chords placed at this depth (:func:`_place_chords`); the
-    caller consumes it, and may then ``send`` back pruned ``(bits, st)`` for the next depth.
-    """
-    n, w = chain.n_units, chain.table.window
-    placed = 0
-    for p in range(1, n + 1):
-        if p > 1:
-            bits, st = _grow(bits, st, chain.table.unit_codes)
-        upto = n + 1 if p == n else max(p - w + 1, 0)
-        pruned = yield p, max(placed, upto), bits, st, _place_chords(chain, bits, st, placed, upto, polar)
-        placed = max(placed, upto)
-        if pruned is not None:
-            bits, st = pruned
-            yield None  # the value of ``send``
-
-
-def _tip_and_curl(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
-    """Tip point and curl (degrees) of whole designs from their final state."""
-    table = chain.table
-    erows = table.lookup(window_codes(bits, table.window, [chain.n_units], n_types=table.n_types)[:, 0], end=True)
-    return st["point"], np.degrees(st["angle"] + table.end[erows])
-
-
-@dataclass(frozen=True)
-class ChainGeometry:
-    """The centres, tip and curl of every design of a chain model, by prefix depth.
-
-    Centre ``j`` is fixed once the prefix covers its windows, at depth ``depth[j]`` (then
-    ``c**depth[j]`` prefixes, ``c`` = 2 choices per unit, ``2k`` over ``k`` unit types);
-    ``x[j]``, ``y[j]`` (and ``theta[j]``, ``r[j]``) hold it for every prefix at every level,
-    so an objective is evaluated once per prefix, not per design. ``tip`` and ``curl`` are
-    those of all ``c**n`` designs, in the order of :attr:`bits` (the first unit most
-    significant).
-    """
-
-    bits: NDArray[np.uint8]
-    depth: tuple[int, ...]
-    x: tuple[FloatArray, ...]
-    y: tuple[FloatArray, ...]
-    theta: tuple[FloatArray, ...]
-    r: tuple[FloatArray, ...]
-    tip: FloatArray
-    curl: FloatArray
-
-
-_GEOMETRY: weakref.WeakKeyDictionary[ChainModel, ChainGeometry] = weakref.WeakKeyDictionary()
-_GEOMETRY_LOCK = threading.Lock()
-
-
-def chain_geometry(chain: ChainModel) -> ChainGeometry:
-    """Every design's centres, tip and curl, grown over shared prefixes (kept per chain model).
-
-    Memory: four arrays of about ``(w + 1) 2^n k`` numbers for window ``w`` (15 units,
-    window 3, 10 levels: about 50 MB); :func:`grow_designs` keeps it up to
-    :data:`KEEP_GEOMETRY_UNITS` units.
-
-    Examples
-    --------
-    >>> from pneumorph.models.chaintables import find_table
-    >>> from pneumorph.models.factory import make_model
-    >>> chain = ChainModel(find_table(make_model(5, {"fidelity": "2d"})), 5)
-    >>> g = chain_geometry(chain)
-    >>> g.bits.shape, len(g.depth), g.tip.shape, chain_geometry(chain) is g
-    ((32, 5), 5, (32, 10, 2), True)
-    """
-    with _GEOMETRY_LOCK:
-        hit = _GEOMETRY.get(chain)
-    if hit is not None:
-        return hit
-    depth: list[int] = []
-    xs: list[FloatArray] = []
-    ys: list[FloatArray] = []
-    ths: list[FloatArray] = []
-    rs: list[FloatArray] = []
-    with np.errstate(all="ignore"):
-        # the last depth's designs and state are the complete designs' (used after the loop)
-        for p, _, bits, st, centres in _depths(chain, *_seed_prefixes(chain, polar=True), polar=True):  # noqa: B007
-            for _, x, y in centres:
-                depth.append(p)
-                xs.append(x)
-                ys.append(y)
-                ths.append(st["theta"])
-                rs.append(st["r"])
-        tip, curl = _tip_and_curl(chain, bits, st)
-    geom = ChainGeometry(bits, tuple(depth), tuple(xs), tuple(ys), tuple(ths), tuple(rs), tip, curl)
-    with _GEOMETRY_LOCK:
-        _GEOMETRY[chain] = geom
-    return geom
 
 
 def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]) -> ChainScores:
@@ -655,7 +440,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     Designs grow unit by unit, sharing their prefixes: a prefix of ``p`` units fixes the
     chords whose windows it covers, hence the first centres and the partial sums of Eq 4.1
     (which only grow), or the point where the remaining chords start (the tip then stays in
-    the box they can reach, :func:`_reach_box`). Prefixes whose bound reaches ``threshold`` are
+    the box they can reach, :func:`~pneumorph.design.reach.box_bound`). Prefixes whose bound reaches ``threshold`` are
     dropped (branch-and-bound); with no threshold this enumerates all ``2^n`` designs at
     about two chord placements per design. With ``beam``, only the ``beam`` prefixes of
     lowest bound are kept at every depth (a heuristic: no longer every design below the
@@ -676,7 +461,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     length = chain.length
     e = errors["centre"]
     slope = _target_slope(chain, prof, errors) if profile else 0.0
-    bits, st = _seed_prefixes(chain, polar)
+    bits, st = seed_prefixes(chain, polar)
     curve, refine = None, False
     if profile and not polar and np.isfinite(slope) and (np.isfinite(threshold) or beam is not None):
         curve = _curve_range(chain, prof, errors, slope)
@@ -685,7 +470,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     if polar:
         st["bsum"] = np.zeros((len(bits), k))
     with np.errstate(all="ignore"):
-        growth = _depths(chain, bits, st, polar)
+        growth = depths(chain, bits, st, polar)
         for p, placed, bits, st, centres in growth:
             for _, x, y in centres:
                 if profile:
@@ -717,7 +502,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         if profile:
             values = np.sqrt(st["sum"])
         else:
-            tip, curl = _tip_and_curl(chain, bits, st)
+            tip, curl = tip_and_curl(chain, bits, st)
             values = tip_value_array(tip, np.asarray(table.tip_ref), curl, goal.name, goal.point)
         if polar:
             beta = e[None, :] * np.sqrt(st["bsum"])
