@@ -76,7 +76,7 @@ def search(tables: list[str], units: list[int]) -> None:
 
 def build() -> None:
     from pneumorph.execution import CachedEvaluator, EvaluationCache, ProcessPoolEvaluator
-    from pneumorph.models.chain import build_table
+    from pneumorph.models.chainfit import build_table
     from pneumorph.models.fe import Reduced2D
 
     evaluator = CachedEvaluator(ProcessPoolEvaluator(workers=2), EvaluationCache(":memory:"))

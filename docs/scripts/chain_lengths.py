@@ -12,7 +12,8 @@ from __future__ import annotations
 import argparse
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, ProcessPoolEvaluator, default_cache_path
-from pneumorph.models.chain import ChainModel, ChainTable, heldout_designs, prediction_errors
+from pneumorph.models.chain import ChainModel, ChainTable
+from pneumorph.models.chainfit import heldout_designs, prediction_errors
 from pneumorph.models.chaintables import shipped_path
 from pneumorph.models.factory import make_model
 

@@ -19,7 +19,8 @@ from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import ChainModel, ChainTable, build_table, design_strings
+from pneumorph.models.chain import ChainModel, ChainTable, design_strings
+from pneumorph.models.chainfit import build_table
 from pneumorph.models.chaintables import shipped_path
 from pneumorph.models.fe import RampSpec, Reduced2D
 

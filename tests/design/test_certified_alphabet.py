@@ -19,7 +19,8 @@ from pneumorph.design.certified import (
 )
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel, build_table
+from pneumorph.models.chain import ChainModel
+from pneumorph.models.chainfit import build_table
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 N = 6

@@ -16,7 +16,6 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.chain import (
     ChainModel,
     ChainTable,
-    build_table,
     check_source,
     covering_designs,
     design_array,
@@ -24,6 +23,7 @@ from pneumorph.models.chain import (
     possible_codes,
     window_codes,
 )
+from pneumorph.models.chainfit import build_table
 from pneumorph.models.chaintables import shipped_path
 from pneumorph.models.factory import make_model
 from pneumorph.models.fe import RampSpec, Reduced2D

@@ -12,7 +12,8 @@ import pytest
 from pneumorph.errors import ChainTableError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel, ChainTable, build_table, fit_table
+from pneumorph.models.chain import ChainModel, ChainTable
+from pneumorph.models.chainfit import build_table, fit_table
 from pneumorph.models.chaintables import shipped_path
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.windows import (

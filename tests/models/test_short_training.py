@@ -6,7 +6,7 @@ import numpy as np
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import build_table, prediction_errors
+from pneumorph.models.chainfit import build_table, prediction_errors
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.windows import covering_designs, end_designs, window_codes
 

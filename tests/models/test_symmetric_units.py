@@ -9,7 +9,8 @@ from pneumorph.design import make_objective
 from pneumorph.design.certified import chain_errors, grow_designs
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel, build_table, covering_designs
+from pneumorph.models.chain import ChainModel, covering_designs
+from pneumorph.models.chainfit import build_table
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 N = 6

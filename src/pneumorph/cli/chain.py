@@ -56,7 +56,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         make_evaluator,
     )
     from pneumorph.io import strict_json
-    from pneumorph.models.chain import build_table
+    from pneumorph.models.chainfit import build_table
     from pneumorph.models.chaintables import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.factory import make_model
 
@@ -73,7 +73,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         raise ChainTableError(f"--window {window} needs 1 <= window and 2 window + 1 <= --units ({n_units})")
     model = make_model(n_units, settings)
     if getattr(model, "mixed", False):
-        from pneumorph.models.chain import check_training_size
+        from pneumorph.models.chainfit import check_training_size
 
         check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
     evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))

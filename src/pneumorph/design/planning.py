@@ -35,7 +35,8 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import ChainTableError, MissingTableError, SearchConfigError
-from pneumorph.models.chain import MAX_WINDOW, ChainTable, source_key
+from pneumorph.models.chain import ChainTable, source_key
+from pneumorph.models.chainfit import MAX_WINDOW
 from pneumorph.models.chaintables import (
     TRAINING_UNITS,
     ServedTable,

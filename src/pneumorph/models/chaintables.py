@@ -34,16 +34,8 @@ import numpy as np
 from pneumorph.errors import ChainTableError, PneumorphError
 from pneumorph.io.lock import FileLock
 from pneumorph.io.provenance import digest
-from pneumorph.models.chain import (
-    DEFAULT_TOLERANCE,
-    MAX_WINDOW,
-    ChainTable,
-    build_table,
-    check_source,
-    check_training_size,
-    heldout_designs,
-    source_key,
-)
+from pneumorph.models.chain import ChainTable, check_source, source_key
+from pneumorph.models.chainfit import DEFAULT_TOLERANCE, MAX_WINDOW, build_table, check_training_size, heldout_designs
 from pneumorph.models.windows import covering_designs
 
 T = TypeVar("T")
@@ -460,7 +452,7 @@ def unit_text(model: Any) -> str:
 
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
                window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False) -> BuildPlan:
-    """What :func:`~pneumorph.models.chain.build_table` will solve to fit a table to ``model`` (the training
+    """What :func:`~pneumorph.models.chainfit.build_table` will solve to fit a table to ``model`` (the training
     actuator: its designs have ``model.n_units`` units), counted without a solve.
 
     Parameters
@@ -475,7 +467,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         ``cached(designs)``: how many of the designs the evaluation cache holds already.
     window : int, optional
         A fixed window; by default ``build_table``'s: 1, 2, ... up to
-        :data:`~pneumorph.models.chain.MAX_WINDOW` (those a library of several types allows).
+        :data:`~pneumorph.models.chainfit.MAX_WINDOW` (those a library of several types allows).
     tolerance : float
         The worst held-out centre error the build accepts (mm).
     short : bool

@@ -29,7 +29,8 @@ from numpy.typing import NDArray
 
 from pneumorph import checks
 from pneumorph.errors import ChainTableError
-from pneumorph.models.chain import ChainModel, ChainTable, covering_designs, fit_table, source_description, source_key
+from pneumorph.models.chain import ChainModel, ChainTable, covering_designs, source_description, source_key
+from pneumorph.models.chainfit import fit_table
 from pneumorph.models.windows import design_numbers
 from pneumorph.sensitivity.tolerances import Tolerance, box_units, corner_label
 

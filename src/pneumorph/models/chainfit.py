@@ -1,0 +1,423 @@
+"""Fitting and validating a chain table: covering designs solved by FE, windows averaged, held-out designs checked.
+
+A table (:class:`~pneumorph.models.chain.ChainTable`) is fitted from FE solves of a *covering
+set* of designs in which every window occurs (:func:`~pneumorph.models.windows.covering_designs`;
+with ``short``, the end windows from actuators of ``2w`` units), each window's entry the mean
+over its occurrences and their mirrors (:func:`fit_table`). It is validated on held-out random
+designs of the full length (:func:`prediction_errors`), and :func:`build_table` grows the
+window half-width until the worst unit-centre error of the held-out designs is within a
+tolerance at every level.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from pneumorph.errors import ChainTableError, LocalityError
+from pneumorph.geometry.library import UnitLibrary
+from pneumorph.io.provenance import provenance
+from pneumorph.models.chain import ChainTable, source_description, source_key
+from pneumorph.models.response import FloatArray, Response
+from pneumorph.models.windows import (
+    covering_designs,
+    design_array,
+    design_strings,
+    mirror_codes,
+    random_designs,
+    unit_codes,
+    window_codes,
+)
+
+__all__ = ["DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", "build_table", "check_training_size", "first_symbols",
+           "fit_table", "heldout_designs", "prediction_errors", "response_elements"]
+
+#: a level's worst held-out centre error above this is refused (mm, default)
+DEFAULT_TOLERANCE = 0.2
+#: widest window tried by :func:`build_table`
+MAX_WINDOW = 3
+#: most covering designs a table over several unit types may ask for (the base windows alone need
+#: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
+MAX_TRAINING = 200
+
+
+def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
+    """Refuse, before any solve, a window whose base windows alone need more than :data:`MAX_TRAINING` designs.
+
+    >>> check_training_size(2, 2)
+    >>> check_training_size(4, 2)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use fewer unit types or a window of +-1
+    """
+    need = (2 * int(n_types) - int(symmetric)) ** (int(window) + 1) // 2
+    if n_types > 1 and need > MAX_TRAINING:
+        raise LocalityError(f"a chain table over {n_types} unit types at window +-{window} needs at least {need} FE "
+                            f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use fewer "
+                            "unit types or a window of +-1")
+
+
+# -- elements of a response -----------------------------------------------------------------
+def _wrap(a: FloatArray) -> FloatArray:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def response_elements(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Turns (rad) and lengths (mm) of the ``n + 1`` chords, and the end turn, per level.
+
+    Returns
+    -------
+    turn, length : ndarray, shape (k, n + 1)
+    end : ndarray, shape (k,)
+    """
+    k = response.n_levels
+    pts = np.stack([response.centreline(i) for i in range(k)])  # (k, n + 2, 2)
+    chords = np.diff(pts, axis=1)
+    angle = np.unwrap(np.arctan2(chords[..., 1], chords[..., 0]), axis=-1)
+    turn = np.diff(angle, axis=-1, prepend=0.0)
+    length = np.hypot(chords[..., 0], chords[..., 1])
+    end = _wrap(np.radians(response.curl) - angle[:, -1])
+    return turn, length, end
+
+
+# -- fitting --------------------------------------------------------------------------------
+def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
+              library: UnitLibrary | None = None) -> ChainTable:
+    """Fit a table to converged training responses (of one ramp; of any lengths).
+
+    Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
+    mirrored occurrences with negated turns).
+
+    Parameters
+    ----------
+    library : UnitLibrary, optional
+        The unit library of designs over several types (responses keyed by its letters); the
+        table then covers its types (:attr:`ChainTable.alphabet`), and each type's pitch and
+        centre offset are the library's units', checked against the training actuators.
+        None or a one-type library: a 0/1 table.
+
+    Raises
+    ------
+    ChainTableError
+        No responses, a failed one, mixed lengths or levels; over a library, training
+        actuators whose undeformed centres are not where the library's units put them.
+    """
+    if not responses:
+        raise ChainTableError("a chain table needs at least one training response")
+    longest = max(responses, key=lambda r: r.n_units)
+    n = longest.n_units
+    pressures = responses[0].pressures
+    for r in responses:
+        if not r.converged or not np.isfinite(r.centres).all():
+            raise ChainTableError(f"training design {r.orientation} did not converge; the chain table needs "
+                                  "every training design solved to the last level")
+        if not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
+            raise ChainTableError("training responses of different pressure levels")
+    w = int(window)
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
+    k = max(1, len(alphabet))
+    all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
+    for r in responses:
+        turn, length, end = response_elements(r)
+        codes = window_codes(design_array(r.orientation, alphabet=alphabet, symmetric=symmetric), w, n_types=k)[0]
+        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k, symmetric), -1.0)] if mirror else [])
+        for c, sign in variants:
+            all_codes.append(c)
+            all_turn.append(sign * turn.T)
+            all_len.append(length.T)
+            e_codes.append(c[-1:])
+            e_end.append(sign * end[None])
+    codes = np.concatenate(all_codes)
+    turn = np.concatenate(all_turn)
+    length = np.concatenate(all_len)
+    uniq, inv = np.unique(codes, return_inverse=True)
+    counts = np.bincount(inv)[:, None]
+    k = len(pressures)
+    mean_turn = np.zeros((len(uniq), k))
+    mean_len = np.zeros((len(uniq), k))
+    np.add.at(mean_turn, inv, turn)
+    np.add.at(mean_len, inv, length)
+    mean_turn /= counts
+    mean_len /= counts
+    spread = float(max(np.abs(turn - mean_turn[inv]).max(), np.abs(length - mean_len[inv]).max()))
+    ecodes = np.concatenate(e_codes)
+    end = np.concatenate(e_end)
+    euniq, einv = np.unique(ecodes, return_inverse=True)
+    mean_end = np.zeros((len(euniq), k))
+    np.add.at(mean_end, einv, end)
+    mean_end /= np.bincount(einv)[:, None]
+
+    ref = longest
+    xs = ref.reference_centres[:, 0]
+    if n < 2:
+        raise ChainTableError("a chain table needs training designs of at least 2 units")
+    if alphabet:
+        assert library is not None
+        return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
+            window=w, pressures=np.asarray(pressures, dtype=float), codes=uniq, turn=mean_turn, length=mean_len,
+            end_codes=euniq, end=mean_end, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0),
+            source=dict(source), training=tuple(r.orientation for r in responses), spread=spread))
+    pitch = float(np.mean(np.diff(xs)))
+    tip_y = float(ref.reference_tip[1])
+    heights: dict[int, list[float]] = {0: [], 1: []}
+    for r in responses:
+        for o, y in zip(r.orientation, r.reference_centres[:, 1], strict=False):
+            heights[int(o)].append(float(y))
+            if mirror:
+                heights[1 - int(o)].append(2 * tip_y - float(y))
+    if not heights[0] or not heights[1] or max(np.ptp(heights[0]), np.ptp(heights[1])) > 1e-9:
+        raise ChainTableError("the training designs do not show both unit orientations at fixed heights")
+    centre_y = (heights[0][0], heights[1][0])
+    if not np.allclose(np.diff(xs), pitch, atol=1e-9):
+        raise ChainTableError("the training actuator's unit centres are not evenly spaced; a chain table "
+                              "needs identical units")
+    return ChainTable(
+        window=w,
+        pressures=np.asarray(pressures, dtype=float),
+        codes=uniq,
+        turn=mean_turn,
+        length=mean_len,
+        end_codes=euniq,
+        end=mean_end,
+        pitch=pitch,
+        centre_y=centre_y,
+        first_offset=float(xs[0]),
+        tip_ref=(float(ref.reference_tip[0] - xs[-1]), tip_y),
+        source=dict(source),
+        training=tuple(r.orientation for r in responses),
+        spread=spread,
+    )
+
+
+def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], library: UnitLibrary, mirror: bool,
+                  table: ChainTable) -> ChainTable:
+    """The undeformed geometry of a table over several unit types, checked against the training actuators."""
+    k = len(alphabet)
+    pitch = tuple(float(library[a].pitch) for a in alphabet)
+    offset = tuple(float(sum(library[a].cavity[:2]) / 2) for a in alphabet)  # the tracked cavity's middle
+    tip_y = float(responses[0].reference_tip[1])
+    heights: dict[int, list[float]] = {c: [] for c in range(2 * k)}
+    symmetric = set(library.symmetric_types)
+    for r in responses:
+        codes = design_array(r.orientation, alphabet=alphabet)[0]
+        for c, y in zip(codes, r.reference_centres[:, 1], strict=True):
+            heights[int(c)].append(float(y))
+            if mirror:
+                heights[int(c) ^ 1].append(2 * tip_y - float(y))
+            if int(c) // 2 in symmetric:  # turned over, the same body: its centre where it was
+                heights[int(c) ^ 1].append(float(y))
+    missing = [design_strings(np.array([[c]], dtype=np.uint8), alphabet)[0] for c, ys in heights.items() if not ys]
+    if missing:
+        raise ChainTableError(f"the training designs do not show the unit(s) {', '.join(missing)}; every type and "
+                              "orientation must occur")
+    if max(np.ptp(ys) for ys in heights.values()) > 1e-9:
+        raise ChainTableError("the training designs show a unit type's centre at different heights")
+    first = responses[0]
+    cap = float(first.reference_tip[0]) - float(np.sum([library[a].pitch for a in
+                                                         first_symbols(first.orientation, alphabet)]))
+    geometry = {"type_pitch": pitch, "type_offset": offset,
+                "type_centre_y": tuple(heights[c][0] for c in range(2 * k))}
+    fitted = ChainTable(**{**table.__dict__, "alphabet": alphabet, **geometry, "pitch": pitch[0],
+                           "symmetric": library.symmetric,
+                           "centre_y": (heights[0][0], heights[1][0]), "first_offset": offset[0],
+                           "tip_ref": (cap + pitch[0] - offset[0], tip_y)})
+    for r in responses:
+        centres, tip = fitted.reference(fitted.designs(r.orientation))
+        if not (np.allclose(centres[0], r.reference_centres, atol=1e-9, rtol=0)
+                and np.allclose(tip[0], r.reference_tip, atol=1e-9, rtol=0)):
+            raise ChainTableError(f"the undeformed centres of training design {r.orientation} are not where the "
+                                  "library's units put them (pitch, cavity middle); a table of another library?")
+    return fitted
+
+
+def first_symbols(design: str, alphabet: Sequence[str]) -> str:
+    """The type symbol of every unit of a design over ``alphabet`` (lower case; digits: the first type).
+
+    >>> first_symbols("aE1", ("a", "e"))
+    'aea'
+    """
+    return "".join(alphabet[int(c) // 2] for c in design_array(design, alphabet=alphabet)[0])
+
+
+def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[str, Any]:
+    """Centre, tip and curl errors of the table's predictions against FE responses.
+
+    Returns a dict with per-level lists ``centre_mean_mm``, ``centre_worst_mm``,
+    ``tip_worst_mm``, ``curl_worst_deg``, ``norm_worst_mm`` (the worst root of the summed
+    squared centre errors of one design), and ``designs``. A table over several unit
+    types adds ``per_type``: per symbol the ``centre_worst_mm``, ``centre_mean_mm`` (per
+    level) and ``centres`` (how many) of the centres of the units of that type.
+    """
+    k = table.n_levels
+    centre_err, tip_err, curl_err, norm_err = [], [], [], []
+    types = []
+    for r in responses:
+        bits = table.designs(r.orientation)
+        types.append(bits[0] // 2)
+        c, t, cu = table.predict(bits)
+        e = np.hypot(*(c[0] - r.centres).transpose(2, 0, 1))  # (k, n)
+        centre_err.append(e)
+        norm_err.append(np.sqrt((e**2).sum(axis=1)))
+        tip_err.append(np.hypot(*(t[0] - r.tip).T))
+        curl_err.append(np.abs(cu[0] - r.curl))
+    if not responses:
+        nan = [float("nan")] * k
+        return {"designs": [], "centre_mean_mm": nan, "centre_worst_mm": nan, "tip_worst_mm": nan,
+                "curl_worst_deg": nan, "norm_worst_mm": nan}
+    all_c = np.concatenate(centre_err, axis=1)
+    out: dict[str, Any] = {
+        "designs": [r.orientation for r in responses],
+        "centre_mean_mm": all_c.mean(axis=1).tolist(),
+        "centre_worst_mm": all_c.max(axis=1).tolist(),
+        "tip_worst_mm": np.max(tip_err, axis=0).tolist(),
+        "curl_worst_deg": np.max(curl_err, axis=0).tolist(),
+        "norm_worst_mm": np.max(norm_err, axis=0).tolist(),
+    }
+    if table.alphabet:
+        of_type = np.concatenate(types)
+        out["per_type"] = {}
+        for code, symbol in enumerate(table.alphabet):
+            mine = all_c[:, of_type == code]
+            out["per_type"][symbol] = {"centres": int(mine.shape[1])}
+            if mine.size:
+                out["per_type"][symbol].update(centre_mean_mm=mine.mean(axis=1).tolist(),
+                                               centre_worst_mm=mine.max(axis=1).tolist())
+    return out
+
+
+def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed: int = 1,
+                    alphabet: Sequence[str] = (), symmetric: Sequence[int] = ()) -> list[str]:
+    """``count`` random designs of ``n_units`` units, none of them in ``exclude`` (seeded).
+
+    Over several unit types (``alphabet``) every unit is a random type and orientation (one
+    orientation for the ``symmetric`` types' indices).
+    """
+    rng = np.random.default_rng(seed)
+    out: list[str] = []
+    taken = set(exclude)
+    k = max(1, len(alphabet))
+    limit = len(unit_codes(k, symmetric)) ** n_units - len(taken)
+    while len(out) < min(count, limit):
+        d = design_strings(random_designs(1, n_units, rng, k, symmetric) if k > 1 else
+                           rng.integers(0, 2, size=(1, n_units), dtype=np.uint8), alphabet)[0]
+        if d not in taken:
+            taken.add(d)
+            out.append(d)
+    return out
+
+
+def build_table(
+    model: Any,
+    evaluator: Any = None,
+    window: int | None = None,
+    tolerance: float = DEFAULT_TOLERANCE,
+    heldout: int = 20,
+    seed: int = 1,
+    max_window: int = MAX_WINDOW,
+    on_progress: Callable[[str], None] | None = None,
+    short: bool = False,
+) -> ChainTable:
+    """Fit and validate a chain table to an FE model by solving covering and held-out designs.
+
+    Parameters
+    ----------
+    model : ActuatorModel
+        The FE model of the training actuator (e.g. 15 units); it must be free (no gravity)
+        and mirror-symmetric.
+    evaluator : Evaluator, optional
+        How the designs are solved (serial by default); a
+        :class:`~pneumorph.execution.CachedEvaluator` makes the build resumable.
+    window : int, optional
+        A fixed half-width; by default 1, 2, ... up to ``max_window`` until the worst
+        held-out centre error is within ``tolerance`` at every level.
+    tolerance : float
+        Worst held-out unit-centre error allowed at any level (mm).
+    heldout : int
+        Random held-out designs (seeded by ``seed``) solved to validate the table.
+    on_progress : callable, optional
+        Called with a line of text after each stage.
+    short : bool
+        Learn the windows that hold the base or the tip from actuators of ``2w`` units
+        (:func:`~pneumorph.models.windows.covering_designs` with ``short``; the model must have
+        ``with_units``), the interior ones from actuators of the model's length. The held-out
+        designs are of the model's length, as always.
+
+    Raises
+    ------
+    LocalityError
+        The model has gravity, or no window up to ``max_window`` meets the tolerance.
+    ChainTableError
+        A training design failed to converge.
+    """
+    from pneumorph.execution.evaluators import SerialEvaluator
+
+    if getattr(model, "gravity", None) is not None:
+        raise LocalityError("the chain model needs a free actuator: with gravity the weight makes moments along "
+                            "the chain, so a unit's response depends on the whole actuator; search with the FE "
+                            "model (--search ga or exhaustive)")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ChainTableError(f"the tolerance must be a positive number of mm, got {tolerance!r}")
+    evaluator = evaluator or SerialEvaluator()
+    n = int(model.n_units)
+    say = on_progress or (lambda text: None)
+    windows = [int(window)] if window is not None else list(range(1, max_window + 1))
+    if windows[0] < 1 or 2 * windows[-1] + 1 > n:
+        raise ChainTableError(f"a window of +-{windows[-1]} units needs training designs of at least "
+                              f"{2 * windows[-1] + 1} units; the model has {n}")
+    src = {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
+           "n_units": n, "description": source_description(model)}
+    library = getattr(model, "library", None)
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
+    solved: dict[str, Response] = {}
+
+    def solve(designs: list[str], what: str) -> list[Response]:
+        todo = [d for d in designs if d not in solved]
+        t0 = time.perf_counter()
+        done = 0
+        for length in sorted({len(d) for d in todo}):  # a model per length (short training designs)
+            actuator = model if length == n else model.with_units(length)
+            for _i, outcome in evaluator.iter_evaluate(actuator, [d for d in todo if len(d) == length]):
+                done += 1
+                if not outcome.ok:
+                    raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
+                                          f"({outcome.failure}); the chain table needs every design solved")
+                solved[outcome.design] = outcome.response
+                say(f"  {what}: {done}/{len(todo)} solved ({'cached' if outcome.cached else 'solved'} "
+                    f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
+        return [solved[d] for d in designs]
+
+    start = time.perf_counter()
+    best: ChainTable | None = None
+    for w in windows:
+        check_training_size(max(1, len(alphabet)), w, len(symmetric))
+        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric,
+                                 short=short)
+        say(f"window +-{w}: {len(train)} covering designs")
+        table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
+        tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet, symmetric=symmetric)
+        val = prediction_errors(table, solve(tests, "held-out"))
+        val.update(tolerance_mm=tolerance, seed=seed)
+        worst = max(val["centre_worst_mm"])
+        say(f"window +-{w}: worst held-out centre error {worst:.4f} mm, mean at the last level "
+            f"{val['centre_mean_mm'][-1]:.4f} mm")
+        for symbol, errs in val.get("per_type", {}).items():
+            if errs["centres"]:
+                say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
+                    f"({errs['centres']} centres)")
+        meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - start)
+        table = ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})
+        best = table
+        if worst <= tolerance:
+            return table
+    assert best is not None
+    raise LocalityError(
+        f"the chain model does not reproduce this model within {tolerance:g} mm: with window +-{best.window} "
+        f"the worst held-out unit-centre error is {max(best.validation['centre_worst_mm']):.3g} mm; the units "
+        "interact further than the window reaches, so search with the FE model (--search ga or exhaustive)"
+    )
