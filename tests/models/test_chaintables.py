@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from pneumorph.errors import ChainTableError
+from pneumorph.models.buildplan import build_plan
 from pneumorph.models.chain import ChainModel, ChainTable, check_source, source_key
 from pneumorph.models.chaintables import (
-    build_plan,
     ramp_variant,
     restrict_table,
     restriction_levels,

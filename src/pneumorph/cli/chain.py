@@ -56,8 +56,8 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         make_evaluator,
     )
     from pneumorph.io import strict_json
+    from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chainfit import build_table
-    from pneumorph.models.chaintables import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.factory import make_model
 
     settings: dict = {"fidelity": fidelity}

@@ -35,18 +35,10 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import ChainTableError, MissingTableError, SearchConfigError
+from pneumorph.models.buildplan import build_plan, estimate_text
 from pneumorph.models.chain import ChainTable, source_key
 from pneumorph.models.chainfit import MAX_WINDOW
-from pneumorph.models.chaintables import (
-    TRAINING_UNITS,
-    ServedTable,
-    build_plan,
-    estimate_text,
-    same_source,
-    serve_table,
-    shipped_path,
-    table_file,
-)
+from pneumorph.models.chaintables import TRAINING_UNITS, ServedTable, same_source, serve_table, shipped_path, table_file
 
 #: the model settings `pneumorph chain build` takes as options (the command of a missing table names them)
 _BUILD_OPTIONS = {"fidelity": "--model", "pressure_kpa": "--pressure", "unit_file": "--unit", "library": "--library"}

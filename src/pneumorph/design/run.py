@@ -100,8 +100,9 @@ from pneumorph.io.files import (
 from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 from pneumorph.io.lock import RunLock
 from pneumorph.io.provenance import provenance as make_provenance
+from pneumorph.models.buildplan import evaluator_workers
 from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import evaluator_workers, serve_table, table_for
+from pneumorph.models.chaintables import serve_table, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for

@@ -338,7 +338,7 @@ def tolerance_plan_text(model: Any, tolerance: Tolerance, workers: int = 1, n_un
     >>> tolerance_plan_text(make_model(15, {"fidelity": "3d"}), Tolerance(0.1), 2, what=False)  # doctest: +ELLIPSIS
     '15 window-1 tables, 30 FE solves of 15-unit designs; estimated 3.8 min with 2 workers (about 15 s a 3d solve ...'
     """
-    from pneumorph.models.chaintables import estimate_text, unit_text
+    from pneumorph.models.buildplan import estimate_text, unit_text
 
     m = len(tolerance.fields)
     tables = 1 + 2 * m + (2**m if corners else 0)
@@ -361,7 +361,8 @@ def tolerance_tables_for(model: Any, tolerance: Tolerance, folder: str | Path | 
     and holds a lock on its file (:func:`~pneumorph.models.chaintables.build_once`): another
     process that needs the same tables waits for them and reuses them.
     """
-    from pneumorph.models.chaintables import build_once, evaluator_workers
+    from pneumorph.models.buildplan import evaluator_workers
+    from pneumorph.models.chaintables import build_once
 
     found = find_tolerance_tables(model, tolerance, folder)
     if found is not None:
