@@ -233,3 +233,26 @@ class LocalityError(SearchConfigError):
 
 class ScanError(PneumorphError, ValueError):
     """A scan that cannot be compared with a model: unreadable, empty, too few points, wrong units."""
+
+
+class JobLimitError(PneumorphError, RuntimeError):
+    """A background job the bench refuses: the session or the bench has as many jobs queued or
+    running as it may, or the bench is stopping. The message names the limit and its option."""
+
+
+class StateQuotaError(JobLimitError):
+    """The bench's state folder is past its disk quota even without its finished jobs."""
+
+
+class BodyTooLargeError(PneumorphError, ValueError):
+    """A request body past the bench's limit, counted as it arrives (whatever its Content-Length says).
+
+    Parameters
+    ----------
+    limit : int
+        The limit in bytes (named in the message).
+    """
+
+    def __init__(self, limit: int) -> None:
+        self.limit = limit
+        super().__init__(f"requests are limited to {limit:,} bytes here")

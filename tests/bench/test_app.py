@@ -18,6 +18,7 @@ from pneumorph.design.targets import make_objective
 from pneumorph.geometry.assembly import assemble
 
 SIN = {"target": {"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}}
+BASE = "http://127.0.0.1:8000"  # a host the bench serves (its loopback names)
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +33,7 @@ def app(state: Path):  # type: ignore[no-untyped-def]
 
 @pytest.fixture()
 def client(app) -> TestClient:  # type: ignore[no-untyped-def]
-    return TestClient(app)
+    return TestClient(app, base_url=BASE)
 
 
 def test_default_answer_is_the_design_commands_certified_optimum(client: TestClient) -> None:
@@ -169,13 +170,13 @@ def test_verification_runs_the_design_command_and_is_private(client: TestClient,
     report = client.get(f"/api/jobs/{job['id']}/files/report.md")
     assert report.status_code == 200 and "001111010001000" in report.text
     # another browser session sees none of it
-    other = TestClient(app)
+    other = TestClient(app, base_url=BASE)
     assert other.get("/api/jobs").json()["jobs"] == []
     assert other.get(f"/api/jobs/{job['id']}").status_code == 404
     assert other.get(f"/api/jobs/{job['id']}/files/report.md").status_code == 404
     assert client.get(f"/api/jobs/{job['id']}/files/..%2Fjob.json").status_code == 404
     # a restarted server lists the finished job again
-    again = TestClient(create_app(state_dir=state / "state", cache=state / "cache.sqlite"),
+    again = TestClient(create_app(state_dir=state / "state", cache=state / "cache.sqlite"), base_url=BASE,
                        cookies={"pneumorph_session": client.cookies["pneumorph_session"]})
     assert [j["id"] for j in again.get("/api/jobs").json()["jobs"]] == [job["id"]]
 
@@ -241,7 +242,7 @@ def test_export_zips_the_parts_the_mould_and_the_deck(client: TestClient) -> Non
 def test_answers_from_worker_processes_equal_answers_computed_here(state: Path) -> None:
     app = create_app(state_dir=state / "pool", cache=state / "cache.sqlite", answer_workers=1)
     body = {"target": {"kind": "expression", "expression": "y = 0.2*x", "amplitude": 1}, "model": "2d"}
-    with TestClient(app) as c:  # the lifespan starts the worker
+    with TestClient(app, base_url=BASE) as c:  # the lifespan starts the worker
         remote = c.post("/api/design", json=body).json()
         assert c.post("/api/design", json={**body, "unit": "u99"}).json()["error"]["field"] == "unit"
     bench = Bench()

@@ -13,6 +13,7 @@ the winner in the model itself.
 from __future__ import annotations
 
 import json
+import re
 import threading
 import time
 from collections import OrderedDict
@@ -21,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.bench.query import MODELS, Query, QueryError, parse_query
+from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import best_scores
 from pneumorph.design.targets import ProfileTarget, TipGoal
@@ -36,6 +37,8 @@ from pneumorph.models.windows import design_numbers
 
 TARGET_SAMPLES = 201
 BUILTIN = "builtin"
+UNIT_ID = re.compile(r"u[0-9a-f]{15,16}")
+"""An uploaded unit's id: ``u`` and 16 random hex digits (15: the hashed ids of earlier versions)."""
 
 
 class Bench:
@@ -87,10 +90,14 @@ class Bench:
 
     def knows(self, unit: str) -> bool:
         """True for a unit queries may name (one added by another process is read from ``unit_dir``)."""
+        if not isinstance(unit, str):
+            return False
         if unit in self._specs:
             return True
-        path = None if self.unit_dir is None else self.unit_dir / f"{unit}.toml"
-        if path is None or not unit.isalnum() or not path.is_file():
+        if self.unit_dir is None or UNIT_ID.fullmatch(unit) is None:
+            return False
+        path = self.unit_dir / f"{unit}.toml"
+        if not path.is_file():
             return False
         with self._lock:
             self._specs[unit] = UnitSpec.from_toml(path)
@@ -99,12 +106,25 @@ class Bench:
     def unit_spec(self, unit: str = BUILTIN) -> UnitSpec:
         return self._specs[unit]
 
-    def add_unit(self, spec: UnitSpec) -> str:
-        """Offer a unit to queries (kept in ``unit_dir``); its id is a hash of its parameters."""
-        import hashlib
+    def add_unit(self, spec: UnitSpec, unit_id: str | None = None) -> str:
+        """Offer a unit to queries (kept in ``unit_dir``) under ``unit_id`` (default: a random id).
 
-        text = json.dumps(spec.to_dict(), sort_keys=True)
-        unit_id = "builtin" if spec == UnitSpec() else "u" + hashlib.sha256(text.encode()).hexdigest()[:15]
+        The built-in unit's parameters are the built-in unit. Ids are ``u`` and 16 hex
+        digits (:data:`UNIT_ID`), random so that nobody can name another's unit by guessing.
+
+        Examples
+        --------
+        >>> bench = Bench()
+        >>> bench.add_unit(UnitSpec()), bench.add_unit(UnitSpec(layer=2.5), "u0123456789abcdef")
+        ('builtin', 'u0123456789abcdef')
+        """
+        import secrets
+
+        if spec == UnitSpec():
+            unit_id = BUILTIN
+        unit_id = unit_id or "u" + secrets.token_hex(8)
+        if unit_id != BUILTIN and UNIT_ID.fullmatch(unit_id) is None:
+            raise QueryError("unit", f"a unit id is u and 16 hex digits, got {unit_id[:40]!r}")
         with self._lock:
             if unit_id not in self._specs:
                 if self.unit_dir is not None:
@@ -149,20 +169,25 @@ class Bench:
         return self.chain(fidelity, unit).length
 
     # -- answers ------------------------------------------------------------------------
-    def parse(self, body: Any) -> Query:
+    def parse(self, body: Any, units: tuple[str, ...] | None = None) -> Query:
         """A query's JSON body checked against its model and unit (:func:`parse_query`).
+
+        Parameters
+        ----------
+        body : dict
+        units : tuple of str, optional
+            The units the query may name (a session's own); default: every unit known here.
 
         Raises
         ------
         QueryError
         """
-        model = body.get("model", "3d") if isinstance(body, dict) else "3d"
+        model = choice(body.get("model", "3d") if isinstance(body, dict) else "3d", MODELS, "model", "model")
         unit = body.get("unit", BUILTIN) if isinstance(body, dict) else BUILTIN
-        if model not in MODELS:
-            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        if not isinstance(unit, str) or not self.knows(unit):
-            raise QueryError("unit", f"unknown unit {unit!r}; upload its TOML file to build its chain table first")
-        return parse_query(body, self.length(model, unit), self.unit_ids)
+        if not isinstance(unit, str) or (units is not None and unit not in units) or not self.knows(unit):
+            raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}; upload its TOML file to build its chain "
+                                     "table first")
+        return parse_query(body, self.length(model, unit), self.unit_ids if units is None else units)
 
     def recall(self, query: Query) -> dict[str, Any] | None:
         """A remembered answer to ``query`` (marked ``memo``), or None."""

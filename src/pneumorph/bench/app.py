@@ -10,27 +10,31 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import logging
 import multiprocessing
 import os
 import secrets
 from collections.abc import AsyncIterator
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from http.cookies import CookieError, SimpleCookie
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.concurrency import run_in_threadpool
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
+from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.requests import ClientDisconnect, cookie_parser
 
 from pneumorph.bench.answer import Bench
-from pneumorph.bench.jobs import JobBoard
-from pneumorph.bench.query import MODELS, Query, QueryError
+from pneumorph.bench.jobs import JobBoard, JobLimits
+from pneumorph.bench.query import MODELS, Query, QueryError, choice, load_json
 from pneumorph.design.targets import PRESETS, TIP_GOALS
-from pneumorph.errors import PneumorphError
+from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
+from pneumorph.geometry.limits import MeshLimitError, check_mesh
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import json_safe
@@ -38,6 +42,7 @@ from pneumorph.io.files import json_safe
 COOKIE = "pneumorph_session"
 MAX_UNIT_FILE = 64 * 1024  # bytes of an uploaded unit TOML
 MAX_BODY = 1 << 20  # bytes of a JSON request
+MAX_UPLOAD = MAX_UNIT_FILE + 16 * 1024  # bytes of a unit upload: the file and the form around it
 
 
 def read_unit(raw: bytes) -> UnitSpec:
@@ -58,6 +63,8 @@ def read_unit(raw: bytes) -> UnitSpec:
         raise QueryError("unit", "the unit file is not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise QueryError("unit", f"the unit file is not valid TOML: {exc}") from None
+    except RecursionError:
+        raise QueryError("unit", "the unit file is nested too deep to be a unit") from None
     table = data.get("unit")
     if not isinstance(table, dict):
         raise QueryError("unit", "the unit file needs a [unit] table (lengths in mm)")
@@ -136,45 +143,211 @@ class AnswerPool:
             self._pool = None
 
 
-class Sessions:
-    """ASGI middleware: every request gets a browser session (a random cookie), oversized bodies a 413.
+SAFE_METHODS = ("GET", "HEAD", "OPTIONS")
+UPLOAD_ROUTES = ("/api/jobs/table",)  # multipart; every other route that takes a body takes JSON
+LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+log = logging.getLogger("pneumorph.bench")
 
-    The session id is ``request.state.session``; a request without a valid cookie gets a
-    new one, sent back with the response (HttpOnly, SameSite=Strict).
+
+def error_body(field: str, message: str) -> dict[str, Any]:
+    """The bench's one error format, ``{"error": {"field", "message"}}`` (the message bounded to one short line).
+
+    Examples
+    --------
+    >>> error_body("top", "top must be a whole number")
+    {'error': {'field': 'top', 'message': 'top must be a whole number'}}
+    >>> len(error_body("unit", "x" * 10_000)["error"]["message"])
+    500
+    """
+    text = " ".join(str(message).split())
+    return {"error": {"field": str(field)[:64], "message": text if len(text) <= 500 else text[:497] + "..."}}
+
+
+def error(status: int, field: str, message: str, headers: dict[str, str] | None = None) -> JSONResponse:
+    """An error response in the bench's one format."""
+    return JSONResponse(error_body(field, message), status_code=status, headers=headers)
+
+
+def host_name(value: str) -> str:
+    """The host of a ``Host`` header or a URL's netloc, lower case, without port, brackets or final dot.
+
+    Examples
+    --------
+    >>> host_name("LocalHost:8000"), host_name("[::1]:8000"), host_name("127.0.0.1")
+    ('localhost', '::1', '127.0.0.1')
+    """
+    value = value.strip().lower()
+    if value.startswith("["):
+        return value[1:value.find("]")] if "]" in value else value
+    return value.rsplit(":", 1)[0].rstrip(".") if value.count(":") == 1 else value.rstrip(".")
+
+
+class Signing:
+    """The server's session cookies: random ids signed with a secret of this server (itsdangerous).
+
+    The secret is kept in the state folder (``session.key``, readable by its owner only), so
+    a restarted server knows its sessions; a cookie the server did not sign is no session.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> sign = Signing(Path(tempfile.mkdtemp()))
+    >>> value = sign.issue()
+    >>> sign.check(value) == value.split(".")[0], sign.check("0" * 32), sign.check("")
+    (True, None, None)
     """
 
-    def __init__(self, app: Any) -> None:
+    def __init__(self, state: Path) -> None:
+        from itsdangerous import Signer
+
+        key = state / "session.key"
+        try:
+            secret = key.read_bytes()
+        except FileNotFoundError:
+            secret = b""
+        if len(secret) < 32:
+            secret = secrets.token_bytes(32)
+            fd = os.open(key, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            with os.fdopen(fd, "wb") as out:
+                out.write(secret)
+        self._signer = Signer(secret, salt="pneumorph-bench-session")
+
+    def issue(self) -> str:
+        """A new signed session cookie value (the session id and its signature)."""
+        return self._signer.sign(secrets.token_hex(16)).decode("ascii")
+
+    def check(self, value: str) -> str | None:
+        """The session id of a cookie value this server signed, else None."""
+        from itsdangerous import BadSignature
+
+        if not value or len(value) > 200:
+            return None
+        try:
+            return self._signer.unsign(value.encode("latin-1")).decode("ascii")
+        except (BadSignature, UnicodeError):
+            return None
+
+
+class Guard:
+    """ASGI middleware in front of every route: hosts, sessions, cross-site refusals, body limits, 500s.
+
+    In order, for each HTTP request:
+
+    1. the ``Host`` header must name a host the server was started for (``allowed_hosts``):
+       a page on another name whose DNS points here (DNS rebinding) gets a 400;
+    2. the session is the signed cookie's (:class:`Signing`), else a new one sent back with
+       the response (HttpOnly, SameSite=Strict); other cookies, even malformed, are ignored;
+    3. a request that may change something (any method but GET, HEAD, OPTIONS) is refused
+       (403) when it comes from another site (an ``Origin`` other than this server's, or a
+       ``Sec-Fetch-Site`` other than same-origin), and (415) unless its body is JSON
+       (``application/json``; multipart for the unit upload): a cross-site form or a
+       ``text/plain`` POST cannot start work;
+    4. the body is counted as it arrives, whatever ``Content-Length`` says (chunked bodies
+       have none): past ``max_body`` bytes (``max_upload`` for the upload) the request ends
+       with a 413 and the rest is never read;
+    5. an unexpected error is a 500 in the one error format, logged in a few bounded lines
+       (no body; a client that went away is logged in one line, without a traceback).
+    """
+
+    def __init__(self, app: Any, signing: Signing, allowed_hosts: tuple[str, ...], max_body: int = MAX_BODY,
+                 max_upload: int = MAX_UPLOAD) -> None:
         self.app = app
+        self.signing = signing
+        self.allowed = tuple(host_name(h) for h in allowed_hosts)
+        self.max_body, self.max_upload = int(max_body), int(max_upload)
 
     async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
         if scope["type"] != "http":
             return await self.app(scope, receive, send)
-        headers = dict(scope["headers"])
-        length = headers.get(b"content-length")
-        if length is not None and (not length.isdigit() or int(length) > MAX_BODY):
-            refusal = JSONResponse({"error": {"field": "target", "message": f"requests are limited to {MAX_BODY} "
-                                              "bytes"}}, status_code=413)
-            return await refusal(scope, receive, send)
-        jar = SimpleCookie()
-        try:
-            jar.load(headers.get(b"cookie", b"").decode("latin-1"))
-        except CookieError:
-            pass
-        sid = jar[COOKIE].value if COOKIE in jar else ""
-        fresh = len(sid) != 32 or not all(c in "0123456789abcdef" for c in sid)
-        if fresh:
-            sid = secrets.token_hex(16)
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope["headers"]}
+        host = headers.get("host", "")
+        if host_name(host) not in self.allowed:
+            return await error(400, "host", f"this bench serves {', '.join(self.allowed)} only, not "
+                                            f"{host[:60]!r}")(scope, receive, send)
+        jar = cookie_parser(headers.get("cookie", ""))
+        sid = self.signing.check(jar.get(COOKIE, ""))
+        cookie = None
+        if sid is None:
+            value = self.signing.issue()
+            sid = value.split(".")[0]
+            cookie = f"{COOKIE}={value}; HttpOnly; Max-Age={30 * 86400}; Path=/; SameSite=strict".encode()
         scope.setdefault("state", {})["session"] = sid
-        if not fresh:
-            return await self.app(scope, receive, send)
-        cookie = f"{COOKIE}={sid}; HttpOnly; Max-Age={30 * 86400}; Path=/; SameSite=strict".encode()
+        started = False
 
-        async def send_with_cookie(message: Any) -> None:
+        async def reply(message: Any) -> None:
+            nonlocal started
             if message["type"] == "http.response.start":
-                message["headers"] = [*message.get("headers", []), (b"set-cookie", cookie)]
+                started = True
+                if cookie is not None:
+                    message["headers"] = [*message.get("headers", []), (b"set-cookie", cookie)]
             await send(message)
 
-        await self.app(scope, receive, send_with_cookie)
+        refusal = self.refusal(scope, headers)
+        if refusal is not None:
+            return await refusal(scope, receive, reply)
+        limit = self.max_upload if scope["path"] in UPLOAD_ROUTES else self.max_body
+        length = headers.get("content-length")
+        if length is not None and (not length.isdigit() or int(length) > limit):
+            return await error(413, "body", str(BodyTooLargeError(limit)), {"Connection": "close"})(
+                scope, receive, reply)
+        seen = 0
+
+        async def counted() -> Any:
+            nonlocal seen
+            message = await receive()
+            if message["type"] == "http.request":
+                seen += len(message.get("body", b""))
+                if seen > limit:
+                    raise BodyTooLargeError(limit)
+            return message
+
+        try:
+            await self.app(scope, counted, reply)
+        except BodyTooLargeError as exc:
+            if not started:
+                await error(413, "body", str(exc), {"Connection": "close"})(scope, receive, reply)
+        except ClientDisconnect:
+            log.info("%s %s: the client went away", scope["method"], scope["path"][:100])
+        except Exception as exc:
+            log.error("%s %s failed: %s", scope["method"], scope["path"][:100], brief(exc))
+            if not started:
+                await error(500, "server", "an internal error of the bench; the server's log says where")(
+                    scope, receive, reply)
+
+    def refusal(self, scope: Any, headers: dict[str, str]) -> JSONResponse | None:
+        """The response refusing a request that may change something, from another site or not JSON; else None."""
+        if scope["method"] in SAFE_METHODS:
+            return None
+        origin = headers.get("origin")
+        host = headers.get("host", "")
+        if origin is not None and origin.lower() not in (f"http://{host}".lower(), f"https://{host}".lower()):
+            return error(403, "origin", f"requests from another site ({origin[:80]}) may not change anything here")
+        site = headers.get("sec-fetch-site")
+        if site is not None and site not in ("same-origin", "none"):
+            return error(403, "origin", f"requests from another site (Sec-Fetch-Site: {site[:40]}) may not change "
+                                        "anything here")
+        if scope["method"] == "DELETE":
+            return None
+        kind = headers.get("content-type", "").split(";")[0].strip().lower()
+        wanted = "multipart/form-data" if scope["path"] in UPLOAD_ROUTES else "application/json"
+        if kind != wanted:
+            return error(415, "content-type", f"this route takes {wanted}, not {kind[:60] or 'an unnamed type'}")
+        return None
+
+
+def brief(exc: BaseException, frames: int = 8) -> str:
+    """An exception in a few bounded lines: its type and message (at most 300 characters) and its last frames.
+
+    Examples
+    --------
+    >>> brief(ValueError("x" * 1000)).count("x") <= 300
+    True
+    """
+    import traceback
+
+    text = " ".join(str(exc).split())
+    where = [f"{Path(f.filename).name}:{f.lineno} {f.name}" for f in traceback.extract_tb(exc.__traceback__)[-frames:]]
+    return f"{type(exc).__name__}: {text[:300]} (at {' <- '.join(reversed(where))})"
 
 
 def static_dir() -> Path:
@@ -190,20 +363,39 @@ def default_state_dir() -> Path:
 
 
 def create_app(state_dir: str | Path | None = None, cache: str | Path | None = None, workers: int = 1,
-               answer_workers: int | None = None) -> FastAPI:
+               answer_workers: int | None = None, allowed_hosts: tuple[str, ...] | list[str] = LOCAL_HOSTS,
+               limits: JobLimits | None = None) -> FastAPI:
     """The bench as an ASGI application.
 
     Parameters
     ----------
     state_dir : path, optional
-        Jobs and FE shapes (default: ``bench/`` beside the evaluation cache).
+        Jobs, FE shapes, uploaded units and the session key (default: ``bench/`` beside the
+        evaluation cache).
     cache : path, optional
         The evaluation cache (default: the design command's, so both share solves).
     workers : int
-        FE worker processes of background jobs.
+        FE worker processes of a background job.
     answer_workers : int, optional
         Processes that compute answers (default: one per core, at most 4); 0 computes them
         on the server's threads.
+    allowed_hosts : sequence of str
+        The host names (``Host`` header) served; any other is refused (DNS rebinding).
+        Default: this machine's loopback names.
+    limits : JobLimits, optional
+        Jobs per session and in all, their expiry and the state folder's quota.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from fastapi.testclient import TestClient
+    >>> root = Path(tempfile.mkdtemp())
+    >>> client = TestClient(create_app(root / "state", root / "cache.sqlite", answer_workers=0),
+    ...                     base_url="http://127.0.0.1:8000")
+    >>> client.get("/api/jobs").json()
+    {'jobs': []}
+    >>> client.post("/api/jobs", content=b'{"kind": "export"}', headers={"content-type": "text/plain"}).json()
+    {'error': {'field': 'content-type', 'message': 'this route takes application/json, not text/plain'}}
     """
     from pneumorph import __version__
     from pneumorph.execution.cache import default_cache_path
@@ -213,36 +405,55 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     state.mkdir(parents=True, exist_ok=True)
     bench = Bench(table_dir=cache_path.parent / "chain-tables", unit_dir=state / "units")
     bench.shape_dir = state / "shapes"
-    board = JobBoard(bench, state, cache_path, workers)
+    board = JobBoard(bench, state, cache_path, workers, limits)
     answers = AnswerPool(bench, answer_workers)
 
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         await answers.start()
-        yield
-        answers.close()
-        board.close()
+        try:
+            yield
+        finally:  # Ctrl-C, SIGTERM: the running job's processes end now, the job is marked interrupted
+            board.close()
+            answers.close()
 
-    app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None, lifespan=lifespan)
+    app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None, openapi_url=None,
+                  lifespan=lifespan)
     app.state.bench, app.state.board = bench, board
-
-    def error(status: int, field: str, message: str) -> JSONResponse:
-        return JSONResponse({"error": {"field": field, "message": message}}, status_code=status)
 
     @app.exception_handler(QueryError)
     async def _query_error(request: Request, exc: QueryError) -> JSONResponse:
         return error(422, exc.field, exc.message)
 
-    app.add_middleware(Sessions)
+    @app.exception_handler(StarletteHTTPException)
+    async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+        field = {404: "path", 405: "method"}.get(exc.status_code, "request")
+        message = {404: f"no such route: {request.url.path[:100]}",
+                   405: f"{request.method} is not allowed on {request.url.path[:100]}"}.get(exc.status_code,
+                                                                                            str(exc.detail))
+        return error(exc.status_code, field, message, getattr(exc, "headers", None))
+
+    @app.exception_handler(RequestValidationError)
+    async def _validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
+        first = exc.errors()[0] if exc.errors() else {}
+        field = str(first.get("loc", ["", "request"])[-1])
+        return error(422, field, f"{field}: {first.get('msg', 'invalid')}")
+
+    @app.exception_handler(JobLimitError)
+    async def _job_limit(request: Request, exc: JobLimitError) -> JSONResponse:
+        return error(507 if isinstance(exc, StateQuotaError) else 429, "job", str(exc))
+
+    @app.exception_handler(BodyTooLargeError)
+    async def _too_large(request: Request, exc: BodyTooLargeError) -> JSONResponse:
+        return error(413, "body", str(exc), {"Connection": "close"})
+
+    app.add_middleware(Guard, signing=Signing(state), allowed_hosts=tuple(allowed_hosts))
 
     async def body_of(request: Request) -> Any:
-        raw = await request.body()
-        if len(raw) > MAX_BODY:
-            raise QueryError("target", f"requests are limited to {MAX_BODY} bytes")
-        try:
-            return json.loads(raw or b"null")
-        except (ValueError, UnicodeDecodeError):
-            raise QueryError("target", "the request is not valid JSON") from None
+        return load_json(await request.body())
+
+    def session_units(request: Request) -> tuple[str, ...]:
+        return board.unit_ids_of(request.state.session)
 
     @app.get("/", include_in_schema=False)
     async def index() -> FileResponse:
@@ -262,7 +473,7 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     @app.post("/api/design")
     async def design(request: Request) -> Response:
         body = await body_of(request)
-        query = bench.parse(body)  # a fraction of a millisecond
+        query = bench.parse(body, session_units(request))  # a fraction of a millisecond
         answer = bench.recall(query)
         if answer is None:
             answer = await answers.compute(query)
@@ -274,20 +485,20 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
             text = json.dumps(json_safe(answer), allow_nan=False)
         return Response(text, media_type="application/json")
 
-    def check_model(model: str, unit: str) -> None:
-        if model not in MODELS:
-            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        if unit not in bench.unit_ids:
-            raise QueryError("unit", f"unknown unit {unit!r}")
+    def check_model(model: Any, unit: Any, request: Request) -> None:
+        choice(model, MODELS, "model", "model")
+        if not isinstance(unit, str) or unit not in session_units(request) or not bench.knows(unit):
+            raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}")
 
     @app.get("/api/profiles")
-    async def profiles(design: str, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
-        check_model(model, unit)
+    async def profiles(design: str, request: Request, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
+        check_model(model, unit, request)
         return {"design": design, "profiles": await run_in_threadpool(bench.chain_profiles, design, model, unit)}
 
     @app.get("/api/shape")
-    async def shape(design: str, level: int, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
-        check_model(model, unit)
+    async def shape(design: str, level: int, request: Request, model: str = "3d",
+                    unit: str = "builtin") -> dict[str, Any]:
+        check_model(model, unit, request)
         return await run_in_threadpool(bench.chain_shape, design, model, level, unit)
 
     @app.get("/api/units")
@@ -297,14 +508,18 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
 
     @app.post("/api/jobs/table", status_code=202)
     async def start_table(request: Request) -> dict[str, Any]:
+        # the Guard has bounded the whole body to MAX_UPLOAD bytes: the form is parsed in memory
         form = await request.form(max_files=1, max_fields=4)
-        upload, model = form.get("unit"), form.get("model", "3d")
-        if model not in MODELS:
-            raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        upload = form.get("unit")
+        model = choice(form.get("model", "3d"), MODELS, "model", "model")
         if upload is None or isinstance(upload, str):
             raise QueryError("unit", "attach a unit TOML file (a [unit] table, lengths in mm)")
         raw = await upload.read(MAX_UNIT_FILE + 1)
         spec = await run_in_threadpool(read_unit, raw)
+        try:  # what it costs, before anything is meshed: the same rule as the command line's
+            check_mesh(spec, bench.units, 3 if model == "3d" else 2)
+        except MeshLimitError as exc:
+            raise QueryError("unit", str(exc)) from None
         return {"job_id": board.table(request.state.session, spec, str(model)).id}
 
     @app.post("/api/jobs", status_code=202)
@@ -313,18 +528,18 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
         kind = body.get("kind") if isinstance(body, dict) else None
         session = request.state.session
         if kind == "verify":
-            query = await run_in_threadpool(bench.parse, body.get("query"))
+            query = await run_in_threadpool(bench.parse, body.get("query"), session_units(request))
             job = board.verify(session, query)
         elif kind == "export":
             design, unit = body.get("design"), body.get("unit", "builtin")
-            check_model("3d", unit)
+            check_model("3d", unit, request)
             try:
                 design = parse_orientation(design if isinstance(design, str) else "", bench.units)
             except PneumorphError as exc:
                 raise QueryError("design", str(exc)) from None
             job = board.export(session, design, unit)
         else:
-            raise QueryError("kind", f"a job is 'verify' or 'export', got {kind!r}")
+            raise QueryError("kind", f"a job is 'verify' or 'export', got {str(kind)[:40]!r}")
         return {"job_id": job.id}
 
     @app.get("/api/jobs")
@@ -334,6 +549,13 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     @app.get("/api/jobs/{job_id}")
     async def job(job_id: str, request: Request) -> Any:
         found = board.get(request.state.session, job_id)
+        if found is None:
+            return error(404, "job", "no such job in this session")
+        return found.to_dict()
+
+    @app.delete("/api/jobs/{job_id}")
+    async def cancel_job(job_id: str, request: Request) -> Any:
+        found = await run_in_threadpool(board.cancel, request.state.session, job_id)
         if found is None:
             return error(404, "job", "no such job in this session")
         return found.to_dict()
@@ -348,4 +570,4 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     return app
 
 
-__all__ = ["create_app", "default_state_dir", "static_dir"]
+__all__ = ["Guard", "Signing", "create_app", "default_state_dir", "error_body", "static_dir"]

@@ -1,37 +1,75 @@
-"""Work that takes longer than a query: FE verification and export, run in the background.
+"""Work that takes longer than a query: FE verification, export and chain tables, each in a process of its own.
 
-A :class:`JobBoard` runs one job at a time on a thread of the server (the machine's other
-core stays with the live answers); the FE solves themselves run in a worker process through
-the package's evaluators and the shared evaluation cache, so a verified design is never
-solved twice and a design run from the CLI answers the bench from the cache. Every job lives
-in its own folder under the state directory, with a ``job.json`` written atomically at each
-change: a page reload finds it, and a server restart lists finished jobs again (a job that
-was running when the server stopped is marked failed).
+A :class:`JobBoard` runs one job at a time (the machine's other core stays with the live
+answers), each in a new process of :mod:`pneumorph.bench.worker` in a process group of its
+own: the server never solves, meshes or writes a part itself, so it answers queries while a
+job runs, and a cancelled job (``DELETE``) or a stopping server ends the job's whole process
+group at once, its FE workers with it. The FE solves go through the package's evaluators and
+the shared evaluation cache, so a verified design is never solved twice and a design run
+from the CLI answers the bench from the cache. Every job lives in its own folder under the
+state directory, with a ``job.json`` written atomically at each change: a page reload finds
+it, and a server restart lists finished jobs again (a job that was running when the server
+stopped is marked interrupted).
 
-Jobs belong to a browser session; one session cannot see or fetch another's jobs.
+Jobs belong to a browser session; one session cannot see, fetch or cancel another's jobs.
+A session has at most :attr:`JobLimits.per_session` jobs queued or running, the board at most
+:attr:`JobLimits.queued`; finished jobs expire after :attr:`JobLimits.expiry_days`, and the
+oldest finished jobs make room when the state folder passes :attr:`JobLimits.quota_mb`.
 """
 
 from __future__ import annotations
 
 import json
-import multiprocessing
+import os
+import queue
+import secrets
 import shutil
+import signal
+import subprocess
+import sys
 import threading
 import time
-import uuid
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from pneumorph.bench.answer import Bench
 from pneumorph.bench.query import Query
-from pneumorph.execution.evaluators import prepare_worker
+from pneumorph.errors import JobLimitError, StateQuotaError
 from pneumorph.io.files import atomic_write_text, json_safe
 
-STATES = ("queued", "running", "done", "failed")
-SHOWN = ("report.md", "certificate.json", "top.csv", "profile.png", "chain-vs-fe.png", "mould.png")
+STATES = ("queued", "running", "done", "failed", "cancelled", "interrupted")
+ACTIVE = ("queued", "running")
+MAX_LOG = 500  # lines a job keeps
+STOP_GRACE = 2.0  # seconds a job's processes get between SIGTERM and SIGKILL
+
+
+@dataclass(frozen=True)
+class JobLimits:
+    """What the bench's jobs may take.
+
+    Attributes
+    ----------
+    per_session : int
+        Jobs one session may have queued or running at once.
+    queued : int
+        Jobs all sessions together may have queued or running.
+    expiry_days : float
+        Finished jobs (and their files) are deleted this long after they were started.
+    quota_mb : float
+        Disk space the jobs' folders may take; past it the oldest finished jobs are deleted,
+        and a new job is refused while the running ones alone exceed it.
+
+    Examples
+    --------
+    >>> JobLimits().per_session, JobLimits(quota_mb=100).quota_mb
+    (2, 100)
+    """
+
+    per_session: int = 2
+    queued: int = 8
+    expiry_days: float = 7.0
+    quota_mb: float = 2000.0
 
 
 @dataclass
@@ -50,6 +88,8 @@ class Job:
     result: dict[str, Any] | None = None
     files: list[str] = field(default_factory=list)
     created: float = field(default_factory=time.time)
+    process: subprocess.Popen[bytes] | None = field(default=None, repr=False)
+    stop: str | None = None  # why the job is being stopped: "cancelled" or "interrupted"
 
     def to_dict(self) -> dict[str, Any]:
         """The job as the page sees it (file links relative to the server)."""
@@ -59,12 +99,30 @@ class Job:
                 "files": [{"name": f, "url": f"/api/jobs/{self.id}/files/{f}"} for f in self.files]}
 
     def save(self) -> None:
-        record = {**self.to_dict(), "session": self.session}
+        record = {**self.to_dict(), "log": self.log, "session": self.session}
         atomic_write_text(self.folder / "job.json", json.dumps(json_safe(record), indent=1))
 
 
+def folder_size(path: Path) -> int:
+    """Bytes of the files under ``path`` (0 for a missing folder).
+
+    Examples
+    --------
+    >>> folder_size(Path("no-such-folder"))
+    0
+    """
+    total = 0
+    for root, _, files in os.walk(path):
+        for name in files:
+            try:
+                total += os.lstat(os.path.join(root, name)).st_size
+            except OSError:
+                continue
+    return total
+
+
 class JobBoard:
-    """The background jobs of every session.
+    """The background jobs of every session, each run in a worker process.
 
     Parameters
     ----------
@@ -74,19 +132,27 @@ class JobBoard:
     cache : path
         The evaluation cache (SQLite) the FE solves go through.
     workers : int
-        FE worker processes.
+        FE worker processes of a job.
+    limits : JobLimits, optional
     """
 
-    def __init__(self, bench: Bench, state_dir: str | Path, cache: str | Path, workers: int = 1) -> None:
+    def __init__(self, bench: Bench, state_dir: str | Path, cache: str | Path, workers: int = 1,
+                 limits: JobLimits | None = None) -> None:
         self.bench = bench
-        self.root = Path(state_dir) / "jobs"
+        self.state_dir = Path(state_dir)
+        self.root = self.state_dir / "jobs"
         self.root.mkdir(parents=True, exist_ok=True)
         self.cache = Path(cache)
         self.workers = int(workers)
+        self.limits = limits or JobLimits()
         self._jobs: dict[str, Job] = {}
-        self._lock = threading.Lock()
-        self._runner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="pneumorph-job")
+        self._lock = threading.RLock()
+        self._queue: queue.Queue[Job | None] = queue.Queue()
+        self._closing = False
         self._load()
+        self.sweep()
+        self._runner = threading.Thread(target=self._serve, name="pneumorph-jobs", daemon=True)
+        self._runner.start()
 
     def _load(self) -> None:
         for record in sorted(self.root.glob("*/job.json")):
@@ -96,10 +162,10 @@ class JobBoard:
                           data["state"], float(data.get("progress", 0.0)), data.get("message", ""),
                           list(data.get("log", [])), data.get("result"), [f["name"] for f in data.get("files", [])],
                           float(data.get("created", 0.0)))
-            except (OSError, ValueError, KeyError, TypeError):
+            except (OSError, ValueError, KeyError, TypeError, RecursionError):
                 continue  # not a job this version wrote
-            if job.state in ("queued", "running"):
-                job.state, job.message = "failed", "the server stopped before the job finished; start it again"
+            if job.state in ACTIVE:
+                job.state, job.message = "interrupted", "the server stopped before the job finished; start it again"
                 job.save()
             self._jobs[job.id] = job
 
@@ -111,7 +177,9 @@ class JobBoard:
 
     def of(self, session: str) -> list[Job]:
         """The session's jobs, newest first."""
-        return sorted((j for j in self._jobs.values() if j.session == session), key=lambda j: -j.created)
+        with self._lock:
+            mine = [j for j in self._jobs.values() if j.session == session]
+        return sorted(mine, key=lambda j: -j.created)
 
     def file(self, session: str, job_id: str, name: str) -> Path | None:
         """A file a job of ``session`` offers for download (None otherwise)."""
@@ -121,167 +189,232 @@ class JobBoard:
         path = job.folder / "files" / name
         return path if path.is_file() else None
 
-    # -- starting jobs ------------------------------------------------------------------
-    def submit(self, session: str, kind: str, params: dict[str, Any], work: Callable[[Job], None]) -> Job:
-        job = Job(uuid.uuid4().hex, session, kind, self.root / uuid.uuid4().hex, params)
-        job.folder.mkdir(parents=True)
-        job.save()
+    # -- limits ---------------------------------------------------------------------------
+    def sweep(self) -> int:
+        """Delete expired finished jobs, then the oldest finished ones while the jobs pass the quota.
+
+        Returns
+        -------
+        int
+            Bytes the jobs' folders take afterwards.
+        """
+        now = time.time()
         with self._lock:
+            finished = sorted((j for j in self._jobs.values() if j.state not in ACTIVE), key=lambda j: j.created)
+            for job in finished:
+                if now - job.created > self.limits.expiry_days * 86400:
+                    self._delete(job)
+            used = folder_size(self.root)
+            quota = self.limits.quota_mb * 1e6
+            for job in finished:
+                if used <= quota:
+                    break
+                if job.id in self._jobs:
+                    used -= folder_size(job.folder)
+                    self._delete(job)
+        return used
+
+    def _delete(self, job: Job) -> None:
+        self._jobs.pop(job.id, None)
+        shutil.rmtree(job.folder, ignore_errors=True)
+
+    # -- starting and stopping jobs ---------------------------------------------------
+    def submit(self, session: str, kind: str, params: dict[str, Any]) -> Job:
+        """Queue a job of ``kind`` (a job of :mod:`pneumorph.bench.worker`) for ``session``.
+
+        Raises
+        ------
+        JobLimitError
+            The session, or the board, has as many jobs queued or running as it may.
+        StateQuotaError
+            The state folder is full even without the finished jobs.
+        """
+        with self._lock:
+            if self._closing:
+                raise JobLimitError("the bench is stopping; no new jobs")
+            active = [j for j in self._jobs.values() if j.state in ACTIVE]
+            if sum(j.session == session for j in active) >= self.limits.per_session:
+                raise JobLimitError(f"this session has {self.limits.per_session} jobs queued or running, the limit "
+                                    "(serve --jobs-per-session); wait for one or cancel it")
+            if len(active) >= self.limits.queued:
+                raise JobLimitError(f"the bench has {self.limits.queued} jobs queued or running, its limit; "
+                                    "try again when one has finished")
+            used = self.sweep()
+            if used > self.limits.quota_mb * 1e6:
+                raise StateQuotaError(f"the bench's jobs take {used / 1e6:.0f} MB, above its quota of "
+                                      f"{self.limits.quota_mb:g} MB (serve --state-quota); wait for a job to end")
+            job = Job(secrets.token_hex(16), session, kind, self.root / secrets.token_hex(16), params)
+            job.folder.mkdir(parents=True)
+            job.save()
             self._jobs[job.id] = job
-        self._runner.submit(self._run, job, work)
+        self._queue.put(job)
         return job
 
     def verify(self, session: str, query: Query) -> Job:
-        """Certify a query's optimum by FE: ``pneumorph design --certify`` for its target and model.
-
-        In 3D the chain's best design is solved first in a worker process, keeping its fields
-        for the 3D view; its response goes into the cache, where the design run finds it.
-        """
-        return self.submit(session, "verify", {"query": json.loads(query.key())}, lambda job: self._verify(job, query))
+        """Certify a query's optimum by FE: ``pneumorph design --certify`` for its target and model."""
+        return self.submit(session, "verify", {"query": json.loads(query.key())})
 
     def export(self, session: str, design: str, unit: str = "builtin") -> Job:
         """STL parts, casting mould and CalculiX deck of a design, zipped."""
-        return self.submit(session, "export", {"design": design, "unit": unit},
-                           lambda job: self._export(job, design, unit))
+        return self.submit(session, "export", {"design": design, "unit": unit})
 
     def table(self, session: str, spec: Any, fidelity: str) -> Job:
-        """The chain table of an uploaded unit (built on first use through the evaluation cache)."""
-        return self.submit(session, "table", {"model": fidelity, "unit": spec.to_dict()},
-                           lambda job: self._table(job, spec, fidelity))
+        """The chain table of an uploaded unit (built on first use through the evaluation cache).
+
+        The unit gets a random id, offered to ``session`` alone once the job is done (the
+        built-in unit's parameters are the built-in unit).
+        """
+        from pneumorph.geometry.unit import UnitSpec
+
+        unit_id = "builtin" if spec == UnitSpec() else "u" + secrets.token_hex(8)
+        return self.submit(session, "table", {"model": fidelity, "unit": spec.to_dict(), "unit_id": unit_id})
 
     def units_of(self, session: str) -> list[dict[str, Any]]:
         """The units this session's finished table jobs made available."""
         return [{"id": j.result["unit_id"], "name": j.result["name"], "model": j.result["model"]}
                 for j in self.of(session) if j.kind == "table" and j.state == "done" and j.result]
 
-    def close(self) -> None:
-        self._runner.shutdown(wait=False, cancel_futures=True)
+    def unit_ids_of(self, session: str) -> tuple[str, ...]:
+        """The unit ids ``session`` may name: the built-in unit and its own uploaded ones."""
+        return ("builtin", *(u["id"] for u in self.units_of(session) if u["id"] != "builtin"))
+
+    def cancel(self, session: str, job_id: str) -> Job | None:
+        """Cancel a queued or running job of ``session`` (its processes end at once); delete a finished one.
+
+        Returns the job (state ``cancelled``, or as it was when deleted), None if ``session``
+        has no such job.
+        """
+        with self._lock:
+            job = self.get(session, job_id)
+            if job is None:
+                return None
+            if job.state == "queued":
+                job.state, job.message = "cancelled", "cancelled before it started"
+                job.save()
+            elif job.state == "running":
+                job.stop = "cancelled"
+                self._terminate(job)
+            else:
+                self._delete(job)
+        if job.state == "running" and job.process is not None:
+            self._reap(job)
+        return job
+
+    def close(self, timeout: float = 5.0) -> None:
+        """Stop: the running job's processes end (it is marked interrupted), queued jobs are marked interrupted."""
+        with self._lock:
+            if self._closing:
+                return
+            self._closing = True
+            for job in self._jobs.values():
+                if job.state == "queued":
+                    job.state, job.message = "interrupted", "the server stopped before the job started"
+                    job.save()
+                elif job.state == "running":
+                    job.stop = "interrupted"
+                    self._terminate(job)
+        self._queue.put(None)
+        self._runner.join(timeout)
+
+    def _terminate(self, job: Job) -> None:
+        """SIGTERM to the job's process group; SIGKILL after :data:`STOP_GRACE` s if it lives on."""
+        proc = job.process
+        if proc is None or proc.poll() is not None:
+            return
+        try:
+            os.killpg(proc.pid, signal.SIGTERM)
+        except ProcessLookupError:
+            return
+
+        def kill() -> None:
+            try:
+                proc.wait(STOP_GRACE)
+            except subprocess.TimeoutExpired:
+                try:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+
+        threading.Thread(target=kill, daemon=True).start()
+
+    def _reap(self, job: Job, timeout: float = 2 * STOP_GRACE + 1) -> None:
+        """Wait until the runner has recorded a stopped job's end (or ``timeout`` s)."""
+        end = time.monotonic() + timeout
+        while job.state == "running" and time.monotonic() < end:
+            time.sleep(0.02)
 
     # -- running ------------------------------------------------------------------------
-    def _run(self, job: Job, work: Callable[[Job], None]) -> None:
-        job.state, job.message = "running", "started"
-        job.save()
+    def _serve(self) -> None:
+        while True:
+            job = self._queue.get()
+            if job is None or self._closing:
+                return
+            if job.state != "queued":
+                continue  # cancelled while it waited
+            self._run(job)
+
+    def _run(self, job: Job) -> None:
+        from pneumorph.execution.evaluators import THREAD_VARIABLES
+
+        spec = {"kind": job.kind, "params": job.params, "folder": str(job.folder), "cache": str(self.cache),
+                "workers": self.workers, "table_dir": str(self.bench.table_dir) if self.bench.table_dir else None,
+                "unit_dir": str(self.bench.unit_dir) if self.bench.unit_dir else None,
+                "shape_dir": str(self.bench.shape_dir or self.state_dir / "shapes")}
+        env = {**os.environ, **dict.fromkeys(THREAD_VARIABLES, "1"), "PYTHONUNBUFFERED": "1"}
+        with self._lock:
+            if self._closing or job.state != "queued":
+                return
+            job.state, job.message = "running", "started"
+            job.save()
+            with open(job.folder / "worker.log", "wb") as log:
+                job.process = subprocess.Popen([sys.executable, "-m", "pneumorph.bench.worker"], stdin=subprocess.PIPE,
+                                               stdout=subprocess.PIPE, stderr=log, env=env, start_new_session=True)
+        proc = job.process
+        assert proc.stdin is not None and proc.stdout is not None
+        error = None
+        done = False
         try:
-            work(job)
-        except Exception as exc:  # the job fails, the server goes on; the message says why
-            job.state, job.message = "failed", f"{type(exc).__name__}: {exc}"
+            proc.stdin.write(json.dumps(spec).encode())
+            proc.stdin.close()
+        except OSError:
+            pass  # it ended already: said below
+        for line in proc.stdout:
+            try:
+                event = json.loads(line)
+            except ValueError:
+                continue
+            if "say" in event:
+                self._say(job, str(event["say"]), event.get("progress"))
+            elif "file" in event:
+                if event["file"] not in job.files:
+                    job.files.append(str(event["file"]))
+            elif "result" in event:
+                job.result, done = event["result"], True
+            elif "error" in event:
+                error = str(event["error"])
+        code = proc.wait()
+        with self._lock:
+            if job.stop == "cancelled":
+                job.state, job.message = "cancelled", "cancelled"
+            elif job.stop == "interrupted" or self._closing:
+                job.state, job.message = "interrupted", "the server stopped while the job ran; start it again"
+            elif done and code == 0:
+                job.state, job.progress, job.message = "done", 1.0, "done"
+            else:
+                job.state = "failed"
+                job.message = error or (f"the job's process ended with code {code}"
+                                        + (" (killed: out of memory?)" if code == -signal.SIGKILL else ""))
             job.log.append(job.message)
-        else:
-            job.state, job.progress, job.message = "done", 1.0, "done"
-        job.save()
+            job.process = None
+            job.save()
 
     def _say(self, job: Job, text: str, progress: float | None = None) -> None:
         job.log.append(text)
+        del job.log[:-MAX_LOG]
         job.message = text
-        if progress is not None:
+        if isinstance(progress, (int, float)):
             job.progress = max(job.progress, min(float(progress), 0.99))
         job.save()
-
-    def _offer(self, job: Job, path: Path, name: str | None = None) -> None:
-        out = job.folder / "files"
-        out.mkdir(exist_ok=True)
-        target = out / (name or path.name)
-        if path.resolve() != target.resolve():
-            shutil.copyfile(path, target)
-        if target.name not in job.files:
-            job.files.append(target.name)
-
-    def _verify(self, job: Job, query: Query) -> None:
-        from pneumorph.design.run import run_design
-
-        unit = None if query.unit == "builtin" else self.bench.unit_spec(query.unit).to_dict()
-        config = query.config(self.bench.units, unit, certify=True, executor="processes", workers=self.workers,
-                              cache=str(self.cache))
-        model = self.bench.model(query.model, query.unit)
-        if query.model == "3d":  # solve the chain's best once, keeping its fields for the 3D view
-            design = self.bench.answer(query)["winner"]["design"]
-            self._say(job, f"solving {design} by 3D FE (its shape and its verification)", 0.05)
-            self._presolve(model, design, query.unit)
-        run = job.folder / "run"
-        self._say(job, f"design run: certified search on the {query.model.upper()} model", 0.5)
-        result = run_design(config, model, run, on_message=lambda text: self._say(job, str(text)))
-        cert = result.certified
-        if result.status != "finished" or cert is None:
-            raise RuntimeError(f"the design run ended {result.status}")
-        winner = cert.winner
-        self._say(job, f"verified {winner.design}: {winner.value:.4g} {result.objective.unit} by FE", 0.9)
-        for path in result.files:
-            if path.name in SHOWN:
-                self._offer(job, path)
-        archive = shutil.make_archive(str(job.folder / "run"), "zip", root_dir=run)
-        self._offer(job, Path(archive))
-        job.result = {"design": winner.design, "fe_value": winner.value, "chain_value": cert.winner_chain.value,
-                      "level": winner.level, "pressure_kpa": None if winner.pressure is None else winner.pressure * 1e3,
-                      "certified": bool(cert.certificate["certified"]), "gap": cert.certificate["gap"],
-                      "could_beat": cert.certificate["could_beat"], "verified": cert.certificate["verified"],
-                      "solves": result.solves, "unit": result.objective.unit, "model": query.model,
-                      "shape": self.bench.fe_shape_file(winner.design, query.unit) is not None}
-
-    def _presolve(self, model: Any, design: str, unit: str) -> None:
-        """Solve ``design`` in a worker process: its surface for the viewer, its response into the cache."""
-        from pneumorph.execution.cache import EvaluationCache
-        from pneumorph.execution.outcome import Outcome
-
-        with EvaluationCache(self.cache) as cache:
-            fe_known = self.bench.fe_shape_file(design, unit) is not None
-            if cache.get(model.fingerprint(), design) is not None and fe_known:
-                return  # verified and drawn before
-        # spawned, as the evaluators' workers: a fork of the threaded server could inherit a held lock
-        with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
-                                 initializer=prepare_worker) as pool:
-            response, shape, wall = pool.submit(fe_solve_shape, model, design).result()
-        if response is None or shape is None:
-            return  # the design run solves it again and reports the failure
-        self.bench.add_fe_shape(design, shape, unit)
-        with EvaluationCache(self.cache) as cache:
-            if cache.get(model.fingerprint(), design) is None:
-                cache.put(model.fingerprint(), Outcome(design, response, wall_time=wall))
-
-    def _table(self, job: Job, spec: Any, fidelity: str) -> None:
-        from pneumorph.execution import CachedEvaluator, EvaluationCache, make_evaluator
-        from pneumorph.models.chaintables import table_for
-
-        unit_id = self.bench.add_unit(spec)
-        model = self.bench.model(fidelity, unit_id)
-        self._say(job, f"chain table of unit {spec.name!r} for the {fidelity.upper()} model", 0.02)
-        with EvaluationCache(self.cache) as cache, make_evaluator("processes", self.workers) as inner:
-            table = table_for(model, model.with_units, folder=self.bench.table_dir,
-                              evaluator=CachedEvaluator(inner, cache), on_progress=lambda t: self._say(
-                                  job, str(t), _fraction(str(t))))
-        val = table.validation
-        job.result = {"unit_id": unit_id, "name": spec.name, "model": fidelity, "window": table.window,
-                      "centre_worst_mm": max(val.get("centre_worst_mm", [float("nan")]))}
-        self._say(job, f"unit {spec.name!r} ready: window {table.window}, held-out centre error at most "
-                       f"{job.result['centre_worst_mm']:.3g} mm", 0.99)
-
-    def _export(self, job: Job, design: str, unit_id: str = "builtin") -> None:
-        from pneumorph.export import BaseBlock, MouldSpec, actuator_parts, casting_mould, plot_mould, write_stl
-        from pneumorph.export.calculix import write_calculix_deck
-
-        model = self.bench.model("3d", unit_id)
-        unit = model.unit
-        out = job.folder / "export"
-        self._say(job, f"parts of {design}", 0.1)
-        write_stl(actuator_parts(unit, design, BaseBlock()), out / "parts")
-        self._say(job, "casting mould", 0.3)
-        mould = casting_mould(unit, design, MouldSpec())
-        write_stl(mould.parts, out / "mould")
-        plot_mould(mould, out / "mould" / "mould.png")
-        self._offer(job, out / "mould" / "mould.png")
-        self._say(job, "CalculiX deck", 0.8)
-        write_calculix_deck(model, design, out / f"{design}.inp")
-        archive = shutil.make_archive(str(job.folder / f"export-{design}"), "zip", root_dir=out)
-        self._offer(job, Path(archive))
-        job.result = {"design": design, "parts": sorted(p.name for p in (out / "parts").glob("*.stl")),
-                      "mould_parts": len(mould.parts)}
-
-
-def _fraction(text: str) -> float | None:
-    """The share done in a table build's progress line ("covering: 12/30 solved ..."), if it says."""
-    import re
-
-    found = re.search(r"(\d+)/(\d+) solved", text)
-    return None if found is None else 0.05 + 0.9 * int(found.group(1)) / max(int(found.group(2)), 1)
 
 
 def fe_solve_shape(model: Any, design: str) -> tuple[Any, dict[str, Any] | None, float]:
@@ -307,4 +440,4 @@ def fe_solve_shape(model: Any, design: str) -> tuple[Any, dict[str, Any] | None,
     return solution.response, shape, wall
 
 
-__all__ = ["STATES", "Job", "JobBoard", "fe_solve_shape"]
+__all__ = ["ACTIVE", "STATES", "Job", "JobBoard", "JobLimits", "fe_solve_shape", "folder_size"]

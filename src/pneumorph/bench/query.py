@@ -24,6 +24,8 @@ KINDS = ("preset", "expression", "tip", "curve")
 MODELS = ("3d", "2d")
 MAX_TOP = 100
 MAX_TEXT = 400
+MAX_DEPTH = 32  # nesting of a request's JSON (a query needs 4)
+MAX_INT_DIGITS = 18  # longer integers in a request are read as floats (then refused where not finite)
 
 
 class QueryError(SettingsError):
@@ -84,6 +86,20 @@ class Query:
         """A canonical text of the query (equal queries, equal keys)."""
         return json.dumps(asdict(self), sort_keys=True)
 
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Query:
+        """The query of ``json.loads(query.key())`` (lists back to tuples).
+
+        Examples
+        --------
+        >>> q = Query("reach", "reach", point=(100.0, 50.0))
+        >>> Query.from_dict(json.loads(q.key())) == q
+        True
+        """
+        point, curve = data.get("point"), data.get("curve")
+        return cls(**{**data, "point": None if point is None else (float(point[0]), float(point[1])),
+                      "curve": None if curve is None else tuple((float(x), float(y)) for x, y in curve)})
+
     def config(self, units: int, unit: dict[str, Any] | None = None, **settings: Any) -> DesignConfig:
         """The design run of this query (certified search on its model), as the CLI would run it.
 
@@ -94,6 +110,61 @@ class Query:
             model["unit"] = dict(unit)
         return DesignConfig(objective=self.spec, amplitude=self.amplitude, periods=self.periods, point=self.point,
                             curve=self.curve, units=units, search="certified", model=model, **settings)
+
+
+def load_json(raw: bytes | str, field: str = "target") -> Any:
+    """A request's JSON, refused as a :class:`QueryError` when it is not JSON or nested too deep.
+
+    Integers of more than :data:`MAX_INT_DIGITS` digits are read as floats (an integer of
+    400 digits is then an infinite number, refused by the field's check), so that no
+    conversion of a huge integer fails later; nesting deeper than :data:`MAX_DEPTH` is refused.
+
+    Examples
+    --------
+    >>> load_json(b'{"top": 3, "a": [1.5]}')
+    {'top': 3, 'a': [1.5]}
+    >>> load_json("1" * 400)
+    inf
+    >>> load_json("[" * 40 + "]" * 40)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.bench.query.QueryError: the request is nested deeper than 32 levels
+    """
+    try:
+        data = json.loads(raw or b"null", parse_int=lambda t: int(t) if len(t) <= MAX_INT_DIGITS else float(t))
+    except RecursionError:
+        raise QueryError(field, f"the request is nested deeper than {MAX_DEPTH} levels") from None
+    except (ValueError, UnicodeDecodeError):
+        raise QueryError(field, "the request is not valid JSON") from None
+    level, depth = [data], 0
+    while level:  # breadth first, without recursion
+        depth += 1
+        if depth > MAX_DEPTH:
+            raise QueryError(field, f"the request is nested deeper than {MAX_DEPTH} levels")
+        level = [v for item in level if isinstance(item, (dict, list))
+                 for v in (item.values() if isinstance(item, dict) else item) if isinstance(v, (dict, list))]
+    return data
+
+
+def choice(value: Any, options: Any, field: str, what: str) -> str:
+    """``value`` if it is one of ``options`` (texts), else a :class:`QueryError` naming ``field``.
+
+    A list or a dict given for a name is refused as any other wrong value.
+
+    Examples
+    --------
+    >>> choice("3d", MODELS, "model", "model")
+    '3d'
+    >>> choice(["max-x"], ("max-x",), "goal", "the tip goal")
+    Traceback (most recent call last):
+    ...
+    pneumorph.bench.query.QueryError: the tip goal must be one of max-x, got a list
+    """
+    if isinstance(value, str) and value in options:
+        return value
+    shown = repr(value[:40]) if isinstance(value, str) else "null" if value is None else \
+        f"a {'list' if isinstance(value, list) else 'JSON object' if isinstance(value, dict) else type(value).__name__}"
+    raise QueryError(field, f"{what} must be one of {', '.join(options)}, got {shown}")
 
 
 def _number(data: dict[str, Any], name: str, default: float, low: float, high: float) -> float:
@@ -151,23 +222,18 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
     target = body.get("target")
     if not isinstance(target, dict):
         raise QueryError("target", "the query needs a target object")
-    model = body.get("model", "3d")
-    if model not in MODELS:
-        raise QueryError("model", f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    model = choice(body.get("model", "3d"), MODELS, "model", "model")
     top = body.get("top", 10)
     if isinstance(top, bool) or not isinstance(top, int) or not 1 <= top <= MAX_TOP:
-        raise QueryError("top", f"top must be a whole number from 1 to {MAX_TOP}, got {top!r}")
-    kind = target.get("kind")
-    if kind not in KINDS:
-        raise QueryError("target", f"the target kind must be one of {', '.join(KINDS)}, got {kind!r}")
+        raise QueryError("top", f"top must be a whole number from 1 to {MAX_TOP}, got {str(top)[:40]}")
+    kind = choice(target.get("kind"), KINDS, "target", "the target kind")
     unit = body.get("unit", "builtin")
-    if unit not in units:
-        raise QueryError("unit", f"unknown unit {unit!r}; upload its TOML file to build its chain table first")
+    if not isinstance(unit, str) or unit not in units:
+        raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}; upload its TOML file to build its chain table "
+                                 "first")
     fields: dict[str, Any] = {"kind": kind, "model": model, "top": top, "unit": unit}
     if kind == "preset":
-        name = target.get("name", "sin")
-        if name not in PRESETS:
-            raise QueryError("preset", f"the preset must be one of {', '.join(PRESETS)}, got {name!r}")
+        name = choice(target.get("name", "sin"), PRESETS, "preset", "the preset")
         fields.update(spec=name, amplitude=_number(target, "amplitude", 10.0, 0.0, 1e4),
                       periods=_number(target, "periods", 1.0, 0.0, 1000.0))
         blame = "amplitude"
@@ -175,9 +241,7 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
         fields.update(spec=_text(target, "expression"), amplitude=_number(target, "amplitude", 10.0, 0.0, 1e4))
         blame = "expression"
     elif kind == "tip":
-        goal = target.get("goal")
-        if goal not in TIP_GOALS:
-            raise QueryError("goal", f"the tip goal must be one of {', '.join(TIP_GOALS)}, got {goal!r}")
+        goal = choice(target.get("goal"), tuple(TIP_GOALS), "goal", "the tip goal")
         point = target.get("point")
         if goal == "reach":
             try:
@@ -201,4 +265,4 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
     return query
 
 
-__all__ = ["KINDS", "MODELS", "Query", "QueryError", "parse_query"]
+__all__ = ["KINDS", "MAX_DEPTH", "MODELS", "Query", "QueryError", "choice", "load_json", "parse_query"]

@@ -35,6 +35,26 @@ def _is_local(host: str) -> bool:
         return host == "localhost"
 
 
+def allowed_hosts(host: str, extra: tuple[str, ...]) -> tuple[str, ...]:
+    """The ``Host`` names the bench serves: the address it listens on, this machine's loopback names when it
+    listens there, its own names when it listens on every address, and ``--allow-host``.
+
+    Examples
+    --------
+    >>> allowed_hosts("127.0.0.1", ())
+    ('127.0.0.1', 'localhost', '::1')
+    >>> allowed_hosts("10.0.0.5", ("bench.lab.example",))
+    ('10.0.0.5', 'bench.lab.example')
+    """
+    names = [host]
+    if _is_local(host):
+        names += ["127.0.0.1", "localhost", "::1"]
+    elif host in ("0.0.0.0", "::"):
+        names += ["127.0.0.1", "localhost", "::1", socket.gethostname(), socket.getfqdn()]
+    names += list(extra)
+    return tuple(dict.fromkeys(n.lower() for n in names if n))
+
+
 @click.command("serve")
 @click.option("--host", default="127.0.0.1", show_default=True, type=P.Text(),
               help="Address to listen on (this machine only by default).")
@@ -44,17 +64,35 @@ def _is_local(host: str) -> bool:
               help="Jobs and shapes of the bench (default: bench/ beside the evaluation cache).")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (SQLite) shared with design runs; default ~/.cache/pneumorph/evaluations.sqlite.")
-@click.option("--workers", default=1, show_default=True, type=P.WORKERS, help="FE worker processes of background jobs.")
-def serve(host: str, port: int, open_browser: bool, state: str | None, cache: str | None, workers: int) -> None:
+@click.option("--workers", default=1, show_default=True, type=P.WORKERS,
+              help="FE worker processes of a background job.")
+@click.option("--allow-host", "allow_host", multiple=True, type=P.Text(max_length=253), metavar="NAME",
+              help="Another host name the page may be reached by (repeatable); requests naming any other host are "
+                   "refused (DNS rebinding).")
+@click.option("--jobs-per-session", default=2, show_default=True, type=P.Count(1, 100),
+              help="Background jobs one browser session may have queued or running at once.")
+@click.option("--max-jobs", default=8, show_default=True, type=P.Count(1, 1000),
+              help="Background jobs all sessions together may have queued or running.")
+@click.option("--job-days", default=7.0, show_default=True, type=P.Real(0.0, 3650.0, low_open=True, unit="days"),
+              help="Finished jobs and their files are deleted this long after they started.")
+@click.option("--state-quota", default=2000.0, show_default=True, type=P.Real(1.0, 1e7, unit="MB"),
+              help="Disk space the jobs may take in the state folder (MB): past it the oldest finished jobs are "
+                   "deleted, and new jobs are refused while running ones fill it.")
+def serve(host: str, port: int, open_browser: bool, state: str | None, cache: str | None, workers: int,
+          allow_host: tuple[str, ...], jobs_per_session: int, max_jobs: int, job_days: float,
+          state_quota: float) -> None:
     """Open the designer's bench: type or draw a target, see the certified design at once.
 
     A local web page: the target as a preset, an expression, a tip goal or a curve drawn
     with the mouse; the chain model's certified optimum, its pressure, error and
     certificate, the best designs, the profile at every pressure and the 3D shape; FE
-    verification and export (STL, mould, CalculiX deck) in the background, with downloads.
-    Stop it with Ctrl-C.
+    verification and export (STL, mould, CalculiX deck) in the background, each job in a
+    process of its own, with downloads. Requests of 1 MB at most (unit files 64 kB); only
+    this page may start work (same origin, JSON); sessions are signed cookies. Stop it with
+    Ctrl-C (or SIGTERM): a running job is stopped and marked interrupted.
     """
     try:
+        import itsdangerous  # noqa: F401
         import uvicorn
 
         from pneumorph.bench.app import create_app
@@ -63,10 +101,13 @@ def serve(host: str, port: int, open_browser: bool, state: str | None, cache: st
                                "pip install -e \".[web]\"") from None
     _check_port(host, port)
     from pneumorph.bench.app import default_state_dir
+    from pneumorph.bench.jobs import JobLimits
     from pneumorph.io.files import check_writable_dir
 
     check_writable_dir(state if state is not None else default_state_dir(), "--state")
-    app = create_app(state_dir=state, cache=cache, workers=workers)
+    limits = JobLimits(per_session=jobs_per_session, queued=max_jobs, expiry_days=job_days, quota_mb=state_quota)
+    app = create_app(state_dir=state, cache=cache, workers=workers, allowed_hosts=allowed_hosts(host, allow_host),
+                     limits=limits)
     url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
     click.echo(f"pneumorph bench at {url} (Ctrl-C stops it)")
     if not _is_local(host):
@@ -76,4 +117,5 @@ def serve(host: str, port: int, open_browser: bool, state: str | None, cache: st
         import webbrowser
 
         threading.Timer(1.0, webbrowser.open, args=(url,)).start()
-    uvicorn.run(app, host=host, port=port, log_level="warning")
+    # open connections get 3 s after Ctrl-C or SIGTERM; then the jobs are stopped (the app's lifespan)
+    uvicorn.run(app, host=host, port=port, log_level="warning", timeout_graceful_shutdown=3)

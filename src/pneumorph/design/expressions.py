@@ -166,7 +166,10 @@ def _where(text: str, node: ast.AST) -> str:
 def _constant_value(node: ast.AST) -> float | None:
     """The value of a number or a signed number; None for anything else."""
     if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
-        return float(node.value)
+        try:
+            return float(node.value)
+        except OverflowError:  # an integer of more than about 309 digits: too large, as 1e400 is
+            return math.inf
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
         inner = _constant_value(node.operand)
         if inner is not None:

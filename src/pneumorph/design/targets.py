@@ -52,6 +52,8 @@ _HINTS_POLAR = {
 }
 
 
+MAX_TARGET_MM = 1e5
+"""Largest size of a target anywhere (mm): a profile's values, a curve's points."""
 MAX_CURVE_POINTS = 2000
 """Most points accepted for a drawn curve."""
 MIN_CURVE_SPAN = 0.2
@@ -95,7 +97,7 @@ def _curve_points(points: ArrayLike) -> NDArray[np.float64]:
         raise TargetExpressionError(f"a curve is a list of [x, y] points in mm, got an array of shape {p.shape}")
     if not 2 <= len(p) <= MAX_CURVE_POINTS:
         raise TargetExpressionError(f"a curve needs 2 to {MAX_CURVE_POINTS} points, got {len(p)}")
-    if not np.isfinite(p).all() or np.abs(p).max() > 1e5:
+    if not np.isfinite(p).all() or np.abs(p).max() > MAX_TARGET_MM:
         raise TargetExpressionError("every point of a curve must be a finite number of mm, at most 1e5 in size")
     return p
 
@@ -215,7 +217,8 @@ class ProfileTarget:
         Raises
         ------
         TargetExpressionError
-            Naming the first point where the target is NaN or infinite.
+            Naming the first point where the target is NaN or infinite, or beyond
+            :data:`MAX_TARGET_MM` in size (a constant ``y = 1e100``, say).
 
         Examples
         --------
@@ -233,6 +236,13 @@ class ProfileTarget:
             except (ArithmeticError, ValueError) as exc:
                 raise TargetExpressionError(f"the target {self.label} cannot be evaluated: {exc}") from None
         bad = np.flatnonzero(~np.isfinite(values))
+        large = np.flatnonzero(np.abs(np.where(np.isfinite(values), values, 0.0)) > MAX_TARGET_MM)
+        if large.size and not bad.size:
+            where = f"theta = {s[large[0]]:.4g} rad" if polar else f"x = {s[large[0]]:.4g}"
+            raise TargetExpressionError(
+                f"the target {self.label} is {values[large[0]]:.4g} mm at {where}, beyond {MAX_TARGET_MM:g} mm "
+                "(MAX_TARGET_MM): no actuator reaches it"
+            )
         if bad.size:
             where = f"theta = {s[bad[0]]:.4g} rad" if polar else f"x = {s[bad[0]]:.4g}"
             span = "0 <= theta <= pi" if polar else f"0 <= x <= L = {length:g} mm"

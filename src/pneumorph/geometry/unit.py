@@ -54,6 +54,7 @@ from typing import Any
 
 from pneumorph.checks import MIN_ELEMENT_FRACTION
 from pneumorph.errors import GeometryError
+from pneumorph.geometry.limits import MAX_NAME_CHARS, MeshLimitError, check_lengths
 from pneumorph.materials.filler import FillerLaw
 
 _LENGTHS = (
@@ -176,6 +177,10 @@ class UnitSpec:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise GeometryError(f"unit {key} must be a finite number of mm, got {value!r}")
+        check_lengths(self)
+        if len(self.name) > MAX_NAME_CHARS:
+            raise MeshLimitError(f"unit name is {len(self.name):,} characters long; the limit is {MAX_NAME_CHARS} "
+                                 "(MAX_NAME_CHARS, pneumorph.geometry.limits)")
         for key in ("pitch", "width", "wall", "side_wall", "end_wall", "cavity_height", "element_size"):
             if getattr(self, key) <= 0:
                 raise GeometryError(f"unit {key} must be positive, got {getattr(self, key)} mm")

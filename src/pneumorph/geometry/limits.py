@@ -1,0 +1,210 @@
+"""What a unit may be: its dimensions, and the size of the mesh it implies, checked before meshing.
+
+A unit that passes :class:`~pneumorph.geometry.unit.UnitSpec`'s own checks can still cost
+without bound: a pitch of 10 m at a 1.5 mm element size is a mesh of millions of nodes,
+whose solve grows by hundreds of MB a second until the machine runs out. The rule here is
+the one every entry point uses (the bench's upload, :func:`pneumorph.models.factory.make_model`
+behind the command line and design configs): every length of a unit is at most
+:data:`MAX_LENGTH_MM`, and the structured grid of an actuator of ``units`` units, counted
+from the grid's breaks without building it (:func:`estimate_mesh`), has at most
+:data:`MAX_NODES_2D` or :data:`MAX_NODES_3D` nodes. A refusal states the estimate.
+
+The estimate is exact for the grid of :func:`pneumorph.geometry.assembly.assemble` (lines
+through every break, no gap wider than the element size) and an upper bound of the mesh
+(cavity cells are counted); memory is estimated from the nodes at
+:data:`BYTES_PER_NODE_3D` and :data:`BYTES_PER_NODE_2D`, the peak of one solve of the
+built-in actuator (``BENCHMARKS.md``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from pneumorph.errors import GeometryError
+
+if TYPE_CHECKING:
+    from pneumorph.geometry.unit import UnitSpec
+
+MAX_LENGTH_MM = 1000.0
+"""Largest length of any part of a unit (pitch, width, walls, cavity, layer, slit, element size), mm."""
+MAX_NAME_CHARS = 200
+"""Longest name of a unit (characters)."""
+MAX_NODES_3D = 80_000
+"""Largest 3D mesh (nodes of the half model) a model may be built on: about 4 x the built-in actuator, 3.8 GB."""
+MAX_NODES_2D = 200_000
+"""Largest 2D mesh (nodes): about 70 x the built-in actuator, 2 GB."""
+BASE_BYTES = 150_000_000
+"""Memory of a solving process before its mesh: Python, NumPy, SciPy, FElupe (0.15 GB: a 2D solve of 2,747 nodes)."""
+BYTES_PER_NODE_3D = 46_000
+"""Peak memory of a 3D solve per node (hex20, direct solver): the built-in actuator's 19,512 nodes peak at 1.12 GB."""
+BYTES_PER_NODE_2D = 10_000
+"""Peak memory of a 2D solve per node (quad8), an upper bound: the built-in actuator's 2,747 nodes add little."""
+
+
+class MeshLimitError(GeometryError):
+    """A unit whose dimensions or mesh exceed the limits of :mod:`pneumorph.geometry.limits`.
+
+    The message states the estimate (nodes, elements, memory) and the limit.
+    """
+
+
+@dataclass(frozen=True)
+class MeshEstimate:
+    """The size of an actuator's structured mesh, counted before it is built.
+
+    Attributes
+    ----------
+    cells : (int, int, int)
+        Grid cells along x (the whole actuator), y and z (1 in 2D).
+    elements : int
+        Cells of the grid (an upper bound of the elements: cavity cells are counted).
+    nodes : int
+        Nodes of the grid: corners, and with quadratic elements (hex20, quad8) the mid-edge nodes.
+    bytes : int
+        Estimated peak memory of one solve.
+    dim : int
+    """
+
+    cells: tuple[int, int, int]
+    elements: int
+    nodes: int
+    bytes: int
+    dim: int
+
+    def describe(self) -> str:
+        """One line: nodes, elements and memory.
+
+        Examples
+        --------
+        >>> MeshEstimate((10, 4, 1), 40, 189, 151_890_000, 2).describe()
+        'about 189 nodes, 40 elements, 0.15 GB for one solve'
+        """
+        return f"about {self.nodes:,} nodes, {self.elements:,} elements, {self.bytes / 1e9:.2g} GB for one solve"
+
+
+def cells_between(breaks: Iterable[float], size: float) -> int:
+    """Grid cells through ``breaks`` with no gap wider than ``size``, counted without building the lines.
+
+    The count of :func:`pneumorph.geometry.grid.grid_lines` minus one (breaks closer than
+    1e-6 mm merged), in constant memory however long the gaps.
+
+    Examples
+    --------
+    >>> cells_between([0.0, 1.5, 4.5], 1.5)
+    3
+    >>> cells_between([0.0, 1e9], 1.5)
+    666666667
+    """
+    b = sorted({round(float(x), 6) for x in breaks})
+    return sum(max(1, math.ceil((hi - lo) / size - 1e-9)) for lo, hi in itertools.pairwise(b))
+
+
+def check_lengths(spec: UnitSpec) -> None:
+    """Refuse a unit with any length above :data:`MAX_LENGTH_MM`.
+
+    Raises
+    ------
+    MeshLimitError
+        Naming the length, its value and the limit.
+
+    Examples
+    --------
+    >>> from pneumorph.geometry.unit import UnitSpec
+    >>> check_lengths(UnitSpec())
+    >>> check_lengths(UnitSpec(pitch=1e4))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.geometry.limits.MeshLimitError: unit pitch 1e+04 mm is above the limit MAX_LENGTH_MM = 1000 mm...
+    """
+    from pneumorph.geometry.unit import _LENGTHS as LENGTHS
+
+    for key in LENGTHS:
+        value = getattr(spec, key)
+        if value > MAX_LENGTH_MM:
+            raise MeshLimitError(f"unit {key} {value:.4g} mm is above the limit MAX_LENGTH_MM = {MAX_LENGTH_MM:g} mm "
+                                 "(pneumorph.geometry.limits)")
+
+
+def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshEstimate:
+    """The mesh of ``units`` units of ``spec`` in ``dim`` dimensions, counted from the grid's breaks.
+
+    Parameters
+    ----------
+    spec : UnitSpec
+    units : int
+        Units along the actuator.
+    dim : {2, 3}
+    half : bool
+        3D: the half model across the width (the models' default).
+
+    Examples
+    --------
+    >>> from pneumorph.geometry.unit import UnitSpec
+    >>> e = estimate_mesh(UnitSpec(), 15, 3)
+    >>> e.cells, e.elements, e.nodes  # the mesh itself: 3,480 elements, 19,512 nodes (no cavity cells)
+    ((105, 8, 5), 4200, 21252)
+    >>> estimate_mesh(UnitSpec(pitch=500.0), 15, 3).describe()
+    'about 1,007,157 nodes, 200,400 elements, 46 GB for one solve'
+    """
+    from pneumorph.geometry.grid import section_breaks, width_breaks
+
+    h = spec.element_size
+    xb, yb = section_breaks(spec)
+    nx = int(units) * cells_between(xb, h)
+    ny = cells_between(yb, h)
+    nz = cells_between(width_breaks(spec, half), h) if dim == 3 else 1
+    if dim == 3:
+        nodes = (nx + 1) * (ny + 1) * (nz + 1)
+        if spec.element_order == 2:  # a mid-node on every edge of the grid
+            nodes += nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz
+        per = BYTES_PER_NODE_3D
+    else:
+        nodes = (nx + 1) * (ny + 1)
+        if spec.element_order == 2:
+            nodes += nx * (ny + 1) + (nx + 1) * ny
+        per = BYTES_PER_NODE_2D
+    return MeshEstimate((nx, ny, nz), nx * ny * nz, nodes, BASE_BYTES + nodes * per, dim)
+
+
+def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshEstimate:
+    """Refuse a unit too large or too finely meshed for an actuator of ``units`` units, before meshing.
+
+    Returns
+    -------
+    MeshEstimate
+        The estimate of a unit within the limits.
+
+    Raises
+    ------
+    MeshLimitError
+        A length above :data:`MAX_LENGTH_MM`, or more nodes than :data:`MAX_NODES_3D`
+        (:data:`MAX_NODES_2D` in 2D); the message states the estimate.
+
+    Examples
+    --------
+    >>> from pneumorph.geometry.unit import UnitSpec
+    >>> check_mesh(UnitSpec(), 15, 3).nodes <= MAX_NODES_3D
+    True
+    >>> check_mesh(UnitSpec(pitch=400.0), 15, 3)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.geometry.limits.MeshLimitError: a 3D actuator of 15 units of this unit is a mesh of about 805,152
+    nodes, ...GB for one solve; the limit is 80,000 nodes...
+    """
+    check_lengths(spec)
+    estimate = estimate_mesh(spec, units, dim, half)
+    limit, name = (MAX_NODES_3D, "MAX_NODES_3D") if dim == 3 else (MAX_NODES_2D, "MAX_NODES_2D")
+    if estimate.nodes > limit:
+        raise MeshLimitError(f"a {dim}D actuator of {units} units of this unit is a mesh of {estimate.describe()}; "
+                             f"the limit is {limit:,} nodes ({name}, pneumorph.geometry.limits): make the unit "
+                             "smaller, its element_size larger or the actuator shorter")
+    return estimate
+
+
+__all__ = ["BASE_BYTES", "BYTES_PER_NODE_2D", "BYTES_PER_NODE_3D", "MAX_LENGTH_MM", "MAX_NAME_CHARS", "MAX_NODES_2D",
+           "MAX_NODES_3D", "MeshEstimate", "MeshLimitError", "cells_between", "check_lengths", "check_mesh",
+           "estimate_mesh"]
