@@ -237,8 +237,8 @@ class JobBoard:
                 raise JobLimitError(f"this session has {self.limits.per_session} jobs queued or running, the limit "
                                     "(serve --jobs-per-session); wait for one or cancel it")
             if len(active) >= self.limits.queued:
-                raise JobLimitError(f"the bench has {self.limits.queued} jobs queued or running, its limit; "
-                                    "try again when one has finished")
+                raise JobLimitError(f"the bench has {self.limits.queued} jobs queued or running, its limit "
+                                    "(serve --max-jobs); try again when one has finished")
             used = self.sweep()
             if used > self.limits.quota_mb * 1e6:
                 raise StateQuotaError(f"the bench's jobs take {used / 1e6:.0f} MB, above its quota of "
