@@ -354,10 +354,12 @@ def ramp(
             stats.cutbacks += 1
             if cutbacks_here > settings.max_cutbacks:
                 stats.reached = t_now
+                first = (f"; it failed on the first load step, cut to {t_try:.3g} of the full load: not the size "
+                         "of the load but the model or the solver settings") if t_now == 0.0 else ""
                 raise SimulationFailed(
                     reached=t_now,
                     cause=f"no convergence at load factor {t_try:.4g} after "
-                    f"{settings.max_cutbacks} cut-backs ({cause})",
+                    f"{settings.max_cutbacks} cut-backs ({cause}){first}",
                 )
             dt = (t_try - t_now) / 2.0  # the step that failed, halved (dt may reach past the level)
         stats.reached = t_now

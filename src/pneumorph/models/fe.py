@@ -298,18 +298,26 @@ class FEModel:
         """
         return parse_design(design, self.library, self.n_units)
 
+    def mesh(self, orientation: str | Design) -> ActuatorMesh:
+        """The meshed design (no solver data): what :meth:`build` solves on.
+
+        >>> Full3D(2).mesh("01").cells.shape[1]
+        20
+        """
+        if self.mixed:
+            return assemble(self.library, self.parse(orientation), self.dim, half=self.half, passage=self.passage,
+                            base=self.base_block)
+        # today's call, to the last bit
+        return assemble(self.unit, orientation if isinstance(orientation, str) else orientation.orientation,
+                        self.dim, half=self.half, passage=self.passage, base=self.base_block)
+
     def build(self, orientation: str | Design) -> tuple[ActuatorMesh, PressurisedBody, Any]:
         """The meshed design, its pressurised body and ``set_pressure(p)`` for a load level.
 
         ``set_pressure`` sets the cavity pressure and everything that follows it (the 2D
         filler's modulus). ``orientation`` is a design over the model's library.
         """
-        if self.mixed:
-            mesh = assemble(self.library, self.parse(orientation), self.dim, half=self.half, passage=self.passage,
-                            base=self.base_block)
-        else:  # today's call, to the last bit
-            mesh = assemble(self.unit, orientation if isinstance(orientation, str) else orientation.orientation,
-                            self.dim, half=self.half, passage=self.passage, base=self.base_block)
+        mesh = self.mesh(orientation)
         # a design of extending units has no layer cells: the empty region is left out
         silicones = {name: material for name, material in self.silicones.items() if len(mesh.regions[name])}
         regions = [(name, mesh.regions[name], self._silicone_umat(material)) for name, material in silicones.items()]
@@ -410,6 +418,7 @@ class FEModel:
         meta.update(
             newton_iterations=stats.newton_iterations + gravity_iterations,
             factorisations=getattr(substep, "factorisations", stats.newton_iterations),
+            precision=getattr(substep, "precision", "double"),
             substeps=stats.substeps,
             cutbacks=stats.cutbacks,
             wall_time_s=time.perf_counter() - t0,
