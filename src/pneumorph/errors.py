@@ -204,6 +204,21 @@ class SchedulerUnreachableError(PneumorphError, ConnectionError):
     """A Dask scheduler address that could not be reached within the timeout."""
 
 
+class ClusterLostError(PneumorphError, ConnectionError):
+    """The Dask cluster went away during a run: the scheduler, or every worker for too long.
+
+    Nothing finished is lost (every solve was stored in the evaluation cache as it
+    arrived); the same command resumes. The command line exits with ``exit_code`` (3)
+    and appends the command that resumes.
+    """
+
+    exit_code = 3
+
+
+class WorkerVersionError(PneumorphError, RuntimeError):
+    """Dask workers that run another pneumorph (or none): refused at connect, naming both versions."""
+
+
 class RunFolderError(PneumorphError, ValueError):
     """A run folder that holds a different run, is in use by another run, or cannot be written."""
 

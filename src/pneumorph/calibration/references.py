@@ -18,7 +18,6 @@ True
 from __future__ import annotations
 
 import contextlib
-import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -29,6 +28,7 @@ import numpy as np
 from pneumorph.calibration.designs import calibration_designs, holdout_designs
 from pneumorph.errors import SimulationFailed
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator, default_cache_path
+from pneumorph.execution.evaluators import Evaluator
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Full3D, RampSpec
@@ -127,6 +127,25 @@ class ReferenceSolve:
     failure: str | None = None
 
 
+def reference_jobs(unit: UnitSpec, n_units: int, pressures_kpa: Sequence[float], runs: int = 3, seed: int = 0,
+                   n_validate: int = 10) -> list[tuple[Full3D, str]]:
+    """The ``(3D model, design)`` references a calibration and its validation ask for, in order.
+
+    The calibration designs (:func:`~pneumorph.calibration.calibration_designs`) on the
+    reference ramp, then ``n_validate`` held-out designs ramped to the highest pressure.
+
+    Examples
+    --------
+    >>> jobs = reference_jobs(UnitSpec(), 5, (10, 20), runs=2, n_validate=1)
+    >>> len(jobs), [m.ramp.steps.increments for m, _ in jobs][:2]
+    (3, [2, 2])
+    """
+    jobs = [(reference_model(unit, n_units, pressures_kpa), d) for d in calibration_designs(n_units, runs, seed)]
+    holdout = Full3D(n_units, unit, RampSpec(pressure=max(pressures_kpa) / 1e3))
+    held = holdout_designs(n_units, n_validate, seed, [d for _, d in jobs])
+    return jobs + [(holdout, d) for d in held]
+
+
 def solve_references(
     unit: UnitSpec,
     n_units: int,
@@ -136,13 +155,13 @@ def solve_references(
     n_validate: int = 10,
     cache: EvaluationCache | str | Path | None = None,
     on_reference: Callable[[ReferenceSolve], None] | None = None,
+    evaluator: Evaluator | None = None,
 ) -> list[ReferenceSolve]:
-    """Solve the 3D references of a calibration and its validation into the cache, one by one.
+    """Solve the 3D references of a calibration and its validation into the cache.
 
-    The calibration designs (:func:`~pneumorph.calibration.calibration_designs`) on the
-    reference ramp, then ``n_validate`` held-out designs ramped to the highest pressure,
-    exactly as :func:`~pneumorph.calibration.run_calibration` with the same settings asks
-    for them. A reference that fails is reported and the others go on.
+    The references of :func:`reference_jobs`, exactly as
+    :func:`~pneumorph.calibration.run_calibration` with the same settings asks for them.
+    A reference that fails is reported and the others go on.
 
     Parameters
     ----------
@@ -151,29 +170,29 @@ def solve_references(
     cache : EvaluationCache, str or Path, optional
         Where the responses go (:func:`open_cache`).
     on_reference : callable, optional
-        Progress: called with each :class:`ReferenceSolve` as it ends.
+        Progress: called with each :class:`ReferenceSolve` as it ends (in the order they end).
+    evaluator : Evaluator, optional
+        Solves them (:mod:`pneumorph.execution`: a process pool or a Dask cluster solve
+        several at once); by default one after another in this process.
 
     Returns
     -------
     list of ReferenceSolve
+        In the order of :func:`reference_jobs`.
     """
-    jobs = [(reference_model(unit, n_units, pressures_kpa), d) for d in calibration_designs(n_units, runs, seed)]
-    holdout = Full3D(n_units, unit, RampSpec(pressure=max(pressures_kpa) / 1e3))
-    held = holdout_designs(n_units, n_validate, seed, [d for _, d in jobs])
-    jobs += [(holdout, d) for d in held]
-    done = []
+    jobs = reference_jobs(unit, n_units, pressures_kpa, runs, seed, n_validate)
+    done: dict[int, ReferenceSolve] = {}
     with open_cache(cache) as store:
-        solve_3d = cached_3d_solver(store)
-        for i, (model, design) in enumerate(jobs, 1):
-            t0 = time.perf_counter()
+        cached = CachedEvaluator(evaluator or SerialEvaluator(), store)
+        for j, outcome in cached.iter_cases(jobs):
+            i = j + 1
             kind = "calibration" if i <= runs else "validation"
-            curl, failure = None, None
-            try:
-                curl = float(solve_3d(model, design).curl[-1])
-            except Exception as exc:  # a failed reference is reported, the others go on
-                failure = str(exc)
-            report = ReferenceSolve(i, len(jobs), kind, design, time.perf_counter() - t0, curl, failure)
-            done.append(report)
+            ok = outcome.ok and outcome.response is not None
+            curl = float(outcome.response.curl[-1]) if ok and outcome.response is not None else None
+            failure = None if ok else f"3D reference failed: {outcome.failure}"
+            seconds = 0.0 if outcome.cached else outcome.wall_time
+            report = ReferenceSolve(i, len(jobs), kind, jobs[j][1], seconds, curl, failure)
+            done[j] = report
             if on_reference is not None:
                 on_reference(report)
-    return done
+    return [done[j] for j in sorted(done)]

@@ -31,10 +31,17 @@ from pneumorph.calibration.figures import plot_calibration, plot_filler_paths, p
 from pneumorph.calibration.laws import constant_law, fit_law
 from pneumorph.calibration.method import Calibration, calibrate
 from pneumorph.calibration.points import FillerPoint, point_weights
-from pneumorph.calibration.references import Solve3D, cached_3d_solver, open_cache
+from pneumorph.calibration.references import (
+    ReferenceSolve,
+    Solve3D,
+    cached_3d_solver,
+    open_cache,
+    solve_references,
+)
 from pneumorph.calibration.validation import Validation, validate
 from pneumorph.errors import MaterialDataError, SearchConfigError
 from pneumorph.execution import EvaluationCache
+from pneumorph.execution.evaluators import Evaluator
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io import atomic_write_text, check_writable_dir, provenance, write_json
 from pneumorph.materials.filler import FillerLaw
@@ -172,6 +179,8 @@ def run_calibration(
     weighting: str = "relative",
     cache: EvaluationCache | str | Path | None = None,
     on_point: Callable[[FillerPoint], None] | None = None,
+    evaluator: Evaluator | None = None,
+    on_reference: Callable[[ReferenceSolve], None] | None = None,
 ) -> CalibrationRun:
     """Calibrate a unit's filler law against 3D, check it on held-out designs and write the folder.
 
@@ -197,6 +206,13 @@ def run_calibration(
         :func:`~pneumorph.execution.default_cache_path`.
     on_point : callable, optional
         Progress: called with each :class:`~pneumorph.calibration.FillerPoint`.
+    evaluator : Evaluator, optional
+        Solves every 3D reference first, several at once (a process pool or a Dask
+        cluster, :mod:`pneumorph.execution`; :func:`~pneumorph.calibration.solve_references`),
+        into the cache the calibration then reads; by default each is solved in this process
+        when the calibration asks for it.
+    on_reference : callable, optional
+        Progress of those solves: called with each :class:`~pneumorph.calibration.ReferenceSolve`.
 
     Returns
     -------
@@ -224,6 +240,8 @@ def run_calibration(
         raise SearchConfigError(f"a calibration needs at least two different pressures, got {list(pressures_kpa)}")
     folder = check_writable_dir(out, "calibration folder")
     with open_cache(cache) as store:
+        if evaluator is not None:
+            solve_references(unit, n_units, levels, runs, seed, n_validate, store, on_reference, evaluator)
         solve_3d = cached_3d_solver(store)
         result = calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point,
                            weighting=weighting)

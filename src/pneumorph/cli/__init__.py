@@ -91,7 +91,9 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code.
 
     Every error a user can cause prints one line and returns 2: bad options and arguments
-    (click's usage errors) and every :class:`~pneumorph.errors.PneumorphError`. Ctrl-C
+    (click's usage errors) and every :class:`~pneumorph.errors.PneumorphError`, except a
+    lost Dask cluster (:class:`~pneumorph.errors.ClusterLostError`): one line with the
+    command that resumes, exit 3. Ctrl-C
     returns 130, SIGTERM 143 (both after the run has written what it had); anything else
     is a defect of pneumorph: one line asking for a report, exit 1 (``PNEUMORPH_DEBUG=1``
     shows the traceback).
@@ -115,8 +117,14 @@ def main(argv: list[str] | None = None) -> int:
         click.echo(f"error: {' '.join(exc.format_message().split())}", err=True)
         return exc.exit_code
     except PneumorphError as exc:
-        click.echo(f"error: {' '.join(str(exc).split())}", err=True)
-        return 2
+        text = " ".join(str(exc).split())
+        code = getattr(exc, "exit_code", 2)
+        if code == 3:  # the cluster went away: the same command resumes from the cache
+            import shlex
+
+            text += f"; resume with: pneumorph {shlex.join(sys.argv[1:] if argv is None else argv)}"
+        click.echo(f"error: {text}", err=True)
+        return code
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
         return 143 if code == 130 and _terminated.is_set() else code  # a run that stopped on SIGTERM

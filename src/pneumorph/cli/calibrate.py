@@ -6,6 +6,7 @@ import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
 from pneumorph.cli import params as P
+from pneumorph.cli.execution import check_options, cluster_line, execution_options, open_evaluator
 
 
 @click.command("calibrate")
@@ -22,6 +23,7 @@ from pneumorph.cli import params as P
 @click.option("--validate", "n_validate", type=P.Count(0, MAX_STARTS, limit="MAX_STARTS"), default=10,
               show_default=True,
               help="Held-out random designs for the 2D-against-3D check.")
+@execution_options(default="serial", what="3D references")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="3D results cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", type=P.OutputDir(), default="runs/calibration", show_default=True, metavar="DIR")
@@ -33,33 +35,44 @@ from pneumorph.cli import params as P
                    "measured sensitivity of Eq 5.1 (two more 2D solves per point), or none.")
 @click.option("--json", "as_json", is_flag=True)
 def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs: int, seed: int, n_validate: int,
-              cache: str | None, out: str, references_only: bool, weighting: str, as_json: bool) -> None:
+              executor: str, workers: int | None, scheduler: str | None, cache: str | None, out: str,
+              references_only: bool, weighting: str, as_json: bool) -> None:
     """Fit the filler law E(P) of the 2D model to the 3D model (chapter 5) and check it.
 
     Writes calibration.json, calibration.png (Fig 5.3) and unit.toml: the unit with the
     chosen law and its provenance, ready for --unit of the other commands.
     """
     from pneumorph.calibration import run_calibration, solve_references
-    from pneumorph.execution import default_cache_path
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import strict_json
 
+    check_options(executor, workers, scheduler)
     levels = tuple(sorted(set(pressures)))
     if len(levels) < 2:
         raise click.BadParameter(f"--pressures needs at least two different pressures, got {pressures}",
                                  param_hint="'--pressures'")
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
-    store = cache or default_cache_path()
-
-    if references_only:
-        solve_references(unit, n_units, levels, runs, seed, n_validate, store, on_reference=_echo_reference)
-        return
 
     def on_point(p) -> None:
         click.echo(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
                    f"(Eq 5.1 = {p.gamma:.4g} mm^2, {p.evaluations} 2D solves)", err=True)
 
-    done = run_calibration(unit, n_units, levels, out, runs, seed, n_validate, weighting, store, on_point)
+    evaluator = open_evaluator(executor, workers, scheduler, cache)  # the 3D references: solved first, into the cache
+    try:
+        if references_only:
+            solve_references(unit, n_units, levels, runs, seed, n_validate, evaluator.cache,
+                             on_reference=_echo_reference, evaluator=evaluator.inner)
+            done = None
+        else:
+            done = run_calibration(unit, n_units, levels, out, runs, seed, n_validate, weighting, evaluator.cache,
+                                   on_point, evaluator=evaluator.inner, on_reference=_echo_reference)
+    finally:
+        evaluator.close()
+        evaluator.cache.close()
+    if (line := cluster_line(evaluator)) is not None:
+        click.echo(line, err=True)
+    if done is None:
+        return
     result = done.calibration
     if as_json:
         click.echo(strict_json({k: v for k, v in done.summary.items() if k != "provenance"}))

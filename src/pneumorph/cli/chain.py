@@ -6,6 +6,7 @@ import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
 from pneumorph.cli import params as P
+from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
 
 
 @click.group("chain")
@@ -30,7 +31,7 @@ def chain() -> None:
               help="Worst held-out unit-centre error allowed at every level, mm.")
 @click.option("--heldout", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=20, show_default=True,
               help="Held-out random designs solved.")
-@click.option("--workers", type=P.WORKERS, help="Processes solving designs (default: all cores).")
+@execution_options(what="training and held-out designs")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", required=True, metavar="FILE", type=P.OutputFile((".json",)), help="Table file to write (JSON).")
@@ -39,8 +40,8 @@ def chain() -> None:
                    "the held-out designs keep --units.")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
-          window: int | None, tolerance: float, heldout: int, workers: int | None, cache: str | None, out: str,
-          short: bool, as_json: bool) -> None:
+          window: int | None, tolerance: float, heldout: int, executor: str, workers: int | None,
+          scheduler: str | None, cache: str | None, out: str, short: bool, as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with
@@ -49,17 +50,12 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pathlib import Path
 
     from pneumorph.errors import ChainTableError
-    from pneumorph.execution import (
-        CachedEvaluator,
-        EvaluationCache,
-        default_cache_path,
-        make_evaluator,
-    )
     from pneumorph.io import strict_json
     from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chainfit import build_table
     from pneumorph.models.factory import make_model
 
+    check_options(executor, workers, scheduler)
     settings: dict = {"fidelity": fidelity}
     if unit_file:
         settings["unit_file"] = unit_file
@@ -76,7 +72,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         from pneumorph.models.chainfit import check_training_size
 
         check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
-    evaluator = CachedEvaluator(make_evaluator("processes", workers), EvaluationCache(cache or default_cache_path()))
+    evaluator = open_evaluator(executor, workers, scheduler, cache)
     try:
         plan = build_plan(model, heldout=heldout, workers=evaluator_workers(evaluator), window=window,
                           tolerance=tolerance, cached=cached_counter(evaluator, model), short=short)
@@ -85,12 +81,15 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
                             on_progress=lambda text: click.echo(text, err=True), short=short)
     finally:
         evaluator.close()
+    cluster = cluster_report(evaluator)
+    if (line := cluster_line(evaluator)) is not None:
+        click.echo(line, err=True)
     target.parent.mkdir(parents=True, exist_ok=True)
     table.save(target)
     v = table.validation
     if as_json:
         click.echo(strict_json({"file": str(target), "window": table.window, "training": list(table.training),
-                                "validation": v}))
+                                "validation": v, **({"cluster": cluster} if cluster else {})}))
     else:
         click.echo(f"{target}: window +-{table.window}, {len(table.training)} covering designs, "
                    f"{len(v['designs'])} held-out: worst centre error {max(v['centre_worst_mm']):.4f} mm, "

@@ -10,6 +10,7 @@ import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli import params as P
+from pneumorph.cli.execution import check_options, execution_options
 
 # a fallback to the GA
 _NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "chain_table": None}
@@ -64,11 +65,7 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
                    "with tolerance tables) and verify the most robust by FE.")
 @click.option("--robust-samples", type=P.Count(1, 10_000),
               help="Seeded samples of the tolerance class (default 30 by the chain model, 8 FE solves otherwise).")
-@click.option("--executor", type=click.Choice(["serial", "processes", "dask"]),
-              help="Where designs are solved (default processes: all cores).")
-@click.option("--workers", type=P.WORKERS, help="Processes or Dask workers (default: all cores).")
-@click.option("--scheduler", metavar="ADDR", type=P.ADDRESS,
-              help="Dask scheduler address (tcp://host:8786); default a local cluster.")
+@execution_options(default=None, what="designs (and the tables a run builds)")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]),
               help="Model fidelity (default: 3d for the certified search, 2d for ga and exhaustive).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
@@ -126,6 +123,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if library is not None:
         P.library_option(library, unit_file)
     config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
+    check_options(executor or config.executor, config.workers if workers is None else workers,
+                  scheduler or config.scheduler)
     changes: dict[str, Any] = {}
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
                        ("point", point), ("units", units), ("search", search), ("seed", seed),
@@ -225,7 +224,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             },
             "hall_of_fame": [{"design": c.design, "pressure_kpa": _kpa(c.pressure), "fitness": c.value,
                               "failure": c.failure} for c in result.hall_of_fame],
-            "search": result.search, "search_note": result.search_note,
+            "search": result.search, "search_note": result.search_note, "retried": result.retried,
             "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
             "cache_entries_rejected": result.rejected,
             "robustness": None if result.robustness is None else
@@ -249,6 +248,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             click.echo(f"  under +-{rob['tolerance_mm']:g} mm mould tolerances ({rob['samples']} samples, "
                        f"{rob['method'].split(',')[0]}): {w['design']} mean {w['mean']:.4g}, 95th percentile "
                        f"{w['p95']:.4g}, worst {w['worst']:.4g}")
+        if result.retried:
+            click.echo(f"  {result.retried} design(s) retried on other Dask workers after lost workers")
         click.echo(f"report: {result.folder / 'report.md'}")
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)

@@ -10,6 +10,7 @@ from typing import Any
 import click
 
 from pneumorph.cli import params as P
+from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
 
 
 def _common(command: Callable[..., Any]) -> Callable[..., Any]:
@@ -23,9 +24,6 @@ def _common(command: Callable[..., Any]) -> Callable[..., Any]:
                      help="Units of the default design (ignored with --design)."),
         click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure, kPa."),
         click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit)."),
-        click.option("--executor", type=click.Choice(["serial", "processes"]), default="processes", show_default=True,
-                     help="Solve the cases one after another, or in parallel processes."),
-        click.option("--workers", type=P.WORKERS, help="Processes (default: all cores)."),
         click.option("--cache", metavar="FILE", type=P.CacheFile(),
                      help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes."),
         click.option("--out", type=P.OutputDir(), help="Folder for study.json and study.png."),
@@ -33,7 +31,7 @@ def _common(command: Callable[..., Any]) -> Callable[..., Any]:
     ]
     for option in reversed(options):
         command = option(command)
-    return command
+    return execution_options(what="cases")(command)
 
 
 @click.group("sensitivity")
@@ -45,13 +43,13 @@ def sensitivity() -> None:
 def _run(name: str, common: dict[str, Any], **options: Any) -> None:
     from pathlib import Path
 
-    from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
     from pneumorph.io.files import write_json
     from pneumorph.models import make_model
     from pneumorph.sensitivity import BUILDERS, run_study
 
+    check_options(common["executor"], common["workers"], common["scheduler"])
     design, n = common["design"], common["n_units"]
     if design is not None:
         with P.blame("--design"):
@@ -64,8 +62,7 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
     total = len(study.cases) + 1
     click.echo(f"{name} study of design {study.design} ({common['fidelity']} model, {model.n_units} units, "
                f"{common['pressure']:g} kPa): {total} solves", err=True)
-    cache = EvaluationCache(common["cache"] or default_cache_path())
-    evaluator = CachedEvaluator(make_evaluator(common["executor"], common["workers"]), cache)
+    evaluator = open_evaluator(common["executor"], common["workers"], common["scheduler"], common["cache"])
     t0 = time.perf_counter()
 
     def progress(done: int, total: int, r: Any) -> None:
@@ -77,7 +74,11 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
         result = run_study(study, evaluator, on_case=progress)
     finally:
         evaluator.close()
+    if (line := cluster_line(evaluator)) is not None:
+        click.echo(line, err=True)
     data = result.to_dict()
+    if (cluster := cluster_report(evaluator)) is not None:
+        data["cluster"] = cluster
     data["provenance"] = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if common["out"]:
         from pneumorph.plot.sensitivity import plot_study

@@ -8,6 +8,7 @@ import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_STARTS
 from pneumorph.cli import params as P
+from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
 
 
 @click.command("study")
@@ -22,15 +23,15 @@ from pneumorph.cli import params as P
 @click.option("--units", type=P.UNITS, help="Number of units (default: the config's, else 15).")
 @click.option("--target", type=P.Text(), help="Profile target (default: the config's, else sin, amplitude 10 mm).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
-@click.option("--executor", type=click.Choice(["serial", "processes", "dask"]), default="processes", show_default=True)
+@execution_options()
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", type=P.OutputDir(), default="runs/population-study", show_default=True, metavar="DIR",
               help="Folder for study.json and study.png.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 def study(config_file: str | None, populations: list[int], seeds: int, generations: int, units: int | None,
-          target: str | None, pressure: float | None, executor: str, cache: str | None, out: str,
-          as_json: bool) -> None:
+          target: str | None, pressure: float | None, executor: str, workers: int | None, scheduler: str | None,
+          cache: str | None, out: str, as_json: bool) -> None:
     """Best fitness against GA population size over several seeds (lowest, largest, mean).
 
     Every design is solved once for the whole study: all runs share the evaluation cache.
@@ -39,15 +40,10 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     from pathlib import Path
 
     from pneumorph.design import DesignConfig, plot_study, population_study
-    from pneumorph.execution import (
-        CachedEvaluator,
-        EvaluationCache,
-        default_cache_path,
-        make_evaluator,
-    )
     from pneumorph.io import provenance, strict_json, write_json
     from pneumorph.models.factory import make_model
 
+    check_options(executor, workers, scheduler)
     pops = tuple(populations)
     if target is not None:
         from pneumorph.design.targets import make_objective
@@ -64,7 +60,7 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     config = DesignConfig.from_dict(config.to_dict())
     model = make_model(config.units, config.model)
     objective = config.make_objective()
-    evaluator = CachedEvaluator(make_evaluator(executor), EvaluationCache(cache or default_cache_path()))
+    evaluator = open_evaluator(executor, workers, scheduler, cache)
     click.echo(f"population study: {objective.label}, populations {pops}, {seeds} seeds, "
                f"{generations} generations, {config.units} units", err=True)
 
@@ -76,14 +72,15 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
         result = population_study(model, objective, pops, tuple(range(seeds)), generations,
                                   base=replace(config.ga, seed=0), evaluator=evaluator, on_run=on_run)
     finally:
-        close = getattr(evaluator, "close", None)
-        if callable(close):
-            close()
+        evaluator.close()
+    cluster = cluster_report(evaluator)
+    if (line := cluster_line(evaluator)) is not None:
+        click.echo(line, err=True)
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     summary = {
         "objective": result.objective, "unit": result.unit, "generations": result.generations,
-        "rows": [row.as_dict() for row in result.rows],
+        "rows": [row.as_dict() for row in result.rows], **({"cluster": cluster} if cluster else {}),
         "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint(), config=config.to_dict()),
     }
     write_json(folder / "study.json", summary)

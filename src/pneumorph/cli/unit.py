@@ -10,6 +10,7 @@ import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_UNITS
 from pneumorph.cli import params as P
+from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
 
 
 @click.group("unit")
@@ -36,9 +37,7 @@ def unit() -> None:
 @click.option("--element-size", type=P.POSITIVE_MM, help="Element size of the candidates' mesh, mm (default: "
               "the base unit's, 1.5).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Base unit TOML file (default: the built-in unit).")
-@click.option("--executor", type=click.Choice(["serial", "processes"]), default="processes", show_default=True,
-              help="Solve the candidates one after another, or in parallel processes.")
-@click.option("--workers", type=P.WORKERS, help="Processes (default: all cores).")
+@execution_options(what="candidates")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes.")
 @click.option("--out", required=True, type=P.OutputDir(),
@@ -46,19 +45,20 @@ def unit() -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the front as JSON.")
 def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n_units: int, pop_size: int,
              generations: int, seed: int, resolution: float, element_size: float | None, unit_file: str | None,
-             executor: str, workers: int | None, cache: str | None, out: str, as_json: bool) -> None:
+             executor: str, workers: int | None, scheduler: str | None, cache: str | None, out: str,
+             as_json: bool) -> None:
     """Maximise the bending angle per unit (Omega) and minimise the ballooning height (h_b) within a
     strain limit (Ellis 2020, 8.3.2), NSGA-II on a 3-unit 3D actuator; resumable through the cache."""
     from dataclasses import replace
     from pathlib import Path
 
-    from pneumorph.execution import CachedEvaluator, EvaluationCache, default_cache_path, make_evaluator
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import strict_json
     from pneumorph.io.lock import RunLock
     from pneumorph.unitopt.run import OptimiseSettings, check_settings, optimise, write_outputs
     from pneumorph.unitopt.space import DesignSpace, parse_variable
 
+    check_options(executor, workers, scheduler)
     with P.blame("--unit"):
         base = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     base = replace(base, name="unitopt")
@@ -74,7 +74,7 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     click.echo(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
                f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
                f"{generations} generations, seed {seed}", err=True)
-    evaluator = CachedEvaluator(make_evaluator(executor, workers), EvaluationCache(cache or default_cache_path()))
+    evaluator = open_evaluator(executor, workers, scheduler, cache)
     t0 = time.perf_counter()
     count = {"n": 0}
 
@@ -98,12 +98,16 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
             result = optimise(settings, evaluator, on_candidate, on_generation)
         finally:
             evaluator.close()
+        if (line := cluster_line(evaluator)) is not None:
+            click.echo(line, err=True)
         write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
     rows = [c.row(strain_limit) for c in result.front]
     better = result.better()
     if as_json:
+        cluster = cluster_report(evaluator)
         click.echo(strict_json({"front": rows, "base": result.base.row(strain_limit),
-                                "better_than_base": [c.row(strain_limit) for c in better]}))
+                                "better_than_base": [c.row(strain_limit) for c in better],
+                                **({"cluster": cluster} if cluster else {})}))
         return
     names = space.names
     click.echo(" ".join(f"{n:>13}" for n in names) + f" {'Omega [deg]':>11} {'h_b [mm]':>8} {'strain':>7}")

@@ -45,7 +45,7 @@ from pneumorph.errors import (
     TargetExpressionError,
     UnknownObjectiveError,
 )
-from pneumorph.execution.evaluators import EXECUTORS
+from pneumorph.execution.evaluators import EXECUTORS, check_execution
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import read_toml
 
@@ -141,6 +141,8 @@ class DesignConfig:
             _integer(self.workers, "[execution] workers", 1, 1024)
         if self.scheduler is not None:
             _address(self.scheduler, "[execution] scheduler")
+        check_execution(self.executor, self.workers, self.scheduler,
+                        ("[execution] executor", "[execution] workers", "[execution] scheduler"))
         for key in ("chain_table", "cache"):
             if getattr(self, key) is not None:
                 _text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")

@@ -160,6 +160,8 @@ class RunResult:
     wall_time : float
     rejected : int
         Cache entries that failed their checksum and were solved again instead of used.
+    retried : int
+        Designs retried on other workers after a Dask worker was lost (0 for other executors).
     files : tuple of Path
     search : str
         The search that ran: the config's, or for a certified run of an actuator shorter
@@ -185,6 +187,7 @@ class RunResult:
     robust_winner: Candidate | None = None
     search: str = ""
     search_note: str = ""
+    retried: int = 0
 
     @property
     def best(self) -> Candidate | None:
@@ -494,7 +497,7 @@ def run_design(
                 cache.close()
 
     try:
-        inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler)
+        inner = evaluator or make_evaluator(config.executor, config.workers, config.scheduler, on_message=say)
         cache = cache or EvaluationCache(config.cache or default_cache_path())
         cached = CachedEvaluator(inner, cache)
         # the folder is claimed before any table is built: a second run into it is refused at once; a start that
@@ -580,7 +583,8 @@ def run_design(
         result = RunResult(status, folder, objective, tuple(hof), tuple(history), cached.solves, cached.hits,
                            time.perf_counter() - start, certified=cert, rejected=int(getattr(cache, "rejected", 0)),
                            robustness=robustness, robust_winner=robust_best, search=search,
-                           search_note=plan.note if plan is not None else "")
+                           search_note=plan.note if plan is not None else "",
+                           retried=int(getattr(inner, "retried", 0)))
         files: list[Path] = []
         try:
             if cert is not None:
