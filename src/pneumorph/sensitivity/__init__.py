@@ -4,6 +4,8 @@
 - :func:`shape_difference` - the largest distance between matching centreline points and
   its X and Y errors in %, as the dissertation measures.
 - :func:`scaled_bulk_modulus`, :func:`tension_only` - the material variants of E.1.
+- :func:`converge`, :func:`mesh_points`, :class:`MeshStudy` - mesh convergence: observed
+  order, Richardson limit and grid convergence index of a design's shape over element sizes.
 - :class:`Study` and its builders (:func:`simplifications`, :func:`tolerances`,
   :func:`bulk_modulus`, :func:`calibration`, :func:`temperature`), solved by
   :func:`run_study` through any evaluator.
@@ -13,6 +15,15 @@ base_block=..., temperature_change=..., materials=...)`` (:mod:`pneumorph.models
 """
 
 from pneumorph.sensitivity.compare import ShapeDifference, shape_difference
+from pneumorph.sensitivity.mesh import (
+    Convergence,
+    MeshPoint,
+    MeshStudy,
+    converge,
+    mesh_points,
+    refined,
+    representative_size,
+)
 from pneumorph.sensitivity.studies import (
     BUILDERS,
     DISSERTATION,
@@ -31,7 +42,34 @@ from pneumorph.sensitivity.studies import (
 from pneumorph.sensitivity.tolerances import FIELDS, MACHINED, PRINTED, Tolerance, perturbed
 from pneumorph.sensitivity.variants import scaled_bulk_modulus, tension_only
 
-__all__ = ["BUILDERS", "DISSERTATION", "FIELDS", "MACHINED", "PRINTED", "STUDIES", "Case", "CaseResult",
-           "ShapeDifference", "Study", "StudyResult", "Tolerance", "bulk_modulus", "calibration", "perturbed",
-           "run_study", "scaled_bulk_modulus", "shape_difference", "simplifications", "temperature", "tension_only",
-           "tolerances"]
+__all__ = [
+    "BUILDERS",
+    "DISSERTATION",
+    "FIELDS",
+    "MACHINED",
+    "PRINTED",
+    "STUDIES",
+    "Case",
+    "CaseResult",
+    "Convergence",
+    "MeshPoint",
+    "MeshStudy",
+    "ShapeDifference",
+    "Study",
+    "StudyResult",
+    "Tolerance",
+    "bulk_modulus",
+    "calibration",
+    "converge",
+    "mesh_points",
+    "perturbed",
+    "refined",
+    "representative_size",
+    "run_study",
+    "scaled_bulk_modulus",
+    "shape_difference",
+    "simplifications",
+    "temperature",
+    "tension_only",
+    "tolerances",
+]
