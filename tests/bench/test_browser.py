@@ -169,3 +169,15 @@ def test_switching_model_and_verifying_by_fe_survives_a_reload(browser) -> None:
     _wait(lambda: _answered(browser), timeout=30)
     _wait(lambda: "verify" in _el(browser, "jobs").text and "done" in _el(browser, "jobs").text)
     assert _el(browser, "job-status").get_attribute("data-state") == "done"
+
+
+def test_a_job_is_cancelled_from_the_page(browser) -> None:  # type: ignore[no-untyped-def]
+    _wait(lambda: _answered(browser), timeout=30)
+    _el(browser, "export-button").click()
+    _wait(lambda: _el(browser, "job-cancel").is_displayed(), timeout=10)  # shown while the job is queued or running
+    _el(browser, "job-cancel").click()
+    _wait(lambda: _el(browser, "job-status").get_attribute("data-state") == "cancelled", timeout=15)
+    _wait(lambda: not _el(browser, "job-cancel").is_displayed())
+    _wait(lambda: "export cancelled" in _el(browser, "jobs").text)
+    # (the earlier tests' refused expressions are in the log too)
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE" and "/api/jobs" in e["message"]]

@@ -6,6 +6,7 @@ import { DrawArea } from "./draw.js";
 const $ = (id) => document.getElementById(id);
 const state = { info: null, answer: null, seq: 0, selected: null, profiles: null, curve: null, job: null,
   polling: new Set(), shapeSeq: 0 };
+const ACTIVE = ["queued", "running"];
 const FIELDS = ["target", "preset", "amplitude", "periods", "expression", "goal", "point", "points", "model", "unit", "top"];
 
 async function api(path, options = {}) {
@@ -145,6 +146,7 @@ function renderJob(job) {
   $("job-status").textContent = job.state;
   $("job-status").title = job.message;
   $("job-log").textContent = job.log.join("\n");
+  $("job-cancel").hidden = !ACTIVE.includes(job.state);
   $("downloads").innerHTML = job.files.map((f) => `<li><a href="${f.url}" download="${f.name}">${f.name}</a></li>`).join("");
   if (job.state === "done" && job.kind === "verify" && job.result) {
     const r = job.result;
@@ -162,7 +164,7 @@ async function refreshJobs() {
     `${j.state}${j.state === "running" ? ` (${Math.round(100 * j.progress)} %)` : ""}` +
     `${j.state === "done" ? summary(j) : `: ${escape(j.message)}`}</li>`).join("");
   for (const j of jobs) {
-    if (j.state === "queued" || j.state === "running") poll(j.id);
+    if (ACTIVE.includes(j.state)) poll(j.id);
   }
   return jobs;
 }
@@ -186,7 +188,7 @@ async function poll(id) {
     for (;;) {
       const job = await api(`/api/jobs/${id}`);
       renderJob(job);
-      if (job.state === "done" || job.state === "failed") {
+      if (!ACTIVE.includes(job.state)) {                            // done, failed, cancelled or interrupted
         await refreshJobs();
         if (job.kind === "verify" && job.state === "done") loadShape();
         if (job.kind === "table" && job.state === "done") await refreshUnits(job.result.unit_id);
@@ -246,6 +248,11 @@ async function main() {
   $("top-table").addEventListener("click", (e) => { const tr = e.target.closest("tr[data-design]"); if (tr) select(tr.dataset.design); });
   $("verify-button").addEventListener("click", () => start({ kind: "verify", query: currentBody() }));
   $("export-button").addEventListener("click", () => start({ kind: "export", design: state.selected, unit: $("unit").value }));
+  $("job-cancel").addEventListener("click", async () => {
+    if (!state.job) return;
+    try { renderJob(await api(`/api/jobs/${state.job}`, { method: "DELETE" })); await refreshJobs(); }
+    catch (error) { showError(error.field, error.message); }
+  });
   $("unit-upload").addEventListener("click", () => {
     const file = $("unit-file").files[0];
     if (!file) { showError("unit", "choose a unit TOML file first"); return; }
