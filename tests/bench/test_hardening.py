@@ -23,6 +23,7 @@ from pneumorph.bench import create_app
 from pneumorph.bench.app import COOKIE
 from pneumorph.bench.jobs import JobLimits
 from pneumorph.design.config import to_toml
+from pneumorph.errors import StateQuotaError
 from pneumorph.geometry.limits import MAX_NODES_3D, MeshLimitError, check_mesh, estimate_mesh
 from pneumorph.geometry.unit import UnitSpec
 
@@ -170,10 +171,21 @@ def test_finished_jobs_expire_and_the_oldest_go_past_the_quota(tmp_path: Path) -
         job.save()
         board._jobs[job.id] = job
         jobs.append(job)
+    shapes = tmp_path / "shapes"
+    shapes.mkdir()
+    old, new = shapes / "old.json", shapes / "new.json"
+    for path in (old, new):
+        path.write_text("{}")
+    os.utime(old, (time.time() - 2 * 86400,) * 2)
     used = board.sweep()
     assert "j0" not in board._jobs and not jobs[0].folder.exists()  # older than a day
     assert "j1" not in board._jobs  # the oldest of the rest, to get under 1 MB
     assert {"j2", "j3"} <= set(board._jobs) and used <= 1e6
+    assert not old.exists() and new.exists()
+    (tmp_path / "units").mkdir()
+    (tmp_path / "units" / "big.bin").write_bytes(b"\0" * 2_000_000)  # what no finished job can make room for
+    with pytest.raises(StateQuotaError, match="state-quota"):
+        board.submit("s", "wait", {"seconds": 0})
     board.close()
 
 

@@ -42,6 +42,7 @@ STATES = ("queued", "running", "done", "failed", "cancelled", "interrupted")
 ACTIVE = ("queued", "running")
 MAX_LOG = 500  # lines a job keeps
 STOP_GRACE = 2.0  # seconds a job's processes get between SIGTERM and SIGKILL
+SWEEP_EVERY = 3600.0  # seconds between sweeps of expired jobs while the bench is idle
 
 
 @dataclass(frozen=True)
@@ -57,8 +58,8 @@ class JobLimits:
     expiry_days : float
         Finished jobs (and their files) are deleted this long after they were started.
     quota_mb : float
-        Disk space the jobs' folders may take; past it the oldest finished jobs are deleted,
-        and a new job is refused while the running ones alone exceed it.
+        Disk space the state folder may take (jobs, FE shapes, units); past it the oldest
+        finished jobs are deleted, and a new job is refused while the rest exceeds it.
 
     Examples
     --------
@@ -191,20 +192,28 @@ class JobBoard:
 
     # -- limits ---------------------------------------------------------------------------
     def sweep(self) -> int:
-        """Delete expired finished jobs, then the oldest finished ones while the jobs pass the quota.
+        """Delete expired finished jobs and FE shapes, then the oldest finished jobs while the state folder
+        is past its quota. Runs at start, before each new job and every :data:`SWEEP_EVERY` s.
 
         Returns
         -------
         int
-            Bytes the jobs' folders take afterwards.
+            Bytes the state folder takes afterwards.
         """
         now = time.time()
+        expiry = self.limits.expiry_days * 86400
         with self._lock:
             finished = sorted((j for j in self._jobs.values() if j.state not in ACTIVE), key=lambda j: j.created)
             for job in finished:
-                if now - job.created > self.limits.expiry_days * 86400:
+                if now - job.created > expiry:
                     self._delete(job)
-            used = folder_size(self.root)
+            for shape in (self.state_dir / "shapes").glob("*.json"):  # a verified design's 3D view, kept as long
+                try:
+                    if now - shape.stat().st_mtime > expiry:
+                        shape.unlink()
+                except OSError:
+                    continue
+            used = folder_size(self.state_dir)
             quota = self.limits.quota_mb * 1e6
             for job in finished:
                 if used <= quota:
@@ -241,7 +250,7 @@ class JobBoard:
                                     "(serve --max-jobs); try again when one has finished")
             used = self.sweep()
             if used > self.limits.quota_mb * 1e6:
-                raise StateQuotaError(f"the bench's jobs take {used / 1e6:.0f} MB, above its quota of "
+                raise StateQuotaError(f"the bench's state folder takes {used / 1e6:.0f} MB, above its quota of "
                                       f"{self.limits.quota_mb:g} MB (serve --state-quota); wait for a job to end")
             job = Job(secrets.token_hex(16), session, kind, self.root / secrets.token_hex(16), params)
             job.folder.mkdir(parents=True)
@@ -346,7 +355,11 @@ class JobBoard:
     # -- running ------------------------------------------------------------------------
     def _serve(self) -> None:
         while True:
-            job = self._queue.get()
+            try:
+                job = self._queue.get(timeout=SWEEP_EVERY)
+            except queue.Empty:
+                self.sweep()
+                continue
             if job is None or self._closing:
                 return
             if job.state != "queued":
