@@ -109,3 +109,10 @@ def test_precision_attribute_follows_the_solver() -> None:
     assert step.precision == "single" and system.tangent_dtype == np.float32
     step._to_double()
     assert step.precision == "double" and system.tangent_dtype == np.float64
+
+
+def test_large_systems_start_in_double_precision(monkeypatch: pytest.MonkeyPatch) -> None:
+    import pneumorph.fem.fast.newton as newton
+
+    monkeypatch.setattr(newton, "SINGLE_PRECISION_MAX_DOFS", 1000)
+    assert _model(increments=1).evaluate("0").metadata["precision"] == "double"

@@ -192,3 +192,123 @@ def calibration_cmd(reach: float, **common: Any) -> None:
 def temperature_cmd(changes: tuple[float, ...], **common: Any) -> None:
     """Appendix D.3: a uniform temperature change from the casting temperature."""
     _run("temperature", common, changes=changes or (10.0,))
+
+
+@sensitivity.command("mesh")
+@click.option("--design", "designs", metavar="DIGITS", type=P.Text(max_length=1000), multiple=True,
+              help="A design, base first (repeat; default: all units aligned). All of one length.")
+@click.option("--units", "n_units", type=P.UNITS, default=15, show_default=True,
+              help="Units of the default design (ignored with --design).")
+@click.option("--size", "sizes", type=P.Real(0.0, 100.0, low_open=True, unit="mm"), multiple=True,
+              help="Element size, mm (repeat; default 1.5, 1.0 and 0.75).")
+@click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="3d", show_default=True,
+              help="The FE model.")
+@click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure, kPa.")
+@click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--target", type=P.Text(), default="sin", show_default=True,
+              help="The objective whose value is compared: a profile ('sin', 'y = ...') or a tip goal ('max-x').")
+@click.option("--amplitude", type=P.Real(-1e4, 1e4, unit="mm"), default=10.0, show_default=True,
+              help="Amplitude of a preset profile, mm.")
+@click.option("--order", type=P.Real(0.0, 12.0, low_open=True), default=None,
+              help="Order of convergence to assume for a design solved on two meshes only (e.g. observed on a "
+                   "short actuator).")
+@click.option("--cache", metavar="FILE", type=P.CacheFile(),
+              help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes.")
+@click.option("--out", type=P.OutputDir(), help="Folder for mesh.json and mesh.png.")
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
+@execution_options(default="serial", what="solves")
+def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], fidelity: str, pressure: float,
+             unit_file: str | None, target: str, amplitude: float, order: float | None, cache: str | None,
+             out: str | None, as_json: bool, executor: str, workers: int | None, scheduler: str | None) -> None:
+    """Mesh convergence: designs solved at several element sizes; observed order, Richardson limit and error
+    estimate of the tip, the curl and the objective (docs/mesh-convergence.md)."""
+    import os
+    from pathlib import Path
+
+    from pneumorph.design.targets import make_objective
+    from pneumorph.geometry import parse_orientation
+    from pneumorph.io import provenance, strict_json
+    from pneumorph.io.files import write_json
+    from pneumorph.models import make_model
+    from pneumorph.sensitivity.mesh import MeshStudy, check_refinement, mesh_points
+
+    check_options(executor, workers, scheduler)
+    lengths = set()
+    for design in designs:
+        with P.blame("--design"):
+            lengths.add(len(parse_orientation(design)))
+    if len(lengths) > 1:
+        raise click.BadParameter(f"the designs have different lengths ({sorted(lengths)}); give designs of one "
+                                 "length", param_hint="--design")
+    n = lengths.pop() if lengths else n_units
+    designs = tuple(dict.fromkeys(designs)) or ("0" * n,)
+    sizes = tuple(sorted(set(sizes or (1.5, 1.0, 0.75)), reverse=True))
+    settings: dict[str, Any] = {"fidelity": fidelity, "pressure_kpa": pressure}
+    if unit_file:
+        settings["unit_file"] = unit_file
+    model = make_model(n, settings)
+    with P.blame("--target"):
+        objective = make_objective(target, amplitude, length=n * model.unit.pitch)
+    parallel = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
+    with P.blame("--size"):
+        check_refinement(model, sizes, parallel=min(parallel, len(designs) * len(sizes)))
+    click.echo(f"mesh study ({fidelity} model, {n} units, {pressure:g} kPa): {len(designs)} design(s) x "
+               f"{len(sizes)} element size(s) = {len(designs) * len(sizes)} solves", err=True)
+    evaluator = open_evaluator(executor, workers, scheduler, cache)
+    t0 = time.perf_counter()
+    done = [0]
+
+    def progress(point: Any) -> None:
+        done[0] += 1
+        state = (f"curl {point.curl:.4f} deg, value {point.value:.4g} {objective.unit}" if point.ok
+                 else f"failed: {point.failure}")
+        click.echo(f"  [{done[0]}/{len(designs) * len(sizes)}] {point.design} at {point.element_size:g} mm "
+                   f"({point.cells:,} cells): {state}  [{time.perf_counter() - t0:.0f} s]", err=True)
+
+    try:
+        points = mesh_points(model, designs, sizes, objective, evaluator, on_point=progress)
+    finally:
+        evaluator.close()
+    study = MeshStudy(tuple(points), objective.label, order)
+    data = study.to_dict()
+    data["objective_unit"] = objective.unit
+    if (cluster := cluster_report(evaluator)) is not None:
+        data["cluster"] = cluster
+    data["provenance"] = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
+    if out:
+        from pneumorph.plot.mesh import plot_mesh_study
+
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        write_json(folder / "mesh.json", data)
+        plot_mesh_study(study, folder / "mesh.png", unit=objective.unit, fingerprint=model.fingerprint())
+    if as_json:
+        click.echo(strict_json(data))
+        return
+    _print_mesh(study, objective.unit)
+    if out:
+        click.echo(f"written to {Path(out)}/ (mesh.json, mesh.png)")
+
+
+def _print_mesh(study: Any, unit: str) -> None:
+    click.echo(f"{'design':<18} {'size':>5} {'h [mm]':>7} {'cells':>7} {'dofs':>8} {'tip x':>9} {'tip y':>9} "
+               f"{'curl [deg]':>10} {'value [' + unit + ']':>11} {'at kPa':>7} {'s':>6}")
+    for p in study.points:
+        if not p.ok:
+            click.echo(f"{p.design:<18} {p.element_size:5.3g} {p.cell_size:7.3f} {p.cells:7,} {'':>8} failed: "
+                       f"{p.failure}")
+            continue
+        assert p.tip is not None
+        click.echo(f"{p.design:<18} {p.element_size:5.3g} {p.cell_size:7.3f} {p.cells:7,} {p.dofs:8,} "
+                   f"{p.tip[0]:9.3f} {p.tip[1]:9.3f} {p.curl:10.4f} {p.value:11.4f} {p.pressure_kpa:7.4g} "
+                   f"{p.wall_time_s:6.0f}")
+    click.echo("")
+    click.echo(f"{'design':<18} {'quantity':<8} {'order':>6} {'limit':>10} {'+-':>8}  method")
+    for design in study.designs:
+        for quantity in ("tip_x", "tip_y", "curl", "value"):
+            c = study.convergence(design, quantity)
+            if c is None:
+                continue
+            order = "-" if c.order is None else f"{c.order:.2f}"
+            limit = "-" if c.extrapolated is None else f"{c.extrapolated:.4f}"
+            click.echo(f"{design:<18} {quantity:<8} {order:>6} {limit:>10} {c.error:8.4f}  {c.method}")
