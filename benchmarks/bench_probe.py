@@ -17,7 +17,8 @@ options) and, while ``--clients`` clients send design queries (each a different 
 
 Prints the latency percentiles of ``/api/design`` during the probes, the peak memory of the
 server process (and of the server with its answer and job processes), what each probe got
-back, and the machine.
+back, how long the server takes to stop on SIGINT (Ctrl-C) with its jobs still queued or
+running and the jobs' states then, and the machine.
 """
 
 from __future__ import annotations
@@ -222,11 +223,18 @@ def main() -> None:
             spooled = [p.name for p in Path(tmp).iterdir() if p.name not in ("state", "cache.sqlite")
                        and not p.name.startswith(("cache.sqlite", "chain-tables"))]
         finally:
-            server.send_signal(signal.SIGINT)
+            t = time.perf_counter()
+            server.send_signal(signal.SIGINT)  # as Ctrl-C: jobs still queued or running are stopped
             try:
                 server.wait(30)
+                stop = f"{time.perf_counter() - t:.1f} s"
             except subprocess.TimeoutExpired:
                 os.killpg(server.pid, signal.SIGKILL)
+                stop = "not within 30 s (killed)"
+            states: dict[str, int] = {}
+            for record in state.glob("jobs/*/job.json"):
+                job_state = json.loads(record.read_text())["state"]
+                states[job_state] = states.get(job_state, 0) + 1
     ms = np.asarray(lat) * 1e3
     print(f"machine: {platform.node()}, {os.cpu_count()} cores, {platform.processor() or platform.machine()}, "
           f"Python {platform.python_version()}")
@@ -239,6 +247,7 @@ def main() -> None:
     print(f"files left in the server's temporary folder: {spooled or 'none'}")
     for name, value in found.items():
         print(f"{name}: {value}")
+    print(f"Ctrl-C (SIGINT) after the probes: the server ended in {stop}; jobs by state: {states}")
     for e in errors[:5]:
         print("  error:", e)
 
