@@ -10,8 +10,8 @@
 separate processes and times one 3D solve of a design three ways: on that worker as it is
 (a plain ``Client.submit``, before pneumorph's worker settings are registered), through
 :class:`~pneumorph.execution.DaskEvaluator` (which registers them), and in a process pool of
-one worker. The times are those of the solve inside its process (``Outcome.wall_time``: no
-start-up, no transfer). ``--repeat`` repeats the three on a fresh cluster.
+one worker. The times are those of the solve inside its process (wall, user and system CPU
+from ``getrusage``: no start-up, no transfer). ``--repeat`` repeats the three on a fresh cluster.
 
 ``table`` runs ``pneumorph chain build`` as a subprocess, each with a fresh evaluation cache:
 ``--executor processes --workers N`` and ``--executor dask --scheduler ADDR`` with N
@@ -86,41 +86,54 @@ def solve_case(units: int) -> tuple[object, str]:
     return model, design
 
 
+def timed_solve(model: object, design: str) -> tuple[object, float, float, float]:
+    """Solve in this process: the outcome, and the wall, user CPU and system CPU seconds of the solve."""
+    import resource
+
+    from pneumorph.execution import solve
+
+    before = resource.getrusage(resource.RUSAGE_SELF)
+    t0 = time.perf_counter()
+    outcome = solve(model, design)  # type: ignore[arg-type]
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_SELF)
+    return outcome, wall, after.ru_utime - before.ru_utime, after.ru_stime - before.ru_stime
+
+
 def time_solve(args: argparse.Namespace) -> None:
     from distributed import Client
 
     from pneumorph.execution import DaskEvaluator, ProcessPoolEvaluator
-    from pneumorph.execution.evaluators import _solve_on_dask_worker
 
     model, design = solve_case(args.units)
-    rows: list[tuple[str, float]] = []
+    rows: list[tuple[str, tuple[float, float, float]]] = []
+    plain_name = "dask worker, nanny defaults (MALLOC_TRIM_THRESHOLD_=65536)"
+    tuned_name = "dask worker with pneumorph's worker settings (DaskEvaluator connected)"
+    pool_name = "process pool, 1 worker"
     for r in range(args.repeat):
+        results = {}
         with tempfile.TemporaryDirectory() as tmp, cluster(1, Path(tmp)) as address:
             with Client(address, timeout=30) as client:  # the standard worker as it is
-                plain = client.submit(_solve_on_dask_worker, model, design, pure=False).result()
-                rows.append(("dask worker, nanny defaults (MALLOC_TRIM_THRESHOLD_=65536)", plain.wall_time))
-            with DaskEvaluator(address) as ev:  # registers the worker settings; a new worker process
-                client = ev.client
-                client.restart()  # a fresh worker process, as the first case had, now with the settings
-                (tuned,) = ev.evaluate_many(model, [design])
-                rows.append(("dask worker with pneumorph's worker settings (DaskEvaluator)", tuned.wall_time))
+                results[plain_name] = client.submit(timed_solve, model, design, pure=False).result()
+            with DaskEvaluator(address) as ev:  # registers the worker settings
+                ev.client.restart()  # a fresh worker process, as the first case had, now with the settings
+                results[tuned_name] = ev.client.submit(timed_solve, model, design, pure=False).result()
         with ProcessPoolEvaluator(workers=1) as pool:
-            (pooled,) = pool.evaluate_many(model, [design])
-            rows.append(("process pool, 1 worker", pooled.wall_time))
-        same = all(o.ok for o in (plain, tuned, pooled)) and \
-            bool((plain.response.centres == pooled.response.centres).all()) and \
-            bool((tuned.response.centres == pooled.response.centres).all())
+            results[pool_name] = pool._ensure_pool(model).submit(timed_solve, model, design).result()
+        outcomes = [v[0] for v in results.values()]
+        same = all(o.ok for o in outcomes) and all(  # type: ignore[attr-defined]
+            bool((o.response.centres == outcomes[0].response.centres).all()) for o in outcomes)  # type: ignore
         print(f"repeat {r + 1}: the three responses are {'bit-identical' if same else 'DIFFERENT'}", flush=True)
-        for name, seconds in rows[-3:]:
-            print(f"  {name}: {seconds:.1f} s", flush=True)
+        for name, (_, wall, user, system) in results.items():
+            rows.append((name, (wall, user, system)))
+            print(f"  {name}: {wall:.1f} s wall, {user:.1f} s user, {system:.1f} s system", flush=True)
     print(f"\none 3D solve of {args.units} units (design {design}), {args.repeat} repeat(s); {machine()}")
-    names = list(dict.fromkeys(name for name, _ in rows))
-    pool = min(s for n, s in rows if n.startswith("process pool"))
-    print("| where | best of the repeats, s | against the pool |")
-    print("|---|---|---|")
-    for name in names:
-        best = min(s for n, s in rows if n == name)
-        print(f"| {name} | {best:.1f} | {best / pool:.2f}x |")
+    best = {name: min((t for n, t in rows if n == name), key=lambda t: t[0]) for name, _ in rows}
+    pool = best[pool_name]
+    print("| where | wall, s (best) | user CPU, s | system CPU, s | wall against the pool |")
+    print("|---|---|---|---|---|")
+    for name, (wall, user, system) in best.items():
+        print(f"| {name} | {wall:.1f} | {user:.1f} | {system:.1f} | {wall / pool[0]:.2f}x |")
 
 
 # -- table builds ------------------------------------------------------------------------

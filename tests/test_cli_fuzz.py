@@ -189,6 +189,12 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 
+# the one execution option set of every command that solves many designs (pneumorph.cli.execution)
+for _command in ("design", "study", "calibrate", "chain", "optimise", "simplifications", "tolerances", "bulk-modulus",
+                 "calibration", "temperature"):
+    OPTIONS[_command].setdefault("--workers", POS_COUNT)
+    OPTIONS[_command].setdefault("--scheduler", ["not a url", ""])
+
 CASES = [(cmd, opt, bad) for cmd, options in OPTIONS.items() for opt, values in options.items() for bad in values]
 
 
