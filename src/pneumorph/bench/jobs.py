@@ -364,7 +364,13 @@ class JobBoard:
                 return
             if job.state != "queued":
                 continue  # cancelled while it waited
-            self._run(job)
+            try:
+                self._run(job)
+            except Exception as exc:  # the worker could not be started (or read): this job fails, the board goes on
+                with self._lock:
+                    job.state, job.message, job.process = "failed", f"the job could not run: {exc}"[:500], None
+                    job.log.append(job.message)
+                    job.save()
 
     def _run(self, job: Job) -> None:
         from pneumorph.execution.evaluators import THREAD_VARIABLES

@@ -31,6 +31,7 @@ from typing import Any, TextIO
 from pneumorph.bench.answer import Bench
 from pneumorph.bench.query import Query
 from pneumorph.errors import PneumorphError
+from pneumorph.io.files import json_safe
 
 SHOWN = ("report.md", "certificate.json", "top.csv", "profile.png", "chain-vs-fe.png", "mould.png")
 
@@ -45,6 +46,9 @@ class Reporter:
     >>> Reporter(out).say("casting mould", 0.3)
     >>> out.getvalue()
     '{"say": "casting mould", "progress": 0.3}\\n'
+    >>> Reporter(out).send({"result": {"gap": float("nan")}})  # NaN and infinities as null, as in every JSON
+    >>> out.getvalue().splitlines()[-1]
+    '{"result": {"gap": null, "gap_reason": "not a number"}}'
     """
 
     def __init__(self, stream: TextIO) -> None:
@@ -53,7 +57,7 @@ class Reporter:
 
     def send(self, event: dict[str, Any]) -> None:
         with self._lock:
-            self.stream.write(json.dumps(event, allow_nan=False, default=str) + "\n")
+            self.stream.write(json.dumps(json_safe(event), allow_nan=False, default=str) + "\n")
             self.stream.flush()
 
     def say(self, text: str, progress: float | None = None) -> None:
