@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import hashlib
 import json
 import logging
 import multiprocessing
@@ -210,7 +211,7 @@ class Signing:
             fd = os.open(key, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
             with os.fdopen(fd, "wb") as out:
                 out.write(secret)
-        self._signer = Signer(secret, salt="pneumorph-bench-session")
+        self._signer = Signer(secret, salt="pneumorph-bench-session", digest_method=hashlib.sha256)
 
     def issue(self) -> str:
         """A new signed session cookie value (the session id and its signature)."""
