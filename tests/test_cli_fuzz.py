@@ -99,6 +99,7 @@ BASE = {
     "optimise": ["unit", "optimise", "--out", "run", "--executor", "serial", "--pop", "4", "--gen", "1"],
     **{study: ["sensitivity", study, "--units", "2", "--executor", "serial", "--out", "run"]
        for study in ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature")},
+    "mesh": ["sensitivity", "mesh", "--units", "2", "--executor", "serial", "--out", "run"],
 }
 
 REAL = ["nan", "inf", "-inf", "1e999", "abc", ""]  # never a number
@@ -111,7 +112,7 @@ HUGE = ["100000", "1000000000"]
 OPTIONS: dict[str, dict[str, list[str]]] = {
     "design": {
         "--pressure": [*POSITIVE, "1e9"], "--amplitude": POSITIVE, "--periods": POSITIVE, "--margin": POSITIVE,
-        "--epsilon": [*NONNEG, "1e9"],
+        "--epsilon": [*NONNEG, "1e9"], "--refine": [*POSITIVE, "1.5", "2", "0.01", "1e9"],
         "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
         "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
@@ -187,13 +188,17 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
                  "--resolution": ["-1", "11", *REAL], "--element-size": [*POSITIVE, "1e-4"],
                  "--unit": ["binary.bin", "folder", "missing.toml", ""], "--workers": POS_COUNT,
                  "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
+    "mesh": {"--design": ["", "0120", "abc"], "--units": POS_COUNT + HUGE, "--size": [*POSITIVE, "0.01", "1e9"],
+             "--pressure": [*POSITIVE, "1e9"], "--unit": ["binary.bin", "folder", ""], "--model": ["", "4d"],
+             "--target": ["", "y = 1/0", "max-q"], "--amplitude": REAL, "--order": [*POSITIVE, "13"],
+             "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 
 # the one execution option set of every command that solves many designs (pneumorph.cli.execution)
 for _command in ("design", "study", "calibrate", "chain", "optimise", "simplifications", "tolerances", "bulk-modulus",
-                 "calibration", "temperature"):
+                 "calibration", "temperature", "mesh"):
     OPTIONS[_command].setdefault("--workers", POS_COUNT)
     OPTIONS[_command].setdefault("--scheduler", ["not a url", ""])
 

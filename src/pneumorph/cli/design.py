@@ -13,7 +13,8 @@ from pneumorph.cli import params as P
 from pneumorph.cli.execution import check_options, execution_options
 
 # a fallback to the GA
-_NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "chain_table": None}
+_NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "refine": 0.0,
+                                   "chain_table": None}
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
 
 
@@ -55,6 +56,10 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--epsilon", type=P.Real(0.0, 1e3),
               help="Certified search: certify within this much (the objective's units): designs that could beat the "
                    "winner by less are counted as ties, not verified (default 0).")
+@click.option("--refine", metavar="MM", type=P.Real(0.0, 100.0, low_open=True, unit="mm"),
+              help="Certified search: solve the FE-verified designs again with this element size (e.g. 1.0 or 0.75; "
+                   "the default mesh is 1.5 mm), report both meshes' values, the estimated mesh error and whether "
+                   "the winner holds (docs/mesh-convergence.md).")
 @click.option("--chain-table", metavar="FILE", type=P.InputFile(),
               help="Certified search: a chain table file (default: the shipped one, or built on first use).")
 @click.option("--tolerance", type=P.Real(0.0, 1.0, unit="mm"),
@@ -85,7 +90,8 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
            periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
            generations: int | None, seed: int | None, search: str | None, certify: bool | None,
-           verify: int | None, margin: float | None, epsilon: float | None, chain_table: str | None,
+           verify: int | None, margin: float | None, epsilon: float | None, refine: float | None,
+           chain_table: str | None,
            tolerance: float | None,
            robust: str | None, robust_samples: int | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
@@ -129,6 +135,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
                        ("point", point), ("units", units), ("search", search), ("seed", seed),
                        ("certify", certify), ("verify", verify), ("margin", margin), ("epsilon", epsilon),
+                       ("refine", refine),
                        ("chain_table", chain_table),
                        ("tolerance", tolerance), ("robust", robust), ("robust_samples", robust_samples),
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
@@ -150,6 +157,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
     _check_options_apply(search or config.search, "certified",
                          {"--certify": certify, "--verify": verify, "--margin": margin, "--epsilon": epsilon,
+                          "--refine": refine,
                           "--chain-table": chain_table})
     config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
     fidelity_given = "fidelity" in config.model
@@ -165,6 +173,11 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if mixed:
         _check_library_run(config, model, tolerance)
     config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
+    if config.refine and config.search == "certified":  # refused here, naming the option; run_design checks again
+        from pneumorph.design.refine import check_refine
+
+        with P.blame("--refine" if refine is not None else "[design] refine"):
+            check_refine(model, config.refine)
 
     if fallback:  # said once every setting has been checked
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
@@ -229,6 +242,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             "cache_entries_rejected": result.rejected,
             "robustness": None if result.robustness is None else
             {k: v for k, v in result.robustness.items() if k not in ("offsets_mm", "winner_values")},
+            "mesh": result.refinement,
             **_certified_json(result),
         }))
     elif best is not None:
@@ -242,6 +256,14 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                        + ("no other design can beat it" if c["certified"] else
                           f"{c['could_beat']} could beat it by up to {c['gap']:.3g} (--certify verifies them)")
                        + ("" if two_d is None else f"; the 2D model's value: {two_d:.4g}"))
+        ref = result.refinement
+        if ref is not None:
+            mine = next(r for r in ref["rows"] if r["design"] == best.design)
+            fine = "failed" if mine.get("refined") is None else f"{mine['refined']:.4g}"
+            click.echo(f"  at {ref['element_size_mm'][1]:g} mm elements: {best.design} {best.value:.4g} -> {fine}; "
+                       + ("the winner holds" if ref["holds"] else f"{ref['refined_best']} is better there")
+                       + (f"; could still overtake it: {', '.join(ref['could_overtake'])}"
+                          if ref["could_overtake"] else ""))
         rob = result.robustness
         if rob is not None and "mean" in rob["winner"]:
             w = rob["winner"]

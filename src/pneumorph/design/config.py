@@ -90,6 +90,7 @@ class DesignConfig:
     verify: int | None = None
     margin: float = 1.0
     epsilon: float = 0.0
+    refine: float = 0.0
     chain_table: str | None = None
     tolerance: float = 0.1
     robust: str | None = None
@@ -118,6 +119,7 @@ class DesignConfig:
         object.__setattr__(self, "periods", _real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
         object.__setattr__(self, "margin", _real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
         object.__setattr__(self, "epsilon", _real(self.epsilon, "[design] epsilon", 0.0, 1e3))
+        object.__setattr__(self, "refine", _real(self.refine, "[design] refine", 0.0, 100.0, unit="mm"))
         object.__setattr__(self, "tolerance", _real(self.tolerance, "[design] tolerance", 0.0, 1.0, unit="mm"))
         if self.robust_samples is not None:
             _integer(self.robust_samples, "[design] robust_samples", 1, 10_000)
@@ -129,7 +131,7 @@ class DesignConfig:
         if self.search != "certified":
             given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
                                     ("chain_table", self.chain_table), ("margin", self.margin != 1.0),
-                                    ("epsilon", self.epsilon != 0.0)) if v]
+                                    ("epsilon", self.epsilon != 0.0), ("refine", self.refine != 0.0)) if v]
             if given:
                 raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} "
                                         "to the "
@@ -178,14 +180,17 @@ class DesignConfig:
 
     # -- plain-data form --------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """Nested tables ``design``, ``ga``, ``execution``, ``model`` (None values and ``epsilon = 0`` left out)."""
+        """Nested tables ``design``, ``ga``, ``execution``, ``model`` (None values, ``epsilon = 0`` and
+        ``refine = 0`` left out)."""
         design = {
             k: getattr(self, k)
             for k in ("objective", "amplitude", "periods", "point", "curve", "anchored", "units", "search", "seed",
-                      "certify", "verify", "margin", "epsilon", "chain_table", "tolerance", "robust", "robust_samples")
+                      "certify", "verify", "margin", "epsilon", "refine", "chain_table", "tolerance", "robust",
+                      "robust_samples")
         }
-        if self.epsilon == 0.0:  # absent by default: the settings of earlier run folders stay the same
-            design["epsilon"] = None
+        for key in ("epsilon", "refine"):  # absent by default: the settings of earlier run folders stay the same
+            if design[key] == 0.0:
+                design[key] = None
         ga = {k: v for k, v in asdict(self.ga).items() if k != "seed"}
         execution = {k: getattr(self, k) for k in ("executor", "workers", "scheduler", "cache")}
 

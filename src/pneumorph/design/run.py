@@ -169,6 +169,9 @@ class RunResult:
     search_note : str
         A certified run's choice: its table and the levels it scores, or why it searched
         exhaustively (and the estimated cost).
+    refinement : dict or None
+        With ``[design] refine``: the verified designs on the finer mesh
+        (:func:`pneumorph.design.refine.refine_verified`).
     """
 
     status: str
@@ -188,6 +191,7 @@ class RunResult:
     search: str = ""
     search_note: str = ""
     retried: int = 0
+    refinement: dict[str, Any] | None = None
 
     @property
     def best(self) -> Candidate | None:
@@ -471,6 +475,8 @@ def run_design(
                     f"shipped nor kept in {table_dir}; run without --no-build to build them "
                     f"({tolerance_plan_text(model, tolerance, workers, what=False)}), or leave the robustness "
                     "report out with --tolerance 0")
+    if config.refine and search == "certified":
+        _check_refine(config, model, evaluator)
     fingerprint = model.fingerprint()
     _check_folder(folder, config, fingerprint, overwrite)  # checked again under the lock
 
@@ -553,6 +559,7 @@ def run_design(
         cert: CertifiedResult | None = None
         robustness: dict[str, Any] | None = None
         robust_best: Candidate | None = None
+        refinement: dict[str, Any] | None = None
         try:
             if search == "ga":
                 ga = run_ga(model, objective, config.ga, cached, on_gen)
@@ -564,6 +571,8 @@ def run_design(
                                         hall_of_fame=config.ga.hall_of_fame, margin=config.margin,
                                         on_progress=say, epsilon=config.epsilon)
                 hof = cert.hall_of_fame
+                if config.refine:
+                    refinement = _refine(config, model, objective, cert, cached, say)
                 order = cert.scores.order()[:1000]
                 names = chain.table.texts(cert.scores.bits[order])
                 ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order, strict=False)]
@@ -575,7 +584,7 @@ def run_design(
         except KeyboardInterrupt:  # Ctrl-C, and its subclasses (the CLI's SIGTERM)
             status = "interrupted"
             history = tuple(log.rows) if log else ()
-            hof, ranking, cert, robustness, robust_best = (), None, None, None, None
+            hof, ranking, cert, robustness, robust_best, refinement = (), None, None, None, None, None
         finally:
             if log:
                 log.close()
@@ -584,7 +593,7 @@ def run_design(
                            time.perf_counter() - start, certified=cert, rejected=int(getattr(cache, "rejected", 0)),
                            robustness=robustness, robust_winner=robust_best, search=search,
                            search_note=plan.note if plan is not None else "",
-                           retried=int(getattr(inner, "retried", 0)))
+                           retried=int(getattr(inner, "retried", 0)), refinement=refinement)
         files: list[Path] = []
         try:
             if cert is not None:
@@ -603,6 +612,24 @@ def run_design(
             lock.release()
         if not started and made is not None:
             _remove_empty(folder, made)
+
+
+def _check_refine(config: DesignConfig, model: Any, evaluator: Any) -> None:
+    """Refuse, before the folder is touched, a refinement that is not finer or would not fit in memory."""
+    from pneumorph.design.refine import check_refine
+
+    workers = evaluator_workers(evaluator) if evaluator is not None else planned_workers(config)
+    check_refine(model, config.refine, parallel=max(1, min(int(workers or 1), config.verify or 1024)))
+
+
+def _refine(config: DesignConfig, model: Any, objective: Objective, cert: CertifiedResult, evaluator: Any,
+            say: Callable[[str], None]) -> dict[str, Any]:
+    """The verified designs on the finer mesh of ``[design] refine`` (:func:`.refine.refine_verified`)."""
+    from pneumorph.design.refine import refine_verified
+
+    values = {d: c.value for d, c in cert.verified.items() if c.failure is None}
+    return refine_verified(model, objective, list(values), values, cert.winner.design, config.refine, evaluator,
+                           say=say)
 
 
 def _robustness(config: DesignConfig, model: ActuatorModel, objective: Objective, evaluator: Any,
@@ -785,6 +812,8 @@ def _write_certificate(result: RunResult, folder: Path) -> list[Path]:
         "verified": {d: c.to_dict() for d, c in cert.verified.items()},
         "top": rows,
     }
+    if result.refinement is not None:
+        doc["mesh"] = result.refinement
     path = write_json(folder / "certificate.json", doc)
     text = _csv_text(list(rows[0]), [list(row.values()) for row in rows])
     return [path, atomic_write_text(folder / "top.csv", text)]
@@ -867,11 +896,45 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
             lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
                          f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kPa'] or row['chain_pressure_kPa'])} |")
         lines.append("")
+    if result.refinement is not None:
+        lines += _refinement_lines(result.refinement, o)
     if result.robustness is not None:
         lines += _robustness_lines(result.robustness, o)
     if files:
         lines += ["## Files", "", *[f"- [{f}]({f})" for f in files], ""]
     return "\n".join(lines)
+
+
+def _refinement_lines(ref: dict[str, Any], o: Objective) -> list[str]:
+    """The report's section on the finer mesh."""
+    u = o.unit
+    coarse, fine = ref["element_size_mm"]
+    lines = ["## Mesh", "",
+             f"The verified designs solved again with {fine:g} mm elements (the model's: {coarse:g} mm; "
+             f"representative cell sizes {ref['cell_size_mm'][0]:.3g} and {ref['cell_size_mm'][1]:.3g} mm). "
+             f"Limits by Richardson extrapolation with the order {ref['order']:g} observed in the mesh study "
+             f"(docs/mesh-convergence.md), +- its grid convergence index (safety factor {ref['safety_factor']:g}). "
+             "The gap to the winner is extrapolated the same way: the mesh moves all designs alike, so the gap "
+             "is known far better than either value.", "",
+             f"| design | {coarse:g} mm ({u}) | {fine:g} mm ({u}) | change ({u}) | limit ({u}) | "
+             f"gap to the winner, limit ({u}) |",
+             "|---|---:|---:|---:|---:|---:|"]
+    for r in ref["rows"]:
+        if r.get("refined") is None:
+            lines.append(f"| `{r['design']}` | {r['value']:.4g} | failed: {r.get('failure')} | - | - | - |")
+            continue
+        gap = ref["gaps"].get(r["design"])
+        gap_text = "-" if gap is None else f"{gap['limit']:+.3g} +- {gap['error']:.2g}"
+        lines.append(f"| `{r['design']}` | {r['value']:.4g} | {r['refined']:.4g} | {r['change']:+.3g} | "
+                     f"{r['extrapolated']:.4g} +- {r['error']:.2g} | {gap_text} |")
+    held = ("**the winner holds** on the finer mesh" if ref["holds"] else
+            f"**the winner does not hold**: `{ref['refined_best']}` is better on the finer mesh")
+    could = ref["could_overtake"]
+    lines += ["", f"- {held}",
+              "- " + (f"designs whose gap to the winner could close on a converged mesh: "
+                      f"{', '.join(f'`{d}`' for d in could)}" if could else
+                      "no verified design's gap to the winner can close within the estimated mesh error"), ""]
+    return lines
 
 
 def _robustness_lines(rob: dict[str, Any], o: Objective) -> list[str]:

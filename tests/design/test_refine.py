@@ -1,0 +1,91 @@
+"""``design --refine``: the verified designs on a finer mesh, their extrapolated gap, and refusals."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from pneumorph.cli import main
+from pneumorph.design import DesignConfig
+from pneumorph.design.fitness import score
+from pneumorph.design.refine import MESH_ORDERS, refined_row, verdict
+from pneumorph.design.targets import make_objective
+from pneumorph.models.fe import Reduced2D
+from pneumorph.sensitivity.mesh import refined
+
+
+def test_gap_is_extrapolated_not_the_values() -> None:
+    """Both designs move by +0.27 on the finer mesh: each value is uncertain by ~0.5, their gap by far less."""
+    rows = [refined_row("w", 7.51, 7.789, 1.5, 0.75, "min", 1.4), refined_row("r", 7.569, 7.843, 1.5, 0.75, "min", 1.4)]
+    v = verdict(rows, "w", "min", 1.4, 2.0)
+    assert v["holds"] and v["could_overtake"] == []
+    gap = v["gaps"]["r"]
+    assert gap["gap"] == pytest.approx(0.059) and gap["refined_gap"] == pytest.approx(0.054)
+    assert gap["limit"] == pytest.approx(0.054 - 0.005 / (2**1.4 - 1))
+    assert rows[0]["error"] > 10 * gap["error"]
+
+
+def test_a_gap_that_closes_and_a_swap() -> None:
+    rows = [refined_row("w", 5.0, 5.3, 1.5, 0.75, "min", 1.0), refined_row("r", 5.1, 5.25, 1.5, 0.75, "min", 1.0)]
+    v = verdict(rows, "w", "min", 1.0, 2.0)
+    assert not v["holds"] and v["refined_best"] == "r" and v["could_overtake"] == ["r"]
+    # maximised objectives: the sign turns
+    up = [refined_row("w", 30.0, 31.0, 1.5, 0.75, "max", 1.0), refined_row("r", 29.0, 29.9, 1.5, 0.75, "max", 1.0)]
+    assert verdict(up, "w", "max", 1.0, 2.0) == {"holds": True, "refined_best": "w", "could_overtake": [],
+                                                 "gaps": {"r": pytest.approx({"gap": 1.0, "refined_gap": 1.1,
+                                                                              "limit": 1.2, "error": 0.3})}}
+
+
+def test_refine_is_left_out_of_default_settings() -> None:
+    assert "refine" not in DesignConfig().to_dict()["design"]
+    c = DesignConfig(refine=0.75)
+    assert DesignConfig.from_dict(c.to_dict()).refine == 0.75
+    with pytest.raises(Exception, match="only appl"):
+        DesignConfig(search="ga", refine=1.0)
+
+
+def test_design_refine_in_2d(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                             monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PNEUMORPH_CACHE", str(tmp_path / "cache.sqlite"))
+    out = tmp_path / "run"
+    code = main(["design", "--model", "2d", "--refine", "0.75", "--tolerance", "0", "--executor", "serial",
+                 "--out", str(out), "--json"])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    mesh = data["mesh"]
+    assert mesh["element_size_mm"] == [1.5, 0.75] and mesh["order"] == MESH_ORDERS["2d"]
+    cert = json.loads((out / "certificate.json").read_text())
+    assert cert["mesh"] == mesh
+    verified = {d: c["value"] for d, c in cert["verified"].items()}
+    assert {r["design"] for r in mesh["rows"]} == set(verified)
+    # every refined value is the objective of an independent solve on the 0.75 mm mesh
+    objective = make_objective("sin", 10.0)
+    fine = refined(Reduced2D(15), 0.75)
+    for row in mesh["rows"]:
+        assert row["value"] == pytest.approx(verified[row["design"]])
+        assert row["refined"] == pytest.approx(score(fine.evaluate(row["design"]), objective).value, abs=1e-6)
+    winner = cert["winner"]["design"]
+    best_fine = min(mesh["rows"], key=lambda r: r["refined"])["design"]
+    assert mesh["holds"] == (best_fine == winner)
+    report = (out / "report.md").read_text()
+    assert "## Mesh" in report and "0.75 mm elements" in report
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--refine", "2.0"], "not finer than the model's element size"),
+        (["--search", "ga", "--refine", "1.0"], "--refine only applies to --search certified"),
+        (["--refine", "0.19"], "GB per solve"),
+    ],
+)
+def test_design_refine_refusals(args: list[str], message: str, tmp_path: Path,
+                                capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "never"
+    code = main(["design", *args, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert message in err and "Traceback" not in err
+    assert not out.exists()
