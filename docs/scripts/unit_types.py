@@ -1,4 +1,4 @@
-"""The built-in unit types' responses in 3D (issue 16, docs/unit-library.md).
+"""The built-in unit types' responses in 3D (docs/unit-library.md).
 
 For every type of the built-in library: a single unit's bending angle (the turn of its
 free end face) and extension (the free end's displacement along the actuator) against

@@ -625,14 +625,14 @@ class Full3D(FEModel):
     # 15-unit benchmark design, double-precision factorisations: 17 factorisations and 69
     # iterations where Newton's method took 37 of each; a threshold of 0.3 took 21 and 60,
     # 0.7 took 15 and 74. Single precision with element matrices in single precision too
-    # (issue 13, one thread): at 0.5 17 factorisations and 76 iterations, 16.5 s, at 0.7 14 and
+    # (one thread): at 0.5 17 factorisations and 76 iterations, 16.5 s, at 0.7 14 and
     # 84, 15.8 s (0.8: 14 and 86, 17.8 s); the all-aligned design 69 and 178, 52.9 s at 0.5,
     # 60 and 174, 47.9 s at 0.7 (0.8: 61, 49.8 s); curls equal to 1e-4 degrees.
     tangent_reuse = 0.7
     anderson_depth = 6
     # the all-aligned 15-unit design curls harder level by level: 3 cut-backs where starting
     # every level at the nominal substep took 4 (and 5 where a failed step clipped at a level
-    # was tried again unchanged), 43.9 s against 45.3 s (issue 13)
+    # was tried again unchanged), 43.9 s against 45.3 s
     carry_step = True
 
     def __init__(

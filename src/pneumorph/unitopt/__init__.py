@@ -1,4 +1,4 @@
-"""Unit geometry optimisation (issue 16, Ellis 2020 section 8.3.2, Fig 8.1): ``pneumorph unit optimise``.
+"""Unit geometry optimisation (Ellis 2020 section 8.3.2, Fig 8.1): ``pneumorph unit optimise``.
 
 Maximise the bending angle per unit (Omega) and minimise the ballooning height (h_b) of the
 articulating unit, subject to a largest principal strain of the body material, over a few
