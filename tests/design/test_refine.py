@@ -12,6 +12,7 @@ from pneumorph.design import DesignConfig
 from pneumorph.design.fitness import score
 from pneumorph.design.refine import MESH_ORDERS, refined_row, verdict
 from pneumorph.design.targets import make_objective
+from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Reduced2D
 from pneumorph.sensitivity.mesh import refined
 
@@ -89,3 +90,27 @@ def test_design_refine_refusals(args: list[str], message: str, tmp_path: Path,
     assert code == 2, err
     assert message in err and "Traceback" not in err
     assert not out.exists()
+
+
+def _study(model, objective, values):  # type: ignore[no-untyped-def]
+    points = [{"design": d, "element_size_mm": h, "value": v} for d, by in values.items() for h, v in by.items()]
+    return {"objective": objective.label, "points": points, "provenance": {"model": model.describe()}}
+
+
+def test_mesh_note_from_a_study_of_the_same_model() -> None:
+    from pneumorph.design.refine import mesh_note
+    from pneumorph.models.fe import Full3D
+
+    model, objective = Full3D(15), make_objective("sin", 10.0)
+    study = _study(model, objective, {"a": {1.5: 7.40, 1.0: 7.30, 0.75: 7.25}, "b": {1.5: 7.53, 0.75: 7.40},
+                                      "c": {1.5: 9.0, 0.75: 8.80}})
+    note = mesh_note(model, objective, {"w": 7.0, "x": 7.02, "y": 7.5}, "w", study)
+    assert note is not None
+    assert note["sizes_mm"] == [1.5, 0.75] and note["designs"] == 3
+    assert note["value_change"] == pytest.approx([-0.2, -0.13])
+    assert note["gap_change"] == pytest.approx(0.07)  # the gap b - c: -1.47 at 1.5 mm, -1.40 at 0.75 mm
+    assert note["within"] == ["x"]
+    # another objective, unit or fidelity: the study says nothing
+    assert mesh_note(model, make_objective("cos", 10.0), {"w": 7.0}, "w", study) is None
+    assert mesh_note(Full3D(15, UnitSpec(wall=2.0)), objective, {"w": 7.0}, "w", study) is None
+    assert mesh_note(Reduced2D(15), objective, {"w": 7.0}, "w", study) is None

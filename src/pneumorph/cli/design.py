@@ -257,7 +257,13 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                           f"{c['could_beat']} could beat it by up to {c['gap']:.3g} (--certify verifies them)")
                        + ("" if two_d is None else f"; the 2D model's value: {two_d:.4g}"))
         ref = result.refinement
-        if ref is not None:
+        if ref is not None and "study" in ref:
+            note = ref["study"]
+            click.echo(f"  mesh: the mesh study moved gaps between designs by at most {note['gap_change']:.3g} from "
+                       f"{note['sizes_mm'][0]:g} to {note['sizes_mm'][1]:g} mm elements; "
+                       + (f"within it of the winner: {', '.join(note['within'])} (--refine checks them)"
+                          if note["within"] else "no verified design lies within it of the winner"))
+        elif ref is not None:
             mine = next(r for r in ref["rows"] if r["design"] == best.design)
             fine = "failed" if mine.get("refined") is None else f"{mine['refined']:.4g}"
             click.echo(f"  at {ref['element_size_mm'][1]:g} mm elements: {best.design} {best.value:.4g} -> {fine}; "

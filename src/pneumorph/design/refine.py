@@ -79,6 +79,66 @@ def verdict(rows: Sequence[dict[str, Any]], winner: str, sense: str, order: floa
             "refined_best": None if best is None else best["design"], "could_overtake": could, "gaps": gaps}
 
 
+#: The shipped mesh study of the default 3D model (``pneumorph sensitivity mesh``; docs/mesh-convergence.md)
+STUDY_FILE = "mesh-study-3d.json"
+
+
+def load_study(name: str = STUDY_FILE) -> dict[str, Any] | None:
+    """The shipped mesh study (its ``mesh.json``), or None if the package has none."""
+    import json
+    from importlib.resources import files
+
+    path = files("pneumorph.models") / "data" / name
+    if not path.is_file():
+        return None
+    data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+    return data
+
+
+def mesh_note(model: Any, objective: Any, values: dict[str, float], winner: str,
+              study: dict[str, Any] | None = None) -> dict[str, Any] | None:
+    """What the mesh study says about a run's verified values, without solving anything.
+
+    Applies where the study's model is the run's (fidelity, units, unit, element size) and
+    its objective the run's; None otherwise.
+
+    Returns
+    -------
+    dict or None
+        ``sizes_mm`` (the study's coarsest and finest element sizes), ``value_change``
+        (least and most change of the objective from the coarsest to the finest mesh over
+        the study's designs), ``gap_change`` (the most any gap between two of them changed),
+        and ``within``: the verified designs closer to the winner than ``gap_change``,
+        whose order the mesh could swap.
+    """
+    study = load_study() if study is None else study
+    if study is None or getattr(model, "dim", None) is None:
+        return None
+    described = study.get("provenance", {}).get("model", {})
+    mine = model.describe()
+    if (described.get("fidelity") != mine.get("fidelity") or described.get("unit") != mine.get("unit")
+            or described.get("n_units") != mine.get("n_units") or study.get("objective") != objective.label):
+        return None
+    by_design: dict[str, dict[float, float]] = {}
+    for p in study["points"]:
+        if p.get("value") is not None:
+            by_design.setdefault(p["design"], {})[float(p["element_size_mm"])] = float(p["value"])
+    sizes = sorted({h for v in by_design.values() for h in v}, reverse=True)
+    if len(sizes) < 2 or sizes[0] != float(model.unit.element_size):
+        return None
+    coarse, fine = sizes[0], sizes[-1]
+    both = {d: v for d, v in by_design.items() if coarse in v and fine in v}
+    if len(both) < 2:
+        return None
+    changes = [v[fine] - v[coarse] for v in both.values()]
+    names = sorted(both)
+    gap_change = max(abs((both[a][fine] - both[b][fine]) - (both[a][coarse] - both[b][coarse]))
+                     for i, a in enumerate(names) for b in names[i + 1:])
+    within = [d for d, v in values.items() if d != winner and abs(v - values[winner]) < gap_change]
+    return {"sizes_mm": [coarse, fine], "designs": len(both), "value_change": [min(changes), max(changes)],
+            "gap_change": gap_change, "within": within}
+
+
 def check_refine(model: Any, element_size: float, parallel: int = 1) -> None:
     """Refuse a refinement that is not finer than ``model``'s mesh or would not fit in memory (before any solve).
 
@@ -159,4 +219,5 @@ def refine_verified(model: Any, objective: Any, designs: Sequence[str], values: 
             **verdict(rows, winner, objective.sense, order, h0 / h1)}
 
 
-__all__ = ["MESH_ORDER", "MESH_ORDERS", "check_refine", "refine_verified", "refined_row", "verdict"]
+__all__ = ["MESH_ORDER", "MESH_ORDERS", "STUDY_FILE", "check_refine", "load_study", "mesh_note", "refine_verified",
+           "refined_row", "verdict"]

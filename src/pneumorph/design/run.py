@@ -573,6 +573,8 @@ def run_design(
                 hof = cert.hall_of_fame
                 if config.refine:
                     refinement = _refine(config, model, objective, cert, cached, say)
+                else:
+                    refinement = _mesh_note(model, objective, cert)
                 order = cert.scores.order()[:1000]
                 names = chain.table.texts(cert.scores.bits[order])
                 ranking = [(d, _chain_score(cert, i)) for d, i in zip(names, order, strict=False)]
@@ -630,6 +632,15 @@ def _refine(config: DesignConfig, model: Any, objective: Objective, cert: Certif
     values = {d: c.value for d, c in cert.verified.items() if c.failure is None}
     return refine_verified(model, objective, list(values), values, cert.winner.design, config.refine, evaluator,
                            say=say)
+
+
+def _mesh_note(model: Any, objective: Objective, cert: CertifiedResult) -> dict[str, Any] | None:
+    """What the shipped mesh study says about the verified values (:func:`.refine.mesh_note`)."""
+    from pneumorph.design.refine import mesh_note
+
+    values = {d: c.value for d, c in cert.verified.items() if c.failure is None}
+    note = mesh_note(model, objective, values, cert.winner.design)
+    return None if note is None else {"study": note}
 
 
 def _robustness(config: DesignConfig, model: ActuatorModel, objective: Objective, evaluator: Any,
@@ -906,8 +917,22 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
 
 
 def _refinement_lines(ref: dict[str, Any], o: Objective) -> list[str]:
-    """The report's section on the finer mesh."""
+    """The report's section on the finer mesh (or, without one, what the mesh study says)."""
     u = o.unit
+    if "study" in ref:
+        s = ref["study"]
+        coarse, fine = s["sizes_mm"]
+        lo, hi = s["value_change"]
+        within = s["within"]
+        return ["## Mesh", "",
+                f"The values above are on the model's {coarse:g} mm mesh. In the mesh study of this model "
+                f"(docs/mesh-convergence.md, {s['designs']} designs), refining to {fine:g} mm moved the values "
+                f"by {lo:+.3g} to {hi:+.3g} {u}, but the gap between any two designs by at most "
+                f"{s['gap_change']:.3g} {u}.", "",
+                "- " + (f"verified designs within {s['gap_change']:.3g} {u} of the winner, whose order a finer mesh "
+                        f"could swap: {', '.join(f'`{d}`' for d in within)} (`--refine {fine:g}` solves them on it)"
+                        if within else f"no verified design lies within {s['gap_change']:.3g} {u} of the winner: "
+                        "the mesh study gives no reason for a finer mesh to swap them"), ""]
     coarse, fine = ref["element_size_mm"]
     lines = ["## Mesh", "",
              f"The verified designs solved again with {fine:g} mm elements (the model's: {coarse:g} mm; "
