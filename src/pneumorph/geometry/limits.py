@@ -11,9 +11,9 @@ from the grid's breaks without building it (:func:`estimate_mesh`), has at most
 
 The estimate is exact for the grid of :func:`pneumorph.geometry.assembly.assemble` (lines
 through every break, no gap wider than the element size) and an upper bound of the mesh
-(cavity cells are counted); memory is estimated from the nodes at
-:data:`BYTES_PER_NODE_3D` and :data:`BYTES_PER_NODE_2D`, the peak of one solve of the
-built-in actuator (``BENCHMARKS.md``).
+(cavity cells are counted); the peak memory of one solve is estimated from the nodes by
+:func:`solve_memory`, a law fitted to measured 3D solves (a direct solver's fill grows
+faster than the nodes).
 """
 
 from __future__ import annotations
@@ -33,14 +33,16 @@ MAX_LENGTH_MM = 1000.0
 """Largest length of any part of a unit (pitch, width, walls, cavity, layer, slit, element size), mm."""
 MAX_NAME_CHARS = 200
 """Longest name of a unit (characters)."""
-MAX_NODES_3D = 80_000
-"""Largest 3D mesh (nodes of the half model) a model may be built on: about 4 x the built-in actuator, 3.8 GB."""
+MAX_NODES_3D = 60_000
+"""Largest 3D mesh (nodes of the half model) a model may be built on: about 3 x the built-in actuator, 4 GB."""
 MAX_NODES_2D = 200_000
 """Largest 2D mesh (nodes): about 70 x the built-in actuator, 2 GB."""
 BASE_BYTES = 150_000_000
 """Memory of a solving process before its mesh: Python, NumPy, SciPy, FElupe (0.15 GB: a 2D solve of 2,747 nodes)."""
-BYTES_PER_NODE_3D = 46_000
-"""Peak memory of a 3D solve per node (hex20, direct solver): the built-in actuator's 19,512 nodes peak at 1.12 GB."""
+BYTES_3D = 1_640.0
+"""Peak memory of a 3D solve (hex20, direct solver) is ``BASE_BYTES + BYTES_3D * nodes**(4/3)`` bytes: the built-in
+actuator (21,252 nodes estimated, 19,512 meshed) peaks at 1.12 GB (estimated 1.12 GB), at a 1.0 mm element size (91,322
+estimated) at 6.0 GB (estimated 6.9 GB; :mod:`pneumorph.sensitivity.mesh`)."""
 BYTES_PER_NODE_2D = 10_000
 """Peak memory of a 2D solve per node (quad8), an upper bound: the built-in actuator's 2,747 nodes add little."""
 
@@ -82,8 +84,12 @@ class MeshEstimate:
         --------
         >>> MeshEstimate((10, 4, 1), 40, 189, 151_890_000, 2).describe()
         'about 189 nodes, 40 elements, 0.15 GB for one solve'
+        >>> MeshEstimate((10, 4, 1), 40, 189, 123_456_000_000, 2).describe()
+        'about 189 nodes, 40 elements, 123 GB for one solve'
         """
-        return f"about {self.nodes:,} nodes, {self.elements:,} elements, {self.bytes / 1e9:.2g} GB for one solve"
+        gb = self.bytes / 1e9
+        size = f"{gb:.2f}" if gb < 1 else f"{gb:.1f}" if gb < 100 else f"{gb:,.0f}"
+        return f"about {self.nodes:,} nodes, {self.elements:,} elements, {size} GB for one solve"
 
 
 def cells_between(breaks: Iterable[float], size: float) -> int:
@@ -148,7 +154,7 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> Me
     >>> e.cells, e.elements, e.nodes  # the mesh itself: 3,480 elements, 19,512 nodes (no cavity cells)
     ((105, 8, 5), 4200, 21252)
     >>> estimate_mesh(UnitSpec(pitch=500.0), 15, 3).describe()
-    'about 1,007,157 nodes, 200,400 elements, 46 GB for one solve'
+    'about 1,007,157 nodes, 200,400 elements, 166 GB for one solve'
     """
     from pneumorph.geometry.grid import section_breaks, width_breaks
 
@@ -161,13 +167,29 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> Me
         nodes = (nx + 1) * (ny + 1) * (nz + 1)
         if spec.element_order == 2:  # a mid-node on every edge of the grid
             nodes += nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz
-        per = BYTES_PER_NODE_3D
     else:
         nodes = (nx + 1) * (ny + 1)
         if spec.element_order == 2:
             nodes += nx * (ny + 1) + (nx + 1) * ny
-        per = BYTES_PER_NODE_2D
-    return MeshEstimate((nx, ny, nz), nx * ny * nz, nodes, BASE_BYTES + nodes * per, dim)
+    return MeshEstimate((nx, ny, nz), nx * ny * nz, nodes, solve_memory(nodes, dim), dim)
+
+
+def solve_memory(nodes: int, dim: int) -> int:
+    """Estimated peak memory (bytes) of one FE solve on a mesh of ``nodes`` nodes.
+
+    3D: ``BASE_BYTES + BYTES_3D * nodes**(4/3)`` (:data:`BYTES_3D`); 2D:
+    ``BASE_BYTES + BYTES_PER_NODE_2D * nodes``.
+
+    Examples
+    --------
+    >>> round(solve_memory(21_252, 3) / 1e9, 2), round(solve_memory(MAX_NODES_3D, 3) / 1e9, 1)
+    (1.12, 4.0)
+    >>> round(solve_memory(2_747, 2) / 1e9, 2)
+    0.18
+    """
+    if dim == 3:
+        return int(BASE_BYTES + BYTES_3D * float(nodes) ** (4 / 3))
+    return int(BASE_BYTES + BYTES_PER_NODE_2D * nodes)
 
 
 def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshEstimate:
@@ -193,7 +215,7 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshE
     Traceback (most recent call last):
     ...
     pneumorph.geometry.limits.MeshLimitError: a 3D actuator of 15 units of this unit is a mesh of about 805,152
-    nodes, ...GB for one solve; the limit is 80,000 nodes...
+    nodes, ...GB for one solve; the limit is 60,000 nodes...
     """
     check_lengths(spec)
     estimate = estimate_mesh(spec, units, dim, half)
@@ -205,6 +227,6 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshE
     return estimate
 
 
-__all__ = ["BASE_BYTES", "BYTES_PER_NODE_2D", "BYTES_PER_NODE_3D", "MAX_LENGTH_MM", "MAX_NAME_CHARS", "MAX_NODES_2D",
+__all__ = ["BASE_BYTES", "BYTES_3D", "BYTES_PER_NODE_2D", "MAX_LENGTH_MM", "MAX_NAME_CHARS", "MAX_NODES_2D",
            "MAX_NODES_3D", "MeshEstimate", "MeshLimitError", "cells_between", "check_lengths", "check_mesh",
-           "estimate_mesh"]
+           "estimate_mesh", "solve_memory"]
