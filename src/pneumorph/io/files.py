@@ -100,13 +100,29 @@ def check_writable_file(path: str | Path, option: str = "--out") -> Path:
     return path
 
 
+def current_umask() -> int:
+    """The process's file-creation mask (read without changing it where the system allows)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)  # elsewhere: set and restore at once
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path beside ``path`` to write to; renamed over ``path`` if the block succeeds.
 
     The temporary name ends in ``path``'s suffix, so writers that pick their format from
     the name (matplotlib's ``savefig``) write the right one. If the block fails, the
-    temporary file is removed and ``path`` is left as it was.
+    temporary file is removed and ``path`` is left as it was. The file gets the mode an
+    ordinary ``open`` would give it (0666 less the umask), not the temporary file's 0600,
+    so that a shared folder's group can read what a run wrote.
 
     Examples
     --------
@@ -116,12 +132,16 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     ...     _ = tmp.write_text("done")
     >>> p.read_text(), sorted(f.name for f in p.parent.iterdir())
     ('done', ['a.txt'])
+    >>> oct(p.stat().st_mode & 0o777) == oct(0o666 & ~current_umask())
+    True
     """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent)
     os.close(fd)
     try:
         yield Path(tmp)
+        if Path(tmp).exists():
+            os.chmod(tmp, 0o666 & ~current_umask())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
