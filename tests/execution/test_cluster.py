@@ -247,3 +247,16 @@ def test_a_scheduler_lost_in_the_middle_of_a_batch_raises_cluster_lost(tmp_path:
             assert len(got) < len(DESIGNS)
     finally:
         cluster.stop()
+
+
+def test_a_batch_without_any_worker_says_so_and_ends_after_the_timeout(tmp_path: Path) -> None:
+    cluster = Cluster(tmp_path)  # a scheduler, no worker
+    lines: list[str] = []
+    try:
+        with DaskEvaluator(cluster.address, on_message=lines.append) as ev:
+            ev.poll, ev.no_worker_timeout = 0.2, 1.0
+            with pytest.raises(ClusterLostError, match=r"no Dask worker at tcp://127\.0\.0\.1:\d+ for 1 s; every"):
+                ev.evaluate_many(SlowToy(seconds=0.0, n_units=6), DESIGNS)
+    finally:
+        cluster.stop()
+    assert len(lines) == 1 and lines[0].startswith(f"no Dask worker at {cluster.address}: waiting up to 1 s")

@@ -495,8 +495,9 @@ class DaskEvaluator(_Base):
     loses no model. A worker that dies while solving has its designs retried on the others
     by Dask (``retried`` counts them; a design whose workers keep dying, 3 by default,
     becomes a failed transient outcome, as in the process pool). Results are fetched as
-    each finishes and released on the cluster at once. A lost scheduler ends the batch
-    with :class:`~pneumorph.errors.ClusterLostError`.
+    each finishes and released on the cluster at once. A lost scheduler, or no worker at
+    all for ``no_worker_timeout`` seconds, ends the batch with
+    :class:`~pneumorph.errors.ClusterLostError`.
 
     Raises
     ------
@@ -515,6 +516,8 @@ class DaskEvaluator(_Base):
 
     #: seconds between looks at the cluster (workers lost, designs in flight) while waiting for results
     poll = 1.0
+    #: seconds a batch waits with no worker at all before it ends with ClusterLostError
+    no_worker_timeout = 300.0
 
     def __init__(
         self, address: str | None = None, workers: int | None = None, processes: bool = True, timeout: float = 5.0,
@@ -619,7 +622,7 @@ class DaskEvaluator(_Base):
         index = {f.key: i for i, f in enumerate(futures)}
         pending = set(futures)
         seen: dict[str, set[Any]] = self._processing(index) or {}
-        alone = False  # said that no worker is left
+        alone: float | None = None  # since when no worker is left (said once)
         try:
             while pending:
                 try:
@@ -652,10 +655,15 @@ class DaskEvaluator(_Base):
                     self.retried += len(again)
                     self._say(f"Dask worker {addr} lost; the {len(again)} design(s) it was solving or held queued "
                               f"are retried on the other workers ({self.retried} retried in this run)")
-                if not now and pending and not alone:
-                    self._say(f"no Dask worker at {self.where}: waiting for one to join "
-                              f"(dask worker {self.where} --nworkers 1 --nthreads 1)")
-                alone = not now
+                if now or not pending:
+                    alone = None
+                elif alone is None:
+                    alone = time.monotonic()
+                    self._say(f"no Dask worker at {self.where}: waiting up to {self.no_worker_timeout:.0f} s for "
+                              f"one to join (dask worker {self.where} --nworkers 1 --nthreads 1)")
+                elif time.monotonic() - alone > self.no_worker_timeout:
+                    raise ClusterLostError(f"no Dask worker at {self.where} for {self.no_worker_timeout:.0f} s; "
+                                           "every design finished before is in the evaluation cache")
                 seen = now
         finally:
             live = [f for f in pending if not f.done()]
