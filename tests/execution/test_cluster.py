@@ -260,3 +260,25 @@ def test_a_batch_without_any_worker_says_so_and_ends_after_the_timeout(tmp_path:
     finally:
         cluster.stop()
     assert len(lines) == 1 and lines[0].startswith(f"no Dask worker at {cluster.address}: waiting up to 1 s")
+
+
+def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
+                                                            capsys: pytest.CaptureFixture[str]) -> None:
+    cluster = Cluster(tmp_path)
+    try:
+        cluster.add_workers(1)
+        argv = ["design", "--model", "2d", "--unit", str(coarse_unit(tmp_path)), "--units", "7", "--pressure", "20",
+                "--tolerance", "0", "--executor", "dask", "--scheduler", cluster.address, "--cache",
+                str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"), "--json"]
+        assert main(argv) == 0
+        with distributed.Client(cluster.address, timeout=30) as client:
+            from pneumorph.execution import evaluators
+
+            kept = client.run(lambda: len(evaluators._DASK_MODELS))  # the models the worker solved designs of
+    finally:
+        cluster.stop()
+    captured = capsys.readouterr()
+    report = json.loads(captured.out)
+    assert "building the chain table of the 2d model" in captured.err and "executor dask" in captured.err
+    assert report["status"] == "finished" and report["retried"] == 0 and report["solves"] >= 2
+    assert list(kept.values()) == [2]  # the table's model and the verifications' (its levels)
