@@ -20,9 +20,9 @@ import time
 
 
 def _solve(design: str, size: float, queue: mp.Queue) -> None:  # type: ignore[type-arg]
+    from pneumorph.geometry.limits import estimate_mesh
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.models.fe import Full3D
-    from pneumorph.sensitivity.mesh import refined_memory
 
     model = Full3D(len(design), UnitSpec(element_size=size))
     t0 = time.perf_counter()
@@ -36,7 +36,7 @@ def _solve(design: str, size: float, queue: mp.Queue) -> None:  # type: ignore[t
         row = {"design": design, "element_size_mm": size, "failed": str(exc)}
     row["wall_time_s"] = time.perf_counter() - t0
     row["peak_rss_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
-    row["estimated_gb"] = refined_memory(model, size)[1] / 1e9
+    row["estimated_gb"] = estimate_mesh(model.unit, model.n_units, 3).bytes / 1e9
     queue.put(row)
 
 

@@ -79,7 +79,7 @@ def test_design_refine_in_2d(tmp_path: Path, capsys: pytest.CaptureFixture[str],
     [
         (["--refine", "2.0"], "not finer than the model's element size"),
         (["--search", "ga", "--refine", "1.0"], "--refine only applies to --search certified"),
-        (["--refine", "0.19"], "GB per solve"),
+        (["--refine", "0.19"], "GB for one solve"),
     ],
 )
 def test_design_refine_refusals(args: list[str], message: str, tmp_path: Path,

@@ -14,9 +14,12 @@ def _run(*args: str) -> tuple[int, str, float]:
     return done.returncode, done.stdout + done.stderr, time.perf_counter() - start
 
 
-def test_a_100_unit_3d_simulation_is_refused_with_its_estimate() -> None:
-    code, out, seconds = _run("simulate", "-o", "0" * 100, "--model", "3d")  # the issue: past 6 GB
-    assert code == 2 and "140,847 nodes" in out and "GB" in out and "MAX_NODES_3D" in out
+def test_a_simulation_past_the_memory_is_refused_with_its_estimate(tmp_path: Path) -> None:
+    """The command line's limit is the memory available: 15 units at 0.4 mm elements would need ~100 GB."""
+    unit = tmp_path / "fine.toml"
+    unit.write_text("[unit]\nelement_size = 0.4\n")
+    code, out, seconds = _run("simulate", "-o", "0" * 15, "--model", "3d", "--unit", str(unit))
+    assert code == 2 and "nodes" in out and "GB for one solve" in out and "GB are available" in out
     assert "Traceback" not in out and seconds < 30
 
 

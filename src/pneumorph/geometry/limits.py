@@ -34,9 +34,10 @@ MAX_LENGTH_MM = 1000.0
 MAX_NAME_CHARS = 200
 """Longest name of a unit (characters)."""
 MAX_NODES_3D = 60_000
-"""Largest 3D mesh (nodes of the half model) a model may be built on: about 3 x the built-in actuator, 4 GB."""
+"""Largest 3D mesh (nodes of the half model) the bench builds: about 3 x the built-in actuator, 4 GB (the command
+line's limit is the memory available instead, :func:`check_mesh`)."""
 MAX_NODES_2D = 200_000
-"""Largest 2D mesh (nodes): about 70 x the built-in actuator, 2 GB."""
+"""Largest 2D mesh (nodes) the bench builds: about 70 x the built-in actuator, 2 GB."""
 BASE_BYTES = 150_000_000
 """Memory of a solving process before its mesh: Python, NumPy, SciPy, FElupe (0.15 GB: a 2D solve of 2,747 nodes)."""
 BYTES_3D = 1_640.0
@@ -192,8 +193,40 @@ def solve_memory(nodes: int, dim: int) -> int:
     return int(BASE_BYTES + BYTES_PER_NODE_2D * nodes)
 
 
-def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshEstimate:
+def available_memory() -> int:
+    """Bytes of memory available to a new solve now (``MemAvailable``; else the physical memory).
+
+    >>> available_memory() > 0
+    True
+    """
+    import os
+
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return int(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+
+
+def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: int | None = None,
+               parallel: int = 1) -> MeshEstimate:
     """Refuse a unit too large or too finely meshed for an actuator of ``units`` units, before meshing.
+
+    Parameters
+    ----------
+    spec : UnitSpec
+    units, dim, half
+        As for :func:`estimate_mesh`.
+    memory : int, optional
+        Bytes the solves may use (the command line: :func:`available_memory`). The mesh is
+        refused when ``parallel`` solves of it are estimated to need more. Without it, the
+        fixed limits :data:`MAX_NODES_3D` and :data:`MAX_NODES_2D` (the bench's: a server
+        never starts a solve that large, whatever the machine has free).
+    parallel : int
+        Solves of this mesh that may run at once.
 
     Returns
     -------
@@ -203,30 +236,43 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshE
     Raises
     ------
     MeshLimitError
-        A length above :data:`MAX_LENGTH_MM`, or more nodes than :data:`MAX_NODES_3D`
-        (:data:`MAX_NODES_2D` in 2D); the message states the estimate.
+        A length above :data:`MAX_LENGTH_MM`, or a mesh past the limit; the message states
+        the estimate.
 
     Examples
     --------
     >>> from pneumorph.geometry.unit import UnitSpec
     >>> check_mesh(UnitSpec(), 15, 3).nodes <= MAX_NODES_3D
     True
+    >>> check_mesh(UnitSpec(element_size=1.0), 15, 3, memory=8 * 10**9).nodes   # refined: fits in 8 GB
+    91322
     >>> check_mesh(UnitSpec(pitch=400.0), 15, 3)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     pneumorph.geometry.limits.MeshLimitError: a 3D actuator of 15 units of this unit is a mesh of about 805,152
     nodes, ...GB for one solve; the limit is 60,000 nodes...
+    >>> check_mesh(UnitSpec(element_size=1.0), 15, 3, memory=4 * 10**9)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.geometry.limits.MeshLimitError: a 3D actuator of 15 units of this unit is a mesh of about 91,322
+    nodes, ... 6.9 GB for one solve; 4.0 GB are available...
     """
     check_lengths(spec)
     estimate = estimate_mesh(spec, units, dim, half)
+    what = f"a {dim}D actuator of {units} units of this unit is a mesh of {estimate.describe()}"
+    advice = "make the unit smaller, its element_size larger or the actuator shorter"
+    if memory is not None:
+        if estimate.bytes * parallel > memory:
+            at_once = f" x {parallel} at once" if parallel > 1 else ""
+            raise MeshLimitError(f"{what}{at_once}; {memory / 1e9:.1f} GB are available: {advice}"
+                                 + (", or solve fewer at once" if parallel > 1 else ""))
+        return estimate
     limit, name = (MAX_NODES_3D, "MAX_NODES_3D") if dim == 3 else (MAX_NODES_2D, "MAX_NODES_2D")
     if estimate.nodes > limit:
-        raise MeshLimitError(f"a {dim}D actuator of {units} units of this unit is a mesh of {estimate.describe()}; "
-                             f"the limit is {limit:,} nodes ({name}, pneumorph.geometry.limits): make the unit "
-                             "smaller, its element_size larger or the actuator shorter")
+        raise MeshLimitError(f"{what}; the limit is {limit:,} nodes ({name}, pneumorph.geometry.limits): {advice}")
     return estimate
 
 
 __all__ = ["BASE_BYTES", "BYTES_3D", "BYTES_PER_NODE_2D", "MAX_LENGTH_MM", "MAX_NAME_CHARS", "MAX_NODES_2D",
-           "MAX_NODES_3D", "MeshEstimate", "MeshLimitError", "cells_between", "check_lengths", "check_mesh",
-           "estimate_mesh", "solve_memory"]
+           "MAX_NODES_3D", "MeshEstimate", "MeshLimitError", "available_memory", "cells_between", "check_lengths",
+           "check_mesh", "estimate_mesh", "solve_memory"]

@@ -11,7 +11,7 @@ from pneumorph import checks
 from pneumorph.errors import GeometryError, SearchConfigError, SettingsError
 from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.geometry.limits import check_mesh
+from pneumorph.geometry.limits import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
@@ -101,8 +101,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         unit = UnitSpec.from_dict(dict(s.get("unit", {})), source="[model.unit]")
     fidelity = checks.text(s.get("fidelity", "2d"), "[model] fidelity", ("2d", "3d"), error=SearchConfigError)
     Model: type[Reduced2D | Full3D] = Reduced2D if fidelity == "2d" else Full3D
+    free = available_memory()
     for spec in ([unit] if unit is not None else list(library.units) if library is not None else []):
-        check_mesh(spec, units, Model.dim)  # before any mesh is built: the estimate in the message
+        check_mesh(spec, units, Model.dim, memory=free)  # before any mesh is built: the estimate in the message
     # the model class's tuned ramp (one substep per level, its iteration limit) unless asked otherwise,
     # so that API and CLI runs of the same design share their cache entries
     defaults = Model.default_steps

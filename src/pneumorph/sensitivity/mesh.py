@@ -42,11 +42,6 @@ from pneumorph.errors import SettingsError
 #: Roache's factors of safety on the Richardson error: three meshes with an observed order,
 #: and two meshes with an order assumed from another study
 SAFETY_THREE, SAFETY_TWO = 1.25, 3.0
-#: Peak memory of a 3D solve as ``REFINED_BASE + REFINED_BYTES * nodes^(4/3)`` (a direct solver's fill
-#: in 3D grows as the unknowns to the 4/3): through the 15-unit runner-up at 1.0 mm (81,782 nodes,
-#: double precision, 6.0 GB); it over-estimates the single-precision solves of the default mesh
-#: (19,512 nodes: 1.1 GB measured, 1.0 GB estimated)
-REFINED_BASE, REFINED_BYTES = 150e6, 1_640.0
 #: the bracket of observed orders searched (quadratic elements: 2-4 where the solution is smooth)
 ORDER_RANGE = (0.05, 12.0)
 
@@ -277,66 +272,42 @@ def _quantity(point: MeshPoint, name: str) -> float | None:
     raise SettingsError(f"unknown quantity {name!r}; known: tip_x, tip_y, curl, value")
 
 
-def refined_memory(model: Any, element_size: float) -> tuple[int, float]:
-    """Nodes and estimated peak memory (bytes) of one solve of ``model`` at ``element_size`` mm (3D).
-
-    Counted from the unit's grid before meshing, cavities included (an upper bound;
-    :func:`pneumorph.geometry.limits.estimate_mesh`): 6.9 GB for the 1.0 mm actuator that peaked at 6.0 GB.
-
-    >>> from pneumorph.models.fe import Full3D
-    >>> nodes, peak = refined_memory(Full3D(15), 1.0)
-    >>> nodes, round(peak / 1e9, 1)
-    (91322, 6.9)
-    """
-    from pneumorph.geometry.limits import estimate_mesh
-
-    unit = replace(model.unit, element_size=element_size)
-    nodes = estimate_mesh(unit, model.n_units, model.dim, getattr(model, "half", True)).nodes
-    if model.dim != 3:
-        from pneumorph.geometry.limits import BASE_BYTES, BYTES_PER_NODE_2D
-
-        return nodes, float(BASE_BYTES + BYTES_PER_NODE_2D * nodes)
-    return nodes, REFINED_BASE + REFINED_BYTES * nodes ** (4 / 3)
-
-
-def available_memory() -> float:
-    """Bytes of memory available to new processes (``MemAvailable``; else the physical memory)."""
-    import os
-
-    try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-
-
 def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
-                     memory: float | None = None) -> dict[float, tuple[int, float]]:
+                     memory: int | None = None) -> dict[float, tuple[int, int]]:
     """Refuse, before any solve, element sizes whose solves would not fit in memory.
 
-    ``parallel`` solves run at once (the workers). Returns the nodes and estimated bytes per size.
+    The mesh is counted from the unit's grid, cavities included (an upper bound;
+    :func:`pneumorph.geometry.limits.check_mesh`): 6.9 GB estimated for the 15-unit actuator
+    at 1.0 mm, which peaked at 6.0 GB. ``parallel`` solves run at once (the workers).
+
+    Returns
+    -------
+    dict
+        Nodes and estimated bytes of one solve per size.
 
     Raises
     ------
     MeshLimitError
         One line: the size, its nodes and estimated memory, and what is available.
-    """
-    from pneumorph.geometry.limits import MeshLimitError
 
-    free = available_memory() if memory is None else float(memory)
+    Examples
+    --------
+    >>> from pneumorph.models.fe import Full3D
+    >>> check_refinement(Full3D(15), [1.0], memory=8 * 10**9)
+    {1.0: (91322, 6894416781)}
+    """
+    from pneumorph.geometry.limits import MeshLimitError, available_memory, check_mesh
+
+    free = available_memory() if memory is None else int(memory)
     out = {}
     for h in sorted(set(float(s) for s in sizes)):
-        nodes, peak = refined_memory(model, h)
-        if peak * parallel > free:
-            raise MeshLimitError(
-                f"element size {h:g} mm: {model.n_units} units are a mesh of about {nodes:,} nodes, an estimated "
-                f"{peak / 1e9:.1f} GB per solve{f' x {parallel} at once' if parallel > 1 else ''}, and "
-                f"{free / 1e9:.1f} GB are available; choose a larger element size"
-                + (" or fewer workers" if parallel > 1 else ""))
-        out[h] = (nodes, peak)
+        unit = replace(model.unit, element_size=h)
+        try:
+            estimate = check_mesh(unit, model.n_units, model.dim, getattr(model, "half", True), memory=free,
+                                  parallel=parallel)
+        except MeshLimitError as exc:
+            raise MeshLimitError(f"element size {h:g} mm: {exc}") from None
+        out[h] = (estimate.nodes, estimate.bytes)
     return out
 
 
@@ -402,6 +373,5 @@ def _mesh_size(model: Any, design: str) -> tuple[int, float]:
     return len(mesh.cells), representative_size(mesh)
 
 
-__all__ = ["ORDER_RANGE", "REFINED_BASE", "REFINED_BYTES", "SAFETY_THREE", "SAFETY_TWO", "Convergence", "MeshPoint",
-           "MeshStudy", "available_memory", "check_refinement", "converge", "mesh_points", "refined",
-           "refined_memory", "representative_size"]
+__all__ = ["ORDER_RANGE", "SAFETY_THREE", "SAFETY_TWO", "Convergence", "MeshPoint", "MeshStudy", "check_refinement",
+           "converge", "mesh_points", "refined", "representative_size"]
