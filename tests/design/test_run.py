@@ -100,8 +100,11 @@ def test_exhaustive_run_writes_the_ranking(tmp_path: Path) -> None:
 
 def test_another_run_in_the_same_folder_is_refused(tmp_path: Path) -> None:
     run_design(config(tmp_path), ToyModel(), tmp_path / "run", figures=False)
-    with pytest.raises(RunFolderError, match=r"other \[design\] settings"):
+    with pytest.raises(RunFolderError, match=r"other \[design\] settings") as info:
         run_design(config(tmp_path, amplitude=15.0), ToyModel(), tmp_path / "run")
+    # the message names the differing setting and both ways out, on one line
+    assert "amplitude = 10.0 there, 15.0 now;" in str(info.value)
+    assert "--out" in str(info.value) and "--overwrite" in str(info.value) and "\n" not in str(info.value)
     with pytest.raises(RunFolderError, match="another model"):
         run_design(config(tmp_path), ToyModel(turn=25.0), tmp_path / "run")
     redo = run_design(config(tmp_path, amplitude=15.0), ToyModel(), tmp_path / "run", overwrite=True, figures=False)

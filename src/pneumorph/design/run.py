@@ -217,17 +217,27 @@ def _check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrit
     new = config.to_dict()
     for table in _COMPARED:
         if old.get(table, {}) != new.get(table, {}):
+            there, here = old.get(table, {}), new.get(table, {})
+            keys = sorted(k for k in {*there, *here} if there.get(k) != here.get(k))
+            diff = "; ".join(f"{k} = {_setting(there.get(k))} there, {_setting(here.get(k))} now" for k in keys[:4])
+            more = f" (and {len(keys) - 4} more)" if len(keys) > 4 else ""
             raise RunFolderError(
-                f"{folder} holds a run with other [{table}] settings ({old.get(table)} instead of "
-                f"{new.get(table)}); choose another output folder or overwrite it"
+                f"{folder} holds a run with other [{table}] settings: {diff}{more}; give another folder with --out "
+                "or replace that run with --overwrite"
             )
     old_fp = old.get("provenance", {}).get("model_fingerprint")
     if old_fp not in (None, fingerprint):
         raise RunFolderError(
             f"{folder} holds a run of another model (fingerprint {old_fp}, now {fingerprint}); "
-            "choose another output folder or overwrite it"
+            "give another folder with --out or replace that run with --overwrite"
         )
     return True
+
+
+def _setting(value: Any) -> str:
+    """A setting as a config shows it (``unset`` when absent), cut to 40 characters."""
+    text = "unset" if value is None else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 class _GenerationLog:
