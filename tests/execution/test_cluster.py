@@ -124,11 +124,16 @@ def test_workers_of_another_version_are_refused_naming_both(cluster: Cluster, mo
     import pneumorph
 
     theirs = pneumorph.__version__
+    with DaskEvaluator(cluster.address) as ev:  # connected; then the versions part (as a worker joining later)
+        monkeypatch.setattr(pneumorph, "__version__", "98.0")
+        with pytest.raises(WorkerVersionError, match=f"runs pneumorph {theirs}, this client pneumorph 98.0"):
+            ev.evaluate_many(SlowToy(seconds=0.0, n_units=6), DESIGNS[:1])  # checked at the start of a batch
     monkeypatch.setattr(pneumorph, "__version__", "99.0")
     with pytest.raises(WorkerVersionError) as err:
         DaskEvaluator(cluster.address)
     text = str(err.value)
     assert f"runs pneumorph {theirs}, this client pneumorph 99.0" in text and cluster.address in text
+    assert "(and 1 more)" in text  # both workers named by count
 
 
 def test_a_lost_worker_has_its_designs_retried_and_counted(cluster: Cluster) -> None:

@@ -486,9 +486,10 @@ class DaskEvaluator(_Base):
         Called with a line of text when something happens on the cluster (a worker lost and
         the designs it was solving retried, no worker left).
 
-    On connect, every worker must run the same pneumorph version as this process (else
-    :class:`~pneumorph.errors.WorkerVersionError` naming both), and each worker, present or
-    joining later, gets :class:`SolverSettings` (allocator and thread counts for solving).
+    On connect and at the start of every batch, every worker must run the same pneumorph
+    version as this process (else :class:`~pneumorph.errors.WorkerVersionError` naming
+    both), and each worker, present or joining later, gets :class:`SolverSettings`
+    (allocator and thread counts for solving).
 
     Each task carries its model (a few kB); a worker keeps the instance of each model it
     has seen (by fingerprint), so no data lives on the cluster only: losing any worker
@@ -584,7 +585,9 @@ class DaskEvaluator(_Base):
         from pneumorph import __version__
 
         found = self.client.run(importlib.metadata.version, "pneumorph", on_error="return")
-        wrong = {addr: v for addr, v in found.items() if v != __version__}
+        # a string: the version; PackageNotFoundError: none; another error (a worker going away) is not the version's
+        wrong = {addr: v for addr, v in found.items()
+                 if (isinstance(v, str) and v != __version__) or isinstance(v, importlib.metadata.PackageNotFoundError)}
         if wrong:
             addr, v = sorted(wrong.items())[0]
             theirs = f"pneumorph {v}" if isinstance(v, str) else f"no pneumorph ({type(v).__name__})"
@@ -616,6 +619,7 @@ class DaskEvaluator(_Base):
         if not cases:
             return
         try:
+            self._check_versions()  # workers that joined since the last batch, too
             futures = [self.client.submit(_solve_on_dask_worker, m, d, pure=False) for m, d in cases]
         except (OSError, CancelledError):
             raise self._lost("its connection closed") from None
