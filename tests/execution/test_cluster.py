@@ -287,3 +287,36 @@ def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
     assert "building the chain table of the 2d model" in captured.err and "executor dask" in captured.err
     assert report["status"] == "finished" and report["retried"] == 0 and report["solves"] >= 2
     assert list(kept.values()) == [2]  # the table's model and the verifications' (its levels)
+
+
+def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: Cluster, tmp_path: Path) -> None:
+    common = ["chain", "build", "--model", "2d", "--unit", str(coarse_unit(tmp_path)), "--pressure", "20",
+              "--units", "7", "--heldout", "40", "--window", "2", "--json"]
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    build = subprocess.Popen([sys.executable, "-m", "pneumorph", *common, "--executor", "dask", "--scheduler",
+                              cluster.address, "--cache", str(tmp_path / "d.sqlite"), "--out",
+                              str(tmp_path / "dask.json")], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             env=env, cwd=tmp_path)
+    with distributed.Client(cluster.address, timeout=30) as client:
+        pids = client.run(os.getpid)
+        deadline = time.monotonic() + 120
+        killed = False
+        while not killed and time.monotonic() < deadline and build.poll() is None:
+            busy = [addr for addr, keys in client.processing().items() if keys]
+            if busy:
+                os.kill(pids[busy[0]], signal.SIGKILL)  # kill -9 of a worker solving a design of the build
+                killed = True
+            time.sleep(0.02)
+        out, err = build.communicate(timeout=300)
+        client.wait_for_workers(2, timeout=60)  # the nanny's new worker, for the next tests
+    assert killed and build.returncode == 0, err[-500:]
+    report = json.loads(out)
+    assert report["cluster"]["lost_workers"] == 1 and report["cluster"]["retried"] >= 1
+    retried = report["cluster"]["retried"]
+    assert "lost; the " in err and err.strip().splitlines()[-1] == (
+        f"1 Dask worker(s) lost during the run; {retried} design(s) they were solving were retried on the others")
+    assert main([*common, "--executor", "processes", "--workers", "2", "--cache", str(tmp_path / "p.sqlite"),
+                 "--out", str(tmp_path / "pool.json")]) == 0
+    dask, pool = (json.loads((tmp_path / f"{n}.json").read_text()) for n in ("dask", "pool"))
+    for key in set(dask) - {"metadata"}:  # the same table as without the fault
+        assert dask[key] == pool[key], key
