@@ -314,7 +314,8 @@ def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: C
     assert report["cluster"]["lost_workers"] == 1 and report["cluster"]["retried"] >= 1
     retried = report["cluster"]["retried"]
     assert "lost; the " in err and err.strip().splitlines()[-1] == (
-        f"1 Dask worker(s) lost during the run; {retried} design(s) they were solving were retried on the others")
+        f"1 Dask worker(s) lost during the run; {retried} design(s) they were solving or held "
+        "queued were retried on the others")
     assert main([*common, "--executor", "processes", "--workers", "2", "--cache", str(tmp_path / "p.sqlite"),
                  "--out", str(tmp_path / "pool.json")]) == 0
     dask, pool = (json.loads((tmp_path / f"{n}.json").read_text()) for n in ("dask", "pool"))

@@ -130,4 +130,4 @@ def cluster_line(evaluator: Any) -> str | None:
     if not report or not report["lost_workers"]:
         return None
     return (f"{report['lost_workers']} Dask worker(s) lost during the run; {report['retried']} design(s) they were "
-            "solving were retried on the others")
+            "solving or held queued were retried on the others")
