@@ -72,6 +72,18 @@ def test_design_refine_in_2d(tmp_path: Path, capsys: pytest.CaptureFixture[str],
     assert mesh["holds"] == (best_fine == winner)
     report = (out / "report.md").read_text()
     assert "## Mesh" in report and "0.75 mm elements" in report
+    # the value in words and units: Eq 4.1 and its RMS per centre (sqrt(15) smaller)
+    value = cert["winner"]["value"]
+    assert f"{value / 15**0.5:.3g} mm RMS per centre" in report
+
+
+def test_summary_line_names_the_value(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PNEUMORPH_CACHE", str(tmp_path / "cache.sqlite"))
+    assert main(["design", "--model", "2d", "--units", "4", "--search", "exhaustive", "--objective", "max-y",
+                 "--executor", "serial", "--out", str(tmp_path / "run")]) == 0
+    line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("best design"))
+    assert ": max-y " in line and " mm (" in line and "fitness" not in line
 
 
 @pytest.mark.parametrize(

@@ -246,7 +246,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             **_certified_json(result),
         }))
     elif best is not None:
-        click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: fitness {best.value:.4g} "
+        click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {_value_words(result, config)} "
                    f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
         if result.certified is not None:
             c = result.certified.certificate
@@ -282,6 +282,18 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
         sys.exit(130)
+
+
+def _value_words(result: Any, config: Any) -> str:
+    """The winner's value in words with its unit: Eq 4.1 and its RMS per centre for a profile."""
+    from pneumorph.design.targets import ProfileTarget
+
+    best, objective = result.best, result.objective
+    if isinstance(objective, ProfileTarget):
+        n = config.units
+        return (f"error {best.value:.4g} {objective.unit} (Eq 4.1: root of the summed squared offsets of the {n} "
+                f"unit centres from the target; {best.value / n**0.5:.3g} {objective.unit} RMS per centre)")
+    return f"{objective.name} {best.value:.4g} {objective.unit}"
 
 
 def _check_options_apply(search: str, owner: str, options: dict) -> None:

@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import os
 import re
 import time
@@ -874,7 +875,10 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
             "",
             f"- design (base first): `{best.design}`",
             f"- pressure: {pressure}",
-            f"- {what}: {best.value:.6g} {o.unit}",
+            f"- {what}: {best.value:.6g} {o.unit}" + (
+                f" (the root of the summed squared offsets of the {config.units} unit centres from the target: "
+                f"{best.value / config.units**0.5:.3g} {o.unit} RMS per centre)"
+                if isinstance(o, ProfileTarget) and math.isfinite(best.value) else ""),
             "",
             "## Hall of fame",
             "",
