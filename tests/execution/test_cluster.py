@@ -117,7 +117,8 @@ def test_the_workers_are_set_up_for_solving(cluster: Cluster) -> None:
         assert all("pneumorph-solver-settings" in names for names in plugins.values())
         from pneumorph.execution.evaluators import tune_allocator
 
-        assert set(ev.client.run(tune_allocator).values()) == {True}  # glibc on Linux: mallopt took the values
+        if sys.platform.startswith("linux"):  # glibc: mallopt took the values
+            assert set(ev.client.run(tune_allocator).values()) == {True}
 
 
 def test_workers_of_another_version_are_refused_naming_both(cluster: Cluster, monkeypatch: pytest.MonkeyPatch) -> None:
