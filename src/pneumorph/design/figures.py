@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -45,38 +46,58 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     assert r is not None, "a candidate without a response has no profile"
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
-    fig = new_figure(6.4, 4.2, layout="tight")
-    ax = fig.add_subplot()
-    ax.axhline(0.0, color="0.8", lw=0.8, ls="--", label="undeformed axis")
+    curves: list[tuple[np.ndarray, np.ndarray, dict[str, Any]]] = []
     if isinstance(objective, ProfileTarget):
         if objective.coordinates == "cartesian":
             xs = np.linspace(0.0, max(length, float(np.nanmax(pts[:, 0]))), 300)
-            ax.plot(xs, objective.curve(xs, length), color="C1", lw=2, label=f"target {objective.label}")
+            ys = objective.curve(xs, length)
         else:
             th = np.unwrap(np.arctan2(pts[1:-1, 1], pts[1:-1, 0]))
             ts = np.linspace(min(th.min(), 0.0), max(th.max(), 0.0), 300)
             rs = objective.curve(ts, length)
-            ax.plot(rs * np.cos(ts), rs * np.sin(ts), color="C1", lw=2, label=f"target {objective.label}")
-        what = f"error {candidate.value:.3g} {unit}"
+            xs, ys = rs * np.cos(ts), rs * np.sin(ts)
+        curves.append((xs, np.broadcast_to(ys, xs.shape), {"color": "C1", "lw": 2,
+                                                           "label": f"target {objective.display}"}))
+        what = f"Eq 4.1 error {candidate.value:.3g} {unit}"
     else:
-        if objective.point is not None:
-            ax.plot(*objective.point, "x", color="C1", ms=10, mew=2, label="point to reach")
         what = f"{objective.label}: {candidate.value:.4g} {objective.unit}"
+    others = []
+    for name, other in compare:
+        o = Candidate(other.design, other.value, candidate.level, candidate.pressure, None, other.response)
+        others.append((name, profile_points(o)))
+    # true proportions (equal axes) on a figure as tall as the shape needs: a flat profile gets a flat figure
+    # with its legend below, not a square of empty space
+    point = None if isinstance(objective, ProfileTarget) else objective.point
+    marks = [np.array([point], dtype=float)] if point is not None else []
+    everything = np.vstack([pts, *[np.column_stack([x, y]) for x, y, _ in curves], *[q for _, q in others], *marks])
+    finite = everything[np.all(np.isfinite(everything), axis=1)]
+    lo, hi = finite.min(axis=0), finite.max(axis=0)
+    span = np.maximum(hi - lo, 1.0)
+    pad = 0.06 * max(span)
+    width = 7.0
+    axes_height = float(np.clip((width - 1.0) * (span[1] + 2 * pad) / (span[0] + 2 * pad), 1.1, 6.0))
+    fig = new_figure(width, axes_height + 2.2, layout="constrained")
+    ax = fig.add_subplot()
+    ax.axhline(0.0, color="0.8", lw=0.8, ls="--", label="undeformed axis")
+    for xs, ys, style in curves:
+        ax.plot(xs, ys, **style)
+    if point is not None:
+        ax.plot(*point, "x", color="C1", ms=10, mew=2, label="point to reach")
     fidelity = (r.metadata or {}).get("fidelity")
     ax.plot(pts[:, 0], pts[:, 1], "-", color="C0", lw=1.5,
             label="actuator centreline" + (f" ({fidelity} FE)" if compare and fidelity else ""))
     ax.plot(pts[1:-1, 0], pts[1:-1, 1], "o", color="C0", ms=4, label="unit centres")
     ax.plot(*pts[-1], "s", color="C3", ms=6, label="tip")
-    for i, (name, other) in enumerate(compare):
-        o = Candidate(other.design, other.value, candidate.level, candidate.pressure, None, other.response)
-        q = profile_points(o)
+    for i, (name, q) in enumerate(others):
         ax.plot(q[:, 0], q[:, 1], ":", marker="x", ms=6, color=f"C{i + 4}", lw=1.2, zorder=5, label=name)
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x along the actuator (mm)")
     ax.set_ylabel("y (mm)")
     pressure = candidate.pressure * 1e3 if candidate.pressure is not None else float("nan")
     ax.set_title(f"{candidate.design} at {pressure:.4g} kPa - {what}", fontsize=9)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, frameon=False)
     ax.grid(alpha=0.3)
     return save_figure(fig, path)
 

@@ -252,6 +252,24 @@ class ProfileTarget:
         return self
 
     @property
+    def display(self) -> str:
+        """The target as a figure shows it: ``y = A·sin(2·π·x/L), A = 10 mm``.
+
+        >>> profile_target("sin", amplitude=10.0).display
+        'y = A·sin(2·π·x/L), A = 10 mm'
+        >>> profile_target("y = 0.5*x**2/L").display
+        'y = 0.5·x^2/L'
+        """
+        lhs = "y" if self.coordinates == "cartesian" else "r"
+        text = re.sub(r"2\*pi\*1\*(x|theta)", r"2*pi*\1", self.expression.text)
+        text = text.replace("**", "^").replace("*", "·").replace("theta", "θ")
+        text = re.sub(r"\bpi\b", "π", text)
+        text = f"{lhs} = {text}"
+        if "A" in self.expression.used:
+            text += f", A = {self.amplitude:g} mm"
+        return text
+
+    @property
     def label(self) -> str:
         lhs = "y" if self.coordinates == "cartesian" else "r"
         text = f"{lhs} = {self.expression.text}"
