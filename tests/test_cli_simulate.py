@@ -65,3 +65,9 @@ def test_simulate_builds_the_same_model_as_design_and_the_api(tmp_path: Path) ->
     api = Reduced2D(4, ramp_spec=RampSpec(0.01, replace(Reduced2D.default_steps, increments=2)))
     assert written == make_model(4, {"fidelity": "2d", "pressure_kpa": 10, "increments": 2}).fingerprint()
     assert written == api.fingerprint()  # one source of defaults: the cache entries are shared
+
+
+def test_written_line_has_one_slash(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simulate", "-o", "01", "--pressure", "10", "--increments", "1", "--out", f"{tmp_path / 'sim'}/"]) == 0
+    line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("written to"))
+    assert f"written to {tmp_path / 'sim'}/ (" in line and "//" not in line

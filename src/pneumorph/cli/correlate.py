@@ -74,4 +74,4 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
         if m.count:
             click.echo(f"  {name:<10} RMS {m.rms:.4g} mm, max {m.max:.4g} mm ({m.count} points)")
     if out:
-        click.echo(f"written to {out}/ (correlation.json, correlation.png)")
+        click.echo(f"written to {Path(out)}/ (correlation.json, correlation.png)")

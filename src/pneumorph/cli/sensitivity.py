@@ -92,7 +92,7 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
         return
     _print(result)
     if common["out"]:
-        click.echo(f"written to {common['out']}/ (study.json, study.png)")
+        click.echo(f"written to {Path(common['out'])}/ (study.json, study.png)")
 
 
 def _print(result: Any) -> None:

@@ -109,4 +109,4 @@ def simulate(
         click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
                    f"{m['wall_time_s']:.2f} s")
         if out:
-            click.echo(f"written to {out}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")
+            click.echo(f"written to {Path(out)}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")

@@ -124,4 +124,4 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     else:
         click.echo("no unit bends more than the base unit at the same or a lower h_b within the strain limit")
     click.echo(f"{len(result.candidates)} candidates ({result.solves} solved, {result.hits} from the cache) in "
-               f"{time.perf_counter() - t0:.0f} s; written to {out}/")
+               f"{time.perf_counter() - t0:.0f} s; written to {Path(out)}/")
