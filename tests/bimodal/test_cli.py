@@ -37,3 +37,17 @@ def test_bad_crimp_ratio(capsys) -> None:
 def test_bulk_from_poisson() -> None:
     # K = 2 mu (1 + nu) / (3 (1 - 2 nu)); nu = 0.25 gives K = 5/3 mu
     assert bulk_from_poisson(3.0, 0.25) == pytest.approx(5.0)
+
+
+def test_a_ramp_that_ends_early_is_not_a_success(tmp_path, capsys) -> None:
+    """One Newton iteration and no cut-back cannot reach the first level: the table is printed, the outputs
+    written, and the command ends with one line naming the cause and exit 2 (not 0)."""
+    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5",
+                 "--max-iterations", "1", "--max-cutbacks", "0", "-q", "--out", str(tmp_path)])
+    captured = capsys.readouterr()
+    assert code == 2
+    assert "ramp ended early" in captured.out
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: simulation failed, converged up to 0 kPa of 5 kPa")
+    assert "printed and written" in err[0]
+    assert (tmp_path / "bimodal-cr0_3.json").is_file()

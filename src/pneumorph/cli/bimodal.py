@@ -88,8 +88,14 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
         data["files"] = [str(p) for p in write_outputs(result, Path(out))]
     if as_json:
         click.echo(strict_json(data, indent=2))
-        return
-    click.echo(format_result(data))
+    else:
+        click.echo(format_result(data))
+    if not result.completed:  # a partial ramp is reported and written, and ends with its cause (exit 2)
+        from pneumorph.errors import SimulationFailed
+
+        reached = float(result.pressures[-1]) / result.pmax if len(result.pressures) else 0.0
+        kept = "the levels before it are printed" + (" and written" if out is not None else "")
+        raise SimulationFailed(reached=reached, cause=f"{result.cause.strip()}; {kept}", pressure=result.pmax)
 
 
 def format_result(d: dict[str, Any]) -> str:
