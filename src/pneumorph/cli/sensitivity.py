@@ -13,13 +13,14 @@ from pneumorph.cli import params as P
 from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
 
 
-def _common(command: Callable[..., Any]) -> Callable[..., Any]:
-    """The options every study shares: the design, the model, the executor, the outputs."""
+def _common(command: Callable[..., Any], models: tuple[str, ...] = ("2d", "3d")) -> Callable[..., Any]:
+    """The options every study shares: the design, the model (of ``models``), the executor, the outputs."""
     options = [
         click.option("--design", metavar="DIGITS", type=P.Text(max_length=1000),
                      help="The design, base first (default: all units aligned, as appendix E)."),
-        click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="3d", show_default=True,
-                     help="The FE model."),
+        click.option("--model", "fidelity", type=click.Choice(models), default="3d", show_default=True,
+                     help="The FE model." + ("" if len(models) > 1 else " This study varies options of the 3D "
+                                             "model only.")),
         click.option("--units", "n_units", type=P.UNITS, default=15, show_default=True,
                      help="Units of the default design (ignored with --design)."),
         click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure, kPa."),
@@ -130,8 +131,13 @@ def _print(result: Any) -> None:
             click.echo(f"{label:<16}" + "".join(f"{s[key][f]:12.3f}" for f in fields))
 
 
+def _common_3d(command: Callable[..., Any]) -> Callable[..., Any]:
+    """:func:`_common` for a study whose variants exist in the 3D model only."""
+    return _common(command, models=("3d",))
+
+
 @sensitivity.command("simplifications")
-@_common
+@_common_3d
 @click.option("--passage", type=P.Real(0.0, 100.0, low_open=True, unit="mm"), default=1.5, show_default=True,
               help="Diameter of the air passages between cavities (section 6.4.1), mm.")
 @click.option("--base-length", type=P.POSITIVE_MM, default=10.0, show_default=True,
@@ -186,7 +192,7 @@ def calibration_cmd(reach: float, **common: Any) -> None:
 
 
 @sensitivity.command("temperature")
-@_common
+@_common_3d
 @click.option("--change", "changes", type=P.Real(-100.0, 100.0, unit="degC"), multiple=True,
               help="Uniform temperature change, degC (repeat; default 10).")
 def temperature_cmd(changes: tuple[float, ...], **common: Any) -> None:
