@@ -250,3 +250,21 @@ def test_no_build_stops_a_run_whose_tolerance_tables_are_missing(tmp_path: Path,
     assert "--no-build: the mould tolerance tables of this unit (+-0.05 mm) are neither shipped nor kept" in err
     assert "30 FE solves of 15-unit designs; estimated" in err and "--tolerance 0" in err
     assert not (tmp_path / "run6").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--objective", "max-x", "--amplitude", "20"], "--amplitude shapes a profile target, not the tip goal max-x"),
+        (["--objective", "min-distance", "--periods", "2", "--amplitude", "5"], "--amplitude/--periods shape"),
+        (["--target", "y = 0.1*x", "--amplitude", "5"], "which the target y = 0.1*x does not use"),
+        (["--target", "y = A*x/L", "--periods", "2"], "--periods applies to the sin and cos presets"),
+    ],
+)
+def test_shape_options_that_would_be_ignored_are_refused(args: list[str], message: str, tmp_path: Path,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "never"
+    assert main(["design", *args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()

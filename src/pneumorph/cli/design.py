@@ -172,7 +172,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     mixed = bool(getattr(model, "mixed", False))
     if mixed:
         _check_library_run(config, model, tolerance)
-    config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
+    made = config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
+    _check_shape_options(made, amplitude, periods)
     if config.refine and config.search == "certified":  # refused here, naming the option; run_design checks again
         from pneumorph.design.refine import check_refine
 
@@ -282,6 +283,25 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
         sys.exit(130)
+
+
+def _check_shape_options(objective: Any, amplitude: float | None, periods: float | None) -> None:
+    """Refuse --amplitude and --periods where the objective would ignore them (one line, exit 2)."""
+    from pneumorph.design.targets import PRESETS, ProfileTarget
+
+    if isinstance(objective, ProfileTarget):
+        uses_a = "A" in getattr(objective.expression, "used", ())
+        if amplitude is not None and not uses_a:
+            raise click.UsageError(f"--amplitude sets A, which the target {objective.label} does not use; leave "
+                                   "it out or write A into the target")
+        if periods is not None and objective.name not in PRESETS:
+            raise click.UsageError(f"--periods applies to the sin and cos presets, not to the target "
+                                   f"{objective.label}; write the periods into the expression")
+        return
+    given = [name for name, value in (("--amplitude", amplitude), ("--periods", periods)) if value is not None]
+    if given:
+        raise click.UsageError(f"{'/'.join(given)} shape{'s' if len(given) == 1 else ''} a profile target, not the "
+                               f"tip goal {objective.name}; leave {'/'.join(given)} out")
 
 
 def _value_words(result: Any, config: Any) -> str:
