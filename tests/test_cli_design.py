@@ -259,6 +259,7 @@ def test_no_build_stops_a_run_whose_tolerance_tables_are_missing(tmp_path: Path,
         (["--objective", "min-distance", "--periods", "2", "--amplitude", "5"], "--amplitude/--periods shape"),
         (["--target", "y = 0.1*x", "--amplitude", "5"], "which the target y = 0.1*x does not use"),
         (["--target", "y = A*x/L", "--periods", "2"], "--periods applies to the sin and cos presets"),
+        (["--tolerance", "0", "--robust-samples", "5"], "which --tolerance 0 turns off"),
     ],
 )
 def test_shape_options_that_would_be_ignored_are_refused(args: list[str], message: str, tmp_path: Path,

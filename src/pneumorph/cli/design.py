@@ -174,6 +174,9 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         _check_library_run(config, model, tolerance)
     made = config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
     _check_shape_options(made, amplitude, periods)
+    if robust_samples is not None and config.tolerance == 0:
+        raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
+                               "turns off; leave one of them out")
     if config.refine and config.search == "certified":  # refused here, naming the option; run_design checks again
         from pneumorph.design.refine import check_refine
 
