@@ -38,3 +38,26 @@ def test_a_run_folder_is_readable_by_the_group(tmp_path: Path) -> None:
     files = [p for p in out.rglob("*") if p.is_file()]
     assert files
     assert {oct(p.stat().st_mode & 0o777) for p in files} == {oct(0o664)}
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs the proc pseudo-filesystem")
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["simulate", "-o", "01", "--out", "/proc/sx"],
+        ["export", "0110", "--stl", "/proc/x"],
+        ["export", "0110", "--inp", "/proc/deck.inp"],
+        ["chain", "build", "--model", "2d", "--units", "4", "--out", "/proc/t.json"],
+        ["sensitivity", "tolerances", "--out", "/proc/x"],
+        ["unit", "optimise", "--out", "/proc/uo"],
+        ["sensitivity", "mesh", "--out", "/proc/m"],
+        ["design", "--out", "/proc/dx"],
+    ],
+)
+def test_unwritable_outputs_are_refused_before_any_work(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """Permissions alone say /proc is writable to root; the check makes and removes a folder there instead."""
+    from pneumorph.cli import main
+
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "/proc" in err[0] and ("cannot be" in err[0] or "nothing can be created" in err[0])

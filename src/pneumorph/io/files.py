@@ -72,6 +72,11 @@ def check_writable_dir(path: str | Path, option: str = "--out") -> Path:
         raise OutputPathError(f"{option} {path}: {base} is a file, not a folder")
     if not os.access(base, os.W_OK | os.X_OK):
         raise OutputPathError(f"{option} {path}: {base} is not writable")
+    try:  # permissions alone do not tell (root, read-only mounts, /proc and /sys): make and remove a folder there
+        os.rmdir(tempfile.mkdtemp(prefix=".pneumorph-probe-", dir=base))
+    except OSError as exc:
+        raise OutputPathError(f"{option} {path}: nothing can be created in {base} "
+                              f"({exc.strerror or type(exc).__name__})") from None
     return path
 
 
