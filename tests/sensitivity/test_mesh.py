@@ -130,7 +130,7 @@ def test_memory_check_before_meshing() -> None:
     nodes, peak = check_refinement(model, [1.0], memory=10**12)[1.0]
     assert nodes > 4 * check_refinement(model, [1.5], memory=10**12)[1.5][0]
     assert check_refinement(model, [1.5, 1.0], memory=int(1.01 * peak))[1.0] == (nodes, peak)
-    with pytest.raises(MeshLimitError, match=r"x 2 at once.*fewer at once"):
+    with pytest.raises(MeshLimitError, match=r"x 2 at once.*fewer workers"):
         check_refinement(model, [1.0], parallel=2, memory=int(1.5 * peak))
     with pytest.raises(MeshLimitError, match=r"element size 0\.75 mm"):
         check_refinement(model, [1.5, 0.75], memory=int(1.01 * peak))
