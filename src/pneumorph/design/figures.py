@@ -92,7 +92,7 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
         ax.plot(q[:, 0], q[:, 1], ":", marker="x", ms=6, color=f"C{i + 4}", lw=1.2, zorder=5, label=name)
     ax.set_xlim(lo[0] - pad, hi[0] + pad)
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
-    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x along the actuator (mm)")
     ax.set_ylabel("y (mm)")
     pressure = candidate.pressure * 1e3 if candidate.pressure is not None else float("nan")

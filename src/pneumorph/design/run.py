@@ -110,6 +110,8 @@ from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_t
 from pneumorph.sensitivity.tolerances import Tolerance
 
 _COMPARED = ("design", "ga", "model")
+#: designs a certified run with ``refine`` verifies (and solves on the finer mesh) at least
+REFINE_TOP = 3
 
 #: The files a run writes into its folder (glob patterns, relative to it): what ``overwrite`` removes,
 #: besides the files the old run's report lists and the temporary files of an interrupted write.
@@ -578,6 +580,8 @@ def run_design(
             elif search == "certified":
                 assert chain is not None
                 verify = config.verify or int(getattr(inner, "workers", 1) or 1)
+                if config.refine:  # the designs to refine: the winner and its closest runners-up at least
+                    verify = max(verify, REFINE_TOP)
                 cert = certified_search(model, chain, objective, cached, verify=verify, certify=config.certify,
                                         hall_of_fame=config.ga.hall_of_fame, margin=config.margin,
                                         on_progress=say, epsilon=config.epsilon)
