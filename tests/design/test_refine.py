@@ -126,3 +126,24 @@ def test_mesh_note_from_a_study_of_the_same_model() -> None:
     assert mesh_note(model, make_objective("cos", 10.0), {"w": 7.0}, "w", study) is None
     assert mesh_note(Full3D(15, UnitSpec(wall=2.0)), objective, {"w": 7.0}, "w", study) is None
     assert mesh_note(Reduced2D(15), objective, {"w": 7.0}, "w", study) is None
+
+
+def test_the_shipped_study_speaks_for_the_default_run() -> None:
+    """The shipped 3D study (15 units, sin A = 10 mm) applies to the default certified run's model: refining
+    1.5 -> 0.75 mm lowers every study design's Eq 4.1 value by more than 0.1 mm but moves their gap by a
+    tenth of that, so only a design verified within that gap change of the winner could swap with it."""
+    from pneumorph.design.refine import load_study, mesh_note
+    from pneumorph.models import make_model
+
+    study = load_study()
+    assert study is not None
+    model = make_model(15, {"fidelity": "3d"})
+    note = mesh_note(model, make_objective("sin", 10.0), {"001111010001001": 7.4035, "001111010001000": 7.5306},
+                     "001111010001001")
+    assert note is not None and note["sizes_mm"] == [1.5, 0.75] and note["designs"] >= 2
+    lo, hi = note["value_change"]
+    assert hi < -0.1 and 0 < note["gap_change"] < 0.1 * abs(hi)
+    assert note["within"] == []  # the runner-up is 0.127 mm behind, more than the gap moved
+    # another pressure is another model: the study says nothing
+    assert mesh_note(make_model(15, {"fidelity": "3d", "pressure_kpa": 30}), make_objective("sin", 10.0),
+                     {"a": 1.0}, "a") is None

@@ -100,8 +100,8 @@ def mesh_note(model: Any, objective: Any, values: dict[str, float], winner: str,
               study: dict[str, Any] | None = None) -> dict[str, Any] | None:
     """What the mesh study says about a run's verified values, without solving anything.
 
-    Applies where the study's model is the run's (fidelity, units, unit, element size) and
-    its objective the run's; None otherwise.
+    Applies where the study's model is the run's (fidelity, units, unit and its element size,
+    materials, pressure) and its objective the run's; None otherwise.
 
     Returns
     -------
@@ -117,8 +117,8 @@ def mesh_note(model: Any, objective: Any, values: dict[str, float], winner: str,
         return None
     described = study.get("provenance", {}).get("model", {})
     mine = model.describe()
-    if (described.get("fidelity") != mine.get("fidelity") or described.get("unit") != mine.get("unit")
-            or described.get("n_units") != mine.get("n_units") or study.get("objective") != objective.label):
+    keys = ("fidelity", "unit", "n_units", "materials", "pressure_mpa", "library")
+    if any(described.get(k) != mine.get(k) for k in keys) or study.get("objective") != objective.label:
         return None
     by_design: dict[str, dict[float, float]] = {}
     for p in study["points"]:
