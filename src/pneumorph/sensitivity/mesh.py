@@ -226,7 +226,7 @@ class MeshStudy:
         The objective's label (what ``value`` measures).
     order : float or None
         The order assumed for designs solved on two meshes only (observed on a short
-        actuator, :func:`study_order`), if given.
+        actuator on nested meshes), if given.
     """
 
     points: tuple[MeshPoint, ...]
