@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import click
@@ -272,7 +273,8 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
                    f"({point.cells:,} cells): {state}  [{time.perf_counter() - t0:.0f} s]", err=True)
 
     try:
-        points = mesh_points(model, designs, sizes, objective, evaluator, on_point=progress)
+        points = mesh_points(model, designs, sizes, partial(_objective_at_best, objective), evaluator,
+                             on_point=progress)
     finally:
         evaluator.close()
     study = MeshStudy(tuple(points), objective.label, order)
@@ -294,6 +296,14 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     _print_mesh(study, objective.unit)
     if out:
         click.echo(f"written to {Path(out)}/ (mesh.json, mesh.png)")
+
+
+def _objective_at_best(objective: Any, response: Any) -> tuple[float, int | None]:
+    """The objective at its best level (and the level) of a response."""
+    from pneumorph.design.fitness import score
+
+    s = score(response, objective)
+    return float(s.value), s.level
 
 
 def _print_mesh(study: Any, unit: str) -> None:

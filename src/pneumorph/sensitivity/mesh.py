@@ -324,7 +324,8 @@ def refined(model: Any, element_size: float) -> Any:
     return model.variant(unit=unit)
 
 
-def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float], objective: Any, evaluator: Any,
+def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float],
+                measure: Callable[[Any], tuple[float, int]], evaluator: Any,
                 on_point: Callable[[MeshPoint], None] | None = None) -> list[MeshPoint]:
     """Solve every design at every element size through ``evaluator`` (cached: a rerun resumes).
 
@@ -335,15 +336,16 @@ def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float], obje
     designs : iterable of str
     sizes : iterable of float
         Element sizes (mm), any order.
-    objective : ProfileTarget or TipGoal
-        What ``value`` measures (:func:`pneumorph.design.fitness.score`).
+    measure : callable
+        ``measure(response) -> (value, level)``: the quantity compared besides tip and curl
+        and the level it is taken at (a design objective at its best level, e.g.
+        ``lambda r: (s := score(r, objective)).value, s.level`` with
+        :func:`pneumorph.design.fitness.score`).
     evaluator : Evaluator
         Solves the ``(model, design)`` cases (``iter_cases``).
     on_point : callable, optional
         Called with each :class:`MeshPoint` as it arrives (progress).
     """
-    from pneumorph.design.fitness import score
-
     designs = list(designs)
     models = {h: refined(model, h) for h in sorted(set(float(s) for s in sizes), reverse=True)}
     meshes = {h: _mesh_size(m, designs[0]) for h, m in models.items()}
@@ -355,10 +357,10 @@ def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float], obje
         r = outcome.response
         meta = {} if r is None else dict(r.metadata)
         if outcome.ok and r is not None:
-            s = score(r, objective)
-            level = int(s.level) if s.level is not None else len(r.pressures) - 1
+            value, level = measure(r)
+            level = int(level) if level is not None else len(r.pressures) - 1
             point = MeshPoint(design, h, size, cells, int(meta.get("dofs", 0)),
-                              (float(r.tip[-1, 0]), float(r.tip[-1, 1])), float(r.curl[-1]), float(s.value),
+                              (float(r.tip[-1, 0]), float(r.tip[-1, 1])), float(r.curl[-1]), float(value),
                               float(r.pressures[level] * 1e3), float(outcome.wall_time),
                               extra={"precision": meta.get("precision")})
         else:
