@@ -325,7 +325,7 @@ def refined(model: Any, element_size: float) -> Any:
 
 
 def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float],
-                measure: Callable[[Any], tuple[float, int]], evaluator: Any,
+                measure: Callable[[Any], tuple[float, int | None]], evaluator: Any,
                 on_point: Callable[[MeshPoint], None] | None = None) -> list[MeshPoint]:
     """Solve every design at every element size through ``evaluator`` (cached: a rerun resumes).
 
