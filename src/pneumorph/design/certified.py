@@ -584,6 +584,17 @@ class CertifiedResult:
     wall_time: float = 0.0
 
 
+def _solve_estimate(model: Any, count: int) -> str:
+    """`` (about 15 s each)``: the measured solve time of the model's fidelity, or nothing."""
+    from pneumorph.models.buildplan import duration_text, solve_seconds
+
+    seconds = solve_seconds(str(getattr(model, "fidelity", "")), int(getattr(model, "n_units", 0) or 0))
+    if not seconds:
+        return ""
+    each = " each" if count > 1 else ""
+    return f" ({getattr(model, 'fidelity', '')}, about {duration_text(seconds)}{each})"
+
+
 def chain_candidate(chain: ChainModel, objective: Objective, design: str) -> Candidate:
     """A design as the chain model sees it: its response and its score."""
     r = chain.evaluate(design)
@@ -687,6 +698,7 @@ def certified_search(
                                     f"({failures}); check the model (units, pressure) with pneumorph simulate")
         batch = pending[:verify]
         todo = [designs[i] for i in batch]
+        say(f"verifying {', '.join(todo)} by FE{_solve_estimate(fe_model, len(todo))} ...")
         book.score_many(todo)
         done[batch] = True
         verified += todo
