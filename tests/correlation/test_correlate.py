@@ -126,3 +126,19 @@ def test_correlate_command_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixt
     assert data["outline"]["rms_mm"] < 0.05 and abs(data["transform"]["angle_deg"]) < 0.2
     assert (tmp_path / "c" / "correlation.png").stat().st_size > 0
     assert json.loads((tmp_path / "c" / "correlation.json").read_text())["provenance"]["fingerprint"]
+
+
+def test_the_readme_sample_scan_correlates_to_its_noise(tmp_path, capsys) -> None:
+    """examples/data/scan-0110-30kpa.xyz (docs/scripts/sample_scan.py) is the 3D model's surface moved and given
+    0.05 mm noise: `pneumorph correlate` as the README runs it aligns it to a surface RMS of sigma * sqrt(3)."""
+    import json
+    from pathlib import Path
+
+    from pneumorph.cli import main
+
+    scan = Path(__file__).resolve().parents[2] / "examples" / "data" / "scan-0110-30kpa.xyz"
+    assert main(["correlate", str(scan), "--design", "0110", "--pressure", "30", "--out", str(tmp_path / "corr"),
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert abs(data["surface"]["rms_mm"] - 0.05 * 3**0.5) < 0.01
+    assert (tmp_path / "corr" / "correlation.png").is_file()
