@@ -28,3 +28,15 @@ def test_a_unit_file_with_a_huge_pitch_is_refused(tmp_path: Path) -> None:
     unit.write_text("[unit]\npitch = 1e9\n")  # the issue: a base block 1e9 mm long went past 6 GB
     code, out, _ = _run("simulate", "-o", "0" * 15, "--model", "2d", "--unit", str(unit))
     assert code == 2 and "MAX_LENGTH_MM" in out and "Traceback" not in out
+
+
+def test_list_fields_of_a_unit_file_are_checked(tmp_path: Path) -> None:
+    """Text in a unit's list fields is a one-line refusal naming the field, not an internal error."""
+    for body, message in (('filler_coefficients = ["a", "b"]', "filler_coefficients must be a list of numbers"),
+                          ('filler_range_kpa = "x"', "filler_range_kpa must be a list of 2 numbers"),
+                          ("filler_range_kpa = [45, 0]", "must rise from its low to its high pressure"),
+                          ("filler_coefficients = [true, 1]", "filler_coefficients must be a list of numbers")):
+        unit = tmp_path / "u.toml"
+        unit.write_text(f"[unit]\n{body}\n")
+        code, out, _ = _run("simulate", "-o", "01", "--unit", str(unit))
+        assert code == 2 and message in out and "internal error" not in out, out

@@ -72,6 +72,26 @@ _LENGTHS = (
 )
 
 
+def _numbers(values: object, key: str, count: int | None = None) -> tuple[float, ...]:
+    """A list field of numbers, refused as one line naming the field (text, booleans, a wrong count).
+
+    >>> _numbers([1, 2.5], "filler_coefficients")
+    (1.0, 2.5)
+    >>> _numbers("x", "filler_range_kpa", 2)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.GeometryError: unit filler_range_kpa must be a list of 2 numbers, got 'x'
+    """
+    what = f"a list of {count} numbers" if count is not None else "a list of numbers"
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise GeometryError(f"unit {key} must be {what}, got {values!r}")
+    items = list(values)
+    if (count is not None and len(items) != count) or any(
+            isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) for v in items):
+        raise GeometryError(f"unit {key} must be {what}, got {values!r}")
+    return tuple(float(v) for v in items)
+
+
 @dataclass(frozen=True)
 class UnitSpec:
     """Dimensions (mm), materials and element size of one articulating unit.
@@ -164,8 +184,12 @@ class UnitSpec:
     def __post_init__(self) -> None:
         if not isinstance(self.solid, bool):
             raise GeometryError(f"unit solid must be true or false, got {self.solid!r}")
-        object.__setattr__(self, "filler_coefficients", tuple(float(c) for c in self.filler_coefficients))
-        object.__setattr__(self, "filler_range_kpa", tuple(float(c) for c in self.filler_range_kpa))
+        object.__setattr__(self, "filler_coefficients", _numbers(self.filler_coefficients, "filler_coefficients"))
+        object.__setattr__(self, "filler_range_kpa", _numbers(self.filler_range_kpa, "filler_range_kpa", 2))
+        low, high = self.filler_range_kpa
+        if not low < high:
+            raise GeometryError(f"unit filler_range_kpa must rise from its low to its high pressure, got "
+                                f"[{low:g}, {high:g}] kPa")
         if self.filler_coefficients:
             self.filler_law()  # validates: positive modulus over the range, Poisson's ratio
         if isinstance(self.element_order, bool) or self.element_order not in (1, 2):
