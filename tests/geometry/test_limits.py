@@ -40,3 +40,12 @@ def test_list_fields_of_a_unit_file_are_checked(tmp_path: Path) -> None:
         unit.write_text(f"[unit]\n{body}\n")
         code, out, _ = _run("simulate", "-o", "01", "--unit", str(unit))
         assert code == 2 and message in out and "internal error" not in out, out
+
+
+def test_an_actuator_of_solid_units_only_is_refused(tmp_path: Path) -> None:
+    unit = tmp_path / "solid.toml"
+    unit.write_text("[unit]\nsolid = true\n")
+    for command in (("simulate", "-o", "01", "--unit", str(unit)),
+                    ("simulate", "-o", "01", "--model", "3d", "--unit", str(unit))):
+        code, out, _ = _run(*command)
+        assert code == 2 and "nothing to inflate" in out and "internal error" not in out, out

@@ -154,6 +154,9 @@ class FEModel:
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.library = model_library(unit, library)
         self.unit = self.library[self.library.default]
+        if all(spec.solid for spec in self.library.units):
+            raise SettingsError("every unit type is solid (solid = true: no cavity), so there is nothing to "
+                                "inflate; a solid unit joins units with a cavity in a library (docs/unit-library.md)")
         self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
         self.filler = filler
         self.materials = dict(materials or {})
