@@ -142,3 +142,19 @@ def test_the_readme_sample_scan_correlates_to_its_noise(tmp_path, capsys) -> Non
     data = json.loads(capsys.readouterr().out)
     assert abs(data["surface"]["rms_mm"] - 0.05 * 3**0.5) < 0.01
     assert (tmp_path / "corr" / "correlation.png").is_file()
+
+
+def test_unreadable_scans_say_what_is_wrong_with_the_file(tmp_path, capsys) -> None:
+    import numpy as np
+
+    from pneumorph.cli import main
+
+    junk = tmp_path / "junk.stl"
+    junk.write_bytes(np.random.default_rng(0).integers(0, 256, 2000, dtype=np.uint8).tobytes())
+    ply = tmp_path / "flat.ply"
+    ply.write_text("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n"
+                   "1 2\n3 4\n")
+    for path, words in ((junk, "neither a binary nor a text .stl file"), (ply, "its vertices have no z coordinate")):
+        assert main(["correlate", str(path), "--design", "0110"]) == 2
+        err = capsys.readouterr().err
+        assert words in err and "ModuleNotFoundError" not in err and "KeyError" not in err

@@ -12,6 +12,7 @@ import csv
 import io
 from dataclasses import dataclass
 from pathlib import Path
+from struct import error as struct_error
 
 import numpy as np
 from numpy.typing import NDArray
@@ -121,13 +122,29 @@ def _read_csv(path: Path) -> FloatArray:
     return np.array(values, dtype=float).reshape(-1, width)
 
 
+def _why(exc: Exception, suffix: str) -> str:
+    """A parser's failure in words: what is wrong with the file, not which module tripped.
+
+    >>> _why(KeyError("z"), ".ply"), _why(ModuleNotFoundError("charset_normalizer"), ".stl")
+    ('its vertices have no z coordinate', 'its contents are neither a binary nor a text .stl file')
+    """
+    kind = suffix.lower() or "mesh"
+    if isinstance(exc, KeyError) and exc.args and str(exc.args[0]) in ("x", "y", "z"):
+        return f"its vertices have no {exc.args[0]} coordinate"
+    if isinstance(exc, (ModuleNotFoundError, UnicodeDecodeError)):
+        return f"its contents are neither a binary nor a text {kind} file"
+    if isinstance(exc, (IndexError, ValueError, struct_error)):
+        return f"its contents do not match the {kind} format ({type(exc).__name__}: {exc})"
+    return f"{type(exc).__name__}: {exc}"
+
+
 def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
     import trimesh
 
     try:
         loaded = trimesh.load(path, force=None, process=False)
     except Exception as exc:  # any parser failure is a file that is not a scan
-        raise ScanError(f"scan {path}: not a readable mesh or point cloud ({type(exc).__name__}: {exc})") from None
+        raise ScanError(f"scan {path}: not a readable mesh or point cloud ({_why(exc, path.suffix)})") from None
     if isinstance(loaded, trimesh.Scene):
         geometries = list(loaded.geometry.values())
         if not geometries:
