@@ -174,6 +174,11 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         _check_library_run(config, model, tolerance)
     made = config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
     _check_shape_options(made, amplitude, periods)
+    if config.tolerance > 0 and not mixed:  # the robustness report's mould tolerance, checked before any solve
+        from pneumorph.sensitivity.tolerances import Tolerance
+
+        with P.blame("--tolerance" if tolerance is not None else "[design] tolerance"):
+            Tolerance(config.tolerance).check(model.unit)
     if robust_samples is not None and config.tolerance == 0:
         raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
                                "turns off; leave one of them out")

@@ -56,6 +56,24 @@ class Tolerance:
         if unknown:
             raise SettingsError(f"unknown unit thickness(es) {', '.join(unknown)}; known: {', '.join(sorted(lengths))}")
 
+    def check(self, unit: UnitSpec) -> None:
+        """Refuse a tolerance as large as one of the unit's thicknesses it varies.
+
+        >>> Tolerance(0.9).check(UnitSpec(side_wall=0.5))
+        Traceback (most recent call last):
+        ...
+        pneumorph.errors.SettingsError: the tolerance +-0.9 mm is not smaller than the unit's side_wall (0.5 mm): a
+        mould within it could leave no side_wall; give a smaller tolerance (--tolerance)
+        """
+        for f in self.fields:
+            value = float(getattr(unit, f))
+            if f == "layer" and value == 0.0:
+                continue  # a unit without a layer has none to vary
+            if self.tolerance >= value:
+                raise SettingsError(f"the tolerance +-{self.tolerance:g} mm is not smaller than the unit's {f} "
+                                    f"({value:g} mm): a mould within it could leave no {f}; give a smaller "
+                                    "tolerance (--tolerance)")
+
     def samples(self, n: int, seed: int) -> FloatArray:
         """``n`` offsets (n, fields), each uniform in ``[-t, t]``, from a seeded generator."""
         n = checks.integer(n, "samples", 1, 100_000)
@@ -107,6 +125,7 @@ def matched_element_size(unit: UnitSpec, tolerance: Tolerance, steps: int = 40) 
     """
     from pneumorph.errors import GeometryError
 
+    tolerance.check(unit)
     corners = [perturbed(unit, tolerance.fields, c) for c in tolerance.corners()]
     for k in range(steps + 1):
         size = round(unit.element_size * (1 + k / 100), 6)
