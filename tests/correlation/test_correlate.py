@@ -158,3 +158,37 @@ def test_unreadable_scans_say_what_is_wrong_with_the_file(tmp_path, capsys) -> N
         assert main(["correlate", str(path), "--design", "0110"]) == 2
         err = capsys.readouterr().err
         assert words in err and "ModuleNotFoundError" not in err and "KeyError" not in err
+
+
+def _png_header(width: int, height: int) -> bytes:
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    # a few hundred bytes whose header claims the size: IHDR, a tiny IDAT, IEND
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b"")
+
+
+def test_a_bad_photo_is_refused_before_the_solve(tmp_path, capsys) -> None:
+    """Not an image, or a header claiming 60000 x 60000 pixels: one line, exit 2, nothing solved or written."""
+    from pneumorph.cli import main
+
+    trace = tmp_path / "trace.csv"
+    trace.write_text("x,y\n" + "".join(f"{x},{0.01 * x * x}\n" for x in range(0, 200, 5)))
+    text = tmp_path / "notes.png"
+    text.write_text("not an image")
+    huge = tmp_path / "huge.png"
+    huge.write_bytes(_png_header(60_000, 60_000))
+    large = tmp_path / "large.png"
+    large.write_bytes(_png_header(8_000, 8_000))
+    for photo, words in ((text, "not a readable image"), (huge, "MAX_PHOTO_PIXELS"),
+                         (large, "8,000 x 8,000 pixels")):
+        out = tmp_path / "corr"
+        assert main(["correlate", str(trace), "--design", "0110", "--model", "2d", "--scale", "0.2",
+                     "--photo", str(photo), "--out", str(out)]) == 2
+        captured = capsys.readouterr()
+        assert words in captured.err and "solving" not in captured.err
+        assert not out.exists()

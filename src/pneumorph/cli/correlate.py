@@ -43,6 +43,11 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
     data = read_scan(scan, scan_unit, scale)  # a bad scan is refused before the model is solved
     if photo is not None and data.dim != 2:
         raise click.BadParameter("a photo goes with a 2D trace (a CSV of x,y), not a 3D scan", param_hint="'--photo'")
+    if photo is not None:
+        from pneumorph.correlation.figures import check_photo
+
+        with P.blame("--photo"):
+            check_photo(photo)
     if data.dim == 3 and fidelity == "2d":
         raise ScanError("a 3D scan needs the 3D model: leave out --model 2d")
     settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure}

@@ -51,6 +51,38 @@ def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | 
     return fig
 
 
+#: Largest photo drawn under a trace (pixels): 40 megapixels, about 0.6 GB as the float image matplotlib reads.
+MAX_PHOTO_PIXELS = 40_000_000
+
+
+def check_photo(photo: Any) -> tuple[int, int]:
+    """Refuse a photo that is no readable image or too large, from its header, before anything is solved.
+
+    Returns ``(width, height)`` in pixels.
+
+    Raises
+    ------
+    ScanError
+        Not an image Pillow can read, or more than :data:`MAX_PHOTO_PIXELS` pixels.
+    """
+    from PIL import Image, UnidentifiedImageError
+
+    from pneumorph.errors import ScanError
+
+    try:
+        with Image.open(photo) as image:  # reads the header only
+            width, height = image.size
+    except Image.DecompressionBombError as exc:  # Pillow's own limit, far above ours
+        raise ScanError(f"photo {photo}: more than the {MAX_PHOTO_PIXELS:,} pixels (MAX_PHOTO_PIXELS) drawn under "
+                        f"a trace ({exc}); scale it down") from None
+    except (UnidentifiedImageError, OSError, ValueError) as exc:
+        raise ScanError(f"photo {photo}: not a readable image ({type(exc).__name__})") from None
+    if width * height > MAX_PHOTO_PIXELS:
+        raise ScanError(f"photo {photo}: {width:,} x {height:,} pixels, more than the {MAX_PHOTO_PIXELS:,} "
+                        "(MAX_PHOTO_PIXELS) drawn under a trace; scale it down")
+    return width, height
+
+
 def _photo(ax: Any, result: Correlation, photo: Any, scale: float) -> None:
     from matplotlib.image import imread
     from matplotlib.transforms import Affine2D
