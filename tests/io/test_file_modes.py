@@ -61,3 +61,16 @@ def test_unwritable_outputs_are_refused_before_any_work(argv: list[str], capsys:
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "/proc" in err[0] and ("cannot be" in err[0] or "nothing can be created" in err[0])
+
+
+@pytest.mark.parametrize("body", ["[design]\nobjective = " + "[" * 1000 + "]" * 1000,
+                                  "[model]\nunit = " + "{a = " * 1000 + "1" + "}" * 1000,
+                                  "[design]\nobjective = " + "[" * 40 + "]" * 40])
+def test_a_deeply_nested_config_is_one_line(tmp_path: Path, body: str, capsys: pytest.CaptureFixture[str]) -> None:
+    from pneumorph.cli import main
+
+    config = tmp_path / "deep.toml"
+    config.write_text(body + "\n")
+    assert main(["design", str(config), "--out", str(tmp_path / "never")]) == 2
+    err = capsys.readouterr().err
+    assert "nested more than 32 levels deep" in err and "RecursionError" not in err

@@ -268,6 +268,10 @@ def read_text_file(path: str | Path, what: str, error: type[PneumorphError] = Se
         raise error(f"{what} {p}: cannot be read ({exc.strerror or exc})") from None
 
 
+#: Deepest nesting of tables and arrays a settings file may have (the package's own go 4 deep)
+MAX_TOML_DEPTH = 32
+
+
 def read_toml(path: str | Path, what: str, error: type[PneumorphError] = SettingsError) -> dict[str, Any]:
     """The tables of a TOML file a user gave, or one line saying why it cannot be read.
 
@@ -282,7 +286,18 @@ def read_toml(path: str | Path, what: str, error: type[PneumorphError] = Setting
     pneumorph.errors.SettingsError: design config ...c.toml: not valid TOML: ...
     """
     text = read_text_file(path, what, error)
+    deep = f"{what} {path}: nested more than {MAX_TOML_DEPTH} levels deep (MAX_TOML_DEPTH)"
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{what} {path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise error(deep) from None
+    stack: list[tuple[Any, int]] = [(data, 1)]
+    while stack:  # iteratively: the readers of the settings recurse
+        value, depth = stack.pop()
+        if depth > MAX_TOML_DEPTH:
+            raise error(deep)
+        children = value.values() if isinstance(value, dict) else value if isinstance(value, list) else ()
+        stack.extend((child, depth + 1) for child in children)
+    return data
