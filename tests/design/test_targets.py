@@ -138,3 +138,21 @@ def test_reach_needs_a_point_and_others_refuse_one() -> None:
         make_objective("max-x", point=(1.0, 2.0))
     with pytest.raises(SearchConfigError, match="only used by the objective 'reach'"):
         make_objective("sin", point=(1.0, 2.0))
+
+
+@pytest.mark.parametrize(
+    ("curve", "message"),
+    [
+        ([[0, 0], [True, 1]], "must be a list of"),
+        ([["0", "0"], ["100", "5"]], "must be a list of"),
+        ([[0, 0], [1e-9, 1]], "the curve spans 1e-09 mm"),
+        ([[-100, 0], [-50, 5]], "the curve spans 0 mm"),
+    ],
+)
+def test_curve_configs_that_would_be_read_wrongly_are_refused(curve: list, message: str) -> None:
+    from pneumorph.design import DesignConfig
+    from pneumorph.errors import SearchConfigError
+
+    with pytest.raises(SearchConfigError, match=message):
+        DesignConfig(objective="curve", curve=curve, units=15)
+    assert DesignConfig(objective="curve", curve=[[0, 0], [80, 2], [160, 5]]).curve == ((0, 0), (80, 2), (160, 5))

@@ -156,6 +156,8 @@ class DesignConfig:
             object.__setattr__(self, "point", _pair(self.point, "[design] point", unit="mm"))
         if self.curve is not None:
             try:
+                if any(isinstance(v, (bool, str, bytes)) for xy in self.curve for v in xy):
+                    raise TypeError("text or true/false")
                 points = tuple((float(x), float(y)) for x, y in self.curve)
             except (TypeError, ValueError):
                 raise SearchConfigError(f"[design] curve must be a list of [x, y] points in mm, got {self.curve!r}") \

@@ -88,7 +88,16 @@ class Polyline:
 
 
 def _curve_points(points: ArrayLike) -> NDArray[np.float64]:
-    """Points as a checked (n, 2) array of finite mm values."""
+    """Points as a checked (n, 2) array of finite mm values (numbers only: not text, not true/false)."""
+    if not isinstance(points, np.ndarray):
+        try:
+            rows = list(points)  # type: ignore[arg-type]
+            bad = next((v for row in rows for v in (row if isinstance(row, (list, tuple)) else [row])
+                        if isinstance(v, (bool, str, bytes)) or not isinstance(v, (int, float, np.number))), None)
+        except TypeError:
+            raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
+        if bad is not None:
+            raise TargetExpressionError(f"a curve's points are numbers of mm, got {bad!r}")
     try:
         p = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
@@ -145,6 +154,16 @@ def smooth_curve(points: ArrayLike, length: float, knots: int = 41,
     return np.c_[xk, yk]
 
 
+def _check_span(xs: ArrayLike, length: float) -> None:
+    """Refuse a curve that covers less than :data:`MIN_CURVE_SPAN` of the actuator's ``0 <= x <= length``."""
+    x = np.asarray(xs, dtype=float)
+    lo, hi = max(float(x.min()), 0.0), min(float(x.max()), float(length))
+    if hi - lo < MIN_CURVE_SPAN * length:
+        raise TargetExpressionError(
+            f"the curve spans {max(hi - lo, 0.0):.3g} mm of the actuator's 0 to {length:g} mm; give points over "
+            f"at least {MIN_CURVE_SPAN * length:.3g} mm of it ({MIN_CURVE_SPAN:.0%})")
+
+
 def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarget:
     """A profile target through the points ``(x, y)`` (mm): the polyline joining them.
 
@@ -164,6 +183,8 @@ def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarge
     ys = np.bincount(inverse, weights=p[:, 1]) / np.bincount(inverse)
     if len(xs) < 2:
         raise TargetExpressionError("a curve needs points at two different x at least")
+    if length is not None:
+        _check_span(xs, length)
     line = Polyline(tuple(float(v) for v in xs), tuple(float(v) for v in ys))
     return ProfileTarget(line, "cartesian", 0.0, length, "curve")
 
@@ -443,6 +464,8 @@ def make_objective(
         if point is not None:
             raise SearchConfigError("a tip point is only used by the objective 'reach', not by 'curve'")
         target = curve_target(curve)  # type: ignore[arg-type]
+        if length is not None:
+            _check_span(np.asarray(curve, dtype=float)[:, 0], length)
         return target if length is None else target.check(length)
     if key in TIP_GOALS:
         return tip_goal(key, point)
