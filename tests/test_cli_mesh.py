@@ -57,3 +57,4 @@ def test_mesh_study_refuses_before_solving(args: list[str], message: str, tmp_pa
     assert message in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
     assert not out.exists()
+

@@ -93,6 +93,9 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
         click.echo(strict_json(data))
         return
     _print(result)
+    if name == "tolerances" and model.dim == 2:
+        click.echo("note: the 2D model is a section along the length; the side walls are not in it, so the "
+                   "side_wall rows equal the reference (use --model 3d for them)")
     if common["out"]:
         click.echo(f"written to {Path(common['out'])}/ (study.json, study.png)")
 
