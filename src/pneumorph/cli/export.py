@@ -57,6 +57,11 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
                                "(a CalculiX deck)")
     if with_mould and stl_dir is None:
         raise click.UsageError("--mould writes into the --stl folder: give --stl DIR")
+    if stl_dir is not None and inp_file is not None:
+        deck_path, stl_path = Path(inp_file).resolve(), Path(stl_dir).resolve()
+        if deck_path == stl_path or deck_path in stl_path.parents:
+            raise click.UsageError(f"--inp {inp_file} and the --stl folder {stl_dir} collide: the deck would be "
+                                   "written where the STL folder goes; give them different paths")
     if inp_file is None and ctx.get_parameter_source("pressure") is not click.core.ParameterSource.DEFAULT:
         raise click.UsageError("--pressure applies to the deck only: add --inp FILE")
     if not with_mould:
