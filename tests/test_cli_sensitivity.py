@@ -20,12 +20,3 @@ def test_2d_tolerances_say_why_the_side_wall_rows_are_the_reference(capsys: pyte
     assert rows and all(" 0.000 " in line for line in rows)  # the 2D section has no side walls
     assert "the side walls are not in it" in out
 
-
-@pytest.mark.parametrize("stl", ["X.inp", "X.inp/parts"])
-def test_export_refuses_a_deck_where_the_stl_folder_goes(tmp_path: Path, stl: str,
-                                                         capsys: pytest.CaptureFixture[str]) -> None:
-    """The deck used to be written, then the STL folder refused: now nothing is written."""
-    deck = tmp_path / "X.inp"
-    assert main(["export", "0110", "--stl", str(tmp_path / stl), "--inp", str(deck)]) == 2
-    assert "collide" in capsys.readouterr().err
-    assert not deck.exists()
