@@ -52,3 +52,18 @@ def test_a_tiny_run_prints_the_front_and_writes_its_folder(tmp_path: Path,
     data = json.loads(capsys.readouterr().out)
     assert data["front"] and data["base"]["cavity_height"] == 6.0
     assert (out / "front.png").stat().st_size > 0 and (out / "units" / "knee.toml").exists()
+
+
+
+def test_the_printed_front_lists_the_base_unit_once() -> None:
+    from types import SimpleNamespace as S
+
+    from pneumorph.cli.unit import listed
+
+    base = S(values={"cavity_height": 6.0, "end_wall": 3.0})
+    front = [S(values={"cavity_height": 6.0, "end_wall": 3.0}), S(values={"cavity_height": 7.5, "end_wall": 2.0})]
+    rows = listed(S(base=base, front=front), ["cavity_height", "end_wall"])
+    assert [c.values for c, _ in rows] == [base.values, front[1].values]
+    assert rows[0][1] == "  <- base unit (on the front)"
+    off = listed(S(base=base, front=front[1:]), ["cavity_height", "end_wall"])
+    assert len(off) == 2 and off[0][1] == "  <- base unit"

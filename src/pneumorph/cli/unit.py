@@ -111,11 +111,10 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
         return
     names = space.names
     click.echo(" ".join(f"{n:>13}" for n in names) + f" {'Omega [deg]':>11} {'h_b [mm]':>8} {'strain':>7}")
-    for c in [result.base, *result.front]:
+    for c, mark in listed(result, names):
         m = c.measures
         tail = "failed" if m is None else f"{m.omega_deg:11.2f} {m.balloon_mm:8.2f} {m.strain:7.2f}"
-        click.echo(" ".join(f"{c.values[n]:13.2f}" for n in names) + f" {tail}"
-                   + ("  <- base unit" if c is result.base else ""))
+        click.echo(" ".join(f"{c.values[n]:13.2f}" for n in names) + f" {tail}{mark}")
     if better:
         m = better[0].measures
         assert m is not None
@@ -125,3 +124,20 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
         click.echo("no unit bends more than the base unit at the same or a lower h_b within the strain limit")
     click.echo(f"{len(result.candidates)} candidates ({result.solves} solved, {result.hits} from the cache) in "
                f"{time.perf_counter() - t0:.0f} s; written to {Path(out)}/")
+
+
+def listed(result: Any, names: Any) -> list[tuple[Any, str]]:
+    """The rows of the printed front: the base unit first (once, also when it is on the front), then the front.
+
+    >>> from types import SimpleNamespace as S
+    >>> base = S(values={"wall": 1.5})
+    >>> r = S(base=base, front=[S(values={"wall": 1.5}), S(values={"wall": 2.0})])
+    >>> [(c.values["wall"], mark) for c, mark in listed(r, ["wall"])]
+    [(1.5, '  <- base unit (on the front)'), (2.0, '')]
+    """
+    def key(c: Any) -> dict[str, float]:
+        return {n: round(float(c.values[n]), 9) for n in names}
+
+    front = [c for c in result.front if key(c) != key(result.base)]
+    on_front = len(front) < len(result.front)
+    return [(result.base, "  <- base unit" + (" (on the front)" if on_front else "")), *[(c, "") for c in front]]
