@@ -449,3 +449,15 @@ def test_a_port_in_use_is_refused_before_the_bench_starts(sandbox: Path, capsys:
         port = taken.getsockname()[1]
         line = _refused(sandbox, capsys, ["serve", "--port", str(port), "--state", "run"])
     assert f"127.0.0.1:{port} is in use" in line
+
+
+@pytest.mark.parametrize("cmd", sorted(BASE))
+def test_an_option_given_twice_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str) -> None:
+    """click keeps the last value of a repeated option and never checks the first: refused instead."""
+    argv = list(BASE[cmd])
+    option = next((a for a in argv if a.startswith("--") and a not in ("--mould", "--json")), None)
+    if option is None:
+        pytest.skip("no option with a value in the baseline")
+    value = argv[argv.index(option) + 1]
+    line = _refused(sandbox, capsys, [*argv, option, value])
+    assert f"{option} is given 2 times" in line, line

@@ -87,6 +87,34 @@ def _usage_line(exc: click.UsageError) -> str:
     return text + where
 
 
+def check_repeats(argv: list[str]) -> None:
+    """Refuse an option given more than once where only one value is kept (click keeps the last, unchecked).
+
+    >>> check_repeats(["simulate", "-o", "01", "--pressure", "abc", "--pressure=10"])
+    Traceback (most recent call last):
+    ...
+    click.exceptions.UsageError: --pressure is given 2 times; give it once
+    >>> check_repeats(["design", "--objective", "max-x", "--out", "a"])
+    """
+    command: click.Command = cli
+    i = 0
+    while isinstance(command, click.Group) and i < len(argv) and argv[i] in command.commands:
+        command = command.commands[argv[i]]
+        i += 1
+    single = {name: p for p in command.params if isinstance(p, click.Option) and not p.multiple and not p.count
+              for name in (*p.opts, *p.secondary_opts)}
+    seen: dict[str, list[str]] = {}
+    for token in argv[i:]:
+        if token == "--":
+            break
+        key = token.split("=", 1)[0] if token.startswith("--") else token
+        if key in single:
+            seen.setdefault(single[key].name or key, []).append(key)
+    for keys in seen.values():
+        if len(keys) > 1:
+            raise click.UsageError(f"{keys[0]} is given {len(keys)} times; give it once")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code.
 
@@ -103,6 +131,7 @@ def main(argv: list[str] | None = None) -> int:
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     _terminated.clear()
     try:
+        check_repeats(list(sys.argv[1:] if argv is None else argv))
         cli.main(args=argv, prog_name="pneumorph", standalone_mode=False)
     except Terminated:
         click.echo("terminated", err=True)
