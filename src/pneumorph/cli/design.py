@@ -268,7 +268,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         ref = result.refinement
         if ref is not None and "study" in ref:
             note = ref["study"]
-            click.echo(f"  mesh: the mesh study moved gaps between designs by at most {note['gap_change']:.3g} from "
+            click.echo(f"  mesh: the mesh study moved gaps between designs by at most {note['gap_change']:.3g} "
+                       f"{result.objective.unit} from "
                        f"{note['sizes_mm'][0]:g} to {note['sizes_mm'][1]:g} mm elements; "
                        + (f"within it of the winner: {', '.join(note['within'])} (--refine checks them)"
                           if note["within"] else "no verified design lies within it of the winner"))
