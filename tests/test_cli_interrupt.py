@@ -49,10 +49,16 @@ def _env(tmp_path: Path) -> dict[str, str]:
     return {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "xdg"), "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
 
 
+def _default_sigint() -> None:
+    """Start the run as a shell would, with Ctrl-C at its default: a process that inherits an ignored SIGINT keeps
+    it ignored (Python installs its KeyboardInterrupt handler only where SIGINT is not ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start_and_wait(tmp_path: Path, command: list[str], marker: str = "generation  1/") -> subprocess.Popen[str]:
     """Start a run and return once its stderr shows ``marker`` (the run is then mid-way)."""
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=_env(tmp_path),
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=_default_sigint)
     assert proc.stderr is not None
     deadline = time.monotonic() + 120
     for line in proc.stderr:

@@ -144,6 +144,7 @@ def test_a_single_worker_dies_and_is_restarted(serial: list, monkeypatch: pytest
 
 _CHILDREN = """
 import json, multiprocessing, os, signal, sys, threading, time
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as a shell starts it, whatever SIGINT state it inherited
 sys.path.insert(0, {repo!r})
 from pneumorph.execution import ProcessPoolEvaluator
 from tests.execution.test_evaluators import TroubleToy
