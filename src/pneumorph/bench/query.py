@@ -19,6 +19,7 @@ from pneumorph import checks
 from pneumorph.design.config import DesignConfig
 from pneumorph.design.targets import PRESETS, TIP_GOALS, Objective, make_objective, smooth_curve
 from pneumorph.errors import PneumorphError, SettingsError
+from pneumorph.io.files import nested_deeper
 
 KINDS = ("preset", "expression", "tip", "curve")
 MODELS = ("3d", "2d")
@@ -136,13 +137,8 @@ def load_json(raw: bytes | str, field: str = "target") -> Any:
         raise QueryError(field, f"the request is nested deeper than {MAX_DEPTH} levels") from None
     except (ValueError, UnicodeDecodeError):
         raise QueryError(field, "the request is not valid JSON") from None
-    level, depth = [data], 0
-    while level:  # breadth first, without recursion
-        depth += 1
-        if depth > MAX_DEPTH:
-            raise QueryError(field, f"the request is nested deeper than {MAX_DEPTH} levels")
-        level = [v for item in level if isinstance(item, (dict, list))
-                 for v in (item.values() if isinstance(item, dict) else item) if isinstance(v, (dict, list))]
+    if nested_deeper(data, MAX_DEPTH):
+        raise QueryError(field, f"the request is nested deeper than {MAX_DEPTH} levels")
     return data
 
 

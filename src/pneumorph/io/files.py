@@ -293,11 +293,22 @@ def read_toml(path: str | Path, what: str, error: type[PneumorphError] = Setting
         raise error(f"{what} {path}: not valid TOML: {exc}") from None
     except RecursionError:
         raise error(deep) from None
-    stack: list[tuple[Any, int]] = [(data, 1)]
-    while stack:  # iteratively: the readers of the settings recurse
-        value, depth = stack.pop()
-        if depth > MAX_TOML_DEPTH:
-            raise error(deep)
-        children = value.values() if isinstance(value, dict) else value if isinstance(value, list) else ()
-        stack.extend((child, depth + 1) for child in children)
+    if nested_deeper(data, MAX_TOML_DEPTH - 1):  # the values at the bottom count as a level here
+        raise error(deep)
     return data
+
+
+def nested_deeper(data: Any, limit: int) -> bool:
+    """Whether tables and lists (dicts and lists) nest deeper than ``limit`` levels, found without recursion.
+
+    >>> nested_deeper({"a": [1, {"b": 2}]}, 3), nested_deeper({"a": [1, {"b": [2]}]}, 3)
+    (False, True)
+    """
+    level, depth = [data], 0
+    while level:  # breadth first: the readers of the data recurse
+        depth += 1
+        if depth > limit:
+            return True
+        level = [v for item in level if isinstance(item, (dict, list))
+                 for v in (item.values() if isinstance(item, dict) else item) if isinstance(v, (dict, list))]
+    return False
