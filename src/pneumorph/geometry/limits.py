@@ -212,7 +212,7 @@ def available_memory() -> int:
 
 
 def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: int | None = None,
-               parallel: int = 1) -> MeshEstimate:
+               parallel: int = 1, advice: str | None = None) -> MeshEstimate:
     """Refuse a unit too large or too finely meshed for an actuator of ``units`` units, before meshing.
 
     Parameters
@@ -227,6 +227,8 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: 
         never starts a solve that large, whatever the machine has free).
     parallel : int
         Solves of this mesh that may run at once.
+    advice : str, optional
+        What a refusal tells the user to change (default: the unit or the actuator's length).
 
     Returns
     -------
@@ -260,12 +262,13 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: 
     check_lengths(spec)
     estimate = estimate_mesh(spec, units, dim, half)
     what = f"a {dim}D actuator of {units} units of this unit is a mesh of {estimate.describe()}"
-    advice = "make the unit smaller, its element_size larger or the actuator shorter"
+    fewer = ", or solve fewer at once" if advice is None else " or fewer workers"
+    advice = advice or "make the unit smaller, its element_size larger or the actuator shorter"
     if memory is not None:
         if estimate.bytes * parallel > memory:
             at_once = f" x {parallel} at once" if parallel > 1 else ""
             raise MeshLimitError(f"{what}{at_once}; {memory / 1e9:.1f} GB are available: {advice}"
-                                 + (", or solve fewer at once" if parallel > 1 else ""))
+                                 + (fewer if parallel > 1 else ""))
         return estimate
     limit, name = (MAX_NODES_3D, "MAX_NODES_3D") if dim == 3 else (MAX_NODES_2D, "MAX_NODES_2D")
     if estimate.nodes > limit:

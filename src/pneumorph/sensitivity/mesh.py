@@ -296,20 +296,17 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
     >>> check_refinement(Full3D(15), [1.0], memory=8 * 10**9)
     {1.0: (91322, 6894416781)}
     """
-    from pneumorph.geometry.limits import MeshLimitError, available_memory, check_lengths, estimate_mesh
+    from pneumorph.geometry.limits import MeshLimitError, available_memory, check_mesh
 
     free = available_memory() if memory is None else int(memory)
     out = {}
     for h in sorted(set(float(s) for s in sizes)):
         unit = replace(model.unit, element_size=h)
-        check_lengths(unit)
-        estimate = estimate_mesh(unit, model.n_units, model.dim, getattr(model, "half", True))
-        if estimate.bytes * parallel > free:
-            at_once = f" x {parallel} at once" if parallel > 1 else ""
-            raise MeshLimitError(
-                f"element size {h:g} mm: {model.n_units} units are a mesh of {estimate.describe()}{at_once}; "
-                f"{free / 1e9:.1f} GB are available: choose a larger element size"
-                + (" or fewer workers" if parallel > 1 else ""))
+        try:
+            estimate = check_mesh(unit, model.n_units, model.dim, getattr(model, "half", True), memory=free,
+                                  parallel=parallel, advice="choose a larger element size")
+        except MeshLimitError as exc:
+            raise MeshLimitError(f"element size {h:g} mm: {exc}") from None
         out[h] = (estimate.nodes, estimate.bytes)
     return out
 
