@@ -15,8 +15,13 @@ TINY = ["--units", "2", "--search", "ga", "--pop", "4", "--gen", "2", "--pressur
 def test_tiny_design_run_writes_the_folder_and_resumes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     args = ["design", *TINY, "--cache", str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"), "--json"]
     assert main(args) == 0
-    first = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    first = json.loads(captured.out)
     assert first["status"] == "finished" and first["solves"] >= 1
+    err = captured.err.splitlines()
+    assert "evaluating generation 0: " in err[1] and "generation  0/2: best" in err[2], err  # after the first line
+    # the run's cache hits are the sum of its generations' (an empty cache: none)
+    assert first["cache_hits"] == 0 and all(" 0 cache hits" in line for line in err if "/2: best" in line)
     assert first["best"]["design"] in {"00", "01", "10", "11"}
     for name in ("config.toml", "generations.csv", "hall_of_fame.json", "report.md", "profile.png",
                  "winner/deformed.png", "winner/vtk/winner.pvd"):
@@ -49,7 +54,17 @@ def test_population_study_command(tmp_path: Path, capsys: pytest.CaptureFixture[
     args = ["study", "--units", "2", "--pressure", "10", "--populations", "2,4", "--seeds", "2", "--gen", "2",
             "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "st"), "--json"]
     assert main(args) == 0
-    rows = json.loads(capsys.readouterr().out)["rows"]
+    captured = capsys.readouterr()
+    rows = json.loads(captured.out)["rows"]
+    # progress: a line before each run's generation 0, one per generation of each run, one per run
+    err = captured.err.splitlines()
+    assert sum("evaluating generation 0: " in line for line in err) == 4
+    for pop in (2, 4):
+        for seed in (0, 1):
+            for gen in (0, 1, 2):
+                assert sum(f"population {pop}, seed {seed}, generation {gen}/2: best " in line
+                           for line in err) == 1, (pop, seed, gen)
+    assert "run 4/4 done" in captured.err
     assert [r["population"] for r in rows] == [2, 4]
     for r in rows:
         assert r["lowest"] <= r["mean"] <= r["largest"] and len(r["best"]) == 2
@@ -64,8 +79,14 @@ def _certified(tmp_path: Path, *extra: str) -> list[str]:
 
 def test_certified_design_on_the_shipped_2d_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main([*_certified(tmp_path, "--target", "cos", "--amplitude", "5", "--certify"), "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
     cert = out["certificate"]
+    # the FE verification is never silent: every verified design is named before its solve and after it
+    before = [line for line in captured.err.splitlines() if "  verifying " in line]
+    after = [line for line in captured.err.splitlines() if "  verified " in line]
+    for design in cert["verified"]:
+        assert sum(design in line for line in before) == 1 and sum(design in line for line in after) == 1
     assert cert["certified"] and cert["designs_scored"] == 64 and cert["complete"]
     assert out["best"]["design"] in cert["verified"] and out["solves"] == len(cert["verified"])
     top = out["top"]

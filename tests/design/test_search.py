@@ -186,8 +186,27 @@ def test_statistics_budget_elitism_and_hall_of_fame(model: ToyModel) -> None:
     hof = result.hall_of_fame
     assert len({c.design for c in hof}) == 5 and [c.value for c in hof] == sorted((c.value for c in hof), reverse=True)
     assert hof[0].value == max(s.value for s in result.scores.values())
-    assert all(h.evaluations == h.cache_hits + h.solves for h in result.history)
+    assert all(h.evaluations == h.cache_hits + h.solves + h.repeats for h in result.history)
     assert sum(h.solves for h in result.history) == result.solves == len(result.scores)
+
+
+def test_cache_hits_are_counted_the_same_per_generation_and_per_run(tmp_path) -> None:
+    """A generation's cache hits are the evaluation cache's answers, as the run's total counts them (the
+    designs a run scored before are repeats): "0 cache hits" at the end never follows generations with hits."""
+    model, goal = ToyModel(n_units=6), objective("sin")
+    config = GAConfig(population=12, generations=6, seed=2)
+    messages: list[str] = []
+    first = CachedEvaluator(SerialEvaluator(), EvaluationCache(tmp_path / "c.sqlite"))
+    result = run_ga(model, goal, config, first, on_message=messages.append)
+    assert first.hits == 0 == sum(h.cache_hits for h in result.history)
+    assert sum(h.repeats for h in result.history) > 0  # a GA meets its designs again
+    assert sum(h.solves for h in result.history) == first.solves
+    again = CachedEvaluator(SerialEvaluator(), EvaluationCache(tmp_path / "c.sqlite"))
+    rerun = run_ga(model, goal, config, again)
+    assert again.solves == 0 and sum(h.cache_hits for h in rerun.history) == again.hits == first.solves
+    assert [h.repeats for h in rerun.history] == [h.repeats for h in result.history]
+    # said before generation 0, which holds only new designs (the toy model has no measured solve time)
+    assert messages == [f"evaluating generation 0: {result.history[0].solves} designs ..."]
 
 
 def test_bad_search_settings_are_rejected() -> None:

@@ -206,8 +206,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         total = config.ga.generations
         done = stats.generation
         bar = "#" * int(20 * done / max(total, 1))
-        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: best {stats.best:.4g}  mean {stats.mean:.4g}  "
-                   f"solves {stats.solves}  cache hits {stats.cache_hits}  {stats.wall_time:.1f} s", err=True)
+        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: {stats.describe()}", err=True)
 
     def on_progress(done: int, total: int) -> None:
         announce()

@@ -64,13 +64,26 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     click.echo(f"population study: {objective.label}, populations {pops}, {seeds} seeds, "
                f"{generations} generations, {config.units} units", err=True)
 
+    runs = len(pops) * seeds
+    done: list[int] = []
+
+    def on_message(text: str) -> None:  # before a run's generation 0
+        click.echo(f"  run {len(done) + 1}/{runs}: {text}", err=True)
+
+    def on_generation(pop: int, seed: int, stats) -> None:
+        click.echo(f"    population {pop}, seed {seed}, generation {stats.generation}/{generations}: "
+                   f"{stats.describe()}", err=True)
+
     def on_run(pop: int, seed: int, result) -> None:
+        done.append(pop)
         best = result.best
-        click.echo(f"  population {pop:3d}, seed {seed}: best {best.value:.4g} ({best.design})", err=True)
+        click.echo(f"  population {pop:3d}, seed {seed}: best {best.value:.4g} {objective.unit} ({best.design}); "
+                   f"run {len(done)}/{runs} done", err=True)
 
     try:
         result = population_study(model, objective, pops, tuple(range(seeds)), generations,
-                                  base=replace(config.ga, seed=0), evaluator=evaluator, on_run=on_run)
+                                  base=replace(config.ga, seed=0), evaluator=evaluator, on_run=on_run,
+                                  on_generation=on_generation, on_message=on_message)
     finally:
         evaluator.close()
     cluster = cluster_report(evaluator)

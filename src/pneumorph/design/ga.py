@@ -124,9 +124,12 @@ class GAConfig:
 class GenerationStats:
     """Statistics of one generation's population (finite fitness values only).
 
-    ``evaluations`` = individuals whose fitness was computed (eaSimple's ``nevals``), of
-    which ``cache_hits`` were known (earlier in the run or from the evaluation cache) and
-    ``solves`` were new model solves; ``failures`` = individuals with a failed solve.
+    ``evaluations`` = individuals whose fitness was computed (eaSimple's ``nevals``) =
+    ``solves`` (new model solves) + ``cache_hits`` (answered by the evaluation cache, the
+    same count as :attr:`CachedEvaluator.hits <pneumorph.execution.CachedEvaluator>` and a
+    run's ``cache_hits``, so a run's hits are the sum of its generations') + ``repeats``
+    (designs this run had scored before, or twice in the generation: not asked of the
+    evaluator at all); ``failures`` = individuals with a failed solve.
     """
 
     generation: int
@@ -140,9 +143,21 @@ class GenerationStats:
     failures: int
     wall_time: float
     best_design: str
+    repeats: int = 0
 
     def as_row(self) -> dict[str, object]:
         return dict(self.__dict__)
+
+    def describe(self) -> str:
+        """One progress line: fitness statistics, where the evaluations came from, wall time.
+
+        Examples
+        --------
+        >>> GenerationStats(3, 1.5, 2.25, 4.0, 0.5, 10, 2, 5, 0, 12.34, "0101", repeats=3).describe()
+        'best 1.5  mean 2.25  10 evaluated: 5 solved, 2 cache hits, 3 repeats  12.3 s'
+        """
+        return (f"best {self.best:.4g}  mean {self.mean:.4g}  {self.evaluations} evaluated: {self.solves} solved, "
+                f"{self.cache_hits} cache hits, {self.repeats} repeats  {self.wall_time:.1f} s")
 
 
 @dataclass(frozen=True)
@@ -264,7 +279,7 @@ def _design(ind: Sequence[int], symbols: Sequence[str] = (), symmetric: Sequence
     return design_strings(np.asarray(canonical_codes(np.asarray([ind], dtype=np.uint8), symmetric)), symbols)[0]
 
 
-def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[int, int, int],
+def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[int, int, int, int],
            wall: float, symbols: Sequence[str] = (), symmetric: Sequence[int] = ()) -> GenerationStats:
     values = np.array([ind.fitness.values[0] for ind in population], dtype=float)
     finite = values[np.isfinite(values)]
@@ -274,21 +289,23 @@ def _stats(gen: int, population: Sequence[Any], book: ScoreBook, counts: tuple[i
         mean, std = float(finite.mean()), float(finite.std())
     else:
         best = worst_ = mean = std = math.nan
+    evaluations, hits, solves, repeats = counts
     return GenerationStats(
-        gen, float(best), mean, float(worst_), std, *counts, int(values.size - finite.size), wall,
-        _design(best_ind, symbols, symmetric)
+        gen, float(best), mean, float(worst_), std, evaluations, hits, solves, int(values.size - finite.size), wall,
+        _design(best_ind, symbols, symmetric), repeats
     )
 
 
 def _evaluate(population: Sequence[Any], book: ScoreBook, symbols: Sequence[str] = (),
-              symmetric: Sequence[int] = ()) -> tuple[int, int, int]:
+              symmetric: Sequence[int] = ()) -> tuple[int, int, int, int]:
+    """Score the individuals whose fitness is invalid: (evaluations, cache hits, solves, repeats)."""
     invalid = [ind for ind in population if not ind.fitness.valid]
-    before = book.solves
+    solves, hits = book.solves, book.hits
     scores = book.score_many([_design(ind, symbols, symmetric) for ind in invalid])
     for ind, s in zip(invalid, scores, strict=True):
         ind.fitness.values = (s.value,)
-    solves = book.solves - before
-    return len(invalid), len(invalid) - solves, solves
+    solves, hits = book.solves - solves, book.hits - hits
+    return len(invalid), hits, solves, len(invalid) - hits - solves
 
 
 def run_ga(
@@ -297,6 +314,7 @@ def run_ga(
     config: GAConfig = GAConfig(),
     evaluator: Evaluator | None = None,
     on_generation: Callable[[GenerationStats], None] | None = None,
+    on_message: Callable[[str], None] | None = None,
 ) -> GAResult:
     """Search the orientation vectors of ``model`` for the best fitness with eaSimple.
 
@@ -312,6 +330,9 @@ def run_ga(
         :class:`~pneumorph.execution.CachedEvaluator` to persist the solves.
     on_generation : callable, optional
         Called with each generation's :class:`GenerationStats` as soon as it is known.
+    on_message : callable, optional
+        Called with a line of text before generation 0 is evaluated (its designs and the
+        expected solve time), so that the longest wait of a run is announced.
 
     Returns
     -------
@@ -332,6 +353,11 @@ def run_ga(
 
     start = time.perf_counter()
     population = toolbox.population(n=config.population)
+    if on_message:  # the FE verification's estimate of a solve (pneumorph.design.certified)
+        from pneumorph.design.certified import _solve_estimate
+
+        distinct = len({_design(ind, symbols, symmetric) for ind in population})
+        on_message(f"evaluating generation 0: {distinct} designs{_solve_estimate(model, distinct)} ...")
     counts = _evaluate(population, book, symbols, symmetric)
     history.append(_stats(0, population, book, counts, time.perf_counter() - start, symbols, symmetric))
     if on_generation:

@@ -575,7 +575,7 @@ def run_design(
         refinement: dict[str, Any] | None = None
         try:
             if search == "ga":
-                ga = run_ga(model, objective, config.ga, cached, on_gen)
+                ga = run_ga(model, objective, config.ga, cached, on_gen, on_message=say)
                 hof, history = ga.hall_of_fame, ga.history
             elif search == "certified":
                 assert chain is not None

@@ -62,6 +62,9 @@ def check_units(model: ActuatorModel) -> int:
 class ScoreBook:
     """Scores of every design evaluated in one search (each design is solved once).
 
+    ``solves`` counts the designs the evaluator solved, ``hits`` those it answered from
+    the evaluation cache (a design scored before in this search is asked of neither).
+
     Parameters
     ----------
     model : ActuatorModel
@@ -80,6 +83,7 @@ class ScoreBook:
         self.scores: dict[str, Score] = {}
         self.outcomes: dict[str, Outcome] = {}
         self.solves = 0
+        self.hits = 0
 
     def add(self, outcome: Outcome) -> Score:
         """Score an outcome and remember it."""
@@ -94,6 +98,7 @@ class ScoreBook:
         if new:
             for outcome in self.evaluator.evaluate_many(self.model, new):
                 self.solves += not outcome.cached
+                self.hits += outcome.cached
                 self.add(outcome)
         return [self.scores[d] for d in designs]
 

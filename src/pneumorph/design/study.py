@@ -11,11 +11,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from pneumorph.design.ga import GAConfig, GAResult, run_ga
+from pneumorph.design.ga import GAConfig, GAResult, GenerationStats, run_ga
 from pneumorph.design.targets import Objective
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
@@ -97,6 +98,8 @@ def population_study(
     base: GAConfig | None = None,
     evaluator: Evaluator | None = None,
     on_run: Callable[[int, int, GAResult], None] | None = None,
+    on_generation: Callable[[int, int, GenerationStats], None] | None = None,
+    on_message: Callable[[str], None] | None = None,
 ) -> StudyResult:
     """Run the GA for every population size and seed; summarise the best fitness.
 
@@ -114,6 +117,12 @@ def population_study(
         Shared by all runs (use a cached evaluator to solve each design once).
     on_run : callable, optional
         Called with (population, seed, result) after each run.
+    on_generation : callable, optional
+        Called with (population, seed, stats) after each generation of each run
+        (:class:`~pneumorph.design.ga.GenerationStats`).
+    on_message : callable, optional
+        Called with a line of text before each run's generation 0 is evaluated
+        (:func:`~pneumorph.design.ga.run_ga`).
 
     Returns
     -------
@@ -127,7 +136,8 @@ def population_study(
         results = []
         for seed in seeds:
             config = replace(base, population=int(pop), generations=int(generations), seed=int(seed))
-            res = run_ga(model, objective, config, evaluator)
+            step = None if on_generation is None else partial(on_generation, int(pop), int(seed))
+            res = run_ga(model, objective, config, evaluator, step, on_message=on_message)
             results.append(res)
             if on_run:
                 on_run(int(pop), int(seed), res)
