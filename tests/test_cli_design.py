@@ -8,6 +8,10 @@ from pathlib import Path
 import pytest
 
 from pneumorph.cli import main
+from pneumorph.models.buildplan import build_plan
+from pneumorph.models.chaintables import build_options
+from pneumorph.models.factory import make_model
+from pneumorph.models.windows import covering_designs
 
 TINY = ["--units", "2", "--search", "ga", "--pop", "4", "--gen", "2", "--pressure", "10", "--executor", "serial"]
 
@@ -96,6 +100,14 @@ def test_certified_design_on_the_shipped_2d_table(tmp_path: Path, capsys: pytest
     assert "## Certificate" in (tmp_path / "run" / "report.md").read_text()
     saved = json.loads((tmp_path / "run" / "certificate.json").read_text())
     assert saved["winner"]["design"] == out["best"]["design"]
+    # the certificate in words, printed and in the report (the same run again: answered from the cache)
+    assert main(_certified(tmp_path, "--target", "cos", "--amplitude", "5", "--certify")) == 0
+    text = capsys.readouterr().out
+    verdict = f"Certified: of the 64 designs scored by the chain model, none can beat {out['best']['design']}."
+    verified = f"Verified by FE (2d): {len(cert['verified'])} design"
+    assert f"  {verdict}\n" in text and f"  {verified}" in text and "  Bound: the chain model's value of " in text
+    report = (tmp_path / "run" / "report.md").read_text()
+    assert f"- {verdict}\n" in report and f"- {verified}" in report
 
 
 def test_certified_design_refuses_bad_tables_before_writing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -143,7 +155,11 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     # the plan and its estimate before the first solve, then the build's progress
     plan = captured.err.index("building the chain table of the 2d model (unit with element_size 3, 2-20 kPa in 10 "
                               "levels)")
-    assert "22-59 FE solves, estimated" in captured.err and plan < captured.err.index("covering: 1/")
+    training = make_model(15, {"fidelity": "2d", "unit_file": str(unit), "pressure_kpa": 20})
+    counts = build_plan(training, **build_options(training))
+    assert counts.windows == (2, 3) and counts.fewest == len(covering_designs(15, 2)) + 6  # 6 held-out if clear
+    assert f"{counts.fewest}-{counts.solves[-1]} FE solves, estimated" in captured.err
+    assert plan < captured.err.index("covering: 1/")
     assert "held-out" in captured.err and "building the tolerance tables" in captured.err
     kept = sorted((tmp_path / "cache" / "chain-tables").glob("chain-2d-*.json"))
     tables = [p for p in kept if "tolerance" not in p.name]
@@ -245,7 +261,7 @@ def test_a_pressure_between_the_tables_levels_is_served_by_the_levels_below_it(
     assert top["fe"] is not None and abs(top["fe"] - top["chain"]) <= cert["bound"]
     assert not (tmp_path / "cache" / "chain-tables").exists()  # nothing built, nothing kept
     config = (tmp_path / "run6" / "config.toml").read_text()
-    assert "pressures_kPa = [4.5, 9.0, 13.5, 18.0, 22.5]" in config and "pressure_kpa = 25.0" in config
+    assert "pressures_kpa = [4.5, 9.0, 13.5, 18.0, 22.5]" in config and "pressure_kpa = 25.0" in config
     assert note in (tmp_path / "run6" / "report.md").read_text()
 
 
@@ -259,7 +275,9 @@ def test_no_build_stops_a_run_that_needs_a_table_with_one_line(tmp_path: Path,
     assert "--no-build: no chain table serves the 2d model (the built-in unit, 0.3-3 kPa in 10 levels" in err
     assert "(the shipped table's levels start at 4.5 kPa)" in err
     assert f"`pneumorph chain build --model 2d --pressure 3 --out {tables}/chain-2d-" in err
-    assert "22-59 FE solves, estimated" in err
+    training = make_model(15, {"fidelity": "2d", "pressure_kpa": 3})
+    counts = build_plan(training, **build_options(training))
+    assert f"{counts.fewest}-{counts.solves[-1]} FE solves, estimated" in err
     assert not (tmp_path / "run8").exists() and not tables.exists()
 
 

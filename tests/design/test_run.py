@@ -30,7 +30,18 @@ class Killed(BaseException):
 def config(tmp_path: Path, **kw) -> DesignConfig:
     ga = GAConfig(population=16, generations=8, indpb=1 / 8, hall_of_fame=5)
     return DesignConfig(**{"objective": "sin", "units": 8, "ga": ga, "cache": str(tmp_path / "cache.sqlite"),
-                           "search": "ga", **kw})
+                           "search": "ga", "executor": "serial", **kw})  # toy models, solved in this process
+
+
+def test_the_api_defaults_are_the_command_lines() -> None:
+    """DesignConfig's defaults run as ``pneumorph design``: a process pool, the 3D model for the certified
+    search (2D for the others), through DesignConfig.make_model."""
+    c = DesignConfig()
+    assert c.search == "certified" and c.executor == "processes" and c.fidelity == "3d"
+    assert c.make_model().fidelity == "3d" and c.model_settings() == {"fidelity": "3d"}
+    assert DesignConfig(search="ga").make_model().fidelity == "2d"
+    assert DesignConfig(model={"fidelity": "2d"}).make_model().fidelity == "2d"
+    assert DesignConfig.from_dict({"design": {"units": 4}}).executor == "processes"  # a config file without one
 
 
 def test_run_folder_contents(tmp_path: Path) -> None:
@@ -45,7 +56,7 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     assert DesignConfig.from_dict(saved) == cfg
     prov = saved["provenance"]
     assert prov["model_fingerprint"] == ToyModel().fingerprint() and prov["seed"] == 0
-    assert prov["model_fidelity"] == "toy" and prov["pressures_kPa"][-1] == 45.0
+    assert prov["model_fidelity"] == "toy" and prov["pressures_kpa"][-1] == 45.0
     assert {"numpy", "deap"} <= set(prov["dependencies"]) and prov["pneumorph"]
     rows = list(csv.DictReader((folder / "generations.csv").open()))
     assert [int(r["generation"]) for r in rows] == list(range(9))
@@ -53,7 +64,10 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     hof = json.loads((folder / "hall_of_fame.json").read_text())
     best = result.best
     assert hof["designs"][0]["design"] == best.design and hof["sense"] == "min"
-    assert hof["designs"][0]["pressure_kPa"] == pytest.approx(best.pressure * 1e3)
+    assert hof["designs"][0]["pressure_kpa"] == pytest.approx(best.pressure * 1e3)
+    for name in ("hall_of_fame.json", "config.toml", "ranking.csv"):  # one spelling of kPa in keys: pressure_kpa
+        if (folder / name).exists():
+            assert "kPa" not in (folder / name).read_text(), name
     report = (folder / "report.md").read_text()
     assert f"`{best.design}`" in report and f"{best.pressure * 1e3:.4g} kPa" in report and "error (Eq 4.1)" in report
 

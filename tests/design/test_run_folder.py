@@ -45,7 +45,7 @@ class BrokenPressures(ToyModel):
 def config(tmp_path: Path, **kw) -> DesignConfig:
     ga = GAConfig(population=16, generations=8, indpb=1 / 8, hall_of_fame=5)
     return DesignConfig(**{"objective": "sin", "units": 8, "ga": ga, "cache": str(tmp_path / "cache.sqlite"),
-                           "search": "ga", **kw})
+                           "search": "ga", "executor": "serial", **kw})  # toy models, solved in this process
 
 
 def snapshot(folder: Path) -> dict[str, bytes | None]:
@@ -155,12 +155,17 @@ def test_a_resumed_run_appends_to_generations_csv(tmp_path: Path) -> None:
 def test_generation_log_rules(tmp_path: Path) -> None:
     path = tmp_path / "generations.csv"
     fields = ",".join(_GenerationLog.FIELDS)
-    path.write_text(f"{fields}\n0,1,2,3,4,5,6,7,8,9,01\nx,1\n0,9,9,9,9,9,9,9,9,9,11\n1,1,2,3,4,5,6,7,8,9,10\n")
+    path.write_text(f"{fields}\n0,1,2,3,4,5,6,7,8,9,01,0\nx,1\n0,9,9,9,9,9,9,9,9,9,11,0\n1,1,2,3,4,5,6,7,8,9,10,0\n")
     log = _GenerationLog(path, resume=True)
     log.close()
     rows = list(csv.reader(path.read_text().splitlines()))
-    assert [r[0] for r in rows[1:]] == ["0", "1"] and rows[1][-1] == "01"  # unreadable and repeated rows dropped
+    assert [r[0] for r in rows[1:]] == ["0", "1"] and rows[1][-2] == "01"  # unreadable and repeated rows dropped
     assert not temporaries(tmp_path)
+    # a log written before the repeats column: its rows kept under the new header, the column empty
+    old = ",".join(f for f in _GenerationLog.FIELDS if f != "repeats")
+    path.write_text(f"{old}\n0,1,2,3,4,5,6,7,8,9,01\n")
+    _GenerationLog(path, resume=True).close()
+    assert path.read_text().splitlines() == [fields, "0,1,2,3,4,5,6,7,8,9,01,"]
     _GenerationLog(path, resume=False).close()  # a new run starts the file afresh
     assert path.read_text().splitlines() == [fields]
 
@@ -202,7 +207,7 @@ def _needs_a_table(tmp_path: Path) -> tuple[DesignConfig, object]:
     from pneumorph.models.factory import make_model
 
     settings = {"fidelity": "2d", "unit": {"element_size": 3.0}, "pressure_kpa": 10}
-    cfg = DesignConfig(objective="cos", units=7, search="certified", tolerance=0.0,
+    cfg = DesignConfig(objective="cos", units=7, search="certified", tolerance=0.0, executor="serial",
                        cache=str(tmp_path / "cache" / "c.sqlite"), model=settings)
     return cfg, make_model(7, settings)
 

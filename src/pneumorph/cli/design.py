@@ -109,7 +109,6 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     from pneumorph.design import DesignConfig, run_design
     from pneumorph.errors import LocalityError, SearchConfigError
     from pneumorph.io.files import strict_json
-    from pneumorph.models.factory import make_model
 
     if target and objective:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
@@ -128,7 +127,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             UnitSpec.from_toml(unit_file)
     if library is not None:
         P.library_option(library, unit_file)
-    config = DesignConfig.read(config_file) if config_file else DesignConfig(executor="processes")
+    config = DesignConfig.read(config_file) if config_file else DesignConfig()
     check_options(executor or config.executor, config.workers if workers is None else workers,
                   scheduler or config.scheduler)
     changes: dict[str, Any] = {}
@@ -164,11 +163,10 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
     if fallback:
         config = replace(config, search="ga", **_NOT_CERTIFIED)
-    if "fidelity" not in config.model:  # the certified search works on the 3D model by default
-        config = replace(config, model={**config.model, "fidelity": "3d" if config.search == "certified" else "2d"})
+    config = replace(config, model=config.model_settings())  # the fidelity of the search (3d for certified)
     config = DesignConfig.from_dict(config.to_dict())  # validate the combination
     folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
-    model = make_model(config.units, config.model)
+    model = config.make_model()
     mixed = bool(getattr(model, "mixed", False))
     if mixed:
         _check_library_run(config, model, tolerance)
@@ -226,7 +224,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
         settings = dict(config.model) if fidelity_given else {**config.model, "fidelity": "2d"}
         config = replace(config, search="ga", model=settings, **_NOT_CERTIFIED)
-        model = make_model(config.units, config.model)
+        model = config.make_model()
         folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
         said.clear()  # the new run says its own first line
         result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
@@ -257,13 +255,14 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {_value_words(result, config)} "
                    f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
         if result.certified is not None:
-            c = result.certified.certificate
+            from pneumorph.design.certificate import certificate_text
+
+            for line in certificate_text(result.certified.certificate, result.objective.unit, best.design,
+                                         model.fidelity):
+                click.echo(f"  {line}")
             two_d = result.opinion_2d.get(best.design)
-            click.echo(f"  {'certified' if c['certified'] else 'not certified'}: "
-                       f"{c['designs_scored']:,} designs scored by the chain, {len(c['verified'])} verified by FE; "
-                       + ("no other design can beat it" if c["certified"] else
-                          f"{c['could_beat']} could beat it by up to {c['gap']:.3g} (--certify verifies them)")
-                       + ("" if two_d is None else f"; the 2D model's value: {two_d:.4g}"))
+            if two_d is not None:
+                click.echo(f"  The 2D model's chain value of {best.design}: {two_d:.4g} {result.objective.unit}.")
         ref = result.refinement
         if ref is not None and "study" in ref:
             note = ref["study"]

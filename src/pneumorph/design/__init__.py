@@ -5,7 +5,7 @@ The functions a front end calls:
 - :func:`make_objective` - an objective from text (``"sin"``, ``"max-y"``, ``"y = ..."``).
 - :func:`score` - a response's fitness at every pressure level and its best level.
 - :func:`certified_search` - every design scored by a chain model, the best verified by FE,
-  with a bound on what any other design could do.
+  with a bound on what any other design could do; :func:`certificate_text` says it in words.
 - :func:`run_ga` / :func:`run_exhaustive` - the searches, through any evaluator.
 - :func:`run_design` - a whole run into a folder (resumable), from a :class:`DesignConfig`.
 - :func:`population_study` - the population-size study of section 6.1.
@@ -17,6 +17,7 @@ Examples
 'sin: y = A*sin(2*pi*1*x/L), A = 15 mm'
 """
 
+from pneumorph.design.certificate import certificate_text
 from pneumorph.design.certified import CertifiedResult, certified_search
 from pneumorph.design.config import DesignConfig
 from pneumorph.design.exhaustive import (
@@ -60,6 +61,7 @@ __all__ = [
     "Score",
     "StudyResult",
     "TipGoal",
+    "certificate_text",
     "certified_search",
     "curve_target",
     "make_objective",

@@ -20,11 +20,11 @@ A config file::
     generations = 15
 
     [execution]
-    executor = "serial"      # serial | processes | dask
+    executor = "processes"   # processes (default) | serial | dask
     cache = "evaluations.sqlite"
 
-    [model]                  # handed to the model factory unchanged
-    fidelity = "2d"
+    [model]                  # handed to the model factory (DesignConfig.make_model)
+    fidelity = "3d"          # default: 3d for the certified search, 2d for ga and exhaustive
 """
 
 from __future__ import annotations
@@ -66,6 +66,13 @@ _address = partial(checks.address, error=SearchConfigError)
 class DesignConfig:
     """Everything that defines a design run (the model's own settings go in ``model``).
 
+    The defaults are those of ``pneumorph design``: a 15-unit actuator for the target
+    "sin, amplitude 10 mm, one period", the certified search, the solves in a pool of
+    processes (``executor = "processes"``, one per core; ``"serial"`` solves in this
+    process), and the model of :attr:`fidelity` (3D for the certified search, 2D for the
+    others) built by :meth:`make_model`. A script that uses the process pool (or Dask)
+    needs an ``if __name__ == "__main__":`` guard: the workers import it.
+
     Examples
     --------
     >>> c = DesignConfig(objective="cos", amplitude=20.0, units=8)
@@ -96,7 +103,7 @@ class DesignConfig:
     robust: str | None = None
     robust_samples: int | None = None
     ga: GAConfig = field(default_factory=GAConfig)
-    executor: str = "serial"
+    executor: str = "processes"
     workers: int | None = None
     scheduler: str | None = None
     cache: str | None = None
@@ -170,6 +177,45 @@ class DesignConfig:
             self.make_objective(length=self.units * (pitch if ok else UnitSpec.pitch))
         except (TargetExpressionError, UnknownObjectiveError) as exc:
             raise SearchConfigError(f"[design] objective: {exc}") from None
+
+    @property
+    def fidelity(self) -> str:
+        """The model's fidelity: ``[model] fidelity`` if given, else ``"3d"`` for the certified search and
+        ``"2d"`` for the genetic algorithm and the exhaustive search (as ``pneumorph design`` chooses).
+
+        >>> DesignConfig().fidelity, DesignConfig(search="ga").fidelity, DesignConfig(model={"fidelity": "2d"}).fidelity
+        ('3d', '2d', '2d')
+        """
+        given = self.model.get("fidelity")
+        if given is not None:
+            return str(given)
+        return "3d" if self.search == "certified" else "2d"
+
+    def model_settings(self) -> dict[str, Any]:
+        """``model`` with the :attr:`fidelity` written in: the settings :meth:`make_model` builds from."""
+        return {**self.model, "fidelity": self.fidelity}
+
+    def make_model(self) -> Any:
+        """The FE model of these settings, as ``pneumorph design`` builds it (:attr:`fidelity`, ``units``).
+
+        Returns
+        -------
+        pneumorph.models.fe.FEModel
+
+        Raises
+        ------
+        SearchConfigError
+            A model setting that is unknown or out of range (:func:`pneumorph.models.factory.make_model`).
+
+        Examples
+        --------
+        >>> m = DesignConfig(units=4).make_model()
+        >>> m.fidelity, m.n_units
+        ('3d', 4)
+        """
+        from pneumorph.models.factory import make_model
+
+        return make_model(self.units, self.model_settings())
 
     def samples(self, chain: bool) -> int:
         """Samples of the tolerance class: ``robust_samples``, else 30 by the chain model, 8 by FE solves."""

@@ -208,7 +208,7 @@ def refine_verified(model: Any, objective: Any, designs: Sequence[str], values: 
         if outcome.ok:
             s = score(outcome.response, objective)
             row = refined_row(design, values[design], float(s.value), h0, h1, objective.sense, order)
-            row["refined_pressure_kPa"] = None if s.pressure is None else round(float(s.pressure) * 1e3, 9)
+            row["refined_pressure_kpa"] = None if s.pressure is None else round(float(s.pressure) * 1e3, 9)
         else:
             row = {"design": design, "value": values[design], "refined": None, "failure": outcome.failure}
         found[i] = row

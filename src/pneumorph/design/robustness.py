@@ -34,7 +34,7 @@ def chain_robustness(config: Any, chain: Any, tables: Any, objective: Any, winne
     return {"method": "chain model with tolerance tables", "tolerance_mm": config.tolerance,
             "samples": config.samples(chain=True), "seed": config.seed,
             "winner": {"design": winner.design, "level": level,
-                       "pressure_kPa": None if winner.pressure is None else winner.pressure * 1e3,
+                       "pressure_kpa": None if winner.pressure is None else winner.pressure * 1e3,
                        "nominal_fe": winner.value, **rob.summary(0)},
             "offsets_mm": rob.offsets.tolist(), "winner_values": rob.values[:, 0].tolist()}
 
@@ -49,7 +49,7 @@ def robust_ranking(config: Any, chain: Any, tables: Any, objective: Any,
     order = np.lexsort((np.arange(len(cost)), cost))[:TOP]
     names = design_strings(rob.bits[order])
     pressures = chain.pressures()
-    rows = [{"rank": r + 1, "design": d, "pressure_kPa": float(pressures[rob.level[i]] * 1e3),
+    rows = [{"rank": r + 1, "design": d, "pressure_kpa": float(pressures[rob.level[i]] * 1e3),
              **rob.summary(i)} for r, (d, i) in enumerate(zip(names, order, strict=True))]
     return rows, rob
 
@@ -79,7 +79,7 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
                            "element_size_mm": nominal.element_size, "offsets_mm": offsets.tolist(),
                            "winner_values": [None if not np.isfinite(v) else float(v) for v in values[1:]]}
     out["winner"] = {"design": winner.design, "level": int(winner.level),
-                     "pressure_kPa": None if winner.pressure is None else winner.pressure * 1e3,
+                     "pressure_kpa": None if winner.pressure is None else winner.pressure * 1e3,
                      "nominal_fe": winner.value, "nominal_matched_mesh": float(values[0]),
                      **(spread(values[1:][ok], objective.sense) if ok.any() else {})}
     return out

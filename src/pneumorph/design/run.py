@@ -65,6 +65,7 @@ from typing import Any
 
 import numpy as np
 
+from pneumorph.design.certificate import certificate_text
 from pneumorph.design.certified import (
     CertifiedResult,
     certified_search,
@@ -141,7 +142,7 @@ def provenance(config: DesignConfig, model: ActuatorModel) -> dict[str, Any]:
         model_fidelity=str(getattr(model, "fidelity", "unknown")),
         model_fingerprint=model.fingerprint(),
         model_units=int(model.n_units),
-        pressures_kPa=[round(float(p) * 1e3, 9) for p in model.pressures()],
+        pressures_kpa=[round(float(p) * 1e3, 9) for p in model.pressures()],
     )
 
 
@@ -760,7 +761,7 @@ def _write_outputs(
         for i, (d, s) in enumerate(ranking, 1):
             p = "" if s.pressure is None else round(s.pressure * 1e3, 9)
             rows.append([i, d, s.value, "" if s.level is None else s.level, p, s.failed])
-        text = _csv_text(["rank", "design", "value", "level", "pressure_kPa", "failed"], rows)
+        text = _csv_text(["rank", "design", "value", "level", "pressure_kpa", "failed"], rows)
         files.append(atomic_write_text(folder / "ranking.csv", text))
     if result.hall_of_fame:
         entries = [{"rank": i, **c.to_dict()} for i, c in enumerate(result.hall_of_fame, 1)]
@@ -818,9 +819,9 @@ def _top_rows(result: RunResult) -> list[dict[str, Any]]:
         fe = cert.verified.get(c.design)
         rows.append({
             "rank_chain": i, "design": c.design, "chain": c.value,
-            "chain_pressure_kPa": None if c.pressure is None else round(c.pressure * 1e3, 9),
+            "chain_pressure_kpa": None if c.pressure is None else round(c.pressure * 1e3, 9),
             "fe": None if fe is None or fe.failure else fe.value,
-            "fe_pressure_kPa": None if fe is None or fe.pressure is None else round(fe.pressure * 1e3, 9),
+            "fe_pressure_kpa": None if fe is None or fe.pressure is None else round(fe.pressure * 1e3, 9),
             "chain_2d": result.opinion_2d.get(c.design),
         })
     return rows
@@ -897,22 +898,12 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
     if cert is not None:
         sure = cert.certificate
         u = o.unit
-        eps = float(sure.get("epsilon", 0.0))
-        within = (f" by more than {eps:g} {u} ({sure['tied']:,} unverified design(s) could beat it by less: tied)"
-                  if eps > 0 else "")
-        verdict = (f"**certified**: no unverified design can beat the winner{within}" if sure["certified"] else
-                   f"not certified: {sure['could_beat']} unverified design(s) could beat the winner by up to "
-                   f"{sure['gap']:.3g} {u}" + (f" (by more than epsilon = {eps:g} {u})" if eps > 0 else "")
-                   + "; run with --certify to verify them")
+        words = certificate_text(sure, u, cert.winner.design, getattr(model, "fidelity", None),
+                                 show=len(sure["verified"]))
         lines += [
             "## Certificate",
             "",
-            f"- designs scored by the chain model: {sure['designs_scored']:,}"
-            + ("" if sure["complete"] else " (branch-and-bound; every other design is worse by the chain)"),
-            f"- verified by FE ({getattr(model, 'fidelity', '?')}): {', '.join(f'`{d}`' for d in sure['verified'])}",
-            f"- bound on the chain's objective error: {sure['bound']:.3g} {u} "
-            f"(validated centre errors x {sure['margin']:g})",
-            f"- {verdict}",
+            *[f"- {line}" for line in words],
             "",
             f"| chain rank | design | chain ({u}) | FE ({u}) | 2D chain ({u}) | pressure (kPa) |",
             "|---:|---|---:|---:|---:|---:|",
@@ -923,7 +914,7 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
 
         for row in _top_rows(result):
             lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
-                         f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kPa'] or row['chain_pressure_kPa'])} |")
+                         f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kpa'] or row['chain_pressure_kpa'])} |")
         lines.append("")
     if result.refinement is not None:
         lines += _refinement_lines(result.refinement, o)
@@ -989,7 +980,7 @@ def _robustness_lines(rob: dict[str, Any], o: Objective) -> list[str]:
              f"{rob['method']}.", ""]
 
     def row(label: str, w: dict[str, Any]) -> str:
-        p = "-" if w.get("pressure_kPa") is None else f"{w['pressure_kPa']:.4g}"
+        p = "-" if w.get("pressure_kpa") is None else f"{w['pressure_kpa']:.4g}"
         if "mean" not in w:
             return f"| {label} | `{w['design']}` | {p} | {w['nominal_fe']:.4g} | - | - | - |"
         return (f"| {label} | `{w['design']}` | {p} | {w['nominal_fe']:.4g} | {w['mean']:.4g} | {w['p95']:.4g} | "
@@ -1005,6 +996,6 @@ def _robustness_lines(rob: dict[str, Any], o: Objective) -> list[str]:
         lines += ["", f"Designs by their {rob['statistic']} error under the tolerance (chain model):", "",
                   f"| rank | design | pressure (kPa) | mean ({u}) | 95th percentile ({u}) | worst ({u}) |",
                   "|---:|---|---:|---:|---:|---:|"]
-        lines += [f"| {r['rank']} | `{r['design']}` | {r['pressure_kPa']:.4g} | {r['mean']:.4g} | {r['p95']:.4g} | "
+        lines += [f"| {r['rank']} | `{r['design']}` | {r['pressure_kpa']:.4g} | {r['mean']:.4g} | {r['p95']:.4g} | "
                   f"{r['worst']:.4g} |" for r in rob["ranking"]]
     return [*lines, ""]

@@ -26,7 +26,9 @@ class Candidate:
     level : int or None
         Index of the best reported level.
     pressure : float or None
-        Pressure of the best level (MPa).
+        Pressure of the best level, in MPa: the unit of the models and their results
+        (``Response.pressures``, ``model.ramp.pressure``). Settings, reports and JSON files
+        give kPa (``pressure_kpa``): ``pressure * 1e3``.
     failure : str or None
         Why the solve failed, if it did.
     response : Response or None
@@ -46,7 +48,7 @@ class Candidate:
             "design": self.design,
             "value": self.value,
             "level": self.level,
-            "pressure_kPa": None if self.pressure is None else round(self.pressure * 1e3, 9),
+            "pressure_kpa": None if self.pressure is None else round(self.pressure * 1e3, 9),
             "failure": self.failure,
         }
 

@@ -56,7 +56,10 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     units : int
         Number of articulating units.
     settings : mapping, optional
-        ``fidelity`` ("2d" default, or "3d"), ``pressure_kpa`` (45), ``increments`` (10),
+        ``fidelity`` ("2d" default, or "3d"; this factory serves every command and has no
+        search to choose by: a design run's default, 3D for the certified search as on the
+        command line, is :attr:`pneumorph.design.DesignConfig.fidelity`, built by
+        :meth:`~pneumorph.design.DesignConfig.make_model`), ``pressure_kpa`` (45), ``increments`` (10),
         ``substeps`` (the model class's default: 1), ``gravity`` (none; ``"hanging"``, ``"horizontal"`` or a vector in
         mm/s^2, :func:`pneumorph.models.gravity.gravity_vector`), and the unit: ``unit`` (a
         table of UnitSpec parameters) or ``unit_file`` (a TOML file with a ``[unit]`` table);
