@@ -176,14 +176,15 @@ def table(job: dict[str, Any], bench: Bench, report: Reporter) -> dict[str, Any]
     from pneumorph.execution import CachedEvaluator, EvaluationCache, make_evaluator
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.models.buildplan import build_plan
-    from pneumorph.models.chaintables import TRAINING_UNITS, table_for
+    from pneumorph.models.chaintables import TRAINING_UNITS, build_options, table_for
 
     params = job["params"]
     spec = UnitSpec.from_dict(params["unit"], "uploaded unit")
     fidelity, unit_id = params["model"], params["unit_id"]
     bench.add_unit(spec, unit_id)
     model = bench.model(fidelity, unit_id)
-    progress = TableProgress(build_plan(model.with_units(TRAINING_UNITS)).solves)
+    training = model.with_units(TRAINING_UNITS)
+    progress = TableProgress(build_plan(training, **build_options(training)).solves)
     report.say(f"chain table of unit {spec.name!r} for the {fidelity.upper()} model", 0.02)
     with EvaluationCache(job["cache"]) as cache, make_evaluator("processes", job["workers"]) as inner:
         built = table_for(model, model.with_units, folder=bench.table_dir, evaluator=CachedEvaluator(inner, cache),

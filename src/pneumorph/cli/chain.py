@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
@@ -26,7 +28,8 @@ def chain() -> None:
 @click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,
               help="Units of the training designs.")
 @click.option("--window", type=P.Count(1, 3),
-              help="Fixed window half-width (default: grow 1, 2, 3 until within tolerance).")
+              help="Fixed window half-width (default: grow from the window the shipped table of the model's "
+                   "fidelity needed, up to 3, until within tolerance; over several unit types from 1).")
 @click.option("--tolerance", type=P.Real(0.0, 100.0, low_open=True, unit="mm"), default=0.2, show_default=True,
               help="Worst held-out unit-centre error allowed at every level, mm.")
 @click.option("--heldout", type=P.Count(1, MAX_STARTS, limit="MAX_STARTS"), default=20, show_default=True,
@@ -38,10 +41,13 @@ def chain() -> None:
 @click.option("--short", is_flag=True,
               help="Learn the windows at the base and the tip from actuators of 2w units (docs/chain-model.md); "
                    "the held-out designs keep --units.")
+@click.option("--all-heldout", is_flag=True,
+              help="Solve every held-out design, even when the first 6 show the table within half the tolerance "
+                   "(as the shipped tables are validated).")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
           window: int | None, tolerance: float, heldout: int, executor: str, workers: int | None,
-          scheduler: str | None, cache: str | None, out: str, short: bool, as_json: bool) -> None:
+          scheduler: str | None, cache: str | None, out: str, short: bool, all_heldout: bool, as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with
@@ -53,6 +59,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pneumorph.io import strict_json
     from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chainfit import build_table
+    from pneumorph.models.chaintables import start_window
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
@@ -74,11 +81,12 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
     evaluator = open_evaluator(executor, workers, scheduler, cache)
     try:
-        plan = build_plan(model, heldout=heldout, workers=evaluator_workers(evaluator), window=window,
-                          tolerance=tolerance, cached=cached_counter(evaluator, model), short=short)
+        options: dict[str, Any] = {"heldout": heldout, "window": window, "tolerance": tolerance, "short": short,
+                   "first_window": start_window(model), "early": not all_heldout}
+        plan = build_plan(model, workers=evaluator_workers(evaluator), cached=cached_counter(evaluator, model),
+                          **options)
         click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve
-        table = build_table(model, evaluator, window=window, tolerance=tolerance, heldout=heldout,
-                            on_progress=lambda text: click.echo(text, err=True), short=short)
+        table = build_table(model, evaluator, on_progress=lambda text: click.echo(text, err=True), **options)
     finally:
         evaluator.close()
     cluster = cluster_report(evaluator)

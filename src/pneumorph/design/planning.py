@@ -38,7 +38,15 @@ from pneumorph.errors import ChainTableError, MissingTableError, SearchConfigErr
 from pneumorph.models.buildplan import build_plan, estimate_text
 from pneumorph.models.chain import ChainTable, source_key
 from pneumorph.models.chainfit import MAX_WINDOW
-from pneumorph.models.chaintables import TRAINING_UNITS, ServedTable, same_source, serve_table, shipped_path, table_file
+from pneumorph.models.chaintables import (
+    TRAINING_UNITS,
+    ServedTable,
+    build_options,
+    same_source,
+    serve_table,
+    shipped_path,
+    table_file,
+)
 
 #: the model settings `pneumorph chain build` takes as options (the command of a missing table names them)
 _BUILD_OPTIONS = {"fidelity": "--model", "pressure_kpa": "--pressure", "unit_file": "--unit", "library": "--library"}
@@ -193,11 +201,11 @@ def missing_table_message(config: Any, model: Any, table_dir: str | Path | None,
     ... # doctest: +ELLIPSIS +NORMALIZE_WHITESPACE
     --no-build: no chain table serves the 3d model (the built-in unit, 0.3-3 kPa in 10 levels; source ...): none
     is shipped or kept in tables (the shipped table's levels start at 4.5 kPa); build it with `pneumorph chain
-    build --model 3d --pressure 3 --out tables/chain-3d-....json` (22-59 FE solves, estimated ...), or run without
+    build --model 3d --pressure 3 --out tables/chain-3d-....json` (38-52 FE solves, estimated ...), or run without
     --no-build
     """
     training = model.with_units(TRAINING_UNITS) if callable(getattr(model, "with_units", None)) else model
-    plan = build_plan(training, workers=workers)
+    plan = build_plan(training, workers=workers, **build_options(training))
     p = model.pressures() * 1e3
     fidelity = str(getattr(model, "fidelity", "?"))
     where = f"kept in {table_dir}" if table_dir is not None else "kept (the evaluation cache is in memory)"

@@ -17,7 +17,14 @@ from typing import Any
 import numpy as np
 
 from pneumorph.errors import PneumorphError
-from pneumorph.models.chainfit import DEFAULT_TOLERANCE, MAX_WINDOW, check_training_size, heldout_designs
+from pneumorph.models.chainfit import (
+    DEFAULT_TOLERANCE,
+    MAX_WINDOW,
+    MIN_HELDOUT,
+    check_training_size,
+    evaluator_workers,
+    heldout_designs,
+)
 from pneumorph.models.windows import covering_designs
 
 #: held-out designs that validate a table built on first use
@@ -91,6 +98,9 @@ class BuildPlan:
         Covering designs of each window.
     solves : tuple of int
         Distinct FE solves if the build stops at each window (covering and held-out designs, cumulated).
+    fewest : int
+        FE solves if the first window is accepted on the fewest held-out designs (all of them,
+        unless the validation may stop early).
     heldout : int
     tolerance : float
         Worst held-out centre error allowed (mm).
@@ -106,6 +116,7 @@ class BuildPlan:
     windows: tuple[int, ...]
     covering: tuple[int, ...]
     solves: tuple[int, ...]
+    fewest: int = 0
     heldout: int = HELDOUT
     tolerance: float = DEFAULT_TOLERANCE
     cached: int = 0
@@ -113,7 +124,7 @@ class BuildPlan:
 
     def cost_text(self) -> str:
         """The FE solves (fewest to most, those cached not counted) and their estimated wall time."""
-        lo, hi = (max(s - self.cached, 0) for s in (self.solves[0], self.solves[-1]))
+        lo, hi = (max(s - self.cached, 0) for s in (self.fewest or self.solves[0], self.solves[-1]))
         count = f"{lo} FE solves" if lo == hi else f"{lo}-{hi} FE solves"
         per = solve_seconds(self.fidelity, self.n_units)
         if per is None:
@@ -131,8 +142,9 @@ class BuildPlan:
         tries = ", ".join(f"+-{w} ({c} covering designs)" for w, c in zip(self.windows, self.covering, strict=True))
         grow = (f"windows {tries} tried in turn until" if len(self.windows) > 1 else f"window {tries}, checked that")
         cached = f" ({self.cached} designs already in the evaluation cache)" if self.cached else ""
+        early = f" ({MIN_HELDOUT} if they are clearly within)" if self.fewest and self.fewest < self.solves[0] else ""
         return (f"building the chain table of the {self.fidelity} model ({self.unit}, {ramp}) on {self.n_units}-unit "
-                f"designs: {grow} the worst centre error of {self.heldout} held-out designs is within "
+                f"designs: {grow} the worst centre error of {self.heldout} held-out designs{early} is within "
                 f"{self.tolerance:g} mm; {self.cost_text()}{cached}")
 
 
@@ -169,7 +181,8 @@ def unit_text(model: Any) -> str:
 
 
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
-               window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False) -> BuildPlan:
+               window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False,
+               first_window: int = 1, early: bool = False) -> BuildPlan:
     """What :func:`~pneumorph.models.chainfit.build_table` will solve to fit a table to ``model`` (the training
     actuator: its designs have ``model.n_units`` units), counted without a solve.
 
@@ -191,6 +204,9 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     short : bool
         The build learns the end windows from short actuators (``build_table(short=True)``); each
         short design counts as one solve (the estimate takes it at the full length's time).
+    first_window, early : int, bool
+        As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, and whether
+        the validation may stop after :data:`~pneumorph.models.chainfit.MIN_HELDOUT` designs.
 
     Examples
     --------
@@ -209,32 +225,30 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     alphabet = library.alphabet if library is not None else ()
     types = max(1, len(alphabet))
     symmetric = library.symmetric_types if library is not None else ()
-    windows, covering, solves = [], [], []
+    windows: list[int] = []
+    covering: list[int] = []
+    solves: list[int] = []
     seen: set[str] = set()
-    for w in [int(window)] if window is not None else range(1, min(MAX_WINDOW, (n_units - 1) // 2) + 1):
+    first = min(max(1, int(first_window)), max(1, min(MAX_WINDOW, (n_units - 1) // 2)))
+    fewest = 0
+    for w in [int(window)] if window is not None else range(first, min(MAX_WINDOW, (n_units - 1) // 2) + 1):
         try:
             check_training_size(types, w, len(symmetric))
         except PneumorphError:
             break
         train = covering_designs(n_units, w, n_types=types, alphabet=alphabet, symmetric=symmetric, short=short)
         seen.update(train)
-        seen.update(heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet, symmetric=symmetric))
+        tests = heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet, symmetric=symmetric)
+        if not windows:
+            fewest = len(seen) + (min(MIN_HELDOUT, len(tests)) if early else len(tests))
+        seen.update(tests)
         windows.append(w)
         covering.append(len(train))
         solves.append(len(seen))
     held = int(cached(sorted(seen))) if cached is not None and seen else 0
     return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
                      tuple(float(p) for p in model.pressures()), int(n_units), tuple(windows), tuple(covering),
-                     tuple(solves), heldout, float(tolerance), held, max(1, int(workers)))
-
-
-def evaluator_workers(evaluator: Any) -> int:
-    """How many designs an evaluator solves at once (its ``workers``, or its inner evaluator's; else 1)."""
-    for candidate in (evaluator, getattr(evaluator, "inner", None)):
-        workers = getattr(candidate, "workers", None)
-        if isinstance(workers, int) and workers > 0:
-            return workers
-    return 1
+                     tuple(solves), fewest, heldout, float(tolerance), held, max(1, int(workers)))
 
 
 def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | None:

@@ -32,13 +32,18 @@ from pneumorph.models.windows import (
     window_codes,
 )
 
-__all__ = ["DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", "build_table", "check_training_size", "first_symbols",
-           "fit_table", "heldout_designs", "prediction_errors", "response_elements"]
+__all__ = ["CLEAR_FRACTION", "DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", "MIN_HELDOUT", "build_table",
+           "check_training_size", "evaluator_workers", "first_symbols", "fit_table", "heldout_designs",
+           "prediction_errors", "response_elements"]
 
 #: a level's worst held-out centre error above this is refused (mm, default)
 DEFAULT_TOLERANCE = 0.2
 #: widest window tried by :func:`build_table`
 MAX_WINDOW = 3
+#: held-out designs after which the validation may stop early (:func:`build_table` with ``early``)
+MIN_HELDOUT = 6
+#: the validation stops early once the worst held-out error is within this fraction of the tolerance
+CLEAR_FRACTION = 0.5
 #: most covering designs a table over several unit types may ask for (the base windows alone need
 #: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
 MAX_TRAINING = 200
@@ -311,6 +316,48 @@ def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed:
     return out
 
 
+def evaluator_workers(evaluator: Any) -> int:
+    """How many designs an evaluator solves at once (its ``workers``, or its inner evaluator's; else 1)."""
+    for candidate in (evaluator, getattr(evaluator, "inner", None)):
+        workers = getattr(candidate, "workers", None)
+        if isinstance(workers, int) and workers > 0:
+            return workers
+    return 1
+
+
+def _validate(table: ChainTable, tests: Sequence[str], solve: Callable[..., list[Response]],
+              tolerance: float, early: bool, batch: int) -> dict[str, Any]:
+    """The table's errors on held-out designs solved in rounds of ``batch``: all of them, unless one round refutes
+    the table (a worst error above ``tolerance``) or, with ``early``, at least :data:`MIN_HELDOUT` designs show it
+    clearly within (at most ``CLEAR_FRACTION * tolerance``)."""
+    responses: list[Response] = []
+    val = prediction_errors(table, [])
+    stop = ""
+    for lo in range(0, len(tests), batch):
+        responses += solve(list(tests[lo : lo + batch]), "held-out", lo, len(tests))
+        val = prediction_errors(table, responses)
+        worst = max(val["centre_worst_mm"])
+        if worst > tolerance:
+            stop = "refuted"
+            break
+        if early and len(responses) >= MIN_HELDOUT and worst <= CLEAR_FRACTION * tolerance:
+            stop = "clear"
+            break
+    val.update(heldout_solved=len(responses), heldout_planned=len(tests),
+               stopped_early=stop if len(responses) < len(tests) else "")
+    return val
+
+
+def _stop_note(val: dict[str, Any], tolerance: float) -> str:
+    """Why the validation stopped before its last held-out design, as a clause ('' if it did not)."""
+    if val.get("stopped_early") == "refuted":
+        return f" (stopped: above {tolerance:g} mm already)"
+    if val.get("stopped_early") == "clear":
+        return (f" (stopped early of {val['heldout_planned']}: within {CLEAR_FRACTION:g} of the tolerance after "
+                f"{MIN_HELDOUT} or more)")
+    return ""
+
+
 def build_table(
     model: Any,
     evaluator: Any = None,
@@ -321,6 +368,8 @@ def build_table(
     max_window: int = MAX_WINDOW,
     on_progress: Callable[[str], None] | None = None,
     short: bool = False,
+    first_window: int = 1,
+    early: bool = False,
 ) -> ChainTable:
     """Fit and validate a chain table to an FE model by solving covering and held-out designs.
 
@@ -333,12 +382,16 @@ def build_table(
         How the designs are solved (serial by default); a
         :class:`~pneumorph.execution.CachedEvaluator` makes the build resumable.
     window : int, optional
-        A fixed half-width; by default 1, 2, ... up to ``max_window`` until the worst
-        held-out centre error is within ``tolerance`` at every level.
+        A fixed half-width; by default ``first_window``, ``first_window + 1``, ... up to
+        ``max_window`` until the worst held-out centre error is within ``tolerance`` at every
+        level.
     tolerance : float
         Worst held-out unit-centre error allowed at any level (mm).
     heldout : int
-        Random held-out designs (seeded by ``seed``) solved to validate the table.
+        Random held-out designs (seeded by ``seed``) solved to validate the table. They are
+        solved in rounds of the evaluator's width, those already solved first; a window is
+        refused as soon as one of them is off by more than ``tolerance``, without solving the
+        rest (the refusal needs no more evidence).
     on_progress : callable, optional
         Called with a line of text after each stage.
     short : bool
@@ -346,6 +399,14 @@ def build_table(
         (:func:`~pneumorph.models.windows.covering_designs` with ``short``; the model must have
         ``with_units``), the interior ones from actuators of the model's length. The held-out
         designs are of the model's length, as always.
+    first_window : int
+        The first half-width tried when ``window`` is not given (e.g. the window the shipped
+        table of the same fidelity needed: :func:`~pneumorph.models.chaintables.start_window`).
+    early : bool
+        Stop the validation once at least :data:`MIN_HELDOUT` held-out designs are solved and
+        their worst centre error is within :data:`CLEAR_FRACTION` of the tolerance at every
+        level; the validation records how many designs it used (``heldout_solved``) and
+        whether it stopped early.
 
     Raises
     ------
@@ -365,7 +426,8 @@ def build_table(
     evaluator = evaluator or SerialEvaluator()
     n = int(model.n_units)
     say = on_progress or (lambda text: None)
-    windows = [int(window)] if window is not None else list(range(1, max_window + 1))
+    first = min(max(1, int(first_window)), max_window, max(1, (n - 1) // 2))
+    windows = [int(window)] if window is not None else list(range(first, max_window + 1))
     if windows[0] < 1 or 2 * windows[-1] + 1 > n:
         raise ChainTableError(f"a window of +-{windows[-1]} units needs training designs of at least "
                               f"{2 * windows[-1] + 1} units; the model has {n}")
@@ -376,10 +438,12 @@ def build_table(
     symmetric = library.symmetric_types if library is not None else ()
     solved: dict[str, Response] = {}
 
-    def solve(designs: list[str], what: str) -> list[Response]:
+    def solve(designs: list[str], what: str, before: int = 0, total: int | None = None) -> list[Response]:
+        """Solve ``designs`` (those not solved yet); progress lines count from ``before`` up to ``total``."""
         todo = [d for d in designs if d not in solved]
         t0 = time.perf_counter()
-        done = 0
+        done = 0 if total is None else before + len(designs) - len(todo)
+        total = len(todo) if total is None else total
         for length in sorted({len(d) for d in todo}):  # a model per length (short training designs)
             actuator = model if length == n else model.with_units(length)
             for _i, outcome in evaluator.iter_evaluate(actuator, [d for d in todo if len(d) == length]):
@@ -388,7 +452,7 @@ def build_table(
                     raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
                                           f"({outcome.failure}); the chain table needs every design solved")
                 solved[outcome.design] = outcome.response
-                say(f"  {what}: {done}/{len(todo)} solved ({'cached' if outcome.cached else 'solved'} "
+                say(f"  {what}: {done}/{total} solved ({'cached' if outcome.cached else 'solved'} "
                     f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
         return [solved[d] for d in designs]
 
@@ -401,11 +465,12 @@ def build_table(
         say(f"window +-{w}: {len(train)} covering designs")
         table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
         tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet, symmetric=symmetric)
-        val = prediction_errors(table, solve(tests, "held-out"))
+        tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
+        val = _validate(table, tests, solve, tolerance, early, evaluator_workers(evaluator))
         val.update(tolerance_mm=tolerance, seed=seed)
         worst = max(val["centre_worst_mm"])
-        say(f"window +-{w}: worst held-out centre error {worst:.4f} mm, mean at the last level "
-            f"{val['centre_mean_mm'][-1]:.4f} mm")
+        say(f"window +-{w}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
+            f"design(s){_stop_note(val, tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
         for symbol, errs in val.get("per_type", {}).items():
             if errs["centres"]:
                 say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "

@@ -50,6 +50,38 @@ def shipped_path(fidelity: str) -> Path:
     return Path(str(resources.files("pneumorph.models") / "data" / f"chain-{fidelity}.json"))
 
 
+def start_window(model: Any) -> int:
+    """The first window half-width a new table of ``model`` tries: the one the shipped table of its fidelity needed.
+
+    A unit of the same family interacts about as far along the chain as the built-in unit, so
+    smaller windows would only cost their covering designs before they are refused (the
+    built-in unit's 3D table needs +-3: +-1 and +-2 are off by mm and tenths of a mm). Tables
+    over several unit types and models without a shipped table start at +-1.
+
+    >>> from pneumorph.models.factory import make_model
+    >>> start_window(make_model(15, {"fidelity": "3d"})), start_window(make_model(15, {"fidelity": "2d"}))
+    (3, 2)
+    >>> start_window(make_model(15, {"fidelity": "2d", "library": "builtin"}))
+    1
+    """
+    library = getattr(model, "library", None)
+    path = shipped_path(str(getattr(model, "fidelity", "")))
+    if (library is not None and not library.is_single) or not path.is_file():
+        return 1
+    return ChainTable.load(path).window
+
+
+def build_options(model: Any) -> dict[str, Any]:
+    """How a table of ``model`` is built on first use: :func:`~pneumorph.models.chainfit.build_table`'s (and
+    :func:`~pneumorph.models.buildplan.build_plan`'s) ``heldout``, ``first_window`` and ``early``.
+
+    >>> from pneumorph.models.factory import make_model
+    >>> build_options(make_model(15, {"fidelity": "3d"}))
+    {'heldout': 20, 'first_window': 3, 'early': True}
+    """
+    return {"heldout": HELDOUT, "first_window": start_window(model), "early": True}
+
+
 def table_file(folder: str | Path, model: Any) -> Path:
     """Where the table of ``model`` is kept in a table folder."""
     return Path(folder) / f"chain-{getattr(model, 'fidelity', 'model')}-{source_key(model)}.json"
@@ -409,9 +441,10 @@ def table_for(
         training = make_training(TRAINING_UNITS)
         if source_key(training) != source_key(model):  # pragma: no cover - a factory that changes the model
             raise ChainTableError("the training model differs from the searched one")
-        say(build_plan(training, workers=evaluator_workers(evaluator),
-                       cached=cached_counter(evaluator, training)).text())
-        table = build_table(training, evaluator, heldout=HELDOUT, on_progress=on_progress)
+        options = build_options(training)
+        say(build_plan(training, workers=evaluator_workers(evaluator), cached=cached_counter(evaluator, training),
+                       **options).text())
+        table = build_table(training, evaluator, on_progress=on_progress, **options)
         if folder is not None:
             table.save(table_file(folder, model))
         return table
