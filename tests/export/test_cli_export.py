@@ -122,3 +122,43 @@ def test_export_writes_the_calculix_deck_of_the_3d_model(tmp_path: Path) -> None
     assert "*NODE" in text and "C3D20" in text and "design 0110" in text and "pressure 20 kPa" in text
     assert "files" not in data  # no --stl: the deck only
     assert main(["export", "0110", "--stl", str(tmp_path / "s"), "--pressure", "30"]) == 2  # a deck option alone
+
+
+def test_a_solid_unit_is_exported_as_a_solid_body(tmp_path):
+    """``solid = true``: the cavity is filled with the body material, so the body has none (it had four)."""
+    unit = tmp_path / "solid.toml"
+    unit.write_text("[unit]\nsolid = true\n")
+    result = run("0101", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--mould", "--json")
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    # 42 x 12 x 15 mm minus the four 10.5 x 3 x 15 mm layer pieces, no cavity
+    assert summary["volumes_mm3"]["body"] == pytest.approx(42 * 12 * 15 - 4 * 472.5, rel=1e-12)
+    body = trimesh.load_mesh(tmp_path / "out" / "body.stl")
+    assert body.is_watertight and body.body_count == 1 and body.volume == pytest.approx(5670.0, rel=1e-6)
+    mould = summary["mould"]
+    assert mould["check"]["ok"] and not any(name.startswith("core_") for name in mould["volumes_mm3"])
+    text = run("0101", "--stl", str(tmp_path / "out2"), "--unit", str(unit)).output
+    assert "mold_star_15 body, no cavities (solid unit)" in " ".join(text.split())
+
+
+def test_a_unit_without_a_layer_has_no_layer_pieces(tmp_path):
+    """``layer = 0`` (an extending unit): a body and a base block, with its mould (not 'an empty box')."""
+    unit = tmp_path / "extending.toml"
+    unit.write_text("[unit]\nwall = 3.0\nlayer = 0.0\n")
+    result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--mould", "--json")
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert sorted(summary["volumes_mm3"]) == ["base_block", "body"] and summary["layer_pieces"] == []
+    # 21 x 12 x 15 mm minus two 4.5 x 6 x 12 mm cavities
+    assert summary["volumes_mm3"]["body"] == pytest.approx(21 * 12 * 15 - 2 * 324.0, rel=1e-12)
+    assert summary["mould"]["check"]["ok"]
+
+
+def test_an_unknown_body_material_is_refused_before_anything_is_written(tmp_path):
+    unit = tmp_path / "unit.toml"
+    for table in ('body_material = "nonesuch"', 'layer_material = "nonesuch"'):
+        unit.write_text(f"[unit]\n{table}\n")
+        result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--mould")
+        assert result.exit_code == 2, result.output
+        assert "'--unit': unknown material 'nonesuch'; known materials: " in " ".join(result.output.split())
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["unit.toml"]

@@ -41,6 +41,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         MouldSpec,
         actuator_parts,
         casting_mould,
+        check_materials,
         layer_pieces,
         plot_mould,
         write_stl,
@@ -72,6 +73,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
                                    "mould only: add --mould")
     with P.blame("--unit"):
         unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
+        check_materials(unit)  # the parts' materials, before anything is built
     folder = Path(stl_dir) if stl_dir is not None else Path()
     mould_spec = None
     if with_mould:
@@ -112,7 +114,8 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     pieces = layer_pieces(unit, orientation)
     n = len(orientation)
     length = n * unit.pitch + unit.end_cap
-    describe = {"body": f"{unit.body_material} body, {n} cavit{'y' if n == 1 else 'ies'}",
+    cavities = "no cavities (solid unit)" if unit.solid else f"{n} cavit{'y' if n == 1 else 'ies'}"
+    describe = {"body": f"{unit.body_material} body, {cavities}",
                 "base_block": f"base block {block.length:g} x {unit.height + 2 * block.margin:g} x "
                               f"{unit.width + 2 * block.margin:g} mm, {block.material}"}
     layer_names = [k for k in parts if k.startswith("layer_")]

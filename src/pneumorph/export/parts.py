@@ -86,6 +86,7 @@ __all__ = [
     "actuator_parts",
     "actuator_solids",
     "box",
+    "check_materials",
     "layer_pieces",
     "outline_solid",
     "to_manifold",
@@ -165,10 +166,14 @@ def layer_pieces(spec: UnitSpec, orientation: str) -> list[LayerPiece]:
     [(0, 1, 'top', 21.0), (2, 4, 'bottom', 31.5)]
     >>> layer_pieces(UnitSpec(end_cap=2.0), "0")[0].length
     12.5
+    >>> layer_pieces(UnitSpec(wall=3.0, layer=0.0), "01")   # no stiff layer: no pieces
+    []
     """
     orientation = parse_orientation(orientation)
     n, P = len(orientation), spec.pitch
     pieces: list[LayerPiece] = []
+    if spec.layer == 0:  # a unit without a stiff layer (an extending unit): no strip to cut
+        return pieces
     start = 0
     for i in range(1, n + 1):
         if i == n or orientation[i] != orientation[start]:
@@ -180,7 +185,10 @@ def layer_pieces(spec: UnitSpec, orientation: str) -> list[LayerPiece]:
 
 
 def _cavity_boxes(spec: UnitSpec, orientation: str) -> list[Box]:
-    """Each unit's cavity in the actuator's frame (mirrored in y for orientation 1)."""
+    """Each unit's cavity in the actuator's frame (mirrored in y for orientation 1); none for a solid unit
+    (``solid = true``: its cavity is filled with the body material)."""
+    if spec.solid:
+        return []
     x0, x1, y0, y1 = spec.cavity
     H, W, P = spec.height, spec.width, spec.pitch
     out = []
@@ -290,12 +298,42 @@ def outline_solid(spec: UnitSpec, orientation: str, z0: float, z1: float) -> man
     return m3.Manifold.batch_boolean([box((0.0, L, 0.0, H, z0, z1)), *cutters], m3.OpType.Subtract)
 
 
+def check_materials(spec: UnitSpec, base_block: BaseBlock | None = DEFAULT_BLOCK) -> None:
+    """Refuse parts of a material the material library does not know (the body's, the layer's, the block's).
+
+    Raises
+    ------
+    UnknownMaterialError
+        Naming the material and listing the known ones.
+
+    Examples
+    --------
+    >>> check_materials(UnitSpec())
+    >>> check_materials(UnitSpec(body_material="nonesuch"))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.UnknownMaterialError: unknown material 'nonesuch'; known materials: ...
+    """
+    from pneumorph.materials.library import get
+
+    for name in (spec.body_material, *([spec.layer_material] if spec.layer > 0 else []),
+                 *([base_block.material] if base_block is not None else [])):
+        get(name)
+
+
 def actuator_solids(
     spec: UnitSpec, orientation: str, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, manifold3d.Manifold]:
-    """The actuator's parts as manifold3d solids (see :func:`actuator_parts`)."""
+    """The actuator's parts as manifold3d solids (see :func:`actuator_parts`).
+
+    Raises
+    ------
+    UnknownMaterialError
+        A part of a material the library does not know (:func:`check_materials`).
+    """
     import manifold3d as m3
 
+    check_materials(spec, base_block)
     orientation = parse_orientation(orientation)
     cavities = [box(b) for b in _cavity_boxes(spec, orientation)]
     body = m3.Manifold.batch_boolean([outline_solid(spec, orientation, 0.0, spec.width), *cavities],
