@@ -29,6 +29,7 @@ Examples
 from importlib.metadata import PackageNotFoundError, version
 
 try:
+    #: The installed package's version.
     __version__ = version("pneumorph")
 except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0.0.0+unknown"

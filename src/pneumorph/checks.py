@@ -11,16 +11,16 @@ Limits
 Sizes beyond these are refused up front instead of hanging or exhausting memory; each is
 far beyond what the dissertation's actuators need (15 units, 45-85 kPa, 10 levels).
 
-=====================  =======  ==========================================================
-``MAX_UNITS``              100  units of an actuator (1.05 m of the built-in unit)
-``MAX_PRESSURE_KPA``      1000  kPa; the silicones tear long before (Table A.2 strains)
-``MAX_INCREMENTS``        1000  reported pressure levels of a ramp
-``MAX_SUBSTEPS``           100  substeps per level
-``MAX_POPULATION``      10 000  GA population
-``MAX_GENERATIONS``     10 000  GA generations
-``MAX_STARTS``            1000  multistarts of a fit, runs, seeds, held-out designs
-``MIN_ELEMENT_FRACTION``   1/8  element size against the unit's thinnest wall
-=====================  =======  ==========================================================
+========================  ======  =======================================================
+``MAX_UNITS``                100  units of an actuator (1.05 m of the built-in unit)
+``MAX_PRESSURE_KPA``        1000  kPa; the silicones tear long before (Table A.2 strains)
+``MAX_INCREMENTS``          1000  reported pressure levels of a ramp
+``MAX_SUBSTEPS``             100  substeps per level
+``MAX_POPULATION``        10 000  GA population
+``MAX_GENERATIONS``       10 000  GA generations
+``MAX_STARTS``              1000  multistarts of a fit, runs, seeds, held-out designs
+``MIN_ELEMENT_FRACTION``     1/8  element size against the unit's thinnest wall
+========================  ======  =======================================================
 """
 
 from __future__ import annotations

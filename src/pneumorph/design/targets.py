@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -333,8 +333,163 @@ class TipGoal:
         return TIP_GOALS[self.name][1]
 
 
-Objective = ProfileTarget | TipGoal
+#: relative difference within which a stage's pressure is a level of the ramp
+LEVEL_MATCH = 1e-6
+#: most stages of one staged target
+MAX_STAGES = 20
 
+
+@dataclass(frozen=True)
+class Stage:
+    """One stage of a :class:`StagedTarget`: a target to meet at one pressure of the ramp.
+
+    Attributes
+    ----------
+    pressure : float
+        The pressure (MPa), a level of the model's ramp.
+    target : ProfileTarget or TipGoal
+        A Cartesian profile (preset, expression or drawn curve; Eq 4.1 in mm) or the tip goal
+        ``reach`` (the tip's distance to a point, mm).
+    weight : float
+        The stage's weight in the root-sum-square (positive).
+    """
+
+    pressure: float
+    target: ProfileTarget | TipGoal
+    weight: float = 1.0
+
+    @property
+    def label(self) -> str:
+        weight = f" (weight {self.weight:g})" if self.weight != 1.0 else ""
+        return f"{self.pressure * 1e3:g} kPa: {self.target.label}{weight}"
+
+
+@dataclass(frozen=True)
+class StagedTarget:
+    """Targets at several pressures of one ramp, met together (minimised).
+
+    The cost of a design is the weighted root-sum-square of its stages' values,
+    ``sqrt(sum_s (w_s v_s)^2)``, each ``v_s`` the stage's value at its own level: Eq 4.1 of a
+    profile (mm) or the tip's distance to a point (mm). Every other level of the ramp counts
+    as the worst value, so the cost stands at the level of the highest stage (its best
+    level).
+
+    Examples
+    --------
+    >>> t = staged_target([(0.018, make_objective("y = 0.02*x")), (0.045, make_objective("sin"))])
+    >>> t.levels(np.linspace(0.0045, 0.045, 10))
+    (3, 9)
+    >>> float(t.combine(np.array([3.0, 4.0])))
+    5.0
+    >>> t.label
+    'stages: 18 kPa: y = 0.02*x; 45 kPa: sin: y = A*sin(2*pi*1*x/L), A = 10 mm'
+    """
+
+    stages: tuple[Stage, ...]
+    name: str = field(default="stages", init=False)
+    sense: Sense = field(default="min", init=False)
+    unit: str = field(default="mm", init=False)
+    point: None = field(default=None, init=False)
+
+    @property
+    def label(self) -> str:
+        return "stages: " + "; ".join(stage.label for stage in self.stages)
+
+    @property
+    def weights(self) -> NDArray[np.float64]:
+        return np.array([stage.weight for stage in self.stages], dtype=float)
+
+    def levels(self, pressures: ArrayLike) -> tuple[int, ...]:
+        """The level of each stage among a ramp's ``pressures`` (MPa).
+
+        Raises
+        ------
+        SearchConfigError
+            A stage's pressure that is not one of the levels, naming the levels.
+        """
+        p = np.asarray(pressures, dtype=float)
+        out = []
+        for stage in self.stages:
+            near = np.flatnonzero(np.abs(p - stage.pressure) <= LEVEL_MATCH * max(abs(stage.pressure), 1e-12))
+            if not near.size:
+                levels = ", ".join(f"{v * 1e3:.4g}" for v in p)
+                raise SearchConfigError(f"stage at {stage.pressure * 1e3:g} kPa: not a level of the model's ramp; "
+                                        f"the levels are {levels} kPa (a stage's pressure must be one of them)")
+            out.append(int(near[0]))
+        return tuple(out)
+
+    def combine(self, values: ArrayLike) -> NDArray[np.float64]:
+        """The weighted root-sum-square over the last axis (one value per stage)."""
+        v = np.asarray(values, dtype=float)
+        return np.sqrt(np.sum((v * self.weights) ** 2, axis=-1))
+
+    def at_levels(self, per_stage: ArrayLike, pressures: ArrayLike) -> NDArray[np.float64]:
+        """Values per level, shape (..., k): the combined value at the highest stage's level, worst elsewhere.
+
+        ``per_stage`` holds each stage's value at its own level, shape (..., S).
+        """
+        k = len(np.asarray(pressures))
+        combined = self.combine(per_stage)
+        out = np.full((*combined.shape, k), np.inf)
+        out[..., max(self.levels(pressures))] = combined
+        return out
+
+
+def staged_target(stages: Any) -> StagedTarget:
+    """A staged target from ``(pressure_MPa, target[, weight])`` entries, checked.
+
+    Raises
+    ------
+    SearchConfigError
+        No stages or more than :data:`MAX_STAGES`, a pressure that is not positive and finite,
+        a weight that is not positive and finite, two stages at one pressure with the same
+        target, or a target that cannot be staged (polar profiles, tip goals other than
+        ``reach``: a maximum or minimum has no distance to add up).
+
+    Examples
+    --------
+    >>> staged_target([(0.03, tip_goal("max-x"))])
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: stage at 30 kPa: 'max-x' is a maximum, not a distance to add up with the
+    other stages; a stage's target is a Cartesian profile, a drawn curve or 'reach' (a tip point)
+    """
+    entries = list(stages)
+    if not 1 <= len(entries) <= MAX_STAGES:
+        raise SearchConfigError(f"a staged target needs 1 to {MAX_STAGES} stages (MAX_STAGES), got {len(entries)}")
+    out = []
+    for entry in entries:
+        pressure, target, *rest = entry
+        weight = float(rest[0]) if rest else 1.0
+        if not (np.isfinite(pressure) and pressure > 0):
+            raise SearchConfigError(f"a stage's pressure must be a positive number of kPa, got {pressure * 1e3!r}")
+        where = f"stage at {pressure * 1e3:g} kPa"
+        if not (np.isfinite(weight) and weight > 0):
+            raise SearchConfigError(f"{where}: the weight must be a positive number, got {weight!r}")
+        if isinstance(target, ProfileTarget) and target.coordinates == "polar":
+            raise SearchConfigError(f"{where}: polar profiles r = f(theta) cannot be staged yet; give y = f(x), a "
+                                    "preset or a drawn curve")
+        if isinstance(target, TipGoal) and target.name != "reach":
+            kind = "a maximum" if target.sense == "max" else "a minimum"
+            raise SearchConfigError(f"{where}: {target.name!r} is {kind}, not a distance to add up with the other "
+                                    "stages; a stage's target is a Cartesian profile, a drawn curve or 'reach' (a "
+                                    "tip point)")
+        if not isinstance(target, ProfileTarget | TipGoal):
+            raise SearchConfigError(f"{where}: a stage's target must be a profile or a tip point, not a staged target")
+        out.append(Stage(float(pressure), target, weight))
+    seen = set()
+    for stage in out:
+        key = (stage.pressure, stage.target.label)
+        if key in seen:
+            raise SearchConfigError(f"stage at {stage.pressure * 1e3:g} kPa: given twice with the same target")
+        seen.add(key)
+    return StagedTarget(tuple(out))
+
+
+#: What a search optimises: a target profile, a goal for the tip, or targets at several pressures.
+Objective = ProfileTarget | TipGoal | StagedTarget
+
+#: The tip goals by name: whether they are minimised or maximised, and their label.
 TIP_GOALS: dict[str, tuple[Sense, str]] = {
     "max-x": ("max", "maximum horizontal tip position (max X)"),
     "min-x": ("min", "minimum horizontal tip position (min X)"),
@@ -345,6 +500,7 @@ TIP_GOALS: dict[str, tuple[Sense, str]] = {
     "reach": ("min", "distance of the tip to a given point"),
 }
 _ALIASES = {"min-radius": "min-distance", "min-dist": "min-distance", "curl": "max-curl"}
+#: The target profiles known by name (:func:`profile_target`); any other profile is an expression.
 PRESETS = ("sin", "cos")
 
 

@@ -311,7 +311,7 @@ class EvaluationCache:
     def get(self, fingerprint: str, design: str) -> Outcome | None:
         """The stored outcome of ``design`` under a model fingerprint, or None.
 
-        A damaged entry is deleted, counted in :attr:`rejected` and answered with None.
+        A damaged entry is deleted, counted in ``rejected`` and answered with None.
         """
         with self._lock:
             try:

@@ -701,6 +701,7 @@ class DaskEvaluator(_Base):
             self._restore_logging()
 
 
+#: The names :func:`make_evaluator` knows: in this process, a process pool, a Dask cluster.
 EXECUTORS = ("serial", "processes", "dask")
 
 

@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 Mode = Literal["uniaxial", "equibiaxial", "planar"]
+#: The homogeneous deformation modes of the test data: uniaxial, equibiaxial, planar (pure shear).
 MODES: tuple[Mode, ...] = ("uniaxial", "equibiaxial", "planar")
 
 FloatArray = NDArray[np.float64]

@@ -37,6 +37,7 @@ from pneumorph.sensitivity.compare import ShapeDifference, shape_difference
 from pneumorph.sensitivity.tolerances import FIELDS, Tolerance, box_units, corner_label
 from pneumorph.sensitivity.variants import scaled_bulk_modulus, tension_only
 
+#: The studies ``pneumorph sensitivity`` runs (appendices D and E), by name.
 STUDIES = ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature")
 
 #: what the dissertation reports, for the tables beside pneumorph's (mm, %, kPa)
@@ -267,6 +268,7 @@ def temperature(model: FEModel, design: str | None = None, changes: Sequence[flo
     return Study("temperature", _design(model, design), Case("as cast", model), cases)
 
 
+#: The function that sets up each study of :data:`STUDIES`, by name.
 BUILDERS: dict[str, Callable[..., Study]] = {"simplifications": simplifications, "tolerances": tolerances,
                                              "bulk-modulus": bulk_modulus, "calibration": calibration,
                                              "temperature": temperature}

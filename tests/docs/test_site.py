@@ -1,0 +1,93 @@
+"""The documentation site builds without a warning and documents every public name.
+
+The site (``docs/``, Sphinx with MyST and numpydoc) is built once per test session the way
+the README tells a user to build it, with warnings as errors, so a broken docstring, a
+reference to a name that moved or a page left out of the table of contents fails here.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+import re
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+import pytest
+
+import pneumorph
+
+REPO = Path(__file__).resolve().parents[2]
+DOCS = REPO / "docs"
+# the command line has no Python API of its own: it is documented by ``pneumorph --help``
+NOT_IN_REFERENCE = {"pneumorph.cli", "pneumorph.__main__"}
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The built site (HTML), or the build's warnings as the failure."""
+    out = tmp_path_factory.mktemp("site")
+    done = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-j", "1", "-q", "-b", "html", str(DOCS), str(out)],
+        cwd=REPO, capture_output=True, text=True,
+    )
+    assert done.returncode == 0, done.stderr[-6000:]
+    return out
+
+
+def inventory(site: Path) -> set[str]:
+    """The Python objects of the site's ``objects.inv`` (Sphinx's inventory format, version 2)."""
+    data = (site / "objects.inv").read_bytes()
+    header_end = 0
+    for _ in range(4):  # four text lines, then the zlib-compressed entries
+        header_end = data.index(b"\n", header_end) + 1
+    entries = zlib.decompress(data[header_end:]).decode()
+    return {m.group(1) for m in re.finditer(r"^(\S+) py:\w+ ", entries, flags=re.MULTILINE)}
+
+
+def public_names() -> list[str]:
+    """Every public name of the package: each sub-package's ``__all__``, and the public members
+    of the top-level modules (``checks``, ``errors``) that define them."""
+    names = [f"pneumorph.{name}" for name in pneumorph.__all__]
+    for info in pkgutil.iter_modules(pneumorph.__path__, "pneumorph."):
+        if info.name in NOT_IN_REFERENCE:
+            continue
+        module = importlib.import_module(info.name)
+        if info.ispkg:
+            packages = [module] + [importlib.import_module(sub.name) for sub in
+                                   pkgutil.walk_packages(module.__path__, f"{info.name}.") if sub.ispkg]
+            for package in packages:
+                assert hasattr(package, "__all__"), f"{package.__name__} says what it exports in __all__"
+                names += [f"{package.__name__}.{name}" for name in package.__all__]
+        else:
+            names += [f"{info.name}.{name}" for name, obj in vars(module).items()
+                      if not name.startswith("_") and (inspect.isfunction(obj) or inspect.isclass(obj))
+                      and obj.__module__ == info.name]
+    return names
+
+
+def test_the_site_builds_without_warnings(site: Path) -> None:
+    assert (site / "index.html").is_file() and (site / "reference" / "pneumorph.design.html").is_file()
+    for page in DOCS.glob("*.md"):
+        assert (site / f"{page.stem}.html").is_file(), page.name
+
+
+def test_every_public_name_is_in_the_api_reference(site: Path) -> None:
+    documented = inventory(site)
+    names = public_names()
+    assert len(names) > 200 and "pneumorph.design.run_ga" in names  # the walk found the sub-packages
+    missing = [name for name in names if name not in documented]
+    assert not missing, f"not in the API reference (docs/reference/): {missing}"
+
+
+def test_the_example_pages_show_every_example_and_its_figures(site: Path) -> None:
+    listed = (DOCS / "example-files.md").read_text(encoding="utf-8")
+    for path in sorted((REPO / "examples").glob("*.toml")):
+        assert f"../examples/{path.name}" in listed, f"{path.name} is not on docs/example-files.md"
+    results = (site / "examples.html").read_text(encoding="utf-8")
+    for path in sorted((DOCS / "figures" / "examples").glob("*.png")):
+        assert path.name in results, f"{path.name} is not on the examples page"
+        assert (site / "_images" / path.name).is_file(), path.name
