@@ -14,7 +14,8 @@ def _run(*args: str) -> subprocess.CompletedProcess[str]:
 
 
 def test_ruff_finds_nothing() -> None:
-    done = _run("ruff", "check", "--output-format", "concise", "src", "tests", "benchmarks", "docs/scripts", "docs/conf.py")
+    done = _run("ruff", "check", "--output-format", "concise", "src", "tests", "benchmarks", "docs/scripts",
+                "docs/conf.py")
     assert done.returncode == 0, done.stdout + done.stderr
 
 
