@@ -42,20 +42,24 @@ def unit() -> None:
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes.")
 @click.option("--out", required=True, type=P.OutputDir(),
               help="Folder for candidates.csv, pareto.csv/.json, front.png and units/*.toml.")
+@click.option("--overwrite", is_flag=True,
+              help="Write into a folder that holds another run (a unit optimisation's files are replaced).")
 @click.option("--json", "as_json", is_flag=True, help="Print the front as JSON.")
 def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n_units: int, pop_size: int,
              generations: int, seed: int, resolution: float, element_size: float | None, unit_file: str | None,
              executor: str, workers: int | None, scheduler: str | None, cache: str | None, out: str,
-             as_json: bool) -> None:
+             overwrite: bool, as_json: bool) -> None:
     """Maximise the bending angle per unit (Omega) and minimise the ballooning height (h_b) within a
     strain limit (Ellis 2020, 8.3.2), NSGA-II on a 3-unit 3D actuator; resumable through the cache."""
     from dataclasses import replace
     from pathlib import Path
+    from types import SimpleNamespace
 
+    from pneumorph.design.planning import planned_workers
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import strict_json
     from pneumorph.io.lock import RunLock
-    from pneumorph.unitopt.run import OptimiseSettings, check_settings, optimise, write_outputs
+    from pneumorph.unitopt.run import OptimiseSettings, check_folder, check_settings, optimise, write_outputs
     from pneumorph.unitopt.space import DesignSpace, parse_variable
 
     check_options(executor, workers, scheduler)
@@ -68,9 +72,12 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     with P.blame("--var"):
         space = (DesignSpace(tuple(parse_variable(v) for v in variables), base, resolution) if variables
                  else replace(DesignSpace.default(base), resolution=resolution))
-        check_settings(space, strain_limit)
+    # the messages name what to change (the unit, a range, the resolution, the units, the memory per worker)
+    check_settings(space, strain_limit, n_units,
+                   parallel=planned_workers(SimpleNamespace(executor=executor, workers=workers)))
     settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
                                 pop_size=pop_size, generations=generations, seed=seed)
+    check_folder(out, settings, overwrite)
     click.echo(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
                f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
                f"{generations} generations, seed {seed}", err=True)

@@ -26,14 +26,14 @@ import csv
 import io
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from pneumorph import checks
-from pneumorph.errors import SettingsError
+from pneumorph.errors import GeometryError, RunFolderError, SettingsError
 from pneumorph.unitopt.probe import DEFAULT_UNITS
 from pneumorph.unitopt.problem import (
     Candidate,
@@ -203,7 +203,7 @@ def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[
     from pymoo.core.callback import Callback
     from pymoo.optimize import minimize
 
-    settings.space.check()
+    check_settings(settings.space, settings.strain_limit, settings.n_units)
     candidates = CandidateEvaluator(settings.space, evaluator, settings.n_units, settings.pressure, on_candidate)
     problem = UnitProblem(candidates, settings.strain_limit)
     base = candidates.evaluate(settings.space.base_point()[None])[0]  # in or outside the box: the reference
@@ -290,21 +290,119 @@ def write_outputs(result: UnitOptimisation, folder: str | Path, **provenance_ext
     written.append(plot_front(result, out / "front.png"))
     for label, c in chosen.items():
         written.append(atomic_write_text(out / "units" / f"{label}.toml", unit_file(c, label, result, prov)))
+    for label in set(CHOSEN) - set(chosen):  # an earlier run's choice that this run did not make
+        (out / "units" / f"{label}.toml").unlink(missing_ok=True)
     return written
 
 
-def check_settings(space: DesignSpace, strain_limit: float) -> None:
-    """The checks of :func:`optimise` that need no solve (for the command line, before anything is written).
+#: what :func:`write_outputs` writes into a folder (``units`` holds the files of :data:`CHOSEN`)
+OUTPUTS = ("candidates.csv", "pareto.csv", "pareto.json", "front.png", "units")
+#: the chosen units' file names (``units/<label>.toml``)
+CHOSEN = ("max-omega", "min-balloon", "knee", "better")
+
+
+def check_folder(folder: str | Path, settings: OptimiseSettings, overwrite: bool = False) -> None:
+    """Refuse an output folder that holds another run, before anything is solved or written.
+
+    A folder that does not exist, is empty (a lock file aside), or holds a unit optimisation
+    of the same settings (its ``pareto.json``; the rerun resumes through the cache and writes
+    the same files again) is taken; so is any folder with ``overwrite``: the files of
+    :data:`OUTPUTS` are then replaced, other files stay.
 
     Raises
     ------
-    SettingsError, GeometryError
+    RunFolderError
+        The folder holds a unit optimisation of other settings, or other files (another
+        command's run); the message names them and the two ways out.
     """
+    import json
+
+    from pneumorph.io.files import strict_json
+    from pneumorph.io.lock import LOCK_NAME
+
+    path = Path(folder)
+    if overwrite or not path.is_dir():
+        return
+    entries = sorted(p.name for p in path.iterdir() if p.name != LOCK_NAME)
+    if not entries:
+        return
+    others = [name for name in entries if name not in OUTPUTS]
+    old = None
+    if not others:
+        try:
+            old = json.loads((path / "pareto.json").read_text(encoding="utf-8"))["provenance"]["settings"]
+        except (OSError, ValueError, KeyError, TypeError):
+            old = None
+        if old == json.loads(strict_json(settings.to_dict())):
+            return
+    named = others or entries
+    what = ("a unit optimisation with other settings" if old is not None else
+            f"another run's files ({', '.join(named[:3])}{', ...' if len(named) > 3 else ''})")
+    raise RunFolderError(f"{path} holds {what}; give another folder with --out, or write into it with --overwrite "
+                         "(the files of a unit optimisation are replaced, others stay)")
+
+
+def check_settings(space: DesignSpace, strain_limit: float, n_units: int = DEFAULT_UNITS, parallel: int = 1,
+                   memory: int | None = None) -> None:
+    """The checks of :func:`optimise` that need no solve (for the command line, before anything is written).
+
+    In this order: the strain limit; a base unit that bends (not ``solid``); every variable's
+    range holds at least two values at the space's resolution; the probe's mesh at every
+    corner of the box, estimated before anything is meshed
+    (:func:`pneumorph.geometry.limits.check_mesh`: ``parallel`` solves of ``n_units`` units
+    within ``memory`` bytes, by default the memory available now); then every corner is
+    built and meshed (:meth:`DesignSpace.check`).
+
+    Raises
+    ------
+    SettingsError
+        A bad strain limit, a solid base unit, a range without two values.
+    GeometryError
+        A corner that makes no unit or does not mesh; :class:`~pneumorph.geometry.limits.MeshLimitError`
+        with the estimate for a probe too large for the memory.
+
+    Examples
+    --------
+    >>> from pneumorph.unitopt.space import Variable
+    >>> check_settings(DesignSpace((Variable("wall", 1.0, 1.04),)), 4.4)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: the range of wall 1-1.04 mm holds one value (1 mm) at the resolution
+        0.1 mm: widen it or give a finer --resolution
+    """
+    from itertools import product
+
+    from pneumorph.geometry import limits
+
     check_strain_limit(strain_limit)
     if not isinstance(space, DesignSpace):
         raise SettingsError(f"expected a DesignSpace, got {type(space).__name__}")
+    if space.base.solid:
+        raise SettingsError("the base unit is solid (solid = true: its cavity is filled), so it does not bend: "
+                            "its Omega is 0 whatever its dimensions; optimise a unit with a cavity")
+    r = space.resolution
+    for v in space.variables:
+        if r == 0:
+            continue
+        first, last = math.ceil(v.low / r - 1e-9), math.floor(v.high / r + 1e-9)  # the grid's values in the range
+        if last - first < 1:
+            held = f"one value ({round(first * r, 9):g} mm)" if last == first else "no value"
+            raise SettingsError(f"the range of {v.name} {v.low:g}-{v.high:g} mm holds {held} at the resolution "
+                                f"{r:g} mm: widen it or give a finer --resolution")
+    free = limits.available_memory() if memory is None else memory
+    for corner in product(*[(v.low, v.high) for v in space.variables]):
+        values: dict[str, Any] = dict(zip(space.names, corner, strict=True))
+        where = ", ".join(f"{n}={c:g}" for n, c in values.items())
+        try:
+            spec = replace(space.base, **values)
+        except GeometryError:
+            continue  # no unit at this corner: DesignSpace.check says so, naming the corner
+        limits.check_mesh(spec, n_units, 3, memory=free, parallel=parallel,
+                          advice=f"narrow the bounds (this is the unit at {where} mm), raise --element-size or use "
+                                 "fewer --units")
     space.check()
 
 
-__all__ = ["DEFAULT_STRAIN_LIMIT", "STRAIN_LIMIT_SOURCE", "OptimiseSettings", "UnitOptimisation", "check_settings",
+__all__ = ["CHOSEN", "DEFAULT_STRAIN_LIMIT", "OUTPUTS", "STRAIN_LIMIT_SOURCE", "OptimiseSettings", "UnitOptimisation",
+           "check_folder", "check_settings",
            "front_of", "latin_hypercube", "optimise", "table_csv", "unit_file", "write_outputs"]
