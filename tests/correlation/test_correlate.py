@@ -139,8 +139,10 @@ def test_the_readme_sample_scan_correlates_to_its_noise(tmp_path, capsys) -> Non
     scan = Path(__file__).resolve().parents[2] / "examples" / "data" / "scan-0110-30kpa.xyz"
     assert main(["correlate", str(scan), "--design", "0110", "--pressure", "30", "--out", str(tmp_path / "corr"),
                  "--json"]) == 0
-    data = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    data = json.loads(captured.out)
     assert abs(data["surface"]["rms_mm"] - 0.05 * 3**0.5) < 0.01
+    assert "aligning 1,170 scan points to the model (about 0.1 s) ..." in captured.err
     assert (tmp_path / "corr" / "correlation.png").is_file()
 
 
@@ -192,3 +194,32 @@ def test_a_bad_photo_is_refused_before_the_solve(tmp_path, capsys) -> None:
         captured = capsys.readouterr()
         assert words in captured.err and "solving" not in captured.err
         assert not out.exists()
+
+
+def test_a_scan_past_the_point_limit_is_refused_with_its_estimate_before_the_solve(tmp_path, capsys,
+                                                                                   monkeypatch) -> None:
+    """A 600,000-point scan (STL and CSV) would align for about 36 s: refused in one line, nothing solved or written
+    (a 2-million-point scan ran for minutes without a word)."""
+    import numpy as np
+
+    import pneumorph.models.fe as fe
+    from pneumorph.cli import main
+
+    def tripwire(*a: object, **k: object) -> None:
+        raise AssertionError("a solve was reached")
+
+    monkeypatch.setattr(fe.FEModel, "solve", tripwire)
+    triangles = 200_000  # 600,000 vertices, read without merging
+    record = np.dtype([("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attr", "<u2")])
+    data = np.zeros(triangles, dtype=record)
+    data["vertices"] = np.random.default_rng(0).random((triangles, 3, 3)) * 40
+    stl = tmp_path / "big.stl"
+    stl.write_bytes(b"\0" * 80 + np.uint32(triangles).tobytes() + data.tobytes())
+    csv = tmp_path / "big.csv"
+    csv.write_text("x,y,z\n" + "1,2,3\n" * 600_000)
+    for path in (stl, csv):
+        assert main(["correlate", str(path), "--design", "0110", "--out", str(tmp_path / "corr")]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "600,000 points, more than MAX_SCAN_POINTS = 500,000" in err, err
+        assert "aligning them would take about 36 s; thin the scan out (one point in 2 leaves 300,000)" in err
+        assert not (tmp_path / "corr").exists()

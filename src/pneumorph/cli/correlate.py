@@ -59,6 +59,11 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
     solution = model.solve(orientation)
     shape = model_shape(solution)
     check_units(data, shape)
+    from pneumorph.correlation.scans import align_seconds
+    from pneumorph.models.buildplan import duration_text
+
+    click.echo(f"aligning {len(data.points):,} scan points to the model (about "
+               f"{duration_text(align_seconds(len(data.points)))}) ...", err=True)
     result = align_and_measure(data, shape, scale=fit_scale)
     summary = {"scan": str(scan), "design": orientation, "pressure_kpa": pressure, "model": fidelity,
                "scan_points": len(data.points), **result.to_dict()}

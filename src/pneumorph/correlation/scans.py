@@ -26,6 +26,47 @@ FloatArray = NDArray[np.float64]
 SCAN_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
 MESH_SUFFIXES = (".stl", ".ply", ".obj", ".off", ".xyz")
 MIN_POINTS = 10
+#: most points of a scan: the alignment (ICP from several starts, a nearest-neighbour query of every point per
+#: iteration) grows with the points, about :data:`ALIGN_SECONDS_PER_POINT` each; this many take about 30 s
+MAX_SCAN_POINTS = 500_000
+#: seconds of alignment per scan point (measured: 200,000 points against the 3D model of 4 units in 11.5 s)
+ALIGN_SECONDS_PER_POINT = 6e-5
+
+
+def align_seconds(points: int) -> float:
+    """The estimated wall time of aligning a scan of ``points`` points (s).
+
+    >>> round(align_seconds(2_000_000))
+    120
+    """
+    return ALIGN_SECONDS_PER_POINT * int(points)
+
+
+def check_points(path: str | Path, points: int) -> None:
+    """Refuse a scan of more than :data:`MAX_SCAN_POINTS` points, with the estimate of its alignment.
+
+    Raises
+    ------
+    ScanError
+        Naming the count, the limit and how to thin the scan out.
+
+    Examples
+    --------
+    >>> check_points("big.stl", 2_000_000)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.ScanError: scan big.stl: 2,000,000 points, more than MAX_SCAN_POINTS = 500,000
+        (pneumorph.correlation.scans): aligning them would take about 2 min; thin the scan out (one point in 4
+        leaves 500,000)
+    """
+    if points > MAX_SCAN_POINTS:
+        from pneumorph.models.buildplan import duration_text
+
+        every = -(-int(points) // MAX_SCAN_POINTS)
+        raise ScanError(f"scan {path}: {points:,} points, more than MAX_SCAN_POINTS = {MAX_SCAN_POINTS:,} "
+                        f"(pneumorph.correlation.scans): aligning them would take about "
+                        f"{duration_text(align_seconds(points))}; thin the scan out (one point in {every} "
+                        f"leaves {-(-int(points) // every):,})")
 
 
 @dataclass(frozen=True)
@@ -67,7 +108,8 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
     Raises
     ------
     ScanError
-        Unreadable, empty, not a mesh or point cloud, fewer than 10 points, not finite.
+        Unreadable, empty, not a mesh or point cloud, fewer than 10 points or more than
+        :data:`MAX_SCAN_POINTS` (:func:`check_points`), not finite.
 
     Examples
     --------
@@ -97,6 +139,7 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
         raise ScanError(f"scan {p}: unknown format {suffix or '(none)'}; give STL, PLY, OBJ, OFF, XYZ or CSV")
     if len(points) < MIN_POINTS:
         raise ScanError(f"scan {p}: {len(points)} points; at least {MIN_POINTS} are needed")
+    check_points(p, len(points))
     if not np.all(np.isfinite(points)):
         raise ScanError(f"scan {p}: some coordinates are not finite")
     return Scan(points * factor, faces, str(p))
@@ -104,6 +147,7 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
 
 def _read_csv(path: Path) -> FloatArray:
     text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig")
+    check_points(path, text.count("\n") - 1)  # the rows below the header, before they are parsed
     rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
     if not rows:
         raise ScanError(f"scan {path}: no rows")
