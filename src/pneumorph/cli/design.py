@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 from typing import Any
@@ -38,6 +39,10 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
               help="Periods of the sin/cos target over the actuator (default 1).")
 @click.option("--point", type=P.Real(-1e5, 1e5, unit="mm"), nargs=2, metavar="X Y",
               help="Tip point (mm) for --objective reach.")
+@click.option("--stage", "stages", metavar="KPA:TARGET", type=P.Text(), multiple=True,
+              help="A target at one pressure of the ramp (repeat for several): 'KPA:sin', 'KPA:y = <expr>', or "
+                   "'KPA:reach X Y' (a tip point, mm); --amplitude and --periods shape the presets. The cost is "
+                   "the root-sum-square of the stages (weights: [[design.stage]] in a config file).")
 @click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
 @click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"),
               help="GA population (default 100; also the GA a certified search falls back to).")
@@ -88,7 +93,8 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
                    "that no shipped or kept table serves.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
-           periods: float | None, point: tuple[float, float] | None, units: int | None, population: int | None,
+           periods: float | None, point: tuple[float, float] | None, stages: tuple[str, ...], units: int | None,
+           population: int | None,
            generations: int | None, seed: int | None, search: str | None, certify: bool | None,
            verify: int | None, margin: float | None, epsilon: float | None, refine: float | None,
            chain_table: str | None,
@@ -112,6 +118,9 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
 
     if target and objective:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
+    if stages and (target or objective or point):
+        raise click.UsageError("--stage gives the targets at each pressure: leave out --target, --objective and "
+                               "--point")
     if target is not None:
         from pneumorph.design.targets import make_objective
         from pneumorph.geometry.unit import UnitSpec
@@ -140,6 +149,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
         if value is not None:
             changes[key] = value
+    if stages:
+        changes.update(objective="stages", stage=tuple(_stage_option(text, amplitude, periods) for text in stages))
     ga_changes: dict[str, Any] = {k: v for k, v in (("population", population), ("generations", generations))
                                   if v is not None}
     model_settings = dict(config.model)
@@ -292,10 +303,46 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
         sys.exit(130)
 
 
+def _stage_option(text: str, amplitude: float | None, periods: float | None) -> dict[str, Any]:
+    """One ``--stage KPA:TARGET`` as a ``[[design.stage]]`` table (its values checked by the config).
+
+    >>> _stage_option("18:reach 60 40", None, None)
+    {'pressure_kpa': 18.0, 'objective': 'reach', 'point': (60.0, 40.0)}
+    >>> _stage_option("45: sin", 5.0, None)
+    {'pressure_kpa': 45.0, 'objective': 'sin', 'amplitude': 5.0}
+    """
+    kpa, sep, target = text.partition(":")
+    try:
+        pressure = float(kpa)
+    except ValueError:
+        pressure = float("nan")
+    if not sep or not target.strip() or not math.isfinite(pressure):
+        raise click.BadParameter(f"{text!r} is not KPA:TARGET (e.g. 18:sin or '45:reach 60 40')",
+                                 param_hint="'--stage'")
+    words = target.split()
+    if words[0].lower() == "reach":
+        try:
+            x, y = (float(v) for v in words[1:])
+        except ValueError:
+            raise click.BadParameter(f"{text!r}: reach needs the tip point X Y in mm, e.g. '45:reach 60 40'",
+                                     param_hint="'--stage'") from None
+        return {"pressure_kpa": pressure, "objective": "reach", "point": (x, y)}
+    stage: dict[str, Any] = {"pressure_kpa": pressure, "objective": target.strip()}
+    stage.update({k: v for k, v in (("amplitude", amplitude), ("periods", periods)) if v is not None})
+    return stage
+
+
 def _check_shape_options(objective: Any, amplitude: float | None, periods: float | None) -> None:
     """Refuse --amplitude and --periods where the objective would ignore them (one line, exit 2)."""
-    from pneumorph.design.targets import PRESETS, ProfileTarget
+    from pneumorph.design.targets import PRESETS, ProfileTarget, StagedTarget
 
+    if isinstance(objective, StagedTarget):
+        profiles = [s.target for s in objective.stages if isinstance(s.target, ProfileTarget)]
+        if amplitude is not None and not any("A" in getattr(t.expression, "used", ()) for t in profiles):
+            raise click.UsageError("--amplitude sets A, which none of the stages' targets uses; leave it out")
+        if periods is not None and not any(t.name in PRESETS for t in profiles):
+            raise click.UsageError("--periods applies to the sin and cos presets, which none of the stages uses")
+        return
     if isinstance(objective, ProfileTarget):
         uses_a = "A" in getattr(objective.expression, "used", ())
         if amplitude is not None and not uses_a:

@@ -43,12 +43,12 @@ from pneumorph.design.fitness import profile_error_array, score, tip_value_array
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry, depths, seed_prefixes, tip_and_curl
 from pneumorph.design.reach import CurveRange, box_bound, profile_rest, reach_of, tip_goal_rest
 from pneumorph.design.scoring import Candidate, ScoreBook
-from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
+from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.chain import ChainModel
 from pneumorph.models.response import ActuatorModel
-from pneumorph.models.windows import design_numbers
+from pneumorph.models.windows import design_numbers, every_design
 
 FloatArray = NDArray[np.float64]
 
@@ -163,9 +163,28 @@ def _polar_term(r: FloatArray, e: FloatArray, slope: float) -> FloatArray:
 def _uniform_bound(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
                    slope: float) -> FloatArray:
     """``beta_k`` of the objectives whose bound is the same for every design, shape (k,)."""
+    if isinstance(objective, StagedTarget):
+        return _staged_bound(chain, objective, errors)
     if isinstance(objective, ProfileTarget):
         return errors["centre"] * np.sqrt(chain.n_units * (1.0 + slope**2))
     return errors["curl"] if objective.name == "max-curl" else errors["tip"]
+
+
+def _staged_bound(chain: ChainModel, objective: StagedTarget, errors: dict[str, FloatArray]) -> FloatArray:
+    """``beta`` of a staged target, shape (k,): at the highest stage's level ``sqrt(sum_s (w_s beta_s)^2)``, each
+    ``beta_s`` its stage's bound at the stage's level; 0 at the other levels (their value is the worst anyway).
+
+    The weighted root-sum-square is a norm of the stages' values, so by the triangle
+    inequality it moves by at most the same norm of the stages' bounds.
+    """
+    levels = objective.levels(chain.table.pressures)
+    each = []
+    for stage, k in zip(objective.stages, levels, strict=True):
+        slope = _target_slope(chain, stage.target, errors) if isinstance(stage.target, ProfileTarget) else 0.0
+        each.append(_uniform_bound(chain, stage.target, errors, slope)[k])
+    beta = np.zeros(chain.table.n_levels)
+    beta[max(levels)] = objective.combine(np.array(each))
+    return beta
 
 
 def objective_bounds(chain: ChainModel, objective: Objective, centres: FloatArray, reference: FloatArray,
@@ -232,13 +251,19 @@ def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integ
     """Objective per design and level (m, k), with the predicted centres and references."""
     centres, tip, curl = chain.predict(bits)
     ref_c, _ = chain.table.reference(bits)
-    # L: the actuator of the first unit type (over a library the designs' lengths differ), and the
-    # tip's undeformed height, which every design shares
-    if isinstance(objective, ProfileTarget):
-        values = profile_error_array(centres, ref_c[:, None], objective, chain.length)
-    else:
-        values = tip_value_array(tip, np.asarray(chain.table.tip_ref), curl, objective.name, objective.point)
-    return values, centres, ref_c
+
+    def values_of(o: ProfileTarget | TipGoal) -> FloatArray:
+        # L: the actuator of the first unit type (over a library the designs' lengths differ), and the
+        # tip's undeformed height, which every design shares
+        if isinstance(o, ProfileTarget):
+            return profile_error_array(centres, ref_c[:, None], o, chain.length)
+        return tip_value_array(tip, np.asarray(chain.table.tip_ref), curl, o.name, o.point)
+
+    if isinstance(objective, StagedTarget):
+        levels = objective.levels(chain.table.pressures)
+        per = np.stack([values_of(st.target)[:, k] for st, k in zip(objective.stages, levels, strict=True)], axis=-1)
+        return objective.at_levels(per, chain.table.pressures), centres, ref_c
+    return values_of(objective), centres, ref_c
 
 
 def _costs(values: FloatArray, beta: FloatArray, sense: str) -> tuple[FloatArray, NDArray[np.int64], FloatArray,
@@ -529,6 +554,8 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     """
     errors = chain_errors(chain, margin)
     n = chain.n_units
+    if isinstance(objective, StagedTarget):
+        return _score_staged(chain, objective, errors, max_enumerate)
     if _enumerable(chain, max_enumerate):
         return grow_designs(chain, objective, errors)
     beamed = grow_designs(chain, objective, errors, beam=4096)
@@ -544,6 +571,24 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     keep = scores.cost < threshold
     return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
                        scores.optimistic[keep], scores.bound[keep], floor=threshold - beta, choices=scores.choices)
+
+
+def _score_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, FloatArray],
+                  max_enumerate: int) -> ChainScores:
+    """Chain scores of every design for a staged target (all ``(2k)^n`` of them, in chunks).
+
+    Raises
+    ------
+    SearchConfigError
+        More designs than ``2^max_enumerate``: stages have no branch-and-bound yet.
+    """
+    if not _enumerable(chain, max_enumerate):
+        raise SearchConfigError(f"a staged target is certified by scoring every design, at most 2^{max_enumerate} "
+                                f"of them; {designs_of(chain):.3g} designs of {chain.n_units} units are too many - use "
+                                "fewer units or --search ga")
+    codes = np.asarray(chain.table.unit_codes, dtype=np.uint8)
+    bits = every_design(chain.n_units, codes)
+    return score_designs(chain, objective, bits, errors)
 
 
 # -- the search -------------------------------------------------------------------------------

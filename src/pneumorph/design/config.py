@@ -3,7 +3,7 @@
 A config file::
 
     [design]
-    objective = "sin"        # a tip goal, a preset (sin, cos) or "y = ..." / "r = ..."
+    objective = "sin"        # a tip goal, a preset (sin, cos), "y = ..." / "r = ...", or "stages"
     amplitude = 10.0         # mm
     periods = 1.0
     units = 15
@@ -14,6 +14,11 @@ A config file::
     tolerance = 0.1          # mould tolerance of the winner's robustness report, +- mm (0: none)
     robust = "worst"         # certified search: rank designs by their worst (or mean) error under it
     robust_samples = 30      # seeded samples of the tolerance class (default 30 by the chain, 8 by FE)
+
+    [[design.stage]]         # with objective = "stages": a target at each of several pressures
+    pressure_kpa = 18        # a level of the model's ramp
+    objective = "curve"      # a profile, a drawn curve or "reach"; its own amplitude, periods,
+    curve = [[0, 0], [80, 2], [160, 5]]   # curve, point, anchored, and a weight (default 1)
 
     [ga]
     population = 100
@@ -39,7 +44,7 @@ from typing import Any
 from pneumorph import checks
 from pneumorph.design.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.ga import GAConfig
-from pneumorph.design.targets import Objective, make_objective
+from pneumorph.design.targets import Objective, make_objective, staged_target
 from pneumorph.errors import (
     SearchConfigError,
     TargetExpressionError,
@@ -90,6 +95,7 @@ class DesignConfig:
     point: tuple[float, float] | None = None
     curve: tuple[tuple[float, float], ...] | None = None
     anchored: bool = True
+    stage: tuple[dict[str, Any], ...] | None = None
     units: int = 15
     search: str = "certified"
     seed: int = 0
@@ -162,14 +168,8 @@ class DesignConfig:
         if self.point is not None:
             object.__setattr__(self, "point", _pair(self.point, "[design] point", unit="mm"))
         if self.curve is not None:
-            try:
-                if any(isinstance(v, (bool, str, bytes)) for xy in self.curve for v in xy):
-                    raise TypeError("text or true/false")
-                points = tuple((float(x), float(y)) for x, y in self.curve)
-            except (TypeError, ValueError):
-                raise SearchConfigError(f"[design] curve must be a list of [x, y] points in mm, got {self.curve!r}") \
-                    from None
-            object.__setattr__(self, "curve", points)
+            object.__setattr__(self, "curve", _curve(self.curve, "[design] curve"))
+        object.__setattr__(self, "stage", _stages(self.objective, self.stage))
         unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
         pitch = unit.get("pitch", UnitSpec.pitch)  # the inline unit's, else the built-in unit's
         ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
@@ -177,6 +177,10 @@ class DesignConfig:
             self.make_objective(length=self.units * (pitch if ok else UnitSpec.pitch))
         except (TargetExpressionError, UnknownObjectiveError) as exc:
             raise SearchConfigError(f"[design] objective: {exc}") from None
+        except SearchConfigError as exc:
+            if self.stage is None:
+                raise
+            raise SearchConfigError(f"[[design.stage]]: {exc}") from None
 
     @property
     def fidelity(self) -> str:
@@ -222,7 +226,19 @@ class DesignConfig:
         return self.robust_samples or (30 if chain else 8)
 
     def make_objective(self, length: float | None = None) -> Objective:
-        """The objective these settings describe (a profile checked along ``length`` mm, if given)."""
+        """The objective these settings describe (a profile checked along ``length`` mm, if given).
+
+        >>> c = DesignConfig(objective="stages", stage=({"pressure_kpa": 18, "objective": "y = 0.05*x"},
+        ...                                            {"pressure_kpa": 45, "objective": "sin", "weight": 2}))
+        >>> c.make_objective().label
+        'stages: 18 kPa: y = 0.05*x; 45 kPa: sin: y = A*sin(2*pi*1*x/L), A = 10 mm (weight 2)'
+        """
+        if self.stage is not None:
+            return staged_target([
+                (s["pressure_kpa"] / 1e3,
+                 make_objective(s["objective"], s.get("amplitude", 10.0), s.get("periods", 1.0), s.get("point"),
+                                s.get("anchored", True), length, s.get("curve")),
+                 s.get("weight", 1.0)) for s in self.stage])
         return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
                               self.curve)
 
@@ -232,7 +248,8 @@ class DesignConfig:
         ``refine = 0`` left out)."""
         design = {
             k: getattr(self, k)
-            for k in ("objective", "amplitude", "periods", "point", "curve", "anchored", "units", "search", "seed",
+            for k in ("objective", "amplitude", "periods", "point", "curve", "anchored", "stage", "units", "search",
+                      "seed",
                       "certify", "verify", "margin", "epsilon", "refine", "chain_table", "tolerance", "robust",
                       "robust_samples")
         }
@@ -244,6 +261,8 @@ class DesignConfig:
 
         def clean(d: dict[str, Any]) -> dict[str, Any]:
             def plain(v: Any) -> Any:
+                if isinstance(v, dict):
+                    return {k: plain(x) for k, x in v.items()}
                 return [plain(x) for x in v] if isinstance(v, tuple) else v
 
             return {k: plain(v) for k, v in d.items() if v is not None}
@@ -277,6 +296,61 @@ class DesignConfig:
         """Settings from a TOML file (a run folder's ``config.toml`` works too)."""
         data = read_toml(path, "design config", SearchConfigError)
         return cls.from_dict(data)
+
+
+#: the settings of one ``[[design.stage]]`` table, and those it must have
+STAGE_KEYS = ("pressure_kpa", "objective", "amplitude", "periods", "curve", "point", "anchored", "weight")
+_STAGE_NEEDS = ("pressure_kpa", "objective")
+
+
+def _curve(points: Any, name: str) -> tuple[tuple[float, float], ...]:
+    """A drawn curve's points as numbers (mm), refusing text and true/false."""
+    try:
+        if any(isinstance(v, (bool, str, bytes)) for xy in points for v in xy):
+            raise TypeError("text or true/false")
+        return tuple((float(x), float(y)) for x, y in points)
+    except (TypeError, ValueError):
+        raise SearchConfigError(f"{name} must be a list of [x, y] points in mm, got {points!r}") from None
+
+
+def _stages(objective: str, stages: Any) -> tuple[dict[str, Any], ...] | None:
+    """The ``[[design.stage]]`` tables checked (types and ranges; the targets when the objective is made)."""
+    staged = objective.strip().lower() == "stages"
+    if stages is None:
+        if staged:
+            raise SearchConfigError("objective = \"stages\" needs its stages: [[design.stage]] tables with "
+                                    "pressure_kpa and objective (or --stage KPA:TARGET)")
+        return None
+    if not staged:
+        raise SearchConfigError(f"[[design.stage]] only applies to objective = \"stages\", not to {objective!r}")
+    if isinstance(stages, dict) or not isinstance(stages, (list, tuple)):
+        raise SearchConfigError(f"[[design.stage]] must be a list of tables, got {stages!r}")
+    out = []
+    for i, stage in enumerate(stages, 1):
+        where = f"[[design.stage]] {i}"
+        if not isinstance(stage, dict):
+            raise SearchConfigError(f"{where} must be a table of settings, got {stage!r}")
+        for key in set(stage) - set(STAGE_KEYS):
+            raise SearchConfigError(f"unknown key {key!r} in {where}; known keys: {', '.join(STAGE_KEYS)}")
+        for key in _STAGE_NEEDS:
+            if key not in stage:
+                raise SearchConfigError(f"{where} needs {key}")
+        s = dict(stage)
+        s["pressure_kpa"] = _real(s["pressure_kpa"], f"{where} pressure_kpa", 0.0, 1000.0, low_open=True, unit="kPa")
+        _text(s["objective"], f"{where} objective")
+        if s["objective"].strip().lower() == "stages":
+            raise SearchConfigError(f"{where} objective: a stage cannot hold stages")
+        for key, low, high in (("amplitude", 0.0, 1e5), ("periods", 0.0, 1000.0), ("weight", 0.0, 1e6)):
+            if key in s:
+                s[key] = _real(s[key], f"{where} {key}", low, high, low_open=True)
+        if "anchored" in s:
+            _flag(s["anchored"], f"{where} anchored")
+        if "point" in s:
+            s["point"] = _pair(s["point"], f"{where} point", unit="mm")
+        if "curve" in s:
+            s["curve"] = _curve(s["curve"], f"{where} curve")
+        out.append(s)
+    return tuple(out)
 
 
 # -- a small TOML writer (tables of scalars, lists and one level of sub-tables) -----------
@@ -316,10 +390,18 @@ def to_toml(tables: dict[str, dict[str, Any]]) -> str:
     for name, table in tables.items():
         lines.append(f"[{name}]")
         subtables = {k: v for k, v in table.items() if isinstance(v, dict)}
-        lines += [f"{k} = {_value(v)}" for k, v in table.items() if k not in subtables and v is not None]
+        arrays = {k: v for k, v in table.items() if isinstance(v, (list, tuple)) and v
+                  and all(isinstance(x, dict) for x in v)}
+        lines += [f"{k} = {_value(v)}" for k, v in table.items()
+                  if k not in subtables and k not in arrays and v is not None]
         lines.append("")
         for sub, content in subtables.items():
             lines.append(f"[{name}.{sub}]")
             lines += [f"{k} = {_value(v)}" for k, v in content.items() if v is not None]
             lines.append("")
+        for sub, entries in arrays.items():  # arrays of tables: [[design.stage]]
+            for content in entries:
+                lines.append(f"[[{name}.{sub}]]")
+                lines += [f"{k} = {_value(v)}" for k, v in content.items() if v is not None]
+                lines.append("")
     return "\n".join(lines)

@@ -6,17 +6,18 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import matplotlib
 import numpy as np
 
 from pneumorph.design.ga import GenerationStats
 from pneumorph.design.scoring import Candidate
-from pneumorph.design.targets import Objective, ProfileTarget
+from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget
 from pneumorph.plot.figure import new_figure, save_figure
 
 
-def profile_points(candidate: Candidate) -> np.ndarray:
-    """Base, unit centres and tip at the best level, heights above their undeformed positions."""
-    r, k = candidate.response, candidate.level
+def profile_points(candidate: Candidate, level: int | None = None) -> np.ndarray:
+    """Base, unit centres and tip at the best level (or ``level``), heights above their undeformed positions."""
+    r, k = candidate.response, candidate.level if level is None else level
     assert r is not None and k is not None
     centres = np.column_stack([r.centres[k, :, 0], r.centres[k, :, 1] - r.reference_centres[:, 1]])
     tip = np.array([r.tip[k, 0], r.tip[k, 1] - r.reference_tip[1]])
@@ -44,6 +45,8 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     """
     r = candidate.response
     assert r is not None, "a candidate without a response has no profile"
+    if isinstance(objective, StagedTarget):
+        return plot_stages(candidate, objective, path)
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
     curves: list[tuple[np.ndarray, np.ndarray, dict[str, Any]]] = []
@@ -99,6 +102,69 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     ax.set_title(f"{candidate.design} at {pressure:.4g} kPa - {what}", fontsize=9)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, frameon=False)
     ax.grid(alpha=0.3)
+    return save_figure(fig, path)
+
+
+def plot_stages(candidate: Candidate, objective: StagedTarget, path: str | Path) -> Path:
+    """A staged design: each stage's shape at its pressure beside its target, and the whole ramp.
+
+    One panel per stage (the centreline at the stage's level, the target profile or the point to
+    reach, the stage's value in mm), and a last panel with the centreline at every level of the
+    ramp, the stages' levels drawn bold.
+
+    Returns
+    -------
+    Path
+    """
+    r = candidate.response
+    assert r is not None, "a candidate without a response has no profile"
+    from pneumorph.design.fitness import stage_values
+
+    levels = objective.levels(r.pressures)
+    values = stage_values(r, objective)
+    length = float(r.reference_tip[0])
+    ramp = [profile_points(candidate, k) for k in range(r.n_levels)]
+    finite = np.vstack([q[np.all(np.isfinite(q), axis=1)] for q in ramp] or [np.zeros((1, 2))])
+    lo, hi = finite.min(axis=0), finite.max(axis=0)
+    panels = len(objective.stages) + 1
+    pad = 0.06 * float(max(np.max(hi - lo), 1.0))
+    aspect = (hi[1] - lo[1] + 2 * pad) / (hi[0] - lo[0] + 2 * pad)
+    fig = new_figure(6.4, panels * float(np.clip(5.4 * aspect + 1.1, 1.8, 4.8)) + 1.2, layout="constrained")
+    axes = fig.subplots(panels, 1, squeeze=False)[:, 0]
+    for ax, stage, k, v in zip(axes, objective.stages, levels, values, strict=False):
+        pts = ramp[k]
+        target = stage.target
+        if isinstance(target, ProfileTarget):
+            xs = np.linspace(0.0, max(length, float(np.nanmax(pts[:, 0]))), 300)
+            ax.plot(xs, np.broadcast_to(target.curve(xs, length), xs.shape), color="C1", lw=2,
+                    label=f"target {target.display}")
+            what = f"Eq 4.1 error {v:.3g} mm"
+        else:
+            assert target.point is not None
+            ax.plot(*target.point, "x", color="C1", ms=10, mew=2, label="point to reach")
+            what = f"tip {v:.3g} mm from the point"
+            lo, hi = np.minimum(lo, target.point), np.maximum(hi, target.point)
+        ax.plot(pts[:, 0], pts[:, 1], "-o", color="C0", ms=3, lw=1.5, label="actuator centreline")
+        ax.plot(*pts[-1], "s", color="C3", ms=6, label="tip")
+        ax.set_title(f"stage at {r.pressures[k] * 1e3:.4g} kPa (weight {stage.weight:g}): {what}", fontsize=9)
+        ax.legend(fontsize=7, loc="best")
+    ax = axes[-1]
+    cmap = matplotlib.colormaps["viridis"]
+    for k, pts in enumerate(ramp):
+        staged = k in levels
+        ax.plot(pts[:, 0], pts[:, 1], "-", color=cmap(k / max(r.n_levels - 1, 1)), lw=2.0 if staged else 0.8,
+                label=f"{r.pressures[k] * 1e3:.4g} kPa" + (" (a stage)" if staged else ""))
+    ax.set_title(f"{candidate.design} over the ramp: weighted root-sum-square of the stages {candidate.value:.3g} mm",
+                 fontsize=9)
+    ax.legend(fontsize=6, ncol=5, loc="upper center", bbox_to_anchor=(0.5, -0.42), frameon=False)
+    for ax in axes:
+        ax.axhline(0.0, color="0.8", lw=0.8, ls="--")
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_xlabel("x along the actuator (mm)")
+        ax.set_ylabel("y (mm)")
+        ax.grid(alpha=0.3)
     return save_figure(fig, path)
 
 

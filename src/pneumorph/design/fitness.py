@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.targets import Objective, ProfileTarget, Sense
+from pneumorph.design.targets import Objective, ProfileTarget, Sense, StagedTarget
 from pneumorph.models.response import Response
 
 FloatArray = NDArray[np.float64]
@@ -134,10 +134,37 @@ def tip_values(response: Response, name: str, point: tuple[float, float] | None 
 
 
 def objective_values(response: Response, objective: Objective) -> FloatArray:
-    """Raw objective value at every level (NaN where the level is missing)."""
+    """Raw objective value at every level (NaN where the level is missing).
+
+    A :class:`~pneumorph.design.targets.StagedTarget` has its combined value at the level of
+    its highest stage and the worst value elsewhere (:meth:`~pneumorph.design.targets.StagedTarget.at_levels`).
+    """
+    if isinstance(objective, StagedTarget):
+        return objective.at_levels(stage_values(response, objective), response.pressures)
     if isinstance(objective, ProfileTarget):
         return profile_errors(response, objective)
     return tip_values(response, objective.name, objective.point)
+
+
+def stage_values(response: Response, objective: StagedTarget) -> FloatArray:
+    """Each stage's value at its own level (mm), shape (S,).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pneumorph.design.targets import make_objective, staged_target
+    >>> ref = np.array([[5.0, 0.0], [15.0, 0.0]])
+    >>> r = Response.empty("00", np.array([0.01, 0.02]), ref, np.array([20.0, 0.0]))
+    >>> r.centres[:] = ref; r.centres[1, :, 1] = 1.0; r.tip[:] = [20.0, 0.0]; r.curl[:] = 0.0
+    >>> t = staged_target([(0.01, make_objective("y = 0*x")), (0.02, make_objective("y = 0*x"))])
+    >>> stage_values(r, t).tolist()  # flat at 10 kPa; both centres 1 mm up at 20 kPa: sqrt(2)
+    [0.0, 1.4142135623730951]
+    >>> objective_values(r, t).tolist()  # the root-sum-square at the top stage's level
+    [inf, 1.4142135623730951]
+    """
+    levels = objective.levels(response.pressures)
+    return np.array([objective_values(response, stage.target)[k] for stage, k in zip(objective.stages, levels,
+                                                                                       strict=True)])
 
 
 def failed_score(objective: Objective, n_levels: int) -> Score:

@@ -74,12 +74,12 @@ from pneumorph.design.certified import (
 from pneumorph.design.config import DesignConfig, to_toml
 from pneumorph.design.exhaustive import run_exhaustive
 from pneumorph.design.figures import plot_convergence, plot_profile
-from pneumorph.design.fitness import Score
+from pneumorph.design.fitness import Score, stage_values
 from pneumorph.design.ga import GenerationStats, run_ga
 from pneumorph.design.planning import plan_search, planned_workers
 from pneumorph.design.robustness import chain_robustness, fe_robustness, robust_ranking, robust_winner
 from pneumorph.design.scoring import Candidate
-from pneumorph.design.targets import Objective, ProfileTarget
+from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget
 from pneumorph.errors import (
     MissingTableError,
     OutputPathError,
@@ -489,6 +489,8 @@ def run_design(
                     f"shipped nor kept in {table_dir}; run without --no-build to build them "
                     f"({tolerance_plan_text(model, tolerance, workers, what=False)}), or leave the robustness "
                     "report out with --tolerance 0")
+    if isinstance(objective, StagedTarget):
+        objective.levels(model.pressures())  # a stage off the levels of the ramp: refused before anything is written
     if config.refine and search == "certified":
         _check_refine(config, model, evaluator)
     fingerprint = model.fingerprint()
@@ -722,6 +724,16 @@ def _chain_score(cert: CertifiedResult, i: int) -> Score:
     return Score(sc.per_level[i], level, sign * float(sc.cost[i]), p)
 
 
+def _stage_lines(objective: Objective, best: Candidate) -> list[str]:
+    """A staged winner's value at each stage, one report line each (none for other objectives)."""
+    if not isinstance(objective, StagedTarget) or best.response is None or not best.response.converged:
+        return []
+    values = stage_values(best.response, objective)
+    return [f"  - stage at {stage.pressure * 1e3:g} kPa (weight {stage.weight:g}): {v:.4g} mm "
+            f"({'Eq 4.1' if isinstance(stage.target, ProfileTarget) else 'tip to the point'}, {stage.target.label})"
+            for stage, v in zip(objective.stages, values, strict=True)]
+
+
 def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective,
                 cert: CertifiedResult) -> dict[str, float]:
     """The 2D reduced-order model's values of the listed designs (its shipped chain table, at the levels the
@@ -871,7 +883,8 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
     ]
     best = result.best
     if best is not None:
-        what = "error (Eq 4.1)" if isinstance(o, ProfileTarget) else "value"
+        what = ("error (Eq 4.1)" if isinstance(o, ProfileTarget) else
+                "weighted root-sum-square of the stages" if isinstance(o, StagedTarget) else "value")
         pressure = "-" if best.pressure is None else f"{best.pressure * 1e3:.4g} kPa"
         if best.failure is not None:
             lines += [f"**No design converged.** The best entry failed: {best.failure}", ""]
@@ -884,6 +897,7 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
                 f" (the root of the summed squared offsets of the {config.units} unit centres from the target: "
                 f"{best.value / config.units**0.5:.3g} {o.unit} RMS per centre)"
                 if isinstance(o, ProfileTarget) and math.isfinite(best.value) else ""),
+            *_stage_lines(o, best),
             "",
             "## Hall of fame",
             "",

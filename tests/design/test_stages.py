@@ -1,0 +1,140 @@
+"""Targets at several pressures of the ramp: the staged cost, its bound, the certified search, the config and CLI."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pneumorph.cli import main
+from pneumorph.design import DesignConfig, make_objective, run_exhaustive
+from pneumorph.design.certified import certified_search, chain_errors, chain_scores, objective_bounds
+from pneumorph.design.config import to_toml
+from pneumorph.design.fitness import objective_values, stage_values
+from pneumorph.design.targets import StagedTarget, staged_target, tip_goal
+from pneumorph.errors import SearchConfigError
+from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.models.chain import ChainModel, design_strings
+from pneumorph.models.chainfit import build_table
+from pneumorph.models.fe import RampSpec, Reduced2D
+
+N = 6
+RAMP = RampSpec(pressure=0.025)  # levels 2.5, 5, ..., 25 kPa
+
+
+@pytest.fixture(scope="module")
+def setup() -> tuple[Reduced2D, ChainModel, CachedEvaluator]:
+    """The real 2D model (coarse mesh, 25 kPa, 6 units) and its chain."""
+    model = Reduced2D(N, UnitSpec(element_size=3.0), RAMP)
+    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
+    return model, ChainModel(build_table(model, evaluator, window=2, heldout=8), N), evaluator
+
+
+def _staged(length: float) -> StagedTarget:
+    return staged_target([(0.01, make_objective("y = 0.04*x")),
+                          (0.025, make_objective("sin", amplitude=5.0, length=length), 2.0),
+                          (0.02, tip_goal("reach", (60.0, 15.0)), 0.5)])
+
+
+def test_the_staged_cost_is_the_weighted_root_sum_square_of_each_stage_at_its_level(setup) -> None:
+    model, chain, _ = setup
+    staged = _staged(chain.length)
+    assert staged.levels(model.pressures()) == (3, 9, 7)
+    scores = chain_scores(chain, staged)
+    assert scores.complete and len(scores.bits) == 2**N
+    # every design: the stages' own chain values at their own levels, combined with the weights
+    each = [chain_scores(chain, s.target) for s in staged.stages]
+    number = {d: i for i, d in enumerate(design_strings(each[0].bits))}
+    at = np.array([number[d] for d in design_strings(scores.bits)])
+    parts = np.stack([e.per_level[at, k] for e, k in zip(each, (3, 9, 7), strict=True)], axis=1)
+    expected = np.sqrt(((parts * [1.0, 2.0, 0.5]) ** 2).sum(axis=1))
+    assert np.allclose(scores.cost, expected, rtol=1e-12, atol=1e-12)
+    assert np.all(scores.level == 9)  # the cost stands at the highest stage's level; the others are the worst
+    assert np.isinf(scores.per_level[:, :9]).all()
+    # the bound: the same weighted norm of the stages' own bounds at their levels
+    errors = chain_errors(chain)
+    own = [objective_bounds(chain, s.target, np.zeros((1, 10, N, 2)), np.zeros((1, N, 2)), errors)[0, k]
+           for s, k in zip(staged.stages, (3, 9, 7), strict=True)]
+    assert scores.bound[0] == pytest.approx(np.sqrt(sum((w * b) ** 2 for w, b in zip((1.0, 2.0, 0.5), own,
+                                                                                      strict=True))), rel=1e-12)
+
+
+def test_the_certified_search_over_stages_equals_the_fe_exhaustive_search(setup) -> None:
+    model, chain, evaluator = setup
+    staged = _staged(chain.length)
+    truth = run_exhaustive(model, staged, evaluator)
+    result = certified_search(model, chain, staged, evaluator, verify=1, certify=True)
+    assert result.certificate["certified"] and result.certificate["gap"] == 0.0
+    assert result.winner.value == pytest.approx(truth.best.value, abs=1e-9)
+    assert result.winner.design == truth.best.design
+    assert result.winner.pressure == pytest.approx(0.025)
+    # the FE value is the weighted root-sum-square of the FE stages, and within the bound of the chain's
+    fe = result.winner.response
+    assert result.winner.value == pytest.approx(float(np.sqrt(((stage_values(fe, staged) * [1, 2, 0.5]) ** 2).sum())))
+    order = result.scores.order()
+    names = design_strings(result.scores.bits[order])
+    for design, c in result.verified.items():
+        i = order[names.index(design)]
+        assert abs(result.scores.cost[i] - c.value) <= result.scores.bound[i] + 1e-9
+    assert np.isinf(objective_values(fe, staged)[:9]).all()
+
+
+def test_stages_that_cannot_be_added_up_or_are_off_the_ramp_are_refused() -> None:
+    with pytest.raises(SearchConfigError, match="'max-y' is a maximum, not a distance"):
+        staged_target([(0.02, tip_goal("max-y"))])
+    with pytest.raises(SearchConfigError, match="polar profiles"):
+        staged_target([(0.02, make_objective("r = 20 + 5*theta"))])
+    with pytest.raises(SearchConfigError, match="the weight must be a positive number"):
+        staged_target([(0.02, make_objective("sin"), 0.0)])
+    with pytest.raises(SearchConfigError, match="given twice"):
+        staged_target([(0.02, make_objective("sin")), (0.02, make_objective("sin"))])
+    staged = staged_target([(0.018, make_objective("sin")), (0.02, make_objective("cos"))])
+    with pytest.raises(SearchConfigError, match=r"stage at 20 kPa: not a level of the model's ramp; the levels are "
+                                                r"4\.5, 9, 13\.5, 18, 22\.5, 27, 31\.5, 36, 40\.5, 45 kPa"):
+        staged.levels(np.linspace(0.0045, 0.045, 10))
+
+
+def test_a_config_with_stages_round_trips_through_toml() -> None:
+    config = DesignConfig(objective="stages", units=8, stage=(
+        {"pressure_kpa": 18, "objective": "curve", "curve": [[0, 0], [40, 2], [80, 5]]},
+        {"pressure_kpa": 45, "objective": "reach", "point": [60, 20], "weight": 0.5}))
+    again = DesignConfig.from_dict(tomllib.loads(to_toml(config.to_dict())))
+    assert again == config
+    assert again.make_objective().label.startswith("stages: 18 kPa: curve: y = curve through 3 points; 45 kPa")
+    with pytest.raises(SearchConfigError, match=r"\[\[design.stage\]\] 1 needs pressure_kpa"):
+        DesignConfig(objective="stages", stage=({"objective": "sin"},))
+    with pytest.raises(SearchConfigError, match="unknown key 'pressure' in"):
+        DesignConfig(objective="stages", stage=({"pressure": 18, "objective": "sin"},))
+    with pytest.raises(SearchConfigError, match='only applies to objective = "stages"'):
+        DesignConfig(objective="sin", stage=({"pressure_kpa": 18, "objective": "sin"},))
+    with pytest.raises(SearchConfigError, match="needs its stages"):
+        DesignConfig(objective="stages")
+    with pytest.raises(SearchConfigError, match=r"\[\[design.stage\]\]: stage at 18 kPa: 'max-x' is a maximum"):
+        DesignConfig(objective="stages", stage=({"pressure_kpa": 18, "objective": "max-x"},))
+
+
+def test_design_with_stages_on_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    unit = tmp_path / "coarse.toml"
+    unit.write_text("[unit]\nelement_size = 3.0\n")
+    common = ["design", "--model", "2d", "--unit", str(unit), "--pressure", "20", "--units", "7", "--executor",
+              "serial", "--tolerance", "0", "--cache", str(tmp_path / "c.sqlite")]
+    # a stage off the ramp's levels: one line, exit 2, nothing written, before any solve
+    assert main([*common, "--stage", "10:sin", "--stage", "15:y = 0.1*x", "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "stage at 15 kPa: not a level of the model's ramp" in err
+    assert not (tmp_path / "bad").exists() and not (tmp_path / "c.sqlite").exists()
+    assert main([*common, "--stage", "10:reach 40", "--out", str(tmp_path / "bad")]) == 2
+    assert "reach needs the tip point X Y" in capsys.readouterr().err
+    out = tmp_path / "run"
+    assert main([*common, "--stage", "10:y = 0.05*x", "--stage", "20:sin", "--amplitude", "4", "--out",
+                 str(out)]) == 0
+    report = (out / "report.md").read_text()
+    assert "- weighted root-sum-square of the stages:" in report
+    assert "  - stage at 10 kPa (weight 1):" in report and "  - stage at 20 kPa (weight 1):" in report
+    assert (out / "profile.png").stat().st_size > 10_000
+    config = DesignConfig.read(out / "config.toml")
+    assert config.objective == "stages" and [s["pressure_kpa"] for s in config.stage or ()] == [10.0, 20.0]
+    assert config.stage is not None and config.stage[1]["amplitude"] == 4.0
