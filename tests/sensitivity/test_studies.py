@@ -156,3 +156,26 @@ def test_cli_study_writes_its_results_and_resumes(tmp_path: Path, capsys: pytest
     assert main([*argv, "--json"]) == 0
     out, err = capsys.readouterr()
     assert "bulk modulus x1.1: cached" in err and json.loads(out)["cases"][0]["cached"]
+
+
+def test_the_tolerance_figure_starts_its_bars_at_the_nominal_design_and_explains_its_lines() -> None:
+    """Bars of the curl change from the nominal design (zero), not of the curl on an axis from 145 degrees; case
+    labels at 8 pt; the grey centrelines and the bar colours named in legends."""
+    from pneumorph.plot.sensitivity import plot_study
+
+    result = run_study(tolerances(Reduced2D(2, ramp_spec=LOW), "01", Tolerance(0.1), samples=3, seed=4),
+                       SerialEvaluator())
+    fig = plot_study(result)
+    ax, bx = fig.axes
+    lo, hi = bx.get_xlim()
+    nominal = float(result.reference.outcome.response.curl[result.study.level])
+    changes = [c.difference.curl_deg - nominal for c in result.cases]
+    assert lo < 0 < hi and lo <= min(changes) and max(changes) <= hi
+    assert [p.get_x() for p in bx.patches] == [0.0] * len(result.cases)  # every bar starts at zero
+    assert [p.get_width() for p in bx.patches] == pytest.approx(changes)
+    assert "curl change from the nominal design's" in bx.get_xlabel()
+    assert all(t.get_fontsize() >= 8 for t in bx.get_yticklabels())
+    assert [t.get_text() for t in bx.get_yticklabels()] == [c.case.label for c in result.cases]
+    assert {t.get_text() for t in bx.get_legend().get_texts()} == {
+        "extremes and corners of the tolerance box", "random samples", "nominal design"}
+    assert "the other cases (extremes, corners, random samples)" in [t.get_text() for t in ax.get_legend().get_texts()]

@@ -37,6 +37,13 @@ def plot_tip_paths(
     >>> r = BimodalResult(0.3, p, tip, np.zeros((3, 2, 2)), 0.01, True, "", find_switch(p, tip[:, 1]))
     >>> len(plot_tip_paths([("a", r)]).axes)
     2
+
+    The switch (dotted) is named in the legend of the pressure plot:
+
+    >>> p = np.array([0.005, 0.01, 0.015]); tip = np.array([[0.1, 0.2], [0.3, 0.3], [0.4, -0.2]])
+    >>> r = BimodalResult(0.3, p, tip, np.zeros((3, 2, 2)), 0.01, True, "", find_switch(p, tip[:, 1]))
+    >>> [t.get_text() for t in plot_tip_paths([("a", r)]).axes[1].get_legend().get_texts()]
+    ['a', 'a: switch at 13.0 kPa']
     """
     fig = new_figure(11, 5.0)
     ax, ax2 = fig.subplots(1, 2)
@@ -58,7 +65,7 @@ def plot_tip_paths(
             ax.annotate(f"{pi:g}", (vi, ui), textcoords="offset points", xytext=(4, 2), fontsize=6, color=c)
         ax2.plot(p, v, "o-", color=c, ms=3.5, lw=1.2, label=label)
         if s.switch is not None:
-            ax2.axvline(1e3 * s.switch, color=c, ls=":", lw=1)
+            ax2.axvline(1e3 * s.switch, color=c, ls=":", lw=1, label=f"{label}: switch at {1e3 * s.switch:.1f} kPa")
     for a in (ax, ax2):
         a.axhline(0, color="0.6", lw=0.6)
         a.grid(alpha=0.3)
@@ -68,6 +75,7 @@ def plot_tip_paths(
     ax.legend(fontsize=7, loc="best")
     ax2.set_xlabel("pressure (kPa)")
     ax2.set_ylabel("transverse tip displacement u_y (mm)")
+    ax2.legend(fontsize=7, loc="best")
     ax.set_title(title, fontsize=10)
     _save(fig, path, dpi)
     return fig

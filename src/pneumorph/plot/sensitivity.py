@@ -24,11 +24,12 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
     """
     study = result.study
     tolerances = study.name == "tolerances"
-    fig = new_figure(11.0 if tolerances else 6.5, 5.0)
+    ok = [c for c in result.cases if c.outcome.ok]
+    # a tolerance study lists every case by name beside its bar: the figure grows with them, readable at 8 pt
+    fig = new_figure(11.0 if tolerances else 6.5, max(5.0, 1.6 + 0.16 * len(ok)) if tolerances else 5.0)
     ax = fig.add_subplot(1, 2 if tolerances else 1, 1)
     ref = result.reference.outcome.response
     level = study.level
-    ok = [c for c in result.cases if c.outcome.ok]
     if ref is not None and result.reference.outcome.ok:
         line = ref.centreline(level)
         ax.plot(line[:, 0], line[:, 1], "k.-", lw=2.0, ms=4, label=f"{study.reference.label} (reference)", zorder=3)
@@ -37,11 +38,14 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
     if tolerances:
         curls = np.array([c.difference.curl_deg for c in ok if c.difference is not None])
         lo, hi = (int(np.argmin(curls)), int(np.argmax(curls))) if len(curls) else (-1, -1)
+        others = False
         for i, c in enumerate(ok):
             line = c.outcome.response.centreline(level)
             style: dict[str, Any] = {"color": "tab:blue" if i == lo else "tab:red" if i == hi else "0.55",
                                      "lw": 1.4 if i in (lo, hi) else 0.5}
             label = "minimum curl" if i == lo else "maximum curl" if i == hi else None
+            if label is None and not others:  # the grey lines, named once
+                label, others = "the other cases (extremes, corners, random samples)", True
             ax.plot(line[:, 0], line[:, 1], "-", label=label, **style)
     else:
         for c in ok:
@@ -75,21 +79,36 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
     p = ref.pressures[level] * 1e3 if ref is not None else float("nan")
     ax.set_title(f"{study.name}: design {study.design} at {p:.4g} kPa", fontsize=9)
     if tolerances and ok:
+        from matplotlib.patches import Patch
+
         bx = fig.add_subplot(1, 2, 2)
         labels = [c.case.label for c in ok]
-        bars = [c.difference.curl_deg if c.difference is not None else np.nan for c in ok]
+        curls = np.array([c.difference.curl_deg if c.difference is not None else np.nan for c in ok], dtype=float)
+        nominal = result.reference.outcome.ok and ref is not None
+        # each case's bar starts at the nominal design's curl (zero): its change, not a bar cut off at 145 degrees
+        bars = curls - float(ref.curl[level]) if nominal else curls  # type: ignore[union-attr]
         colours = ["tab:orange" if not lab.startswith("sample") else "tab:gray" for lab in labels]
         bx.barh(range(len(ok)), bars, color=colours)
-        if result.reference.outcome.ok:
-            bx.axvline(float(ref.curl[level]), color="k", lw=1.2, label="nominal")
-        bx.set_yticks(range(len(ok)), labels, fontsize=5)
-        finite = np.array(bars, dtype=float)
-        finite = finite[np.isfinite(finite)]
-        if finite.size:
-            pad = max(1.0, 0.1 * float(np.ptp(finite)))
-            bx.set_xlim(float(finite.min()) - pad, float(finite.max()) + pad)
-        bx.set_xlabel("curl [deg]; orange: extremes and corners, grey: random samples")
-        bx.legend(loc="lower right", fontsize=7)
+        bx.axvline(0.0, color="k", lw=1.2)
+        bx.set_yticks(range(len(ok)), labels, fontsize=8)
+        bx.invert_yaxis()  # the first case on top, as listed
+        finite = bars[np.isfinite(bars)]
+        lo, hi = (min(0.0, float(finite.min())), max(0.0, float(finite.max()))) if finite.size else (0.0, 0.0)
+        pad = 0.1 * (hi - lo) or 1.0
+        if nominal:  # symmetric about the nominal design: a larger and a smaller curl read alike
+            reach = max(hi, -lo) * 1.15 or 1.0
+            bx.set_xlim(-reach, reach)
+            curl = float(ref.curl[level])  # type: ignore[union-attr]
+            bx.set_xlabel(f"curl change from the nominal design's {curl:.4g} deg [deg]")
+        else:  # no nominal shape to compare with: the curl itself, from zero
+            bx.set_xlim(lo - pad if lo < 0 else 0.0, hi + pad)
+            bx.set_xlabel("curl [deg] (the nominal design failed)")
+        handles = [Patch(color="tab:orange", label="extremes and corners of the tolerance box"),
+                   Patch(color="tab:gray", label="random samples"),
+                   *([bx.lines[0]] if nominal else [])]
+        if nominal:
+            bx.lines[0].set_label("nominal design")
+        bx.legend(handles=handles, loc="best", fontsize=7)
     fig.text(0.01, 0.005, f"pneumorph {__version__} | {study.reference.model.fingerprint()}", fontsize=6, color="0.4")
     if path is not None:
         save_figure(fig, path, f"{study.name} study of design {study.design}")
