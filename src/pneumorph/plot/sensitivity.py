@@ -86,7 +86,7 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
         curls = np.array([c.difference.curl_deg if c.difference is not None else np.nan for c in ok], dtype=float)
         nominal = result.reference.outcome.ok and ref is not None
         # each case's bar starts at the nominal design's curl (zero): its change, not a bar cut off at 145 degrees
-        bars = curls - float(ref.curl[level]) if nominal else curls  # type: ignore[union-attr]
+        bars = curls - float(ref.curl[level]) if nominal else curls
         colours = ["tab:orange" if not lab.startswith("sample") else "tab:gray" for lab in labels]
         bx.barh(range(len(ok)), bars, color=colours)
         bx.axvline(0.0, color="k", lw=1.2)
@@ -96,9 +96,9 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
         lo, hi = (min(0.0, float(finite.min())), max(0.0, float(finite.max()))) if finite.size else (0.0, 0.0)
         pad = 0.1 * (hi - lo) or 1.0
         if nominal:  # symmetric about the nominal design: a larger and a smaller curl read alike
-            reach = max(hi, -lo) * 1.15 or 1.0
+            reach = float(max(hi, -lo) * 1.15) or 1.0
             bx.set_xlim(-reach, reach)
-            curl = float(ref.curl[level])  # type: ignore[union-attr]
+            curl = float(ref.curl[level])
             bx.set_xlabel(f"curl change from the nominal design's {curl:.4g} deg [deg]")
         else:  # no nominal shape to compare with: the curl itself, from zero
             bx.set_xlim(lo - pad if lo < 0 else 0.0, hi + pad)
