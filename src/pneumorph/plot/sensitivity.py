@@ -93,15 +93,15 @@ def plot_study(result: Any, path: str | Path | None = None) -> Figure:
         bx.set_yticks(range(len(ok)), labels, fontsize=8)
         bx.invert_yaxis()  # the first case on top, as listed
         finite = bars[np.isfinite(bars)]
-        lo, hi = (min(0.0, float(finite.min())), max(0.0, float(finite.max()))) if finite.size else (0.0, 0.0)
-        pad = 0.1 * (hi - lo) or 1.0
+        left, right = (min(0.0, float(finite.min())), max(0.0, float(finite.max()))) if finite.size else (0.0, 0.0)
+        pad = 0.1 * (right - left) or 1.0
         if nominal:  # symmetric about the nominal design: a larger and a smaller curl read alike
-            reach = float(max(hi, -lo) * 1.15) or 1.0
+            reach = max(right, -left) * 1.15 or 1.0
             bx.set_xlim(-reach, reach)
             curl = float(ref.curl[level])
             bx.set_xlabel(f"curl change from the nominal design's {curl:.4g} deg [deg]")
         else:  # no nominal shape to compare with: the curl itself, from zero
-            bx.set_xlim(lo - pad if lo < 0 else 0.0, hi + pad)
+            bx.set_xlim(left - pad if left < 0 else 0.0, right + pad)
             bx.set_xlabel("curl [deg] (the nominal design failed)")
         handles = [Patch(color="tab:orange", label="extremes and corners of the tolerance box"),
                    Patch(color="tab:gray", label="random samples"),
