@@ -13,7 +13,8 @@ from pneumorph.cli.execution import check_options, cluster_line, cluster_report,
 
 @click.group("chain")
 def chain() -> None:
-    """Chain tables: per-window chord turns and lengths fitted to FE solves (docs/chain-model.md)."""
+    """Chain tables: per-window chord turns and lengths fitted to FE solves (documentation page chain-model,
+    docs/chain-model.md in the source)."""
 
 
 @chain.command("build")
@@ -23,7 +24,7 @@ def chain() -> None:
               help="Unit TOML file (default: the built-in unit).")
 @click.option("--library", metavar="builtin|FILE", type=P.Text(),
               help="A unit library ('builtin' or a library TOML file): the table covers its unit types "
-                   "(docs/unit-library.md); instead of --unit.")
+                   "(documentation page unit-library, docs/unit-library.md in the source); instead of --unit.")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,
               help="Units of the training designs.")
@@ -39,8 +40,8 @@ def chain() -> None:
               help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite).")
 @click.option("--out", required=True, metavar="FILE", type=P.OutputFile((".json",)), help="Table file to write (JSON).")
 @click.option("--short", is_flag=True,
-              help="Learn the windows at the base and the tip from actuators of 2w units (docs/chain-model.md); "
-                   "the held-out designs keep --units.")
+              help="Learn the windows at the base and the tip from actuators of 2w units (documentation page "
+                   "chain-model, docs/chain-model.md in the source); the held-out designs keep --units.")
 @click.option("--all-heldout", is_flag=True,
               help="Solve every held-out design, even when the first 6 show the table within half the tolerance "
                    "(as the shipped tables are validated).")

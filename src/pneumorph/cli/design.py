@@ -64,7 +64,7 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--refine", metavar="MM", type=P.Real(0.0, 100.0, low_open=True, unit="mm"),
               help="Certified search: solve the FE-verified designs again with this element size (e.g. 1.0 or 0.75; "
                    "the default mesh is 1.5 mm), report both meshes' values, the estimated mesh error and whether "
-                   "the winner holds (docs/mesh-convergence.md).")
+                   "the winner holds (documentation page mesh-convergence, docs/mesh-convergence.md in the source).")
 @click.option("--chain-table", metavar="FILE", type=P.InputFile(),
               help="Certified search: a chain table file (default: the shipped one, or built on first use).")
 @click.option("--tolerance", type=P.Real(0.0, 1.0, unit="mm"),
@@ -81,8 +81,9 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file.")
 @click.option("--library", metavar="builtin|FILE", type=P.Text(),
-              help="Designs over a unit library ('builtin' or a library TOML file; docs/unit-library.md): "
-                   "certified search over every type and orientation per unit; instead of --unit.")
+              help="Designs over a unit library ('builtin' or a library TOML file; documentation page unit-library, "
+                   "docs/unit-library.md in the source): certified search over every type and orientation per unit; "
+                   "instead of --unit.")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
 @click.option("--out", metavar="DIR", type=P.OutputDir(),

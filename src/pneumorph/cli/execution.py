@@ -42,14 +42,15 @@ def execution_options(default: str | None = "processes", what: str = "designs") 
     options = [
         click.option("--executor", type=click.Choice(EXECUTORS), default=default, show_default=default is not None,
                      help=f"Where the {what} are solved: one after another in this process (serial), a pool of "
-                          "processes on this machine, or a Dask cluster (dask; docs/cluster.md)"
+                          "processes on this machine, or a Dask cluster (dask; documentation page cluster, "
+                          "docs/cluster.md in the source)"
                           + ("" if default is not None else "; default processes") + "."),
         click.option("--workers", type=P.WORKERS,
                      help="Processes of the pool, or workers of a local Dask cluster (default: all cores); "
                           "not with serial or --scheduler."),
         click.option("--scheduler", metavar="ADDR", type=P.ADDRESS,
-                     help="With --executor dask: the scheduler of a Dask cluster (tcp://host:8786; docs/cluster.md); "
-                          "default a local cluster on this machine."),
+                     help="With --executor dask: the scheduler of a Dask cluster (tcp://host:8786; documentation page "
+                          "cluster, docs/cluster.md in the source); default a local cluster on this machine."),
     ]
 
     def decorate(command: Any) -> Any:

@@ -15,7 +15,8 @@ _DECK_ONLY = ("pressure",)
 @click.option("--stl", "stl_dir", type=P.OutputDir(),
               help="Folder for the parts' STL files (mm): body, layer pieces, base block.")
 @click.option("--inp", "inp_file", type=P.OutputFile((".inp",)),
-              help="The 3D model as a CalculiX/Abaqus input deck (mm, Pa; docs/manufacturing.md).")
+              help="The 3D model as a CalculiX/Abaqus input deck (mm, Pa; documentation page manufacturing, "
+                   "docs/manufacturing.md in the source).")
 @click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True,
               help="Deck: the final pressure of the ramp, kPa (levels as the 3D model's).")
 @click.option("--mould", "with_mould", is_flag=True,
@@ -32,7 +33,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     """Write DESIGN's parts (the Mold Star body with its cavities, the Smooth-Sil layer
     pieces, the base block) as watertight STL files, with --mould the printable casting
     mould of the body, and with --inp the 3D model as a CalculiX/Abaqus deck
-    (docs/manufacturing.md).
+    (documentation page manufacturing, docs/manufacturing.md in the source).
     """
     from pathlib import Path
 

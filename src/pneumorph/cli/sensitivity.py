@@ -39,7 +39,8 @@ def _common(command: Callable[..., Any], models: tuple[str, ...] = ("2d", "3d"))
 @click.group("sensitivity")
 def sensitivity() -> None:
     """How far a design's inflated shape moves with the model's simplifications, mould
-    tolerances and material data (appendices D and E; docs/sensitivity.md)."""
+    tolerances and material data (appendices D and E; documentation page sensitivity, docs/sensitivity.md in the
+    source)."""
 
 
 def _run(name: str, common: dict[str, Any], **options: Any) -> None:
@@ -231,7 +232,8 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
              unit_file: str | None, target: str, amplitude: float, order: float | None, cache: str | None,
              out: str | None, as_json: bool, executor: str, workers: int | None, scheduler: str | None) -> None:
     """Mesh convergence: designs solved at several element sizes; observed order, Richardson limit and error
-    estimate of the tip, the curl and the objective (docs/mesh-convergence.md)."""
+    estimate of the tip, the curl and the objective (documentation page mesh-convergence, docs/mesh-convergence.md
+    in the source)."""
     import os
     from pathlib import Path
 

@@ -21,8 +21,8 @@ from pneumorph.cli import params as P
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
 @click.option("--library", metavar="builtin|FILE", type=P.Text(),
-              help="A unit library ('builtin' or a library TOML file; docs/unit-library.md): the design's "
-                   "letters name its unit types; instead of --unit.")
+              help="A unit library ('builtin' or a library TOML file; documentation page unit-library, "
+                   "docs/unit-library.md in the source): the design's letters name its unit types; instead of --unit.")
 @click.option("--gravity", type=click.Choice(["none", "hanging", "horizontal"]), default="none", show_default=True,
               help="Weight of the silicones, applied before the pressure: hanging from the clamped base "
                    "(appendix A.2.2) or lying horizontal with gravity across the height.")

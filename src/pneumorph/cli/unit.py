@@ -15,7 +15,8 @@ from pneumorph.cli.execution import check_options, cluster_line, cluster_report,
 
 @click.group("unit")
 def unit() -> None:
-    """The articulating unit: geometry optimisation (docs/unit-library.md)."""
+    """The articulating unit: geometry optimisation (documentation page unit-library, docs/unit-library.md in the
+    source)."""
 
 
 @unit.command("optimise")
