@@ -156,3 +156,16 @@ def test_ctrl_c_and_sigterm_stop_a_running_job_at_once(tmp_path: Path, sig: sign
         assert json.loads(record.read_text())["state"] == "interrupted"
     finally:
         srv.stop()
+
+
+def test_the_missing_web_extra_is_named_with_the_install_command_of_a_wheel(monkeypatch, capsys) -> None:
+    """Without the web extra: one line, exit 2, `pip install "pneumorph[web]"` (quoted for every shell; the editable
+    install of a checkout only as the second way)."""
+    import sys
+
+    from pneumorph.cli import main
+
+    monkeypatch.setitem(sys.modules, "uvicorn", None)  # an import of it raises ImportError
+    assert main(["serve", "--port", "8765"]) == 2  # refused before the port is bound
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and 'uvicorn is missing): pip install "pneumorph[web]" (in a checkout' in err

@@ -98,7 +98,7 @@ def serve(host: str, port: int, open_browser: bool, state: str | None, cache: st
         from pneumorph.bench.app import create_app
     except ImportError as exc:
         raise click.UsageError(f"the bench needs the web extra ({exc.name} is missing): pip install "
-                               "'pneumorph[web]' (in a checkout of the repository: pip install -e '.[web]')") from None
+                               '"pneumorph[web]" (in a checkout of the repository: pip install -e ".[web]")') from None
     _check_port(host, port)
     from pneumorph.bench.app import default_state_dir
     from pneumorph.bench.jobs import JobLimits
