@@ -138,3 +138,25 @@ def test_design_with_stages_on_the_command_line(tmp_path: Path, capsys: pytest.C
     config = DesignConfig.read(out / "config.toml")
     assert config.objective == "stages" and [s["pressure_kpa"] for s in config.stage or ()] == [10.0, 20.0]
     assert config.stage is not None and config.stage[1]["amplitude"] == 4.0
+
+
+def test_branch_and_bound_over_stages_keeps_every_design_that_matters() -> None:
+    """30-unit-style growth on 15 units of the shipped 3D table: forced past enumeration, it keeps every design
+    whose enumerated cost is below its threshold, with the same cost, and the same best design."""
+    from pneumorph.models.chain import ChainTable
+    from pneumorph.models.chaintables import shipped_path
+
+    chain = ChainModel(ChainTable.load(shipped_path("3d")), 15)
+    staged = staged_target([(0.018, make_objective("y = 0.05*x")),
+                            (0.045, make_objective("sin", amplitude=10.0, length=chain.length)),
+                            (0.027, tip_goal("reach", (150.0, 20.0)), 0.5)])
+    every = chain_scores(chain, staged)
+    grown = chain_scores(chain, staged, max_enumerate=10)  # the beam, then branch-and-bound
+    assert every.complete and not grown.complete and len(grown.cost) < len(every.cost) / 10
+    threshold = grown.floor + float(grown.bound.max())
+    names = dict(zip(design_strings(every.bits), every.cost, strict=True))
+    kept = dict(zip(design_strings(grown.bits), grown.cost, strict=True))
+    must = {d for d, c in names.items() if c < threshold - 1e-9}
+    assert must and must <= set(kept)
+    assert all(abs(kept[d] - names[d]) < 1e-9 for d in kept)
+    assert design_strings(grown.bits[grown.order()[:1]]) == design_strings(every.bits[every.order()[:1]])

@@ -476,6 +476,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     SearchConfigError
         More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose).
     """
+    if isinstance(objective, StagedTarget):
+        return _grow_staged(chain, objective, errors, threshold, max_nodes, beam)
     if not np.isfinite(threshold) and beam is None and _enumerable(chain, KEEP_GEOMETRY_UNITS):
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
@@ -554,8 +556,6 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     """
     errors = chain_errors(chain, margin)
     n = chain.n_units
-    if isinstance(objective, StagedTarget):
-        return _score_staged(chain, objective, errors, max_enumerate)
     if _enumerable(chain, max_enumerate):
         return grow_designs(chain, objective, errors)
     beamed = grow_designs(chain, objective, errors, beam=4096)
@@ -573,22 +573,58 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
                        scores.optimistic[keep], scores.bound[keep], floor=threshold - beta, choices=scores.choices)
 
 
-def _score_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, FloatArray],
-                  max_enumerate: int) -> ChainScores:
-    """Chain scores of every design for a staged target (all ``(2k)^n`` of them, in chunks).
+def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, FloatArray], threshold: float,
+                 max_nodes: int, beam: int | None) -> ChainScores:
+    """:func:`grow_designs` for a staged target: every design below ``threshold`` (all ``(2k)^n`` for ``inf``).
 
-    Raises
-    ------
-    SearchConfigError
-        More designs than ``2^max_enumerate``: stages have no branch-and-bound yet.
+    A prefix's bound is the weighted root-sum-square of its profile stages' partial sums of
+    Eq 4.1, each at its stage's level (they only grow; a ``reach`` stage counts 0 until the
+    tip is placed), so no design of a dropped prefix costs less than ``threshold``.
     """
-    if not _enumerable(chain, max_enumerate):
-        raise SearchConfigError(f"a staged target is certified by scoring every design, at most 2^{max_enumerate} "
-                                f"of them; {designs_of(chain):.3g} designs of {chain.n_units} units are too many - use "
-                                "fewer units or --search ga")
-    codes = np.asarray(chain.table.unit_codes, dtype=np.uint8)
-    bits = every_design(chain.n_units, codes)
-    return score_designs(chain, objective, bits, errors)
+    if not np.isfinite(threshold) and beam is None:
+        if not _enumerable(chain, MAX_ENUMERATE):
+            raise SearchConfigError(f"scoring every one of {designs_of(chain):.3g} designs of {chain.n_units} units "
+                                    "takes too long; give a threshold")
+        bits = every_design(chain.n_units, np.asarray(chain.table.unit_codes, dtype=np.uint8))
+        return score_designs(chain, objective, bits, errors)
+    n, length = chain.n_units, chain.length
+    levels = objective.levels(chain.table.pressures)
+    weights = objective.weights
+    profiles = [(i, cast(ProfileTarget, st.target), levels[i]) for i, st in enumerate(objective.stages)
+                if isinstance(st.target, ProfileTarget)]
+    bits, state = seed_prefixes(chain)
+    state["ssum"] = np.zeros((len(bits), len(objective.stages)))
+    with np.errstate(all="ignore"):
+        growth = depths(chain, bits, state)
+        for p, _placed, bits, state, centres in growth:
+            for _, x, y in centres:
+                for i, target, k in profiles:
+                    state["ssum"][:, i] += (target.curve(x[:, k], length) - y[:, k]) ** 2
+            if p == n:
+                continue
+            bound = np.sqrt(((weights**2) * state["ssum"]).sum(axis=1))
+            keep = bound < threshold
+            if beam is not None and keep.sum() > beam:
+                keep = np.zeros(len(bits), dtype=bool)
+                keep[np.argpartition(bound, beam)[:beam]] = True
+            if keep.sum() > max_nodes:
+                raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too "
+                                     "many designs come within the chain's error bound of the best to list them all "
+                                     "- use --search ga", float(bound[keep].min()))
+            bits = bits[keep]
+            state = {key: v[keep] for key, v in state.items()}
+            growth.send((bits, state))
+        tip, curl = tip_and_curl(chain, bits, state)
+        per = np.sqrt(state["ssum"])
+        for i, st in enumerate(objective.stages):
+            if isinstance(st.target, TipGoal):
+                k = levels[i]
+                per[:, i] = tip_value_array(tip[:, k], np.asarray(chain.table.tip_ref), curl[:, k], st.target.name,
+                                            st.target.point)
+        values = objective.at_levels(per, chain.table.pressures)
+    beta = np.broadcast_to(_staged_bound(chain, objective, errors), values.shape)
+    cost, level, optimistic, bound = _costs(values, beta, objective.sense)
+    return ChainScores(bits, values, cost, level, optimistic, bound, choices=_radix(chain))
 
 
 # -- the search -------------------------------------------------------------------------------
