@@ -590,7 +590,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     n, length = chain.n_units, chain.length
     levels = objective.levels(chain.table.pressures)
     weights = objective.weights
-    profiles = [(i, cast(ProfileTarget, st.target), levels[i]) for i, st in enumerate(objective.stages)
+    profiles = [(i, st.target, levels[i]) for i, st in enumerate(objective.stages)
                 if isinstance(st.target, ProfileTarget)]
     bits, state = seed_prefixes(chain)
     state["ssum"] = np.zeros((len(bits), len(objective.stages)))
