@@ -36,6 +36,7 @@ from pneumorph.cli.chain import chain  # noqa: E402
 from pneumorph.cli.correlate import correlate  # noqa: E402
 from pneumorph.cli.design import design  # noqa: E402
 from pneumorph.cli.export import export  # noqa: E402
+from pneumorph.cli.identify import identify  # noqa: E402
 from pneumorph.cli.sensitivity import sensitivity  # noqa: E402
 from pneumorph.cli.serve import serve  # noqa: E402
 from pneumorph.cli.simulate import simulate  # noqa: E402
@@ -46,6 +47,7 @@ cli.add_command(chain)
 cli.add_command(correlate)
 cli.add_command(design)
 cli.add_command(export)
+cli.add_command(identify)
 cli.add_command(sensitivity)
 cli.add_command(serve)
 cli.add_command(simulate)

@@ -80,6 +80,9 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
               help="Model fidelity (default: 3d for the certified search, 2d for ga and exhaustive).")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file.")
+@click.option("--model-file", type=P.InputFile(),
+              help="A model's [model] table (an identified model, identified.toml from pneumorph identify): its "
+                   "unit and material scales; --model, --pressure, --unit and --library still apply.")
 @click.option("--library", metavar="builtin|FILE", type=P.Text(),
               help="Designs over a unit library ('builtin' or a library TOML file; documentation page unit-library, "
                    "docs/unit-library.md in the source): certified search over every type and orientation per unit; "
@@ -103,7 +106,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
            robust: str | None, robust_samples: int | None, executor: str | None,
            workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
            unit_file: str | None, library: str | None, cache: str | None, out: str | None, overwrite: bool,
-           no_build: bool, as_json: bool) -> None:
+           no_build: bool, as_json: bool, model_file: str | None = None) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
 
     Without options: a 15-unit actuator for the target "sin, amplitude 10 mm, one period":
@@ -155,6 +158,15 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     ga_changes: dict[str, Any] = {k: v for k, v in (("population", population), ("generations", generations))
                                   if v is not None}
     model_settings = dict(config.model)
+    if model_file is not None:  # the identified model's settings over the config's
+        from pneumorph.models.factory import read_model_file
+
+        with P.blame("--model-file"):
+            table = read_model_file(model_file)
+        if {"unit", "unit_file", "library"} & set(table):
+            for key in ("unit", "unit_file", "library"):
+                model_settings.pop(key, None)
+        model_settings.update(table)
     for key, value in (("fidelity", fidelity), ("pressure_kpa", pressure), ("unit_file", unit_file)):
         if value is not None:
             model_settings[key] = value

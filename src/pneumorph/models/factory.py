@@ -17,7 +17,9 @@ from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
-              "temperature_change", "passage", "base_block", "library")
+              "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale")
+#: the range of ``body_bulk_scale`` and ``body_shear_scale``: factors on the body silicone's moduli
+SCALE_RANGE = (0.1, 10.0)
 
 
 def load_library(value: Any, where: str = "[model] library",
@@ -48,6 +50,36 @@ def load_library(value: Any, where: str = "[model] library",
         raise error(f"{where}: {exc}") from None
 
 
+def read_model_file(path: str | Path) -> dict[str, Any]:
+    """The ``[model]`` table of a TOML file (an identified model, ``pneumorph identify``; a design config).
+
+    Other tables (``[provenance]``, a config's ``[design]``) are left aside; the settings are
+    checked when the model is built (:func:`make_model`).
+
+    Raises
+    ------
+    SearchConfigError
+        Unreadable, not TOML, or without a ``[model]`` table: one line naming the file.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "identified.toml"
+    >>> _ = p.write_text("[model]\\nbody_bulk_scale = 1.06\\n[model.unit]\\nwall = 1.58\\n"
+    ...                  "[provenance]\\npneumorph = 'x'\\n")
+    >>> read_model_file(p)
+    {'body_bulk_scale': 1.06, 'unit': {'wall': 1.58}}
+    """
+    from pneumorph.io.files import read_toml
+
+    data = read_toml(path, "model file", SearchConfigError)
+    table = data.get("model")
+    if not isinstance(table, dict):
+        raise SearchConfigError(f"model file {path}: no [model] table (an identified model from pneumorph identify, "
+                                "or a design config with one)")
+    return dict(table)
+
+
 def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel:
     """A 2D or 3D FE model of ``units`` units from plain settings.
 
@@ -68,7 +100,13 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         :class:`~pneumorph.geometry.features.BaseBlock` parameters: ``length``, ``margin``,
         ``material``); or, instead of the unit, ``library``: ``"builtin"`` or the path of a
         unit library TOML file (:func:`load_library`): designs over its symbols, the
-        model's fingerprint then holding the library (unless it has one type only).
+        model's fingerprint then holding the library (unless it has one type only); the
+        body silicone's moduli scaled, as an identified model has them
+        (``pneumorph identify``, docs/identify.md): ``body_bulk_scale`` (its bulk modulus,
+        :func:`~pneumorph.sensitivity.variants.scaled_bulk_modulus`) and
+        ``body_shear_scale`` (its Ogden moduli,
+        :func:`~pneumorph.sensitivity.variants.scaled_shear_modulus`), each in
+        :data:`SCALE_RANGE` (default 1: the library's silicone, the same fingerprint).
 
     Examples
     --------
@@ -77,6 +115,13 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     ('2d', 4, 0.03, 1.0)
     >>> make_model(4, {"library": "builtin"}).library.symbols
     ('a', 'e', 'r', 's')
+    >>> m = make_model(4, {"body_bulk_scale": 1.06})
+    >>> round(m.body.bulk_modulus.value / make_model(4).body.bulk_modulus.value, 12)
+    1.06
+    >>> make_model(4, {"body_shear_scale": 0})
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: [model] body_shear_scale must be a finite number >= 0.1 and <= 10, got 0
     """
     checks.integer(units, "units", 1, checks.MAX_UNITS, limit="MAX_UNITS", error=SearchConfigError)
     s = dict(settings or {})
@@ -139,6 +184,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     extra: dict[str, Any] = {"base_block": block} if block is not None else {}
     if library is not None:
         extra["library"] = library
+    body = _scaled_body(s, unit if unit is not None else library.units[0] if library is not None else UnitSpec())
+    if body is not None:
+        extra["materials"] = {body.name: body}
     if change != 0.0 or passage != 0.0:
         if Model is not Full3D:
             what = "temperature_change" if change != 0.0 else "passage"
@@ -148,3 +196,20 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         except GeometryError as exc:
             raise SearchConfigError(f"[model] passage: {exc}") from None
     return Model(units, unit, ramp, gravity=gravity, **extra)
+
+
+def _scaled_body(settings: Mapping[str, Any], unit: UnitSpec) -> Any:
+    """The body silicone of ``unit`` with ``body_bulk_scale`` and ``body_shear_scale`` applied, or None (both 1)."""
+    scales = [checks.real(settings.get(key, 1.0), f"[model] {key}", *SCALE_RANGE, error=SearchConfigError)
+              for key in ("body_bulk_scale", "body_shear_scale")]
+    if scales == [1.0, 1.0]:
+        return None  # the library's material: every earlier fingerprint stays valid
+    from pneumorph.materials import get
+    from pneumorph.sensitivity.variants import scaled_bulk_modulus, scaled_shear_modulus
+
+    body = get(unit.body_material)
+    if scales[0] != 1.0:
+        body = scaled_bulk_modulus(body, scales[0])
+    if scales[1] != 1.0:
+        body = scaled_shear_modulus(body, scales[1])
+    return body

@@ -3,7 +3,8 @@
 - :class:`Tolerance`, :func:`perturbed` - mould tolerances on the unit's thicknesses (E.2).
 - :func:`shape_difference` - the largest distance between matching centreline points and
   its X and Y errors in %, as the dissertation measures.
-- :func:`scaled_bulk_modulus`, :func:`tension_only` - the material variants of E.1.
+- :func:`scaled_bulk_modulus`, :func:`tension_only` - the material variants of E.1;
+  :func:`scaled_shear_modulus` - the body's Ogden moduli scaled (model identification).
 - :func:`converge`, :func:`mesh_points`, :class:`MeshStudy` - mesh convergence: observed
   order, Richardson limit and grid convergence index of a design's shape over element sizes.
 - :class:`Study` and its builders (:func:`simplifications`, :func:`tolerances`,
@@ -40,7 +41,7 @@ from pneumorph.sensitivity.studies import (
     tolerances,
 )
 from pneumorph.sensitivity.tolerances import FIELDS, MACHINED, PRINTED, Tolerance, perturbed
-from pneumorph.sensitivity.variants import scaled_bulk_modulus, tension_only
+from pneumorph.sensitivity.variants import scaled_bulk_modulus, scaled_shear_modulus, tension_only
 
 __all__ = [
     "BUILDERS",
@@ -67,6 +68,7 @@ __all__ = [
     "representative_size",
     "run_study",
     "scaled_bulk_modulus",
+    "scaled_shear_modulus",
     "shape_difference",
     "simplifications",
     "temperature",

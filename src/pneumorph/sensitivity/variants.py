@@ -1,6 +1,8 @@
 """Materials of the sensitivity studies' variants (appendix E.1).
 
 - :func:`scaled_bulk_modulus` - a silicone with its bulk modulus raised (E.1.2: +5 %, +10 %).
+- :func:`scaled_shear_modulus` - a silicone with its Ogden moduli scaled (every ``mu_n``, so its
+  shear modulus and its whole stress-stretch curve by the same factor; the exponents kept).
 - :func:`tension_only` - a silicone's Ogden model refitted to its uniaxial *tension* curve
   alone (E.1.1), the calibration a lab without compression grips would make.
 
@@ -51,6 +53,44 @@ def scaled_bulk_modulus(material: Material, factor: float) -> Material:
     return replace(material, bulk_modulus=scaled)
 
 
+def scaled_shear_modulus(material: Material, factor: float) -> Material:
+    """``material`` with every Ogden modulus ``mu_n`` multiplied by ``factor`` (same name, exponents kept).
+
+    The initial shear modulus ``mu0 = sum mu_n alpha_n / 2`` and every stress of the
+    incompressible part scale by ``factor``; the bulk modulus is left as it is
+    (:func:`scaled_bulk_modulus` scales that).
+
+    Raises
+    ------
+    MaterialDataError
+        A material whose model is not Ogden's (the FE models' silicones are).
+
+    Examples
+    --------
+    >>> from pneumorph.materials import get
+    >>> ms = get("mold_star_15")
+    >>> round(scaled_shear_modulus(ms, 1.1).shear_modulus / ms.shear_modulus, 12)
+    1.1
+    """
+    from pneumorph.errors import MaterialDataError
+    from pneumorph.materials.hyperelastic import Ogden
+
+    factor = checks.real(factor, "shear modulus factor", 0.0, 100.0, low_open=True)
+    model, record = material.model, material.model_record
+    if not isinstance(model, Ogden):
+        raise MaterialDataError(f"{material.name!r} has no Ogden model whose moduli could be scaled")
+    scaled = Ogden(mu=tuple(m * factor for m in model.mu), alpha=model.alpha)
+    note = f"mu_n x {factor:g} (identified scale of the shear modulus)"
+    if record is not None:
+        params = tuple((k, _times(v, factor) if k == "mu" else v) for k, v in record.parameters)
+        record = replace(record, parameters=params, source=f"{record.source}, {note}")
+    return replace(material, model=scaled, model_record=record)
+
+
+def _times(value: float | tuple[float, ...], factor: float) -> float | tuple[float, ...]:
+    return tuple(x * factor for x in value) if isinstance(value, tuple) else value * factor
+
+
 def tension_curve(material: Material, stretch: tuple[float, float] = TENSION_RANGE, points: int = 41) -> TestCurve:
     """The uniaxial curve of ``material``'s model at ``points`` stretches in ``stretch``."""
     assert material.model is not None
@@ -83,4 +123,5 @@ def tension_only(material: Material, seed: int = 0) -> tuple[Material, FitResult
     return replace(material, model=result.model, model_record=record), result
 
 
-__all__ = ["COMPRESSION_RANGE", "TENSION_RANGE", "scaled_bulk_modulus", "tension_curve", "tension_only"]
+__all__ = ["COMPRESSION_RANGE", "TENSION_RANGE", "scaled_bulk_modulus", "scaled_shear_modulus", "tension_curve",
+           "tension_only"]

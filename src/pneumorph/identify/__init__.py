@@ -1,0 +1,51 @@
+"""Model identification from scans of cast actuators (``pneumorph identify``, docs/identify.md).
+
+Read the scans and check them against their designs (:func:`read_manifest`,
+:func:`load_scans`), fit the body silicone's bulk and shear modulus scales and the three
+mould thicknesses of Fig E.4 by least squares on the correlation distances
+(:func:`identify`), and write the identified model as a ``[model]`` table that ``design``
+and ``simulate`` take (:func:`identified_toml`).
+"""
+
+from pneumorph.identify.fit import (
+    MAX_CORRELATION,
+    MAX_ITERATIONS,
+    MAX_POINTS,
+    MIN_EIGENVALUE,
+    Identification,
+    Observation,
+    build_probes,
+    confounded,
+    identify,
+)
+from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
+from pneumorph.identify.probe import SHAPE_REVISION, ShapeProbe, shape_of
+from pneumorph.identify.result import identified_toml, write_identified
+from pneumorph.identify.scans import MAX_SCANS, SCAN_KEYS, ScanSpec, load_scans, read_manifest
+
+__all__ = [
+    "MAX_CORRELATION",
+    "MAX_ITERATIONS",
+    "MAX_POINTS",
+    "MAX_SCANS",
+    "MIN_EIGENVALUE",
+    "NAMES",
+    "SCAN_KEYS",
+    "SHAPE_REVISION",
+    "SPANS",
+    "STEPS",
+    "Identification",
+    "Observation",
+    "ParameterSet",
+    "ScanSpec",
+    "ShapeProbe",
+    "build_probes",
+    "confounded",
+    "identified_toml",
+    "identify",
+    "load_scans",
+    "parameter_indices",
+    "read_manifest",
+    "shape_of",
+    "write_identified",
+]

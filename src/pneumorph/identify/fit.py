@@ -1,0 +1,630 @@
+"""The identification: the model's parameters fitted to scans by least squares on the correlation distances.
+
+The method (docs/identify.md):
+
+1. **Align.** Each scan is aligned to the nominal model's deformed shape as
+   ``pneumorph correlate`` aligns it (:func:`pneumorph.correlation.correlate`): the
+   residual RMS *before*.
+2. **Jacobian by FE.** At the current parameters, every scanned design is solved, and
+   again with each free parameter moved by its step (forward differences; a thickness
+   moved with the mesh grid kept, as the tolerance study keeps it, so that surface nodes
+   correspond): the nodes' sensitivities ``dQ/dtheta``.
+3. **Gauss-Newton on the linearised shape.** The residual of a scan point is its signed
+   distance to the model's surface (3D: the tangent plane at its nearest surface node;
+   2D: its nearest outline segment). With the shape linear in the parameters, the
+   parameters and every scan's rigid alignment are solved together by bounded linear
+   least squares (:func:`scipy.optimize.lsq_linear`), the nearest points matched again
+   at every step, until the step vanishes.
+4. **Iterate** 2-3 at the new parameters until the parameter step is below a tenth of its
+   standard error (or 0.001), then **confirm**: solve at the fitted parameters and measure
+   each scan as ``correlate`` does (the residual RMS *after*).
+
+The standard errors are those of linear least squares, ``s^2 (J^T J)^-1`` with the
+alignment parameters in ``J`` (so a parameter that a rigid motion could mimic is not
+credited), ``s^2`` the residual variance. Parameters the scans cannot tell apart
+(|correlation| > :data:`MAX_CORRELATION`, a near-singular ``J^T J``, or a standard error
+larger than a plausible change) are fixed at nominal and reported as not identified.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from itertools import pairwise
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import lsq_linear
+from scipy.spatial import cKDTree
+
+from pneumorph.correlation.align import Transform, _rotation
+from pneumorph.correlation.compare import ModelShape, _resample, check_units, correlate
+from pneumorph.correlation.scans import Scan
+from pneumorph.errors import FitError, ScanError
+from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
+from pneumorph.identify.probe import ShapeProbe, shape_of
+from pneumorph.identify.scans import ScanSpec
+from pneumorph.models.factory import make_model
+
+FloatArray = NDArray[np.float64]
+
+#: pairs of parameters correlated beyond this cannot be told apart
+MAX_CORRELATION = 0.95
+#: the smallest eigenvalue of the parameters' correlation matrix below which J^T J is near-singular
+MIN_EIGENVALUE = 1e-3
+#: scan points used per scan (a seeded sample of larger scans)
+MAX_POINTS = 4000
+#: a Gauss-Newton step moves each parameter by at most this many plausible changes (its trust region)
+TRUST = 3.0
+#: a scan spanning outside this times its design's model (solved at nominal) is not of that design
+MATCH_RANGE = (0.8, 1.25)
+#: the Gauss-Newton iterations (FE Jacobians) before the fit is declared not converged
+MAX_ITERATIONS = 6
+#: converged when every free parameter's step is below this fraction of its standard error ...
+STEP_FRACTION = 0.1
+#: ... or below this (scales; mm for thicknesses)
+STEP_FLOOR = 1e-3
+
+
+@dataclass(frozen=True)
+class Observation:
+    """A scan with its design and pressure, read and checked (:func:`~pneumorph.identify.scans.load_scans`)."""
+
+    spec: ScanSpec
+    scan: Scan
+
+
+@dataclass(frozen=True)
+class Identification:
+    """The fitted parameters, their uncertainty and what the scans could not tell apart.
+
+    Attributes
+    ----------
+    values, nominal, standard_errors : ndarray, shape (5,)
+        In the order of :data:`~pneumorph.identify.parameters.NAMES` (scales, then mm);
+        the standard error is NaN for a parameter that was not fitted.
+    fitted, identified : ndarray of bool, shape (5,)
+        Fitted by the least squares; fitted and not confounded with another parameter.
+    notes : tuple of str
+        Per parameter, why it is not identified (empty when it is).
+    correlation : ndarray, shape (k, k)
+        Correlations of the fitted parameters (``free`` order).
+    free : tuple of str
+        The fitted parameters.
+    rms_before, rms_after : ndarray, shape (scans,)
+        Per scan, ``correlate``'s RMS (3D: surface; 2D: outline), mm, at nominal and at the fit.
+    residual_before, residual_after : ndarray, shape (scans,)
+        Per scan, RMS of the fit's point-to-surface residuals, mm.
+    sigma : float
+        The residual standard deviation of the last linearisation, mm.
+    iterations : int
+        FE Jacobians computed.
+    solves : int
+        FE solves asked of the evaluator (cache hits included).
+    settings : dict
+        The ``[model]`` settings of the fitted model (unit and scales).
+    fingerprints : tuple of str
+        The fitted model's fingerprint per scan (its pressure).
+    """
+
+    values: FloatArray
+    nominal: FloatArray
+    standard_errors: FloatArray
+    fitted: NDArray[np.bool_]
+    identified: NDArray[np.bool_]
+    notes: tuple[str, ...]
+    correlation: FloatArray
+    free: tuple[str, ...]
+    rms_before: FloatArray
+    rms_after: FloatArray
+    residual_before: FloatArray
+    residual_after: FloatArray
+    sigma: float
+    iterations: int
+    solves: int
+    settings: dict[str, Any]
+    fingerprints: tuple[str, ...]
+    observations: tuple[Observation, ...] = field(repr=False, default=())
+
+    def parameters(self) -> dict[str, dict[str, Any]]:
+        """Per parameter: value, standard error, identified, fitted, nominal and a note."""
+        out = {}
+        for i, name in enumerate(NAMES):
+            se = float(self.standard_errors[i])
+            out[name] = {"value": float(self.values[i]), "standard_error": se if np.isfinite(se) else None,
+                         "identified": bool(self.identified[i]), "fitted": bool(self.fitted[i]),
+                         "nominal": float(self.nominal[i]), "unit": "mm" if i >= 2 else "scale",
+                         "note": self.notes[i]}
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        def rms(a: FloatArray) -> dict[str, Any]:
+            return {"per_scan_mm": a.tolist(), "all_mm": float(np.sqrt(np.mean(a**2)))}
+
+        return {"parameters": self.parameters(),
+                "correlation": {"parameters": list(self.free), "matrix": self.correlation.tolist()},
+                "residual_rms": {"before": rms(self.rms_before), "after": rms(self.rms_after),
+                                 "fit_before": rms(self.residual_before), "fit_after": rms(self.residual_after),
+                                 "measure": "surface" if self.observations and self.observations[0].scan.dim == 3
+                                 else "outline"},
+                "sigma_mm": self.sigma, "iterations": self.iterations, "solves": self.solves,
+                "scans": [o.spec.to_dict() for o in self.observations], "model": self.settings,
+                "fingerprints": list(self.fingerprints)}
+
+
+# -- the shape of a model as nodes that move linearly with the parameters ----------------------
+@dataclass(frozen=True)
+class _Linear:
+    """One scan's model shape at the current parameters and its node sensitivities.
+
+    3D: ``nodes`` are the surface nodes (normals kept from the base solve); 2D: the outline's
+    segment end points, two rows per segment.
+    """
+
+    dim: int
+    nodes: FloatArray
+    derivatives: FloatArray  # (free, nodes, dim)
+    normals: FloatArray
+
+    def at(self, step: FloatArray) -> FloatArray:
+        return self.nodes + np.tensordot(step, self.derivatives, axes=1) if len(step) else self.nodes
+
+    def match(self, x: FloatArray, step: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Per point: its signed distance to the shape and the distance's derivative by the free parameters."""
+        nodes = self.at(step)
+        if self.dim == 3:
+            _, i = cKDTree(nodes).query(x)
+            n = self.normals[i]
+            r = ((x - nodes[i]) * n).sum(axis=1)
+            dq = self.derivatives[:, i, :]  # (free, points, 3)
+            return r, -(dq * n[None]).sum(axis=2).T
+        segments = nodes.reshape(-1, 2, 2)
+        samples, segment = _resample(segments)
+        _, k = cKDTree(samples).query(x)
+        s = segment[k]
+        a, b = segments[s, 0], segments[s, 1]
+        d = b - a
+        length2 = np.maximum((d**2).sum(axis=1), 1e-300)
+        t = np.clip(((x - a) * d).sum(axis=1) / length2, 0.0, 1.0)
+        q = a + t[:, None] * d
+        n = np.c_[-d[:, 1], d[:, 0]] / np.sqrt(length2)[:, None]
+        r = ((x - q) * n).sum(axis=1)
+        if not len(self.derivatives):
+            return r, np.zeros((len(x), 0))
+        D = self.derivatives.reshape(len(self.derivatives), -1, 2, 2)
+        dq = (1 - t)[None, :, None] * D[:, s, 0] + t[None, :, None] * D[:, s, 1]
+        return r, -(dq * n[None]).sum(axis=2).T
+
+
+def _nodes(shape: ModelShape, dim: int) -> tuple[FloatArray, FloatArray]:
+    if dim == 3:
+        return shape.surface, shape.normals
+    return shape.outline.reshape(-1, 2), np.empty((0, 2))
+
+
+def _align_columns(x: FloatArray, r_normals: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The columns of a small rigid motion about the points' centre (as ``plane_step``), and that centre."""
+    centre = x.mean(axis=0)
+    p = x - centre
+    if x.shape[1] == 2:
+        rot = (np.c_[-p[:, 1], p[:, 0]] * r_normals).sum(axis=1)[:, None]
+    else:
+        rot = np.cross(p, r_normals)
+    return np.hstack([rot, r_normals]), centre
+
+
+def _normals_of(lin: _Linear, x: FloatArray, step: FloatArray) -> FloatArray:
+    """The unit normals the residuals of ``x`` are measured along (for the alignment columns)."""
+    nodes = lin.at(step)
+    if lin.dim == 3:
+        _, i = cKDTree(nodes).query(x)
+        return lin.normals[i]
+    segments = nodes.reshape(-1, 2, 2)
+    samples, segment = _resample(segments)
+    _, k = cKDTree(samples).query(x)
+    d = segments[segment[k], 1] - segments[segment[k], 0]
+    return np.c_[-d[:, 1], d[:, 0]] / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+
+
+@dataclass
+class _State:
+    """The linearised problem's unknowns: the parameter step and each scan's alignment."""
+
+    step: FloatArray
+    transforms: list[Transform]
+
+
+def _system(lins: Sequence[_Linear], points: Sequence[FloatArray], state: _State, scale: FloatArray
+            ) -> tuple[FloatArray, FloatArray, list[FloatArray]]:
+    """Residuals, the Jacobian (free parameters in units of ``scale``, then each scan's motion), centres."""
+    blocks, rows, centres = [], [], []
+    motion = [3 + 3 if lin.dim == 3 else 1 + 2 for lin in lins]
+    for s, (lin, p) in enumerate(zip(lins, points, strict=True)):
+        x = state.transforms[s](p)
+        r, dtheta = lin.match(x, state.step)
+        align, centre = _align_columns(x, _normals_of(lin, x, state.step))
+        a = np.zeros((len(x), len(state.step) + sum(motion)))
+        a[:, :len(state.step)] = dtheta * scale
+        start = len(state.step) + sum(motion[:s])
+        a[:, start:start + motion[s]] = align
+        blocks.append(a)
+        rows.append(r)
+        centres.append(centre)
+    return np.concatenate(rows), np.vstack(blocks), centres
+
+
+def _solve_linearised(lins: Sequence[_Linear], points: Sequence[FloatArray], transforms: list[Transform],
+                      lower: FloatArray, upper: FloatArray, scale: FloatArray, max_steps: int = 60
+                      ) -> tuple[_State, FloatArray, FloatArray]:
+    """Gauss-Newton on the linearised shapes from a zero step: (state, residuals, Jacobian) at its end."""
+    state = _State(np.zeros(len(scale)), list(transforms))
+    for _ in range(max_steps):
+        r, a, centres = _system(lins, points, state, scale)
+        k = len(scale)
+        lo = np.r_[(lower - state.step) / scale, np.full(a.shape[1] - k, -np.inf)]
+        hi = np.r_[(upper - state.step) / scale, np.full(a.shape[1] - k, np.inf)]
+        z = lsq_linear(a, -r, bounds=(lo, hi), method="bvls" if a.shape[1] < 40 else "trf").x
+        state.step = np.clip(state.step + z[:k] * scale, lower, upper)
+        offset = k
+        for s, lin in enumerate(lins):
+            n_rot = 3 if lin.dim == 3 else 1
+            omega, move = z[offset:offset + n_rot], z[offset + n_rot:offset + n_rot + lin.dim]
+            offset += n_rot + lin.dim
+            rotation = _rotation(omega)
+            c = centres[s]
+            state.transforms[s] = state.transforms[s].then(Transform(rotation, c + move - rotation @ c))
+        if np.max(np.abs(z), initial=0.0) < 1e-9:
+            break
+    r, a, _ = _system(lins, points, state, scale)
+    return state, r, a
+
+
+def _covariance(r: FloatArray, a: FloatArray, k: int) -> tuple[FloatArray, float]:
+    """The covariance of the first ``k`` (scaled) unknowns, ``s^2 (J^T J)^-1``, and ``s``."""
+    dof = max(len(r) - a.shape[1], 1)
+    sigma = float(np.sqrt(r @ r / dof))
+    normal = a.T @ a
+    try:
+        inverse = np.linalg.pinv(normal, rcond=1e-13, hermitian=True)
+    except np.linalg.LinAlgError:  # pragma: no cover - pinv of a symmetric matrix converges
+        inverse = np.full_like(normal, np.nan)
+    return np.asarray(sigma**2 * inverse[:k, :k], dtype=float), sigma
+
+
+def _correlation(cov: FloatArray) -> FloatArray:
+    d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
+    return np.asarray(cov / np.outer(d, d), dtype=float)
+
+
+def confounded(names: Sequence[str], cov_scaled: FloatArray, column_norms: FloatArray) -> dict[str, str]:
+    """The parameters to fix, each with why: the scans do not move with it, or cannot tell it from another.
+
+    ``cov_scaled`` is the covariance of the parameters in units of their plausible change
+    (:data:`~pneumorph.identify.parameters.SPANS`), ``column_norms`` the norms of their
+    Jacobian columns. Greedy: a parameter without effect first; then, while a pair is
+    correlated beyond :data:`MAX_CORRELATION` or the correlation matrix is near-singular,
+    the least determined parameter of the worst pair (or of the weakest direction). A
+    parameter that is merely loosely determined (see :func:`loose`) stays fitted: fixing it
+    would bias the others.
+
+    Examples
+    --------
+    >>> cov = np.array([[1.0, 1.08, 0.0], [1.08, 1.2, 0.0], [0.0, 0.0, 1.0]]) * 1e-4
+    >>> confounded(["a", "b", "c"], cov, np.ones(3))
+    {'b': 'cannot be told apart from a (correlation 0.986)'}
+    >>> confounded(["a", "b", "c"], np.diag([1e-4, 4.0, 1e-4]), np.array([1.0, 1.0, 0.0]))
+    {'c': 'the scans do not depend on it'}
+    """
+    out: dict[str, str] = {}
+    names = list(names)
+    keep = list(range(len(names)))
+    top = float(np.max(column_norms, initial=0.0))
+    for i in list(keep):
+        if column_norms[i] <= 1e-9 * max(top, 1e-300):
+            out[names[i]] = "the scans do not depend on it"
+            keep.remove(i)
+    while keep:
+        sub = cov_scaled[np.ix_(keep, keep)]
+        se = np.sqrt(np.maximum(np.diag(sub), 0.0))
+        if len(keep) < 2:
+            break
+        corr = _correlation(sub)
+        off = np.abs(corr - np.eye(len(keep)))
+        i, j = (int(v) for v in np.unravel_index(int(np.argmax(off)), off.shape))
+        worst = float(off[i, j])
+        eigenvalues, vectors = np.linalg.eigh(corr)
+        if worst > MAX_CORRELATION:
+            drop = i if se[i] >= se[j] else j
+            other = j if drop == i else i
+            out[names[keep[drop]]] = (f"cannot be told apart from {names[keep[other]]} (correlation "
+                                      f"{corr[i, j]:.3g})")
+        elif eigenvalues[0] < MIN_EIGENVALUE:
+            weights = np.abs(vectors[:, 0])
+            drop = int(np.argmax(weights * se))
+            partners = [names[keep[m]] for m in np.argsort(-weights) if m != drop and weights[m] > 0.2]
+            out[names[keep[drop]]] = (f"cannot be told apart from a combination of {', '.join(partners)} (J^T J "
+                                      f"near-singular: smallest correlation eigenvalue {eigenvalues[0]:.2g})")
+        else:
+            break
+        del keep[drop]
+    return out
+
+
+# -- the driver ------------------------------------------------------------------------------
+def _sample(scan: Scan, seed: int) -> FloatArray:
+    p = scan.points
+    if len(p) <= MAX_POINTS:
+        return p
+    return p[np.sort(np.random.default_rng(seed).choice(len(p), MAX_POINTS, replace=False))]
+
+
+def check_design(observation: Observation, shape: ModelShape) -> None:
+    """Refuse a scan whose size is not its design's (another unit count): before the fit's many solves.
+
+    The scan must span within :data:`MATCH_RANGE` times the nominal model's deformed shape
+    (the diagonal of the box along their principal axes, whichever way the scan lies);
+    a cast off the model by the parameters the fit can change spans within a few percent
+    of it.
+
+    Raises
+    ------
+    ScanError
+        The scan and the model differ in size beyond the range.
+    """
+    model = shape.surface if len(shape.surface) else shape.samples
+    scan, size = _size(observation.scan.points), _size(model)
+    ratio = scan / max(size, 1e-12)
+    if not MATCH_RANGE[0] <= ratio <= MATCH_RANGE[1]:
+        spec = observation.spec
+        raise ScanError(f"scan {spec.file} spans {scan:.4g} mm but design {spec.design} "
+                        f"({len(spec.design)} units) spans {size:.4g} mm at {spec.pressure_kpa:g} kPa "
+                        f"({ratio:.3g} times): is it the design scanned? (check its unit count and --scan-unit)")
+
+
+def _size(points: FloatArray) -> float:
+    """The diagonal of the points' box along their principal axes (independent of their orientation)."""
+    centred = points - points.mean(axis=0)
+    _, _, vt = np.linalg.svd(centred, full_matrices=False)
+    return float(np.linalg.norm(np.ptp(centred @ vt.T, axis=0)))
+
+
+def build_probes(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any],
+                 values: FloatArray) -> list[ShapeProbe]:
+    """The probe of every scan's design at ``values`` (its model's ramp ends at the scan's pressure).
+
+    Raises
+    ------
+    SearchConfigError, PressureRangeError
+        A setting the model factory refuses, a pressure outside the model's range.
+    """
+    return [ShapeProbe(make_model(len(o.spec.design), params.settings(values, {**base,
+                                                                              "pressure_kpa": o.spec.pressure_kpa})))
+            for o in observations]
+
+
+def identify(observations: Sequence[Observation], params: ParameterSet, evaluator: Any,
+             base: dict[str, Any] | None = None, parameters: Sequence[str] = NAMES, seed: int = 0,
+             max_iterations: int = MAX_ITERATIONS, on_progress: Callable[[str], None] | None = None
+             ) -> Identification:
+    """Fit ``parameters`` to the scans (see the module docstring).
+
+    Parameters
+    ----------
+    observations : sequence of Observation
+        The scans, each with its design and pressure (checked: :func:`~pneumorph.identify.scans.load_scans`).
+    params : ParameterSet
+        The nominal unit, scales and the thicknesses' box.
+    evaluator : Evaluator
+        Solves the probes (``iter_cases``); behind the evaluation cache a rerun is fast.
+    base : dict, optional
+        Further model settings (``fidelity``, ...; not the unit: ``params`` holds it).
+    parameters : sequence of str
+        The parameters to fit; the others stay at nominal.
+    seed : int
+        Seed of the sample of a scan's points when it has more than :data:`MAX_POINTS`.
+
+    Raises
+    ------
+    FitError
+        A solve failed, or the fit did not converge in ``max_iterations``: nothing is identified.
+    ScanError
+        A scan far from its model's size (unit mistake), or a 3D scan against the 2D model.
+
+    Examples
+    --------
+    See ``tests/identify/test_fit.py`` (a fit solves the FE model several times).
+    """
+    base = dict(base or {})
+    say = on_progress or (lambda text: None)
+    free = [NAMES[i] for i in parameter_indices(parameters)]
+    if not observations:
+        raise FitError("no scans to identify from")
+    dim = observations[0].scan.dim
+    fidelity_dim = 3 if base.get("fidelity", "2d") == "3d" else 2
+    if dim == 3 and fidelity_dim == 2:
+        raise ScanError("a 3D scan needs the 3D model (--model 3d); a 2D model has no surface")
+    points = [_sample(o.scan, seed + k) for k, o in enumerate(observations)]
+    theta = params.nominal.copy()
+    build_probes(observations, params, base, theta)  # every model refused now, before any solve
+    solves = 0
+
+    def shapes_at(values_list: list[FloatArray]) -> list[list[ModelShape]]:
+        """The shapes of every scan's design at each parameter vector (one batch of the evaluator)."""
+        nonlocal solves
+        cases, where = [], []
+        for v_index, values in enumerate(values_list):
+            for s, probe in enumerate(build_probes(observations, params, base, values)):
+                cases.append((probe, observations[s].spec.design))
+                where.append((v_index, s))
+        out: list[list[Any]] = [[None] * len(observations) for _ in values_list]
+        for i, outcome in evaluator.iter_cases(cases):
+            v_index, s = where[i]
+            if not outcome.ok or outcome.response is None:
+                changed = ", ".join(f"{n} {x:.6g}" for n, x in zip(NAMES, values_list[v_index], strict=True))
+                raise FitError(f"the fit's solve of design {observations[s].spec.design} at "
+                               f"{observations[s].spec.pressure_kpa:g} kPa ({changed}) failed: {outcome.failure}; "
+                               "nothing is identified")
+            out[v_index][s] = shape_of(outcome.response)
+        solves += len(cases)
+        return out
+
+    say(f"solving the nominal model of {len(observations)} scan(s)")
+    (nominal_shapes,) = shapes_at([theta])
+    transforms, before = [], []
+    for o, shape in zip(observations, nominal_shapes, strict=True):
+        check_units(o.scan, shape)
+        check_design(o, shape)
+        c = correlate(o.scan, shape)
+        transforms.append(c.alignment.transform)
+        before.append(c.surface.rms if dim == 3 else c.outline.rms)
+    rms_before = np.array(before)
+
+    notes = {name: "" for name in NAMES}
+    residual_before: FloatArray | None = None
+    base_shapes: list[ModelShape] = nominal_shapes
+    lower, upper = params.lower, params.upper
+    iterations = 0
+    cov = np.zeros((0, 0))
+    sigma = float("nan")
+    step = np.zeros(0)
+    while True:
+        if iterations >= max_iterations:
+            raise FitError(f"the fit did not converge in {max_iterations} Gauss-Newton iterations (last step "
+                           f"{', '.join(f'{n} {d:+.3g}' for n, d in zip(free, step, strict=True))}); nothing is "
+                           "identified")
+        iterations += 1
+        idx = [NAMES.index(n) for n in free]
+        trial = []
+        for i in idx:  # forward differences, backwards at the top of the box
+            h = STEPS[NAMES[i]] if theta[i] + STEPS[NAMES[i]] <= upper[i] + 1e-12 else -STEPS[NAMES[i]]
+            v = theta.copy()
+            v[i] += h
+            trial.append(v)
+        say(f"iteration {iterations}: {len(trial) * len(observations)} solves for the Jacobian of {', '.join(free)}")
+        if iterations == 1:  # the nominal shapes are solved already
+            moved = shapes_at(trial) if trial else []
+        else:  # the new point and its Jacobian in one batch
+            base_shapes, *moved = shapes_at([theta, *trial])
+        derivatives = []
+        for s in range(len(observations)):
+            nodes, _ = _nodes(base_shapes[s], dim)
+            per = []
+            for j, i in enumerate(idx):
+                other, _ = _nodes(moved[j][s], dim)
+                if other.shape != nodes.shape:
+                    raise FitError(f"the mesh of design {observations[s].spec.design} changed with {NAMES[i]} "
+                                   f"({other.shape[0]} against {nodes.shape[0]} surface nodes); nothing is "
+                                   "identified")
+                per.append((other - nodes) / (trial[j][i] - theta[i]))
+            derivatives.append(np.array(per).reshape(len(idx), *nodes.shape))
+
+        columns = list(range(len(idx)))
+        problem = (dim, base_shapes, derivatives, points, transforms, lower - theta, upper - theta)
+        state, r, a, lins, scale = _linearised(problem, idx, columns)
+        if residual_before is None:
+            r0, _, _ = _system(lins, points, _State(np.zeros(len(idx)), list(transforms)), scale)
+            residual_before = _per_scan_rms(r0, points)
+            cov, sigma = _covariance(r, a, len(idx))
+            fixed = confounded(free, cov, np.linalg.norm(_project_out(a, len(idx)), axis=0))
+            if fixed:
+                for name, why in fixed.items():
+                    notes[name] = why
+                    say(f"{name}: {why}; fixed at nominal")
+                columns = [c for c in columns if NAMES[idx[c]] not in fixed]
+                state, r, a, lins, scale = _linearised(problem, [idx[c] for c in columns], columns)
+                free = [NAMES[idx[c]] for c in columns]
+                idx = [idx[c] for c in columns]
+        cov, sigma = _covariance(r, a, len(idx))
+        se = np.sqrt(np.maximum(np.diag(cov), 0.0)) * scale
+        step = state.step
+        transforms = state.transforms
+        theta = theta.copy()
+        theta[idx] = np.clip(theta[idx] + step, lower[idx], upper[idx])
+        say(f"  step {', '.join(f'{n} {d:+.4g}' for n, d in zip(free, step, strict=True))}; "
+            f"residual {float(np.sqrt(np.mean(r**2))):.4g} mm")
+        if np.all(np.abs(step) <= np.maximum(STEP_FRACTION * se, STEP_FLOOR)):
+            break
+
+    say("confirming the fit by FE")
+    (final_shapes,) = shapes_at([theta])
+    after = []
+    for o, shape in zip(observations, final_shapes, strict=True):
+        c = correlate(o.scan, shape)
+        after.append(c.surface.rms if dim == 3 else c.outline.rms)
+    final_lins = []
+    for shape in final_shapes:
+        nodes, normals = _nodes(shape, dim)
+        final_lins.append(_Linear(dim, nodes, np.zeros((0, *nodes.shape)), normals))
+    r_final, _, _ = _system(final_lins, points, _State(np.zeros(0), list(transforms)), np.zeros(0))
+    idx = [NAMES.index(n) for n in free]
+    errors = np.full(len(NAMES), np.nan)
+    errors[idx] = np.sqrt(np.maximum(np.diag(cov), 0.0)) * np.array([SPANS[n] for n in free])
+    fitted = np.isin(np.arange(len(NAMES)), idx)
+    identified = fitted.copy()
+    for i in idx:
+        name = NAMES[i]
+        at_bound = min(theta[i] - lower[i], upper[i] - theta[i]) <= 1e-9
+        partners = [n for n, why in notes.items() if name in why.split("apart from ", 1)[-1]
+                    and why.startswith("cannot")]
+        if at_bound:
+            identified[i] = False
+            notes[name] = (f"at the bound of the box ({lower[i]:g} to {upper[i]:g}); the scans ask for more "
+                           "(widen --tolerance)")
+        elif partners:
+            identified[i] = False
+            notes[name] = f"fitted with {', '.join(partners)} fixed at nominal: its value absorbs theirs"
+        elif errors[i] > SPANS[name]:  # a plausible change moves the scans less than their scatter
+            identified[i] = False
+            notes[name] = (f"loosely determined: standard error {errors[i]:.3g}, more than a plausible change "
+                           f"({SPANS[name]:g})")
+    settings = params.settings(theta, base)
+    fingerprints = tuple(p.model.fingerprint() for p in build_probes(observations, params, base, theta))
+    return Identification(
+        values=theta, nominal=params.nominal, standard_errors=errors, fitted=fitted, identified=identified,
+        notes=tuple(notes[n] for n in NAMES), correlation=_correlation(cov) if len(idx) else np.zeros((0, 0)),
+        free=tuple(free), rms_before=rms_before, rms_after=np.array(after),
+        residual_before=residual_before if residual_before is not None else np.full(len(points), np.nan),
+        residual_after=_per_scan_rms(r_final, points), sigma=sigma, iterations=iterations, solves=solves,
+        settings=settings, fingerprints=fingerprints, observations=tuple(observations))
+
+
+def _linearised(problem: tuple[Any, ...], chosen: list[int], columns: list[int]
+                ) -> tuple[_State, FloatArray, FloatArray, list[_Linear], FloatArray]:
+    """The linearised problem of the ``columns`` of the Jacobian (parameters ``chosen``), solved."""
+    dim, shapes, derivatives, points, transforms, lower, upper = problem
+    lins = []
+    for shape, d in zip(shapes, derivatives, strict=True):
+        nodes, normals = _nodes(shape, dim)
+        lins.append(_Linear(dim, nodes, d[columns], normals))
+    scale = np.array([SPANS[NAMES[i]] for i in chosen])
+    state, r, a = _solve_linearised(lins, points, transforms, np.maximum(lower[chosen], -TRUST * scale),
+                                    np.minimum(upper[chosen], TRUST * scale), scale)
+    return state, r, a, lins, scale
+
+
+def _project_out(a: FloatArray, k: int) -> FloatArray:
+    """The first ``k`` columns of ``a`` with their parts along the other (alignment) columns removed."""
+    q, _ = np.linalg.qr(a[:, k:])
+    return a[:, :k] - q @ (q.T @ a[:, :k])
+
+
+def _per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
+    bounds = np.cumsum([0, *(len(p) for p in points)])
+    return np.array([float(np.sqrt(np.mean(r[a:b] ** 2))) for a, b in pairwise(bounds)])
+
+
+__all__ = [
+    "MATCH_RANGE",
+    "MAX_CORRELATION",
+    "MAX_ITERATIONS",
+    "MAX_POINTS",
+    "MIN_EIGENVALUE",
+    "TRUST",
+    "Identification",
+    "Observation",
+    "build_probes",
+    "check_design",
+    "confounded",
+    "identify",
+]

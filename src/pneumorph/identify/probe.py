@@ -1,0 +1,102 @@
+"""The evaluator's model of an identification: an FE model whose response carries the shape a scan sees.
+
+:class:`ShapeProbe` is an :class:`~pneumorph.models.response.ActuatorModel` (as the unit
+optimisation's probe is): it solves a design with its FE model and returns the
+:class:`~pneumorph.models.response.Response` with the
+:class:`~pneumorph.correlation.ModelShape` at the last level (the scan's pressure) in its
+metadata (``"model_shape"``). So every solve of a fit goes through the package's
+evaluators (serial, processes, Dask, as ``(model, design)`` cases of ``iter_cases``) and
+its SQLite cache, keyed by the probe's fingerprint (the FE model's and the shape's
+revision): a rerun answers from the cache, an interrupted fit resumes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from pneumorph.correlation.compare import ModelShape, model_shape
+from pneumorph.errors import SimulationFailed
+from pneumorph.io.provenance import digest
+from pneumorph.models.fe import FEModel
+from pneumorph.models.response import FloatArray, Response
+
+#: bumped when what the probe stores changes (part of its fingerprint)
+SHAPE_REVISION = 1
+
+
+class ShapeProbe:
+    """``model`` whose responses hold the deformed shape at the last level.
+
+    Parameters
+    ----------
+    model : FEModel
+        The model at one point of the parameter space (its ramp ends at the scan's pressure).
+
+    Examples
+    --------
+    >>> from pneumorph.models.factory import make_model
+    >>> probe = ShapeProbe(make_model(2, {"pressure_kpa": 10, "unit": {"element_size": 3.0}}))
+    >>> shape = shape_of(probe.evaluate("01"))
+    >>> shape.outline.shape[1:], len(shape.centres), shape.surface.shape
+    ((2, 2), 2, (0, 3))
+    """
+
+    def __init__(self, model: FEModel) -> None:
+        self.model = model
+        self.fidelity = f"shape-{model.fidelity}"
+        self.n_units = model.n_units
+
+    def describe(self) -> dict[str, Any]:
+        return {"probe": "identify-shape", "shape_revision": SHAPE_REVISION, "model": self.model.describe()}
+
+    def fingerprint(self) -> str:
+        return digest(self.describe())
+
+    def pressures(self) -> FloatArray:
+        return self.model.pressures()
+
+    def evaluate(self, orientation: str) -> Response:
+        """Solve ``orientation`` and return the response with its shape at the last level.
+
+        Raises
+        ------
+        SimulationFailed
+            The ramp stopped before the last level.
+        """
+        solution = self.model.solve(orientation)
+        r = solution.response
+        if not np.all(np.isfinite(solution.displacements[-1])):
+            raise SimulationFailed(float(r.reached) if np.isfinite(r.reached) else 0.0,
+                                   "the ramp did not reach the scan's pressure", r.orientation,
+                                   float(self.model.ramp.pressure), partial=r)
+        shape = model_shape(solution)
+        return replace(r, metadata={**r.metadata, "model_shape": shape_to_dict(shape)})
+
+
+def shape_to_dict(shape: ModelShape) -> dict[str, Any]:
+    """Plain lists of a :class:`ModelShape` (the outline's two end points per segment), for the cache."""
+    return {"surface": shape.surface.tolist(), "side": shape.side.astype(int).tolist(),
+            "outline": shape.outline[:, :2].tolist(), "centres": shape.centres.tolist(), "pitch": shape.pitch,
+            "normals": shape.normals.tolist()}
+
+
+def shape_of(response: Response) -> ModelShape:
+    """The :class:`ModelShape` a :class:`ShapeProbe` stored in ``response`` (also read back from a cache).
+
+    Raises
+    ------
+    KeyError
+        The response was not made by a probe.
+    """
+    d = response.metadata["model_shape"]
+    surface = np.asarray(d["surface"], dtype=float).reshape(-1, 3)
+    outline = np.asarray(d["outline"], dtype=float).reshape(-1, 2, 2)
+    return ModelShape(surface, np.asarray(d["side"], dtype=bool), outline,
+                      np.asarray(d["centres"], dtype=float).reshape(-1, 2), float(d["pitch"]),
+                      np.asarray(d["normals"], dtype=float).reshape(-1, 3))
+
+
+__all__ = ["SHAPE_REVISION", "ShapeProbe", "shape_of", "shape_to_dict"]

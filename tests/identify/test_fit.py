@@ -1,0 +1,79 @@
+"""The identification recovers known changes of small actuators, or says what it cannot tell apart."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
+from pneumorph.identify import NAMES, ParameterSet, identify
+from pneumorph.identify.fit import _Linear
+from tests.identify.conftest import SIGMA, synthetic
+
+TRUTH = np.array([0.06, 0.0, 0.0, 0.08, 0.0])  # bulk x1.06, wall +0.08 mm
+
+
+def test_a_photo_trace_recovers_the_wall_and_says_what_2d_cannot_tell_apart(coarse: ParameterSet) -> None:
+    truth = coarse.nominal + TRUTH
+    obs = [synthetic(coarse, truth, "011001", "2d", seed=1)]
+    r = identify(obs, coarse, SerialEvaluator(), {"fidelity": "2d"})
+    p = r.parameters()
+    # the section has no side walls; plane strain cannot tell the bulk modulus from the shear modulus,
+    # nor (one design) the wall from the layer: said, not guessed
+    assert p["side_wall"]["note"] == "the scans do not depend on it" and not p["side_wall"]["fitted"]
+    assert not p["bulk_modulus_scale"]["identified"] and not p["shear_modulus_scale"]["identified"]
+    assert "shear_modulus_scale" in p["bulk_modulus_scale"]["note"]
+    assert not p["layer"]["identified"] and "wall" in p["layer"]["note"]
+    # the layer is nominal in the truth, so the wall that absorbs it is the true wall
+    assert p["wall"]["value"] == pytest.approx(truth[3], abs=0.02)
+    assert p["wall"]["standard_error"] < 0.01
+    # the fit leaves the noise and nothing else; the nominal model left much more
+    assert r.rms_after[0] < 1.1 * SIGMA < 0.6 * r.rms_before[0]
+    assert r.sigma == pytest.approx(SIGMA, rel=0.1)
+
+
+def test_fitting_only_what_a_trace_can_tell_recovers_it(coarse: ParameterSet) -> None:
+    """Shear modulus known (coupons) and layer known: the bulk modulus and the wall from two traces."""
+    truth = coarse.nominal + TRUTH
+    obs = [synthetic(coarse, truth, d, "2d", seed=k) for k, d in enumerate(("011001", "000000"))]
+    r = identify(obs, coarse, SerialEvaluator(), {"fidelity": "2d"}, ["bulk_modulus_scale", "wall"])
+    values, errors = r.values, r.standard_errors
+    assert r.free == ("bulk_modulus_scale", "wall")
+    assert abs(values[0] - truth[0]) < max(0.01, 3 * errors[0])
+    assert abs(values[3] - truth[3]) < 0.02
+    assert np.all(np.isnan(errors[[1, 2, 4]])) and np.all(values[[1, 2, 4]] == coarse.nominal[[1, 2, 4]])
+
+
+def test_a_scan_of_the_nominal_model_comes_back_at_nominal(coarse: ParameterSet, tmp_path) -> None:
+    obs = [synthetic(coarse, coarse.nominal, "011001", "2d", seed=3)]
+    cache = EvaluationCache(tmp_path / "c.sqlite")
+    r = identify(obs, coarse, CachedEvaluator(SerialEvaluator(), cache), {"fidelity": "2d"})
+    fitted = np.flatnonzero(r.fitted)
+    assert len(fitted) >= 2
+    # within three standard errors (one would hold for 68 % of noise draws only)
+    z = np.abs(r.values[fitted] - coarse.nominal[fitted]) / r.standard_errors[fitted]
+    assert np.all(z < 3), dict(zip(np.array(NAMES)[fitted], z, strict=True))
+    # a rerun answers from the cache: the same numbers
+    again = identify(obs, coarse, CachedEvaluator(SerialEvaluator(), cache), {"fidelity": "2d"})
+    assert np.array_equal(again.values, r.values)
+
+
+def test_a_3d_scan_identifies_all_five(coarse: ParameterSet) -> None:
+    """3 units, coarse: every parameter within two of its standard errors of the truth."""
+    truth = coarse.nominal + TRUTH
+    r = identify([synthetic(coarse, truth, "010", "3d", seed=0)], coarse, SerialEvaluator(), {"fidelity": "3d"})
+    assert r.free == NAMES and bool(r.identified.all())
+    z = np.abs(r.values - truth) / r.standard_errors
+    assert np.all(z < 2.5), z
+    assert abs(r.values[3] - truth[3]) < 0.02 and abs(r.values[0] - truth[0]) < 0.05
+    assert r.residual_after[0] < 1.1 * SIGMA < r.residual_before[0]
+
+
+def test_the_linearised_outline_moves_with_its_end_points() -> None:
+    """A 2D residual's derivative is the normal component of its segment's interpolated motion."""
+    nodes = np.array([[0.0, 0.0], [10.0, 0.0]])
+    lin = _Linear(2, nodes, np.array([[[0.0, 1.0], [0.0, 3.0]]]), np.empty((0, 2)))
+    r, d = lin.match(np.array([[2.5, 1.0]]), np.zeros(1))
+    assert abs(r[0]) == pytest.approx(1.0) and abs(d[0, 0]) == pytest.approx(1.0 + 0.25 * 2.0)
+    r2, _ = lin.match(np.array([[2.5, 1.0]]), np.array([0.1]))
+    assert abs(r2[0]) == pytest.approx(1.0 - 0.15, abs=1e-3)  # the segment tilts by 0.02 rad
