@@ -24,13 +24,16 @@ HEX_FACES = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6
 QUAD_EDGES = ((0, 1), (1, 2), (2, 3), (3, 0))
 
 
-def boundary_facets(cells: IntArray) -> tuple[IntArray, IntArray]:
+def boundary_facets(cells: IntArray, dim: int | None = None) -> tuple[IntArray, IntArray]:
     """Facets that belong to one cell only, and the cell each belongs to.
 
     Parameters
     ----------
     cells : ndarray, shape (c, 4 or 8 or more)
         Cells by their corner nodes first (quad4/quad8 or hex8/hex20).
+    dim : {2, 3}, optional
+        The cells' dimension. Eight nodes are a quad8 or a hex8; without ``dim`` they are
+        taken as a hexahedron, so a 2D mesh of quad8 cells must say ``dim=2``.
 
     Returns
     -------
@@ -45,9 +48,13 @@ def boundary_facets(cells: IntArray) -> tuple[IntArray, IntArray]:
     >>> facets, owner = boundary_facets(two)
     >>> len(facets), sorted(owner.tolist())
     (6, [0, 0, 0, 1, 1, 1])
+    >>> quad8 = np.array([[0, 1, 2, 3, 4, 5, 6, 7]])  # one quad8: its four edges, not a hexahedron's faces
+    >>> boundary_facets(quad8, dim=2)[0].shape
+    (4, 2)
     """
     cells = np.asarray(cells)
-    local = HEX_FACES if cells.shape[1] >= 8 and _is_hex(cells) else QUAD_EDGES
+    hexahedra = dim == 3 if dim is not None else cells.shape[1] >= 8 and _is_hex(cells)
+    local = HEX_FACES if hexahedra else QUAD_EDGES
     corners = cells[:, : (8 if local is HEX_FACES else 4)]
     facets = corners[:, np.array(local)].reshape(-1, len(local[0]))
     owner = np.repeat(np.arange(len(cells)), len(local))
@@ -69,12 +76,12 @@ def outer_facets(mesh: ActuatorMesh) -> tuple[IntArray, IntArray]:
     >>> from pneumorph.geometry.unit import UnitSpec
     >>> m = assemble(UnitSpec(element_size=3.0), "0", dim=2)
     >>> facets, _ = outer_facets(m)
-    >>> bool(np.all(~m.cavity_points[facets].all(axis=1)))
-    True
+    >>> bool(np.all(~m.cavity_points[facets].all(axis=1))), facets.shape[1]   # the edges of the section
+    (True, 2)
     """
     cells = mesh.cells if mesh.dim == 3 else np.concatenate([mesh.cells[idx] for name, idx in mesh.regions.items()
                                                              if name != "filler"])
-    facets, owner = boundary_facets(cells)
+    facets, owner = boundary_facets(cells, mesh.dim)
     inner = mesh.cavity_points[facets].all(axis=1)
     if mesh.symmetry_points is not None:
         inner |= mesh.symmetry_points[facets].all(axis=1)
