@@ -305,7 +305,7 @@ def confounded(names: Sequence[str], cov_scaled: FloatArray, column_norms: Float
     Jacobian columns. Greedy: a parameter without effect first; then, while a pair is
     correlated beyond :data:`MAX_CORRELATION` or the correlation matrix is near-singular,
     the least determined parameter of the worst pair (or of the weakest direction). A
-    parameter that is merely loosely determined (see :func:`loose`) stays fitted: fixing it
+    parameter that is merely loosely determined (its standard error above its plausible change) stays fitted: fixing it
     would bias the others.
 
     Examples
