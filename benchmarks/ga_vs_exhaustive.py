@@ -30,7 +30,8 @@ from pneumorph.models.fe import Reduced2D
 
 OBJECTIVES = {"sin A=10": ("sin", {"amplitude": 10.0}), "cos A=10": ("cos", {"amplitude": 10.0}),
               "min-distance": ("min-distance", {})}
-BUDGET_GA = {"population": 20, "generations": 100, "indpb": 1 / 8, "budget": 85}
+BUDGET_GA = {"population": 20, "generations": 100, "indpb": 1 / 8, "budget": 85,
+             "mutpb": 0.2, "elitism": 0, "distinct": False}
 
 
 def main() -> None:

@@ -116,7 +116,8 @@ def test_failed_designs_rank_last_and_do_not_crash(model: ToyModel) -> None:
 # The GA settings of the budget test, fixed before looking at any objective: plain eaSimple
 # with DEAP's example probabilities, one flipped unit per mutation on average (1/n), a
 # population of 20 and a budget of 85 distinct designs (1/3 of 256).
-BUDGET_GA = {"population": 20, "generations": 100, "indpb": 1 / 8, "budget": 85}
+BUDGET_GA = {"population": 20, "generations": 100, "indpb": 1 / 8, "budget": 85,
+             "mutpb": 0.2, "elitism": 0, "distinct": False}
 
 
 @pytest.mark.parametrize("name", ["sin", "cos", "min-distance"])
@@ -133,7 +134,9 @@ def test_ga_finds_the_global_optimum_in_4_of_5_seeds_within_a_third(name: str, m
 
 def test_ga_is_deap_easimple_with_a_private_generator(model: ToyModel) -> None:
     obj = objective("sin")
-    ours = run_ga(model, obj, GAConfig(population=20, generations=8, seed=11))
+    # eaSimple's own settings: DEAP's example probabilities, no elitism, repeats allowed
+    plain = GAConfig(population=20, generations=8, seed=11, mutpb=0.2, indpb=0.05, elitism=0, distinct=False)
+    ours = run_ga(model, obj, plain)
     # DEAP's own eaSimple with the global generator seeded alike
     tb = base.Toolbox()
     tb.register("attr_bool", random.randint, 0, 1)
