@@ -522,7 +522,7 @@ class Reduced2D(FEModel):
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         #: the filler law of every unit type: the given one for all, else each unit's calibrated law, else
-        #: Eq 5.2 (the extending and short units of the built-in library have none calibrated yet)
+        #: Eq 5.2 (the extending and short units of the built-in library have no calibrated law)
         self.fillers = {s: filler or spec.filler_law() or get_filler() for s, spec in zip(
             self.library.symbols, self.library.units, strict=True)}
         # PressureRangeError outside the calibrated range, naming the ramp's top pressure
