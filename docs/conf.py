@@ -16,6 +16,7 @@ import re
 import sys
 from typing import Any
 
+import click
 from docutils.nodes import Node
 from sphinx.application import Sphinx
 from sphinx.pycode import ModuleAnalyzer
@@ -215,8 +216,39 @@ class ExportedData(SphinxDirective):
         return self.parse_text_to_nodes("\n".join(lines))
 
 
+class CommandHelp(SphinxDirective):
+    """``.. command-help:: pneumorph.cli:cli``: every command's ``--help``, as the terminal shows it.
+
+    The text comes from the click commands themselves (one section per command, in the
+    order ``pneumorph --help`` lists them), so the page follows the command line.
+    """
+
+    required_arguments = 1
+
+    def run(self) -> list[Node]:
+        module, _, name = self.arguments[0].partition(":")
+        root = getattr(importlib.import_module(module), name)
+        lines: list[str] = []
+
+        def walk(command: click.Command, path: list[str], parent: click.Context | None) -> None:
+            ctx = click.Context(command, info_name=path[-1], parent=parent, terminal_width=88, max_content_width=88)
+            title = f"``{' '.join(path)}``"
+            lines.extend([title, "-" * len(title), "", "::", ""])
+            lines.extend(f"   {line}" if line else "" for line in command.get_help(ctx).splitlines())
+            lines.append("")
+            if isinstance(command, click.Group):
+                for sub in command.list_commands(ctx):
+                    child = command.get_command(ctx, sub)
+                    if child is not None and not child.hidden:
+                        walk(child, [*path, sub], ctx)
+
+        walk(root, ["pneumorph"], None)
+        return self.parse_text_to_nodes("\n".join(lines), allow_section_headings=True)
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("exported-data", ExportedData)
+    app.add_directive("command-help", CommandHelp)
     app.connect("missing-reference", _resolve_by_object)
     app.connect("autodoc-skip-member", _skip_undocumented_class_members)
     return {"parallel_read_safe": True}

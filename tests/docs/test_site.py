@@ -7,6 +7,7 @@ reference to a name that moved or a page left out of the table of contents fails
 
 from __future__ import annotations
 
+import html
 import importlib
 import inspect
 import pkgutil
@@ -22,7 +23,7 @@ import pneumorph
 
 REPO = Path(__file__).resolve().parents[2]
 DOCS = REPO / "docs"
-# the command line has no Python API of its own: it is documented by ``pneumorph --help``
+# the command line has no Python API of its own: docs/cli.rst shows every command's --help
 NOT_IN_REFERENCE = {"pneumorph.cli", "pneumorph.__main__"}
 
 
@@ -71,8 +72,20 @@ def public_names() -> list[str]:
 
 def test_the_site_builds_without_warnings(site: Path) -> None:
     assert (site / "index.html").is_file() and (site / "reference" / "pneumorph.design.html").is_file()
-    for page in DOCS.glob("*.md"):
+    for page in [*DOCS.glob("*.md"), *DOCS.glob("*.rst")]:
         assert (site / f"{page.stem}.html").is_file(), page.name
+
+
+def test_the_command_line_page_has_every_command(site: Path) -> None:
+    import click
+
+    from pneumorph.cli import cli
+
+    text = html.unescape(re.sub(r"<[^>]+>", "", (site / "cli.html").read_text(encoding="utf-8")))
+    names = cli.list_commands(click.Context(cli))
+    assert len(names) > 10
+    for name in names:
+        assert f"Usage: pneumorph {name} [OPTIONS]" in text, name
 
 
 def test_every_public_name_is_in_the_api_reference(site: Path) -> None:
