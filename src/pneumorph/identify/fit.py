@@ -565,15 +565,17 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     for i in idx:
         name = NAMES[i]
         at_bound = min(theta[i] - lower[i], upper[i] - theta[i]) <= 1e-9
-        partners = [n for n, why in notes.items() if name in why.split("apart from ", 1)[-1]
-                    and why.startswith("cannot")]
+        # fixing a confounded parameter at nominal moves every fitted one by its correlation with it (times
+        # the fixed one's error over its standard error: large when the scans are precise): none stands alone
+        partners = [n for n, why in notes.items() if why.startswith("cannot")]
         if at_bound:
             identified[i] = False
             notes[name] = (f"at the bound of the box ({lower[i]:g} to {upper[i]:g}); the scans ask for more "
                            "(widen --tolerance)")
         elif partners:
             identified[i] = False
-            notes[name] = f"fitted with {', '.join(partners)} fixed at nominal: its value absorbs theirs"
+            notes[name] = (f"fitted with {', '.join(partners)} fixed at nominal: its value absorbs their change "
+                           "from nominal")
         elif errors[i] > SPANS[name]:  # a plausible change moves the scans less than their scatter
             identified[i] = False
             notes[name] = (f"loosely determined: standard error {errors[i]:.3g}, more than a plausible change "
