@@ -245,6 +245,8 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         windows.append(w)
         covering.append(len(train))
         solves.append(len(seen))
+    if not windows:  # not even the first window fits: the check's own refusal, with its advice
+        check_training_size(types, first if window is None else int(window), len(symmetric))
     held = int(cached(sorted(seen))) if cached is not None and seen else 0
     return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
                      tuple(float(p) for p in model.pressures()), int(n_units), tuple(windows), tuple(covering),

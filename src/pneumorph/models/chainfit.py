@@ -57,13 +57,24 @@ def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
     Traceback (most recent call last):
     ...
     pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
-    its base windows alone (at most 200, MAX_TRAINING); use fewer unit types or a window of +-1
+    its base windows alone (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
+    >>> check_training_size(26, 1)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 26 unit types at window +-1 needs at least 1352 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use at most 10 unit types
     """
-    need = (2 * int(n_types) - int(symmetric)) ** (int(window) + 1) // 2
-    if n_types > 1 and need > MAX_TRAINING:
-        raise LocalityError(f"a chain table over {n_types} unit types at window +-{window} needs at least {need} FE "
-                            f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use fewer "
-                            "unit types or a window of +-1")
+    def need(types: int, w: int) -> int:
+        return (2 * types - min(int(symmetric), types)) ** (w + 1) // 2
+
+    n, w = int(n_types), int(window)
+    if n > 1 and need(n, w) > MAX_TRAINING:
+        most = max((t for t in range(1, n) if need(t, w) <= MAX_TRAINING), default=1)
+        advice = f"at most {most} unit types"
+        if w > 1 and need(n, 1) <= MAX_TRAINING:
+            advice = f"a window of +-1 or {advice}"
+        raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {need(n, w)} FE "
+                            f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use {advice}")
 
 
 # -- elements of a response -----------------------------------------------------------------
