@@ -176,10 +176,15 @@ def _why(exc: Exception, suffix: str) -> str:
     if isinstance(exc, KeyError) and exc.args and str(exc.args[0]) in ("x", "y", "z"):
         return f"its vertices have no {exc.args[0]} coordinate"
     if isinstance(exc, (ModuleNotFoundError, UnicodeDecodeError)):
-        return f"its contents are neither a binary nor a text {kind} file"
+        return _neither(suffix)
     if isinstance(exc, (IndexError, ValueError, struct_error)):
         return f"its contents do not match the {kind} format ({type(exc).__name__}: {exc})"
     return f"{type(exc).__name__}: {exc}"
+
+
+def _neither(suffix: str) -> str:
+    """A file that is no mesh of its format, binary or text."""
+    return f"its contents are neither a binary nor a text {suffix.lower() or 'mesh'} file"
 
 
 def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
@@ -191,8 +196,9 @@ def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
         raise ScanError(f"scan {path}: not a readable mesh or point cloud ({_why(exc, path.suffix)})") from None
     if isinstance(loaded, trimesh.Scene):
         geometries = list(loaded.geometry.values())
-        if not geometries:
-            raise ScanError(f"scan {path}: the file holds no geometry")
+        if not geometries:  # an STL parser that finds no facet (junk read as text) answers an empty scene
+            why = f" ({_neither(path.suffix)})" if path.suffix.lower() == ".stl" else ""
+            raise ScanError(f"scan {path}: the file holds no geometry{why}")
         loaded = trimesh.util.concatenate(geometries) if len(geometries) > 1 else geometries[0]
     vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float)
     if vertices.ndim != 2 or vertices.shape[1] != 3 or len(vertices) == 0:
