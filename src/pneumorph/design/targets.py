@@ -442,8 +442,8 @@ def staged_target(stages: Any) -> StagedTarget:
     ------
     SearchConfigError
         No stages or more than :data:`MAX_STAGES`, a pressure that is not positive and finite,
-        a weight that is not positive and finite, two stages at one pressure with the same
-        target, or a target that cannot be staged (polar profiles, tip goals other than
+        a weight that is not positive and finite, two stages at one pressure, or a target that
+        cannot be staged (polar profiles, tip goals other than
         ``reach``: a maximum or minimum has no distance to add up).
 
     Examples
@@ -477,12 +477,12 @@ def staged_target(stages: Any) -> StagedTarget:
         if not isinstance(target, ProfileTarget | TipGoal):
             raise SearchConfigError(f"{where}: a stage's target must be a profile or a tip point, not a staged target")
         out.append(Stage(float(pressure), target, weight))
-    seen = set()
+    seen: set[float] = set()
     for stage in out:
-        key = (stage.pressure, stage.target.label)
-        if key in seen:
-            raise SearchConfigError(f"stage at {stage.pressure * 1e3:g} kPa: given twice with the same target")
-        seen.add(key)
+        if stage.pressure in seen:
+            raise SearchConfigError(f"stage at {stage.pressure * 1e3:g} kPa: two stages at one pressure; give each "
+                                    "pressure once (one target per stage)")
+        seen.add(stage.pressure)
     return StagedTarget(tuple(out))
 
 
