@@ -458,6 +458,25 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold, choices=_radix(chain))
 
 
+def _narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_nodes: int, p: int,
+            n: int) -> NDArray[np.bool_]:
+    """The open prefixes (``keep``) cut to the ``beam`` of lowest bound, if given.
+
+    Raises
+    ------
+    BranchOverflow
+        More than ``max_nodes`` stay open at depth ``p`` of ``n``.
+    """
+    if beam is not None and keep.sum() > beam:
+        keep = np.zeros(len(bound), dtype=bool)
+        keep[np.argpartition(bound, beam)[:beam]] = True
+    if keep.sum() > max_nodes:
+        raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too many "
+                             "designs come within the chain's error bound of the best to list them all - use "
+                             "--search ga", float(bound[keep].min()))
+    return keep
+
+
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
                  threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None) -> ChainScores:
     """Chain scores of every design whose cost is below ``threshold`` (all designs for ``inf``).
@@ -516,13 +535,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 bound[keep] = _prefix_bound(chain, objective, bits[keep], {key: v[keep] for key, v in st.items()},
                                             placed, curve)
                 keep = bound < threshold
-            if beam is not None and keep.sum() > beam:
-                keep = np.zeros(len(bits), dtype=bool)
-                keep[np.argpartition(bound, beam)[:beam]] = True
-            if keep.sum() > max_nodes:
-                raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too "
-                                     "many designs come within the chain's error bound of the best to list them all "
-                                     "- use --search ga", float(bound[keep].min()))
+            keep = _narrow(keep, bound, beam, max_nodes, p, n)
             bits = bits[keep]
             st = {key: v[keep] for key, v in st.items()}
             growth.send((bits, st))
@@ -603,14 +616,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
             if p == n:
                 continue
             bound = np.sqrt(((weights**2) * state["ssum"]).sum(axis=1))
-            keep = bound < threshold
-            if beam is not None and keep.sum() > beam:
-                keep = np.zeros(len(bits), dtype=bool)
-                keep[np.argpartition(bound, beam)[:beam]] = True
-            if keep.sum() > max_nodes:
-                raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too "
-                                     "many designs come within the chain's error bound of the best to list them all "
-                                     "- use --search ga", float(bound[keep].min()))
+            keep = _narrow(bound < threshold, bound, beam, max_nodes, p, n)
             bits = bits[keep]
             state = {key: v[keep] for key, v in state.items()}
             growth.send((bits, state))

@@ -12,22 +12,21 @@ revision): a rerun answers from the cache, an interrupted fit resumes.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from pneumorph.correlation.compare import ModelShape, model_shape
 from pneumorph.errors import SimulationFailed
-from pneumorph.io.provenance import digest
 from pneumorph.models.fe import FEModel
-from pneumorph.models.response import FloatArray, Response
+from pneumorph.models.probe import Probe
+from pneumorph.models.response import Response
 
 #: bumped when what the probe stores changes (part of its fingerprint)
 SHAPE_REVISION = 1
 
 
-class ShapeProbe:
+class ShapeProbe(Probe):
     """``model`` whose responses hold the deformed shape at the last level.
 
     Parameters
@@ -44,36 +43,29 @@ class ShapeProbe:
     ((2, 2), 2, (0, 3))
     """
 
+    kind = "identify-shape"
+    revision_key = "shape_revision"
+    revision = SHAPE_REVISION
+    metadata_key = "model_shape"
+
     def __init__(self, model: FEModel) -> None:
-        self.model = model
+        super().__init__(model)
         self.fidelity = f"shape-{model.fidelity}"
-        self.n_units = model.n_units
 
-    def describe(self) -> dict[str, Any]:
-        return {"probe": "identify-shape", "shape_revision": SHAPE_REVISION, "model": self.model.describe()}
-
-    def fingerprint(self) -> str:
-        return digest(self.describe())
-
-    def pressures(self) -> FloatArray:
-        return self.model.pressures()
-
-    def evaluate(self, orientation: str) -> Response:
-        """Solve ``orientation`` and return the response with its shape at the last level.
+    def measure(self, solution: Any) -> dict[str, Any]:
+        """The deformed shape at the last level (:func:`~pneumorph.correlation.compare.model_shape`), as lists.
 
         Raises
         ------
         SimulationFailed
             The ramp stopped before the last level.
         """
-        solution = self.model.solve(orientation)
         r = solution.response
         if not np.all(np.isfinite(solution.displacements[-1])):
             raise SimulationFailed(float(r.reached) if np.isfinite(r.reached) else 0.0,
                                    "the ramp did not reach the scan's pressure", r.orientation,
                                    float(self.model.ramp.pressure), partial=r)
-        shape = model_shape(solution)
-        return replace(r, metadata={**r.metadata, "model_shape": shape_to_dict(shape)})
+        return shape_to_dict(model_shape(solution))
 
 
 def shape_to_dict(shape: ModelShape) -> dict[str, Any]:

@@ -455,9 +455,12 @@ def build_table(
         t0 = time.perf_counter()
         done = 0 if total is None else before + len(designs) - len(todo)
         total = len(todo) if total is None else total
-        for length in sorted({len(d) for d in todo}):  # a model per length (short training designs)
-            actuator = model if length == n else model.with_units(length)
-            for _i, outcome in evaluator.iter_evaluate(actuator, [d for d in todo if len(d) == length]):
+        # one stream of (model, design) cases, a model per length (short training designs), the longest first: no
+        # pause between the lengths, and the last solves in flight are the short ones
+        todo.sort(key=len, reverse=True)
+        actuators = {length: model if length == n else model.with_units(length) for length in {len(d) for d in todo}}
+        if todo:
+            for _i, outcome in evaluator.iter_cases([(actuators[len(d)], d) for d in todo]):
                 done += 1
                 if not outcome.ok:
                     raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "

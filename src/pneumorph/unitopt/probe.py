@@ -21,9 +21,9 @@ from typing import Any
 
 from pneumorph import checks
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.io.provenance import digest
 from pneumorph.models.fe import Full3D, RampSpec
-from pneumorph.models.response import FloatArray, Response
+from pneumorph.models.probe import Probe
+from pneumorph.models.response import Response
 from pneumorph.unitopt.measures import MEASURES_REVISION, UnitMeasures, measure
 
 #: units of the probe actuator (the fewest with an interior unit)
@@ -35,7 +35,7 @@ DEFAULT_UNITS = 3
 PROBE_STEPS = replace(Full3D.default_steps, max_cutbacks=2)
 
 
-class UnitProbe:
+class UnitProbe(Probe):
     """A candidate unit in a short aligned 3D actuator; ``evaluate`` adds its measures.
 
     Parameters
@@ -59,10 +59,14 @@ class UnitProbe:
     """
 
     fidelity = "unit-probe-3d"
+    kind = "unitopt"
+    revision_key = "measures_revision"
+    revision = MEASURES_REVISION
+    metadata_key = "unit_measures"
 
     def __init__(self, unit: UnitSpec, n_units: int = DEFAULT_UNITS, pressure: float = 0.045) -> None:
-        self.n_units = checks.integer(n_units, "probe units", 3, checks.MAX_UNITS, limit="MAX_UNITS")
-        self.model = Full3D(self.n_units, unit=unit, ramp_spec=RampSpec(pressure=pressure, steps=PROBE_STEPS))
+        n = checks.integer(n_units, "probe units", 3, checks.MAX_UNITS, limit="MAX_UNITS")
+        super().__init__(Full3D(n, unit=unit, ramp_spec=RampSpec(pressure=pressure, steps=PROBE_STEPS)))
         self.unit = unit
 
     @property
@@ -70,29 +74,16 @@ class UnitProbe:
         """The one design the probe solves: every unit aligned (orientation 0)."""
         return "0" * self.n_units
 
-    def describe(self) -> dict[str, Any]:
-        return {"probe": "unitopt", "measures_revision": MEASURES_REVISION, "model": self.model.describe()}
-
-    def fingerprint(self) -> str:
-        return digest(self.describe())
-
-    def pressures(self) -> FloatArray:
-        return self.model.pressures()
-
-    def evaluate(self, orientation: str) -> Response:
-        """Solve ``orientation`` (aligned units) and return the response with its measures.
+    def measure(self, solution: Any) -> dict[str, Any]:
+        """Omega, h_b and the strain of an aligned design's solution (:func:`~pneumorph.unitopt.measures.measure`).
 
         Raises
         ------
-        SimulationFailed
-            The ramp stopped before the design pressure (a limit point): an infeasible unit.
         SettingsError
             A design with a unit turned over (the measures read the soft wall at ``y = 0``).
         """
-        solution = self.model.solve(orientation)
         r = solution.response
-        m = measure(solution.mesh, solution.displacements, float(r.curl[-1]))
-        return replace(r, metadata={**r.metadata, "unit_measures": m.to_dict(), "probe": self.fingerprint()})
+        return measure(solution.mesh, solution.displacements, float(r.curl[-1])).to_dict()
 
 
 def measures_of(response: Response) -> UnitMeasures:
