@@ -16,10 +16,11 @@ import time
 
 import numpy as np
 
+from pneumorph.design.robustness import design_robustness
 from pneumorph.design.targets import make_objective
 from pneumorph.models.chain import ChainTable, design_array
 from pneumorph.models.chaintables import shipped_path
-from pneumorph.sensitivity.robust import design_robustness, shipped_tolerance_tables
+from pneumorph.sensitivity.robust import shipped_tolerance_tables
 
 
 def main() -> None:

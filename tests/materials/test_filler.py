@@ -10,7 +10,8 @@ import pytest
 
 from pneumorph.errors import MaterialDataError, PressureRangeError
 from pneumorph.materials import library
-from pneumorph.materials.filler import FillerLaw, eq_5_2
+from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.library import eq_5_2
 
 
 @pytest.fixture(scope="module")

@@ -126,12 +126,12 @@ def test_a_table_of_another_model_or_too_short_an_actuator_is_refused(small) -> 
 def test_gravity_is_refused() -> None:
     model = Reduced2D(5, COARSE, RAMP, gravity="hanging")
     with pytest.raises(LocalityError, match="gravity"):
-        build_table(model)
+        build_table(model, SerialEvaluator())
 
 
 def test_a_window_wider_than_the_training_actuator_is_refused() -> None:
     with pytest.raises(ChainTableError, match="at least 7 units"):
-        build_table(Reduced2D(5, COARSE, RAMP), window=3)
+        build_table(Reduced2D(5, COARSE, RAMP), SerialEvaluator(), window=3)
 
 
 @pytest.mark.parametrize("fidelity", ["2d", "3d"])

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from pneumorph.cli import main
+from pneumorph.design.robustness import design_robustness
 from pneumorph.errors import ChainTableError
 from pneumorph.models.chain import ChainModel, ChainTable, design_array
 from pneumorph.models.chaintables import shipped_path
@@ -18,7 +19,6 @@ from pneumorph.models.windows import window_codes
 from pneumorph.sensitivity import Tolerance, perturbed
 from pneumorph.sensitivity.robust import (
     ToleranceTables,
-    design_robustness,
     inner_codes,
     shipped_tolerance_path,
     shipped_tolerance_tables,

@@ -15,15 +15,65 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
+from pneumorph import checks
+from pneumorph.design.certified import KEEP_GEOMETRY_UNITS, chain_scores, level_values
 from pneumorph.design.fitness import score
 from pneumorph.design.scoring import Candidate, ScoreBook
-from pneumorph.models.chain import design_array, design_strings
-from pneumorph.sensitivity.robust import design_robustness, spread
+from pneumorph.models.chain import ChainModel, ChainTable, design_array, design_strings
+from pneumorph.models.windows import design_numbers
+from pneumorph.sensitivity.robust import Robustness, ToleranceTables, spread
 from pneumorph.sensitivity.tolerances import Tolerance, box_units
 
 #: designs listed by their robust statistic
 TOP = 10
+
+
+def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any, bits: NDArray[np.integer],
+                      level: NDArray[np.integer] | None = None, samples: int = 30, seed: int = 0,
+                      choose: str | None = None) -> Robustness:
+    """The objective of designs ``bits`` under ``samples`` seeded offsets of the tolerance class.
+
+    Parameters
+    ----------
+    level : ndarray, optional
+        The level each design is judged at (its nominal best level, say); with ``choose``
+        instead, the level of each design that minimises that statistic (``"worst"`` or
+        ``"mean"``: the pressure at which it is most robust).
+
+    Every design of an actuator short enough to keep its prefix geometry is scored by
+    growing the designs unit by unit (:func:`~pneumorph.design.certified.chain_scores`, the
+    certified search's scoring, twice as fast); other sets of designs one by one.
+    """
+    samples = checks.integer(samples, "samples", 1, 10_000)
+    bits = np.atleast_2d(np.asarray(bits, dtype=np.uint8))
+    offsets = tables.tolerance.samples(samples, seed)
+    n = bits.shape[1]
+    codes = design_numbers(bits)
+    every = n <= KEEP_GEOMETRY_UNITS and len(bits) == 2**n and len(np.unique(codes)) == 2**n
+    per = []  # (samples, m, k)
+    for o in offsets:
+        chain = ChainModel(tables.perturbed(table, o), n)
+        if every:
+            scores = chain_scores(chain, objective)
+            grown = design_numbers(scores.bits)
+            where = np.empty(2**n, dtype=np.int64)
+            where[grown] = np.arange(len(grown))
+            values = scores.per_level[where[codes]]
+        else:
+            values, _, _ = level_values(chain, objective, bits)
+        per.append(np.where(np.isfinite(values), values, np.inf if objective.sense == "min" else -np.inf))
+    stack = np.stack(per)
+    if level is None:
+        name = choose or "worst"
+        probe = Robustness(bits, np.zeros(len(bits), dtype=np.int64), stack.reshape(samples, -1), offsets,
+                           objective.sense).statistic(name).reshape(len(bits), -1)
+        cost = probe if objective.sense == "min" else -probe
+        level = np.argmin(cost, axis=1)
+    level = np.asarray(level, dtype=np.int64)
+    values = stack[:, np.arange(len(bits)), level]
+    return Robustness(bits, level, values, offsets, objective.sense)
 
 
 def chain_robustness(config: Any, chain: Any, tables: Any, objective: Any, winner: Candidate) -> dict[str, Any]:
@@ -85,4 +135,4 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
     return out
 
 
-__all__ = ["chain_robustness", "fe_robustness", "robust_ranking", "robust_winner"]
+__all__ = ["chain_robustness", "design_robustness", "fe_robustness", "robust_ranking", "robust_winner"]

@@ -10,11 +10,13 @@ element size. Units of a library share their cross-section lines
 from __future__ import annotations
 
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.geometry.unit import UnitSpec
+if TYPE_CHECKING:
+    from pneumorph.geometry.unit import UnitSpec
 
 FloatArray = NDArray[np.float64]
 
@@ -42,6 +44,7 @@ def section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
 
     Examples
     --------
+    >>> from pneumorph.geometry.unit import UnitSpec
     >>> xb, yb = section_breaks(UnitSpec())
     >>> xb
     [0.0, 3.0, 7.5, 10.5, 10.5]
@@ -62,6 +65,7 @@ def width_breaks(spec: UnitSpec, half: bool = False) -> list[float]:
 
     Examples
     --------
+    >>> from pneumorph.geometry.unit import UnitSpec
     >>> width_breaks(UnitSpec(), half=True)
     [0.0, 1.5, 7.5]
     """
@@ -77,6 +81,7 @@ def cross_section_lines(spec: UnitSpec) -> tuple[FloatArray, FloatArray]:
 
     Examples
     --------
+    >>> from pneumorph.geometry.unit import UnitSpec
     >>> y, z = cross_section_lines(UnitSpec())
     >>> y.tolist()
     [0.0, 1.5, 3.0, 4.5, 6.0, 7.5, 9.0, 10.5, 12.0]

@@ -33,6 +33,20 @@ MAX_LENGTH_MM = 1000.0
 """Largest length of any part of a unit (pitch, width, walls, cavity, layer, slit, element size), mm."""
 MAX_NAME_CHARS = 200
 """Longest name of a unit (characters)."""
+#: the lengths of a :class:`~pneumorph.geometry.unit.UnitSpec` (mm) that :func:`check_lengths` checks
+UNIT_LENGTHS = (
+    "pitch",
+    "width",
+    "wall",
+    "side_wall",
+    "end_wall",
+    "layer",
+    "cavity_height",
+    "slit_width",
+    "slit_depth",
+    "end_cap",
+    "element_size",
+)
 MAX_NODES_3D = 60_000
 """Largest 3D mesh (nodes of the half model) the bench builds: about 3 x the built-in actuator, 4 GB (the command
 line's limit is the memory available instead, :func:`check_mesh`)."""
@@ -127,9 +141,7 @@ def check_lengths(spec: UnitSpec) -> None:
     ...
     pneumorph.geometry.limits.MeshLimitError: unit pitch 1e+04 mm is above the limit MAX_LENGTH_MM = 1000 mm...
     """
-    from pneumorph.geometry.unit import _LENGTHS as LENGTHS
-
-    for key in LENGTHS:
+    for key in UNIT_LENGTHS:
         value = getattr(spec, key)
         if value > MAX_LENGTH_MM:
             raise MeshLimitError(f"unit {key} {value:.4g} mm is above the limit MAX_LENGTH_MM = {MAX_LENGTH_MM:g} mm "

@@ -54,22 +54,8 @@ from typing import Any
 
 from pneumorph.checks import MIN_ELEMENT_FRACTION
 from pneumorph.errors import GeometryError
-from pneumorph.geometry.limits import MAX_NAME_CHARS, MeshLimitError, check_lengths
+from pneumorph.geometry.limits import MAX_NAME_CHARS, UNIT_LENGTHS, MeshLimitError, check_lengths
 from pneumorph.materials.filler import FillerLaw
-
-_LENGTHS = (
-    "pitch",
-    "width",
-    "wall",
-    "side_wall",
-    "end_wall",
-    "layer",
-    "cavity_height",
-    "slit_width",
-    "slit_depth",
-    "end_cap",
-    "element_size",
-)
 
 
 def _numbers(values: object, key: str, count: int | None = None) -> tuple[float, ...]:
@@ -197,7 +183,7 @@ class UnitSpec:
         for key in ("body_material", "layer_material", "name"):
             if not isinstance(getattr(self, key), str) or not getattr(self, key).strip():
                 raise GeometryError(f"unit {key} must be a non-empty text, got {getattr(self, key)!r}")
-        for key in _LENGTHS:
+        for key in UNIT_LENGTHS:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise GeometryError(f"unit {key} must be a finite number of mm, got {value!r}")

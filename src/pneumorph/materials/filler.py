@@ -192,17 +192,3 @@ class FillerLaw:
             coefficients, e_unit, p_unit = self.printed
             out["printed"] = {"coefficients": list(coefficients), "modulus_unit": e_unit, "pressure_unit": p_unit}
         return out
-
-
-def eq_5_2() -> FillerLaw:
-    """The dissertation's filler law, Eq 5.2, from the built-in library.
-
-    Examples
-    --------
-    >>> law = eq_5_2()
-    >>> law.coefficients, [x * 1e3 for x in law.pressure_range]
-    ((0.0643, -1.82, 12.4), [0.0, 45.0])
-    """
-    from pneumorph.materials.library import get_filler  # the library imports this module
-
-    return get_filler("ellis2020_eq5_2")

@@ -44,6 +44,7 @@ __all__ = [
     "Quantity",
     "builtin",
     "clear_registered",
+    "eq_5_2",
     "filler_names",
     "get",
     "get_filler",
@@ -131,6 +132,18 @@ def get_filler(name: str = "ellis2020_eq5_2") -> FillerLaw:
         if normalise(name) in lib.filler_names():
             return lib.filler(name)
     raise UnknownMaterialError(name, filler_names())
+
+
+def eq_5_2() -> FillerLaw:
+    """The dissertation's filler law, Eq 5.2, from the built-in library.
+
+    Examples
+    --------
+    >>> law = eq_5_2()
+    >>> law.coefficients, [x * 1e3 for x in law.pressure_range]
+    ((0.0643, -1.82, 12.4), [0.0, 45.0])
+    """
+    return get_filler("ellis2020_eq5_2")
 
 
 def register_toml(path: str | Path, replace: bool = False) -> Library:

@@ -371,7 +371,7 @@ def _stop_note(val: dict[str, Any], tolerance: float) -> str:
 
 def build_table(
     model: Any,
-    evaluator: Any = None,
+    evaluator: Any,
     window: int | None = None,
     tolerance: float = DEFAULT_TOLERANCE,
     heldout: int = 20,
@@ -389,8 +389,9 @@ def build_table(
     model : ActuatorModel
         The FE model of the training actuator (e.g. 15 units); it must be free (no gravity)
         and mirror-symmetric.
-    evaluator : Evaluator, optional
-        How the designs are solved (serial by default); a
+    evaluator : Evaluator
+        How the designs are solved, a service of the layer above (e.g.
+        :class:`~pneumorph.execution.SerialEvaluator`); a
         :class:`~pneumorph.execution.CachedEvaluator` makes the build resumable.
     window : int, optional
         A fixed half-width; by default ``first_window``, ``first_window + 1``, ... up to
@@ -426,15 +427,12 @@ def build_table(
     ChainTableError
         A training design failed to converge.
     """
-    from pneumorph.execution.evaluators import SerialEvaluator
-
     if getattr(model, "gravity", None) is not None:
         raise LocalityError("the chain model needs a free actuator: with gravity the weight makes moments along "
                             "the chain, so a unit's response depends on the whole actuator; search with the FE "
                             "model (--search ga or exhaustive)")
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise ChainTableError(f"the tolerance must be a positive number of mm, got {tolerance!r}")
-    evaluator = evaluator or SerialEvaluator()
     n = int(model.n_units)
     say = on_progress or (lambda text: None)
     first = min(max(1, int(first_window)), max_window, max(1, (n - 1) // 2))

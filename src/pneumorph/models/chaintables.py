@@ -417,7 +417,8 @@ def table_for(
     path : path, optional
         An explicit table file; it must have been fitted to this model's source.
     evaluator : Evaluator, optional
-        Solves the training and held-out designs of a new table (cached: resumable).
+        Solves the training and held-out designs of a new table (cached: resumable); a new
+        build needs one.
     on_progress : callable, optional
         Called with a line of text: the plan, then the build's progress.
 
@@ -436,6 +437,9 @@ def table_for(
     if found is not None:
         return found
     say = on_progress or (lambda text: None)
+    if evaluator is None:
+        raise ChainTableError(f"no chain table of this model in {folder or 'the shipped tables'}, and no evaluator "
+                              "to build one")
 
     def build() -> ChainTable:
         training = make_training(TRAINING_UNITS)

@@ -11,7 +11,8 @@ tables for three thicknesses, 2 FE solves each for 15 units).
 class: the full nominal table plus, read at each window's inner three units, a polynomial
 in the offsets that is exact for any quadratic with all products of the thicknesses
 (:meth:`ToleranceTables._change`). Scoring every design under ``S`` seeded samples of the
-class costs ``S`` chain scorings (:func:`design_robustness`). The tolerance study's FE
+class costs ``S`` chain scorings
+(:func:`pneumorph.design.robustness.design_robustness`). The tolerance study's FE
 solves of a design check it (``docs/sensitivity.md``).
 """
 
@@ -27,11 +28,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph import checks
 from pneumorph.errors import ChainTableError
-from pneumorph.models.chain import ChainModel, ChainTable, covering_designs, source_description, source_key
+from pneumorph.models.chain import ChainTable, covering_designs, source_description, source_key
 from pneumorph.models.chainfit import fit_table
-from pneumorph.models.windows import design_numbers
 from pneumorph.sensitivity.tolerances import Tolerance, box_units, corner_label
 
 FloatArray = NDArray[np.float64]
@@ -436,55 +435,7 @@ def spread(values: Any, sense: str) -> dict[str, float]:
             "best": float(sign * worse.min()), "samples": len(v)}
 
 
-def design_robustness(table: ChainTable, tables: ToleranceTables, objective: Any, bits: NDArray[np.integer],
-                      level: NDArray[np.integer] | None = None, samples: int = 30, seed: int = 0,
-                      choose: str | None = None) -> Robustness:
-    """The objective of designs ``bits`` under ``samples`` seeded offsets of the tolerance class.
-
-    Parameters
-    ----------
-    level : ndarray, optional
-        The level each design is judged at (its nominal best level, say); with ``choose``
-        instead, the level of each design that minimises that statistic (``"worst"`` or
-        ``"mean"``: the pressure at which it is most robust).
-
-    Every design of an actuator short enough to keep its prefix geometry is scored by
-    growing the designs unit by unit (:func:`~pneumorph.design.certified.chain_scores`, the
-    certified search's scoring, twice as fast); other sets of designs one by one.
-    """
-    from pneumorph.design.certified import KEEP_GEOMETRY_UNITS, chain_scores, level_values
-
-    samples = checks.integer(samples, "samples", 1, 10_000)
-    bits = np.atleast_2d(np.asarray(bits, dtype=np.uint8))
-    offsets = tables.tolerance.samples(samples, seed)
-    n = bits.shape[1]
-    codes = design_numbers(bits)
-    every = n <= KEEP_GEOMETRY_UNITS and len(bits) == 2**n and len(np.unique(codes)) == 2**n
-    per = []  # (samples, m, k)
-    for o in offsets:
-        chain = ChainModel(tables.perturbed(table, o), n)
-        if every:
-            scores = chain_scores(chain, objective)
-            grown = design_numbers(scores.bits)
-            where = np.empty(2**n, dtype=np.int64)
-            where[grown] = np.arange(len(grown))
-            values = scores.per_level[where[codes]]
-        else:
-            values, _, _ = level_values(chain, objective, bits)
-        per.append(np.where(np.isfinite(values), values, np.inf if objective.sense == "min" else -np.inf))
-    stack = np.stack(per)
-    if level is None:
-        name = choose or "worst"
-        probe = Robustness(bits, np.zeros(len(bits), dtype=np.int64), stack.reshape(samples, -1), offsets,
-                           objective.sense).statistic(name).reshape(len(bits), -1)
-        cost = probe if objective.sense == "min" else -probe
-        level = np.argmin(cost, axis=1)
-    level = np.asarray(level, dtype=np.int64)
-    values = stack[:, np.arange(len(bits)), level]
-    return Robustness(bits, level, values, offsets, objective.sense)
-
-
 __all__ = ["STATISTICS", "TOLERANCE_WINDOW", "Robustness", "ToleranceTables", "build_tolerance_tables",
-           "design_robustness", "find_tolerance_tables", "inner_codes", "restrict_tolerance_tables",
+           "find_tolerance_tables", "inner_codes", "restrict_tolerance_tables",
            "shipped_tolerance_path", "shipped_tolerance_tables", "spread", "tolerance_file", "tolerance_plan_text",
            "tolerance_tables_for"]
