@@ -156,7 +156,7 @@ def plot_stages(candidate: Candidate, objective: StagedTarget, path: str | Path)
                 label=f"{r.pressures[k] * 1e3:.4g} kPa" + (" (a stage)" if staged else ""))
     ax.set_title(f"{candidate.design} over the ramp: weighted root-sum-square of the stages {candidate.value:.3g} mm",
                  fontsize=9)
-    ax.legend(fontsize=6, ncol=5, loc="upper center", bbox_to_anchor=(0.5, -0.42), frameon=False)
+    fig.legend(*ax.get_legend_handles_labels(), fontsize=6, ncol=5, loc="outside lower center", frameon=False)
     for ax in axes:
         ax.axhline(0.0, color="0.8", lw=0.8, ls="--")
         ax.set_xlim(lo[0] - pad, hi[0] + pad)
