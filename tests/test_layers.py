@@ -45,7 +45,6 @@ MAX_FUNCTION_LINES = 80
 LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
     "pneumorph.design.certified": 838,
-    "pneumorph.design.run": 1015,
     "pneumorph.design.targets": 635,
     "pneumorph.execution.evaluators": 770,
     "pneumorph.export.calculix": 791,

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-import pneumorph.design.run as run_module
+import pneumorph.design.report as report_module
 from pneumorph.design import DesignConfig, GAConfig, run_design
-from pneumorph.design.run import RUN_FILES, _GenerationLog, run_files
+from pneumorph.design.folder import RUN_FILES, _GenerationLog, run_files
 from pneumorph.errors import (
     CacheError,
     OutputPathError,
@@ -310,7 +310,7 @@ def test_results_are_written_atomically_and_json_is_strict(tmp_path: Path, monke
         Path(path).write_bytes(b"half a figure")
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(run_module, "plot_convergence", broken)
+    monkeypatch.setattr(report_module, "plot_convergence", broken)
     with pytest.raises(RuntimeError, match="disk full"):
         run_design(config(tmp_path), ToyModel(fail={"00000000", "11111111"}), folder)
     assert (folder / "convergence.png").read_bytes() == figure  # the old file, whole
@@ -348,7 +348,7 @@ def test_an_interrupt_while_drawing_still_writes_the_report(tmp_path: Path, monk
     def interrupted(*args, **kw):
         raise Terminated()
 
-    monkeypatch.setattr(run_module, "plot_convergence", interrupted)
+    monkeypatch.setattr(report_module, "plot_convergence", interrupted)
     folder = tmp_path / "run"
     result = run_design(config(tmp_path), ToyModel(), folder)
     assert result.status == "interrupted"

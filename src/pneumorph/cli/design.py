@@ -396,7 +396,7 @@ def _certified_json(result) -> dict:
     """The certificate and the top designs of a certified run (empty otherwise)."""
     if result.certified is None:
         return {}
-    from pneumorph.design.run import _top_rows
+    from pneumorph.design.report import _top_rows
 
     return {"certificate": result.certified.certificate, "top": _top_rows(result),
             "opinion_2d": result.opinion_2d}

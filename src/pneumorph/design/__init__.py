@@ -27,7 +27,8 @@ from pneumorph.design.exhaustive import (
 )
 from pneumorph.design.fitness import Score, score
 from pneumorph.design.ga import GAConfig, GAResult, GenerationStats, run_ga
-from pneumorph.design.run import RunResult, run_design
+from pneumorph.design.report import RunResult
+from pneumorph.design.run import run_design
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.study import StudyResult, plot_study, population_study
 from pneumorph.design.targets import (

@@ -44,28 +44,21 @@ Nothing a run writes is lost or mixed up:
 - every result file is written to a temporary file and renamed over the old one
   (``config.toml``, ``report.md``, the JSON and CSV files, the figures); JSON is strict.
 - ``generations.csv`` is appended to, never truncated by a resumed run (see
-  :class:`_GenerationLog`).
-- ``overwrite=True`` removes the files of the old run (:data:`RUN_FILES` and the files its
+  :class:`~pneumorph.design.folder._GenerationLog`).
+- ``overwrite=True`` removes the files of the old run (:data:`~pneumorph.design.folder.RUN_FILES` and the files its
   report lists), only once every check has passed; files of others in the folder stay.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-import math
-import os
-import re
 import time
-import tomllib
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from pneumorph.design.certificate import certificate_text
 from pneumorph.design.certified import (
     CertifiedResult,
     certified_search,
@@ -73,18 +66,24 @@ from pneumorph.design.certified import (
 )
 from pneumorph.design.config import DesignConfig, to_toml
 from pneumorph.design.exhaustive import run_exhaustive
-from pneumorph.design.figures import plot_convergence, plot_profile
-from pneumorph.design.fitness import Score, stage_values
+from pneumorph.design.fitness import Score
+from pneumorph.design.folder import (
+    _check_folder,
+    _created_top,
+    _GenerationLog,
+    _remove_empty,
+    _remove_run_files,
+)
 from pneumorph.design.ga import GenerationStats, run_ga
 from pneumorph.design.planning import plan_search, planned_workers
+from pneumorph.design.report import RunResult, _write_outputs, _write_report
 from pneumorph.design.robustness import chain_robustness, fe_robustness, robust_ranking, robust_winner
 from pneumorph.design.scoring import Candidate
-from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget
+from pneumorph.design.targets import Objective, StagedTarget
 from pneumorph.errors import (
     MissingTableError,
     OutputPathError,
     PneumorphError,
-    RunFolderError,
     SearchConfigError,
 )
 from pneumorph.execution.cache import (
@@ -94,12 +93,9 @@ from pneumorph.execution.cache import (
 )
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
 from pneumorph.io.files import (
-    atomic_path,
     atomic_write_text,
     check_writable_dir,
-    write_json,
 )
-from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 from pneumorph.io.lock import RunLock
 from pneumorph.io.provenance import provenance as make_provenance
 from pneumorph.models.buildplan import evaluator_workers
@@ -110,29 +106,8 @@ from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for
 from pneumorph.sensitivity.tolerances import Tolerance
 
-_COMPARED = ("design", "ga", "model")
 #: designs a certified run with ``refine`` verifies (and solves on the finer mesh) at least
 REFINE_TOP = 3
-
-#: The files a run writes into its folder (glob patterns, relative to it): what ``overwrite`` removes,
-#: besides the files the old run's report lists and the temporary files of an interrupted write.
-#: The lock file (``.pneumorph.lock``) is not a run file.
-RUN_FILES = (
-    "config.toml",
-    "generations.csv",
-    "ranking.csv",
-    "hall_of_fame.json",
-    "certificate.json",
-    "top.csv",
-    "robustness.json",
-    "profile.png",
-    "chain-vs-fe.png",
-    "convergence.png",
-    "winner/deformed.png",  # an FE model's winner, solved again with its fields
-    "winner/vtk/winner.pvd",
-    "winner/vtk/winner_*.vtu",
-    "report.md",
-)
 
 
 def provenance(config: DesignConfig, model: ActuatorModel) -> dict[str, Any]:
@@ -144,254 +119,6 @@ def provenance(config: DesignConfig, model: ActuatorModel) -> dict[str, Any]:
         model_units=int(model.n_units),
         pressures_kpa=[round(float(p) * 1e3, 9) for p in model.pressures()],
     )
-
-
-@dataclass(frozen=True)
-class RunResult:
-    """What a run produced.
-
-    Attributes
-    ----------
-    status : {"finished", "interrupted"}
-    folder : Path
-    objective : ProfileTarget or TipGoal
-    hall_of_fame : tuple of Candidate
-        Best first; empty if the run was interrupted before its end.
-    history : tuple of GenerationStats
-        GA generations (empty for an exhaustive search).
-    solves, cache_hits : int
-        New model solves and designs answered by the evaluation cache in this run.
-    wall_time : float
-    rejected : int
-        Cache entries that failed their checksum and were solved again instead of used.
-    retried : int
-        Designs retried on other workers after a Dask worker was lost (0 for other executors).
-    files : tuple of Path
-    search : str
-        The search that ran: the config's, or for a certified run of an actuator shorter
-        than its chain table needs, ``"exhaustive"``.
-    search_note : str
-        A certified run's choice: its table and the levels it scores, or why it searched
-        exhaustively (and the estimated cost).
-    refinement : dict or None
-        With ``[design] refine``: the verified designs on the finer mesh
-        (:func:`pneumorph.design.refine.refine_verified`).
-    """
-
-    status: str
-    folder: Path
-    objective: Objective
-    hall_of_fame: tuple[Candidate, ...]
-    history: tuple[GenerationStats, ...]
-    solves: int
-    cache_hits: int
-    wall_time: float
-    files: tuple[Path, ...] = field(default=())
-    certified: CertifiedResult | None = None
-    opinion_2d: dict[str, float] = field(default_factory=dict)
-    rejected: int = 0
-    robustness: dict[str, Any] | None = None
-    robust_winner: Candidate | None = None
-    search: str = ""
-    search_note: str = ""
-    retried: int = 0
-    refinement: dict[str, Any] | None = None
-
-    @property
-    def best(self) -> Candidate | None:
-        """The winner: the most robust design of a ``robust`` run (FE-verified), the FE-verified one of a
-        certified search, else the first of the hall of fame."""
-        if self.robust_winner is not None:
-            return self.robust_winner
-        if self.certified is not None:
-            return self.certified.winner
-        return self.hall_of_fame[0] if self.hall_of_fame else None
-
-
-def _check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrite: bool) -> bool:
-    """True if ``folder`` holds the same run (resume); an error if it holds another one."""
-    path = folder / "config.toml"
-    if not path.exists() or overwrite:
-        return False
-    try:
-        old = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise RunFolderError(f"{folder} holds a config.toml that cannot be read ({exc}); choose another output "
-                             "folder or overwrite it") from None
-    new = config.to_dict()
-    for table in _COMPARED:
-        if old.get(table, {}) != new.get(table, {}):
-            there, here = old.get(table, {}), new.get(table, {})
-            keys = sorted(k for k in {*there, *here} if there.get(k) != here.get(k))
-            diff = "; ".join(f"{k} = {_setting(there.get(k))} there, {_setting(here.get(k))} now" for k in keys[:4])
-            more = f" (and {len(keys) - 4} more)" if len(keys) > 4 else ""
-            raise RunFolderError(
-                f"{folder} holds a run with other [{table}] settings: {diff}{more}; give another folder with --out "
-                "or replace that run with --overwrite"
-            )
-    old_fp = old.get("provenance", {}).get("model_fingerprint")
-    if old_fp not in (None, fingerprint):
-        raise RunFolderError(
-            f"{folder} holds a run of another model (fingerprint {old_fp}, now {fingerprint}); "
-            "give another folder with --out or replace that run with --overwrite"
-        )
-    return True
-
-
-def _setting(value: Any) -> str:
-    """A setting as a config shows it (``unset`` when absent), cut to 40 characters."""
-    text = "unset" if value is None else repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-class _GenerationLog:
-    """``generations.csv``: one row per generation, written (flushed and synced) as it is known.
-
-    A new run starts the file with its header. A resumed run keeps every row the file holds
-    and appends to it; it never truncates it. The rule for rows: **a generation is logged
-    once, by the run that first computed it.** A resumed GA replays generations 0, 1, ...
-    with the same seed, the evaluation cache answering the designs solved before; a replayed
-    generation that the file already holds is not written again (the kept row has the same
-    fitness statistics, and the solves and wall time it really took), and the first
-    generation beyond them is appended. A last line cut short by a kill (no line end) or a
-    row that cannot be read is dropped; only then is the file rewritten, atomically, with the
-    rows it keeps.
-    """
-
-    FIELDS = tuple(GenerationStats.__dataclass_fields__)
-
-    def __init__(self, path: Path, resume: bool) -> None:
-        self.path = path
-        self.rows: list[GenerationStats] = []
-        self.logged: set[int] = set()
-        kept, clean = self._existing() if resume else ([], False)
-        if not clean:
-            atomic_write_text(path, self._lines([self.FIELDS, *kept]))
-        self.file = path.open("a", newline="", encoding="utf-8")
-
-    def _existing(self) -> tuple[list[list[str]], bool]:
-        """The readable rows of the file, and whether it is exactly its header and those rows."""
-        try:
-            text = self.path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError):
-            return [], False
-        lines = text.splitlines(keepends=True)
-        clean = True
-        if lines and not lines[-1].endswith(("\n", "\r")):
-            lines, clean = lines[:-1], False  # cut short by a kill
-        records = list(csv.reader(lines))
-        if not records or "generation" not in records[0]:
-            return [], False
-        header, kept = records[0], []
-        clean = clean and tuple(header) == self.FIELDS
-        for record in records[1:]:
-            row = dict(zip(header, record, strict=False))
-            try:
-                generation = int(row["generation"])
-            except ValueError:
-                generation = None
-            if len(record) != len(header) or generation is None or generation in self.logged:
-                clean = False
-                continue
-            self.logged.add(generation)
-            kept.append([row.get(f, "") for f in self.FIELDS])
-        return kept, clean
-
-    @staticmethod
-    def _lines(records: list[Any]) -> str:
-        buffer = io.StringIO()
-        csv.writer(buffer).writerows(records)
-        return buffer.getvalue()
-
-    def __call__(self, stats: GenerationStats) -> None:
-        self.rows.append(stats)
-        if stats.generation in self.logged:
-            return
-        row = stats.as_row()
-        self.file.write(self._lines([[row[f] for f in self.FIELDS]]))  # one write: a whole line or nothing
-        self.file.flush()
-        os.fsync(self.file.fileno())
-        self.logged.add(stats.generation)
-
-    def close(self) -> None:
-        self.file.close()
-
-
-def _created_top(folder: Path) -> Path | None:
-    """The outermost folder of ``folder`` and its parents that does not exist yet (None if it exists)."""
-    top = None
-    probe = folder
-    while not probe.exists() and probe.parent != probe:
-        top, probe = probe, probe.parent
-    return top
-
-
-def _remove_empty(folder: Path, top: Path) -> None:
-    """Remove ``folder`` and its parents up to ``top`` while they are empty."""
-    probe = folder
-    while True:
-        try:
-            probe.rmdir()
-        except OSError:
-            return
-        if probe == top or probe.parent == probe:
-            return
-        probe = probe.parent
-
-
-def _reported_files(folder: Path) -> list[Path]:
-    """The files of ``folder`` that its ``report.md`` lists (what the last run wrote)."""
-    try:
-        text = (folder / "report.md").read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        return []
-    _, found, files = text.partition("\n## Files\n")
-    out = []
-    for name in re.findall(r"^- \[[^\]]*\]\(([^)\n]+)\)$", files if found else "", flags=re.MULTILINE):
-        rel = Path(name)
-        if rel.is_absolute() or ".." in rel.parts or rel.name == LOCK_FILE:
-            continue
-        out.append(folder / rel)
-    return out
-
-
-def run_files(folder: str | Path) -> list[Path]:
-    """The files of an earlier run in ``folder``: :data:`RUN_FILES`, the files its report lists and
-    the temporary files of an interrupted write, ``config.toml`` last."""
-    folder = Path(folder)
-    found: set[Path] = set(_reported_files(folder))
-    for pattern in RUN_FILES:
-        parent, _, name = pattern.rpartition("/")
-        found.update(folder.glob(pattern))
-        found.update(folder.glob(f"{parent}/.{name}.*.tmp*" if parent else f".{name}.*.tmp*"))
-    files = [p for p in found if p.name != LOCK_FILE and (p.is_file() or p.is_symlink())]
-    return sorted(files, key=lambda p: (p.name == "config.toml", str(p)))
-
-
-def _remove_run_files(folder: Path) -> None:
-    """Remove the old run's files (``config.toml`` last: a removal cut short still reads as that run)."""
-    parents: set[Path] = set()
-    for path in run_files(folder):
-        try:
-            path.unlink()
-        except FileNotFoundError:
-            continue
-        except OSError as exc:
-            raise RunFolderError(f"{folder}: cannot remove {path.name} of the old run "
-                                 f"({exc.strerror or exc})") from None
-        parents.update(p for p in path.parents if p != folder and p.is_relative_to(folder))
-    for parent in sorted(parents, key=lambda p: len(p.parts), reverse=True):
-        try:
-            parent.rmdir()  # only if empty
-        except OSError:
-            pass
-
-
-def _atomic_figure(path: Path, draw: Callable[[Path], Any]) -> Path:
-    """Draw a figure into a temporary file beside ``path`` (same suffix, for its format), then rename it."""
-    with atomic_path(path) as tmp:
-        draw(tmp)
-    return path
 
 
 def run_design(
@@ -724,16 +451,6 @@ def _chain_score(cert: CertifiedResult, i: int) -> Score:
     return Score(sc.per_level[i], level, sign * float(sc.cost[i]), p)
 
 
-def _stage_lines(objective: Objective, best: Candidate) -> list[str]:
-    """A staged winner's value at each stage, one report line each (none for other objectives)."""
-    if not isinstance(objective, StagedTarget) or best.response is None or not best.response.converged:
-        return []
-    values = stage_values(best.response, objective)
-    return [f"  - stage at {stage.pressure * 1e3:g} kPa (weight {stage.weight:g}): {v:.4g} mm "
-            f"({'Eq 4.1' if isinstance(stage.target, ProfileTarget) else 'tip to the point'}, {stage.target.label})"
-            for stage, v in zip(objective.stages, values, strict=True)]
-
-
 def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective,
                 cert: CertifiedResult) -> dict[str, float]:
     """The 2D reduced-order model's values of the listed designs (its shipped chain table, at the levels the
@@ -752,264 +469,3 @@ def _opinion_2d(config: DesignConfig, model: ActuatorModel, objective: Objective
     return {d: chain_candidate(chain, objective, d).value for d in designs}
 
 
-def _csv_text(header: list[str], rows: Any) -> str:
-    buffer = io.StringIO()
-    writer = csv.writer(buffer)
-    writer.writerow(header)
-    writer.writerows(rows)
-    return buffer.getvalue()
-
-
-def _write_outputs(
-    result: RunResult, config: DesignConfig, model: ActuatorModel, ranking: Any, figures: bool, files: list[Path]
-) -> None:
-    """Write the results into the run folder, each file atomically; ``files`` collects them as they are
-    written, the report last."""
-    folder = result.folder
-    if result.history:
-        files.append(folder / "generations.csv")
-    if ranking is not None:
-        rows = []
-        for i, (d, s) in enumerate(ranking, 1):
-            p = "" if s.pressure is None else round(s.pressure * 1e3, 9)
-            rows.append([i, d, s.value, "" if s.level is None else s.level, p, s.failed])
-        text = _csv_text(["rank", "design", "value", "level", "pressure_kpa", "failed"], rows)
-        files.append(atomic_write_text(folder / "ranking.csv", text))
-    if result.hall_of_fame:
-        entries = [{"rank": i, **c.to_dict()} for i, c in enumerate(result.hall_of_fame, 1)]
-        doc = {"objective": result.objective.label, "sense": result.objective.sense,
-               "unit": result.objective.unit, "designs": entries}
-        files.append(write_json(folder / "hall_of_fame.json", doc))
-    cert = result.certified
-    if cert is not None:
-        files += _write_certificate(result, folder)
-    if result.robustness is not None:
-        doc = {"objective": result.objective.label, "sense": result.objective.sense, "unit": result.objective.unit,
-               **result.robustness}
-        files.append(write_json(folder / "robustness.json", doc))
-    best = result.best
-    if figures and best is not None and best.response is not None and best.level is not None:
-        files.append(_atomic_figure(folder / "profile.png", lambda p: plot_profile(best, result.objective, p)))
-        if cert is not None:
-            files.append(_atomic_figure(folder / "chain-vs-fe.png", lambda p: plot_profile(
-                best, result.objective, p, compare=[("chain model", cert.winner_chain)])))
-        if callable(getattr(model, "solve", None)) and cert is None:  # a certified run solves no winner again
-            files.extend(_write_winner(model, best.response.orientation, best.level, folder / "winner"))
-    if figures and result.history:
-        files.append(_atomic_figure(folder / "convergence.png",
-                                    lambda p: plot_convergence(result.history, p, result.objective.unit)))
-    files.append(_write_report(result, config, model, files))
-
-
-def _write_winner(model: Any, design: str, level: int, folder: Path) -> list[Path]:
-    """Solve the winner again with its fields (``model.solve``, an FE model) and write its deformed
-    shape at the winning level and its VTK series (for ParaView) into ``folder``."""
-    from pneumorph.io import provenance as record
-    from pneumorph.io import write_vtk_series
-    from pneumorph.plot.shape import plot_shape
-
-    folder.mkdir(parents=True, exist_ok=True)
-    solution = model.solve(design)
-    shape = folder / "deformed.png"
-    plot_shape(solution, shape, levels=[level])
-    meta = record(model=model.describe(), fingerprint=model.fingerprint(), design=design)
-    return [shape, write_vtk_series(solution, folder / "vtk", stem="winner", meta=meta)]
-
-
-def _write_report(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[Path]) -> Path:
-    folder = result.folder
-    names = [f.relative_to(folder).as_posix() if f.is_relative_to(folder) else f.name for f in files]
-    return atomic_write_text(folder / "report.md", report_text(result, config, model, names))
-
-
-def _top_rows(result: RunResult) -> list[dict[str, Any]]:
-    """The listed designs by chain value with their FE and 2D values."""
-    cert = result.certified
-    assert cert is not None
-    rows = []
-    for i, c in enumerate(cert.hall_of_fame, 1):
-        fe = cert.verified.get(c.design)
-        rows.append({
-            "rank_chain": i, "design": c.design, "chain": c.value,
-            "chain_pressure_kpa": None if c.pressure is None else round(c.pressure * 1e3, 9),
-            "fe": None if fe is None or fe.failure else fe.value,
-            "fe_pressure_kpa": None if fe is None or fe.pressure is None else round(fe.pressure * 1e3, 9),
-            "chain_2d": result.opinion_2d.get(c.design),
-        })
-    return rows
-
-
-def _write_certificate(result: RunResult, folder: Path) -> list[Path]:
-    cert = result.certified
-    assert cert is not None
-    w = cert.winner
-    rows = _top_rows(result)
-    doc = {
-        "objective": result.objective.label, "sense": result.objective.sense, "unit": result.objective.unit,
-        "winner": {**w.to_dict(), "chain_value": cert.winner_chain.value, "chain_2d": result.opinion_2d.get(w.design)},
-        "certificate": cert.certificate,
-        "verified": {d: c.to_dict() for d, c in cert.verified.items()},
-        "top": rows,
-    }
-    if result.refinement is not None:
-        doc["mesh"] = result.refinement
-    path = write_json(folder / "certificate.json", doc)
-    text = _csv_text(list(rows[0]), [list(row.values()) for row in rows])
-    return [path, atomic_write_text(folder / "top.csv", text)]
-
-
-def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[str]) -> str:
-    """The markdown report of a run."""
-    o = result.objective
-    lines = [f"# Design run: {o.label}", ""]
-    if result.status == "interrupted":
-        lines += ["**Interrupted.** Run the same command again to resume; solved designs are cached.", ""]
-    search = {
-        "ga": f"genetic algorithm (population {config.ga.population}, {config.ga.generations} generations, "
-              f"seed {config.seed})",
-        "exhaustive": "exhaustive search",
-        "certified": "certified search (every design scored by the chain model, the best verified by FE)",
-    }[result.search or config.search]
-    if result.search_note:  # a certified run's choice: its table and levels, or why it searched exhaustively
-        search = result.search_note
-    lines += [
-        f"- objective: {o.label} ({'minimised' if o.sense == 'min' else 'maximised'})",
-        f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",
-        f"- search: {search}",
-        (f"- new solves: {result.solves}, answered by the cache: {result.cache_hits}, "
-        f"wall time {result.wall_time:.1f} s"
-         + (f"; {result.rejected} damaged cache entries were solved again, not used" if result.rejected else "")),
-        "",
-    ]
-    best = result.best
-    if best is not None:
-        what = ("error (Eq 4.1)" if isinstance(o, ProfileTarget) else
-                "weighted root-sum-square of the stages" if isinstance(o, StagedTarget) else "value")
-        pressure = "-" if best.pressure is None else f"{best.pressure * 1e3:.4g} kPa"
-        if best.failure is not None:
-            lines += [f"**No design converged.** The best entry failed: {best.failure}", ""]
-        lines += [
-            "## Winner",
-            "",
-            f"- design (base first): `{best.design}`",
-            f"- pressure: {pressure}",
-            f"- {what}: {best.value:.6g} {o.unit}" + (
-                f" (the root of the summed squared offsets of the {config.units} unit centres from the target: "
-                f"{best.value / config.units**0.5:.3g} {o.unit} RMS per centre)"
-                if isinstance(o, ProfileTarget) and math.isfinite(best.value) else ""),
-            *_stage_lines(o, best),
-            "",
-            "## Hall of fame",
-            "",
-            f"| rank | design | {o.unit} | pressure (kPa) |",
-            "|---:|---|---:|---:|",
-        ]
-        for i, c in enumerate(result.hall_of_fame, 1):
-            p = "failed" if c.pressure is None else f"{c.pressure * 1e3:.4g}"
-            lines.append(f"| {i} | `{c.design}` | {c.value:.6g} | {p} |")
-        lines.append("")
-    cert = result.certified
-    if cert is not None:
-        sure = cert.certificate
-        u = o.unit
-        words = certificate_text(sure, u, cert.winner.design, getattr(model, "fidelity", None),
-                                 show=len(sure["verified"]))
-        lines += [
-            "## Certificate",
-            "",
-            *[f"- {line}" for line in words],
-            "",
-            f"| chain rank | design | chain ({u}) | FE ({u}) | 2D chain ({u}) | pressure (kPa) |",
-            "|---:|---|---:|---:|---:|---:|",
-        ]
-
-        def fmt(v: Any) -> str:
-            return "-" if v is None else f"{v:.4g}"
-
-        for row in _top_rows(result):
-            lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
-                         f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kpa'] or row['chain_pressure_kpa'])} |")
-        lines.append("")
-    if result.refinement is not None:
-        lines += _refinement_lines(result.refinement, o)
-    if result.robustness is not None:
-        lines += _robustness_lines(result.robustness, o)
-    if files:
-        lines += ["## Files", "", *[f"- [{f}]({f})" for f in files], ""]
-    return "\n".join(lines)
-
-
-def _refinement_lines(ref: dict[str, Any], o: Objective) -> list[str]:
-    """The report's section on the finer mesh (or, without one, what the mesh study says)."""
-    u = o.unit
-    if "study" in ref:
-        s = ref["study"]
-        coarse, fine = s["sizes_mm"]
-        lo, hi = s["value_change"]
-        within = s["within"]
-        return ["## Mesh", "",
-                f"The values above are on the model's {coarse:g} mm mesh. In the mesh study of this model "
-                f"(docs/mesh-convergence.md, {s['designs']} designs), refining to {fine:g} mm moved the values "
-                f"by {lo:+.3g} to {hi:+.3g} {u}, but the gap between any two designs by at most "
-                f"{s['gap_change']:.3g} {u}.", "",
-                "- " + (f"verified designs within {s['gap_change']:.3g} {u} of the winner, whose order a finer mesh "
-                        f"could swap: {', '.join(f'`{d}`' for d in within)} (`--refine {fine:g}` solves them on it)"
-                        if within else f"no verified design lies within {s['gap_change']:.3g} {u} of the winner: "
-                        "the mesh study gives no reason for a finer mesh to swap them"), ""]
-    coarse, fine = ref["element_size_mm"]
-    lines = ["## Mesh", "",
-             f"The verified designs solved again with {fine:g} mm elements (the model's: {coarse:g} mm; "
-             f"representative cell sizes {ref['cell_size_mm'][0]:.3g} and {ref['cell_size_mm'][1]:.3g} mm). "
-             f"Limits by Richardson extrapolation with the order {ref['order']:g} observed in the mesh study "
-             f"(docs/mesh-convergence.md), +- its grid convergence index (safety factor {ref['safety_factor']:g}). "
-             "The gap to the winner is extrapolated the same way: the mesh moves all designs alike, so the gap "
-             "is known far better than either value.", "",
-             f"| design | {coarse:g} mm ({u}) | {fine:g} mm ({u}) | change ({u}) | limit ({u}) | "
-             f"gap to the winner, limit ({u}) |",
-             "|---|---:|---:|---:|---:|---:|"]
-    for r in ref["rows"]:
-        if r.get("refined") is None:
-            lines.append(f"| `{r['design']}` | {r['value']:.4g} | failed: {r.get('failure')} | - | - | - |")
-            continue
-        gap = ref["gaps"].get(r["design"])
-        gap_text = "-" if gap is None else f"{gap['limit']:+.3g} +- {gap['error']:.2g}"
-        lines.append(f"| `{r['design']}` | {r['value']:.4g} | {r['refined']:.4g} | {r['change']:+.3g} | "
-                     f"{r['extrapolated']:.4g} +- {r['error']:.2g} | {gap_text} |")
-    held = ("**the winner holds** on the finer mesh" if ref["holds"] else
-            f"**the winner does not hold**: `{ref['refined_best']}` is better on the finer mesh")
-    could = ref["could_overtake"]
-    lines += ["", f"- {held}",
-              "- " + (f"designs whose gap to the winner could close on a converged mesh: "
-                      f"{', '.join(f'`{d}`' for d in could)}" if could else
-                      "no verified design's gap to the winner can close within the estimated mesh error"), ""]
-    return lines
-
-
-def _robustness_lines(rob: dict[str, Any], o: Objective) -> list[str]:
-    """The report's section on mould tolerances."""
-    u = o.unit
-    lines = ["## Robustness to mould tolerances", "",
-             f"Every thickness of Fig E.4 (side walls, Mold Star wall, Smooth-Sil layer) within "
-             f"+-{rob['tolerance_mm']:g} mm, {rob['samples']} seeded samples (seed {rob['seed']}); "
-             f"{rob['method']}.", ""]
-
-    def row(label: str, w: dict[str, Any]) -> str:
-        p = "-" if w.get("pressure_kpa") is None else f"{w['pressure_kpa']:.4g}"
-        if "mean" not in w:
-            return f"| {label} | `{w['design']}` | {p} | {w['nominal_fe']:.4g} | - | - | - |"
-        return (f"| {label} | `{w['design']}` | {p} | {w['nominal_fe']:.4g} | {w['mean']:.4g} | {w['p95']:.4g} | "
-                f"{w['worst']:.4g} |")
-
-    lines += [f"| | design | pressure (kPa) | nominal FE ({u}) | mean ({u}) | 95th percentile ({u}) | worst ({u}) |",
-              "|---|---|---:|---:|---:|---:|---:|", row("winner", rob["winner"])]
-    if "robust_winner" in rob:
-        lines.append(row(f"most robust ({rob['statistic']})", rob["robust_winner"]))
-    if rob.get("failed"):
-        lines.append(f"\n{rob['failed']} of the samples did not converge in the FE model.")
-    if "ranking" in rob:
-        lines += ["", f"Designs by their {rob['statistic']} error under the tolerance (chain model):", "",
-                  f"| rank | design | pressure (kPa) | mean ({u}) | 95th percentile ({u}) | worst ({u}) |",
-                  "|---:|---|---:|---:|---:|---:|"]
-        lines += [f"| {r['rank']} | `{r['design']}` | {r['pressure_kpa']:.4g} | {r['mean']:.4g} | {r['p95']:.4g} | "
-                  f"{r['worst']:.4g} |" for r in rob["ranking"]]
-    return [*lines, ""]
