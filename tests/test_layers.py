@@ -46,7 +46,6 @@ LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
     "pneumorph.design.certified": 838,
     "pneumorph.design.targets": 635,
-    "pneumorph.execution.evaluators": 770,
     "pneumorph.export.calculix": 791,
     "pneumorph.export.moulds": 585,
     "pneumorph.fem.fast.system": 567,

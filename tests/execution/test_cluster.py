@@ -278,9 +278,9 @@ def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
                 str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"), "--json"]
         assert main(argv) == 0
         with distributed.Client(cluster.address, timeout=30) as client:
-            from pneumorph.execution import evaluators
+            from pneumorph.execution import cluster as dask_evaluator
 
-            kept = client.run(lambda: len(evaluators._DASK_MODELS))  # the models the worker solved designs of
+            kept = client.run(lambda: len(dask_evaluator._DASK_MODELS))  # the models the worker solved designs of
     finally:
         cluster.stop()
     captured = capsys.readouterr()
