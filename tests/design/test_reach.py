@@ -7,10 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pneumorph.design import bounds, growth
 from pneumorph.design import certified as cs
 from pneumorph.design.prefixes import depths, seed_prefixes
 from pneumorph.design.reach import CurveRange, build_reach
-from pneumorph.design.targets import make_objective, tip_goal
+from pneumorph.design.targets import ProfileTarget, make_objective, tip_goal
 from pneumorph.models.chain import ChainModel, ChainTable
 from pneumorph.models.chaintables import find_table
 from pneumorph.models.factory import make_model
@@ -34,14 +35,14 @@ def library() -> ChainModel:
 
 def _slack(chain: ChainModel, objective) -> list[tuple[int, np.ndarray]]:
     """Per depth from 2w: (depth, the least cost of each prefix's completions minus the prefix's bound)."""
-    n, c = chain.n_units, cs.choices(chain)
+    n, c = chain.n_units, growth.choices(chain)
     errors = cs.chain_errors(chain)
     full = cs.grow_designs(chain, objective, errors)  # every design, enumerated
     cost = np.empty(c**n)
     cost[(full.bits.astype(np.int64) * c ** np.arange(n - 1, -1, -1)).sum(axis=1)] = full.cost
     curve = None
-    if isinstance(objective, cs.ProfileTarget):
-        curve = cs._curve_range(chain, objective, errors, cs._target_slope(chain, objective, errors))
+    if isinstance(objective, ProfileTarget):
+        curve = bounds._curve_range(chain, objective, errors, bounds._target_slope(chain, objective, errors))
     seeds, state = seed_prefixes(chain)
     state["sum"] = np.zeros((len(seeds), chain.table.n_levels))
     out = []
@@ -51,9 +52,9 @@ def _slack(chain: ChainModel, objective) -> list[tuple[int, np.ndarray]]:
                 st["sum"] = st["sum"] + (objective.curve(x, chain.length) - y) ** 2
         if p == n:
             break
-        if not cs._uses_reach(chain, p):
+        if not growth._uses_reach(chain, p):
             continue
-        bound = cs._prefix_bound(chain, objective, bits, st, placed, curve)
+        bound = growth._prefix_bound(chain, objective, bits, st, placed, curve)
         index = (bits.astype(np.int64) * c ** np.arange(p - 1, -1, -1)).sum(axis=1)
         out.append((p, cost.reshape(-1, c ** (n - p)).min(axis=1)[index] - bound))
     assert out

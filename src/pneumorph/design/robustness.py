@@ -18,8 +18,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph import checks
-from pneumorph.design.certified import KEEP_GEOMETRY_UNITS, chain_scores, level_values
+from pneumorph.design.bounds import level_values
 from pneumorph.design.fitness import score
+from pneumorph.design.growth import KEEP_GEOMETRY_UNITS, chain_scores
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.models.chain import ChainModel, ChainTable, design_array, design_strings
 from pneumorph.models.windows import design_numbers
