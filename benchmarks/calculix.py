@@ -32,12 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from pneumorph.errors import SimulationFailed
-from pneumorph.export.calculix import (
-    calculix_mesh,
-    read_dat_displacements,
-    run_calculix,
-    tip_positions,
-)
+from pneumorph.export.calculix import calculix_mesh
+from pneumorph.export.ccx import read_dat_displacements, run_calculix, tip_positions
 from pneumorph.fem import StepSettings
 from pneumorph.models.fe import Full3D, RampSpec
 

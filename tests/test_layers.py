@@ -45,7 +45,6 @@ MAX_FUNCTION_LINES = 80
 LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
     "pneumorph.design.targets": 635,
-    "pneumorph.export.calculix": 791,
     "pneumorph.export.moulds": 585,
     "pneumorph.fem.fast.system": 567,
     "pneumorph.identify.fit": 632,

@@ -27,17 +27,19 @@ from pneumorph.errors import (
 from pneumorph.export.calculix import (
     C3D20_FACES,
     C3D20_NATURAL,
-    NodalDisplacements,
     c3d20_permutation,
     calculix_deck,
     calculix_mesh,
     cavity_faces,
     check_element_order,
+    write_calculix_deck,
+)
+from pneumorph.export.ccx import (
+    NodalDisplacements,
     read_dat_displacements,
     read_frd_displacements,
     run_calculix,
     tip_positions,
-    write_calculix_deck,
 )
 from pneumorph.fem import StepSettings
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D

@@ -1,14 +1,8 @@
 """Export: the actuator's parts as watertight meshes (STL), its casting mould, and solver decks."""
 
-# Solver decks (pneumorph.export.calculix).
-from pneumorph.export.calculix import (
-    calculix_deck,
-    read_dat_displacements,
-    read_frd_displacements,
-    run_calculix,
-    tip_positions,
-    write_calculix_deck,
-)
+# Solver decks (pneumorph.export.calculix) and CalculiX's run and results (pneumorph.export.ccx).
+from pneumorph.export.calculix import calculix_deck, write_calculix_deck
+from pneumorph.export.ccx import read_dat_displacements, read_frd_displacements, run_calculix, tip_positions
 
 # Parts and moulds (pneumorph.export.parts, .moulds, .figures).
 from pneumorph.export.figures import plot_mould
