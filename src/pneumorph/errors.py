@@ -7,6 +7,46 @@ it best (``ValueError``, ``KeyError``), so generic handlers keep working.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+
+# Ctrl-C presses the command line has seen (cli.main's SIGINT handler counts them). Some libraries
+# import their optional parts under ``except BaseException`` (trimesh), which swallows a Ctrl-C that
+# lands there; the count tells that one came.
+_SIGINTS = [0]
+
+
+def note_sigint() -> None:
+    """Count a Ctrl-C (called by the command line's SIGINT handler before it raises KeyboardInterrupt)."""
+    _SIGINTS[0] += 1
+
+
+def sigints() -> int:
+    """How many Ctrl-C presses the command line has seen."""
+    return _SIGINTS[0]
+
+
+@contextlib.contextmanager
+def interrupts_kept() -> Iterator[None]:
+    """Raise KeyboardInterrupt after the block if a Ctrl-C came during it and was swallowed.
+
+    Wrap the lazy import of a library that catches ``BaseException`` around its own imports, so
+    that a Ctrl-C during it stops the run there, as anywhere else.
+
+    Examples
+    --------
+    >>> try:
+    ...     with interrupts_kept():
+    ...         note_sigint()  # a Ctrl-C that a library swallowed
+    ... except KeyboardInterrupt:
+    ...     print("stopped")
+    stopped
+    """
+    before = _SIGINTS[0]
+    yield
+    if _SIGINTS[0] != before:
+        raise KeyboardInterrupt
+
 
 class PneumorphError(Exception):
     """Base class of all errors raised on purpose by pneumorph."""

@@ -11,12 +11,13 @@ import os
 import signal
 import sys
 import threading
+from typing import Any
 
 import click
 
 from pneumorph import __version__
 from pneumorph.cli.materials import materials
-from pneumorph.errors import PneumorphError
+from pneumorph.errors import PneumorphError, note_sigint, sigints
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -117,6 +118,15 @@ def check_repeats(argv: list[str]) -> None:
             raise click.UsageError(f"{keys[0]} is given {len(keys)} times; give it once")
 
 
+def _on_sigint(signum: int, frame: object) -> None:
+    note_sigint()
+    raise KeyboardInterrupt
+
+
+def _on_sigint_at_exit(signum: int, frame: object) -> None:
+    note_sigint()  # the run has ended and said so: its exit code stands
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code.
 
@@ -127,11 +137,41 @@ def main(argv: list[str] | None = None) -> int:
     returns 130, SIGTERM 143 (both after the run has written what it had); anything else
     is a defect of pneumorph: one line asking for a report, exit 1 (``PNEUMORPH_DEBUG=1``
     shows the traceback).
+
+    Ctrl-C is the same at every moment of a run: a press that a library swallowed (trimesh
+    catches ``BaseException`` around its optional imports) or that turned into another error
+    (an ``ImportError`` of a half-imported module) still ends the run with "aborted" and 130,
+    as does a press after the run's last line. Run as the process's own command line
+    (``argv`` None), a press after ``main`` has returned is counted and ignored: the run has
+    ended and said so.
     """
-    previous = None
+    previous: dict[int, Any] = {}
     if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, _on_sigterm)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # an ignored Ctrl-C stays ignored
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, _on_sigint)
     _terminated.clear()
+    pressed = sigints()
+    try:
+        try:
+            code = _run(argv, pressed)
+        except KeyboardInterrupt:  # pressed while a line was being printed
+            code = 130
+            click.echo("aborted", err=True)
+        if code == 0 and sigints() != pressed:  # pressed after the last line, or swallowed by a library
+            click.echo("aborted", err=True)
+            code = 130
+    except KeyboardInterrupt:  # pressed again while saying so
+        code = 130
+    finally:
+        for number, handler in previous.items():
+            exiting = number == signal.SIGINT and argv is None
+            signal.signal(number, _on_sigint_at_exit if exiting else handler)
+    return code
+
+
+def _run(argv: list[str] | None, pressed: int) -> int:
+    """Run the command; its exit code, with the one line that goes with it printed."""
     try:
         check_repeats(list(sys.argv[1:] if argv is None else argv))
         cli.main(args=argv, prog_name="pneumorph", standalone_mode=False)
@@ -142,33 +182,43 @@ def main(argv: list[str] | None = None) -> int:
         click.echo("aborted", err=True)
         return 130
     except click.UsageError as exc:
-        click.echo(f"error: {_usage_line(exc)}", err=True)
-        return 2
+        return _interrupted(pressed) or _say(f"error: {_usage_line(exc)}", 2)
     except click.ClickException as exc:
-        click.echo(f"error: {' '.join(exc.format_message().split())}", err=True)
-        return exc.exit_code
+        return _interrupted(pressed) or _say(f"error: {' '.join(exc.format_message().split())}", exc.exit_code)
     except PneumorphError as exc:
+        if _interrupted(pressed):
+            return 130
         text = " ".join(str(exc).split())
         code = getattr(exc, "exit_code", 2)
         if code == 3:  # the cluster went away: the same command resumes from the cache
             import shlex
 
             text += f"; resume with: pneumorph {shlex.join(sys.argv[1:] if argv is None else argv)}"
-        click.echo(f"error: {text}", err=True)
-        return code
+        return _say(f"error: {text}", code)
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
         return 143 if code == 130 and _terminated.is_set() else code  # a run that stopped on SIGTERM
     except Exception as exc:  # a defect, not a user error
+        if _interrupted(pressed):
+            return 130
         if os.environ.get("PNEUMORPH_DEBUG"):
             raise
-        click.echo(f"internal error: {type(exc).__name__}: {' '.join(str(exc).split())} - please report it "
-                   "(PNEUMORPH_DEBUG=1 shows the traceback)", err=True)
-        return 1
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        return _say(f"internal error: {type(exc).__name__}: {' '.join(str(exc).split())} - please report it "
+                    "(PNEUMORPH_DEBUG=1 shows the traceback)", 1)
     return 0
+
+
+def _say(line: str, code: int) -> int:
+    click.echo(line, err=True)
+    return code
+
+
+def _interrupted(pressed: int) -> int:
+    """130 with "aborted" printed if Ctrl-C came since the run began (an error that follows it is its
+    consequence: an ImportError of a module the press left half imported), else 0."""
+    if sigints() == pressed:
+        return 0
+    return _say("aborted", 130)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -68,11 +68,12 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
     summary = {"scan": str(scan), "design": orientation, "pressure_kpa": pressure, "model": fidelity,
                "scan_points": len(data.points), **result.to_dict()}
     if out:
-        folder = Path(out)
-        folder.mkdir(parents=True, exist_ok=True)
-        write_json(folder / "correlation.json",
-                   {**summary, "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint())})
-        plot_correlation(result, shape, folder / "correlation.png", photo=photo, photo_scale=scale)
+        from pneumorph.io.files import all_or_nothing
+
+        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a bad photo): no partial output
+            write_json(folder / "correlation.json",
+                       {**summary, "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint())})
+            plot_correlation(result, shape, folder / "correlation.png", photo=photo, photo_scale=scale)
     if as_json:
         click.echo(strict_json(summary))
         return

@@ -98,14 +98,15 @@ def simulate(
     resp = solution.response
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
-        folder = Path(out)
-        folder.mkdir(parents=True, exist_ok=True)
-        resp.save(folder / "response")
-        write_vtk_series(solution, folder / "vtk", meta=meta)
-        from pneumorph.plot.shape import plot_shape
+        from pneumorph.io.files import all_or_nothing
 
-        plot_shape(solution, folder / "shape.png", levels=sorted({resp.n_levels // 2 - 1, resp.n_levels - 1}))
-        write_json(folder / "provenance.json", meta)
+        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+            resp.save(folder / "response")
+            write_vtk_series(solution, folder / "vtk", meta=meta)
+            from pneumorph.plot.shape import plot_shape
+
+            plot_shape(solution, folder / "shape.png", levels=sorted({resp.n_levels // 2 - 1, resp.n_levels - 1}))
+            write_json(folder / "provenance.json", meta)
     if as_json:
         levels = [
             {

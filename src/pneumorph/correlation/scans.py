@@ -17,7 +17,7 @@ from struct import error as struct_error
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.errors import ScanError
+from pneumorph.errors import ScanError, interrupts_kept
 from pneumorph.io.files import read_text_file
 
 FloatArray = NDArray[np.float64]
@@ -188,12 +188,13 @@ def _neither(suffix: str) -> str:
 
 
 def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
-    import trimesh
+    with interrupts_kept():  # trimesh swallows a Ctrl-C in its optional imports, at import and at load
+        import trimesh
 
-    try:
-        loaded = trimesh.load(path, force=None, process=False)
-    except Exception as exc:  # any parser failure is a file that is not a scan
-        raise ScanError(f"scan {path}: not a readable mesh or point cloud ({_why(exc, path.suffix)})") from None
+        try:
+            loaded = trimesh.load(path, force=None, process=False)
+        except Exception as exc:  # any parser failure is a file that is not a scan
+            raise ScanError(f"scan {path}: not a readable mesh or point cloud ({_why(exc, path.suffix)})") from None
     if isinstance(loaded, trimesh.Scene):
         geometries = list(loaded.geometry.values())
         if not geometries:  # an STL parser that finds no facet (junk read as text) answers an empty scene

@@ -71,7 +71,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pneumorph.errors import GeometryError
+from pneumorph.errors import GeometryError, interrupts_kept
 from pneumorph.geometry.features import BaseBlock, Box
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
@@ -257,7 +257,8 @@ def to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
     >>> to_trimesh(box((0.0, 1.0, 0.0, 1.0, 0.0, 1.0))).is_watertight
     True
     """
-    import trimesh
+    with interrupts_kept():  # trimesh swallows a Ctrl-C in its optional imports
+        import trimesh
 
     mesh = solid.to_mesh64() if hasattr(solid, "to_mesh64") else solid.to_mesh()
     vertices = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]

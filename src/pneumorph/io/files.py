@@ -13,6 +13,7 @@ import contextlib
 import json
 import math
 import os
+import shutil
 import tempfile
 import tomllib
 from collections.abc import Iterator, Mapping
@@ -150,6 +151,48 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+@contextlib.contextmanager
+def all_or_nothing(folder: str | Path) -> Iterator[Path]:
+    """Create ``folder`` for a command's outputs; if the block fails (an error, Ctrl-C), remove what it added.
+
+    The files and folders that were not there before the block are removed, and the folder itself
+    (with any parents this call created) if it was new: a command stopped while writing leaves no
+    partial output. A file the block replaced (:func:`atomic_path`) is its new version.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> try:
+    ...     with all_or_nothing(d / "new" / "run") as out:
+    ...         _ = (out / "a.json").write_text("{}")
+    ...         raise KeyboardInterrupt
+    ... except KeyboardInterrupt:
+    ...     pass
+    >>> sorted(p.name for p in d.iterdir())
+    []
+    """
+    folder = Path(folder)
+    top = folder
+    while not top.parent.exists() and top.parent != top:
+        top = top.parent
+    existed = folder.exists()
+    before = set(folder.iterdir()) if existed else set()
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        yield folder
+    except BaseException:
+        if not existed:
+            shutil.rmtree(top if top.exists() else folder, ignore_errors=True)
+        else:
+            for entry in set(folder.iterdir()) - before:
+                if entry.is_dir() and not entry.is_symlink():
+                    shutil.rmtree(entry, ignore_errors=True)
+                else:
+                    entry.unlink(missing_ok=True)
         raise
 
 

@@ -1,0 +1,127 @@
+"""Ctrl-C is the same at every moment of a run: inside a lazy import (one that a library swallows
+too), while writing outputs, after the last line. Subprocesses with Ctrl-C at its default.
+
+The signal lands where it should without timing luck: a ``sitecustomize`` hook in the child
+(``PNEUMORPH_TEST_SLOW`` names a module, or a line the command prints) makes a marker file and
+sleeps at that moment; the test waits for the marker, then sends SIGINT. Every case ends with the
+one line "aborted", exit 130, and nothing in the output folder.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SCAN = ROOT / "examples" / "data" / "scan-0110-30kpa.xyz"
+
+HOOK = '''
+import importlib.machinery, os, sys, time
+
+_WHAT = os.environ.get("PNEUMORPH_TEST_SLOW", "")
+_MARK = os.environ.get("PNEUMORPH_TEST_MARK", "")
+
+
+def _stall():
+    open(_MARK, "w").close()
+    time.sleep(120)  # SIGINT lands here
+
+
+class _SlowImport:
+    def find_spec(self, name, path=None, target=None):
+        if name != _WHAT[len("import:"):]:
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        real = spec.loader.exec_module
+
+        def exec_module(module):
+            _stall()
+            real(module)
+
+        spec.loader.exec_module = exec_module
+        return spec
+
+
+if _WHAT.startswith("import:"):
+    sys.meta_path.insert(0, _SlowImport())
+elif _WHAT.startswith("echo:"):  # after the command prints a line holding this text
+    import click
+
+    _echo = click.echo
+
+    def echo(message=None, *args, **kwargs):
+        _echo(message, *args, **kwargs)
+        if _WHAT[len("echo:"):] in str(message):
+            _stall()
+
+    click.echo = echo
+'''
+
+
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # as a shell starts it: Ctrl-C at its default
+
+
+def _interrupt(tmp_path: Path, slow: str, args: list[str]) -> subprocess.CompletedProcess[str]:
+    hook = tmp_path / "hook"
+    hook.mkdir()
+    (hook / "sitecustomize.py").write_text(HOOK, encoding="utf-8")
+    mark = tmp_path / "mark"
+    env = {**os.environ, "PYTHONPATH": str(hook), "PNEUMORPH_TEST_SLOW": slow, "PNEUMORPH_TEST_MARK": str(mark),
+           "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(tmp_path / "xdg")}
+    proc = subprocess.Popen([sys.executable, "-m", "pneumorph", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path, start_new_session=True,
+                            preexec_fn=_default_sigint)
+    deadline = time.monotonic() + 120
+    while not mark.exists():
+        if proc.poll() is not None or time.monotonic() > deadline:
+            proc.kill()
+            out, err = proc.communicate()
+            raise AssertionError(f"the run never reached {slow!r}: exit {proc.returncode}\n{err}")
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+
+
+CORRELATE = ["correlate", str(SCAN), "--design", "0110", "--pressure", "30", "--model", "2d", "--out", "out"]
+SIMULATE = ["simulate", "-o", "0110", "--model", "2d", "--pressure", "5", "--increments", "5", "--out", "out"]
+
+
+@pytest.mark.parametrize(("slow", "args"), [
+    ("import:trimesh", CORRELATE),  # the scan reader's lazy import
+    ("import:trimesh.voxel", CORRELATE),  # one that trimesh imports under `except BaseException` (swallowed)
+    ("import:matplotlib", SIMULATE),  # the figure's, after the solve and the first files
+    ("echo:written to", SIMULATE),  # after the last line
+], ids=["trimesh", "trimesh-swallowed", "matplotlib-after-solve", "after-last-line"])
+def test_ctrl_c_at_any_moment_is_aborted_with_nothing_written(tmp_path: Path, slow: str, args: list[str]) -> None:
+    done = _interrupt(tmp_path, slow, args)
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert done.returncode == 130, done.stderr
+    assert lines[-1] == "aborted", done.stderr
+    assert "Traceback" not in done.stderr and "rror" not in done.stderr
+    if slow.startswith("import:"):
+        assert not (tmp_path / "out").exists(), sorted(p.name for p in (tmp_path / "out").rglob("*"))
+
+
+def test_ctrl_c_after_main_returned_is_ignored(tmp_path: Path) -> None:
+    """Run as the process's command line, the handler left behind counts a press and does not raise."""
+    code = ("import os, signal, sys\n"
+            "from pneumorph.cli import main\n"
+            "sys.argv = ['pneumorph', '--version']\n"
+            "code = main()\n"
+            "os.kill(os.getpid(), signal.SIGINT)\n"
+            "print('still here', code)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          preexec_fn=_default_sigint)
+    assert done.returncode == 0 and "still here 0" in done.stdout, done.stderr
+
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
