@@ -1,0 +1,288 @@
+"""Profile targets (section 6.3): a curve the inflated actuator should follow, ``y = f(x)``
+(Cartesian) or ``r = f(theta)`` (polar), from a safe math expression (:class:`ProfileTarget`)
+or a drawn curve (:func:`curve_target`, :class:`Polyline`, :func:`smooth_curve`); the
+objectives together: :mod:`pneumorph.design.targets`.
+"""
+
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pneumorph.design.expressions import Expression
+from pneumorph.errors import (
+    TargetExpressionError,
+)
+
+Sense = Literal["min", "max"]
+
+
+_CARTESIAN = ("x", "L", "A")
+
+_POLAR = ("theta", "L", "A")
+
+_HINTS_CARTESIAN = {
+    "theta": " - theta is the variable of polar targets; write 'r = f(theta)' for one",
+    "y": " - the expression is the right-hand side of y = f(x)",
+}
+
+_HINTS_POLAR = {
+    "x": " - x is the variable of Cartesian targets; write 'y = f(x)' for one",
+    "r": " - the expression is the right-hand side of r = f(theta)",
+}
+
+MAX_TARGET_MM = 1e5
+"""Largest size of a target anywhere (mm): a profile's values, a curve's points."""
+
+MAX_CURVE_POINTS = 2000
+"""Most points accepted for a drawn curve."""
+
+MIN_CURVE_SPAN = 0.2
+"""Least part of the actuator length a drawn curve must span."""
+
+
+@dataclass(frozen=True)
+class Polyline:
+    """A piecewise-linear ``y(x)`` through knots, level beyond the first and last knot.
+
+    It stands in for an :class:`~pneumorph.design.expressions.Expression` in a
+    :class:`ProfileTarget` (same call signature; ``L`` and ``A`` are ignored).
+
+    Examples
+    --------
+    >>> f = Polyline((0.0, 10.0, 20.0), (0.0, 5.0, 0.0))
+    >>> f(x=[-5.0, 5.0, 10.0, 30.0], L=20.0, A=1.0).tolist()
+    [0.0, 2.5, 5.0, 0.0]
+    """
+
+    xs: tuple[float, ...]
+    ys: tuple[float, ...]
+    variables: tuple[str, ...] = field(default=_CARTESIAN, init=False)
+    used: frozenset[str] = field(default=frozenset({"x"}), init=False)
+
+    @property
+    def text(self) -> str:
+        return f"curve through {len(self.xs)} points"
+
+    def __call__(self, **values: ArrayLike) -> NDArray[np.float64]:
+        return np.interp(np.asarray(values["x"], dtype=float), self.xs, self.ys)
+
+
+def _curve_points(points: ArrayLike) -> NDArray[np.float64]:
+    """Points as a checked (n, 2) array of finite mm values (numbers only: not text, not true/false)."""
+    if not isinstance(points, np.ndarray):
+        try:
+            rows = list(points)  # type: ignore[arg-type]
+            bad = next((v for row in rows for v in (row if isinstance(row, (list, tuple)) else [row])
+                        if isinstance(v, (bool, str, bytes)) or not isinstance(v, (int, float, np.number))), None)
+        except TypeError:
+            raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
+        if bad is not None:
+            raise TargetExpressionError(f"a curve's points are numbers of mm, got {bad!r}")
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise TargetExpressionError(f"a curve is a list of [x, y] points in mm, got an array of shape {p.shape}")
+    if not 2 <= len(p) <= MAX_CURVE_POINTS:
+        raise TargetExpressionError(f"a curve needs 2 to {MAX_CURVE_POINTS} points, got {len(p)}")
+    if not np.isfinite(p).all() or np.abs(p).max() > MAX_TARGET_MM:
+        raise TargetExpressionError("every point of a curve must be a finite number of mm, at most 1e5 in size")
+    return p
+
+
+def smooth_curve(points: ArrayLike, length: float, knots: int = 41,
+                 bandwidth: float | None = None) -> NDArray[np.float64]:
+    """A hand-drawn stroke as ``knots`` evenly spaced points of a smooth curve.
+
+    At knots evenly spaced over the range the stroke covers (clipped to ``0 <= x <= length``),
+    a straight line is fitted to the stroke's points with a Gaussian weight in x (standard
+    deviation ``bandwidth``, default ``length / 40``): local linear smoothing, which follows a
+    sloped stroke to its ends where a plain weighted mean would pull it flat.
+
+    Raises
+    ------
+    TargetExpressionError
+        Too few or too many points, values that are not finite, or a stroke spanning less than
+        :data:`MIN_CURVE_SPAN` of the length.
+
+    Examples
+    --------
+    >>> x = np.linspace(0.0, 100.0, 400)
+    >>> knots = smooth_curve(np.c_[x, 0.5 * x], 100.0, knots=5, bandwidth=1.0)
+    >>> knots[:, 0].tolist(), np.round(knots[1:-1, 1], 3).tolist()
+    ([0.0, 25.0, 50.0, 75.0, 100.0], [12.5, 25.0, 37.5])
+    """
+    p = _curve_points(points)
+    if not (np.isfinite(length) and length > 0):
+        raise TargetExpressionError(f"the actuator length must be positive, got {length!r}")
+    lo, hi = max(float(p[:, 0].min()), 0.0), min(float(p[:, 0].max()), float(length))
+    if hi - lo < MIN_CURVE_SPAN * length:
+        raise TargetExpressionError(
+            f"the curve spans {max(hi - lo, 0.0):.3g} mm of the actuator; draw at least "
+            f"{MIN_CURVE_SPAN * length:.3g} mm ({MIN_CURVE_SPAN:.0%} of its {length:g} mm)")
+    h = float(bandwidth) if bandwidth is not None else length / 40.0
+    xk = np.linspace(lo, hi, int(knots))
+    d = p[None, :, 0] - xk[:, None]
+    w = np.exp(-0.5 * (d / h) ** 2)
+    # a local straight line through the weighted points (no bias at the ends of a sloped stroke)
+    s0, s1, s2 = w.sum(axis=1), (w * d).sum(axis=1), (w * d * d).sum(axis=1)
+    t0, t1 = w @ p[:, 1], (w * d) @ p[:, 1]
+    det = s0 * s2 - s1 * s1
+    flat = det <= 1e-9 * np.maximum(s0 * s2, 1e-300)  # points at one x only: their mean
+    yk = np.where(flat, t0 / np.maximum(s0, 1e-300), (s2 * t0 - s1 * t1) / np.where(flat, 1.0, det))
+    return np.c_[xk, yk]
+
+
+def _check_span(xs: ArrayLike, length: float) -> None:
+    """Refuse a curve that covers less than :data:`MIN_CURVE_SPAN` of the actuator's ``0 <= x <= length``."""
+    x = np.asarray(xs, dtype=float)
+    lo, hi = max(float(x.min()), 0.0), min(float(x.max()), float(length))
+    if hi - lo < MIN_CURVE_SPAN * length:
+        raise TargetExpressionError(
+            f"the curve spans {max(hi - lo, 0.0):.3g} mm of the actuator's 0 to {length:g} mm; give points over "
+            f"at least {MIN_CURVE_SPAN * length:.3g} mm of it ({MIN_CURVE_SPAN:.0%})")
+
+
+def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarget:
+    """A profile target through the points ``(x, y)`` (mm): the polyline joining them.
+
+    Points are sorted by x; repeated x are averaged. The target is level beyond the first
+    and last point.
+
+    Examples
+    --------
+    >>> t = curve_target([[0, 0], [50, 10], [100, 0]])
+    >>> t.curve([25.0, 50.0, 120.0], length=100.0).tolist()
+    [5.0, 10.0, 0.0]
+    >>> t.label
+    'curve: y = curve through 3 points'
+    """
+    p = _curve_points(points)
+    xs, inverse = np.unique(p[:, 0], return_inverse=True)
+    ys = np.bincount(inverse, weights=p[:, 1]) / np.bincount(inverse)
+    if len(xs) < 2:
+        raise TargetExpressionError("a curve needs points at two different x at least")
+    if length is not None:
+        _check_span(xs, length)
+    line = Polyline(tuple(float(v) for v in xs), tuple(float(v) for v in ys))
+    return ProfileTarget(line, "cartesian", 0.0, length, "curve")
+
+
+@dataclass(frozen=True)
+class ProfileTarget:
+    """A target curve for the unit centres, matched by Eq 4.1 (minimised).
+
+    Attributes
+    ----------
+    expression : Expression or Polyline
+        The checked right-hand side (or a drawn curve's polyline).
+    coordinates : {"cartesian", "polar"}
+        ``y = f(x)`` or ``r = f(theta)`` (theta in radians from the x axis, about the base).
+    amplitude : float
+        The value of ``A`` (mm).
+    length : float or None
+        The value of ``L`` (mm); None takes the undeformed length of the actuator.
+    name : str
+        A short label ("sin", "cos" or the expression).
+
+    Examples
+    --------
+    >>> from pneumorph.design.targets import profile_target
+    >>> t = profile_target("sin", amplitude=10.0)
+    >>> t.curve([0.0, 25.0, 50.0], length=100.0).round(6).tolist()
+    [0.0, 10.0, 0.0]
+    >>> profile_target("y = 0.1*x").curve([10.0], length=100.0).tolist()
+    [1.0]
+    """
+
+    expression: Expression | Polyline
+    coordinates: Literal["cartesian", "polar"] = "cartesian"
+    amplitude: float = 10.0
+    length: float | None = None
+    name: str = ""
+    sense: Sense = field(default="min", init=False)
+    unit: str = field(default="mm", init=False)
+
+    def curve(self, s: ArrayLike, length: float) -> NDArray[np.float64]:
+        """The target at ``s`` (x in mm, or theta in rad) for an actuator of ``length`` mm."""
+        L = self.length if self.length is not None else length
+        var = "x" if self.coordinates == "cartesian" else "theta"
+        return self.expression(**{var: np.asarray(s, dtype=float)}, L=L, A=self.amplitude)
+
+    def check(self, length: float) -> ProfileTarget:
+        """Refuse a target that is not finite somewhere on the actuator's range.
+
+        The range is ``0 <= x <= L`` for ``y = f(x)`` and ``0 <= theta <= pi`` for
+        ``r = f(theta)``, sampled at 201 points.
+
+        Raises
+        ------
+        TargetExpressionError
+            Naming the first point where the target is NaN or infinite, or beyond
+            :data:`MAX_TARGET_MM` in size (a constant ``y = 1e100``, say).
+
+        Examples
+        --------
+        >>> from pneumorph.design.targets import profile_target
+        >>> profile_target("y = 1/x").check(157.5)
+        Traceback (most recent call last):
+        ...
+        pneumorph.errors.TargetExpressionError: the target y = 1/x is not finite at x = 0 (inf); it must be
+        finite for 0 <= x <= L = 157.5 mm
+        """
+        polar = self.coordinates == "polar"
+        s = np.linspace(0.0, np.pi if polar else float(length), 201)
+        with np.errstate(all="ignore"):
+            try:
+                values = np.broadcast_to(np.asarray(self.curve(s, length), dtype=float), s.shape)
+            except (ArithmeticError, ValueError) as exc:
+                raise TargetExpressionError(f"the target {self.label} cannot be evaluated: {exc}") from None
+        bad = np.flatnonzero(~np.isfinite(values))
+        large = np.flatnonzero(np.abs(np.where(np.isfinite(values), values, 0.0)) > MAX_TARGET_MM)
+        if large.size and not bad.size:
+            where = f"theta = {s[large[0]]:.4g} rad" if polar else f"x = {s[large[0]]:.4g}"
+            raise TargetExpressionError(
+                f"the target {self.label} is {values[large[0]]:.4g} mm at {where}, beyond {MAX_TARGET_MM:g} mm "
+                "(MAX_TARGET_MM): no actuator reaches it"
+            )
+        if bad.size:
+            where = f"theta = {s[bad[0]]:.4g} rad" if polar else f"x = {s[bad[0]]:.4g}"
+            span = "0 <= theta <= pi" if polar else f"0 <= x <= L = {length:g} mm"
+            raise TargetExpressionError(
+                f"the target {self.label} is not finite at {where} ({values[bad[0]]}); it must be finite for {span}"
+            )
+        return self
+
+    @property
+    def display(self) -> str:
+        """The target as a figure shows it: ``y = A·sin(2·π·x/L), A = 10 mm``.
+
+        >>> from pneumorph.design.targets import profile_target
+        >>> profile_target("sin", amplitude=10.0).display
+        'y = A·sin(2·π·x/L), A = 10 mm'
+        >>> profile_target("y = 0.5*x**2/L").display
+        'y = 0.5·x^2/L'
+        """
+        lhs = "y" if self.coordinates == "cartesian" else "r"
+        text = re.sub(r"2\*pi\*1\*(x|theta)", r"2*pi*\1", self.expression.text)
+        text = text.replace("**", "^").replace("*", "·").replace("theta", "θ")
+        text = re.sub(r"\bpi\b", "π", text)
+        text = f"{lhs} = {text}"
+        if "A" in self.expression.used:
+            text += f", A = {self.amplitude:g} mm"
+        return text
+
+    @property
+    def label(self) -> str:
+        lhs = "y" if self.coordinates == "cartesian" else "r"
+        text = f"{lhs} = {self.expression.text}"
+        if "A" in self.expression.used:
+            text += f", A = {self.amplitude:g} mm"
+        return text if not self.name or self.name == self.expression.text else f"{self.name}: {text}"
