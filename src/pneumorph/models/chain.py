@@ -36,17 +36,14 @@ The table is fitted from FE solves and validated on held-out designs by
 from __future__ import annotations
 
 import hashlib
-import json
-from collections.abc import Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.errors import ChainTableError, UnitLibraryError
+from pneumorph.errors import ChainTableError
 from pneumorph.io.provenance import digest
+from pneumorph.models.chaintable import ALPHABET_FORMAT, TABLE_FORMAT, ChainTable
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.models.windows import (
     BASE,
@@ -56,384 +53,30 @@ from pneumorph.models.windows import (
     design_strings,
     mirror_codes,
     possible_codes,
-    unit_codes,
-    window_code,
     window_codes,
     window_symbols,
     window_text,
 )
 
-__all__ = ["BASE", "TIP", "ChainModel", "ChainTable", "check_source", "covering_designs", "design_array",
-           "design_strings", "mirror_codes", "possible_codes", "source_description", "source_key", "window_codes",
-           "window_symbols", "window_text"]
-
-IntArray = NDArray[np.int64]
-
-#: format of the table file (bumped when its layout changes); a table over several unit types
-#: is written in :data:`ALPHABET_FORMAT` (older readers refuse it instead of misreading it)
-TABLE_FORMAT = 1
-ALPHABET_FORMAT = 2
-
-
-# -- the table --------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class ChainTable:
-    """Per-window turns, lengths and end turns of one unit and FE model, with provenance.
-
-    Attributes
-    ----------
-    window : int
-        Half-width ``w``.
-    pressures : ndarray, shape (k,)
-        The reported levels (MPa).
-    codes : ndarray, shape (K,)
-        Sorted window codes of the elements.
-    turn, length : ndarray, shape (K, k)
-        Mean turn (rad) and chord length (mm) of each window at each level.
-    end_codes : ndarray, shape (E,)
-        Sorted window codes of the last chord.
-    end : ndarray, shape (E, k)
-        Mean end turn (rad).
-    pitch : float
-        Distance between consecutive undeformed unit centres (mm).
-    centre_y : tuple of float
-        Undeformed height of a unit centre of orientation 0 and of orientation 1 (the
-        tracked cavity vertices sit off the mid-plane, so inverting a unit moves its centre).
-        The centreline starts at the base point ``(0, centre_y[first unit])``.
-    first_offset : float
-        Undeformed x of the first centre.
-    tip_ref : tuple of float
-        The undeformed tip: its x from the last undeformed centre, and its height.
-    source : dict
-        The FE model the table was fitted to: ``fidelity``, ``key`` (:func:`source_key`),
-        ``fingerprint`` and ``n_units`` of the training model, ``description``.
-    training : tuple of str
-        The covering designs solved.
-    validation : dict
-        Held-out designs and their mean / worst centre, tip and curl errors per level.
-    spread : float
-        The largest deviation of one training element from its window's mean (rad or mm):
-        how well a window determines its element.
-    alphabet : tuple of str
-        The unit types' symbols of a table over a library of several types (the library's
-        order: code ``2t + o``); empty for a table of one unit (0/1 designs).
-    type_pitch, type_offset : tuple of float
-        Per type: its pitch and the x of its centre from its start (mm); empty for one unit.
-    type_centre_y : tuple of float
-        Per code ``2t + o``: the undeformed height of the unit's centre; empty for one unit.
-    symmetric : tuple of str
-        The types whose unit turned over is the same body (:attr:`UnitSpec.symmetric`): one
-        orientation, one letter (lower case) in designs, one set of windows; empty for none.
-    """
-
-    window: int
-    pressures: FloatArray
-    codes: IntArray
-    turn: FloatArray
-    length: FloatArray
-    end_codes: IntArray
-    end: FloatArray
-    pitch: float
-    centre_y: tuple[float, float]
-    first_offset: float
-    tip_ref: tuple[float, float]
-    source: dict[str, Any]
-    training: tuple[str, ...]
-    validation: dict[str, Any] = field(default_factory=dict)
-    spread: float = 0.0
-    metadata: dict[str, Any] = field(default_factory=dict)
-    alphabet: tuple[str, ...] = ()
-    type_pitch: tuple[float, ...] = ()
-    type_offset: tuple[float, ...] = ()
-    type_centre_y: tuple[float, ...] = ()
-    symmetric: tuple[str, ...] = ()
-
-    @property
-    def n_levels(self) -> int:
-        return len(self.pressures)
-
-    @property
-    def n_types(self) -> int:
-        """Unit types of the table: 1 for a 0/1 table."""
-        return max(1, len(self.alphabet))
-
-    @property
-    def symmetric_types(self) -> tuple[int, ...]:
-        """Indices of the :attr:`symmetric` types in the alphabet."""
-        return tuple(self.alphabet.index(s) for s in self.symmetric)
-
-    @property
-    def unit_codes(self) -> NDArray[np.uint8]:
-        """The unit codes a design may hold (both orientations of a type, one of a symmetric type)."""
-        return unit_codes(self.n_types, self.symmetric_types)
-
-    @property
-    def heights(self) -> FloatArray:
-        """The undeformed centre height of every unit code (``2t + o``)."""
-        return np.asarray(self.type_centre_y if self.alphabet else self.centre_y, dtype=float)
-
-    def designs(self, texts: Sequence[str] | str, n_units: int | None = None) -> NDArray[np.uint8]:
-        """Designs as unit codes over the table's types (:func:`~pneumorph.models.windows.design_array`).
-
-        Raises
-        ------
-        ChainTableError
-            A unit type the table does not cover ("unit type 'x' has no table").
-        """
-        return design_array(texts, n_units, self.alphabet, self.symmetric_types)
-
-    def texts(self, codes: NDArray[np.integer]) -> list[str]:
-        """The canonical texts of designs given as unit codes (0/1 digits for one type)."""
-        return design_strings(codes, self.alphabet)
-
-    def fingerprint(self) -> str:
-        """Hash of everything that changes a prediction."""
-        h = hashlib.sha256()
-        head: dict[str, Any] = {"window": self.window, "source": self.source.get("key"), "pitch": self.pitch,
-                                "centre_y": list(self.centre_y), "first": self.first_offset,
-                                "tip": list(self.tip_ref)}
-        if self.alphabet:  # absent for one unit type: the fingerprints of 0/1 tables stay the same
-            head.update(alphabet=list(self.alphabet), type_pitch=list(self.type_pitch),
-                        type_offset=list(self.type_offset), type_centre_y=list(self.type_centre_y))
-        if self.symmetric:  # likewise absent without symmetric types
-            head["symmetric"] = list(self.symmetric)
-        h.update(json.dumps(head, sort_keys=True).encode())
-        for a in (self.pressures, self.codes, self.turn, self.length, self.end_codes, self.end):
-            h.update(np.ascontiguousarray(a).tobytes())
-        return h.hexdigest()[:16]
-
-    # -- lookup and prediction ----------------------------------------------------------
-    def find(self, codes: IntArray, end: bool = False) -> tuple[IntArray, NDArray[np.bool_]]:
-        """Rows of the chord (or end-turn) entries of window ``codes``, and whether each was found.
-
-        Where a window is missing its row is that of a neighbouring window: read ``found``.
-        """
-        table = self.end_codes if end else self.codes
-        idx = np.clip(np.searchsorted(table, codes), 0, len(table) - 1)
-        return idx, table[idx] == codes
-
-    def lookup(self, codes: IntArray, end: bool = False) -> IntArray:
-        """Rows of the chord (or end-turn) entries of window ``codes``.
-
-        Raises
-        ------
-        ChainTableError
-            A window the table has never seen (too short an actuator, another model).
-        """
-        what = "end" if end else "chord"
-        idx, found = self.find(codes, end)
-        missing = ~found
-        if missing.any():
-            bad = window_text(int(np.asarray(codes)[missing].ravel()[0]), self.window, self.alphabet)
-            raise ChainTableError(
-                f"the chain table has no entry for the {what} window {bad!r} (window +-{self.window}, trained on "
-                f"{self.source.get('n_units')} units); designs with fewer than {2 * self.window + 1} units or "
-                "a table of another model cannot be scored with it"
-            )
-        return idx
-
-    def check_units(self, n_units: int) -> None:
-        """Refuse a number of units whose windows the table cannot have seen."""
-        if int(n_units) < 1:
-            raise ChainTableError(f"an actuator needs at least 1 unit, got {n_units}")
-        trained = int(self.source.get("n_units", 0))
-        need = 2 * self.window + 1
-        if int(n_units) < need and int(n_units) != trained:
-            raise ChainTableError(
-                f"a chain table of window +-{self.window} needs at least {need} units (every window then holds "
-                f"at most one end); got {n_units}. Search so short an actuator with the FE model (--search exhaustive; "
-                "pneumorph design chooses it by itself)"
-            )
-
-    def reference(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray]:
-        """Undeformed unit centres (m, n, 2) and tip (2,) of designs (m, n).
-
-        Over several unit types the tip depends on the design (the units' pitches): then it
-        is (m, 2).
-        """
-        bits = np.atleast_2d(np.asarray(bits))
-        m, n = bits.shape
-        if self.alphabet:
-            types = bits.astype(np.int64) // 2
-            pitch = np.asarray(self.type_pitch)[types]
-            starts = np.cumsum(pitch, axis=1) - pitch
-            x = starts + np.asarray(self.type_offset)[types]
-            centres = np.stack([x, self.heights[bits]], axis=-1)
-            # the end cap (shared by all types) beyond the last unit's end
-            cap = self.tip_ref[0] - self.type_pitch[0] + self.type_offset[0]
-            tips = np.stack([starts[:, -1] + pitch[:, -1] + cap, np.full(m, self.tip_ref[1])], axis=-1)
-            return centres, tips
-        x = self.first_offset + self.pitch * np.arange(n)
-        y = np.asarray(self.centre_y)[bits]
-        centres = np.stack([np.broadcast_to(x, (m, n)), y], axis=-1)
-        tip = np.array([x[-1] + self.tip_ref[0], self.tip_ref[1]])
-        return centres, tip
-
-    def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Centres (m, k, n, 2), tip (m, k, 2) and curl in degrees (m, k) of designs (m, n).
-
-        Examples
-        --------
-        See :class:`ChainModel`.
-        """
-        bits = np.atleast_2d(np.asarray(bits))
-        m, n = bits.shape
-        self.check_units(n)
-        codes = window_codes(bits, self.window, n_types=self.n_types)  # (m, n + 1)
-        rows = self.lookup(codes)
-        erows = self.lookup(codes[:, -1], end=True)
-        angle = np.cumsum(self.turn[rows], axis=1)  # (m, n + 1, k)
-        length = self.length[rows]
-        steps = np.stack([length * np.cos(angle), length * np.sin(angle)], axis=-1)  # (m, n + 1, k, 2)
-        base = np.stack([np.zeros(m), self.heights[bits[:, 0]]], axis=-1)  # (m, 2)
-        pts = np.cumsum(steps, axis=1) + base[:, None, None, :]
-        pts = pts.transpose(0, 2, 1, 3)  # (m, k, n + 1, 2)
-        centres, tip = pts[:, :, :-1], pts[:, :, -1]
-        curl = np.degrees(angle[:, -1, :] + self.end[erows])
-        return centres, tip, curl
-
-    # -- persistence ----------------------------------------------------------------------
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form (arrays as lists; codes also as window text for readers).
-
-        A table over several unit types (format :data:`ALPHABET_FORMAT`) adds ``alphabet``
-        and ``types`` (per symbol: ``pitch_mm``, ``centre_offset_mm``, ``centre_y_mm`` of
-        both orientations), and writes its windows in the types' letters with ``<`` and ``>``
-        for the base and the tip.
-        """
-        extra: dict[str, Any] = {}
-        if self.alphabet:
-            extra = {"alphabet": list(self.alphabet),
-                     "types": {s: {"pitch_mm": self.type_pitch[t], "centre_offset_mm": self.type_offset[t],
-                                   "centre_y_mm": list(self.type_centre_y[2 * t : 2 * t + 2])}
-                               for t, s in enumerate(self.alphabet)}}
-            if self.symmetric:
-                extra["symmetric"] = list(self.symmetric)
-        return {
-            "format": ALPHABET_FORMAT if self.alphabet else TABLE_FORMAT,
-            "kind": "pneumorph chain table",
-            **extra,
-            "window": self.window,
-            "pressures_mpa": self.pressures.tolist(),
-            "windows": [window_text(c, self.window, self.alphabet) for c in self.codes],
-            "turn_rad": self.turn.tolist(),
-            "length_mm": self.length.tolist(),
-            "end_windows": [window_text(c, self.window, self.alphabet) for c in self.end_codes],
-            "end_turn_rad": self.end.tolist(),
-            "pitch_mm": self.pitch,
-            "centre_y_mm": list(self.centre_y),
-            "first_offset_mm": self.first_offset,
-            "tip_ref_mm": list(self.tip_ref),
-            "source": self.source,
-            "training": list(self.training),
-            "validation": self.validation,
-            "spread": self.spread,
-            "metadata": self.metadata,
-            "fingerprint": self.fingerprint(),
-        }
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any], where: str = "chain table") -> ChainTable:
-        """Read :meth:`to_dict`'s form, checking its layout and its fingerprint."""
-        try:
-            fmt = data.get("format")
-            if data.get("kind") != "pneumorph chain table" or fmt not in (TABLE_FORMAT, ALPHABET_FORMAT):
-                raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT} or "
-                                      f"{ALPHABET_FORMAT}")
-            w = int(data["window"])
-            alphabet: tuple[str, ...] = ()
-            symmetric: tuple[str, ...] = ()
-            geometry: dict[str, tuple[float, ...]] = {}
-            if fmt == ALPHABET_FORMAT:
-                from pneumorph.geometry.library import check_symbol
-
-                alphabet = tuple(check_symbol(a, where) for a in data["alphabet"])
-                if len(alphabet) < 2 or len(set(alphabet)) != len(alphabet):
-                    raise ChainTableError(f"{where}: a table over unit types needs two or more distinct symbols, "
-                                          f"got {list(alphabet)}")
-                types = data["types"]
-                symmetric = tuple(check_symbol(a, where) for a in data.get("symmetric", []))
-                geometry = {
-                    "type_pitch": tuple(float(types[a]["pitch_mm"]) for a in alphabet),
-                    "type_offset": tuple(float(types[a]["centre_offset_mm"]) for a in alphabet),
-                    "type_centre_y": tuple(float(y) for a in alphabet for y in types[a]["centre_y_mm"][:2]),
-                }
-
-            def codes_of(texts: list[str]) -> IntArray:
-                out = []
-                for t in texts:
-                    if not isinstance(t, str) or len(t) != 2 * w + 1:
-                        raise ChainTableError(f"{where}: bad window {t!r}")
-                    out.append(window_code(t, alphabet))
-                return np.array(out, dtype=np.int64)
-
-            table = cls(
-                window=w,
-                pressures=np.array(data["pressures_mpa"], dtype=float),
-                codes=codes_of(data["windows"]),
-                turn=np.array(data["turn_rad"], dtype=float),
-                length=np.array(data["length_mm"], dtype=float),
-                end_codes=codes_of(data["end_windows"]),
-                end=np.array(data["end_turn_rad"], dtype=float),
-                pitch=float(data["pitch_mm"]),
-                centre_y=(float(data["centre_y_mm"][0]), float(data["centre_y_mm"][1])),
-                first_offset=float(data["first_offset_mm"]),
-                tip_ref=(float(data["tip_ref_mm"][0]), float(data["tip_ref_mm"][1])),
-                source=dict(data["source"]),
-                training=tuple(data["training"]),
-                validation=dict(data.get("validation", {})),
-                spread=float(data.get("spread", 0.0)),
-                metadata=dict(data.get("metadata", {})),
-                alphabet=alphabet,
-                symmetric=symmetric,
-                **geometry,
-            )
-        except ChainTableError as exc:
-            message = str(exc)
-            if message.startswith(where):
-                raise
-            raise ChainTableError(f"{where}: {message}") from None
-        except UnitLibraryError as exc:
-            raise ChainTableError(f"{where}: bad alphabet: {exc}") from None
-        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
-            raise ChainTableError(f"{where}: damaged chain table ({type(exc).__name__}: {exc})") from None
-        k, K, E = table.n_levels, len(table.codes), len(table.end_codes)
-        shapes_ok = (table.turn.shape == (K, k) and table.length.shape == (K, k) and table.end.shape == (E, k))
-        if not shapes_ok or not (np.all(np.diff(table.codes) > 0) and np.all(np.diff(table.end_codes) > 0)):
-            raise ChainTableError(f"{where}: damaged chain table (array shapes or window order do not match)")
-        if set(table.symmetric) - set(table.alphabet):
-            raise ChainTableError(f"{where}: symmetric unit types {list(table.symmetric)} outside the alphabet")
-        if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
-            raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
-        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures)):
-            raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
-        if data.get("fingerprint") != table.fingerprint():
-            raise ChainTableError(f"{where}: the chain table's contents do not match its fingerprint "
-                                  "(edited or damaged); rebuild it with `pneumorph chain build`")
-        return table
-
-    def save(self, path: str | Path) -> Path:
-        """Write the table as JSON (atomically: a temporary file renamed into place)."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".part")
-        tmp.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
-        tmp.replace(path)
-        return path
-
-    @classmethod
-    def load(cls, path: str | Path) -> ChainTable:
-        """Read a table written by :meth:`save`; :class:`ChainTableError` if it is not one."""
-        path = Path(path)
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise ChainTableError(f"{path}: no such chain table") from None
-        except (UnicodeDecodeError, json.JSONDecodeError, IsADirectoryError) as exc:
-            raise ChainTableError(f"{path}: not a chain table (unreadable JSON: {type(exc).__name__})") from None
-        if not isinstance(data, dict):
-            raise ChainTableError(f"{path}: not a chain table")
-        return cls.from_dict(data, where=str(path))
+__all__ = [
+    "ALPHABET_FORMAT",
+    "BASE",
+    "TABLE_FORMAT",
+    "TIP",
+    "ChainModel",
+    "ChainTable",
+    "check_source",
+    "covering_designs",
+    "design_array",
+    "design_strings",
+    "mirror_codes",
+    "possible_codes",
+    "source_description",
+    "source_key",
+    "window_codes",
+    "window_symbols",
+    "window_text",
+]
 
 
 # -- identity of the source model -------------------------------------------------------------
