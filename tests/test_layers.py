@@ -46,7 +46,6 @@ LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
     "pneumorph.export.moulds": 585,
     "pneumorph.fem.fast.system": 567,
-    "pneumorph.identify.fit": 632,
     "pneumorph.materials.fitting": 565,
     "pneumorph.materials.testdata": 518,
     "pneumorph.models.fe": 668,
