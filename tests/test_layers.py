@@ -44,7 +44,6 @@ MAX_FUNCTION_LINES = 80
 # docs/architecture.md ("Sizes"). The lists may only shrink: an entry under its limit fails too.
 LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
-    "pneumorph.export.moulds": 585,
     "pneumorph.fem.fast.system": 567,
     "pneumorph.materials.fitting": 565,
     "pneumorph.materials.testdata": 518,
