@@ -19,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
+from pneumorph.materials.comparison import compare
 from pneumorph.materials.datasets import load_dataset
-from pneumorph.materials.fitting import compare, r_squared
+from pneumorph.materials.fitting import r_squared
 from pneumorph.materials.hyperelastic import Ogden
 from pneumorph.materials.testdata import TestData, read_curve
 from pneumorph.plot import plot_fits

@@ -10,10 +10,10 @@ import pytest
 
 from pneumorph import __version__
 from pneumorph.errors import FitError, UnknownModelError
+from pneumorph.materials.comparison import compare
 from pneumorph.materials.datasets import load_dataset
 from pneumorph.materials.fitting import (
     MODEL_NAMES,
-    compare,
     fit,
     r_squared,
     resolve_model,

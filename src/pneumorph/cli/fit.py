@@ -8,8 +8,9 @@ from pneumorph import __version__
 from pneumorph.checks import MAX_STARTS
 from pneumorph.cli import params as P
 from pneumorph.io.files import strict_json
+from pneumorph.materials.comparison import compare
 from pneumorph.materials.datasets import list_datasets, read_test_data
-from pneumorph.materials.fitting import MODEL_NAMES, WEIGHTINGS, compare, resolve_model
+from pneumorph.materials.fitting import MODEL_NAMES, WEIGHTINGS, resolve_model
 from pneumorph.materials.hyperelastic import MODES
 from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE
 

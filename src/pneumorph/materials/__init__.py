@@ -19,9 +19,10 @@ Examples
 """
 
 from pneumorph.materials.characterise import bilinear, characterise_bulk_modulus, thermal_expansion
+from pneumorph.materials.comparison import compare
 from pneumorph.materials.datasets import list_datasets, load_dataset, read_test_data
 from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.fitting import FitResult, compare, fit
+from pneumorph.materials.fitting import FitResult, fit
 from pneumorph.materials.hyperelastic import (
     MODES,
     HyperelasticModel,
