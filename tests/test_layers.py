@@ -55,7 +55,7 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.cli.design:design": 218,
     "pneumorph.cli.export:export": 140,
     "pneumorph.cli.identify:identify": 100,
-    "pneumorph.cli.simulate:simulate": 96,
+    "pneumorph.cli.simulate:simulate": 97,
     "pneumorph.cli.unit:optimise": 86,
     "pneumorph.composite.coupon:simulate_coupon": 103,
     "pneumorph.design.certified:certified_search": 131,

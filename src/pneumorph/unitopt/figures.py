@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from pneumorph.plot.figure import new_figure, save_figure
 
 if TYPE_CHECKING:
-    from pneumorph.unitopt.run import UnitOptimisation
+    from pneumorph.unitopt.records import UnitOptimisation
 
 
 def plot_front(result: UnitOptimisation, path: str | Path) -> Path:
