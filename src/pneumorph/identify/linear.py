@@ -20,7 +20,6 @@ from pneumorph.correlation.compare import ModelShape, _resample
 FloatArray = NDArray[np.float64]
 
 #: pairs of parameters correlated beyond this cannot be told apart
-
 MAX_CORRELATION = 0.95
 
 #: the smallest eigenvalue of the parameters' correlation matrix below which J^T J is near-singular
