@@ -44,7 +44,6 @@ MAX_FUNCTION_LINES = 80
 # docs/architecture.md ("Sizes"). The lists may only shrink: an entry under its limit fails too.
 LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
-    "pneumorph.fem.fast.system": 567,
     "pneumorph.materials.testdata": 518,
     "pneumorph.models.fe": 668,
 }
@@ -65,7 +64,7 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.export.moulds:casting_mould": 126,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
-    "pneumorph.fem.fast.system:FastSystem._build_pattern": 81,
+    "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,
     "pneumorph.fem.stepping:ramp": 130,
     "pneumorph.geometry.assembly:assemble": 160,
     "pneumorph.identify.fit:identify": 186,

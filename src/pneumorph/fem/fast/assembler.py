@@ -1,0 +1,308 @@
+"""The fast assembler's base (:class:`FastSystem`): residual and tangent of FElupe items straight
+into a fixed CSR pattern of the free unknowns, any dimension; its plane-strain and 3D hooks:
+:mod:`pneumorph.fem.fast.system`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.fem.fast.loads import DeadLoads
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: cells per chunk of the 3D tangent (keeps the temporaries in the tens of MB)
+_CHUNK = 256
+
+
+@dataclass
+class _Solid:
+    """One material on some cells: gradients in the layouts the products need."""
+
+    cells: IntArray  # (c, n)
+    g: FloatArray  # (c, q, n, d) dN_a/dX_J
+    dV: FloatArray  # (c, q)
+    kernel: Any
+    layouts: dict[str, FloatArray] = field(default_factory=dict)
+    take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # assembled entries
+    scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # their CSR positions
+    edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+
+@dataclass
+class _Walls:
+    """The pressurised faces of one ``SolidBodyPressure``."""
+
+    item: Any
+    cells: IntArray  # (f, n) of the volume cells the faces belong to
+    g: FloatArray  # (f, q, n, d)
+    h: FloatArray  # (q, n)
+    ndA: FloatArray  # (f, q, d)
+    take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+
+def _deformation(g: FloatArray, cells: IntArray, U: FloatArray) -> FloatArray:
+    """``F = I + grad u`` at every quadrature point, (c, q, d, d)."""
+    F = np.matmul(U[cells].transpose(0, 2, 1)[:, None], g)  # (c, q, i, J)
+    for i in range(U.shape[1]):
+        F[..., i, i] += 1.0
+    return F
+
+
+class FastSystem:
+    """Residual and active-block tangent of FElupe items, assembled fast.
+
+    Use the dimension's subclass (:class:`PlaneStrainSystem`, :class:`SolidSystem3D`);
+    this class holds what they share: the items' data, the CSR pattern, the scatter,
+    dead loads, the tangent matrix and the enclosed cavity volume.
+
+    Parameters
+    ----------
+    items : sequence
+        ``felupe.SolidBody`` items with materials the dimension has a kernel for,
+        ``felupe.SolidBodyPressure`` items on boundary regions of closed cavities and
+        ``felupe.SolidBodyForce`` dead loads (all linked to one global field).
+    field : felupe.FieldContainer
+        The global field; only its size and mesh points are read here.
+    dof1, dof0 : ndarray
+        Active and prescribed degrees of freedom (FElupe numbering ``dim * point + component``).
+
+    Attributes
+    ----------
+    indptr, indices : ndarray
+        CSR pattern of ``K[dof1, dof1]`` (its upper triangle if :attr:`symmetric`).
+    """
+
+    dim: ClassVar[int]
+    #: the tangent is symmetric and only its upper triangle is assembled
+    symmetric: ClassVar[bool] = False
+    #: PARDISO's fill-reducing ordering for this dimension's tangents
+    ordering: ClassVar[int] = 0
+    #: a Newton method that keeps its tangents may factorise in single precision
+    single_precision: ClassVar[bool] = False
+    #: the precision the element matrices are computed in (:class:`~pneumorph.fem.fast.newton.FastSubstep`
+    #: sets float32 where it factorises in single precision; the residual is always double)
+    tangent_dtype: type = np.float64
+
+    def __init__(self, items: Sequence[Any], field: Any, dof1: IntArray, dof0: IntArray) -> None:
+        import felupe as fem
+
+        d = self.dim
+        self.ndof = int(field[0].values.size)
+        self.npoints = self.ndof // d
+        self.dof1 = np.asarray(dof1, dtype=np.int64)
+        self.dof0 = np.asarray(dof0, dtype=np.int64)
+        self.points = np.asarray(field[0].region.mesh.points[:, :d], dtype=float)
+        self.solids: list[_Solid] = []
+        self.walls: list[_Walls] = []
+        forces = []
+        for item in items:
+            self._check_field(item.field[0])
+            if isinstance(item, fem.SolidBodyForce):
+                forces.append(item)
+                continue
+            region = item.field[0].region
+            cells = np.asarray(region.mesh.cells, dtype=np.int64)
+            g = np.ascontiguousarray(np.transpose(region.dhdX[:, :d], (3, 2, 0, 1)))  # (c, q, n, d)
+            if isinstance(item, fem.SolidBodyPressure):
+                h = np.ascontiguousarray(region.h[:, :, 0].T)  # (n, q) -> (q, n)
+                ndA = np.ascontiguousarray(np.transpose(region.dA[:d], (2, 1, 0)))  # (f, q, d)
+                self.walls.append(_Walls(item, cells, g, h, ndA))
+            elif isinstance(item, fem.SolidBody):
+                solid = _Solid(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
+                solid.layouts = self._layouts(g)
+                self.solids.append(solid)
+            else:
+                raise TypeError(f"no fast assembly for {type(item).__name__}; use the FElupe backend")
+        self.dead = DeadLoads(forces, self.npoints, d)
+        self._build_pattern()
+        self._state: list[Any] = []
+        self._U = np.zeros((self.npoints, d))
+
+    # -- dimension hooks ---------------------------------------------------------------
+    def _check_field(self, sub: Any) -> None:
+        raise NotImplementedError  # pragma: no cover
+
+    def _kernel_of(self, umat: Any) -> Any:
+        raise NotImplementedError  # pragma: no cover
+
+    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+        """The gradients in the layouts this dimension's products need."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+        """Active (row, column) of every element-matrix entry as it is computed, and which
+        of them are assembled (``act``: the active index of each cell's dofs, (c, n, d))."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+        """The local nodes ``a``, ``b`` that each entry of :meth:`_entries` couples, as index
+        arrays that broadcast to its shape without the cell axis."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+        """The element vectors ``(c, n, d)`` of a solid, its smallest det F and the state
+        :meth:`_solid_tangent` needs."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
+        """The element matrices of a solid, entries in :meth:`_entries` order."""
+        raise NotImplementedError  # pragma: no cover
+
+    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
+        """The follower-pressure stiffness of some walls, entries in :meth:`_entries` order."""
+        raise NotImplementedError  # pragma: no cover
+
+    @staticmethod
+    def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
+        """``cof(F) N dA`` at the boundary points, (f, q, d)."""
+        raise NotImplementedError  # pragma: no cover
+
+    # -- pattern ------------------------------------------------------------------------
+    def _build_pattern(self) -> None:
+        """CSR pattern and every element entry's position in it.
+
+        No sort of the element entries: the nodes a cell couples are paired once
+        (``np.unique`` of the cells' node pairs, unordered where the tangent is
+        symmetric), the pattern follows from the pairs - in a row of node ``P``'s
+        component ``i`` the columns are the active components of ``P``'s partners ``Q``
+        in ascending order, since the active numbering keeps the order of the dofs - and
+        an entry's position is its pair's row start, the columns of the partners before
+        ``Q`` and the components before its own. Only the entries some element assembles
+        are kept, so the pattern is exactly theirs.
+        """
+        d, npts = self.dim, self.npoints
+        active = np.full(self.ndof, -1, dtype=np.int32)  # (int32: half the memory traffic of the gathers)
+        active[self.dof1] = np.arange(self.dof1.size)
+        n1 = self.dof1.size
+        owners: list[_Solid | _Walls] = [*self.solids, *self.walls]
+        # 1. the node pairs every owner's cells couple, numbered
+        pair_keys = []
+        for owner in owners:
+            a, b = owner.cells[:, :, None], owner.cells[:, None, :]
+            if self.symmetric:
+                a, b = np.minimum(a, b), np.maximum(a, b)
+            pair_keys.append((a * npts + b).ravel())
+        every = np.concatenate(pair_keys)
+        if npts * npts < 2**32:
+            every = every.astype(np.uint32)  # sorts faster
+        keys, inverse = np.unique(every, return_inverse=True)
+        keys = keys.astype(np.int64)
+        first, second = keys // npts, keys % npts
+        # 2. the dof entries (pair, i, k) of every pair: position if all were assembled
+        comp = np.arange(d)
+        rows = active[d * first[:, None] + comp]  # (pairs, d)
+        cols = active[d * second[:, None] + comp]
+        exists = (rows[:, :, None] >= 0) & (cols[:, None, :] >= 0)
+        if self.symmetric:  # a node with itself: the upper triangle of its block
+            exists &= (first != second)[:, None, None] | (comp[:, None] <= comp[None, :])
+        per_row = exists.sum(axis=2)  # (pairs, d): columns each pair adds to the rows of first
+        before = np.cumsum(per_row, axis=0) - per_row  # columns of earlier pairs (all nodes)
+        starts = np.flatnonzero(np.r_[True, first[1:] != first[:-1]])
+        group = np.repeat(starts, np.diff(np.r_[starts, first.size]))
+        before -= before[group]  # ... of earlier pairs of the same first node
+        live = rows >= 0
+        indptr = np.r_[0, np.cumsum(np.bincount(rows[live], weights=per_row[live], minlength=n1))].astype(np.int64)
+        full = indptr[np.maximum(rows, 0)][:, :, None] + before[:, :, None] + (np.cumsum(exists, axis=2) - exists)
+        # 3. every element entry's (pair, i, k), of the assembled ones
+        offsets = np.cumsum([0, *(k.size for k in pair_keys)])
+        component = (self.dof1 % d).astype(np.int32)  # of each active dof
+        full_flat = full.reshape(-1)
+        positions = []
+        used = np.zeros(int(indptr[-1]), dtype=bool)
+        for o, owner in enumerate(owners):
+            dofs = d * owner.cells[:, :, None] + np.arange(d)  # (c, n, d)
+            owner.edofs = dofs.ravel()
+            erows, ecols, valid = self._entries(owner, active[dofs])
+            owner.take = np.flatnonzero(valid)
+            n = owner.cells.shape[1]
+            pair = inverse[offsets[o] : offsets[o + 1]].reshape(-1, n, n).astype(np.int32)
+            ia, ib = self._entry_nodes(owner)
+            index = np.broadcast_to(pair[:, ia, ib] * (d * d), erows.shape).ravel()[owner.take]
+            index += component[np.ravel(erows)[owner.take]] * d
+            index += component[np.ravel(ecols)[owner.take]]
+            pos = full_flat[index]
+            used[pos] = True
+            positions.append(pos)
+        # 4. keep the entries some element assembles
+        renumber = np.cumsum(used) - 1
+        self.nnz = int(used.sum())
+        kept_rows = np.repeat(np.arange(n1), np.diff(indptr))[used]
+        self.indptr = np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32)
+        columns = np.empty(int(indptr[-1]), dtype=np.int32)
+        columns[full[exists]] = np.broadcast_to(cols[:, None, :], exists.shape)[exists]
+        self.indices = columns[used]
+        # every owner's CSR positions side by side (each owner's scatter is its slice)
+        self._scatter = np.empty(sum(pos.size for pos in positions), dtype=np.int64)
+        start = 0
+        for owner, pos in zip(owners, positions, strict=True):
+            owner.scatter = self._scatter[start : start + pos.size]
+            np.take(renumber, pos, out=owner.scatter)
+            start += pos.size
+        self._values = np.empty(self._scatter.size)  # kept: a tangent fills it anew
+
+    # -- evaluation -----------------------------------------------------------------------
+    def residual(self, u: FloatArray) -> tuple[FloatArray, float]:
+        """Residual over all dofs at the displacement vector ``u`` and the smallest det F.
+
+        What the tangent needs is kept for :meth:`tangent_data` at the same state.
+        """
+        U = u.reshape(-1, self.dim)
+        self._U = U.copy()
+        r = np.zeros(self.ndof)
+        self._state = []
+        jmin = np.inf
+        for s in self.solids:
+            vectors, j, state = self._solid_residual(s, U)
+            jmin = min(jmin, j)
+            r += np.bincount(s.edofs, weights=vectors.ravel(), minlength=self.ndof)
+            self._state.append(state)
+        for w in self.walls:
+            p = float(w.item.results.pressure)
+            cofN = self._cof_normal(_deformation(w.g, w.cells, U), w.ndA)  # (f, q, d)
+            # r[f, a, i] = p sum_q h[q, a] cof(F)_iJ N_J dA
+            r += np.bincount(w.edofs, weights=(p * np.matmul(w.h.T[None], cofN)).ravel(), minlength=self.ndof)
+        if self.dead:
+            r -= self.dead.vector()
+        return r, jmin
+
+    def tangent_data(self) -> FloatArray:
+        """CSR ``data`` of ``K[dof1, dof1]`` (its upper triangle if symmetric), state of the last residual."""
+        # every owner's assembled entries side by side, then one scatter-add of them all
+        values, start = self._values, 0
+        for s, state in zip(self.solids, self._state, strict=True):
+            values[start : start + s.take.size] = self._solid_tangent(s, state).ravel()[s.take]
+            start += s.take.size
+        for w in self.walls:
+            K = self._wall_tangent(w, float(w.item.results.pressure), self._U)
+            values[start : start + w.take.size] = K.ravel()[w.take]
+            start += w.take.size
+        return np.asarray(np.bincount(self._scatter, weights=values, minlength=self.nnz), dtype=np.float64)
+
+    def tangent(self) -> Any:
+        """``K[dof1, dof1]`` as ``scipy.sparse.csr_matrix`` (state of the last residual)."""
+        import scipy.sparse as sp
+
+        n1 = self.dof1.size
+        matrix = sp.csr_matrix((self.tangent_data(), self.indices, self.indptr), shape=(n1, n1))
+        if self.symmetric:
+            matrix = (matrix + sp.triu(matrix, k=1).T).tocsr()
+        return matrix
+
+    def cavity_volume(self, u: FloatArray) -> float:
+        """Volume (area in 2D) enclosed by the pressurised walls, as :func:`pneumorph.fem.cavity_volume`."""
+        U = u.reshape(-1, self.dim)
+        total = 0.0
+        for w in self.walls:
+            F = _deformation(w.g, w.cells, U)
+            x = np.matmul(w.h[None], (self.points + U)[w.cells])  # (f, q, d)
+            total += float(np.sum(x * self._cof_normal(F, w.ndA)))
+        return -total / self.dim
