@@ -44,7 +44,6 @@ MAX_FUNCTION_LINES = 80
 # docs/architecture.md ("Sizes"). The lists may only shrink: an entry under its limit fails too.
 LONG_MODULES: dict[str, int] = {
     "pneumorph.bench.app": 574,
-    "pneumorph.materials.testdata": 518,
     "pneumorph.models.fe": 668,
 }
 LONG_FUNCTIONS: dict[str, int] = {
