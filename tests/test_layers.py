@@ -43,7 +43,6 @@ MAX_FUNCTION_LINES = 80
 # Modules and functions still over the limits, each named with its reason and plan in
 # docs/architecture.md ("Sizes"). The lists may only shrink: an entry under its limit fails too.
 LONG_MODULES: dict[str, int] = {
-    "pneumorph.bench.app": 574,
     "pneumorph.models.fe": 668,
 }
 LONG_FUNCTIONS: dict[str, int] = {

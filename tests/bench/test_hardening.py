@@ -20,7 +20,7 @@ pytest.importorskip("fastapi")
 from fastapi.testclient import TestClient
 
 from pneumorph.bench import create_app
-from pneumorph.bench.app import COOKIE
+from pneumorph.bench.guard import COOKIE
 from pneumorph.bench.jobs import JobLimits
 from pneumorph.design.config import to_toml
 from pneumorph.errors import StateQuotaError
