@@ -80,6 +80,11 @@ def check_photo(photo: Any) -> tuple[int, int]:
     if width * height > MAX_PHOTO_PIXELS:
         raise ScanError(f"photo {photo}: {width:,} x {height:,} pixels, more than the {MAX_PHOTO_PIXELS:,} "
                         "(MAX_PHOTO_PIXELS) drawn under a trace; scale it down")
+    try:  # a header can be whole over a broken body (truncated, corrupt): decode it now, within the limit
+        with Image.open(photo) as image:
+            image.load()
+    except (OSError, ValueError, SyntaxError) as exc:
+        raise ScanError(f"photo {photo}: not a readable image ({type(exc).__name__}: {exc})") from None
     return width, height
 
 

@@ -140,7 +140,7 @@ def run_exhaustive(
     model: ActuatorModel,
     objective: Objective,
     evaluator: Evaluator | None = None,
-    symmetry: bool = True,
+    symmetry: bool | None = None,
     verify_symmetry: bool = True,
     batch_size: int = 64,
     hall_of_fame: int = 10,
@@ -155,8 +155,9 @@ def run_exhaustive(
     objective : ProfileTarget or TipGoal
     evaluator : Evaluator, optional
         Serial by default; batches of ``batch_size`` designs are sent at once.
-    symmetry : bool
-        Solve only designs starting with 0 and derive their mirrors.
+    symmetry : bool, optional
+        Solve only designs starting with 0 and derive their mirrors. Default: unless the
+        model's gravity has a component across the actuator (y), which the mirror reverses.
     verify_symmetry : bool
         With ``symmetry``, first solve one design and its mirror and stop with an error if
         the model is not mirror-symmetric (one extra solve).
@@ -183,6 +184,9 @@ def run_exhaustive(
         )
     if batch_size < 1:
         raise SearchConfigError(f"the batch size must be at least 1, got {batch_size}")
+    if symmetry is None:
+        gravity = getattr(model, "gravity", None)
+        symmetry = gravity is None or len(gravity) < 2 or gravity[1] == 0.0
     total = 2**n
     todo = all_designs(n, first="0") if symmetry else all_designs(n)
     if symmetry and verify_symmetry and n > 1:

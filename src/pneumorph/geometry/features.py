@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 from pneumorph.errors import GeometryError
+from pneumorph.geometry.limits import MAX_LENGTH_MM
 from pneumorph.geometry.unit import UnitSpec
 
 #: an axis-aligned box ``(x0, x1, y0, y1, z0, z1)`` in mm
@@ -30,6 +31,9 @@ def check_length(name: str, value: float, positive: bool) -> None:
     ok = not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
     if not ok or (value <= 0 if positive else value < 0):
         raise GeometryError(f"{name} must be a finite number {'> 0' if positive else '>= 0'} mm, got {value!r}")
+    if value > MAX_LENGTH_MM:  # the limit of every length of a unit: the mesh grows with it
+        raise GeometryError(f"{name} of {value:g} mm is more than {MAX_LENGTH_MM:g} mm (MAX_LENGTH_MM, "
+                            "pneumorph.geometry.limits)")
 
 
 @dataclass(frozen=True)

@@ -142,6 +142,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     True
     """
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)  # a new folder given with the file (checked up front)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent)
     os.close(fd)
     try:

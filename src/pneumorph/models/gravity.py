@@ -9,12 +9,15 @@ across its height (-y).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
 #: Standard gravity, mm/s^2.
 STANDARD_GRAVITY = 9806.65
+#: The largest acceleration a model accepts, mm/s^2 (100 g: far beyond any bench or centrifuge test of a soft actuator).
+MAX_GRAVITY = 100 * STANDARD_GRAVITY
 
 #: Unit directions of gravity in the models' axes for the named set-ups.
 SETUPS: dict[str, tuple[float, float, float]] = {
@@ -57,9 +60,14 @@ def gravity_vector(gravity: str | Sequence[float] | None, dim: int) -> tuple[flo
                              "or give an acceleration vector in mm/s^2")
         g = STANDARD_GRAVITY * np.asarray(SETUPS[gravity], dtype=float)
     else:
+        if any(isinstance(v, (bool, str, bytes)) for v in np.ravel(np.asarray(gravity, dtype=object))):
+            raise ValueError(f"gravity must be 2 or 3 numbers in mm/s^2, got {gravity!r}")
         g = np.asarray(gravity, dtype=float).ravel()
         if g.size not in (2, 3) or not np.all(np.isfinite(g)):
             raise ValueError(f"gravity must be 2 or 3 finite components in mm/s^2, got {gravity!r}")
+        if math.hypot(*g.tolist()) > MAX_GRAVITY:
+            raise ValueError(f"gravity of {math.hypot(*g.tolist()):.4g} mm/s^2 is more than {MAX_GRAVITY:g} "
+                             "(MAX_GRAVITY: 100 g)")
     if g.size == 3 and dim == 2:
         if g[2] != 0.0:
             raise ValueError(f"the plane-strain model has no z axis: gravity {g.tolist()} mm/s^2 has a z "
