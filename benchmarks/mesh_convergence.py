@@ -20,7 +20,7 @@ import time
 
 
 def _solve(design: str, size: float, queue: mp.Queue) -> None:  # type: ignore[type-arg]
-    from pneumorph.geometry.limits import estimate_mesh
+    from pneumorph.geometry.meshsize import estimate_mesh
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.models.fe import Full3D
 

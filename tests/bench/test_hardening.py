@@ -24,7 +24,8 @@ from pneumorph.bench.guard import COOKIE
 from pneumorph.bench.jobs import JobLimits
 from pneumorph.design.config import to_toml
 from pneumorph.errors import StateQuotaError
-from pneumorph.geometry.limits import MAX_NODES_3D, MeshLimitError, check_mesh, estimate_mesh
+from pneumorph.geometry.limits import MeshLimitError
+from pneumorph.geometry.meshsize import MAX_NODES_3D, check_mesh, estimate_mesh
 from pneumorph.geometry.unit import UnitSpec
 
 BASE = "http://127.0.0.1:8000"

@@ -109,9 +109,9 @@ def test_a_solid_base_unit_is_refused(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_a_probe_larger_than_the_memory_is_refused_with_its_estimate(tmp_path: Path,
                                                                     capsys: pytest.CaptureFixture[str],
                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
-    from pneumorph.geometry import limits
+    from pneumorph.geometry import meshsize
 
-    monkeypatch.setattr(limits, "available_memory", lambda: 4 * 10**9)
+    monkeypatch.setattr(meshsize, "available_memory", lambda: 4 * 10**9)
     line = _refused(["--units", "100"], tmp_path, capsys, monkeypatch, tmp_path / "run")
     assert "a 3D actuator of 100 units of this unit is a mesh of about " in line and "GB for one solve" in line
     assert "4.0 GB are available" in line and "fewer --units" in line and not (tmp_path / "run").exists()

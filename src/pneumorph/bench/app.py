@@ -39,7 +39,8 @@ from pneumorph.bench.jobs import JobBoard, JobLimits
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, load_json
 from pneumorph.design.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
-from pneumorph.geometry.limits import MeshLimitError, check_mesh
+from pneumorph.geometry.limits import MeshLimitError
+from pneumorph.geometry.meshsize import check_mesh
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import json_safe

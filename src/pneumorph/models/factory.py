@@ -11,7 +11,7 @@ from pneumorph import checks
 from pneumorph.errors import GeometryError, SearchConfigError, SettingsError
 from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.geometry.limits import available_memory, check_mesh
+from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.gravity import gravity_vector

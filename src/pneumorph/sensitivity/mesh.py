@@ -277,7 +277,7 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
     """Refuse, before any solve, element sizes whose solves would not fit in memory.
 
     The mesh is counted from the unit's grid, cavities included (an upper bound;
-    :func:`pneumorph.geometry.limits.check_mesh`): 6.9 GB estimated for the 15-unit actuator
+    :func:`pneumorph.geometry.meshsize.check_mesh`): 6.9 GB estimated for the 15-unit actuator
     at 1.0 mm, which peaked at 6.0 GB. ``parallel`` solves run at once (the workers).
 
     Returns
@@ -296,7 +296,8 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
     >>> check_refinement(Full3D(15), [1.0], memory=8 * 10**9)
     {1.0: (91322, 6894416781)}
     """
-    from pneumorph.geometry.limits import MeshLimitError, available_memory, check_mesh
+    from pneumorph.geometry.limits import MeshLimitError
+    from pneumorph.geometry.meshsize import available_memory, check_mesh
 
     free = available_memory() if memory is None else int(memory)
     out = {}

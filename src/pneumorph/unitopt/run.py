@@ -244,7 +244,7 @@ def check_settings(space: DesignSpace, strain_limit: float, n_units: int = DEFAU
     In this order: the strain limit; a base unit that bends (not ``solid``); every variable's
     range holds at least two values at the space's resolution; the probe's mesh at every
     corner of the box, estimated before anything is meshed
-    (:func:`pneumorph.geometry.limits.check_mesh`: ``parallel`` solves of ``n_units`` units
+    (:func:`pneumorph.geometry.meshsize.check_mesh`: ``parallel`` solves of ``n_units`` units
     within ``memory`` bytes, by default the memory available now); then every corner is
     built and meshed (:meth:`DesignSpace.check`).
 
@@ -267,7 +267,7 @@ def check_settings(space: DesignSpace, strain_limit: float, n_units: int = DEFAU
     """
     from itertools import product
 
-    from pneumorph.geometry import limits
+    from pneumorph.geometry import meshsize
 
     check_strain_limit(strain_limit)
     if not isinstance(space, DesignSpace):
@@ -284,7 +284,7 @@ def check_settings(space: DesignSpace, strain_limit: float, n_units: int = DEFAU
             held = f"one value ({round(first * r, 9):g} mm)" if last == first else "no value"
             raise SettingsError(f"the range of {v.name} {v.low:g}-{v.high:g} mm holds {held} at the resolution "
                                 f"{r:g} mm: widen it or give a finer --resolution")
-    free = limits.available_memory() if memory is None else memory
+    free = meshsize.available_memory() if memory is None else memory
     for corner in product(*[(v.low, v.high) for v in space.variables]):
         values: dict[str, Any] = dict(zip(space.names, corner, strict=True))
         where = ", ".join(f"{n}={c:g}" for n, c in values.items())
@@ -292,7 +292,7 @@ def check_settings(space: DesignSpace, strain_limit: float, n_units: int = DEFAU
             spec = replace(space.base, **values)
         except GeometryError:
             continue  # no unit at this corner: DesignSpace.check says so, naming the corner
-        limits.check_mesh(spec, n_units, 3, memory=free, parallel=parallel,
+        meshsize.check_mesh(spec, n_units, 3, memory=free, parallel=parallel,
                           advice=f"narrow the bounds (this is the unit at {where} mm), raise --element-size or use "
                                  "fewer --units")
     space.check()
