@@ -1,9 +1,8 @@
 """The package's shape, read from its source: layers that only point down, no circle between
 modules, modules and functions a reader can hold (docs/architecture.md, "Layers" and "Sizes").
 
-Every import is read with :mod:`ast`, at the top of a module and inside its functions alike;
-imports under ``if TYPE_CHECKING:`` are read for the layers but not for the circles (they never
-run).
+Every import is read with :mod:`ast`, at the top of a module, inside its functions and under
+``if TYPE_CHECKING:`` alike (an import for the types is a dependency too).
 """
 
 from __future__ import annotations
@@ -83,7 +82,6 @@ class Import:
     importer: str
     target: str
     line: int
-    typing_only: bool
 
 
 def modules() -> dict[str, Path]:
@@ -97,19 +95,9 @@ def modules() -> dict[str, Path]:
     return found
 
 
-def _typing_only_lines(tree: ast.AST) -> set[int]:
-    lines: set[int] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            for inner in node.body:
-                lines.update(range(inner.lineno, (inner.end_lineno or inner.lineno) + 1))
-    return lines
-
-
 def imports(name: str, path: Path, known: dict[str, Path]) -> list[Import]:
     """The package's modules that ``name`` imports, at any level of the module."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    typing = _typing_only_lines(tree)
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = []
     for node in ast.walk(tree):
@@ -129,7 +117,7 @@ def imports(name: str, path: Path, known: dict[str, Path]) -> list[Import]:
             if target.split(".")[0] == "pneumorph":
                 while target not in known:  # ``import pneumorph.a.b`` of a name inside a module
                     target = target.rpartition(".")[0]
-                found.append(Import(name, target, node.lineno, node.lineno in typing))
+                found.append(Import(name, target, node.lineno))
     return found
 
 
@@ -204,7 +192,7 @@ def test_no_circle_between_modules() -> None:
     for name in modules():
         edges[name]
     for found in all_imports():
-        if not found.typing_only and found.target != found.importer:
+        if found.target != found.importer:
             edges[found.importer].add(found.target)
     assert not cycles(edges)
 
