@@ -136,6 +136,12 @@ def all_designs(n: int, first: str | None = None) -> list[str]:
     return [first + format(i, f"0{n - 1}b") if n > 1 else first for i in range(2 ** (n - 1))]
 
 
+def _mirror_holds(model: ActuatorModel) -> bool:
+    """Whether a design and its mirror give mirrored responses: no gravity across the actuator (y)."""
+    gravity = getattr(model, "gravity", None)
+    return gravity is None or len(gravity) < 2 or gravity[1] == 0.0
+
+
 def run_exhaustive(
     model: ActuatorModel,
     objective: Objective,
@@ -185,8 +191,7 @@ def run_exhaustive(
     if batch_size < 1:
         raise SearchConfigError(f"the batch size must be at least 1, got {batch_size}")
     if symmetry is None:
-        gravity = getattr(model, "gravity", None)
-        symmetry = gravity is None or len(gravity) < 2 or gravity[1] == 0.0
+        symmetry = _mirror_holds(model)
     total = 2**n
     todo = all_designs(n, first="0") if symmetry else all_designs(n)
     if symmetry and verify_symmetry and n > 1:
