@@ -69,7 +69,8 @@ def _default_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)  # as a shell starts it: Ctrl-C at its default
 
 
-def _interrupt(tmp_path: Path, slow: str, args: list[str]) -> subprocess.CompletedProcess[str]:
+def _interrupt(tmp_path: Path, slow: str, args: list[str],
+               sig: int = signal.SIGINT) -> subprocess.CompletedProcess[str]:
     hook = tmp_path / "hook"
     hook.mkdir()
     (hook / "sitecustomize.py").write_text(HOOK, encoding="utf-8")
@@ -86,7 +87,7 @@ def _interrupt(tmp_path: Path, slow: str, args: list[str]) -> subprocess.Complet
             out, err = proc.communicate()
             raise AssertionError(f"the run never reached {slow!r}: exit {proc.returncode}\n{err}")
         time.sleep(0.05)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     out, err = proc.communicate(timeout=120)
     return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
 
@@ -109,6 +110,15 @@ def test_ctrl_c_at_any_moment_is_aborted_with_nothing_written(tmp_path: Path, sl
     assert "Traceback" not in done.stderr and "rror" not in done.stderr
     if slow.startswith("import:"):
         assert not (tmp_path / "out").exists(), sorted(p.name for p in (tmp_path / "out").rglob("*"))
+
+
+def test_sigterm_inside_a_command_is_terminated_not_aborted(tmp_path: Path) -> None:
+    """click turns a KeyboardInterrupt (the CLI's SIGTERM is one) inside a command into Abort: it said
+    "aborted", exit 130, for every command but design."""
+    done = _interrupt(tmp_path, "echo:simulating design", SIMULATE, signal.SIGTERM)
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert done.returncode == 143 and lines[-1] == "terminated", done.stderr
+    assert not (tmp_path / "out").exists()
 
 
 def test_ctrl_c_after_main_returned_is_ignored(tmp_path: Path) -> None:

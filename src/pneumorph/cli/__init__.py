@@ -179,6 +179,8 @@ def _run(argv: list[str] | None, pressed: int) -> int:
         click.echo("terminated", err=True)
         return 143
     except (click.exceptions.Abort, KeyboardInterrupt):
+        if _terminated.is_set():  # click turns the SIGTERM's Terminated into Abort inside a command
+            return _say("terminated", 143)
         click.echo("aborted", err=True)
         return 130
     except click.UsageError as exc:
