@@ -67,6 +67,13 @@ def test_a_fuzz_case_ends_cleanly(case: object) -> None:
         f"{outcome.verdict} (exit {outcome.code}) for {outcome.argv} {case.files}: {outcome.stderr_tail}")  # type: ignore[attr-defined]
 
 
+@pytest.mark.parametrize("command", sorted(c for c, argv in _BASE.items() if "--unit" in argv))
+def test_a_bad_unit_file_is_blamed_on_the_option(command: str) -> None:
+    """sensitivity and chain build named the factory's key ("[model] unit_file: ...") for a bad --unit file."""
+    outcome = FUZZ.run_case(_C(command, "unit", "empty", _BASE[command], {"unit.toml": ""}, "refuse"))  # type: ignore[attr-defined]
+    assert outcome.verdict == "refused" and "'--unit'" in outcome.stderr_tail[-1], outcome.stderr_tail
+
+
 def test_a_base_block_past_the_length_limit_is_refused_before_meshing() -> None:
     """A study with a base block 1e9 mm long grew past 13 GB meshing it (not run as a case: it would again)."""
     from pneumorph.errors import SearchConfigError

@@ -66,6 +66,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     check_options(executor, workers, scheduler)
     settings: dict = {"fidelity": fidelity}
     if unit_file:
+        P.unit_option(unit_file)
         settings["unit_file"] = unit_file
     if library is not None:
         P.library_option(library, unit_file)

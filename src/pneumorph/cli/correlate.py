@@ -52,6 +52,7 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
         raise ScanError("a 3D scan needs the 3D model: leave out --model 2d")
     settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure}
     if unit_file:
+        P.unit_option(unit_file)
         settings["unit_file"] = unit_file
     model = make_model(len(orientation), settings)
     check_length(data, len(orientation) * model.unit.pitch)

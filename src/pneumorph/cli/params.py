@@ -246,3 +246,12 @@ def library_option(library: str, unit_file: str | None) -> UnitLibrary:
         raise click.UsageError("give either --unit or --library, not both")
     with blame("--library"):
         return load_library(library, "unit library")
+
+
+def unit_option(unit_file: str) -> None:
+    """Refuse a ``--unit`` file that is no valid unit as a usage error naming ``--unit``, before any model is built
+    (the model factory would name its own key, ``[model] unit_file``)."""
+    from pneumorph.geometry.unit import UnitSpec
+
+    with blame("--unit"):
+        UnitSpec.from_toml(unit_file)

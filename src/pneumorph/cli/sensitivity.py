@@ -59,6 +59,7 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
             n = len(parse_orientation(design))
     settings: dict[str, Any] = {"fidelity": common["fidelity"], "pressure_kpa": common["pressure"]}
     if common["unit_file"]:
+        P.unit_option(common["unit_file"])
         settings["unit_file"] = common["unit_file"]
     model = make_model(n, settings)
     study = BUILDERS[name](model, design, **options)  # every variant is built (and checked) before any solve
@@ -257,6 +258,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     sizes = tuple(sorted(set(sizes or (1.5, 1.0, 0.75)), reverse=True))
     settings: dict[str, Any] = {"fidelity": fidelity, "pressure_kpa": pressure}
     if unit_file:
+        P.unit_option(unit_file)
         settings["unit_file"] = unit_file
     model = make_model(n, settings)
     with P.blame("--target"):
