@@ -94,6 +94,8 @@ BASE = {
     "show": ["materials", "show", "mold_star_15"],
     "export": ["export", "0110", "--stl", "run", "--inp", "run/deck.inp", "--mould"],
     "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--scale", "0.2", "--out", "run"],
+    "identify": ["identify", "trace.csv", "--design", "0110", "--pressure", "20", "--model", "2d", "--scale", "0.2",
+                 "--executor", "serial", "--out", "run"],
     "list": ["materials", "list"],
     "serve": ["serve", "--port", "18765", "--state", "run"],
     "optimise": ["unit", "optimise", "--out", "run", "--executor", "serial", "--pop", "4", "--gen", "1"],
@@ -120,11 +122,15 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""], "--chain-table": ["binary.bin", "folder", "missing.json", ""],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
+        "--stage": ["", "abc", "18", "18:", "x:sin", "nan:sin", "18:reach", "18:reach 1", "18:max-x", "20:sin",
+                    "18:r = 20 + theta", "18:y = 1/0"],
+        "--model-file": ["binary.bin", "folder", "missing.toml", ""],
     },
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
+        "--model-file": ["binary.bin", "folder", "missing.toml", ""],
     },
     "study": {
         "--populations": ["", "0", "1", "20,,40", "abc", "1.5", "-20"], "--seeds": POS_COUNT + HUGE,
@@ -194,11 +200,15 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
              "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"], "--unit": ["binary.bin", ""],
                   "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""]},
+    "identify": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"],
+                 "--manifest": ["binary.bin", "folder", "missing.toml", ""], "--unit": ["binary.bin", "folder", ""],
+                 "--scale": POSITIVE, "--fit": ["", "abc", "wall,abc"], "--tolerance": [*POSITIVE, "5"],
+                 "--seed": COUNT, "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 
 # the one execution option set of every command that solves many designs (pneumorph.cli.execution)
 for _command in ("design", "study", "calibrate", "chain", "optimise", "simplifications", "tolerances", "bulk-modulus",
-                 "calibration", "temperature", "mesh"):
+                 "calibration", "temperature", "mesh", "identify"):
     OPTIONS[_command].setdefault("--workers", POS_COUNT)
     OPTIONS[_command].setdefault("--scheduler", ["not a url", ""])
 

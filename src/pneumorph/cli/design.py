@@ -155,6 +155,8 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
             changes[key] = value
     if stages:
         changes.update(objective="stages", stage=tuple(_stage_option(text, amplitude, periods) for text in stages))
+        with P.blame("--stage"):  # each stage's target, along the built-in unit (again below along the model's)
+            DesignConfig(objective="stages", stage=changes["stage"], units=units or DesignConfig.units)
     ga_changes: dict[str, Any] = {k: v for k, v in (("population", population), ("generations", generations))
                                   if v is not None}
     model_settings = dict(config.model)

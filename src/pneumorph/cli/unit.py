@@ -57,6 +57,8 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     from types import SimpleNamespace
 
     from pneumorph.design.planning import planned_workers
+    from pneumorph.errors import GeometryError
+    from pneumorph.geometry.limits import MeshLimitError
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import strict_json
     from pneumorph.io.lock import RunLock
@@ -73,9 +75,15 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     with P.blame("--var"):
         space = (DesignSpace(tuple(parse_variable(v) for v in variables), base, resolution) if variables
                  else replace(DesignSpace.default(base), resolution=resolution))
-    # the messages name what to change (the unit, a range, the resolution, the units, the memory per worker)
-    check_settings(space, strain_limit, n_units,
-                   parallel=planned_workers(SimpleNamespace(executor=executor, workers=workers)))
+    # the messages name what to change (the unit, a range, the resolution, the units, the memory per worker); a
+    # corner of the box that makes no unit is a bad --var
+    try:
+        check_settings(space, strain_limit, n_units,
+                       parallel=planned_workers(SimpleNamespace(executor=executor, workers=workers)))
+    except GeometryError as exc:
+        if isinstance(exc, MeshLimitError) or not variables:
+            raise
+        raise click.BadParameter(" ".join(str(exc).split()), param_hint="'--var'") from None
     settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
                                 pop_size=pop_size, generations=generations, seed=seed)
     check_folder(out, settings, overwrite)

@@ -175,12 +175,12 @@ class DesignConfig:
         ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
         try:  # fail early on a bad objective: a profile finite along the actuator
             self.make_objective(length=self.units * (pitch if ok else UnitSpec.pitch))
-        except (TargetExpressionError, UnknownObjectiveError) as exc:
-            raise SearchConfigError(f"[design] objective: {exc}") from None
-        except SearchConfigError as exc:
-            if self.stage is None:
+        except (TargetExpressionError, UnknownObjectiveError, SearchConfigError) as exc:
+            if self.stage is not None:
+                raise SearchConfigError(f"[[design.stage]]: {exc}") from None
+            if isinstance(exc, SearchConfigError):
                 raise
-            raise SearchConfigError(f"[[design.stage]]: {exc}") from None
+            raise SearchConfigError(f"[design] objective: {exc}") from None
 
     @property
     def fidelity(self) -> str:

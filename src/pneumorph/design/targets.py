@@ -169,7 +169,8 @@ class StagedTarget:
             if not near.size:
                 levels = ", ".join(f"{v * 1e3:.4g}" for v in p)
                 raise SearchConfigError(f"stage at {stage.pressure * 1e3:g} kPa: not a level of the model's ramp; "
-                                        f"the levels are {levels} kPa (a stage's pressure must be one of them)")
+                                        f"the levels are {levels} kPa (a stage's pressure, --stage KPA:... or "
+                                        "pressure_kpa of [[design.stage]], must be one of them)")
             out.append(int(near[0]))
         return tuple(out)
 
