@@ -9,6 +9,7 @@ import pytest
 
 from pneumorph.cli import main
 from pneumorph.models.buildplan import build_plan
+from pneumorph.models.chainfit import MIN_HELDOUT
 from pneumorph.models.chaintables import build_options
 from pneumorph.models.factory import make_model
 from pneumorph.models.windows import covering_designs
@@ -159,7 +160,7 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     counts = build_plan(training, **build_options(training))
     assert counts.windows == (2, 3) and counts.fewest == len(covering_designs(15, 2)) + 6  # 6 held-out if clear
     assert f"{counts.fewest}-{counts.solves[-1]} FE solves, estimated" in captured.err
-    assert plan < captured.err.index("covering: 1/")
+    assert plan < captured.err.index(f"covering and {MIN_HELDOUT} held-out: 1/")  # one stream of solves
     assert "held-out" in captured.err and "building the tolerance tables" in captured.err
     kept = sorted((tmp_path / "cache" / "chain-tables").glob("chain-2d-*.json"))
     tables = [p for p in kept if "tolerance" not in p.name]

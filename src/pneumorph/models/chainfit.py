@@ -418,7 +418,8 @@ def build_table(
         Stop the validation once at least :data:`MIN_HELDOUT` held-out designs are solved and
         their worst centre error is within :data:`CLEAR_FRACTION` of the tolerance at every
         level; the validation records how many designs it used (``heldout_solved``) and
-        whether it stopped early.
+        whether it stopped early. The first :data:`MIN_HELDOUT` held-out designs are then
+        solved in one stream with the covering designs.
 
     Raises
     ------
@@ -475,9 +476,13 @@ def build_table(
         train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric,
                                  short=short)
         say(f"window +-{w}: {len(train)} covering designs")
-        table = fit_table(solve(train, "covering"), w, src, library=library if alphabet else None)
         tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet, symmetric=symmetric)
         tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
+        # the held-out designs an early validation needs at least go in the covering designs' stream (no pause
+        # between the two); they serve the next window too, should this one be refused
+        ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if early else []
+        what = f"covering and {len(ahead)} held-out" if ahead else "covering"
+        table = fit_table(solve(train + ahead, what)[: len(train)], w, src, library=library if alphabet else None)
         val = _validate(table, tests, solve, tolerance, early, evaluator_workers(evaluator))
         val.update(tolerance_mm=tolerance, seed=seed)
         worst = max(val["centre_worst_mm"])
