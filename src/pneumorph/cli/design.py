@@ -122,9 +122,6 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
 
     if target and objective:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
-    if stages and (target or objective or point):
-        raise click.UsageError("--stage gives the targets at each pressure: leave out --target, --objective and "
-                               "--point")
     if target is not None:
         from pneumorph.design.targets import make_objective
         from pneumorph.geometry.unit import UnitSpec
@@ -153,10 +150,7 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
                        ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
         if value is not None:
             changes[key] = value
-    if stages:
-        changes.update(objective="stages", stage=tuple(_stage_option(text, amplitude, periods) for text in stages))
-        with P.blame("--stage"):  # each stage's target, along the built-in unit (again below along the model's)
-            DesignConfig(objective="stages", stage=changes["stage"], units=units or DesignConfig.units)
+    changes.update(_stage_changes(stages, bool(target or objective or point), amplitude, periods, units))
     ga_changes: dict[str, Any] = {k: v for k, v in (("population", population), ("generations", generations))
                                   if v is not None}
     model_settings = dict(config.model)
@@ -316,6 +310,23 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
         sys.exit(130)
+
+
+def _stage_changes(stages: tuple[str, ...], other_target: bool, amplitude: float | None, periods: float | None,
+                   units: int | None) -> dict[str, Any]:
+    """The config's changes for ``--stage`` options (none without them), each stage's target checked along the
+    built-in unit (and again along the model's)."""
+    if not stages:
+        return {}
+    if other_target:
+        raise click.UsageError("--stage gives the targets at each pressure: leave out --target, --objective and "
+                               "--point")
+    from pneumorph.design import DesignConfig
+
+    stage = tuple(_stage_option(text, amplitude, periods) for text in stages)
+    with P.blame("--stage"):
+        DesignConfig(objective="stages", stage=stage, units=units or DesignConfig.units)
+    return {"objective": "stages", "stage": stage}
 
 
 def _stage_option(text: str, amplitude: float | None, periods: float | None) -> dict[str, Any]:

@@ -57,12 +57,10 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     from types import SimpleNamespace
 
     from pneumorph.design.planning import planned_workers
-    from pneumorph.errors import GeometryError
-    from pneumorph.geometry.limits import MeshLimitError
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import strict_json
     from pneumorph.io.lock import RunLock
-    from pneumorph.unitopt.run import OptimiseSettings, check_folder, check_settings, optimise, write_outputs
+    from pneumorph.unitopt.run import OptimiseSettings, check_folder, optimise, write_outputs
     from pneumorph.unitopt.space import DesignSpace, parse_variable
 
     check_options(executor, workers, scheduler)
@@ -75,15 +73,8 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     with P.blame("--var"):
         space = (DesignSpace(tuple(parse_variable(v) for v in variables), base, resolution) if variables
                  else replace(DesignSpace.default(base), resolution=resolution))
-    # the messages name what to change (the unit, a range, the resolution, the units, the memory per worker); a
-    # corner of the box that makes no unit is a bad --var
-    try:
-        check_settings(space, strain_limit, n_units,
-                       parallel=planned_workers(SimpleNamespace(executor=executor, workers=workers)))
-    except GeometryError as exc:
-        if isinstance(exc, MeshLimitError) or not variables:
-            raise
-        raise click.BadParameter(" ".join(str(exc).split()), param_hint="'--var'") from None
+    _check_space(space, strain_limit, n_units, planned_workers(SimpleNamespace(executor=executor, workers=workers)),
+                 bool(variables))
     settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
                                 pop_size=pop_size, generations=generations, seed=seed)
     check_folder(out, settings, overwrite)
@@ -140,6 +131,25 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
         click.echo("no unit bends more than the base unit at the same or a lower h_b within the strain limit")
     click.echo(f"{len(result.candidates)} candidates ({result.solves} solved, {result.hits} from the cache) in "
                f"{time.perf_counter() - t0:.0f} s; written to {Path(out)}/")
+
+
+
+def _check_space(space: Any, strain_limit: float, n_units: int, parallel: int, given: bool) -> None:
+    """The optimisation's checks before anything is written (:func:`pneumorph.unitopt.run.check_settings`).
+
+    The messages name what to change (the unit, a range, the resolution, the units, the memory per worker); a
+    corner of a box the user gave (``given``) that makes no unit is a bad ``--var``.
+    """
+    from pneumorph.errors import GeometryError
+    from pneumorph.geometry.limits import MeshLimitError
+    from pneumorph.unitopt.run import check_settings
+
+    try:
+        check_settings(space, strain_limit, n_units, parallel=parallel)
+    except GeometryError as exc:
+        if isinstance(exc, MeshLimitError) or not given:
+            raise
+        raise click.BadParameter(" ".join(str(exc).split()), param_hint="'--var'") from None
 
 
 def listed(result: Any, names: Any) -> list[tuple[Any, str]]:

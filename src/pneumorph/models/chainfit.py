@@ -22,13 +22,20 @@ from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.chain import ChainTable, source_description, source_key
 from pneumorph.models.response import FloatArray, Response
+from pneumorph.models.validation import (
+    CLEAR_FRACTION,
+    MIN_HELDOUT,
+    evaluator_workers,
+    heldout_designs,
+    prediction_errors,
+    stop_note,
+    validate_in_rounds,
+)
 from pneumorph.models.windows import (
     covering_designs,
     design_array,
     design_strings,
     mirror_codes,
-    random_designs,
-    unit_codes,
     window_codes,
 )
 
@@ -40,10 +47,6 @@ __all__ = ["CLEAR_FRACTION", "DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", 
 DEFAULT_TOLERANCE = 0.2
 #: widest window tried by :func:`build_table`
 MAX_WINDOW = 3
-#: held-out designs after which the validation may stop early (:func:`build_table` with ``early``)
-MIN_HELDOUT = 6
-#: the validation stops early once the worst held-out error is within this fraction of the tolerance
-CLEAR_FRACTION = 0.5
 #: most covering designs a table over several unit types may ask for (the base windows alone need
 #: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
 MAX_TRAINING = 200
@@ -260,113 +263,34 @@ def first_symbols(design: str, alphabet: Sequence[str]) -> str:
     return "".join(alphabet[int(c) // 2] for c in design_array(design, alphabet=alphabet)[0])
 
 
-def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[str, Any]:
-    """Centre, tip and curl errors of the table's predictions against FE responses.
+def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
+            say: Callable[[str], None]) -> Callable[..., list[Response]]:
+    """``solve(designs, what, before=0, total=None)``: the responses of ``designs``, those not in ``solved`` solved
+    through ``evaluator`` (and kept in ``solved``), with a progress line per design."""
+    n = int(model.n_units)
 
-    Returns a dict with per-level lists ``centre_mean_mm``, ``centre_worst_mm``,
-    ``tip_worst_mm``, ``curl_worst_deg``, ``norm_worst_mm`` (the worst root of the summed
-    squared centre errors of one design), and ``designs``. A table over several unit
-    types adds ``per_type``: per symbol the ``centre_worst_mm``, ``centre_mean_mm`` (per
-    level) and ``centres`` (how many) of the centres of the units of that type.
-    """
-    k = table.n_levels
-    centre_err, tip_err, curl_err, norm_err = [], [], [], []
-    types = []
-    for r in responses:
-        bits = table.designs(r.orientation)
-        types.append(bits[0] // 2)
-        c, t, cu = table.predict(bits)
-        e = np.hypot(*(c[0] - r.centres).transpose(2, 0, 1))  # (k, n)
-        centre_err.append(e)
-        norm_err.append(np.sqrt((e**2).sum(axis=1)))
-        tip_err.append(np.hypot(*(t[0] - r.tip).T))
-        curl_err.append(np.abs(cu[0] - r.curl))
-    if not responses:
-        nan = [float("nan")] * k
-        return {"designs": [], "centre_mean_mm": nan, "centre_worst_mm": nan, "tip_worst_mm": nan,
-                "curl_worst_deg": nan, "norm_worst_mm": nan}
-    all_c = np.concatenate(centre_err, axis=1)
-    out: dict[str, Any] = {
-        "designs": [r.orientation for r in responses],
-        "centre_mean_mm": all_c.mean(axis=1).tolist(),
-        "centre_worst_mm": all_c.max(axis=1).tolist(),
-        "tip_worst_mm": np.max(tip_err, axis=0).tolist(),
-        "curl_worst_deg": np.max(curl_err, axis=0).tolist(),
-        "norm_worst_mm": np.max(norm_err, axis=0).tolist(),
-    }
-    if table.alphabet:
-        of_type = np.concatenate(types)
-        out["per_type"] = {}
-        for code, symbol in enumerate(table.alphabet):
-            mine = all_c[:, of_type == code]
-            out["per_type"][symbol] = {"centres": int(mine.shape[1])}
-            if mine.size:
-                out["per_type"][symbol].update(centre_mean_mm=mine.mean(axis=1).tolist(),
-                                               centre_worst_mm=mine.max(axis=1).tolist())
-    return out
+    def solve(designs: list[str], what: str, before: int = 0, total: int | None = None) -> list[Response]:
+        """Solve ``designs`` (those not solved yet); progress lines count from ``before`` up to ``total``."""
+        todo = [d for d in designs if d not in solved]
+        t0 = time.perf_counter()
+        done = 0 if total is None else before + len(designs) - len(todo)
+        total = len(todo) if total is None else total
+        # one stream of (model, design) cases, a model per length (short training designs), the longest first: no
+        # pause between the lengths, and the last solves in flight are the short ones
+        todo.sort(key=len, reverse=True)
+        actuators = {length: model if length == n else model.with_units(length) for length in {len(d) for d in todo}}
+        if todo:
+            for _i, outcome in evaluator.iter_cases([(actuators[len(d)], d) for d in todo]):
+                done += 1
+                if not outcome.ok:
+                    raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
+                                          f"({outcome.failure}); the chain table needs every design solved")
+                solved[outcome.design] = outcome.response
+                say(f"  {what}: {done}/{total} solved ({'cached' if outcome.cached else 'solved'} "
+                    f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
+        return [solved[d] for d in designs]
 
-
-def heldout_designs(n_units: int, count: int, exclude: Sequence[str] = (), seed: int = 1,
-                    alphabet: Sequence[str] = (), symmetric: Sequence[int] = ()) -> list[str]:
-    """``count`` random designs of ``n_units`` units, none of them in ``exclude`` (seeded).
-
-    Over several unit types (``alphabet``) every unit is a random type and orientation (one
-    orientation for the ``symmetric`` types' indices).
-    """
-    rng = np.random.default_rng(seed)
-    out: list[str] = []
-    taken = set(exclude)
-    k = max(1, len(alphabet))
-    limit = len(unit_codes(k, symmetric)) ** n_units - len(taken)
-    while len(out) < min(count, limit):
-        d = design_strings(random_designs(1, n_units, rng, k, symmetric) if k > 1 else
-                           rng.integers(0, 2, size=(1, n_units), dtype=np.uint8), alphabet)[0]
-        if d not in taken:
-            taken.add(d)
-            out.append(d)
-    return out
-
-
-def evaluator_workers(evaluator: Any) -> int:
-    """How many designs an evaluator solves at once (its ``workers``, or its inner evaluator's; else 1)."""
-    for candidate in (evaluator, getattr(evaluator, "inner", None)):
-        workers = getattr(candidate, "workers", None)
-        if isinstance(workers, int) and workers > 0:
-            return workers
-    return 1
-
-
-def _validate(table: ChainTable, tests: Sequence[str], solve: Callable[..., list[Response]],
-              tolerance: float, early: bool, batch: int) -> dict[str, Any]:
-    """The table's errors on held-out designs solved in rounds of ``batch``: all of them, unless one round refutes
-    the table (a worst error above ``tolerance``) or, with ``early``, at least :data:`MIN_HELDOUT` designs show it
-    clearly within (at most ``CLEAR_FRACTION * tolerance``)."""
-    responses: list[Response] = []
-    val = prediction_errors(table, [])
-    stop = ""
-    for lo in range(0, len(tests), batch):
-        responses += solve(list(tests[lo : lo + batch]), "held-out", lo, len(tests))
-        val = prediction_errors(table, responses)
-        worst = max(val["centre_worst_mm"])
-        if worst > tolerance:
-            stop = "refuted"
-            break
-        if early and len(responses) >= MIN_HELDOUT and worst <= CLEAR_FRACTION * tolerance:
-            stop = "clear"
-            break
-    val.update(heldout_solved=len(responses), heldout_planned=len(tests),
-               stopped_early=stop if len(responses) < len(tests) else "")
-    return val
-
-
-def _stop_note(val: dict[str, Any], tolerance: float) -> str:
-    """Why the validation stopped before its last held-out design, as a clause ('' if it did not)."""
-    if val.get("stopped_early") == "refuted":
-        return f" (stopped: above {tolerance:g} mm already)"
-    if val.get("stopped_early") == "clear":
-        return (f" (stopped early of {val['heldout_planned']}: within {CLEAR_FRACTION:g} of the tolerance after "
-                f"{MIN_HELDOUT} or more)")
-    return ""
+    return solve
 
 
 def build_table(
@@ -448,26 +372,7 @@ def build_table(
     symmetric = library.symmetric_types if library is not None else ()
     solved: dict[str, Response] = {}
 
-    def solve(designs: list[str], what: str, before: int = 0, total: int | None = None) -> list[Response]:
-        """Solve ``designs`` (those not solved yet); progress lines count from ``before`` up to ``total``."""
-        todo = [d for d in designs if d not in solved]
-        t0 = time.perf_counter()
-        done = 0 if total is None else before + len(designs) - len(todo)
-        total = len(todo) if total is None else total
-        # one stream of (model, design) cases, a model per length (short training designs), the longest first: no
-        # pause between the lengths, and the last solves in flight are the short ones
-        todo.sort(key=len, reverse=True)
-        actuators = {length: model if length == n else model.with_units(length) for length in {len(d) for d in todo}}
-        if todo:
-            for _i, outcome in evaluator.iter_cases([(actuators[len(d)], d) for d in todo]):
-                done += 1
-                if not outcome.ok:
-                    raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
-                                          f"({outcome.failure}); the chain table needs every design solved")
-                solved[outcome.design] = outcome.response
-                say(f"  {what}: {done}/{total} solved ({'cached' if outcome.cached else 'solved'} "
-                    f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
-        return [solved[d] for d in designs]
+    solve = _solver(model, evaluator, solved, say)
 
     start = time.perf_counter()
     best: ChainTable | None = None
@@ -483,11 +388,11 @@ def build_table(
         ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if early else []
         what = f"covering and {len(ahead)} held-out" if ahead else "covering"
         table = fit_table(solve(train + ahead, what)[: len(train)], w, src, library=library if alphabet else None)
-        val = _validate(table, tests, solve, tolerance, early, evaluator_workers(evaluator))
+        val = validate_in_rounds(table, tests, solve, tolerance, early, evaluator_workers(evaluator))
         val.update(tolerance_mm=tolerance, seed=seed)
         worst = max(val["centre_worst_mm"])
         say(f"window +-{w}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
-            f"design(s){_stop_note(val, tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
+            f"design(s){stop_note(val, tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
         for symbol, errs in val.get("per_type", {}).items():
             if errs["centres"]:
                 say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
