@@ -291,7 +291,11 @@ def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
 
 
 def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: Cluster, tmp_path: Path) -> None:
-    common = ["chain", "build", "--model", "2d", "--unit", str(coarse_unit(tmp_path)), "--pressure", "20",
+    # a mesh fine enough that a solve takes about a second: the kill lands while the worker is solving, not just
+    # after a 0.1 s solve of the coarse unit has returned (then there is nothing to retry)
+    unit = tmp_path / "fine.toml"
+    unit.write_text("[unit]\nelement_size = 0.75\n")
+    common = ["chain", "build", "--model", "2d", "--unit", str(unit), "--pressure", "20",
               "--units", "7", "--heldout", "40", "--window", "2", "--json"]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     build = subprocess.Popen([sys.executable, "-m", "pneumorph", *common, "--executor", "dask", "--scheduler",
