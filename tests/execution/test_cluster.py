@@ -291,10 +291,11 @@ def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
 
 
 def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: Cluster, tmp_path: Path) -> None:
-    # a mesh fine enough that a solve takes about a second: the kill lands while the worker is solving, not just
-    # after a 0.1 s solve of the coarse unit has returned (then there is nothing to retry)
+    # a mesh fine enough that a solve takes about 3 s, and the kill only once a worker has held the same design for
+    # longer than the evaluator's poll (1 s): it is then still solving it, and the run has seen it there (a design
+    # counts as retried when the run knew the lost worker held it)
     unit = tmp_path / "fine.toml"
-    unit.write_text("[unit]\nelement_size = 0.75\n")
+    unit.write_text("[unit]\nelement_size = 0.5\n")
     common = ["chain", "build", "--model", "2d", "--unit", str(unit), "--pressure", "20",
               "--units", "7", "--heldout", "40", "--window", "2", "--json"]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
@@ -306,10 +307,14 @@ def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: C
         pids = client.run(os.getpid)
         deadline = time.monotonic() + 120
         killed = False
+        since: dict[tuple[str, str], float] = {}
         while not killed and time.monotonic() < deadline and build.poll() is None:
-            busy = [addr for addr, keys in client.processing().items() if keys]
-            if busy:
-                os.kill(pids[busy[0]], signal.SIGKILL)  # kill -9 of a worker solving a design of the build
+            now = time.monotonic()
+            held = {(addr, key) for addr, keys in client.processing().items() for key in keys}
+            since = {k: since.get(k, now) for k in held}
+            ripe = [addr for (addr, _), t in since.items() if now - t > 1.3]
+            if ripe:
+                os.kill(pids[ripe[0]], signal.SIGKILL)  # kill -9 of a worker solving a design of the build
                 killed = True
             time.sleep(0.02)
         out, err = build.communicate(timeout=300)
