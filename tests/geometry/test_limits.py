@@ -49,3 +49,34 @@ def test_an_actuator_of_solid_units_only_is_refused(tmp_path: Path) -> None:
                     ("simulate", "-o", "01", "--model", "3d", "--unit", str(unit))):
         code, out, _ = _run(*command)
         assert code == 2 and "nothing to inflate" in out and "internal error" not in out, out
+
+
+def test_the_estimate_counts_the_base_block_and_the_end_cap() -> None:
+    """The mesh estimate is an upper bound of the mesh built, a base block (length, margin) and an end cap included:
+    without them a base block 1000 mm long (7 times the actuator) passed a check made for the actuator alone."""
+    from pneumorph.geometry.assembly import assemble
+    from pneumorph.geometry.features import BaseBlock
+    from pneumorph.geometry.meshsize import estimate_mesh
+    from pneumorph.geometry.unit import UnitSpec
+
+    coarse = {"element_size": 3.0}
+    for unit, base in ((UnitSpec(**coarse), BaseBlock(length=200.0)), (UnitSpec(**coarse), BaseBlock(margin=6.0)),
+                       (UnitSpec(**coarse, end_cap=60.0), None), (UnitSpec(**coarse, end_cap=9.0), BaseBlock())):
+        for dim in (2, 3):
+            mesh = assemble(unit, "0110", dim, half=True, base=base)
+            estimate = estimate_mesh(unit, 4, dim, base=base)
+            assert len(mesh.points) <= estimate.nodes <= 1.3 * len(mesh.points), (unit, base, dim)
+            assert len(mesh.cells) <= estimate.elements, (unit, base, dim)
+    long = estimate_mesh(UnitSpec(), 15, 3, base=BaseBlock(length=1000.0))
+    assert long.cells[0] == 105 + 667 and long.nodes > 7 * estimate_mesh(UnitSpec(), 15, 3).nodes
+
+
+def test_a_base_block_past_the_memory_is_refused_with_its_estimate(tmp_path: Path) -> None:
+    """sensitivity simplifications meshes its base block's cases longer by --base-length: counted before any mesh."""
+    unit = tmp_path / "fine.toml"
+    unit.write_text("[unit]\nelement_size = 0.75\n")  # 3 units: 1.6 GB; with a 1000 mm block about 160 GB
+    code, out, seconds = _run("sensitivity", "simplifications", "--units", "3", "--unit", str(unit),
+                              "--base-length", "1000", "--executor", "serial", "--out", str(tmp_path / "out"))
+    assert code == 2 and "--base-length" in out and "with a base block of 1000 mm" in out, out
+    assert "GB for one solve" in out and "GB are available" in out and "Traceback" not in out
+    assert seconds < 30 and not (tmp_path / "out").exists()

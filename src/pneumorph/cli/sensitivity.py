@@ -48,7 +48,7 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
 
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
-    from pneumorph.io.files import write_json
+    from pneumorph.io.files import all_or_nothing, write_json
     from pneumorph.models import make_model
     from pneumorph.sensitivity import BUILDERS, run_study
 
@@ -62,6 +62,8 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
         P.unit_option(common["unit_file"])
         settings["unit_file"] = common["unit_file"]
     model = make_model(n, settings)
+    if options.get("base") is not None:
+        _check_base_block(model, options["base"], common)
     study = BUILDERS[name](model, design, **options)  # every variant is built (and checked) before any solve
     total = len(study.cases) + 1
     click.echo(f"{name} study of design {study.design} ({common['fidelity']} model, {model.n_units} units, "
@@ -87,10 +89,9 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
     if common["out"]:
         from pneumorph.plot.sensitivity import plot_study
 
-        folder = Path(common["out"])
-        folder.mkdir(parents=True, exist_ok=True)
-        write_json(folder / "study.json", data)
-        plot_study(result, folder / "study.png")
+        with all_or_nothing(common["out"]) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+            write_json(folder / "study.json", data)
+            plot_study(result, folder / "study.png")
     if common["as_json"]:
         click.echo(strict_json(data))
         return
@@ -100,6 +101,23 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
                    "side_wall rows equal the reference (use --model 3d for them)")
     if common["out"]:
         click.echo(f"written to {Path(common['out'])}/ (study.json, study.png)")
+
+
+def _check_base_block(model: Any, base: Any, common: dict[str, Any]) -> None:
+    """Refuse a base block whose variants' mesh would not fit in the memory available, before any mesh is built.
+
+    The model's own mesh was counted by ``make_model``; the base block's cases (two, solved at once by a pool)
+    are longer by the block.
+    """
+    import os
+
+    from pneumorph.geometry.meshsize import available_memory, check_mesh
+
+    parallel = 1 if common["executor"] == "serial" else min(2, common["workers"] or os.cpu_count() or 1)
+    with P.blame("--base-length"):
+        check_mesh(model.unit, model.n_units, model.dim, getattr(model, "half", True), memory=available_memory(),
+                   parallel=parallel, base=base,
+                   advice="give a shorter --base-length or a unit with a larger element_size")
 
 
 def _print(result: Any) -> None:
@@ -241,7 +259,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     from pneumorph.design.targets import make_objective
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
-    from pneumorph.io.files import write_json
+    from pneumorph.io.files import all_or_nothing, write_json
     from pneumorph.models import make_model
     from pneumorph.sensitivity.mesh import MeshStudy, check_refinement, mesh_points
 
@@ -293,10 +311,9 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     if out:
         from pneumorph.plot.mesh import plot_mesh_study
 
-        folder = Path(out)
-        folder.mkdir(parents=True, exist_ok=True)
-        write_json(folder / "mesh.json", data)
-        plot_mesh_study(study, folder / "mesh.png", unit=objective.unit, fingerprint=model.fingerprint())
+        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+            write_json(folder / "mesh.json", data)
+            plot_mesh_study(study, folder / "mesh.png", unit=objective.unit, fingerprint=model.fingerprint())
     if as_json:
         click.echo(strict_json(data))
         return

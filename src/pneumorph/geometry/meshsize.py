@@ -7,10 +7,10 @@ available on the command line (:func:`check_mesh`). A refusal
 (:class:`~pneumorph.geometry.limits.MeshLimitError`) states the estimate.
 
 The estimate is exact for the grid of :func:`pneumorph.geometry.assembly.assemble` (lines
-through every break, no gap wider than the element size) and an upper bound of the mesh
-(cavity cells are counted); the peak memory of one solve is estimated from the nodes by
-:func:`solve_memory`, a law fitted to measured 3D solves (a direct solver's fill grows
-faster than the nodes).
+through every break, no gap wider than the element size, the end cap and a base block
+included) and an upper bound of the mesh (cavity cells are counted); the peak memory of one
+solve is estimated from the nodes by :func:`solve_memory`, a law fitted to measured 3D
+solves (a direct solver's fill grows faster than the nodes).
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 from pneumorph.geometry.limits import MeshLimitError, check_lengths
 
 if TYPE_CHECKING:
+    from pneumorph.geometry.features import BaseBlock
     from pneumorph.geometry.unit import UnitSpec
 
 MAX_NODES_3D = 60_000
@@ -100,7 +101,8 @@ def cells_between(breaks: Iterable[float], size: float) -> int:
     return sum(max(1, math.ceil((hi - lo) / size - 1e-9)) for lo, hi in itertools.pairwise(b))
 
 
-def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> MeshEstimate:
+def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True,
+                  base: BaseBlock | None = None) -> MeshEstimate:
     """The mesh of ``units`` units of ``spec`` in ``dim`` dimensions, counted from the grid's breaks.
 
     Parameters
@@ -111,6 +113,9 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> Me
     dim : {2, 3}
     half : bool
         3D: the half model across the width (the models' default).
+    base : BaseBlock, optional
+        A meshed base block (appendix D.2) before the base face, with its margin (the
+        sensitivity studies' variant, a config's ``[model.base_block]``).
 
     Examples
     --------
@@ -120,23 +125,40 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True) -> Me
     ((105, 8, 5), 4200, 21252)
     >>> estimate_mesh(UnitSpec(pitch=500.0), 15, 3).describe()
     'about 1,007,157 nodes, 200,400 elements, 166 GB for one solve'
+    >>> from pneumorph.geometry.features import BaseBlock
+    >>> estimate_mesh(UnitSpec(), 15, 3, base=BaseBlock(length=1000.0)).describe()  # 7 times as long
+    'about 155,466 nodes, 30,880 elements, 13.9 GB for one solve'
     """
     from pneumorph.geometry.grid import section_breaks, width_breaks
 
     h = spec.element_size
     xb, yb = section_breaks(spec)
-    nx = int(units) * cells_between(xb, h)
+    zb = width_breaks(spec, half)
+    nx = int(units) * cells_between(xb, h) + (cells_between([0.0, spec.end_cap], h) if spec.end_cap > 0 else 0)
     ny = cells_between(yb, h)
-    nz = cells_between(width_breaks(spec, half), h) if dim == 3 else 1
+    nz = cells_between(zb, h) if dim == 3 else 1
+    cells, elements, nodes = (nx, ny, nz), nx * ny * nz, _grid_nodes(nx, ny, nz, dim, spec.element_order)
+    if base is not None:  # the block before the base face, with its margin's cells (the face it shares counted twice)
+        m = float(base.margin)
+        bx = cells_between([-float(base.length), 0.0], h)
+        by = cells_between([*yb, -m, spec.height + m], h)
+        bz = cells_between([*zb, -m] if half else [*zb, -m, spec.width + m], h) if dim == 3 else 1
+        cells, elements = (nx + bx, by, bz), elements + bx * by * bz
+        nodes += _grid_nodes(bx, by, bz, dim, spec.element_order)
+    return MeshEstimate(cells, elements, nodes, solve_memory(nodes, dim), dim)
+
+
+def _grid_nodes(nx: int, ny: int, nz: int, dim: int, order: int) -> int:
+    """Nodes of a structured grid of ``nx x ny (x nz)`` cells: corners, and mid-edge nodes if ``order`` is 2."""
     if dim == 3:
         nodes = (nx + 1) * (ny + 1) * (nz + 1)
-        if spec.element_order == 2:  # a mid-node on every edge of the grid
+        if order == 2:  # a mid-node on every edge of the grid
             nodes += nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz
-    else:
-        nodes = (nx + 1) * (ny + 1)
-        if spec.element_order == 2:
-            nodes += nx * (ny + 1) + (nx + 1) * ny
-    return MeshEstimate((nx, ny, nz), nx * ny * nz, nodes, solve_memory(nodes, dim), dim)
+        return nodes
+    nodes = (nx + 1) * (ny + 1)
+    if order == 2:
+        nodes += nx * (ny + 1) + (nx + 1) * ny
+    return nodes
 
 
 def solve_memory(nodes: int, dim: int) -> int:
@@ -176,7 +198,7 @@ def available_memory() -> int:
 
 
 def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: int | None = None,
-               parallel: int = 1, advice: str | None = None) -> MeshEstimate:
+               parallel: int = 1, advice: str | None = None, base: BaseBlock | None = None) -> MeshEstimate:
     """Refuse a unit too large or too finely meshed for an actuator of ``units`` units, before meshing.
 
     Parameters
@@ -193,6 +215,8 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: 
         Solves of this mesh that may run at once.
     advice : str, optional
         What a refusal tells the user to change (default: the unit or the actuator's length).
+    base : BaseBlock, optional
+        A meshed base block, counted with the actuator (:func:`estimate_mesh`).
 
     Returns
     -------
@@ -222,12 +246,20 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: 
     ...
     pneumorph.geometry.limits.MeshLimitError: a 3D actuator of 15 units of this unit is a mesh of about 91,322
     nodes, ... 6.9 GB for one solve; 4.0 GB are available...
+    >>> from pneumorph.geometry.features import BaseBlock
+    >>> check_mesh(UnitSpec(), 15, 3, memory=8 * 10**9, base=BaseBlock(length=1000.0))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.geometry.limits.MeshLimitError: a 3D actuator of 15 units of this unit with a base block of 1000 mm
+    is a mesh of about 155,466 nodes, 30,880 elements, 13.9 GB for one solve; 8.0 GB are available: ...
     """
     check_lengths(spec)
-    estimate = estimate_mesh(spec, units, dim, half)
-    what = f"a {dim}D actuator of {units} units of this unit is a mesh of {estimate.describe()}"
+    estimate = estimate_mesh(spec, units, dim, half, base)
+    block = "" if base is None else f" with a base block of {float(base.length):g} mm"
+    what = f"a {dim}D actuator of {units} units of this unit{block} is a mesh of {estimate.describe()}"
     fewer = ", or solve fewer at once" if advice is None else " or fewer workers"
-    advice = advice or "make the unit smaller, its element_size larger or the actuator shorter"
+    advice = advice or ("make the unit smaller, its element_size larger or the actuator shorter"
+                        + ("" if base is None else ", or the base block shorter"))
     if memory is not None:
         if estimate.bytes * parallel > memory:
             at_once = f" x {parallel} at once" if parallel > 1 else ""
