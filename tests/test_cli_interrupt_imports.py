@@ -51,6 +51,33 @@ class _SlowImport:
 
 if _WHAT.startswith("import:"):
     sys.meta_path.insert(0, _SlowImport())
+elif _WHAT.startswith("call:"):  # when a function is called: "call:module:name" or "call:module:Class.method"
+    _, _MODULE, _NAME = _WHAT.split(":")
+
+    class _SlowCall:
+        def find_spec(self, name, path=None, target=None):
+            if name != _MODULE:
+                return None
+            sys.meta_path.remove(self)
+            spec = importlib.machinery.PathFinder.find_spec(name, path)
+            real = spec.loader.exec_module
+
+            def exec_module(module):
+                real(module)
+                owner_name, _, attr = _NAME.rpartition(".")
+                owner = getattr(module, owner_name) if owner_name else module
+                function = getattr(owner, attr)
+
+                def stalled(*args, **kwargs):
+                    _stall()
+                    return function(*args, **kwargs)
+
+                setattr(owner, attr, stalled)
+
+            spec.loader.exec_module = exec_module
+            return spec
+
+    sys.meta_path.insert(0, _SlowCall())
 elif _WHAT.startswith("echo:"):  # after the command prints a line holding this text
     import click
 
@@ -110,6 +137,37 @@ def test_ctrl_c_at_any_moment_is_aborted_with_nothing_written(tmp_path: Path, sl
     assert "Traceback" not in done.stderr and "rror" not in done.stderr
     if slow.startswith("import:"):
         assert not (tmp_path / "out").exists(), sorted(p.name for p in (tmp_path / "out").rglob("*"))
+
+
+UNIT = "[unit]\nelement_size = 3.0\n"
+
+
+@pytest.mark.parametrize(("slow", "args", "outputs"), [
+    # the deck, the parts' STL files and the mould's are written; its drawing is next
+    ("call:pneumorph.export:plot_mould",
+     ["export", "0110", "--unit", "unit.toml", "--stl", "out", "--inp", "deck/a.inp", "--mould"], ["out", "deck"]),
+    # study.json is written; the figure is next
+    ("call:pneumorph.plot.sensitivity:plot_study",
+     ["sensitivity", "tolerances", "--model", "2d", "--units", "2", "--pressure", "5", "--unit", "unit.toml",
+      "--samples", "1", "--executor", "serial", "--out", "out"], ["out"]),
+    # the table is built and is being written into a new folder
+    ("call:pneumorph.models.chaintable:ChainTable.save",
+     ["chain", "build", "--model", "2d", "--units", "4", "--pressure", "5", "--unit", "unit.toml", "--window", "1",
+      "--heldout", "1", "--executor", "serial", "--out", "new/t.json"], ["new"]),
+], ids=["export", "sensitivity", "chain-build"])
+def test_ctrl_c_while_writing_leaves_nothing(tmp_path: Path, slow: str, args: list[str], outputs: list[str]) -> None:
+    """export, sensitivity and chain build write all or nothing: stopped midway they left a deck, study.json or an
+    empty folder (issue 28, item 19)."""
+    (tmp_path / "unit.toml").write_text(UNIT, encoding="utf-8")
+    done = _interrupt(tmp_path, slow, args)
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert done.returncode == 130 and lines[-1] == "aborted", done.stderr
+    assert "Traceback" not in done.stderr
+    left = [str(p.relative_to(tmp_path)) for name in outputs if (tmp_path / name).exists()
+            for p in [tmp_path / name, *(tmp_path / name).rglob("*")]]
+    assert not left, left
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["hook", "mark", "unit.toml",
+                                                                                        "xdg"]
 
 
 def test_sigterm_inside_a_command_is_terminated_not_aborted(tmp_path: Path) -> None:

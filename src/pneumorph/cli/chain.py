@@ -58,6 +58,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
 
     from pneumorph.errors import ChainTableError
     from pneumorph.io import strict_json
+    from pneumorph.io.files import all_or_nothing_file
     from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chainfit import build_table
     from pneumorph.models.chaintables import start_window
@@ -94,8 +95,11 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     cluster = cluster_report(evaluator)
     if (line := cluster_line(evaluator)) is not None:
         click.echo(line, err=True)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    table.save(target)
+    with all_or_nothing_file(target) as tmp:  # a failure or Ctrl-C while writing leaves no table and no new folder
+        try:
+            table.save(tmp)
+        finally:
+            tmp.with_name(tmp.name + ".part").unlink(missing_ok=True)  # save's own temporary file, if it stopped there
     v = table.validation
     if as_json:
         click.echo(strict_json({"file": str(target), "window": table.window, "training": list(table.training),

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import click
 
 from pneumorph.cli import params as P
@@ -50,6 +52,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     from pneumorph.geometry import parse_orientation
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import check_writable_dir, strict_json
+    from pneumorph.io.files import all_or_nothing, all_or_nothing_file
 
     # everything is checked before anything is built or written
     with P.blame("DESIGN"):
@@ -97,23 +100,33 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
             settings["unit_file"] = unit_file
         model = make_model(len(orientation), settings)
     summary: dict = {"design": orientation, "units": len(orientation)}
-    if model is not None:
-        from pneumorph.export import write_calculix_deck
+    block = BaseBlock()
+    n = len(orientation)
+    with contextlib.ExitStack() as outputs:  # all or nothing: a failure or Ctrl-C while writing leaves no output
+        if stl_dir is not None:
+            outputs.enter_context(all_or_nothing(folder))
+        if model is not None:
+            from pneumorph.export import write_calculix_deck
 
-        deck = write_calculix_deck(model, orientation, inp_file)  # type: ignore[arg-type]
-        summary["deck"] = {"file": str(deck), "pressure_kpa": pressure, "levels": int(model.ramp.steps.increments),
-                           "fingerprint": model.fingerprint()}
+            assert inp_file is not None
+            deck = outputs.enter_context(all_or_nothing_file(inp_file))  # in place once the STL files are written too
+            write_calculix_deck(model, orientation, deck)
+            summary["deck"] = {"file": str(Path(inp_file)), "pressure_kpa": pressure,
+                               "levels": int(model.ramp.steps.increments), "fingerprint": model.fingerprint()}
+        if stl_dir is not None:
+            parts = actuator_parts(unit, orientation, block)
+            paths = write_stl(parts, folder)
+            if mould_spec is not None:
+                mould = casting_mould(unit, orientation, mould_spec)
+                mould_paths = write_stl(mould.parts, folder / "mould")
+                plot_mould(mould, folder / "mould" / "mould.png")
     if stl_dir is None:
         if as_json:
             click.echo(strict_json(summary))
         else:
             click.echo(f"wrote the CalculiX deck of design {orientation} at {pressure:g} kPa to {inp_file}")
         return
-    block = BaseBlock()
-    parts = actuator_parts(unit, orientation, block)
-    paths = write_stl(parts, folder)
     pieces = layer_pieces(unit, orientation)
-    n = len(orientation)
     length = n * unit.pitch + unit.end_cap
     cavities = "no cavities (solid unit)" if unit.solid else f"{n} cavit{'y' if n == 1 else 'ies'}"
     describe = {"body": f"{unit.body_material} body, {cavities}",
@@ -131,18 +144,12 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         "layer_pieces": [{"name": name, "first_unit": p.first + 1, "last_unit": p.last + 1, "side": p.side,
                           "length_mm": p.length} for name, p in zip(layer_names, pieces, strict=False)],
     })
-    mould = None
     if mould_spec is not None:
-        mould = casting_mould(unit, orientation, mould_spec)
-        mould_dir = folder / "mould"
-        mould_paths = write_stl(mould.parts, mould_dir)
-        drawing = mould_dir / "mould.png"
-        plot_mould(mould, drawing)
         summary["mould"] = {
             "clearance_mm": mould_spec.clearance,
             "draft_deg": mould_spec.draft,
             "files": [str(p) for p in mould_paths],
-            "drawing": str(drawing),
+            "drawing": str(folder / "mould" / "mould.png"),
             "volumes_mm3": {name: float(mesh.volume) for name, mesh in mould.parts.items()},
             "cast_mm3": {name: float(mesh.volume) for name, mesh in mould.cast.items()},
             "check": mould.check.to_dict(),
@@ -157,8 +164,7 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     width = max(len(p.name) for p in paths)
     for path, (name, mesh) in zip(paths, parts.items(), strict=False):
         click.echo(f"  {path.name:<{width}}  {float(mesh.volume):10.2f} mm^3  {describe[name]}")
-    if mould is not None:
-        assert mould_spec is not None
+    if mould_spec is not None:
         c = mould.check
         click.echo(f"mould: {len(mould.parts)} parts (clearance {mould_spec.clearance:g} mm, draft "
                    f"{mould_spec.draft:g} deg) in {folder / 'mould'}/, drawing mould.png")

@@ -197,6 +197,34 @@ def all_or_nothing(folder: str | Path) -> Iterator[Path]:
         raise
 
 
+@contextlib.contextmanager
+def all_or_nothing_file(path: str | Path) -> Iterator[Path]:
+    """A temporary path for ``path``'s new version (:func:`atomic_path`), in place when the block succeeds.
+
+    The one-file counterpart of :func:`all_or_nothing`: if the block fails (an error, Ctrl-C),
+    ``path`` is left as it was and the folders made for it are removed. Nested with
+    :func:`all_or_nothing`, the file appears only once the whole block has succeeded.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> try:
+    ...     with all_or_nothing_file(d / "new" / "deck.inp") as tmp:
+    ...         _ = tmp.write_text("*HEADING")
+    ...         raise KeyboardInterrupt
+    ... except KeyboardInterrupt:
+    ...     pass
+    >>> sorted(p.name for p in d.iterdir())
+    []
+    """
+    path = Path(path)
+    with contextlib.ExitStack() as stack:
+        if not path.parent.exists():
+            stack.enter_context(all_or_nothing(path.parent))
+        yield stack.enter_context(atomic_path(path))
+
+
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` through a temporary file and a rename (:func:`atomic_path`).
 
