@@ -78,6 +78,10 @@ elif _WHAT.startswith("call:"):  # when a function is called: "call:module:name"
             return spec
 
     sys.meta_path.insert(0, _SlowCall())
+elif _WHAT == "exit":  # after main returned: the last exit handler (registered first, run last)
+    import atexit
+
+    atexit.register(_stall)
 elif _WHAT.startswith("echo:"):  # after the command prints a line holding this text
     import click
 
@@ -179,17 +183,18 @@ def test_sigterm_inside_a_command_is_terminated_not_aborted(tmp_path: Path) -> N
     assert not (tmp_path / "out").exists()
 
 
-def test_ctrl_c_after_main_returned_is_ignored(tmp_path: Path) -> None:
-    """Run as the process's command line, the handler left behind counts a press and does not raise."""
-    code = ("import os, signal, sys\n"
-            "from pneumorph.cli import main\n"
-            "sys.argv = ['pneumorph', '--version']\n"
-            "code = main()\n"
-            "os.kill(os.getpid(), signal.SIGINT)\n"
-            "print('still here', code)\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
-                          preexec_fn=_default_sigint)
-    assert done.returncode == 0 and "still here 0" in done.stdout, done.stderr
+@pytest.mark.parametrize(("sig", "line", "code"), [(signal.SIGINT, "aborted", 130),
+                                                  (signal.SIGTERM, "terminated", 143)], ids=["sigint", "sigterm"])
+def test_a_signal_after_main_returned_ends_the_process_with_its_line(tmp_path: Path, sig: int, line: str,
+                                                                     code: int) -> None:
+    """While the interpreter shuts down (exit handlers, threads joined), Ctrl-C and SIGTERM end the run as at any
+    other moment: they were ignored (exit 0, no line), and before that a traceback or a kill without a line."""
+    done = _interrupt(tmp_path, "exit", SIMULATE, sig)
+    lines = [text for text in done.stderr.splitlines() if text.strip()]
+    assert done.returncode == code and lines[-1] == line, done.stderr
+    assert "Traceback" not in done.stderr and "rror" not in done.stderr
+    assert "written to out" in done.stdout  # what the run printed is kept, and its outputs are whole
+    assert {"response.json"} <= {p.name for p in (tmp_path / "out").iterdir()}
 
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")

@@ -123,8 +123,22 @@ def _on_sigint(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
-def _on_sigint_at_exit(signum: int, frame: object) -> None:
-    note_sigint()  # the run has ended and said so: its exit code stands
+def _on_signal_at_exit(signum: int, frame: object) -> None:
+    """Ctrl-C or SIGTERM after ``main`` returned, while the interpreter shuts down (threads joined, exit handlers):
+    the same line and exit code as during the run, at once (a KeyboardInterrupt here would be a traceback, and the
+    default handler kills the process without a line)."""
+    interrupt = signum == signal.SIGINT
+    if interrupt:
+        note_sigint()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except Exception:  # closed, or interrupted in its own write: what it holds is lost either way
+            pass
+    try:
+        os.write(2, b"aborted\n" if interrupt else b"terminated\n")
+    finally:
+        os._exit(130 if interrupt else 143)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -142,12 +156,14 @@ def main(argv: list[str] | None = None) -> int:
     catches ``BaseException`` around its optional imports) or that turned into another error
     (an ``ImportError`` of a half-imported module) still ends the run with "aborted" and 130,
     as does a press after the run's last line. Run as the process's own command line
-    (``argv`` None), a press after ``main`` has returned is counted and ignored: the run has
-    ended and said so.
+    (``argv`` None), that holds to the process's end: a press (or SIGTERM) after ``main`` has
+    returned, while the interpreter shuts down, prints "aborted" ("terminated") and ends the
+    process at once with 130 (143); the run's outputs are complete by then.
     """
     previous: dict[int, Any] = {}
     if threading.current_thread() is threading.main_thread():
-        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, _on_sigterm)
+        if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:  # an ignored SIGTERM (nohup) stays ignored
+            previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, _on_sigterm)
         if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # an ignored Ctrl-C stays ignored
             previous[signal.SIGINT] = signal.signal(signal.SIGINT, _on_sigint)
     _terminated.clear()
@@ -164,9 +180,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:  # pressed again while saying so
         code = 130
     finally:
-        for number, handler in previous.items():
-            exiting = number == signal.SIGINT and argv is None
-            signal.signal(number, _on_sigint_at_exit if exiting else handler)
+        for number, handler in previous.items():  # as the process's command line: to its very end
+            signal.signal(number, _on_signal_at_exit if argv is None else handler)
     return code
 
 
