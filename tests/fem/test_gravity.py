@@ -155,14 +155,14 @@ def test_bad_gravity_is_refused() -> None:
 def test_gravity_needs_densities(monkeypatch: pytest.MonkeyPatch) -> None:
     from dataclasses import replace
 
-    from pneumorph.models import fe
+    from pneumorph.models import febase
 
-    real = fe.get
+    real = febase.get  # FEModel's materials
 
     def without_density(name: str):  # type: ignore[no-untyped-def]
         return replace(real(name), density=None)
 
-    monkeypatch.setattr(fe, "get", without_density)
+    monkeypatch.setattr(febase, "get", without_density)
     with pytest.raises(MaterialDataError, match="gravity needs the density of 'mold_star_15'"):
         Reduced2D(2, gravity="hanging")
     Reduced2D(2)  # without gravity no density is needed

@@ -196,11 +196,12 @@ def test_a_mixed_2d_mesh_solves_and_each_type_does_its_part(monkeypatch: pytest.
     The extending and the near-rigid unit bend less than the bending one (the curl is then mostly
     the first unit's), and the extending unit lengthens more than the near-rigid one.
     """
-    from pneumorph.models import fe
+    from pneumorph.models import fe, febase
 
     lib, responses = builtin_library(), {}
     for design in ("aa", "ae", "ar"):
-        monkeypatch.setattr(fe, "assemble", lambda spec, orientation, *a, _d=design, **k: assemble(lib, _d, *a, **k))
+        monkeypatch.setattr(febase, "assemble",  # FEModel.mesh's assemble
+                            lambda spec, orientation, *a, _d=design, **k: assemble(lib, _d, *a, **k))
         responses[design] = fe.Reduced2D(2, ramp_spec=fe.RampSpec(pressure=0.01)).evaluate("00")
     assert all(r.converged for r in responses.values())
     curl = {d: r.curl[-1] for d, r in responses.items()}

@@ -188,12 +188,12 @@ def test_3d_fingerprint_holds_the_result_determining_ramp_settings_only() -> Non
 
 
 def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyPatch) -> None:
-    import pneumorph.models.fe as fe
+    import pneumorph.models.febase as febase
     from pneumorph.execution.outcome import solve
 
     ramp = RampSpec(pressure=0.01)  # 10 levels
     full = Reduced2D(2, ramp_spec=ramp).evaluate("01")
-    real = fe.ramp
+    real = febase.ramp  # FEModel.solve's ramp
 
     def failing(*args, on_level=None, **kwargs):  # the real ramp, stopped after its third level
         def level(k, t):
@@ -203,7 +203,7 @@ def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyP
 
         return real(*args, on_level=level, **kwargs)
 
-    monkeypatch.setattr(fe, "ramp", failing)
+    monkeypatch.setattr(febase, "ramp", failing)
     outcome = solve(Reduced2D(2, ramp_spec=ramp), "01")
     partial = outcome.response
     assert not outcome.ok and outcome.failure == "stopped by the test" and outcome.reached == pytest.approx(0.003)
