@@ -61,7 +61,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,
     "pneumorph.fem.stepping:ramp": 130,
-    "pneumorph.geometry.assembly:assemble": 160,
     "pneumorph.identify.fit:identify": 186,
     "pneumorph.materials.characterise:characterise_bulk_modulus": 85,
     "pneumorph.materials.felupe_models:isochoric_function": 101,

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,6 +36,8 @@ BoolArray = NDArray[np.bool_]
 FloatArray = NDArray[np.float64]
 
 BODY, LAYER, CAVITY, SLIT, BASE, VOID = 0, 1, 2, 3, 4, 5
+#: How near a point must lie to a cavity's wall or vertex to be on it (mm).
+_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -240,8 +243,6 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     OrientationError
         A design that is not one over ``spec``'s symbols (0/1 for one unit).
     """
-    import felupe as fem
-
     if dim not in (2, 3):
         raise GeometryError(f"dim must be 2 or 3, got {dim!r}")
     library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
@@ -251,11 +252,59 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
         raise GeometryError("a passage between cavities is a 3D feature: the 2D section would be cut in two")
     units = design.units(library)
     ref = library[library.default]  # the cross-section, mesh size and end cap all units share
+    side = _passage_side(units, passage)
+    starts = unit_starts(units)
+    grid = _grid(library, units, starts, dim, half, side, base)
+    label = _label(units, orientation, starts, grid.points[grid.cells].mean(axis=1), side, base)
+    mesh, label = _kept_cells(grid, label, dim, ref.element_order)
+    points = np.asarray(mesh.points, dtype=float)
+    return ActuatorMesh(
+        points=points, cells=np.asarray(mesh.cells, dtype=np.int64), cell_type=mesh.cell_type,
+        regions=_regions(label, dim, base),
+        cavity_points=_cavity_points(points, ref, units, orientation, starts, dim, side),
+        tracked=_tracked(points, ref, units, orientation, starts, dim),
+        end_points=_end_points(points, ref, starts, dim), base_points=_clamped(points, ref.height, base),
+        orientation=orientation, spec=ref, units=units, design=design.text,
+        symmetry_points=np.isclose(points[:, 2], ref.width / 2) if (dim == 3 and half) else None,
+    )
+
+
+def _passage_side(units: Sequence[UnitSpec], passage: float) -> float:
+    """The side (mm) of the square channel of a passage of diameter ``passage`` (0: none), checked in every unit.
+
+    Raises
+    ------
+    GeometryError
+        The passage does not fit a unit's walls, or meets a solid unit.
+    """
     side = 0.0
     for unit in dict.fromkeys(units):
         side = check_passage(unit, passage)
-    n, H, W = len(orientation), ref.height, ref.width
-    starts = unit_starts(units)
+    return side
+
+
+def _grid(library: UnitLibrary, units: Sequence[UnitSpec], starts: FloatArray, dim: int, half: bool, side: float,
+          base: BaseBlock | None) -> Any:
+    """The structured linear grid (FElupe's ``Grid``) with a line on every interface.
+
+    Parameters
+    ----------
+    library : UnitLibrary
+        Its units' section lines cross every unit (the mesh conforms at every interface).
+    units : sequence of UnitSpec
+        The design's units, base first, starting at ``starts`` (:func:`unit_starts`).
+    dim : {2, 3}
+    half : bool
+        3D: the half width only.
+    side : float
+        The side of the square passages between cavities (0: none).
+    base : BaseBlock, optional
+        The base block's lines (behind x = 0, and its margin).
+    """
+    import felupe as fem
+
+    ref = library[library.default]
+    n, H, W = len(units), ref.height, ref.width
     h = ref.element_size
     xb = [float(starts[i]) + x for i, unit in enumerate(units) for x in section_breaks(unit)[0]]
     xb.append(float(starts[n]) + ref.end_cap)
@@ -270,8 +319,17 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
         yb += [-m, H + m]
         zb += [-m] if half else [-m, W + m]
     xs, ys = grid_lines(xb, h), grid_lines(yb, h)
-    grid = fem.Grid(xs, ys, grid_lines(zb, h)) if dim == 3 else fem.Grid(xs, ys)
-    label = _label(units, orientation, starts, grid.points[grid.cells].mean(axis=1), side, base)
+    return fem.Grid(xs, ys, grid_lines(zb, h)) if dim == 3 else fem.Grid(xs, ys)
+
+
+def _kept_cells(grid: Any, label: IntArray, dim: int, order: int) -> tuple[Any, IntArray]:
+    """The grid's cells of the actuator (a 2D section keeps its cavities) as a mesh of ``order``, and their labels.
+
+    Points no kept cell uses are dropped; ``order`` 2 adds the midpoints of the edges
+    (quad8, hex20).
+    """
+    import felupe as fem
+
     solid = (label == BODY) | (label == LAYER) | (label == BASE)
     keep = solid | (label == CAVITY) if dim == 2 else solid
     cells, label = grid.cells[keep], label[keep]
@@ -279,72 +337,97 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     renumber = np.full(len(grid.points), -1)
     renumber[used] = np.arange(len(used))
     linear = fem.Mesh(grid.points[used], renumber[cells], grid.cell_type)
-    mesh = linear.add_midpoints_edges() if ref.element_order == 2 else linear
-    points = np.asarray(mesh.points, dtype=float)
+    return (linear.add_midpoints_edges() if order == 2 else linear), label
+
+
+def _regions(label: IntArray, dim: int, base: BaseBlock | None) -> dict[str, IntArray]:
+    """The cells of each material region: body, layer, the 2D filler, the base block."""
     regions = {"body": np.flatnonzero(label == BODY), "layer": np.flatnonzero(label == LAYER)}
     if dim == 2:
         regions["filler"] = np.flatnonzero(label == CAVITY)
     if base is not None:
         regions["base"] = np.flatnonzero(label == BASE)
+    return regions
 
-    tol = 1e-6
+
+def _cavity_box(unit: UnitSpec, o: str, start: float, H: float) -> tuple[float, float, float, float]:
+    """The cavity of a unit starting at ``start`` in orientation ``o`` (of height ``H``): x0, x1, y0, y1 (mm)."""
+    x0, x1, y0, y1 = unit.cavity
+    cy0, cy1 = (y0, y1) if o == "0" else (H - y1, H - y0)
+    return start + x0, start + x1, cy0, cy1
+
+
+def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orientation: str,
+                   starts: FloatArray, dim: int, side: float) -> BoolArray:
+    """The points on the cavity walls (in 2D inside the filler too) and on the passages' walls.
+
+    ``ref`` is the unit whose cross-section all share; a solid unit has no cavity; a
+    passage of side ``side`` joins cavity i to cavity i + 1.
+    """
+    H, W = ref.height, ref.width
     cavity_points = np.zeros(len(points), dtype=bool)
-    tracked = np.zeros((n, 4), dtype=np.int64)
     for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
-        s = float(starts[i])
-        x0, x1, y0, y1 = unit.cavity
-        cy0, cy1 = (y0, y1) if o == "0" else (H - y1, H - y0)
-        if not unit.solid:
-            inside = (
-                (points[:, 0] > s + x0 - tol)
-                & (points[:, 0] < s + x1 + tol)
-                & (points[:, 1] > cy0 - tol)
-                & (points[:, 1] < cy1 + tol)
-            )
+        if unit.solid:
+            continue
+        x0, x1, cy0, cy1 = _cavity_box(unit, o, float(starts[i]), H)
+        inside = (
+            (points[:, 0] > x0 - _TOL)
+            & (points[:, 0] < x1 + _TOL)
+            & (points[:, 1] > cy0 - _TOL)
+            & (points[:, 1] < cy1 + _TOL)
+        )
+        if dim == 3:
+            inside &= (points[:, 2] > ref.side_wall - _TOL) & (points[:, 2] < W - ref.side_wall + _TOL)
+        cavity_points |= inside
+    if side:  # the passages' walls are loaded by the pressure too
+        for i in range(len(units) - 1):
+            inside = ((points[:, 0] > float(starts[i]) + units[i].cavity[1] - _TOL)
+                      & (points[:, 0] < float(starts[i + 1]) + units[i + 1].cavity[0] + _TOL)
+                      & (np.abs(points[:, 1] - H / 2) < side / 2 + _TOL))
             if dim == 3:
-                inside &= (points[:, 2] > ref.side_wall - tol) & (points[:, 2] < W - ref.side_wall + tol)
+                inside &= np.abs(points[:, 2] - W / 2) < side / 2 + _TOL
             cavity_points |= inside
-        corners = [(s + x0, cy0), (s + x1, cy0), (s + x1, cy1), (s + x0, cy1)]  # a solid unit's box too
+    return cavity_points
+
+
+def _tracked(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orientation: str, starts: FloatArray,
+             dim: int) -> IntArray:
+    """Per unit, the points at its cavity's four vertices (a solid unit's box too; mid-width of ``ref`` in 3D).
+
+    Raises
+    ------
+    GeometryError
+        A vertex without a mesh point (never: the grid has these lines).
+    """
+    H, W = ref.height, ref.width
+    tracked = np.zeros((len(units), 4), dtype=np.int64)
+    for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
+        x0, x1, cy0, cy1 = _cavity_box(unit, o, float(starts[i]), H)
+        corners = [(x0, cy0), (x1, cy0), (x1, cy1), (x0, cy1)]
         for k, (cx, cy) in enumerate(corners):
             d = (points[:, 0] - cx) ** 2 + (points[:, 1] - cy) ** 2
             if dim == 3:
                 d = d + (points[:, 2] - W / 2) ** 2
             tracked[i, k] = int(np.argmin(d))
-            if d[tracked[i, k]] > tol**2:  # pragma: no cover - the grid has these lines
+            if d[tracked[i, k]] > _TOL**2:  # pragma: no cover - the grid has these lines
                 raise GeometryError(f"no mesh point at cavity vertex {k} of unit {i}")
-    if side:  # the passages' walls are loaded by the pressure too
-        for i in range(n - 1):
-            inside = ((points[:, 0] > float(starts[i]) + units[i].cavity[1] - tol)
-                      & (points[:, 0] < float(starts[i + 1]) + units[i + 1].cavity[0] + tol)
-                      & (np.abs(points[:, 1] - H / 2) < side / 2 + tol))
-            if dim == 3:
-                inside &= np.abs(points[:, 2] - W / 2) < side / 2 + tol
-            cavity_points |= inside
-    if base is None:
-        clamped = np.isclose(points[:, 0], 0.0)
-    else:  # the jaws of the clamp hold the block's bottom and top faces
-        jaws = np.isclose(points[:, 1], -base.margin) | np.isclose(points[:, 1], H + base.margin)
-        clamped = jaws & (points[:, 0] < tol)
-    on_end = np.isclose(points[:, 0], float(starts[n]) + ref.end_cap)
-    if dim == 3:
-        on_end &= np.isclose(points[:, 2], W / 2)
-    end_points = np.flatnonzero(on_end)
-    end_points = end_points[np.argsort(points[end_points, 1])]
-    return ActuatorMesh(
-        points=points,
-        cells=np.asarray(mesh.cells, dtype=np.int64),
-        cell_type=mesh.cell_type,
-        regions=regions,
-        cavity_points=cavity_points,
-        tracked=tracked,
-        end_points=end_points,
-        base_points=clamped,
-        orientation=orientation,
-        spec=ref,
-        symmetry_points=np.isclose(points[:, 2], W / 2) if (dim == 3 and half) else None,
-        units=units,
-        design=design.text,
-    )
+    return tracked
 
+
+def _clamped(points: FloatArray, height: float, base: BaseBlock | None) -> BoolArray:
+    """The clamped points: the base face x = 0, or the jaws on the base block's bottom and top faces."""
+    if base is None:
+        return np.isclose(points[:, 0], 0.0)
+    jaws = np.isclose(points[:, 1], -base.margin) | np.isclose(points[:, 1], height + base.margin)
+    return jaws & (points[:, 0] < _TOL)
+
+
+def _end_points(points: FloatArray, ref: UnitSpec, starts: FloatArray, dim: int) -> IntArray:
+    """The points of the free end face (after ``ref``'s end cap) in the section plane, ordered by height."""
+    on_end = np.isclose(points[:, 0], float(starts[-1]) + ref.end_cap)
+    if dim == 3:
+        on_end &= np.isclose(points[:, 2], ref.width / 2)
+    end_points = np.flatnonzero(on_end)
+    return end_points[np.argsort(points[end_points, 1])]
 
 __all__ = ["BASE", "BODY", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "grid_lines", "unit_starts"]
