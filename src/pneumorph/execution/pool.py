@@ -10,6 +10,7 @@ import contextlib
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 import weakref
@@ -133,6 +134,15 @@ def _stop_pool(pool: ProcessPoolExecutor, grace: float) -> dict[int, int | None]
     return {pid: p.exitcode for pid, p in processes.items()}
 
 
+
+def _start_advice() -> str:
+    """What to do when the workers died while starting: the command line's option, or in a script of the API the
+    ``__main__`` guard, without which each spawned worker runs the script's own run again and dies."""
+    if "pneumorph.cli" in sys.modules:
+        return "try --executor serial"
+    return ('a script that solves in worker processes must start its run under `if __name__ == "__main__":` (each '
+            'worker imports the script; documentation page api), or solve in this process with executor "serial"')
+
 class ProcessPoolEvaluator(_Base):
     """Solve designs in a pool of local processes.
 
@@ -189,7 +199,7 @@ class ProcessPoolEvaluator(_Base):
             self.close(grace=0.0)
             raise EvaluationError(f"the worker processes died while starting (the model {type(model).__name__} "
                                   "could not be sent to them, or they could not import pneumorph); "
-                                  "try --executor serial") from exc
+                                  f"{_start_advice()}") from exc
         except BaseException:
             self.close(grace=0.0)
             raise
