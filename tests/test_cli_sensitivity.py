@@ -20,3 +20,14 @@ def test_2d_tolerances_say_why_the_side_wall_rows_are_the_reference(capsys: pyte
     assert rows and all(" 0.000 " in line for line in rows)  # the 2D section has no side walls
     assert "the side walls are not in it" in out
 
+
+
+@pytest.mark.parametrize("study", ["simplifications", "temperature"])
+def test_3d_only_studies_offer_only_the_3d_model(study: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """`sensitivity simplifications --help` offered 2d and then refused it."""
+    assert main(["sensitivity", study, "--help"]) == 0
+    helptext = " ".join(capsys.readouterr().out.split())
+    assert "--model [3d]" in helptext and "2d" not in helptext
+    assert main(["sensitivity", study, "--model", "2d"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'2d' is not" in err[0] and "3d" in err[0]
