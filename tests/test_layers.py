@@ -55,7 +55,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.design.certified:certified_search": 131,
     "pneumorph.design.ga:run_ga": 83,
     "pneumorph.design.run:run_design": 238,
-    "pneumorph.export.moulds:casting_mould": 126,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,

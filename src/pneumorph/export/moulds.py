@@ -163,8 +163,6 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     pneumorph.errors.GeometryError: mould clearance 1.2 mm is not smaller than the core tenon's setback 1.125
     mm (a quarter of the cavity's smaller side, 4.5 mm): silicone would run into the tenon pockets
     """
-    import manifold3d as m3
-
     mould = MouldSpec() if mould is None else mould
     orientation = parse_orientation(orientation)
     inset, tip = _check_fit(spec, mould)  # the same checks as MouldSpec.check
@@ -172,36 +170,77 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     n = len(orientation)
     s, W, H = spec.side_wall, spec.width, spec.height
     L = n * spec.pitch + spec.end_cap
-    w, t, c, seg = mould.wall, mould.plate, mould.clearance, mould.segments
+    w, t = mould.wall, mould.plate
     dy = H + w  # the side sheet's pocket beside the body's, in y
     sheet_offset = (0.0, dy, W - s)
     Y = 2 * H + w  # both pockets
     outer = (-w, L + w, -w, Y + w, s - t, W + t)
-    X0, X1, Y0, Y1, Z0, Z1 = outer
+    cores, pockets = _cores(spec, orientation, mould, inset, tip)
+    pins, pin_holes = _pins(mould, L, Y, s, W)
+    hole_cutters, openings = _holes(holes, mould, dy, W, outer[5])
+    solids = _plates(spec, orientation, outer, dy, pockets, pin_holes, hole_cutters)
+    digits = len(str(n))
+    solids.update({f"core_{k:0{digits}d}": core for k, core in enumerate(cores, start=1)})
+    solids.update({f"pin_{k}": pin for k, pin in enumerate(pins, start=1)})
+    cast, opening = _cast(spec, orientation, cores, sheet_offset, openings)
+    result = (_checked(spec, orientation, solids, cast, opening, [pins, pin_holes, pockets, cores], sheet_offset,
+                       outer) if check else _unchecked())
+    return Mould(parts={name: to_trimesh(solid) for name, solid in solids.items()},
+                 cast={name: to_trimesh(solid) for name, solid in cast.items()}, openings=to_trimesh(opening),
+                 sheet_offset=sheet_offset, explode=_explode(solids, W + t), outer=outer, check=result, spec=mould,
+                 unit=spec, orientation=orientation)
 
-    # the cores (exact cavities on tenons) and the tenons' pockets in the base plate
-    td = mould.tenon_depth
+
+def _cores(spec: UnitSpec, orientation: str, mould: MouldSpec, inset: float,
+           tip: float) -> tuple[list[manifold3d.Manifold], list[manifold3d.Manifold]]:
+    """The cores (exact cavities on tenons) and the tenons' pockets in the base plate.
+
+    Parameters
+    ----------
+    inset, tip : float
+        The tenon's setback from the cavity's sides and the core tip's inset (:func:`_check_fit`).
+    """
+    s, c, td = spec.side_wall, mould.clearance, mould.tenon_depth
     cavities = _cavity_boxes(spec, orientation)
     cores = [_core(cav, tip, inset, td) for cav in cavities]
     pockets = [box((a + inset - c, b - inset + c, p + inset - c, q - inset + c, s - td - c, s + _OUT))
                for a, b, p, q, _, _ in cavities]
+    return cores, pockets
 
-    # alignment pins at the corners, their holes through the walls and into both plates
+
+def _pins(mould: MouldSpec, L: float, Y: float, s: float,
+          W: float) -> tuple[list[manifold3d.Manifold], list[manifold3d.Manifold]]:
+    """The alignment pins at the corners of a mould ``L`` by ``Y`` inside, and their holes through walls and plates."""
+    w, c, seg = mould.wall, mould.clearance, mould.segments
     r = mould.pin_diameter / 2
     pin_xy = [(x, y) for x in (-w / 2, L + w / 2) for y in (-w / 2, Y + w / 2)]
     pins = [_cylinder(x, y, s - mould.pin_depth, W + mould.pin_depth, r, seg) for x, y in pin_xy]
     pin_holes = [_cylinder(x, y, s - mould.pin_depth - c, W + mould.pin_depth + c, r + c, seg) for x, y in pin_xy]
+    return pins, pin_holes
 
-    # pour and vent holes through the lid, over both pockets
+
+def _holes(holes: list[tuple[str, float, float, float]], mould: MouldSpec, dy: float, W: float,
+           top: float) -> tuple[list[manifold3d.Manifold], list[manifold3d.Manifold]]:
+    """The pour and vent holes through the lid (from ``W`` to ``top``) over both pockets: cutters and openings."""
     hole_cutters, openings = [], []
     for _, x, y, radius in holes:
         for oy in (0.0, dy):
-            hole_cutters.append(_cylinder(x, y + oy, W - _OUT, Z1 + _OUT, radius, seg))
-            openings.append(_cylinder(x, y + oy, W, Z1, radius, seg))
+            hole_cutters.append(_cylinder(x, y + oy, W - _OUT, top + _OUT, radius, mould.segments))
+            openings.append(_cylinder(x, y + oy, W, top, radius, mould.segments))
+    return hole_cutters, openings
 
+
+def _plates(spec: UnitSpec, orientation: str, outer: tuple[float, ...], dy: float,
+            pockets: list[manifold3d.Manifold], pin_holes: list[manifold3d.Manifold],
+            hole_cutters: list[manifold3d.Manifold]) -> dict[str, manifold3d.Manifold]:
+    """The base plate (tenon pockets), the side walls (the body's and the sheet's pockets) and the lid (holes)."""
+    import manifold3d as m3
+
+    s, W = spec.side_wall, spec.width
+    X0, X1, Y0, Y1, Z0, Z1 = outer
     body_pocket = outline_solid(spec, orientation, s - _OUT, W + _OUT)
     sheet_pocket = outline_solid(spec, orientation, W - s, W + _OUT).translate((0.0, dy, 0.0))
-    solids: dict[str, m3.Manifold] = {
+    return {
         "base_plate": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, Z0, s)), *pockets, *pin_holes],
                                                 m3.OpType.Subtract),
         "side_walls": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, s, W)), body_pocket, sheet_pocket,
@@ -209,48 +248,63 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
         "lid": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, W, Z1)), *hole_cutters, *pin_holes],
                                          m3.OpType.Subtract),
     }
-    digits = len(str(n))
-    for k, core in enumerate(cores, start=1):
-        solids[f"core_{k:0{digits}d}"] = core
-    for k, pin in enumerate(pins, start=1):
-        solids[f"pin_{k}"] = pin
 
+
+def _cast(spec: UnitSpec, orientation: str, cores: list[manifold3d.Manifold], sheet_offset: tuple[float, ...],
+          openings: list[manifold3d.Manifold]) -> tuple[dict[str, manifold3d.Manifold], manifold3d.Manifold]:
+    """What is cast: the open body (around the cores) and the side sheet at its pocket; the holes' openings."""
+    import manifold3d as m3
+
+    s, W = spec.side_wall, spec.width
     open_body = m3.Manifold.batch_boolean([outline_solid(spec, orientation, s, W), *cores], m3.OpType.Subtract)
     sheet = outline_solid(spec, orientation, 0.0, s)
     cast = {"open_body": open_body, "side_sheet": sheet.translate(sheet_offset)}
-    opening = m3.Manifold.batch_boolean(openings, m3.OpType.Add)
+    return cast, m3.Manifold.batch_boolean(openings, m3.OpType.Add)
 
-    e = W + t  # exploded view: each layer of the assembly one mould height apart
+
+def _explode(solids: dict[str, Any], e: float) -> dict[str, tuple[float, float, float]]:
+    """The exploded view's offsets: each layer of the assembly (and the cast) one mould height ``e`` apart."""
     explode = {"base_plate": (0.0, 0.0, -e), "side_walls": (0.0, 0.0, 2 * e), "lid": (0.0, 0.0, 3 * e),
                "cast": (0.0, 0.0, e)}
     explode.update({name: (0.0, 0.0, 0.0) for name in solids if name.startswith("core_")})
     explode.update({name: (0.0, 0.0, e) for name in solids if name.startswith("pin_")})
+    return explode
 
-    if check:
-        gaps = [hole - pin for hole, pin in zip(pin_holes, pins, strict=False)]
-        gaps += [(pocket ^ box((X0, X1, Y0, Y1, Z0, s))) - core for pocket, core in zip(pockets, cores, strict=False)]
-        body = actuator_solids(spec, orientation, base_block=None)["body"]
-        core_tops = m3.Manifold.batch_boolean(cores, m3.OpType.Add) ^ box((X0, X1, Y0, Y1, s, W))
-        as_cast = outline_solid(spec, orientation, 0.0, W) - core_tops
-        result = _measure(solids, cast, opening, m3.Manifold.batch_boolean(gaps, m3.OpType.Add), body, as_cast,
-                          sheet_offset, outer)
-        if not result.ok:
-            raise GeometryError(_failure(result))
-    else:
-        nan = float("nan")
-        result = MouldCheck({}, nan, 0, nan, nan, nan, nan, nan, nan, nan, nan)
-    return Mould(
-        parts={name: to_trimesh(solid) for name, solid in solids.items()},
-        cast={name: to_trimesh(solid) for name, solid in cast.items()},
-        openings=to_trimesh(opening),
-        sheet_offset=sheet_offset,
-        explode=explode,
-        outer=outer,
-        check=result,
-        spec=mould,
-        unit=spec,
-        orientation=orientation,
-    )
+
+def _unchecked() -> MouldCheck:
+    """The check of a mould not measured: every field NaN (no parts, no pairs)."""
+    nan = float("nan")
+    return MouldCheck({}, nan, 0, nan, nan, nan, nan, nan, nan, nan, nan)
+
+
+def _checked(spec: UnitSpec, orientation: str, solids: dict[str, Any], cast: dict[str, Any], opening: Any,
+             parts: list[list[manifold3d.Manifold]], sheet_offset: tuple[float, ...],
+             outer: tuple[float, ...]) -> MouldCheck:
+    """The measured assembly (:func:`_measure`).
+
+    ``parts`` are the pins, their holes, the tenon pockets and the cores, whose
+    clearance gaps are measured too.
+
+    Raises
+    ------
+    GeometryError
+        A mould that fails a check (:func:`_failure`).
+    """
+    import manifold3d as m3
+
+    pins, pin_holes, pockets, cores = parts
+    X0, X1, Y0, Y1, Z0, _ = outer
+    s, W = spec.side_wall, spec.width
+    gaps = [hole - pin for hole, pin in zip(pin_holes, pins, strict=False)]
+    gaps += [(pocket ^ box((X0, X1, Y0, Y1, Z0, s))) - core for pocket, core in zip(pockets, cores, strict=False)]
+    body = actuator_solids(spec, orientation, base_block=None)["body"]
+    core_tops = m3.Manifold.batch_boolean(cores, m3.OpType.Add) ^ box((X0, X1, Y0, Y1, s, W))
+    as_cast = outline_solid(spec, orientation, 0.0, W) - core_tops
+    result = _measure(solids, cast, opening, m3.Manifold.batch_boolean(gaps, m3.OpType.Add), body, as_cast,
+                      sheet_offset, outer)
+    if not result.ok:
+        raise GeometryError(_failure(result))
+    return result
 
 
 def _bounds_overlap(a: manifold3d.Manifold, b: manifold3d.Manifold) -> bool:
