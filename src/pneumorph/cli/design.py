@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import re
 import sys
+from types import SimpleNamespace
 from typing import Any
 
 import click
@@ -13,9 +14,10 @@ from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli import params as P
 from pneumorph.cli.execution import check_options, execution_options
 
-# a fallback to the GA
-_NOT_CERTIFIED: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "refine": 0.0,
-                                   "chain_table": None}
+# the options that are [design] and [execution] settings of the same name
+_DESIGN_OPTIONS = ("amplitude", "periods", "point", "units", "search", "seed", "certify", "verify", "margin",
+                   "epsilon", "refine", "chain_table", "tolerance", "robust", "robust_samples", "executor", "workers",
+                   "scheduler", "cache")
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
 
 
@@ -23,9 +25,10 @@ def _kpa(pressure: float | None) -> float:
     return float("nan") if pressure is None else pressure * 1e3
 
 
-def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
-    slug = re.sub(r"[^a-z0-9]+", "-", objective.lower()).strip("-")[:40] or "target"
-    return f"runs/{slug}-{units}u-{search}-seed{seed}"
+def _default_folder(config: Any) -> str:
+    """``runs/<target>-<units>u-<search>-seed<seed>``."""
+    slug = re.sub(r"[^a-z0-9]+", "-", config.objective.lower()).strip("-")[:40] or "target"
+    return f"runs/{slug}-{config.units}u-{config.search}-seed{config.seed}"
 
 
 @click.command("design")
@@ -96,17 +99,7 @@ def _default_folder(objective: str, units: int, search: str, seed: int) -> str:
               help="Certified search: stop with a message instead of building a chain table (or tolerance tables) "
                    "that no shipped or kept table serves.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
-def design(config_file: str | None, target: str | None, objective: str | None, amplitude: float | None,
-           periods: float | None, point: tuple[float, float] | None, stages: tuple[str, ...], units: int | None,
-           population: int | None,
-           generations: int | None, seed: int | None, search: str | None, certify: bool | None,
-           verify: int | None, margin: float | None, epsilon: float | None, refine: float | None,
-           chain_table: str | None,
-           tolerance: float | None,
-           robust: str | None, robust_samples: int | None, executor: str | None,
-           workers: int | None, scheduler: str | None, fidelity: str | None, pressure: float | None,
-           unit_file: str | None, library: str | None, cache: str | None, out: str | None, overwrite: bool,
-           no_build: bool, as_json: bool, model_file: str | None = None) -> None:
+def design(config_file: str | None, **options: Any) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
 
     Without options: a 15-unit actuator for the target "sin, amplitude 10 mm, one period":
@@ -114,202 +107,208 @@ def design(config_file: str | None, target: str | None, objective: str | None, a
     verified by a 3D FE solve, with a certificate of how much better at most any other
     design could be. Running the same command again answers from the evaluation cache.
     """
-    from dataclasses import replace
-
-    from pneumorph.design import DesignConfig, run_design
-    from pneumorph.errors import LocalityError, SearchConfigError
-    from pneumorph.io.files import strict_json
-
-    if target and objective:
-        raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
-    if target is not None:
-        from pneumorph.design.targets import make_objective
-        from pneumorph.geometry.unit import UnitSpec
-
-        with P.blame("--target"):  # along the built-in unit; checked again below along the model's
-            make_objective(target, amplitude if amplitude is not None else DesignConfig.amplitude,
-                           periods if periods is not None else DesignConfig.periods,
-                           length=(units or DesignConfig.units) * UnitSpec.pitch)
-    if unit_file is not None:
-        from pneumorph.geometry.unit import UnitSpec
-
-        with P.blame("--unit"):
-            UnitSpec.from_toml(unit_file)
-    if library is not None:
-        P.library_option(library, unit_file)
-    config = DesignConfig.read(config_file) if config_file else DesignConfig()
-    check_options(executor or config.executor, config.workers if workers is None else workers,
-                  scheduler or config.scheduler)
-    changes: dict[str, Any] = {}
-    for key, value in (("objective", target or objective), ("amplitude", amplitude), ("periods", periods),
-                       ("point", point), ("units", units), ("search", search), ("seed", seed),
-                       ("certify", certify), ("verify", verify), ("margin", margin), ("epsilon", epsilon),
-                       ("refine", refine),
-                       ("chain_table", chain_table),
-                       ("tolerance", tolerance), ("robust", robust), ("robust_samples", robust_samples),
-                       ("executor", executor), ("workers", workers), ("scheduler", scheduler), ("cache", cache)):
-        if value is not None:
-            changes[key] = value
-    changes.update(_stage_changes(stages, bool(target or objective or point), amplitude, periods, units))
-    ga_changes: dict[str, Any] = {k: v for k, v in (("population", population), ("generations", generations))
-                                  if v is not None}
-    model_settings = dict(config.model)
-    if model_file is not None:  # the identified model's settings over the config's
-        from pneumorph.models.factory import read_model_file
-
-        with P.blame("--model-file"):
-            table = read_model_file(model_file)
-        if {"unit", "unit_file", "library"} & set(table):
-            for key in ("unit", "unit_file", "library"):
-                model_settings.pop(key, None)
-        model_settings.update(table)
-    for key, value in (("fidelity", fidelity), ("pressure_kpa", pressure), ("unit_file", unit_file)):
-        if value is not None:
-            model_settings[key] = value
-    if unit_file:
-        model_settings.pop("unit", None)
-        model_settings.pop("library", None)
-    if library is not None:
-        model_settings["library"] = library
-        model_settings.pop("unit", None)
-        model_settings.pop("unit_file", None)
-    # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
-    _check_options_apply(search or config.search, "certified",
-                         {"--certify": certify, "--verify": verify, "--margin": margin, "--epsilon": epsilon,
-                          "--refine": refine,
-                          "--chain-table": chain_table})
-    config = replace(config, ga=replace(config.ga, **ga_changes), model=model_settings, **changes)
-    fidelity_given = "fidelity" in config.model
-    fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
-    if fallback:
-        config = replace(config, search="ga", **_NOT_CERTIFIED)
-    config = replace(config, model=config.model_settings())  # the fidelity of the search (3d for certified)
-    config = DesignConfig.from_dict(config.to_dict())  # validate the combination
-    folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
+    o = SimpleNamespace(**options)
+    _check_inputs(o)
+    config, fallback, fidelity_given = _config(config_file, o)
     model = config.make_model()
-    mixed = bool(getattr(model, "mixed", False))
-    if mixed:
-        _check_library_run(config, model, tolerance)
-    made = config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
-    _check_shape_options(made, amplitude, periods)
-    if config.tolerance > 0 and not mixed:  # the robustness report's mould tolerance, checked before any solve
-        from pneumorph.sensitivity.tolerances import Tolerance
-
-        with P.blame("--tolerance" if tolerance is not None else "[design] tolerance"):
-            Tolerance(config.tolerance).check(model.unit)
-    if robust_samples is not None and config.tolerance == 0:
-        raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
-                               "turns off; leave one of them out")
-    if config.refine and config.search == "certified":  # refused here, naming the option; run_design checks again
-        from pneumorph.design.refine import check_refine
-
-        with P.blame("--refine" if refine is not None else "[design] refine"):
-            check_refine(model, config.refine)
-
+    _check_run(config, model, o)
     if fallback:  # said once every setting has been checked
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
                    "falling back to the genetic algorithm", err=True)
-    label = config.make_objective().label
-    said: list[str] = []
-
-    def announce() -> None:  # the run's first line, once it has started: an error before it stays one line
-        if not said:
-            said.append(folder)
-            units = f"{config.units} unit{'s' if config.units != 1 else ''}"
-            click.echo(f"designing {units} for {label} ({model.fidelity} model, {config.search}, "
-                       f"executor {config.executor}) -> {folder}", err=True)
-
-    def on_generation(stats) -> None:
-        announce()
-        total = config.ga.generations
-        done = stats.generation
-        bar = "#" * int(20 * done / max(total, 1))
-        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: {stats.describe()}", err=True)
-
-    def on_progress(done: int, total: int) -> None:
-        announce()
-        bar = "#" * int(20 * done / max(total, 1))
-        click.echo(f"  [{bar:<20}] {done}/{total} designs", err=True)
-
-    def on_message(text: str) -> None:
-        announce()
-        click.echo(f"  {text}", err=True)
-
-    try:
-        result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
-                            overwrite=overwrite, on_message=on_message, build=not no_build)
-    except LocalityError as exc:  # the chain cannot represent this model: nothing was written
-        if config.search != "certified":
-            raise
-        click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
-        settings = dict(config.model) if fidelity_given else {**config.model, "fidelity": "2d"}
-        config = replace(config, search="ga", model=settings, **_NOT_CERTIFIED)
-        model = config.make_model()
-        folder = out or _default_folder(config.objective, config.units, config.search, config.seed)
-        said.clear()  # the new run says its own first line
-        result = run_design(config, model, folder, on_generation=on_generation, on_progress=on_progress,
-                            overwrite=overwrite, on_message=on_message)
-    announce()
+    result, model = _run(config, model, o, fidelity_given)
     if result.rejected:
         click.echo(f"  {result.rejected} cache entries failed their checksum: solved again, not used", err=True)
-    best = result.best
-    if as_json:
-        click.echo(strict_json({
-            "status": result.status,
-            "folder": str(result.folder),
-            "objective": label,
-            "best": None if best is None else {
-                "design": best.design, "pressure_kpa": _kpa(best.pressure), "fitness": best.value,
-            },
-            "hall_of_fame": [{"design": c.design, "pressure_kpa": _kpa(c.pressure), "fitness": c.value,
-                              "failure": c.failure} for c in result.hall_of_fame],
-            "search": result.search, "search_note": result.search_note, "retried": result.retried,
-            "solves": result.solves, "cache_hits": result.cache_hits, "wall_time_s": result.wall_time,
-            "cache_entries_rejected": result.rejected,
-            "robustness": None if result.robustness is None else
-            {k: v for k, v in result.robustness.items() if k not in ("offsets_mm", "winner_values")},
-            "mesh": result.refinement,
-            **_certified_json(result),
-        }))
-    elif best is not None:
-        click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {_value_words(result, config)} "
-                   f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
-        if result.certified is not None:
-            from pneumorph.design.certificate import certificate_text
+    if o.as_json:
+        from pneumorph.io.files import strict_json
 
-            for line in certificate_text(result.certified.certificate, result.objective.unit, best.design,
-                                         model.fidelity):
-                click.echo(f"  {line}")
-            two_d = result.opinion_2d.get(best.design)
-            if two_d is not None:
-                click.echo(f"  The 2D model's chain value of {best.design}: {two_d:.4g} {result.objective.unit}.")
-        ref = result.refinement
-        if ref is not None and "study" in ref:
-            note = ref["study"]
-            click.echo(f"  mesh: the mesh study moved gaps between designs by at most {note['gap_change']:.3g} "
-                       f"{result.objective.unit} from "
-                       f"{note['sizes_mm'][0]:g} to {note['sizes_mm'][1]:g} mm elements; "
-                       + (f"within it of the winner: {', '.join(note['within'])} (--refine checks them)"
-                          if note["within"] else "no verified design lies within it of the winner"))
-        elif ref is not None:
-            mine = next(r for r in ref["rows"] if r["design"] == best.design)
-            fine = "failed" if mine.get("refined") is None else f"{mine['refined']:.4g}"
-            click.echo(f"  at {ref['element_size_mm'][1]:g} mm elements: {best.design} {best.value:.4g} -> {fine}; "
-                       + ("the winner holds" if ref["holds"] else f"{ref['refined_best']} is better there")
-                       + (f"; could still overtake it: {', '.join(ref['could_overtake'])}"
-                          if ref["could_overtake"] else ""))
-        rob = result.robustness
-        if rob is not None and "mean" in rob["winner"]:
-            w = rob["winner"]
-            click.echo(f"  under +-{rob['tolerance_mm']:g} mm mould tolerances ({rob['samples']} samples, "
-                       f"{rob['method'].split(',')[0]}): {w['design']} mean {w['mean']:.4g}, 95th percentile "
-                       f"{w['p95']:.4g}, worst {w['worst']:.4g}")
-        if result.retried:
-            click.echo(f"  {result.retried} design(s) retried on other Dask workers after lost workers")
-        click.echo(f"report: {result.folder / 'report.md'}")
+        click.echo(strict_json(result.summary()))
+    elif result.best is not None:
+        _print_result(result, config, model)
     if result.status == "interrupted":
         click.echo(f"interrupted; run the same command again to resume from {result.folder}", err=True)
         sys.exit(130)
+
+
+def _check_inputs(o: Any) -> None:
+    """The target, unit file and library checked as the options that gave them (before any setting is merged)."""
+    from pneumorph.design import DesignConfig
+    from pneumorph.errors import SearchConfigError
+
+    if o.target and o.objective:
+        raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
+    if o.target is not None:
+        from pneumorph.design.targets import make_objective
+        from pneumorph.geometry.unit import UnitSpec
+
+        with P.blame("--target"):  # along the built-in unit; checked again along the model's
+            make_objective(o.target, o.amplitude if o.amplitude is not None else DesignConfig.amplitude,
+                           o.periods if o.periods is not None else DesignConfig.periods,
+                           length=(o.units or DesignConfig.units) * UnitSpec.pitch)
+    if o.unit_file is not None:
+        P.unit_option(o.unit_file)
+    if o.library is not None:
+        P.library_option(o.library, o.unit_file)
+
+
+def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool]:
+    """The run's settings: the config file's (or the defaults) with the options over them
+    (:meth:`DesignConfig.with_options`), the fidelity of its search written in; whether the certified search fell
+    back to the GA (gravity); whether the fidelity was given."""
+    from pneumorph.design import DesignConfig
+
+    config = DesignConfig.read(config_file) if config_file else DesignConfig()
+    check_options(o.executor or config.executor, config.workers if o.workers is None else o.workers,
+                  o.scheduler or config.scheduler)
+    design = {key: getattr(o, key) for key in _DESIGN_OPTIONS}
+    design["objective"] = o.target or o.objective
+    design.update(_stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods, o.units))
+    identified = None
+    if o.model_file is not None:  # the identified model's settings over the config's
+        from pneumorph.models.factory import read_model_file
+
+        with P.blame("--model-file"):
+            identified = read_model_file(o.model_file)
+    # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
+    _check_options_apply(o.search or config.search, "certified",
+                         {"--certify": o.certify, "--verify": o.verify, "--margin": o.margin, "--epsilon": o.epsilon,
+                          "--refine": o.refine, "--chain-table": o.chain_table})
+    config = config.with_options(design, ga={"population": o.population, "generations": o.generations},
+                                 model={"fidelity": o.fidelity, "pressure_kpa": o.pressure, "unit_file": o.unit_file,
+                                        "library": o.library}, model_file=identified)
+    fidelity_given = "fidelity" in config.model
+    fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
+    if fallback:
+        config = config.as_ga()
+    return config.with_options({}, model=config.model_settings()), fallback, fidelity_given
+
+
+def _check_run(config: Any, model: Any, o: Any) -> None:
+    """What the settings cannot do with this model, refused naming the options, before any solve."""
+    mixed = bool(getattr(model, "mixed", False))
+    if mixed:
+        _check_library_run(config, model, o.tolerance)
+    made = config.make_objective(length=model.n_units * model.unit.pitch)  # finite along this model's actuator
+    _check_shape_options(made, o.amplitude, o.periods)
+    if config.tolerance > 0 and not mixed:  # the robustness report's mould tolerance
+        from pneumorph.sensitivity.tolerances import Tolerance
+
+        with P.blame("--tolerance" if o.tolerance is not None else "[design] tolerance"):
+            Tolerance(config.tolerance).check(model.unit)
+    if o.robust_samples is not None and config.tolerance == 0:
+        raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
+                               "turns off; leave one of them out")
+    if config.refine and config.search == "certified":  # refused here, naming the option; the run checks again
+        from pneumorph.design.refine import check_refine
+
+        with P.blame("--refine" if o.refine is not None else "[design] refine"):
+            check_refine(model, config.refine)
+
+
+def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, Any]:
+    """The run and its model; a certified run the chain cannot represent (nothing written) falls back to the GA
+    (on the 2D model unless the fidelity was given)."""
+    from pneumorph.design import run_design
+    from pneumorph.errors import LocalityError
+
+    progress = _Progress(config, model, o.out or _default_folder(config))
+    try:
+        result = run_design(config, model, progress.folder, overwrite=o.overwrite, build=not o.no_build,
+                            **progress.callbacks())
+        progress.announce()
+        return result, model
+    except LocalityError as exc:
+        if config.search != "certified":
+            raise
+        click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
+    config = config.as_ga()
+    if not fidelity_given:
+        config = config.with_options({}, model={"fidelity": "2d"})
+    model = config.make_model()
+    progress = _Progress(config, model, o.out or _default_folder(config))  # the new run says its own first line
+    result = run_design(config, model, progress.folder, overwrite=o.overwrite, **progress.callbacks())
+    progress.announce()
+    return result, model
+
+
+class _Progress:
+    """A run's lines on stderr: its first line once it has started (an error before it stays one line), then
+    the GA's generations, the exhaustive search's designs and the certified search's messages."""
+
+    def __init__(self, config: Any, model: Any, folder: str) -> None:
+        self.config, self.model, self.folder = config, model, folder
+        self.label = config.make_objective().label
+        self.said = False
+
+    def announce(self) -> None:
+        if not self.said:
+            self.said = True
+            c = self.config
+            units = f"{c.units} unit{'s' if c.units != 1 else ''}"
+            click.echo(f"designing {units} for {self.label} ({self.model.fidelity} model, {c.search}, "
+                       f"executor {c.executor}) -> {self.folder}", err=True)
+
+    def on_generation(self, stats: Any) -> None:
+        self.announce()
+        total, done = self.config.ga.generations, stats.generation
+        bar = "#" * int(20 * done / max(total, 1))
+        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: {stats.describe()}", err=True)
+
+    def on_progress(self, done: int, total: int) -> None:
+        self.announce()
+        bar = "#" * int(20 * done / max(total, 1))
+        click.echo(f"  [{bar:<20}] {done}/{total} designs", err=True)
+
+    def on_message(self, text: str) -> None:
+        self.announce()
+        click.echo(f"  {text}", err=True)
+
+    def callbacks(self) -> dict[str, Any]:
+        return {"on_generation": self.on_generation, "on_progress": self.on_progress, "on_message": self.on_message}
+
+
+def _print_result(result: Any, config: Any, model: Any) -> None:
+    """The winner, its certificate, mesh note, robustness and retries, in words."""
+    best = result.best
+    click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {_value_words(result, config)} "
+               f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
+    if result.certified is not None:
+        from pneumorph.design.certificate import certificate_text
+
+        for line in certificate_text(result.certified.certificate, result.objective.unit, best.design,
+                                     model.fidelity):
+            click.echo(f"  {line}")
+        two_d = result.opinion_2d.get(best.design)
+        if two_d is not None:
+            click.echo(f"  The 2D model's chain value of {best.design}: {two_d:.4g} {result.objective.unit}.")
+    _print_mesh(result)
+    rob = result.robustness
+    if rob is not None and "mean" in rob["winner"]:
+        w = rob["winner"]
+        click.echo(f"  under +-{rob['tolerance_mm']:g} mm mould tolerances ({rob['samples']} samples, "
+                   f"{rob['method'].split(',')[0]}): {w['design']} mean {w['mean']:.4g}, 95th percentile "
+                   f"{w['p95']:.4g}, worst {w['worst']:.4g}")
+    if result.retried:
+        click.echo(f"  {result.retried} design(s) retried on other Dask workers after lost workers")
+    click.echo(f"report: {result.folder / 'report.md'}")
+
+
+def _print_mesh(result: Any) -> None:
+    """What the mesh study or the refinement says of the winner."""
+    best, ref = result.best, result.refinement
+    if ref is not None and "study" in ref:
+        note = ref["study"]
+        click.echo(f"  mesh: the mesh study moved gaps between designs by at most {note['gap_change']:.3g} "
+                   f"{result.objective.unit} from "
+                   f"{note['sizes_mm'][0]:g} to {note['sizes_mm'][1]:g} mm elements; "
+                   + (f"within it of the winner: {', '.join(note['within'])} (--refine checks them)"
+                      if note["within"] else "no verified design lies within it of the winner"))
+    elif ref is not None:
+        mine = next(r for r in ref["rows"] if r["design"] == best.design)
+        fine = "failed" if mine.get("refined") is None else f"{mine['refined']:.4g}"
+        click.echo(f"  at {ref['element_size_mm'][1]:g} mm elements: {best.design} {best.value:.4g} -> {fine}; "
+                   + ("the winner holds" if ref["holds"] else f"{ref['refined_best']} is better there")
+                   + (f"; could still overtake it: {', '.join(ref['could_overtake'])}"
+                      if ref["could_overtake"] else ""))
 
 
 def _stage_changes(stages: tuple[str, ...], other_target: bool, amplitude: float | None, periods: float | None,
@@ -403,16 +402,6 @@ def _check_options_apply(search: str, owner: str, options: dict) -> None:
         raise click.UsageError(f"{'/'.join(given)} only appl{'y' if len(given) > 1 else 'ies'} to --search {owner}, "
                                f"but this run's search is {search}; add --search {owner} or leave "
                                f"{'/'.join(given)} out")
-
-
-def _certified_json(result) -> dict:
-    """The certificate and the top designs of a certified run (empty otherwise)."""
-    if result.certified is None:
-        return {}
-    from pneumorph.design.report import _top_rows
-
-    return {"certificate": result.certified.certificate, "top": _top_rows(result),
-            "opinion_2d": result.opinion_2d}
 
 
 def _check_library_run(config: Any, model: Any, tolerance: float | None) -> None:

@@ -7,7 +7,10 @@ The functions a front end calls:
 - :func:`certified_search` - every design scored by a chain model, the best verified by FE,
   with a bound on what any other design could do; :func:`certificate_text` says it in words.
 - :func:`run_ga` / :func:`run_exhaustive` - the searches, through any evaluator.
-- :func:`run_design` - a whole run into a folder (resumable), from a :class:`DesignConfig`.
+- :func:`run_design` - a whole run into a folder (resumable), from a :class:`DesignConfig`:
+  the driver of the search strategies (:mod:`pneumorph.design.algorithms`), each an
+  :class:`Algorithm` on a :class:`Problem` giving an :class:`Outcome`; a new strategy
+  subclasses :class:`Search` (documentation page extending).
 - :func:`population_study` - the population-size study of section 6.1.
 
 Examples
@@ -27,6 +30,7 @@ from pneumorph.design.exhaustive import (
 )
 from pneumorph.design.fitness import Score, score
 from pneumorph.design.ga import GAConfig, GAResult, GenerationStats, run_ga
+from pneumorph.design.problem import Algorithm, Outcome, Problem, Search
 from pneumorph.design.report import RunResult
 from pneumorph.design.run import run_design
 from pneumorph.design.scoring import Candidate
@@ -48,6 +52,7 @@ from pneumorph.design.targets import (
 __all__ = [
     "PRESETS",
     "TIP_GOALS",
+    "Algorithm",
     "Candidate",
     "CertifiedResult",
     "DesignConfig",
@@ -56,10 +61,13 @@ __all__ = [
     "GAResult",
     "GenerationStats",
     "Objective",
+    "Outcome",
     "Polyline",
+    "Problem",
     "ProfileTarget",
     "RunResult",
     "Score",
+    "Search",
     "StudyResult",
     "TipGoal",
     "certificate_text",

@@ -55,6 +55,8 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import read_toml
 
 SEARCHES = ("certified", "ga", "exhaustive")
+#: the ``[model]`` keys that name the unit (one of them replaces the others)
+UNIT_SOURCES = frozenset({"unit", "unit_file", "library"})
 #: what ``robust`` ranks designs by (pneumorph.sensitivity.robust.STATISTICS)
 ROBUST = ("worst", "mean")
 
@@ -241,6 +243,40 @@ class DesignConfig:
                  s.get("weight", 1.0)) for s in self.stage])
         return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
                               self.curve)
+
+    def with_options(self, design: dict[str, Any], ga: dict[str, Any] | None = None,
+                     model: dict[str, Any] | None = None, model_file: dict[str, Any] | None = None) -> DesignConfig:
+        """These settings with a front end's over them (a None value: not given), checked as a whole.
+
+        ``design`` holds ``[design]`` and ``[execution]`` keys, ``ga`` those of ``[ga]``;
+        ``model_file`` (an identified model's ``[model]`` table) goes over the config's model
+        settings and ``model`` over both. A unit source in a layer (``unit``, ``unit_file`` or
+        ``library``) replaces the one beneath it.
+
+        >>> c = DesignConfig(model={"unit": {"wall": 1.6}, "pressure_kpa": 40})
+        >>> d = c.with_options({"units": 8, "seed": None}, ga={"population": 20}, model={"library": "builtin"})
+        >>> d.units, d.seed, d.ga.population, d.model
+        (8, 0, 20, {'pressure_kpa': 40, 'library': 'builtin'})
+        """
+        settings = dict(self.model)
+        for layer in (model_file or {}, {k: v for k, v in (model or {}).items() if v is not None}):
+            if UNIT_SOURCES & set(layer):
+                settings = {k: v for k, v in settings.items() if k not in UNIT_SOURCES}
+            settings.update(layer)
+        ga_changes = {k: v for k, v in (ga or {}).items() if v is not None}
+        changed = replace(self, ga=replace(self.ga, **ga_changes), model=settings,
+                          **{k: v for k, v in design.items() if v is not None})
+        return DesignConfig.from_dict(changed.to_dict())
+
+    def as_ga(self) -> DesignConfig:
+        """The same settings searched by the genetic algorithm, the certified search's own settings dropped (the
+        fallback of a run the chain model cannot serve).
+
+        >>> DesignConfig(certify=True, epsilon=0.1).as_ga().search
+        'ga'
+        """
+        return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, refine=0.0,
+                       chain_table=None)
 
     # -- plain-data form --------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:

@@ -88,6 +88,30 @@ class RunResult:
             return self.certified.winner
         return self.hall_of_fame[0] if self.hall_of_fame else None
 
+    def summary(self) -> dict[str, Any]:
+        """The result as plain data, as ``pneumorph design --json`` prints it (pressures in kPa, values in the
+        objective's unit; the certificate, the top designs and the 2D model's opinion of a certified run)."""
+        def kpa(pressure: float | None) -> float:
+            return float("nan") if pressure is None else pressure * 1e3
+
+        best = self.best
+        out: dict[str, Any] = {
+            "status": self.status, "folder": str(self.folder), "objective": self.objective.label,
+            "best": None if best is None else {"design": best.design, "pressure_kpa": kpa(best.pressure),
+                                               "fitness": best.value},
+            "hall_of_fame": [{"design": c.design, "pressure_kpa": kpa(c.pressure), "fitness": c.value,
+                              "failure": c.failure} for c in self.hall_of_fame],
+            "search": self.search, "search_note": self.search_note, "retried": self.retried,
+            "solves": self.solves, "cache_hits": self.cache_hits, "wall_time_s": self.wall_time,
+            "cache_entries_rejected": self.rejected,
+            "robustness": None if self.robustness is None else
+            {k: v for k, v in self.robustness.items() if k not in ("offsets_mm", "winner_values")},
+            "mesh": self.refinement,
+        }
+        if self.certified is not None:
+            out.update(certificate=self.certified.certificate, top=_top_rows(self), opinion_2d=self.opinion_2d)
+        return out
+
 
 def _atomic_figure(path: Path, draw: Callable[[Path], Any]) -> Path:
     """Draw a figure into a temporary file beside ``path`` (same suffix, for its format), then rename it."""
@@ -223,7 +247,7 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
               f"seed {config.seed})",
         "exhaustive": "exhaustive search",
         "certified": "certified search (every design scored by the chain model, the best verified by FE)",
-    }[result.search or config.search]
+    }.get(result.search or config.search, result.search)  # another algorithm (run_design's algorithm): its name
     if result.search_note:  # a certified run's choice: its table and levels, or why it searched exhaustively
         search = result.search_note
     lines += [

@@ -136,4 +136,17 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
     return out
 
 
-__all__ = ["chain_robustness", "design_robustness", "fe_robustness", "robust_ranking", "robust_winner"]
+def winner_robustness(problem: Any, winner: Candidate | None) -> dict[str, Any] | None:
+    """A run's winner under the mould tolerance by FE solves (:func:`fe_robustness`) for a
+    :class:`~pneumorph.design.problem.Problem`; None without a tolerance, over a unit library of
+    several types (the tolerances are those of one unit) or for a failed winner."""
+    config = problem.config
+    if config.tolerance == 0 or getattr(problem.model, "mixed", False) or winner is None or winner.failure is not None:
+        return None
+    problem.say(f"robustness of {winner.design}: {config.samples(False) + 1} FE solves under "
+                f"+-{config.tolerance:g} mm")
+    return fe_robustness(config, problem.model, problem.objective, winner, problem.evaluator)
+
+
+__all__ = ["chain_robustness", "design_robustness", "fe_robustness", "robust_ranking", "robust_winner",
+           "winner_robustness"]

@@ -1,0 +1,31 @@
+"""The FE exhaustive search as a search strategy: all 2^n designs of one unit type
+(:func:`pneumorph.design.exhaustive.run_exhaustive`)."""
+
+from __future__ import annotations
+
+from pneumorph.design.exhaustive import run_exhaustive
+from pneumorph.design.problem import Outcome, Problem, Search
+from pneumorph.design.robustness import winner_robustness
+
+
+class ExhaustiveSearch(Search):
+    """Every design solved by the problem's evaluator, ranked; the winner's FE robustness after it.
+
+    Parameters
+    ----------
+    note : str
+        Why this search (a certified run of an actuator too short for its chain table says so).
+    """
+
+    name = "exhaustive"
+
+    def __init__(self, note: str = "") -> None:
+        self.note = note
+
+    def run(self, problem: Problem) -> Outcome:
+        """The ranking of all designs and its hall of fame."""
+        ex = run_exhaustive(problem.model, problem.objective, problem.evaluator,
+                            hall_of_fame=problem.config.ga.hall_of_fame, on_progress=problem.on_progress)
+        best = ex.hall_of_fame[0] if ex.hall_of_fame else None
+        return Outcome(ex.hall_of_fame, ranking=[(d, ex.scores[d]) for d in ex.ranking],
+                       robustness=winner_robustness(problem, best))
