@@ -50,7 +50,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.cli.identify:identify": 100,
     "pneumorph.cli.simulate:simulate": 97,
     "pneumorph.cli.unit:optimise": 85,
-    "pneumorph.composite.coupon:simulate_coupon": 103,
     "pneumorph.design.certified:certified_search": 131,
     "pneumorph.design.ga:run_ga": 83,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,

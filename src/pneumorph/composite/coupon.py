@@ -264,32 +264,13 @@ def simulate_coupon(
     SimulationFailed
         If a level cannot be reached after the allowed cut-backs.
     """
-    import felupe as fem
-
-    if strain_max is None:
-        strain_max = spec.crimp.limit_transition_strain + 0.10
-    if not strain_max > 0:
-        raise ValueError(f"strain_max must be positive, got {strain_max}")
-    if int(levels) < 2:
-        raise ValueError(f"levels must be at least 2, got {levels}")
+    strain_max = _check_load(spec, strain_max, levels)
     settings = settings or StepSettings(increments=int(levels), substeps=1, max_cutbacks=8, max_iterations=30)
     mesh = spec.mesh()
-    umat, young, paper_thickness = _materials(spec)
+    fields, paper_fields, matrix, paper, paper_thickness = _bodies(spec, mesh)
+    dof0, dof1, pulled = _supports(fields, mesh)
+    last = int(mesh.paper[-1])
     L0 = spec.crimp.length
-
-    quad_mesh = fem.Mesh(mesh.points, mesh.quads, "quad")
-    line_mesh = fem.Mesh(mesh.points, mesh.lines, "line")
-    fields = fem.FieldContainer([fem.FieldPlaneStrain(fem.RegionQuad(quad_mesh), dim=2)])
-    paper_fields = fem.FieldContainer([fem.Field(fem.RegionTruss(line_mesh), dim=2)])
-    paper_fields.link(fields)
-    matrix = fem.SolidBody(umat, fields)
-    paper = fem.TrussBody(fem.LinearElastic1D(E=young), paper_fields, area=paper_thickness * 1.0)
-
-    first, last = int(mesh.paper[0]), int(mesh.paper[-1])
-    mask = np.zeros(len(mesh.points), dtype=bool)
-    mask[[first, last]] = True
-    dof0, dof1 = fem.dof.partition(fields, {"ends": fem.Boundary(fields[0], mask=mask)})
-    pulled = dof0 == 2 * last  # x-dof of the loaded node
     d_max = float(strain_max) * L0
 
     top = mesh.top
@@ -318,21 +299,67 @@ def simulate_coupon(
     stats = ramp([matrix, paper], fields, pull, dof1, dof0, settings, on_level=record,
                  check=partial(newton_check, still=UPDATE_TOLERANCE))
     return CouponResult(
-        spec=spec,
-        engineering_strain=np.asarray(eng),
-        surface_strain=np.asarray(surf),
-        force=np.asarray(force),
-        paper_force=np.asarray(pforce),
-        surface_x0=mesh.points[top, 0].copy(),
-        surface=np.asarray(surface),
-        points=mesh.points,
-        quads=mesh.quads,
-        paper_nodes=mesh.paper,
-        snapshots=snaps,
-        seconds=time.perf_counter() - start,
-        newton_iterations=stats.newton_iterations,
-        cutbacks=stats.cutbacks,
+        spec=spec, engineering_strain=np.asarray(eng), surface_strain=np.asarray(surf), force=np.asarray(force),
+        paper_force=np.asarray(pforce), surface_x0=mesh.points[top, 0].copy(), surface=np.asarray(surface),
+        points=mesh.points, quads=mesh.quads, paper_nodes=mesh.paper, snapshots=snaps,
+        seconds=time.perf_counter() - start, newton_iterations=stats.newton_iterations, cutbacks=stats.cutbacks,
     )
+
+
+def _check_load(spec: CouponSpec, strain_max: float | None, levels: int) -> float:
+    """The final engineering strain (by default past the paper's straightening), ``levels`` checked.
+
+    Raises
+    ------
+    ValueError
+        A strain that is not positive, or fewer than 2 levels.
+    """
+    if strain_max is None:
+        strain_max = spec.crimp.limit_transition_strain + 0.10
+    if not strain_max > 0:
+        raise ValueError(f"strain_max must be positive, got {strain_max}")
+    if int(levels) < 2:
+        raise ValueError(f"levels must be at least 2, got {levels}")
+    return strain_max
+
+
+def _bodies(spec: CouponSpec, mesh: CouponMesh) -> tuple[Any, Any, Any, Any, float]:
+    """The matrix (plane-strain quads) and the paper (trusses on the same points), linked.
+
+    Returns
+    -------
+    fields, paper_fields : felupe.FieldContainer
+        The matrix's displacement field and the paper's, linked to it.
+    matrix, paper : felupe.SolidBody, felupe.TrussBody
+    paper_thickness : float
+        mm (the trusses' area per unit depth).
+    """
+    import felupe as fem
+
+    umat, young, paper_thickness = _materials(spec)
+    quad_mesh = fem.Mesh(mesh.points, mesh.quads, "quad")
+    line_mesh = fem.Mesh(mesh.points, mesh.lines, "line")
+    fields = fem.FieldContainer([fem.FieldPlaneStrain(fem.RegionQuad(quad_mesh), dim=2)])
+    paper_fields = fem.FieldContainer([fem.Field(fem.RegionTruss(line_mesh), dim=2)])
+    paper_fields.link(fields)
+    matrix = fem.SolidBody(umat, fields)
+    paper = fem.TrussBody(fem.LinearElastic1D(E=young), paper_fields, area=paper_thickness * 1.0)
+    return fields, paper_fields, matrix, paper, paper_thickness
+
+
+def _supports(fields: Any, mesh: CouponMesh) -> tuple[Any, Any, Any]:
+    """The paper's two end nodes held: ``dof0`` (held), ``dof1`` (free), and which of ``dof0`` is pulled.
+
+    The pulled one is the x-dof of the paper's last node; everything else at both ends is fixed.
+    """
+    import felupe as fem
+
+    first, last = int(mesh.paper[0]), int(mesh.paper[-1])
+    mask = np.zeros(len(mesh.points), dtype=bool)
+    mask[[first, last]] = True
+    dof0, dof1 = fem.dof.partition(fields, {"ends": fem.Boundary(fields[0], mask=mask)})
+    pulled = dof0 == 2 * last  # x-dof of the loaded node
+    return dof0, dof1, pulled
 
 
 #: Newton updates below this norm (mm) count as converged: near the unloaded state the
