@@ -240,6 +240,40 @@ def read_curve(
     """
     path = Path(path)
     src = str(path)
+    body, metadata = _data_lines(path)
+    delimiter = _delimiter(body[0][1], delimiter)
+    header, body, roles = _columns(body, delimiter, columns, src)
+    info = _header_info(header, roles) if header is not None else {}
+    table = _table(body, delimiter, roles, src)
+    rownum = np.array([n for n, _ in body])
+    xrole = next(r for r in roles if r in ("stretch", "strain", "true-strain"))
+    notes: list[str] = []
+    lam = _stretch(table[:, roles.index(xrole)], xrole, roles.index(xrole) + 1, strain_unit or
+                   info.get("strain_unit", "fraction"), rownum, src, notes)
+    p = _nominal_stress(table[:, roles.index("stress")], lam, stress_unit or info.get("stress_unit", "MPa"),
+                        stress_kind or info.get("stress_kind") or "nominal", src, notes)
+    if truncate is None:
+        failure = "pull-to-failure" in metadata.get("Type of test", "").lower()
+        truncate = "peak-stress" if failure else "none"
+    lam, p, rownum = _truncated(lam, p, rownum, truncate, src, notes)
+    lam, p = _increasing(lam, p, rownum, src)
+    if mode is None:
+        mode = guess_mode(path) or "uniaxial"
+    if mode not in MODES:
+        raise DataFormatError(f"unknown loading mode {mode!r}; expected one of {', '.join(MODES)}", path=src)
+    desc = description or metadata.get("Material") or path.stem
+    return TestCurve(mode, lam, p, source=src, description=desc, metadata=metadata, notes=tuple(notes))
+
+
+def _data_lines(path: Path) -> tuple[list[tuple[int, str]], dict[str, str]]:
+    """The file's numbered lines that are neither blank nor comments, and the database's metadata.
+
+    Raises
+    ------
+    DataFormatError
+        An unreadable file, a metadata block without its header, or no data rows.
+    """
+    src = str(path)
     try:
         text = path.read_text(encoding="utf-8-sig", errors="replace")
     except OSError as exc:
@@ -251,18 +285,33 @@ def read_curve(
         body, metadata = _soro_metadata(body, src)
     if not body:
         raise DataFormatError("no data rows found", path=src)
-    if delimiter in (" ", "whitespace"):
-        delimiter = None
-    elif delimiter is None:
-        first = body[0][1]
-        delimiter = next((d for d in (";", ",", "\t") if d in first), None)
+    return body, metadata
 
+
+def _delimiter(first: str, delimiter: str | None) -> str | None:
+    """The delimiter given (``None`` for any whitespace), else the first of ``;``, ``,``, tab in ``first``."""
+    if delimiter in (" ", "whitespace"):
+        return None
+    if delimiter is None:
+        return next((d for d in (";", ",", "\t") if d in first), None)
+    return delimiter
+
+
+def _columns(body: list[tuple[int, str]], delimiter: str | None, columns: Sequence[str] | str | None,
+             src: str) -> tuple[list[str] | None, list[tuple[int, str]], list[str]]:
+    """The header (if the first row is not numbers), the rows after it, and the role of each column.
+
+    Raises
+    ------
+    DataFormatError
+        A header that names no stretch and stress (without ``columns``), or of another width
+        than ``columns``.
+    """
     header: list[str] | None = None
     header_row = body[0][0]
     if not _is_numeric_row(_split(body[0][1], delimiter), delimiter):
         header = _split(body[0][1], delimiter)
         body = body[1:]
-    info: dict[str, str] = {}
     if columns is None:
         if header is not None and (found := _roles_from_header(header)) is not None:
             roles = found
@@ -274,13 +323,21 @@ def read_curve(
             roles = ["stretch", "stress"]
     else:
         roles = column_roles(columns, src)
-    ncol = len(roles)
-    if header is not None and len(header) != ncol:
-        raise DataFormatError(f"the header has {len(header)} columns but columns= names {ncol}",
+    if header is not None and len(header) != len(roles):
+        raise DataFormatError(f"the header has {len(header)} columns but columns= names {len(roles)}",
                               path=src, row=header_row)
-    if header is not None:
-        info = _header_info(header, roles)
+    return header, body, roles
 
+
+def _table(body: list[tuple[int, str]], delimiter: str | None, roles: list[str], src: str) -> np.ndarray:
+    """The rows as numbers, shape (rows, columns) (a skipped column as 0).
+
+    Raises
+    ------
+    DataFormatError
+        A row of another width, a cell that is no finite number, fewer than 2 rows.
+    """
+    ncol = len(roles)
     rows = []
     for n, line in body:
         cells = _split(line, delimiter)
@@ -304,14 +361,18 @@ def read_curve(
         rows.append(values)
     if len(rows) < 2:
         raise DataFormatError(f"expected at least 2 data rows, found {len(rows)}", path=src)
-    table = np.array(rows)
-    rownum = np.array([n for n, _ in body])
-    xrole = next(r for r in roles if r in ("stretch", "strain", "true-strain"))
-    x = table[:, roles.index(xrole)]
-    y = table[:, roles.index("stress")]
-    notes: list[str] = []
+    return np.array(rows)
 
-    strain_unit = strain_unit or info.get("strain_unit", "fraction")
+
+def _stretch(x: np.ndarray, xrole: str, column: int, strain_unit: str, rownum: np.ndarray, src: str,
+             notes: list[str]) -> np.ndarray:
+    """The stretch from column ``column`` read as ``xrole`` in ``strain_unit``; a note of the conversion.
+
+    Raises
+    ------
+    DataFormatError
+        An unknown strain unit, or a stretch that is not positive.
+    """
     if strain_unit not in ("fraction", "percent"):
         raise DataFormatError(f"strain_unit must be 'fraction' or 'percent', got {strain_unit!r}", path=src)
     scale = 0.01 if strain_unit == "percent" and xrole != "stretch" else 1.0
@@ -323,23 +384,41 @@ def read_curve(
     if bad_rows.size:
         i = int(bad_rows[0])
         raise DataFormatError(
-            f"stretch must be positive, found {lam[i]:.6g} (column {roles.index(xrole) + 1}"
+            f"stretch must be positive, found {lam[i]:.6g} (column {column}"
             f" read as {xrole}; is the column order right? see columns=)", path=src, row=int(rownum[i]))
-    unit = stress_unit or info.get("stress_unit", "MPa")
+    return lam
+
+
+def _nominal_stress(y: np.ndarray, lam: np.ndarray, unit: str, kind: str, src: str,
+                    notes: list[str]) -> np.ndarray:
+    """Nominal stress in MPa from ``y`` in ``unit`` (``kind`` nominal or true); notes of the conversions.
+
+    Raises
+    ------
+    DataFormatError
+        An unknown stress unit or kind.
+    """
     factor = stress_unit_factor(unit, src)
     p = y * factor
     if factor != 1.0:
         notes.append(f"stress converted from {unit} to MPa (x {factor:g})")
-    kind = stress_kind or info.get("stress_kind") or "nominal"
     if kind not in ("nominal", "true"):
         raise DataFormatError(f"stress_kind must be 'nominal' or 'true', got {kind!r}", path=src)
     if kind == "true":
         p = p / lam
         notes.append("true stress converted to nominal with incompressibility: P = sigma / lambda")
+    return p
 
-    if truncate is None:
-        failure = "pull-to-failure" in metadata.get("Type of test", "").lower()
-        truncate = "peak-stress" if failure else "none"
+
+def _truncated(lam: np.ndarray, p: np.ndarray, rownum: np.ndarray, truncate: str, src: str,
+               notes: list[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rows up to the largest stretch (``loading``) or stress (``peak-stress``), or all (``none``).
+
+    Raises
+    ------
+    DataFormatError
+        ``truncate`` not one of :data:`TRUNCATE`.
+    """
     if truncate not in TRUNCATE:
         raise DataFormatError(f"truncate must be one of {TRUNCATE}, got {truncate!r}", path=src)
     if truncate != "none":
@@ -348,6 +427,17 @@ def read_curve(
             notes.append(f"truncated at the {'largest stretch' if truncate == 'loading' else 'peak stress'}"
                          f" (row {rownum[end - 1]}); {lam.size - end} later rows dropped")
         lam, p, rownum = lam[:end], p[:end], rownum[:end]
+    return lam, p, rownum
+
+
+def _increasing(lam: np.ndarray, p: np.ndarray, rownum: np.ndarray, src: str) -> tuple[np.ndarray, np.ndarray]:
+    """The curve by increasing stretch (a decreasing one reversed).
+
+    Raises
+    ------
+    DataFormatError
+        A stretch that is not monotonic, naming its row.
+    """
     d = np.diff(lam)
     direction = 1.0 if d.size and d[0] > 0 else -1.0
     wrong = np.flatnonzero(d * direction <= 0)
@@ -359,12 +449,7 @@ def read_curve(
             "unloads or fails use truncate='loading' or 'peak-stress')", path=src, row=int(rownum[i]))
     if direction < 0:
         lam, p = lam[::-1], p[::-1]
-    if mode is None:
-        mode = guess_mode(path) or "uniaxial"
-    if mode not in MODES:
-        raise DataFormatError(f"unknown loading mode {mode!r}; expected one of {', '.join(MODES)}", path=src)
-    desc = description or metadata.get("Material") or path.stem
-    return TestCurve(mode, lam, p, source=src, description=desc, metadata=metadata, notes=tuple(notes))
+    return lam, p
 
 
 def _soro_metadata(body: list[tuple[int, str]], src: str) -> tuple[list[tuple[int, str]], dict[str, str]]:
