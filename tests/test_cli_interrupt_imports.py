@@ -158,10 +158,14 @@ UNIT = "[unit]\nelement_size = 3.0\n"
     ("call:pneumorph.models.chaintable:ChainTable.save",
      ["chain", "build", "--model", "2d", "--units", "4", "--pressure", "5", "--unit", "unit.toml", "--window", "1",
       "--heldout", "1", "--executor", "serial", "--out", "new/t.json"], ["new"]),
-], ids=["export", "sensitivity", "chain-build"])
+    # unit optimise, stopped during its search: its folder was made before the search began and stayed, empty
+    ("call:pneumorph.unitopt.run:optimise",
+     ["unit", "optimise", "--units", "3", "--pop", "4", "--gen", "1", "--element-size", "3.0", "--executor", "serial",
+      "--out", "out"], ["out"]),
+], ids=["export", "sensitivity", "chain-build", "unit-optimise"])
 def test_ctrl_c_while_writing_leaves_nothing(tmp_path: Path, slow: str, args: list[str], outputs: list[str]) -> None:
-    """export, sensitivity and chain build write all or nothing: stopped midway they left a deck, study.json or an
-    empty folder (issue 28, item 19)."""
+    """export, sensitivity, chain build and unit optimise write all or nothing: stopped midway they left a deck,
+    study.json or an empty folder (issue 28, item 19)."""
     (tmp_path / "unit.toml").write_text(UNIT, encoding="utf-8")
     done = _interrupt(tmp_path, slow, args)
     lines = [line for line in done.stderr.splitlines() if line.strip()]

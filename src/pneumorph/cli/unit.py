@@ -59,6 +59,7 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     from pneumorph.design.planning import planned_workers
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.io import strict_json
+    from pneumorph.io.files import all_or_nothing
     from pneumorph.io.lock import RunLock
     from pneumorph.unitopt.run import OptimiseSettings, check_folder, optimise, write_outputs
     from pneumorph.unitopt.space import DesignSpace, parse_variable
@@ -99,8 +100,7 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     def on_generation(g: int, front: list[Any]) -> None:
         click.echo(f"generation {g}: front of {len(front)}", err=True)
 
-    Path(out).mkdir(parents=True, exist_ok=True)
-    with RunLock(out):
+    with all_or_nothing(out) as folder, RunLock(folder):  # stopped before its files are whole: nothing left
         try:
             result = optimise(settings, evaluator, on_candidate, on_generation)
         finally:
