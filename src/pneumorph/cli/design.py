@@ -109,9 +109,10 @@ def design(config_file: str | None, **options: Any) -> None:
     """
     o = SimpleNamespace(**options)
     _check_inputs(o)
-    config, fallback, fidelity_given = _config(config_file, o)
+    config, fallback, fidelity_given, nominal = _config(config_file, o)
     model = config.make_model()
     _check_run(config, model, o)
+    o.reference = nominal.make_model() if nominal is not None and config.search == "certified" else None
     if fallback:  # said once every setting has been checked
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
                    "falling back to the genetic algorithm", err=True)
@@ -150,10 +151,11 @@ def _check_inputs(o: Any) -> None:
         P.library_option(o.library, o.unit_file)
 
 
-def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool]:
+def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
     """The run's settings: the config file's (or the defaults) with the options over them
     (:meth:`DesignConfig.with_options`), the fidelity of its search written in; whether the certified search fell
-    back to the GA (gravity); whether the fidelity was given."""
+    back to the GA (gravity); whether the fidelity was given; with ``--model-file``, the same settings without it
+    (the nominal model, whose design the report compares)."""
     from pneumorph.design import DesignConfig
 
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
@@ -172,14 +174,18 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool]:
     _check_options_apply(o.search or config.search, "certified",
                          {"--certify": o.certify, "--verify": o.verify, "--margin": o.margin, "--epsilon": o.epsilon,
                           "--refine": o.refine, "--chain-table": o.chain_table})
-    config = config.with_options(design, ga={"population": o.population, "generations": o.generations},
-                                 model={"fidelity": o.fidelity, "pressure_kpa": o.pressure, "unit_file": o.unit_file,
-                                        "library": o.library}, model_file=identified)
+    options = {"fidelity": o.fidelity, "pressure_kpa": o.pressure, "unit_file": o.unit_file, "library": o.library}
+    ga = {"population": o.population, "generations": o.generations}
+    nominal = None if identified is None else config.with_options(design, ga=ga, model=options)
+    config = config.with_options(design, ga=ga, model=options, model_file=identified)
     fidelity_given = "fidelity" in config.model
     fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
     if fallback:
         config = config.as_ga()
-    return config.with_options({}, model=config.model_settings()), fallback, fidelity_given
+    if nominal is not None:  # the nominal model at the fidelity and pressure of the run's
+        nominal = nominal.with_options({}, model={"fidelity": config.fidelity,
+                                                  "pressure_kpa": config.model.get("pressure_kpa")})
+    return config.with_options({}, model=config.model_settings()), fallback, fidelity_given, nominal
 
 
 def _check_run(config: Any, model: Any, o: Any) -> None:
@@ -213,7 +219,7 @@ def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, An
     progress = _Progress(config, model, o.out or _default_folder(config))
     try:
         result = run_design(config, model, progress.folder, overwrite=o.overwrite, build=not o.no_build,
-                            **progress.callbacks())
+                            reference=o.reference, **progress.callbacks())
         progress.announce()
         return result, model
     except LocalityError as exc:
@@ -281,6 +287,10 @@ def _print_result(result: Any, config: Any, model: Any) -> None:
         if two_d is not None:
             click.echo(f"  The 2D model's chain value of {best.design}: {two_d:.4g} {result.objective.unit}.")
     _print_mesh(result)
+    from pneumorph.design.comparison import comparison_lines
+
+    for line in comparison_lines(result.comparison):
+        click.echo(f"  {line}")
     rob = result.robustness
     if rob is not None and "mean" in rob["winner"]:
         w = rob["winner"]

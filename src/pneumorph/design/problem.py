@@ -81,6 +81,9 @@ class Problem:
         A line of progress.
     on_generation, on_progress : callable or None
         A GA generation's stats; the exhaustive search's (done, total).
+    reference : ActuatorModel or None
+        A second model whose optimum the certified search also finds and judges by this one
+        (the nominal model of an identified one: :mod:`pneumorph.design.comparison`).
     """
 
     config: DesignConfig
@@ -95,6 +98,7 @@ class Problem:
     say: Callable[[str], None] = _silent
     on_generation: Callable[[GenerationStats], Any] | None = None
     on_progress: Callable[[int, int], Any] | None = None
+    reference: ActuatorModel | None = None
 
 
 @dataclass(frozen=True)
@@ -114,6 +118,8 @@ class Outcome:
     robust_winner : Candidate or None
     opinion_2d : dict
         The 2D model's chain values of the listed designs (a certified 3D run).
+    comparison : dict or None
+        The reference model's optimum judged by this model (:func:`.comparison.compare_with_reference`).
     """
 
     hall_of_fame: tuple[Candidate, ...] = ()
@@ -124,6 +130,7 @@ class Outcome:
     robustness: dict[str, Any] | None = None
     robust_winner: Candidate | None = None
     opinion_2d: dict[str, float] = field(default_factory=dict)
+    comparison: dict[str, Any] | None = None
 
 
 class Algorithm(Protocol):

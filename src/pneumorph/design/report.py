@@ -17,6 +17,7 @@ from typing import Any
 
 from pneumorph.design.certificate import certificate_text
 from pneumorph.design.certified import CertifiedResult
+from pneumorph.design.comparison import comparison_lines
 from pneumorph.design.config import DesignConfig
 from pneumorph.design.figures import plot_convergence, plot_profile
 from pneumorph.design.fitness import stage_values
@@ -57,6 +58,9 @@ class RunResult:
     refinement : dict or None
         With ``[design] refine``: the verified designs on the finer mesh
         (:func:`pneumorph.design.refine.refine_verified`).
+    comparison : dict or None
+        With a reference model (``design --model-file``): the nominal model's optimum judged
+        by this model (:func:`pneumorph.design.comparison.compare_with_reference`).
     """
 
     status: str
@@ -77,6 +81,7 @@ class RunResult:
     search_note: str = ""
     retried: int = 0
     refinement: dict[str, Any] | None = None
+    comparison: dict[str, Any] | None = None
 
     @property
     def best(self) -> Candidate | None:
@@ -107,6 +112,7 @@ class RunResult:
             "robustness": None if self.robustness is None else
             {k: v for k, v in self.robustness.items() if k not in ("offsets_mm", "winner_values")},
             "mesh": self.refinement,
+            "comparison": self.comparison,
         }
         if self.certified is not None:
             out.update(certificate=self.certified.certificate, top=_top_rows(self), opinion_2d=self.opinion_2d)
@@ -308,6 +314,9 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
             lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
                          f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kpa'] or row['chain_pressure_kpa'])} |")
         lines.append("")
+    if result.comparison is not None:
+        lines += ["## The nominal model's design", "", *[f"- {line}" for line in comparison_lines(result.comparison)],
+                  ""]
     if result.refinement is not None:
         lines += _refinement_lines(result.refinement, o)
     if result.robustness is not None:

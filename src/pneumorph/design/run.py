@@ -97,7 +97,7 @@ def provenance(config: DesignConfig, model: ActuatorModel) -> dict[str, Any]:
 def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, evaluator: Evaluator | None = None,
                cache: EvaluationCache | None = None, on_generation: Any = None, on_progress: Any = None,
                overwrite: bool = False, figures: bool = True, on_message: Any = None, build: bool = True,
-               algorithm: Algorithm | None = None) -> RunResult:
+               algorithm: Algorithm | None = None, reference: ActuatorModel | None = None) -> RunResult:
     """Run the config's search on ``model`` (built for it) into ``folder`` (see the module for what it holds).
 
     ``evaluator`` and ``cache`` default to the config's (and are closed at the end);
@@ -105,7 +105,9 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
     exhaustive search's (done, total) and a line of text; ``overwrite`` starts afresh in a
     folder of another run; ``figures`` draws them; ``build`` lets a certified run build the
     tables it needs; ``algorithm`` searches instead of the config's ``search`` (any object with the
-    :class:`~pneumorph.design.problem.Algorithm` interface; the run's provenance names it).
+    :class:`~pneumorph.design.problem.Algorithm` interface; the run's provenance names it);
+    ``reference`` is a model whose optimum a certified run judges by ``model`` (the nominal
+    model of an identified one, :mod:`pneumorph.design.comparison`).
 
     Raises :class:`~pneumorph.errors.SearchConfigError` (the model's units differ from the
     config's), :class:`~pneumorph.errors.RunFolderError` (the folder holds
@@ -119,7 +121,7 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
     workers = evaluator_workers(evaluator) if evaluator is not None else planned_workers(config)
     problem = Problem(config, model, config.make_objective(), workers=workers, table_dir=_table_dir(config, cache),
                       build=build, say=on_message or (lambda text: None), on_generation=on_generation,
-                      on_progress=on_progress)
+                      on_progress=on_progress, reference=reference)
     algorithm, problem = (algorithm or algorithm_for(config)).plan(problem)
     if isinstance(problem.objective, StagedTarget):  # a stage off the levels of the ramp: refused here
         problem.objective.levels(problem.model.pressures())
@@ -222,7 +224,8 @@ def _finish(claim: _Claim, algorithm: Algorithm, problem: Problem, status: str, 
                        certified=outcome.certified, opinion_2d=outcome.opinion_2d,
                        rejected=int(getattr(claim.cache, "rejected", 0)), robustness=outcome.robustness,
                        robust_winner=outcome.robust_winner, search=algorithm.name, search_note=algorithm.note,
-                       retried=int(getattr(claim.inner, "retried", 0)), refinement=outcome.refinement)
+                       retried=int(getattr(claim.inner, "retried", 0)), refinement=outcome.refinement,
+                       comparison=outcome.comparison)
     files: list[Path] = []
     try:
         _write_outputs(result, problem.config, problem.model, outcome.ranking, figures, files)

@@ -19,6 +19,7 @@ import numpy as np
 
 from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
 from pneumorph.design.certified import CertifiedResult, certified_search, chain_candidate
+from pneumorph.design.comparison import compare_with_reference
 from pneumorph.design.fitness import Score
 from pneumorph.design.planning import SearchPlan, plan_search
 from pneumorph.design.problem import Algorithm, Outcome, Problem, Search
@@ -88,7 +89,7 @@ class CertifiedSearch(Search):
 
     def run(self, problem: Problem) -> Outcome:
         """The certificate, its winner and runners-up, the chain's best 1,000, the mesh note or refinement,
-        the winner's robustness and the 2D model's opinion."""
+        the winner's robustness, the 2D model's opinion and, with a reference model, its optimum on this one."""
         config, chain = problem.config, self.chain
         assert chain is not None
         verify = max(config.verify or problem.workers, REFINE_TOP if config.refine else 1)
@@ -100,7 +101,8 @@ class CertifiedSearch(Search):
         outcome = Outcome(cert.hall_of_fame, certified=cert, refinement=_refinement(problem, cert),
                           ranking=[(d, _chain_score(cert, i)) for d, i in zip(names, order, strict=False)])
         outcome = self.robustness(problem, outcome)
-        return replace(outcome, opinion_2d=_opinion_2d(problem, cert))
+        return replace(outcome, opinion_2d=_opinion_2d(problem, cert),
+                       comparison=compare_with_reference(problem, outcome.robust_winner or cert.winner))
 
     def robustness(self, problem: Problem, outcome: Outcome) -> Outcome:
         """The winner's spread under the mould tolerance: by the chain with the unit's tolerance tables, else by
