@@ -59,7 +59,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.identify.fit:identify": 186,
     "pneumorph.materials.characterise:characterise_bulk_modulus": 85,
     "pneumorph.materials.felupe_models:isochoric_function": 101,
-    "pneumorph.materials.fitting:fit": 135,
     "pneumorph.models.chainfit:build_table": 115,
     "pneumorph.models.chainfit:fit_table": 107,
     "pneumorph.models.factory:make_model": 116,

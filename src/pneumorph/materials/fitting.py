@@ -72,8 +72,8 @@ from pneumorph.materials.hyperelastic import (
     StabilityReport,
     Yeoh,
     drucker_stability,
-    mode_stretches,
 )
+from pneumorph.materials.ogdenfit import fit_ogden
 from pneumorph.materials.testdata import TestCurve, TestData
 
 #: Names accepted by :func:`fit` (``N`` is a number of terms, 1-6).
@@ -245,18 +245,6 @@ def r_squared(measured: Any, predicted: Any) -> float:
     return 1.0 - sse / ssto if ssto > 0 else float("nan")
 
 
-def _ogden_columns(curves: Sequence[TestCurve], alpha: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Per unit mu_n: nominal stress (l1^a - l3^a)/l1 and its derivative in a, stacked over modes."""
-    cols, dcols = [], []
-    for c in curves:
-        l1, _, l3 = mode_stretches(c.mode, c.stretch)
-        g1, g3 = np.log(l1)[:, None], np.log(l3)[:, None]
-        p1, p3 = l1[:, None] ** alpha, l3[:, None] ** alpha
-        cols.append((p1 - p3) / l1[:, None])
-        dcols.append((p1 * g1 - p3 * g3) / l1[:, None])
-    return np.vstack(cols), np.vstack(dcols)
-
-
 def _linear_columns(spec: ModelSpec, curves: Sequence[TestCurve]) -> FloatArray:
     """Nominal stress of the model with each parameter 1 and the others 0 (it is linear)."""
     eye = np.eye(spec.n_parameters)
@@ -280,92 +268,10 @@ def _weights(curves: Sequence[TestCurve], weighting: str, mode_weights: Mapping[
     return np.concatenate(w)
 
 
-def _fit_ogden(curves: Sequence[TestCurve], y: FloatArray, w: FloatArray, n: int, starts: int,
-               rng: np.random.Generator, alpha_bound: float, gap: float, stable: bool) -> FloatArray:
-    """Multi-start Ogden fit; returns (mu..., alpha...) with increasing alpha.
-
-    The exponents are parametrised as ``alpha_1`` and the gaps ``alpha_(k+1) - alpha_k >=
-    gap``: two terms with (nearly) equal exponents degenerate into huge moduli of opposite
-    sign that cancel, a solution with no meaning as material parameters. With ``stable``
-    every term keeps ``mu_n alpha_n >= 0`` (such pairs cannot cancel, so the final polish
-    works on the exponents directly, each keeping its sign).
-    """
-    from scipy.optimize import (  # deferred: keeps the CLI start fast
-        least_squares,
-        lsq_linear,
-    )
-
-    yw = y * w
-    tri = np.tril(np.ones((n, n)))
-
-    def alphas(x: FloatArray) -> FloatArray:
-        return tri @ x
-
-    def mu_for(alpha: FloatArray) -> FloatArray:
-        a, _ = _ogden_columns(curves, alpha)
-        if not stable:
-            return np.asarray(np.linalg.lstsq(a * w[:, None], yw, rcond=None)[0], dtype=np.float64)
-        pos = alpha > 0
-        return lsq_linear(a * w[:, None], yw, bounds=(np.where(pos, 0.0, -np.inf), np.where(pos, np.inf, 0.0)),
-                          method="bvls").x
-
-    def projected(x: FloatArray) -> FloatArray:
-        alpha = alphas(x)
-        a, _ = _ogden_columns(curves, alpha)
-        return (a @ mu_for(alpha) - y) * w
-
-    def full(p: FloatArray) -> FloatArray:
-        a, _ = _ogden_columns(curves, p[n:] if stable else alphas(p[n:]))
-        return (a @ p[:n] - y) * w
-
-    def full_jac(p: FloatArray) -> FloatArray:
-        a, da = _ogden_columns(curves, p[n:] if stable else alphas(p[n:]))
-        return np.hstack([a, (da * p[:n]) @ (np.eye(n) if stable else tri)]) * w[:, None]
-
-    lo = [-alpha_bound] + [gap] * (n - 1)
-    hi = [alpha_bound] * n
-    best, best_alpha = None, None
-    for _ in range(starts):
-        a0 = np.sort(rng.uniform(-10.0, 10.0, n))
-        x0 = np.clip(np.concatenate([a0[:1], np.diff(a0)]), lo, hi)
-        with np.errstate(all="ignore"):
-            vp = least_squares(projected, x0, bounds=(lo, hi), max_nfev=200)
-            alpha = alphas(vp.x)
-            mu = mu_for(alpha)
-            if stable:
-                big = max(alpha_bound, float(np.abs(alpha).max()))
-                pos = alpha > 0
-                blo = np.concatenate([np.where(pos, 0.0, -np.inf), np.where(pos, 1e-3, -big)])
-                bhi = np.concatenate([np.where(pos, np.inf, 0.0), np.where(pos, big, -1e-3)])
-                p0 = np.clip(np.concatenate([mu, alpha]), blo, bhi)
-            else:
-                blo = np.array([-np.inf] * n + lo)
-                bhi = np.array([np.inf] * n + hi)
-                p0 = np.concatenate([mu, vp.x])
-            res = least_squares(full, p0, jac=full_jac, bounds=(blo, bhi), x_scale="jac", max_nfev=300)
-        if np.all(np.isfinite(res.x)) and (best is None or res.cost < best.cost):
-            best = res
-            best_alpha = res.x[n:] if stable else alphas(res.x[n:])
-    if best is None or best_alpha is None:
-        raise FitError("the Ogden fit failed from every start (non-finite parameters)")
-    order = np.argsort(best_alpha)
-    return np.concatenate([best.x[:n][order], best_alpha[order]])
-
-
-def fit(
-    model_name: str,
-    data: TestData | TestCurve,
-    *,
-    modes: Sequence[str] | None = None,
-    weighting: str = "absolute",
-    mode_weights: Mapping[str, float] | None = None,
-    starts: int = 8,
-    seed: int | np.random.Generator | None = 0,
-    alpha_bound: float = 30.0,
-    min_alpha_gap: float = 0.5,
-    stable: bool = False,
-    stability_range: tuple[float, float] | None = None,
-) -> FitResult:
+def fit(model_name: str, data: TestData | TestCurve, *, modes: Sequence[str] | None = None, weighting: str = "absolute",
+        mode_weights: Mapping[str, float] | None = None, starts: int = 8, seed: int | np.random.Generator | None = 0,
+        alpha_bound: float = 30.0, min_alpha_gap: float = 0.5, stable: bool = False,
+        stability_range: tuple[float, float] | None = None) -> FitResult:
     """Fit a hyperelastic model to test data by least squares on the nominal stress.
 
     Parameters
@@ -419,12 +325,33 @@ def fit(
     >>> round(r.parameters["C10"], 6), round(r.r2["uniaxial"], 6)
     (0.2, 1.0)
     """
-    from scipy.optimize import (  # deferred: keeps the CLI start fast
-        least_squares,
-        lsq_linear,
-    )
-
     spec = resolve_model(model_name)
+    data, curves, y = _fit_data(spec, data, modes, weighting)
+    w = _weights(curves, weighting, mode_weights)
+    if spec.family == "ogden":
+        if starts < 1:
+            raise ValueError(f"starts must be at least 1, got {starts}")
+        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+        p = fit_ogden(curves, y, w, spec.terms, starts, rng, alpha_bound, min_alpha_gap, stable)
+        nstarts, used_seed = starts, seed if isinstance(seed, int | type(None)) else None
+    else:
+        p, nstarts, used_seed = _fit_linear(spec, curves, y, w, stable), 1, None
+    return _result(spec.build(p.tolist()), spec, curves, y, stability_range, {
+        "starts": nstarts, "seed": used_seed, "weighting": weighting, "data_name": data.name,
+        "sources": data.sources, "stable_constrained": stable})
+
+
+def _fit_data(spec: ModelSpec, data: TestData | TestCurve, modes: Sequence[str] | None,
+              weighting: str) -> tuple[TestData, list[TestCurve], FloatArray]:
+    """The data as :class:`TestData`, the curves to fit (in the order of ``MODES``) and their stresses.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``weighting``.
+    FitError
+        A mode the data do not have, or no more points than the model has parameters.
+    """
     if isinstance(data, TestCurve):
         data = TestData((data,), data.description)
     if weighting not in WEIGHTINGS:
@@ -439,27 +366,42 @@ def fit(
     if y.size <= npar:
         raise FitError(f"{spec.name} has {npar} parameters but only {y.size} data points were given; "
                        f"need more than {npar}")
-    w = _weights(curves, weighting, mode_weights)
-    used_seed = seed if isinstance(seed, int | type(None)) else None
-    if spec.family == "ogden":
-        if starts < 1:
-            raise ValueError(f"starts must be at least 1, got {starts}")
-        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-        p = _fit_ogden(curves, y, w, spec.terms, starts, rng, alpha_bound, min_alpha_gap, stable)
-        nstarts = starts
-    else:
-        a = _linear_columns(spec, curves)
-        aw = a * w[:, None]
-        p0, _, rank, _ = np.linalg.lstsq(aw, y * w, rcond=None)
-        if rank < npar:
-            raise FitError(f"the data cannot determine the {npar} parameters of {spec.name} "
-                           f"(rank {rank}); add points over a wider stretch range or another mode")
-        if stable:  # bounded linear least squares: convex, so still the unique optimum
-            p = lsq_linear(aw, y * w, bounds=(0.0, np.inf), method="bvls").x
-        else:
-            p = least_squares(lambda q: aw @ q - y * w, p0, jac=lambda q: aw, method="lm").x
-        nstarts, used_seed = 1, None
-    model = spec.build(p.tolist())
+    return data, curves, y
+
+
+def _fit_linear(spec: ModelSpec, curves: Sequence[TestCurve], y: FloatArray, w: FloatArray,
+                stable: bool) -> FloatArray:
+    """The parameters of a model linear in them: weighted least squares (``stable``: all >= 0).
+
+    Raises
+    ------
+    FitError
+        The data cannot determine every parameter (a rank-deficient system).
+    """
+    from scipy.optimize import (  # deferred: keeps the CLI start fast
+        least_squares,
+        lsq_linear,
+    )
+
+    npar = spec.n_parameters
+    a = _linear_columns(spec, curves)
+    aw = a * w[:, None]
+    p0, _, rank, _ = np.linalg.lstsq(aw, y * w, rcond=None)
+    if rank < npar:
+        raise FitError(f"the data cannot determine the {npar} parameters of {spec.name} "
+                       f"(rank {rank}); add points over a wider stretch range or another mode")
+    if stable:  # bounded linear least squares: convex, so still the unique optimum
+        return np.asarray(lsq_linear(aw, y * w, bounds=(0.0, np.inf), method="bvls").x, dtype=np.float64)
+    return np.asarray(least_squares(lambda q: aw @ q - y * w, p0, jac=lambda q: aw, method="lm").x, dtype=np.float64)
+
+
+def _result(model: HyperelasticModel, spec: ModelSpec, curves: Sequence[TestCurve], y: FloatArray,
+            stability_range: tuple[float, float] | None, run: dict[str, Any]) -> FitResult:
+    """The fitted ``model``'s goodness per mode and overall, its stability, and the ``run``'s settings.
+
+    The stability range is ``stability_range``, else the curves' stretches widened to
+    0.5-1.5 at least; ``run`` holds the :class:`FitResult` fields from ``starts`` on.
+    """
     pred = [model.nominal_stress(c.mode, c.stretch) for c in curves]
     lo = min(float(c.stretch.min()) for c in curves)
     hi = max(float(c.stretch.max()) for c in curves)
@@ -480,12 +422,7 @@ def fit(
         n_points=MappingProxyType({c.mode: len(c) for c in curves}),
         stretch_range=MappingProxyType({c.mode: (float(c.stretch[0]), float(c.stretch[-1])) for c in curves}),
         stability=drucker_stability(model, stretch_range=srange),
-        starts=nstarts,
-        seed=used_seed,
-        weighting=weighting,
-        data_name=data.name,
-        sources=data.sources,
-        stable_constrained=stable,
+        **run,
     )
 
 
