@@ -144,6 +144,7 @@ def test_ctrl_c_at_any_moment_is_aborted_with_nothing_written(tmp_path: Path, sl
 
 
 UNIT = "[unit]\nelement_size = 3.0\n"
+TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119) ** 2:.4f}\n" for i in range(120))
 
 
 @pytest.mark.parametrize(("slow", "args", "outputs"), [
@@ -162,11 +163,29 @@ UNIT = "[unit]\nelement_size = 3.0\n"
     ("call:pneumorph.unitopt.run:optimise",
      ["unit", "optimise", "--units", "3", "--pop", "4", "--gen", "1", "--element-size", "3.0", "--executor", "serial",
       "--out", "out"], ["out"]),
-], ids=["export", "sensitivity", "chain-build", "unit-optimise"])
+    # identify: the fit is done; its folder was made before the files
+    ("call:pneumorph.identify:write_identified",
+     ["identify", "trace.csv", "--design", "0110", "--model", "2d", "--pressure", "5", "--unit", "unit.toml",
+      "--executor", "serial", "--out", "out"], ["out"]),
+    # study: study.json is written; the figure is next
+    ("call:pneumorph.design:plot_study",
+     ["study", "run.toml", "--populations", "4", "--seeds", "1", "--gen", "1", "--units", "3", "--pressure", "5",
+      "--executor", "serial", "--out", "out"], ["out"]),
+    # bimodal: the JSON and the tip-path figure are written; the outline figure is next
+    ("call:pneumorph.bimodal.figures:plot_outlines",
+     ["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--out", "out"], ["out"]),
+    # composite coupon: the CSV, the JSON and two figures are written; the third is next
+    ("call:pneumorph.composite.figures:plot_surface_strain",
+     ["composite", "coupon", "--crimp-ratio", "0.3", "--length", "20", "--per-flute", "1", "--rows", "1", "--levels",
+      "24", "--strain-max", "0.9", "--gauges", "20", "--out", "out"], ["out"]),
+], ids=["export", "sensitivity", "chain-build", "unit-optimise", "identify", "study", "bimodal", "composite"])
 def test_ctrl_c_while_writing_leaves_nothing(tmp_path: Path, slow: str, args: list[str], outputs: list[str]) -> None:
     """export, sensitivity, chain build and unit optimise write all or nothing: stopped midway they left a deck,
     study.json or an empty folder (issue 28, item 19)."""
     (tmp_path / "unit.toml").write_text(UNIT, encoding="utf-8")
+    (tmp_path / "trace.csv").write_text(TRACE, encoding="utf-8")
+    (tmp_path / "run.toml").write_text('[design]\nobjective = "sin"\n[model]\nunit = {element_size = 3.0}\n',
+                                       encoding="utf-8")
     done = _interrupt(tmp_path, slow, args)
     lines = [line for line in done.stderr.splitlines() if line.strip()]
     assert done.returncode == 130 and lines[-1] == "aborted", done.stderr
@@ -174,8 +193,8 @@ def test_ctrl_c_while_writing_leaves_nothing(tmp_path: Path, slow: str, args: li
     left = [str(p.relative_to(tmp_path)) for name in outputs if (tmp_path / name).exists()
             for p in [tmp_path / name, *(tmp_path / name).rglob("*")]]
     assert not left, left
-    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["hook", "mark", "unit.toml",
-                                                                                        "xdg"]
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
+        "hook", "mark", "run.toml", "trace.csv", "unit.toml", "xdg"]
 
 
 def test_sigterm_inside_a_command_is_terminated_not_aborted(tmp_path: Path) -> None:

@@ -12,7 +12,7 @@ import click
 
 from pneumorph.checks import MAX_INCREMENTS
 from pneumorph.cli import params as P
-from pneumorph.io.files import strict_json, write_json
+from pneumorph.io.files import all_or_nothing, strict_json, write_json
 
 
 def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
@@ -121,13 +121,13 @@ def write_outputs(result: Any, out: Path) -> list[Path]:
     """Write ``bimodal-CR.json`` and the tip-path and outline figures into ``out``."""
     from pneumorph.bimodal import figures
 
-    out.mkdir(parents=True, exist_ok=True)
     tag = f"cr{result.crimp_ratio:g}".replace(".", "_")
     js = out / f"bimodal-{tag}.json"
-    write_json(js, result.to_dict(), indent=2)
     tip = out / f"bimodal-{tag}-tip.png"
-    figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)],
-                           title=f"Bimodal actuator, CR {result.crimp_ratio:g}", path=tip)
     shape = out / f"bimodal-{tag}-shape.png"
-    figures.plot_outlines(result, title=f"Mid-plane outline, CR {result.crimp_ratio:g}", path=shape)
+    with all_or_nothing(out):  # stopped while writing (Ctrl-C, a full disk): no partial output
+        write_json(js, result.to_dict(), indent=2)
+        figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)],
+                               title=f"Bimodal actuator, CR {result.crimp_ratio:g}", path=tip)
+        figures.plot_outlines(result, title=f"Mid-plane outline, CR {result.crimp_ratio:g}", path=shape)
     return [js, tip, shape]

@@ -14,7 +14,7 @@ import click
 
 from pneumorph.cli import params as P
 from pneumorph.errors import CrimpError
-from pneumorph.io.files import strict_json, write_json
+from pneumorph.io.files import all_or_nothing, strict_json, write_json
 
 
 @click.group()
@@ -173,18 +173,18 @@ def write_outputs(result: Any, summary: dict[str, Any], out: Path, snapshot: flo
 
     from pneumorph.composite import figures
 
-    out.mkdir(parents=True, exist_ok=True)
     tag = f"cr{result.spec.crimp.crimp_ratio:.4g}".replace(".", "_")
     csv = out / f"coupon-{tag}.csv"
-    np.savetxt(csv, np.column_stack([result.engineering_strain, result.surface_strain, result.force]),
-               delimiter=",", header="engineering_strain,surface_strain,force_N_per_mm", comments="", fmt="%.8g")
     js = out / f"coupon-{tag}.json"
-    write_json(js, summary, indent=2)
     paths = [csv, js]
-    for name, fn in (("load", lambda p: figures.plot_load_strain([result], p)),
-                     ("deformed", lambda p: figures.plot_deformed(result, snapshot, path=p)),
-                     ("surface-strain", lambda p: figures.plot_surface_strain(result, snapshot, path=p))):
-        path = out / f"coupon-{tag}-{name}.png"
-        fn(path)
-        paths.append(path)
+    with all_or_nothing(out):  # stopped while writing (Ctrl-C, a full disk): no partial output
+        np.savetxt(csv, np.column_stack([result.engineering_strain, result.surface_strain, result.force]),
+                   delimiter=",", header="engineering_strain,surface_strain,force_N_per_mm", comments="", fmt="%.8g")
+        write_json(js, summary, indent=2)
+        for name, fn in (("load", lambda p: figures.plot_load_strain([result], p)),
+                         ("deformed", lambda p: figures.plot_deformed(result, snapshot, path=p)),
+                         ("surface-strain", lambda p: figures.plot_surface_strain(result, snapshot, path=p))):
+            path = out / f"coupon-{tag}-{name}.png"
+            fn(path)
+            paths.append(path)
     return paths

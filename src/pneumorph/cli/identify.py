@@ -112,11 +112,12 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
         evaluator.close()
     summary = {**result.to_dict(), "cluster": cluster_report(evaluator)}
     if out:
-        folder = Path(out)
-        folder.mkdir(parents=True, exist_ok=True)
+        from pneumorph.io.files import all_or_nothing
+
         command = " ".join(["pneumorph", *sys.argv[1:]])
-        write_identified(result, folder, command=command)
-        write_json(folder / "identify.json", {**summary, "provenance": provenance(command=command)})
+        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+            write_identified(result, folder, command=command)
+            write_json(folder / "identify.json", {**summary, "provenance": provenance(command=command)})
     if as_json:
         click.echo(strict_json(summary))
         return

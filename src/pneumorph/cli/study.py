@@ -37,7 +37,6 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     Every design is solved once for the whole study: all runs share the evaluation cache.
     """
     from dataclasses import replace
-    from pathlib import Path
 
     from pneumorph.design import DesignConfig, plot_study, population_study
     from pneumorph.io import provenance, strict_json, write_json
@@ -89,15 +88,16 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     cluster = cluster_report(evaluator)
     if (line := cluster_line(evaluator)) is not None:
         click.echo(line, err=True)
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
+    from pneumorph.io.files import all_or_nothing
+
     summary = {
         "objective": result.objective, "unit": result.unit, "generations": result.generations,
         "rows": [row.as_dict() for row in result.rows], **({"cluster": cluster} if cluster else {}),
         "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint(), config=config.to_dict()),
     }
-    write_json(folder / "study.json", summary)
-    plot_study(result, folder / "study.png")
+    with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+        write_json(folder / "study.json", summary)
+        plot_study(result, folder / "study.png")
     if as_json:
         click.echo(strict_json({k: v for k, v in summary.items() if k != "provenance"}))
     else:
