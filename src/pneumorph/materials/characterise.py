@@ -272,40 +272,51 @@ def characterise_bulk_modulus(
         sig = None
     else:
         ex, ey, sig = _columns(axial_strain, transverse_strain, axial_stress, names=(*names, "axial stress"))
+    use = _in_range(ex, lo, hi)
+    nu = poisson_ratio(ex[use], ey[use])
+    e: FloatArray | None = None
+    k: FloatArray | None = None
+    mean_e = mean_k = avg_k = None
+    if sig is not None:
+        e, k, mean_e, mean_k, avg_k = _moduli(ex, sig, use, nu, modulus)
+    return BulkModulusResult(axial_strain=ex[use], poisson_ratio=nu, youngs_modulus=e, bulk_modulus=k,
+                             mean_poisson_ratio=float(nu.mean()), mean_youngs_modulus=mean_e,
+                             mean_bulk_modulus=mean_k, strain_average_bulk_modulus=avg_k, strain_range=(lo, hi),
+                             modulus=modulus)
+
+
+def _in_range(ex: FloatArray, lo: float, hi: float) -> NDArray[np.bool_]:
+    """The points of axial strain ``ex`` in ``lo``-``hi`` and not zero; :class:`FitError` if none."""
     use = (ex >= lo) & (ex <= hi) & (ex != 0.0)
     if not np.any(use):
         raise FitError(
             f"no data point with non-zero axial strain in the range {lo * 100:g}-{hi * 100:g} % "
             f"(data span {ex.min() * 100:g}-{ex.max() * 100:g} %)" if ex.size else "no data points"
         )
-    nu = poisson_ratio(ex[use], ey[use])
-    e = k = None
-    mean_e = mean_k = avg_k = None
-    if sig is not None:
-        e_all = secant_modulus(ex, sig) if modulus == "secant" else tangent_modulus(ex, sig)
-        e = e_all[use]
-        try:
-            k = bulk_modulus(e, nu)
-        except FitError as exc:
-            first = ex[use][np.flatnonzero(nu >= 0.5)[0]]
-            raise FitError(f"at axial strain {first * 100:.4g} %: {exc}") from None
-        mean_e, mean_k = float(e.mean()), float(k.mean())
-        x = ex[use]
-        span = x[-1] - x[0] if x.size > 1 else 0.0
-        area = float(np.sum(0.5 * (k[1:] + k[:-1]) * np.diff(x)))
-        avg_k = area / span if span != 0.0 else mean_k
-    return BulkModulusResult(
-        axial_strain=ex[use],
-        poisson_ratio=nu,
-        youngs_modulus=e,
-        bulk_modulus=k,
-        mean_poisson_ratio=float(nu.mean()),
-        mean_youngs_modulus=mean_e,
-        mean_bulk_modulus=mean_k,
-        strain_average_bulk_modulus=avg_k,
-        strain_range=(lo, hi),
-        modulus=modulus,
-    )
+    return use
+
+
+def _moduli(ex: FloatArray, sig: FloatArray, use: NDArray[np.bool_], nu: FloatArray,
+            modulus: ModulusKind) -> tuple[FloatArray, FloatArray, float, float, float]:
+    """Young's (Eq A.4) and bulk (Eq A.5) moduli at the points ``use``, their means, and K averaged over strain.
+
+    Raises
+    ------
+    FitError
+        ``nu >= 0.5`` at a point, naming its axial strain.
+    """
+    e_all = secant_modulus(ex, sig) if modulus == "secant" else tangent_modulus(ex, sig)
+    e = e_all[use]
+    try:
+        k = bulk_modulus(e, nu)
+    except FitError as exc:
+        first = ex[use][np.flatnonzero(nu >= 0.5)[0]]
+        raise FitError(f"at axial strain {first * 100:.4g} %: {exc}") from None
+    mean_e, mean_k = float(e.mean()), float(k.mean())
+    x = ex[use]
+    span = x[-1] - x[0] if x.size > 1 else 0.0
+    area = float(np.sum(0.5 * (k[1:] + k[:-1]) * np.diff(x)))
+    return e, k, mean_e, mean_k, area / span if span != 0.0 else mean_k
 
 
 # ---------------------------------------------------------------------------------------
