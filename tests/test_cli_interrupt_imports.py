@@ -178,10 +178,14 @@ TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119)
     ("call:pneumorph.composite.figures:plot_surface_strain",
      ["composite", "coupon", "--crimp-ratio", "0.3", "--length", "20", "--per-flute", "1", "--rows", "1", "--levels",
       "24", "--strain-max", "0.9", "--gauges", "20", "--out", "out"], ["out"]),
-], ids=["export", "sensitivity", "chain-build", "unit-optimise", "identify", "study", "bimodal", "composite"])
+    # calibrate: calibration.png is written; calibration.json is next
+    ("call:pneumorph.calibration.workflow:write_json",
+     ["calibrate", "--units", "1", "--pressures", "5,10", "--runs", "1", "--validate", "0", "--out", "out"], ["out"]),
+], ids=["export", "sensitivity", "chain-build", "unit-optimise", "identify", "study", "bimodal", "composite",
+        "calibrate"])
 def test_ctrl_c_while_writing_leaves_nothing(tmp_path: Path, slow: str, args: list[str], outputs: list[str]) -> None:
-    """export, sensitivity, chain build and unit optimise write all or nothing: stopped midway they left a deck,
-    study.json or an empty folder (issue 28, item 19)."""
+    """Every command that writes several files writes them all or nothing: stopped midway they left a deck,
+    study.json, half the figures or an empty folder (issue 28, item 19)."""
     (tmp_path / "unit.toml").write_text(UNIT, encoding="utf-8")
     (tmp_path / "trace.csv").write_text(TRACE, encoding="utf-8")
     (tmp_path / "run.toml").write_text('[design]\nobjective = "sin"\n[model]\nunit = {element_size = 3.0}\n',

@@ -44,6 +44,7 @@ from pneumorph.execution import EvaluationCache
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io import atomic_write_text, check_writable_dir, provenance, write_json
+from pneumorph.io.files import all_or_nothing
 from pneumorph.materials.filler import FillerLaw
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 from pneumorph.models.response import Response
@@ -245,30 +246,30 @@ def run_calibration(
         solve_3d = cached_3d_solver(store)
         result = calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point,
                            weighting=weighting)
-        folder.mkdir(parents=True, exist_ok=True)
-        files = [plot_calibration(result, folder / "calibration.png")]
-        summary: dict[str, Any] = {
-            "points": [p.__dict__ for p in result.points],
-            "linear": result.linear.__dict__, "quadratic": result.quadratic.__dict__,
-            "chosen_degree": None if result.chosen is None else result.chosen.degree,
-            "provenance": provenance(unit=unit.to_dict(), calibration=result.metadata),
-        }
-        calibrated, check, comparison = None, None, None
-        if result.chosen is not None:
-            calibrated = result.unit_with_law(unit)
-            files.append(atomic_write_text(folder / "unit.toml", to_toml({"unit": calibrated.to_dict()})))
-            if n_validate > 0:
-                taken = calibration_designs(n_units, runs, seed)
-                designs = holdout_designs(n_units, n_validate, seed, taken)
-                p_max = max(levels) / 1e3
-                check = validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
-                summary["validation"] = check.to_dict()
-                comparison = compare_laws(result, calibrated, n_units, designs[0], p_max, solve_3d)
-                figures = [plot_law_profiles({**comparison.runs, "fitted law": comparison.fitted},
-                                             comparison.reference, folder / "profiles.png"),
-                           plot_filler_paths({"E(P)": comparison.fitted, **comparison.constants},
-                                             comparison.reference, folder / "filler_paths.png")]
-                summary["figures"] = [str(f) for f in figures]
-                files += figures
-    files.append(write_json(folder / "calibration.json", summary))
+        with all_or_nothing(folder):  # stopped while writing or validating (Ctrl-C, a full disk): no partial output
+            files = [plot_calibration(result, folder / "calibration.png")]
+            summary: dict[str, Any] = {
+                "points": [p.__dict__ for p in result.points],
+                "linear": result.linear.__dict__, "quadratic": result.quadratic.__dict__,
+                "chosen_degree": None if result.chosen is None else result.chosen.degree,
+                "provenance": provenance(unit=unit.to_dict(), calibration=result.metadata),
+            }
+            calibrated, check, comparison = None, None, None
+            if result.chosen is not None:
+                calibrated = result.unit_with_law(unit)
+                files.append(atomic_write_text(folder / "unit.toml", to_toml({"unit": calibrated.to_dict()})))
+                if n_validate > 0:
+                    taken = calibration_designs(n_units, runs, seed)
+                    designs = holdout_designs(n_units, n_validate, seed, taken)
+                    p_max = max(levels) / 1e3
+                    check = validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
+                    summary["validation"] = check.to_dict()
+                    comparison = compare_laws(result, calibrated, n_units, designs[0], p_max, solve_3d)
+                    figures = [plot_law_profiles({**comparison.runs, "fitted law": comparison.fitted},
+                                                 comparison.reference, folder / "profiles.png"),
+                               plot_filler_paths({"E(P)": comparison.fitted, **comparison.constants},
+                                                 comparison.reference, folder / "filler_paths.png")]
+                    summary["figures"] = [str(f) for f in figures]
+                    files += figures
+            files.append(write_json(folder / "calibration.json", summary))
     return CalibrationRun(result, folder, calibrated, check, comparison, tuple(files), summary)
