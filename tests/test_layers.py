@@ -61,7 +61,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.models.chainfit:build_table": 115,
     "pneumorph.models.chainfit:fit_table": 107,
     "pneumorph.models.factory:make_model": 116,
-    "pneumorph.plot.sensitivity:plot_study": 100,
 }
 
 
