@@ -1,7 +1,7 @@
 """A 3D identification from two synthetic scans of two 15-unit designs (issue 27).
 
     OMP_NUM_THREADS=1 python benchmarks/identify.py                  # 2 workers, a fresh cache
-    OMP_NUM_THREADS=1 python benchmarks/identify.py --workers 2 --cache /tmp/id.sqlite
+    OMP_NUM_THREADS=1 python benchmarks/identify.py --workers 2 --cache /tmp/id.sqlite --out /tmp/id
 
 The "cast" actuators are the 3D model with a known change (the body's bulk modulus x1.06
 and the Mold Star wall +0.08 mm, meshed as the identification meshes them), inflated to
@@ -10,7 +10,9 @@ translation, with 0.05 mm Gaussian noise (as docs/scripts/correlation_check.py m
 The identification fits all five parameters through the process pool behind the given
 cache (default: a fresh one, so the first run's cost is measured), then runs again from the
 cache. Prints the truth, the fit, the standard errors and correlations, the residuals,
-the solves, the wall times and the machine.
+the solves, the wall times and the machine. With ``--out`` it writes the identified model
+(``identified.toml``) and the true one (``truth.toml``, a ``[model]`` table) there, for
+``benchmarks/design_again.py``.
 """
 
 from __future__ import annotations
@@ -27,9 +29,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pneumorph.correlation import Scan, Transform, model_shape
+from pneumorph.design.config import to_toml
 from pneumorph.execution import CachedEvaluator, EvaluationCache, make_evaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.identify import NAMES, Observation, ParameterSet, ScanSpec, identify
+from pneumorph.identify import NAMES, Observation, ParameterSet, ScanSpec, identify, write_identified
 from pneumorph.models.factory import make_model
 
 DESIGNS = ("001111010001001", "000011110000111")
@@ -56,6 +59,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--cache", type=Path)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, help="write identified.toml and truth.toml here")
     args = parser.parse_args()
     params = ParameterSet(UnitSpec())
     truth = params.nominal + CHANGE
@@ -75,6 +79,10 @@ def main() -> None:
             evaluator.close()
         runs.append(time.perf_counter() - t0)
         print(f"{run}: {runs[-1]:.1f} s, {result.solves} solves asked", flush=True)
+    if args.out is not None:
+        write_identified(result, args.out)
+        truth_model = params.settings(truth, {"fidelity": "3d"})
+        (args.out / "truth.toml").write_text(to_toml({"model": truth_model}), encoding="utf-8")
     print(json.dumps({
         "truth": dict(zip(NAMES, truth.tolist(), strict=True)),
         "fit": {n: {"value": p["value"], "standard_error": p["standard_error"], "identified": p["identified"],

@@ -223,3 +223,23 @@ def test_a_scan_past_the_point_limit_is_refused_with_its_estimate_before_the_sol
         assert err.count("\n") == 1 and "600,000 points, more than MAX_SCAN_POINTS = 500,000" in err, err
         assert "aligning them would take about 36 s; thin the scan out (one point in 2 leaves 300,000)" in err
         assert not (tmp_path / "corr").exists()
+
+
+def test_correlate_with_a_model_file_compares_with_that_model(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    # a trace of a softer cast (the identified model's) fits that model to the tracing, not the nominal one
+    from pneumorph.models.factory import make_model
+
+    identified = {"fidelity": "2d", "body_shear_scale": 0.8}
+    soft = make_model(4, {**identified, "pressure_kpa": 20})
+    trace = tmp_path / "trace.csv"
+    rows = "".join(f"{x:.4f},{y:.4f}\n" for x, y in model_shape(soft.solve("0110")).samples[::7])
+    trace.write_text("x,y\n" + rows, encoding="utf-8")
+    (tmp_path / "identified.toml").write_text('[model]\nfidelity = "2d"\nbody_shear_scale = 0.8\n', encoding="utf-8")
+    rms = {}
+    model_file = ["--model-file", str(tmp_path / "identified.toml")]
+    for name, extra in (("nominal", ["--model", "2d"]), ("identified", model_file)):
+        assert main(["correlate", str(trace), "--design", "0110", "--pressure", "20", *extra, "--json"]) == 0
+        data = json.loads(capsys.readouterr().out)
+        assert data["model"] == "2d"  # the file's fidelity: the 3D default is not used
+        rms[name] = data["outline"]["rms_mm"]
+    assert rms["identified"] < 0.01 < rms["nominal"], rms

@@ -14,6 +14,7 @@ from pneumorph.cli import params as P
 @click.option("--model", "fidelity", type=click.Choice(["3d", "2d"]), default="3d", show_default=True,
               help="The model to compare with (a 3D scan needs 3d).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP)
 @click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]), default="mm", show_default=True,
               help="The unit of the scan's coordinates.")
 @click.option("--scale", type=P.Real(0.0, 1e6, low_open=True),
@@ -23,7 +24,8 @@ from pneumorph.cli import params as P
 @click.option("--out", type=P.OutputDir(), help="Folder for correlation.json and correlation.png.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file: str | None, scan_unit: str,
-              scale: float | None, fit_scale: bool, photo: str | None, out: str | None, as_json: bool) -> None:
+              scale: float | None, fit_scale: bool, photo: str | None, out: str | None, as_json: bool,
+              model_file: str | None = None) -> None:
     """Align SCAN (STL, PLY, OBJ, OFF, XYZ, or a CSV of x,y traced on a photo) to the model's
     inflated shape by least squares, and report RMS and maximum distances on the surface,
     along the outline and along the centreline.
@@ -48,12 +50,16 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
 
         with P.blame("--photo"):
             check_photo(photo)
-    if data.dim == 3 and fidelity == "2d":
-        raise ScanError("a 3D scan needs the 3D model: leave out --model 2d")
     settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure}
     if unit_file:
         P.unit_option(unit_file)
         settings["unit_file"] = unit_file
+    settings = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure"})
+    fidelity = str(settings["fidelity"])
+    if data.dim == 3 and fidelity == "2d":
+        raise ScanError("a 3D scan needs the 3D model: leave out --model 2d" if model_file is None else
+                        f"a 3D scan needs the 3D model, but --model-file {model_file} is of the 2D model: "
+                        "give --model 3d")
     model = make_model(len(orientation), settings)
     check_length(data, len(orientation) * model.unit.pitch)
     click.echo(f"solving design {orientation} at {pressure:g} kPa ({fidelity} model)", err=True)

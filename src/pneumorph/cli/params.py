@@ -255,3 +255,25 @@ def unit_option(unit_file: str) -> None:
 
     with blame("--unit"):
         UnitSpec.from_toml(unit_file)
+
+
+#: ``--model-file``'s help, the same for every command that takes it
+MODEL_FILE_HELP = ("A model's [model] table (an identified model, identified.toml from pneumorph identify): its unit, "
+                   "material scales and fidelity; options given on the command line win.")
+
+
+def model_file_option(settings: dict[str, Any], model_file: str | None, options: dict[str, str]) -> dict[str, Any]:
+    """The model settings of a command with ``--model-file``: the file's ``[model]`` table over ``settings``,
+    except the keys whose option (``options``: setting key -> parameter name) was typed on the command line, and
+    its unit when ``settings`` name one (``unit_file`` or ``library``)."""
+    if model_file is None:
+        return settings
+    from pneumorph.models.factory import read_model_file
+
+    with blame("--model-file"):
+        table = read_model_file(model_file)
+    source = click.get_current_context().get_parameter_source
+    typed = {key for key, param in options.items() if source(param) == click.core.ParameterSource.COMMANDLINE}
+    if {"unit_file", "library"} & set(settings):
+        table = {k: v for k, v in table.items() if k not in ("unit", "unit_file", "library")}
+    return {**settings, **{k: v for k, v in table.items() if k not in typed}}

@@ -20,9 +20,7 @@ from pneumorph.cli import params as P
               help="2D reduced-order (plane strain with filler) or 3D model.")
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
-@click.option("--model-file", type=P.InputFile(),
-              help="A model's [model] table (an identified model, identified.toml from pneumorph identify): its "
-                   "unit, material scales and fidelity; options given here win.")
+@click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP)
 @click.option("--library", metavar="builtin|FILE", type=P.Text(),
               help="A unit library ('builtin' or a library TOML file; documentation page unit-library, "
                    "docs/unit-library.md in the source): the design's letters name its unit types; instead of --unit.")
@@ -67,23 +65,13 @@ def simulate(
             UnitSpec.from_toml(unit_file)
     # the factory, as `design` and the API use it: the model class's tuned ramp, the same fingerprint
     settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure, "increments": increments, "gravity": gravity}
-    if model_file is not None:  # the file's settings, unless an option was given on the command line
-        from pneumorph.models.factory import read_model_file
-
-        with P.blame("--model-file"):
-            table = read_model_file(model_file)
-        source = click.get_current_context().get_parameter_source
-        typed = {key for key, param in (("fidelity", "fidelity"), ("pressure_kpa", "pressure"),
-                                        ("increments", "increments"), ("gravity", "gravity"))
-                 if source(param) == click.core.ParameterSource.COMMANDLINE}
-        if unit_file is not None or library is not None:
-            table = {k: v for k, v in table.items() if k not in ("unit", "unit_file", "library")}
-        settings = {**settings, **{k: v for k, v in table.items() if k not in typed}}
-        fidelity = str(settings.get("fidelity", fidelity))
     if unit_file is not None:
         settings["unit_file"] = unit_file
     if library is not None:
         settings["library"] = library
+    settings = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure",
+                                                          "increments": "increments", "gravity": "gravity"})
+    fidelity = str(settings["fidelity"])
     model = make_model(len(design), settings)
     t0 = time.perf_counter()
 
