@@ -60,7 +60,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.materials.felupe_models:isochoric_function": 101,
     "pneumorph.models.chainfit:build_table": 115,
     "pneumorph.models.chainfit:fit_table": 107,
-    "pneumorph.models.factory:make_model": 116,
 }
 
 

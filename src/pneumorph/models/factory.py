@@ -9,6 +9,7 @@ from typing import Any
 
 from pneumorph import checks
 from pneumorph.errors import GeometryError, SearchConfigError, SettingsError
+from pneumorph.fem import StepSettings
 from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary, builtin_library
 from pneumorph.geometry.meshsize import available_memory, check_mesh
@@ -128,40 +129,13 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     unknown = sorted(set(s) - set(MODEL_KEYS))
     if unknown:
         raise SearchConfigError(f"unknown model setting(s) {', '.join(unknown)}; known: {', '.join(MODEL_KEYS)}")
-    if "unit" in s and "unit_file" in s:
-        raise SearchConfigError("give the unit either inline ([model.unit]) or as unit_file, not both")
-    library = None
-    unit: UnitSpec | None
-    if "library" in s:
-        if "unit" in s or "unit_file" in s:
-            raise SearchConfigError("give either a unit ([model.unit] or unit_file) or a unit library ([model] "
-                                    "library), not both: the library names its units")
-        library = load_library(s["library"])
-        unit = None  # the library's first type
-    elif "unit_file" in s:
-        try:
-            unit = UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file", error=SearchConfigError)))
-        except GeometryError as exc:
-            raise SearchConfigError(f"[model] unit_file: {exc}") from None
-    else:
-        if not isinstance(s.get("unit", {}), Mapping):
-            raise SearchConfigError(f"[model.unit] must be a table of unit parameters, got {s['unit']!r}")
-        unit = UnitSpec.from_dict(dict(s.get("unit", {})), source="[model.unit]")
+    unit, library = _unit_or_library(s)
     fidelity = checks.text(s.get("fidelity", "2d"), "[model] fidelity", ("2d", "3d"), error=SearchConfigError)
     Model: type[Reduced2D | Full3D] = Reduced2D if fidelity == "2d" else Full3D
     free = available_memory()
     for spec in ([unit] if unit is not None else list(library.units) if library is not None else []):
         check_mesh(spec, units, Model.dim, memory=free)  # before any mesh is built: the estimate in the message
-    # the model class's tuned ramp (one substep per level, its iteration limit) unless asked otherwise,
-    # so that API and CLI runs of the same design share their cache entries
-    defaults = Model.default_steps
-    pressure = checks.real(s.get("pressure_kpa", 45.0), "[model] pressure_kpa", 0.0, checks.MAX_PRESSURE_KPA,
-                           low_open=True, unit="kPa", limit="MAX_PRESSURE_KPA", error=SearchConfigError)
-    increments = checks.integer(s.get("increments", defaults.increments), "[model] increments", 1,
-                                checks.MAX_INCREMENTS, limit="MAX_INCREMENTS", error=SearchConfigError)
-    substeps = checks.integer(s.get("substeps", defaults.substeps), "[model] substeps", 1, checks.MAX_SUBSTEPS,
-                              limit="MAX_SUBSTEPS", error=SearchConfigError)
-    ramp = RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps))
+    ramp = _ramp(s, Model.default_steps)
     try:
         gravity = gravity_vector(s.get("gravity"), Model.dim)
     except (ValueError, TypeError) as exc:
@@ -169,18 +143,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     change = checks.real(s.get("temperature_change", 0.0), "[model] temperature_change", -100.0, 100.0, unit="degC",
                          error=SearchConfigError)
     passage = checks.real(s.get("passage", 0.0), "[model] passage", 0.0, 100.0, unit="mm", error=SearchConfigError)
-    block = s.get("base_block")
-    if block is not None:
-        if not isinstance(block, Mapping):
-            raise SearchConfigError(f"[model.base_block] must be a table (length, margin, material), got {block!r}")
-        unknown = sorted(set(block) - {"length", "margin", "material"})
-        if unknown:
-            raise SearchConfigError(f"unknown base block setting(s) {', '.join(unknown)}; known: length, margin, "
-                                    "material")
-        try:
-            block = BaseBlock(**block)
-        except GeometryError as exc:
-            raise SearchConfigError(f"[model.base_block] {exc}") from None
+    block = _base_block(s.get("base_block"))
     extra: dict[str, Any] = {"base_block": block} if block is not None else {}
     if library is not None:
         extra["library"] = library
@@ -196,6 +159,75 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         except GeometryError as exc:
             raise SearchConfigError(f"[model] passage: {exc}") from None
     return Model(units, unit, ramp, gravity=gravity, **extra)
+
+
+def _unit_or_library(s: Mapping[str, Any]) -> tuple[UnitSpec | None, UnitLibrary | None]:
+    """The unit (``unit``, ``unit_file`` or the default) or the unit library (``library``) of the settings.
+
+    Raises
+    ------
+    SearchConfigError
+        Both a unit and a library, or a unit both inline and as a file; a unit or a library
+        that cannot be read.
+    """
+    if "unit" in s and "unit_file" in s:
+        raise SearchConfigError("give the unit either inline ([model.unit]) or as unit_file, not both")
+    if "library" in s:
+        if "unit" in s or "unit_file" in s:
+            raise SearchConfigError("give either a unit ([model.unit] or unit_file) or a unit library ([model] "
+                                    "library), not both: the library names its units")
+        return None, load_library(s["library"])  # the model's unit: the library's first type
+    if "unit_file" in s:
+        try:
+            return UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file",
+                                                       error=SearchConfigError))), None
+        except GeometryError as exc:
+            raise SearchConfigError(f"[model] unit_file: {exc}") from None
+    if not isinstance(s.get("unit", {}), Mapping):
+        raise SearchConfigError(f"[model.unit] must be a table of unit parameters, got {s['unit']!r}")
+    return UnitSpec.from_dict(dict(s.get("unit", {})), source="[model.unit]"), None
+
+
+def _ramp(s: Mapping[str, Any], defaults: StepSettings) -> RampSpec:
+    """The ramp of ``pressure_kpa``, ``increments`` and ``substeps``, else the model class's tuned ``defaults``.
+
+    The class's tuned ramp (one substep per level, its iteration limit) unless asked
+    otherwise, so that API and CLI runs of the same design share their cache entries.
+
+    Raises
+    ------
+    SearchConfigError
+        A setting out of its range.
+    """
+    pressure = checks.real(s.get("pressure_kpa", 45.0), "[model] pressure_kpa", 0.0, checks.MAX_PRESSURE_KPA,
+                           low_open=True, unit="kPa", limit="MAX_PRESSURE_KPA", error=SearchConfigError)
+    increments = checks.integer(s.get("increments", defaults.increments), "[model] increments", 1,
+                                checks.MAX_INCREMENTS, limit="MAX_INCREMENTS", error=SearchConfigError)
+    substeps = checks.integer(s.get("substeps", defaults.substeps), "[model] substeps", 1, checks.MAX_SUBSTEPS,
+                              limit="MAX_SUBSTEPS", error=SearchConfigError)
+    return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps))
+
+
+def _base_block(block: Any) -> BaseBlock | None:
+    """The ``[model.base_block]`` table as a :class:`BaseBlock` (None: no block).
+
+    Raises
+    ------
+    SearchConfigError
+        Not a table, an unknown key, or a block that is no valid :class:`BaseBlock`.
+    """
+    if block is None:
+        return None
+    if not isinstance(block, Mapping):
+        raise SearchConfigError(f"[model.base_block] must be a table (length, margin, material), got {block!r}")
+    unknown = sorted(set(block) - {"length", "margin", "material"})
+    if unknown:
+        raise SearchConfigError(f"unknown base block setting(s) {', '.join(unknown)}; known: length, margin, "
+                                "material")
+    try:
+        return BaseBlock(**block)
+    except GeometryError as exc:
+        raise SearchConfigError(f"[model.base_block] {exc}") from None
 
 
 def _scaled_body(settings: Mapping[str, Any], unit: UnitSpec) -> Any:
