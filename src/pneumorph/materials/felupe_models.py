@@ -122,55 +122,74 @@ def isochoric_function(
     1.75
     """
     if isinstance(model, NeoHooke):
-        c10 = float(model.c10)
-
-        def neo_hooke(C: Tensor) -> Tensor:
-            ibar1, _ = _isochoric_invariants(C)
-            return c10 * (ibar1 - 3.0)
-
-        return neo_hooke
-
+        return _neo_hooke_energy(model)
     if isinstance(model, MooneyRivlin):
-        c10, c01, c11 = float(model.c10), float(model.c01), float(model.c11)
-
-        def mooney_rivlin(C: Tensor) -> Tensor:
-            ibar1, ibar2 = _isochoric_invariants(C)
-            w = c10 * (ibar1 - 3.0) + c01 * (ibar2 - 3.0)
-            if c11 != 0.0:
-                w = w + c11 * (ibar1 - 3.0) * (ibar2 - 3.0)
-            return w
-
-        return mooney_rivlin
-
+        return _mooney_rivlin_energy(model)
     if isinstance(model, Yeoh):
-        coefficients = tuple(float(c) for c in model.c)
-
-        def yeoh(C: Tensor) -> Tensor:
-            ibar1, _ = _isochoric_invariants(C)
-            x = ibar1 - 3.0
-            w = coefficients[0] * x
-            for i, ci in enumerate(coefficients[1:], start=2):
-                w = w + ci * x**i
-            return w
-
-        return yeoh
-
+        return _yeoh_energy(model)
     if isinstance(model, Ogden):
-        terms = tuple(zip(model.mu, model.alpha, strict=True))
-        eps = float(eigen_perturbation)
-
-        def ogden(C: Tensor) -> Tensor:
-            # squared isochoric stretches lbar_i^2 = J^(-2/3) l_i^2
-            lbar2 = det(C) ** (-1.0 / 3.0) * eigvalsh(C, eps=eps)
-            w = None
-            for mu, alpha in terms:
-                wn = mu / alpha * (tsum(lbar2 ** (alpha / 2.0)) - 3.0)
-                w = wn if w is None else w + wn
-            return w
-
-        return ogden
-
+        return _ogden_energy(model, eigen_perturbation)
     raise UnknownModelError(type(model).__name__, ("NeoHooke", "MooneyRivlin", "Yeoh", "Ogden"))
+
+
+def _neo_hooke_energy(model: NeoHooke) -> EnergyFunction:
+    """``C10 (Ibar1 - 3)`` (Eq 2.7)."""
+    c10 = float(model.c10)
+
+    def neo_hooke(C: Tensor) -> Tensor:
+        ibar1, _ = _isochoric_invariants(C)
+        return c10 * (ibar1 - 3.0)
+
+    return neo_hooke
+
+
+def _mooney_rivlin_energy(model: MooneyRivlin) -> EnergyFunction:
+    """``C10 (Ibar1 - 3) + C01 (Ibar2 - 3) + C11 (Ibar1 - 3)(Ibar2 - 3)`` (Eqs 2.9, 2.10)."""
+    c10, c01, c11 = float(model.c10), float(model.c01), float(model.c11)
+
+    def mooney_rivlin(C: Tensor) -> Tensor:
+        ibar1, ibar2 = _isochoric_invariants(C)
+        w = c10 * (ibar1 - 3.0) + c01 * (ibar2 - 3.0)
+        if c11 != 0.0:
+            w = w + c11 * (ibar1 - 3.0) * (ibar2 - 3.0)
+        return w
+
+    return mooney_rivlin
+
+
+def _yeoh_energy(model: Yeoh) -> EnergyFunction:
+    """``sum_i C_i (Ibar1 - 3)^i`` (Eq 2.11)."""
+    coefficients = tuple(float(c) for c in model.c)
+
+    def yeoh(C: Tensor) -> Tensor:
+        ibar1, _ = _isochoric_invariants(C)
+        x = ibar1 - 3.0
+        w = coefficients[0] * x
+        for i, ci in enumerate(coefficients[1:], start=2):
+            w = w + ci * x**i
+        return w
+
+    return yeoh
+
+
+def _ogden_energy(model: Ogden, eigen_perturbation: float) -> EnergyFunction:
+    """``sum_n mu_n / alpha_n (lbar1^a_n + lbar2^a_n + lbar3^a_n - 3)`` (Eq 2.12, Marc convention).
+
+    ``eigen_perturbation`` separates repeated eigenvalues of ``C`` (see :func:`isochoric_function`).
+    """
+    terms = tuple(zip(model.mu, model.alpha, strict=True))
+    eps = float(eigen_perturbation)
+
+    def ogden(C: Tensor) -> Tensor:
+        # squared isochoric stretches lbar_i^2 = J^(-2/3) l_i^2
+        lbar2 = det(C) ** (-1.0 / 3.0) * eigvalsh(C, eps=eps)
+        w = None
+        for mu, alpha in terms:
+            wn = mu / alpha * (tsum(lbar2 ** (alpha / 2.0)) - 3.0)
+            w = wn if w is None else w + wn
+        return w
+
+    return ogden
 
 
 def volumetric_energy(
