@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -25,6 +26,8 @@ def test_tiny_design_run_writes_the_folder_and_resumes(tmp_path: Path, capsys: p
     assert first["status"] == "finished" and first["solves"] >= 1
     err = captured.err.splitlines()
     assert "evaluating generation 0: " in err[1] and "generation  0/2: best" in err[2], err  # after the first line
+    # the fitness in the objective's unit (Eq 4.1: mm)
+    assert re.search(r"generation  0/2: best [0-9.e+-]+ mm  mean [0-9.e+-]+ mm  ", err[2]), err[2]
     # the run's cache hits are the sum of its generations' (an empty cache: none)
     assert first["cache_hits"] == 0 and all(" 0 cache hits" in line for line in err if "/2: best" in line)
     assert first["best"]["design"] in {"00", "01", "10", "11"}
@@ -67,7 +70,7 @@ def test_population_study_command(tmp_path: Path, capsys: pytest.CaptureFixture[
     for pop in (2, 4):
         for seed in (0, 1):
             for gen in (0, 1, 2):
-                assert sum(f"population {pop}, seed {seed}, generation {gen}/2: best " in line
+                assert sum(f"population {pop}, seed {seed}, generation {gen}/2: best " in line and " mm  mean " in line
                            for line in err) == 1, (pop, seed, gen)
     assert "run 4/4 done" in captured.err
     assert [r["population"] for r in rows] == [2, 4]
@@ -302,6 +305,9 @@ def test_no_build_stops_a_run_whose_tolerance_tables_are_missing(tmp_path: Path,
         (["--target", "y = 0.1*x", "--amplitude", "5"], "which the target y = 0.1*x does not use"),
         (["--target", "y = A*x/L", "--periods", "2"], "--periods applies to the sin and cos presets"),
         (["--tolerance", "0", "--robust-samples", "5"], "which --tolerance 0 turns off"),
+        (["--units", "5", "--periods", "1000"], "--periods 1000: a sin or cos target over 5 unit centres shows at "
+                                                "most 2.5 periods"),
+        (["--units", "5", "--stage", "45:sin", "--periods", "3"], "shows at most 2.5 periods"),
     ],
 )
 def test_shape_options_that_would_be_ignored_are_refused(args: list[str], message: str, tmp_path: Path,

@@ -50,7 +50,8 @@ def test_design_with_a_model_file_reports_the_nominal_design(tmp_path: Path) -> 
     (tmp_path / "identified.toml").write_text('[model]\nfidelity = "2d"\nbody_bulk_scale = 1.0\n', encoding="utf-8")
     runner = CliRunner()
     args = ["design", "--units", str(UNITS), "--executor", "serial", "--tolerance", "0", "--cache",
-            str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"), "--model-file", str(tmp_path / "identified.toml")]
+            str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "run"),
+            "--model-file", str(tmp_path / "identified.toml")]
     done = runner.invoke(cli, [*args, "--json"])
     assert done.exit_code == 0, done.output
     out = json.loads(done.stdout)

@@ -156,3 +156,18 @@ def test_curve_configs_that_would_be_read_wrongly_are_refused(curve: list, messa
     with pytest.raises(SearchConfigError, match=message):
         DesignConfig(objective="curve", curve=curve, units=15)
     assert DesignConfig(objective="curve", curve=[[0, 0], [80, 2], [160, 5]]).curve == ((0, 0), (80, 2), (160, 5))
+
+
+def test_more_periods_than_the_unit_centres_can_show_are_refused() -> None:
+    from pneumorph.design import DesignConfig
+    from pneumorph.errors import SearchConfigError
+
+    # Eq 4.1 samples the target at the unit centres: n centres show at most n / 2 periods
+    assert DesignConfig(units=5, periods=2.5).periods == 2.5
+    with pytest.raises(SearchConfigError, match=r"\[design\] periods = 3: a sin target over 5 unit centres shows at "
+                                                r"most 2.5 periods"):
+        DesignConfig(units=5, periods=3)
+    with pytest.raises(SearchConfigError, match=r"\[\[design.stage\]\] 2 periods = 4: a cos target"):
+        DesignConfig(units=6, objective="stages", stage=({"pressure_kpa": 18, "objective": "sin"},
+                                                         {"pressure_kpa": 45, "objective": "cos", "periods": 4}))
+    assert DesignConfig(units=5, objective="y = sin(2*pi*40*x/L)").units == 5  # an expression says what it means

@@ -161,6 +161,11 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
     check_options(o.executor or config.executor, config.workers if o.workers is None else o.workers,
                   o.scheduler or config.scheduler)
+    units = o.units or config.units
+    if o.periods is not None and o.periods > units / 2:  # named as typed; the config refuses it for files
+        raise click.UsageError(f"--periods {o.periods:g}: a sin or cos target over {units} unit centres shows at most "
+                               f"{units / 2:g} periods (Eq 4.1 samples it at the centres); give fewer periods or "
+                               "more units")
     design = {key: getattr(o, key) for key in _DESIGN_OPTIONS}
     design["objective"] = o.target or o.objective
     design.update(_stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods, o.units))
@@ -242,7 +247,8 @@ class _Progress:
 
     def __init__(self, config: Any, model: Any, folder: str) -> None:
         self.config, self.model, self.folder = config, model, folder
-        self.label = config.make_objective().label
+        objective = config.make_objective()
+        self.label, self.unit = objective.label, objective.unit
         self.said = False
 
     def announce(self) -> None:
@@ -257,7 +263,7 @@ class _Progress:
         self.announce()
         total, done = self.config.ga.generations, stats.generation
         bar = "#" * int(20 * done / max(total, 1))
-        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: {stats.describe()}", err=True)
+        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: {stats.describe(self.unit)}", err=True)
 
     def on_progress(self, done: int, total: int) -> None:
         self.announce()
@@ -293,10 +299,10 @@ def _print_result(result: Any, config: Any, model: Any) -> None:
         click.echo(f"  {line}")
     rob = result.robustness
     if rob is not None and "mean" in rob["winner"]:
-        w = rob["winner"]
+        w, u = rob["winner"], result.objective.unit
         click.echo(f"  under +-{rob['tolerance_mm']:g} mm mould tolerances ({rob['samples']} samples, "
-                   f"{rob['method'].split(',')[0]}): {w['design']} mean {w['mean']:.4g}, 95th percentile "
-                   f"{w['p95']:.4g}, worst {w['worst']:.4g}")
+                   f"{rob['method'].split(',')[0]}): {w['design']} mean {w['mean']:.4g} {u}, 95th percentile "
+                   f"{w['p95']:.4g} {u}, worst {w['worst']:.4g} {u}")
     if result.retried:
         click.echo(f"  {result.retried} design(s) retried on other Dask workers after lost workers")
     click.echo(f"report: {result.folder / 'report.md'}")

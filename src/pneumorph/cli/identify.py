@@ -47,7 +47,6 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
     after, and which parameters the scans cannot tell apart. With --out, write the identified model
     (identified.toml: a [model] table for design/simulate --model-file).
     """
-    from pathlib import Path
 
     from pneumorph.cli.execution import check_options
     from pneumorph.errors import SettingsError
@@ -56,30 +55,15 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
         NAMES,
         Observation,
         ParameterSet,
-        ScanSpec,
         build_probes,
         load_scans,
-        read_manifest,
         write_identified,
     )
     from pneumorph.identify import identify as fit
     from pneumorph.io import provenance, strict_json, write_json
 
     check_options(executor, workers, scheduler)
-    if manifest is not None:
-        given = [o for o, v in (("SCAN", scan), ("--design", design), ("--pressure", pressure),
-                                ("--scale", scale)) if v is not None]
-        if given:
-            raise click.UsageError(f"give the scans either in --manifest or as SCAN --design --pressure, not both "
-                                   f"({', '.join(given)} with --manifest)")
-        specs = read_manifest(manifest)
-    else:
-        missing = [o for o, v in (("SCAN", scan), ("--design", design), ("--pressure", pressure)) if v is None]
-        if missing:
-            raise click.UsageError(f"missing {', '.join(missing)}: give SCAN --design D --pressure P, or --manifest")
-        assert scan is not None and design is not None and pressure is not None
-        with P.blame("--design"):
-            specs = [ScanSpec(scan, design, pressure, scan_unit, scale)]
+    specs = _scan_specs(scan, design, pressure, manifest, scan_unit, scale)
     unit = UnitSpec()
     if unit_file is not None:
         with P.blame("--unit"):
@@ -120,7 +104,34 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
             write_json(folder / "identify.json", {**summary, "provenance": provenance(command=command)})
     if as_json:
         click.echo(strict_json(summary))
-        return
+    else:
+        _print_identification(result, observations, scans[0].dim, out)
+
+
+def _scan_specs(scan: str | None, design: str | None, pressure: float | None, manifest: str | None, scan_unit: str,
+                scale: float | None) -> list[Any]:
+    """The scans to fit: the manifest's, or the one SCAN --design --pressure (refusing a mix of both)."""
+    from pneumorph.identify import ScanSpec, read_manifest
+
+    if manifest is not None:
+        given = [o for o, v in (("SCAN", scan), ("--design", design), ("--pressure", pressure),
+                                ("--scale", scale)) if v is not None]
+        if given:
+            raise click.UsageError(f"give the scans either in --manifest or as SCAN --design --pressure, not both "
+                                   f"({', '.join(given)} with --manifest)")
+        return list(read_manifest(manifest))
+    missing = [o for o, v in (("SCAN", scan), ("--design", design), ("--pressure", pressure)) if v is None]
+    if missing:
+        raise click.UsageError(f"missing {', '.join(missing)}: give SCAN --design D --pressure P, or --manifest")
+    assert scan is not None and design is not None and pressure is not None
+    with P.blame("--design"):
+        return [ScanSpec(scan, design, pressure, scan_unit, scale)]
+
+
+def _print_identification(result: Any, observations: list[Any], dim: int, out: str | None) -> None:
+    """The parameters, their correlations and the residuals, in words."""
+    from pathlib import Path
+
     click.echo(f"{'parameter':<20} {'nominal':>9} {'value':>10} {'std err':>9}  identified")
     for name, p in result.parameters().items():
         se = "-" if p["standard_error"] is None else f"{p['standard_error']:.3g}"
@@ -131,7 +142,7 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
         click.echo("correlations of the fitted parameters:")
         for name, row in zip(result.free, result.correlation, strict=True):
             click.echo(f"  {name:<20} " + " ".join(f"{v:+6.3f}" for v in row))
-    what = "surface" if scans[0].dim == 3 else "outline"
+    what = "surface" if dim == 3 else "outline"
     for o, before, after in zip(observations, result.rms_before, result.rms_after, strict=True):
         click.echo(f"  {Path(o.spec.file).name}: {what} RMS {before:.4g} mm at nominal, {after:.4g} mm identified")
     click.echo(f"{result.iterations} Gauss-Newton iteration(s), {result.solves} solves (cache hits included), "

@@ -71,7 +71,7 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
 
     def on_generation(pop: int, seed: int, stats) -> None:
         click.echo(f"    population {pop}, seed {seed}, generation {stats.generation}/{generations}: "
-                   f"{stats.describe()}", err=True)
+                   f"{stats.describe(objective.unit)}", err=True)
 
     def on_run(pop: int, seed: int, result) -> None:
         done.append(pop)

@@ -44,7 +44,7 @@ from typing import Any
 from pneumorph import checks
 from pneumorph.design.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.ga import GAConfig
-from pneumorph.design.targets import Objective, make_objective, staged_target
+from pneumorph.design.targets import PRESETS, Objective, make_objective, staged_target
 from pneumorph.errors import (
     SearchConfigError,
     TargetExpressionError,
@@ -172,6 +172,7 @@ class DesignConfig:
         if self.curve is not None:
             object.__setattr__(self, "curve", _curve(self.curve, "[design] curve"))
         object.__setattr__(self, "stage", _stages(self.objective, self.stage))
+        self._check_periods()
         unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
         pitch = unit.get("pitch", UnitSpec.pitch)  # the inline unit's, else the built-in unit's
         ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
@@ -183,6 +184,18 @@ class DesignConfig:
             if isinstance(exc, SearchConfigError):
                 raise
             raise SearchConfigError(f"[design] objective: {exc}") from None
+
+    def _check_periods(self) -> None:
+        """Refuse a sin or cos target of more periods than its unit centres can show (Eq 4.1 samples the target at
+        the ``units`` centres: past ``units / 2`` periods it aliases)."""
+        presets = [("[design] periods", self.objective, self.periods)] if self.stage is None else [
+            (f"[[design.stage]] {i} periods", s["objective"], s.get("periods", 1.0))
+            for i, s in enumerate(self.stage, 1)]
+        for where, name, periods in presets:
+            if name.strip().lower() in PRESETS and periods > self.units / 2:
+                raise SearchConfigError(f"{where} = {periods:g}: a {name.strip().lower()} target over {self.units} "
+                                        f"unit centres shows at most {self.units / 2:g} periods (Eq 4.1 samples it at "
+                                        "the centres); give fewer periods or more units")
 
     @property
     def fidelity(self) -> str:

@@ -169,16 +169,18 @@ class GenerationStats:
     def as_row(self) -> dict[str, object]:
         return dict(self.__dict__)
 
-    def describe(self) -> str:
-        """One progress line: fitness statistics, where the evaluations came from, wall time.
+    def describe(self, unit: str = "") -> str:
+        """One progress line: fitness statistics (in the objective's ``unit``), where the evaluations came from,
+        wall time.
 
         Examples
         --------
-        >>> GenerationStats(3, 1.5, 2.25, 4.0, 0.5, 10, 2, 5, 0, 12.34, "0101", repeats=3).describe()
-        'best 1.5  mean 2.25  10 evaluated: 5 solved, 2 cache hits, 3 repeats  12.3 s'
+        >>> GenerationStats(3, 1.5, 2.25, 4.0, 0.5, 10, 2, 5, 0, 12.34, "0101", repeats=3).describe("mm")
+        'best 1.5 mm  mean 2.25 mm  10 evaluated: 5 solved, 2 cache hits, 3 repeats  12.3 s'
         """
-        return (f"best {self.best:.4g}  mean {self.mean:.4g}  {self.evaluations} evaluated: {self.solves} solved, "
-                f"{self.cache_hits} cache hits, {self.repeats} repeats  {self.wall_time:.1f} s")
+        u = f" {unit}" if unit else ""
+        return (f"best {self.best:.4g}{u}  mean {self.mean:.4g}{u}  {self.evaluations} evaluated: {self.solves} "
+                f"solved, {self.cache_hits} cache hits, {self.repeats} repeats  {self.wall_time:.1f} s")
 
 
 @dataclass(frozen=True)

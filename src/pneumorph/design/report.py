@@ -292,28 +292,8 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
             p = "failed" if c.pressure is None else f"{c.pressure * 1e3:.4g}"
             lines.append(f"| {i} | `{c.design}` | {c.value:.6g} | {p} |")
         lines.append("")
-    cert = result.certified
-    if cert is not None:
-        sure = cert.certificate
-        u = o.unit
-        words = certificate_text(sure, u, cert.winner.design, getattr(model, "fidelity", None),
-                                 show=len(sure["verified"]))
-        lines += [
-            "## Certificate",
-            "",
-            *[f"- {line}" for line in words],
-            "",
-            f"| chain rank | design | chain ({u}) | FE ({u}) | 2D chain ({u}) | pressure (kPa) |",
-            "|---:|---|---:|---:|---:|---:|",
-        ]
-
-        def fmt(v: Any) -> str:
-            return "-" if v is None else f"{v:.4g}"
-
-        for row in _top_rows(result):
-            lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
-                         f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kpa'] or row['chain_pressure_kpa'])} |")
-        lines.append("")
+    if result.certified is not None:
+        lines += _certificate_lines(result, model)
     if result.comparison is not None:
         lines += ["## The nominal model's design", "", *[f"- {line}" for line in comparison_lines(result.comparison)],
                   ""]
@@ -324,6 +304,25 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
     if files:
         lines += ["## Files", "", *[f"- [{f}]({f})" for f in files], ""]
     return "\n".join(lines)
+
+
+def _certificate_lines(result: RunResult, model: ActuatorModel) -> list[str]:
+    """The report's certificate: in words, and the chain's best designs with their FE and 2D values."""
+    cert = result.certified
+    assert cert is not None
+    sure, u = cert.certificate, result.objective.unit
+    words = certificate_text(sure, u, cert.winner.design, getattr(model, "fidelity", None), show=len(sure["verified"]))
+    lines = ["## Certificate", "", *[f"- {line}" for line in words], "",
+             f"| chain rank | design | chain ({u}) | FE ({u}) | 2D chain ({u}) | pressure (kPa) |",
+             "|---:|---|---:|---:|---:|---:|"]
+
+    def fmt(v: Any) -> str:
+        return "-" if v is None else f"{v:.4g}"
+
+    for row in _top_rows(result):
+        lines.append(f"| {row['rank_chain']} | `{row['design']}` | {fmt(row['chain'])} | {fmt(row['fe'])} | "
+                     f"{fmt(row['chain_2d'])} | {fmt(row['fe_pressure_kpa'] or row['chain_pressure_kpa'])} |")
+    return [*lines, ""]
 
 
 def _refinement_lines(ref: dict[str, Any], o: Objective) -> list[str]:

@@ -112,9 +112,9 @@ class CertifiedSearch(Search):
         if config.tolerance == 0 or self.tables is None:
             return replace(outcome, robustness=winner_robustness(problem, cert.winner))
         out = chain_robustness(config, self.chain, self.tables, problem.objective, cert.winner)
-        w = out["winner"]
+        w, u = out["winner"], problem.objective.unit
         problem.say(f"robustness of {w['design']} under +-{config.tolerance:g} mm ({config.samples(True)} samples, "
-                    f"chain): mean {w['mean']:.4g}, 95th percentile {w['p95']:.4g}, worst {w['worst']:.4g}")
+                    f"chain): mean {w['mean']:.4g} {u}, 95th percentile {w['p95']:.4g} {u}, worst {w['worst']:.4g} {u}")
         return replace(outcome, robustness=out)
 
 
