@@ -162,3 +162,22 @@ def test_an_unknown_body_material_is_refused_before_anything_is_written(tmp_path
         assert result.exit_code == 2, result.output
         assert "'--unit': unknown material 'nonesuch'; known materials: " in " ".join(result.output.split())
         assert sorted(p.name for p in tmp_path.iterdir()) == ["unit.toml"]
+
+
+def test_a_model_file_gives_the_parts_its_unit_and_the_deck_its_materials(tmp_path: Path) -> None:
+    from pneumorph.models.factory import make_model
+
+    identified = tmp_path / "identified.toml"
+    identified.write_text('[model]\nfidelity = "3d"\nbody_bulk_scale = 1.06\n[model.unit]\npitch = 12.0\n'
+                          "slit_width = 1.0\nslit_depth = 4.0\n[provenance]\npneumorph = 'x'\n")
+    result = run("0", "--stl", str(tmp_path / "out"), "--model-file", str(identified), "--json")
+    assert result.exit_code == 0, result.output
+    # the identified unit's body, as from the same unit given by --unit (12 x 9 x 15 - slit - cavity)
+    assert json.loads(result.output)["volumes_mm3"]["body"] == pytest.approx(1620 - 60 - 360, rel=1e-12)
+    result = run("0", "--inp", str(tmp_path / "d.inp"), "--pressure", "20", "--model-file", str(identified), "--json")
+    assert result.exit_code == 0, result.output
+    scaled = make_model(1, {"fidelity": "3d", "pressure_kpa": 20, "body_bulk_scale": 1.06,
+                            "unit": {"pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}})
+    assert json.loads(result.output)["deck"]["fingerprint"] == scaled.fingerprint()
+    assert scaled.fingerprint() != make_model(1, {"fidelity": "3d", "pressure_kpa": 20, "unit": {
+        "pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}}).fingerprint()
