@@ -179,3 +179,21 @@ def test_the_tolerance_figure_starts_its_bars_at_the_nominal_design_and_explains
     assert {t.get_text() for t in bx.get_legend().get_texts()} == {
         "extremes and corners of the tolerance box", "random samples", "nominal design"}
     assert "the other cases (extremes, corners, random samples)" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_cli_study_of_an_identified_model(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the study's reference is the model file's: its fingerprint, and the study's 2D fidelity from the file
+    from pneumorph.models.factory import make_model
+
+    identified = tmp_path / "identified.toml"
+    identified.write_text('[model]\nfidelity = "2d"\nbody_shear_scale = 0.9\n[model.unit]\nwall = 1.6\n')
+    argv = ["sensitivity", "bulk-modulus", "--units", "2", "--pressure", "10", "--executor", "serial",
+            "--cache", str(tmp_path / "c.sqlite"), "--factor", "1.1", "--model-file", str(identified), "--json"]
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    assert "(2d model, 2 units, 10 kPa)" in err
+    model = make_model(2, {"fidelity": "2d", "pressure_kpa": 10, "body_shear_scale": 0.9, "unit": {"wall": 1.6}})
+    assert json.loads(out)["reference"]["fingerprint"] == model.fingerprint()
+    # a study of the 3D model only refuses a 2D model file, naming both
+    assert main(["sensitivity", "temperature", "--units", "2", "--model-file", str(identified)]) == 2
+    assert "is of the 2d model, which this study does not vary; give --model 3d" in capsys.readouterr().err

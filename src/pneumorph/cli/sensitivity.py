@@ -26,6 +26,7 @@ def _common(command: Callable[..., Any], models: tuple[str, ...] = ("2d", "3d"))
                      help="Units of the default design (ignored with --design)."),
         click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure, kPa."),
         click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit)."),
+        click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP),
         click.option("--cache", metavar="FILE", type=P.CacheFile(),
                      help="Evaluation cache (default ~/.cache/pneumorph/evaluations.sqlite): a rerun resumes."),
         click.option("--out", type=P.OutputDir(), help="Folder for study.json and study.png."),
@@ -61,6 +62,8 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
     if common["unit_file"]:
         P.unit_option(common["unit_file"])
         settings["unit_file"] = common["unit_file"]
+    settings = _with_model_file(settings, common["model_file"])
+    common["fidelity"], common["pressure"] = settings["fidelity"], settings["pressure_kpa"]
     model = make_model(n, settings)
     if options.get("base") is not None:
         _check_base_block(model, options["base"], common)
@@ -101,6 +104,18 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
                    "side_wall rows equal the reference (use --model 3d for them)")
     if common["out"]:
         click.echo(f"written to {Path(common['out'])}/ (study.json, study.png)")
+
+
+def _with_model_file(settings: dict[str, Any], model_file: str | None) -> dict[str, Any]:
+    """``settings`` with ``--model-file``'s under the options typed; a fidelity the study's ``--model`` does not
+    offer refused, naming both."""
+    merged = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure"})
+    offered = click.get_current_context().command.params
+    choices = next((p.type.choices for p in offered if p.name == "fidelity" and isinstance(p.type, click.Choice)), ())
+    if model_file is not None and merged["fidelity"] not in choices:
+        raise click.UsageError(f"--model-file {model_file} is of the {merged['fidelity']} model, which this study "
+                               f"does not vary; give --model {'/'.join(choices)}")
+    return merged
 
 
 def _check_base_block(model: Any, base: Any, common: dict[str, Any]) -> None:
@@ -235,6 +250,7 @@ def temperature_cmd(changes: tuple[float, ...], **common: Any) -> None:
               help="The FE model.")
 @click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure, kPa.")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP)
 @click.option("--target", type=P.Text(), default="sin", show_default=True,
               help="The objective whose value is compared: a profile ('sin', 'y = ...') or a tip goal ('max-x').")
 @click.option("--amplitude", type=P.Real(-1e4, 1e4, unit="mm"), default=10.0, show_default=True,
@@ -249,7 +265,8 @@ def temperature_cmd(changes: tuple[float, ...], **common: Any) -> None:
 @execution_options(default="serial", what="solves")
 def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], fidelity: str, pressure: float,
              unit_file: str | None, target: str, amplitude: float, order: float | None, cache: str | None,
-             out: str | None, as_json: bool, executor: str, workers: int | None, scheduler: str | None) -> None:
+             out: str | None, as_json: bool, executor: str, workers: int | None, scheduler: str | None,
+             model_file: str | None = None) -> None:
     """Mesh convergence: designs solved at several element sizes; observed order, Richardson limit and error
     estimate of the tip, the curl and the objective (documentation page mesh-convergence, docs/mesh-convergence.md
     in the source)."""
@@ -278,6 +295,8 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     if unit_file:
         P.unit_option(unit_file)
         settings["unit_file"] = unit_file
+    settings = _with_model_file(settings, model_file)
+    fidelity = settings["fidelity"]
     model = make_model(n, settings)
     with P.blame("--target"):
         objective = make_objective(target, amplitude, length=n * model.unit.pitch)
