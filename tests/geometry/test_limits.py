@@ -80,3 +80,25 @@ def test_a_base_block_past_the_memory_is_refused_with_its_estimate(tmp_path: Pat
     assert code == 2 and "--base-length" in out and "with a base block of 1000 mm" in out, out
     assert "GB for one solve" in out and "GB are available" in out and "Traceback" not in out
     assert seconds < 30 and not (tmp_path / "out").exists()
+
+
+def test_a_configs_base_block_past_the_memory_is_refused_with_its_estimate(tmp_path: Path) -> None:
+    """A design config's [model.base_block] counts in the model factory's mesh check: 3 units at 0.75 mm need
+    about 1.6 GB, with a 1000 mm block about 160 GB (refused); the same unit without the block is built."""
+    from pneumorph.geometry.limits import MeshLimitError
+    from pneumorph.models.factory import make_model
+
+    unit = {"element_size": 0.75}
+    try:
+        make_model(3, {"fidelity": "3d", "unit": unit, "base_block": {"length": 1000.0}})
+    except MeshLimitError as exc:
+        assert "base block of 1000 mm" in str(exc) and "GB for one solve" in str(exc), exc
+    else:
+        raise AssertionError("a 160 GB mesh was built")
+    assert make_model(3, {"fidelity": "3d", "unit": unit}).n_units == 3
+    config = tmp_path / "design.toml"
+    config.write_text('[design]\nunits = 3\nsearch = "ga"\n[model]\nfidelity = "3d"\n[model.unit]\n'
+                      'element_size = 0.75\n[model.base_block]\nlength = 1000.0\n')
+    code, out, seconds = _run("design", str(config), "--out", str(tmp_path / "run"))
+    assert code == 2 and "base block of 1000 mm" in out and "Traceback" not in out, out
+    assert seconds < 30 and not (tmp_path / "run").exists()

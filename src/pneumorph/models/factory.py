@@ -133,8 +133,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     fidelity = checks.text(s.get("fidelity", "2d"), "[model] fidelity", ("2d", "3d"), error=SearchConfigError)
     Model: type[Reduced2D | Full3D] = Reduced2D if fidelity == "2d" else Full3D
     free = available_memory()
+    block = _base_block(s.get("base_block"))  # its mesh counts too
     for spec in ([unit] if unit is not None else list(library.units) if library is not None else []):
-        check_mesh(spec, units, Model.dim, memory=free)  # before any mesh is built: the estimate in the message
+        check_mesh(spec, units, Model.dim, memory=free, base=block)  # before any mesh: the estimate in the message
     ramp = _ramp(s, Model.default_steps)
     try:
         gravity = gravity_vector(s.get("gravity"), Model.dim)
@@ -143,7 +144,6 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     change = checks.real(s.get("temperature_change", 0.0), "[model] temperature_change", -100.0, 100.0, unit="degC",
                          error=SearchConfigError)
     passage = checks.real(s.get("passage", 0.0), "[model] passage", 0.0, 100.0, unit="mm", error=SearchConfigError)
-    block = _base_block(s.get("base_block"))
     extra: dict[str, Any] = {"base_block": block} if block is not None else {}
     if library is not None:
         extra["library"] = library
