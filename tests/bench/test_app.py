@@ -266,3 +266,36 @@ def test_an_fe_shape_is_the_solved_surface_at_every_level() -> None:
         lo, hi = np.array(level["bounds"])
         assert np.all(tip >= lo[:2] - 1e-6) and np.all(tip <= hi[:2] + 1e-6)  # the tip is on the surface's box
     assert np.reshape(shape["levels"][-1]["positions"], (-1, 3))[:, 2].max() > 15.0  # the side walls balloon
+
+
+def test_an_identified_model_is_under_every_answer_and_job(tmp_path: Path) -> None:
+    """serve --model-file: the bench's models carry the file's settings (its unit, its material scales), a verify
+    job's design run too; without a table of that model the answer says how to build it."""
+    from pneumorph.bench.query import Query
+    from pneumorph.models.factory import make_model
+
+    identified = {"fidelity": "2d", "body_shear_scale": 0.9, "unit": {"wall": 1.6}}
+    bench = Bench(settings=identified, table_dir=tmp_path / "tables")
+    assert bench.model("2d").fingerprint() == make_model(15, identified).fingerprint()
+    assert bench.model("3d").fingerprint() == make_model(15, {**identified, "fidelity": "3d"}).fingerprint()
+    config = Query("preset", "sin", model="3d").config(15, bench.model_settings("3d"))
+    assert config.make_model().fingerprint() == bench.model("3d").fingerprint()  # the verify job's run
+    uploaded = bench.add_unit(make_model(1, {"unit": {"layer": 2.5}}).unit)
+    assert bench.model_settings("2d", uploaded) == {"fidelity": "2d", "body_shear_scale": 0.9,
+                                                    "unit": bench.unit_spec(uploaded).to_dict()}
+    client = TestClient(create_app(state_dir=tmp_path / "state", cache=tmp_path / "cache.sqlite", answer_workers=0,
+                                   model_settings=identified), base_url=BASE)
+    error = client.post("/api/design", json={**SIN, "model": "2d"}).json()["error"]
+    assert error["field"] == "model" and "pneumorph design --model-file FILE --model 2d" in error["message"]
+
+
+def test_serve_refuses_a_bad_model_file_before_it_starts(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from pneumorph.cli import cli
+
+    bad = tmp_path / "identified.toml"
+    bad.write_text("[model]\nbody_bulk_scale = 50\n")
+    done = CliRunner().invoke(cli, ["serve", "--model-file", str(bad), "--state", str(tmp_path / "s")])
+    assert done.exit_code == 2 and "body_bulk_scale" in done.output and "Traceback" not in done.output
+    assert not (tmp_path / "s").exists()

@@ -52,6 +52,10 @@ class Bench:
         Where chain tables built by the bench (or by design runs on the same cache) are kept.
     memo : int
         Answers kept for repeated queries (a page reload, a pressure slider).
+    settings : dict, optional
+        Model settings under every model (an identified model's ``[model]`` table,
+        ``serve --model-file``): its unit is the bench's built-in unit, its material scales
+        apply to every unit; the fidelity stays the query's.
 
     Examples
     --------
@@ -63,8 +67,9 @@ class Bench:
     """
 
     def __init__(self, units: int = 15, table_dir: str | Path | None = None, memo: int = 256,
-                 unit_dir: str | Path | None = None) -> None:
+                 unit_dir: str | Path | None = None, settings: dict[str, Any] | None = None) -> None:
         self.units = int(units)
+        self.settings = {k: v for k, v in (settings or {}).items() if k != "fidelity"}
         self.table_dir = None if table_dir is None else Path(table_dir)
         self.unit_dir = None if unit_dir is None else Path(unit_dir)
         self._specs: dict[str, UnitSpec] = {BUILTIN: UnitSpec()}
@@ -136,14 +141,24 @@ class Bench:
         return unit_id
 
     # -- models -------------------------------------------------------------------------
+    def model_settings(self, fidelity: str, unit: str = BUILTIN) -> dict[str, Any]:
+        """The model settings of a fidelity and unit: the bench's :attr:`settings` with the fidelity, and an
+        uploaded unit in place of their unit.
+
+        >>> Bench(settings={"fidelity": "2d", "body_bulk_scale": 1.06}).model_settings("3d")
+        {'body_bulk_scale': 1.06, 'fidelity': '3d'}
+        """
+        settings: dict[str, Any] = {**self.settings, "fidelity": fidelity}
+        if unit != BUILTIN:
+            settings = {k: v for k, v in settings.items() if k not in ("unit", "unit_file", "library")}
+            settings["unit"] = self._specs[unit].to_dict()
+        return settings
+
     def model(self, fidelity: str, unit: str = BUILTIN) -> Any:
         """The FE model of a fidelity and unit, as ``pneumorph design --model <fidelity>`` builds it."""
         with self._lock:
             if (fidelity, unit) not in self._models:
-                settings: dict[str, Any] = {"fidelity": fidelity}
-                if unit != BUILTIN:
-                    settings["unit"] = self._specs[unit].to_dict()
-                self._models[fidelity, unit] = make_model(self.units, settings)
+                self._models[fidelity, unit] = make_model(self.units, self.model_settings(fidelity, unit))
             return self._models[fidelity, unit]
 
     def chain(self, fidelity: str, unit: str = BUILTIN) -> ChainModel:
@@ -158,6 +173,10 @@ class Bench:
         with self._lock:
             if (fidelity, unit) not in self._chains:
                 table = find_table(model, self.table_dir)
+                if table is None and unit == BUILTIN and self.settings:
+                    raise QueryError("model", f"no chain table for the {fidelity} model of the served model file "
+                                              f"yet; build it once with `pneumorph design --model-file FILE --model "
+                                              f"{fidelity}` on the same cache")
                 if table is None:
                     raise QueryError("model", f"no chain table for the {fidelity} model of this unit yet; "
                                               "upload the unit to build one")

@@ -78,12 +78,12 @@ def read_unit(raw: bytes) -> UnitSpec:
 _POOL_BENCH: Bench | None = None
 
 
-def _start_answer_worker(table_dir: Path | None, unit_dir: Path | None) -> None:
+def _start_answer_worker(table_dir: Path | None, unit_dir: Path | None, settings: dict[str, Any]) -> None:
     global _POOL_BENCH
     from pneumorph.execution.evaluators import prepare_worker
 
     prepare_worker()
-    _POOL_BENCH = Bench(table_dir=table_dir, unit_dir=unit_dir, memo=0)
+    _POOL_BENCH = Bench(table_dir=table_dir, unit_dir=unit_dir, memo=0, settings=settings)
 
 
 def _answer_in_worker(query: Query) -> dict[str, Any]:
@@ -115,7 +115,7 @@ class AnswerPool:
     def _make(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
                                    initializer=_start_answer_worker,
-                                   initargs=(self.bench.table_dir, self.bench.unit_dir))
+                                   initargs=(self.bench.table_dir, self.bench.unit_dir, self.bench.settings))
 
     async def start(self) -> None:
         """Start the workers and load their tables (before the first query is taken)."""
@@ -158,7 +158,7 @@ def default_state_dir() -> Path:
 
 def create_app(state_dir: str | Path | None = None, cache: str | Path | None = None, workers: int = 1,
                answer_workers: int | None = None, allowed_hosts: tuple[str, ...] | list[str] = LOCAL_HOSTS,
-               limits: JobLimits | None = None) -> FastAPI:
+               limits: JobLimits | None = None, model_settings: dict[str, Any] | None = None) -> FastAPI:
     """The bench as an ASGI application.
 
     Parameters
@@ -178,6 +178,8 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
         Default: this machine's loopback names.
     limits : JobLimits, optional
         Jobs per session and in all, their expiry and the state folder's quota.
+    model_settings : dict, optional
+        Settings under every model of the bench (``serve --model-file``: an identified model; :class:`Bench`).
 
     Examples
     --------
@@ -197,7 +199,7 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     cache_path = Path(cache) if cache is not None else default_cache_path()
     state = Path(state_dir) if state_dir is not None else default_state_dir()
     state.mkdir(parents=True, exist_ok=True)
-    bench = Bench(table_dir=cache_path.parent / "chain-tables", unit_dir=state / "units")
+    bench = Bench(table_dir=cache_path.parent / "chain-tables", unit_dir=state / "units", settings=model_settings)
     bench.shape_dir = state / "shapes"
     board = JobBoard(bench, state, cache_path, workers, limits)
     answers = AnswerPool(bench, answer_workers)

@@ -378,6 +378,7 @@ class JobBoard:
         spec = {"kind": job.kind, "params": job.params, "folder": str(job.folder), "cache": str(self.cache),
                 "workers": self.workers, "table_dir": str(self.bench.table_dir) if self.bench.table_dir else None,
                 "unit_dir": str(self.bench.unit_dir) if self.bench.unit_dir else None,
+                "model_settings": self.bench.settings,
                 "shape_dir": str(self.bench.shape_dir or self.state_dir / "shapes")}
         env = {**os.environ, **dict.fromkeys(THREAD_VARIABLES, "1"), "PYTHONUNBUFFERED": "1"}
         with self._lock:

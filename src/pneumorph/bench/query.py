@@ -101,14 +101,13 @@ class Query:
         return cls(**{**data, "point": None if point is None else (float(point[0]), float(point[1])),
                       "curve": None if curve is None else tuple((float(x), float(y)) for x, y in curve)})
 
-    def config(self, units: int, unit: dict[str, Any] | None = None, **settings: Any) -> DesignConfig:
+    def config(self, units: int, model: dict[str, Any] | None = None, **settings: Any) -> DesignConfig:
         """The design run of this query (certified search on its model), as the CLI would run it.
 
-        ``unit`` is the unit's parameters when it is not the built-in one.
+        ``model`` is the model's settings (the bench's, :meth:`Bench.model_settings`; default: the query's
+        fidelity of the built-in unit).
         """
-        model: dict[str, Any] = {"fidelity": self.model}
-        if unit is not None:
-            model["unit"] = dict(unit)
+        model = dict(model) if model is not None else {"fidelity": self.model}
         return DesignConfig(objective=self.spec, amplitude=self.amplitude, periods=self.periods, point=self.point,
                             curve=self.curve, units=units, search="certified", model=model, **settings)
 

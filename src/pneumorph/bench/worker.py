@@ -123,9 +123,8 @@ def verify(job: dict[str, Any], bench: Bench, report: Reporter) -> dict[str, Any
 
     query = Query.from_dict(job["params"]["query"])
     folder = Path(job["folder"])
-    unit = None if query.unit == "builtin" else bench.unit_spec(query.unit).to_dict()
-    config = query.config(bench.units, unit, certify=True, executor="processes", workers=job["workers"],
-                          cache=job["cache"])
+    config = query.config(bench.units, bench.model_settings(query.model, query.unit), certify=True,
+                          executor="processes", workers=job["workers"], cache=job["cache"])
     model = bench.model(query.model, query.unit)
     if query.model == "3d":  # solve the chain's best once, keeping its fields for the 3D view
         design = bench.answer(query)["winner"]["design"]
@@ -245,7 +244,7 @@ def main() -> int:
     from pneumorph.execution.evaluators import prepare_worker
 
     prepare_worker()  # one BLAS thread; an exit of its own when the server is gone
-    bench = Bench(table_dir=job["table_dir"], unit_dir=job["unit_dir"], memo=0)
+    bench = Bench(table_dir=job["table_dir"], unit_dir=job["unit_dir"], memo=0, settings=job.get("model_settings"))
     bench.shape_dir = Path(job["shape_dir"])
     try:
         result = KINDS[job["kind"]](job, bench, report)

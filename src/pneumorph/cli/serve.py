@@ -78,9 +78,13 @@ def allowed_hosts(host: str, extra: tuple[str, ...]) -> tuple[str, ...]:
 @click.option("--state-quota", default=2000.0, show_default=True, type=P.Real(1.0, 1e7, unit="MB"),
               help="Disk space the jobs may take in the state folder (MB): past it the oldest finished jobs are "
                    "deleted, and new jobs are refused while running ones fill it.")
+@click.option("--model-file", type=P.InputFile(),
+              help="A model's [model] table (an identified model, identified.toml from pneumorph identify) under every "
+                   "answer and job: its unit is the bench's built-in unit, its material scales apply to every unit "
+                   "(its chain table: `pneumorph design --model-file FILE` builds it on the same cache).")
 def serve(host: str, port: int, open_browser: bool, state: str | None, cache: str | None, workers: int,
           allow_host: tuple[str, ...], jobs_per_session: int, max_jobs: int, job_days: float,
-          state_quota: float) -> None:
+          state_quota: float, model_file: str | None = None) -> None:
     """Open the designer's bench: type or draw a target, see the certified design at once.
 
     A local web page: the target as a preset, an expression, a tip goal or a curve drawn
@@ -99,6 +103,13 @@ def serve(host: str, port: int, open_browser: bool, state: str | None, cache: st
     except ImportError as exc:
         raise click.UsageError(f"the bench needs the web extra ({exc.name} is missing): pip install "
                                '"pneumorph[web]" (in a checkout of the repository: pip install -e ".[web]")') from None
+    settings = None
+    if model_file is not None:
+        from pneumorph.models.factory import make_model, read_model_file
+
+        with P.blame("--model-file"):
+            settings = {k: v for k, v in read_model_file(model_file).items() if k != "fidelity"}
+            make_model(1, settings)  # its settings checked before the server starts
     _check_port(host, port)
     from pneumorph.bench.app import default_state_dir
     from pneumorph.bench.jobs import JobLimits
@@ -107,9 +118,10 @@ def serve(host: str, port: int, open_browser: bool, state: str | None, cache: st
     check_writable_dir(state if state is not None else default_state_dir(), "--state")
     limits = JobLimits(per_session=jobs_per_session, queued=max_jobs, expiry_days=job_days, quota_mb=state_quota)
     app = create_app(state_dir=state, cache=cache, workers=workers, allowed_hosts=allowed_hosts(host, allow_host),
-                     limits=limits)
+                     limits=limits, model_settings=settings)
     url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
-    click.echo(f"pneumorph bench at {url} (Ctrl-C stops it)")
+    click.echo(f"pneumorph bench at {url} (Ctrl-C stops it)" + (f", serving the model of {model_file}"
+                                                                   if model_file is not None else ""))
     if not _is_local(host):
         click.echo(f"warning: listening on {host}: anyone who can reach this machine can use the bench", err=True)
     if open_browser:
