@@ -116,10 +116,22 @@ class ActuatorMesh:
     def length(self) -> float:
         return float(self.unit_bounds[-1]) + self.spec.end_cap
 
-    def unit_centres(self, displacement: FloatArray | None = None) -> FloatArray:
-        """Mean (x, y) of each unit's four tracked points, shape (n, 2)."""
+    @property
+    def axes(self) -> int:
+        """The coordinates a response of this mesh keeps: 3 (x, y, z) for a 3D mesh of the full width, else 2.
+
+        A half model holds its unit centres and tip on the mid-plane (u_z = 0 there), a 2D
+        section has no z; the full width lets a sideways unit move them out of the plane.
+
+        >>> assemble(UnitSpec(), "01", dim=3, half=True).axes, assemble(UnitSpec(), "01", dim=3).axes
+        (2, 3)
+        """
+        return 3 if self.dim == 3 and self.symmetry_points is None else 2
+
+    def unit_centres(self, displacement: FloatArray | None = None, axes: int = 2) -> FloatArray:
+        """Mean of each unit's four tracked points: (x, y), shape (n, 2), or with ``axes=3`` (x, y, z)."""
         x = self.points if displacement is None else self.points + displacement
-        return x[self.tracked][..., :2].mean(axis=1)
+        return x[self.tracked][..., :axes].mean(axis=1)
 
     def submesh(self, region: str) -> tuple[FloatArray, IntArray]:
         """Points (all of them, shared) and the cells of one region."""
@@ -163,10 +175,12 @@ def _label(units: Sequence[UnitSpec], orientation: str, starts: FloatArray, cent
     x0, x1, y0, y1 = box.T
     filled = np.array([u.solid for u in units], dtype=bool)[unit]
     cavity = (lx > x0) & (lx < x1) & (ly > y0) & (ly < y1) & ~cap & ~filled
-    if centres.shape[1] == 3:
-        z = centres[:, 2]
-        cavity &= (z > ref.side_wall) & (z < W - ref.side_wall)
-    label = np.where(ly > H - per_unit(u.layer for u in units)[unit], LAYER, BODY)
+    label = np.where(ly > H - per_unit(u.top_layer for u in units)[unit], LAYER, BODY)
+    if centres.shape[1] == 3:  # across the width, turned over too (z -> W - z): a sideways unit's layer
+        lz = np.where(flipped, W - centres[:, 2], centres[:, 2])
+        z0, z1 = per_unit(c for u in units for c in u.cavity_z).reshape(n, 2)[unit].T
+        cavity &= (lz > z0) & (lz < z1)
+        label = np.where(lz > W - per_unit(u.side_layer for u in units)[unit], LAYER, label)
     label = np.where(cavity, CAVITY, label)
     if any(u.slit is not None for u in units):
         slit = np.array([u.slit is not None for u in units], dtype=bool)[unit]
@@ -204,8 +218,8 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
         cavities.
     half : bool
         3D only: mesh the half 0 <= z <= width / 2; the model then holds u_z = 0 on the
-        mid-plane (``symmetry_points``). The actuator is symmetric across its width, so this
-        gives the same solution with half the unknowns.
+        mid-plane (``symmetry_points``): the same solution with half the unknowns for planar
+        units; a design with a sideways unit (``layer_side``) has no such symmetry.
     passage : float
         3D only: the diameter (mm) of an air passage through every wall between adjacent
         cavities (appendix D.1), meshed as a square channel of the same area at mid-height
@@ -239,7 +253,7 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     ------
     GeometryError
         A bad ``dim`` or design, a passage in 2D or one that does not fit the walls (or
-        meets a solid unit).
+        meets a solid unit), a sideways unit (``layer_side``) in 2D or in a half model.
     OrientationError
         A design that is not one over ``spec``'s symbols (0/1 for one unit).
     """
@@ -251,6 +265,7 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     if passage and dim != 3:
         raise GeometryError("a passage between cavities is a 3D feature: the 2D section would be cut in two")
     units = design.units(library)
+    _check_sideways(units, design.text, dim, half)
     ref = library[library.default]  # the cross-section, mesh size and end cap all units share
     side = _passage_side(units, passage)
     starts = unit_starts(units)
@@ -267,6 +282,24 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
         orientation=orientation, spec=ref, units=units, design=design.text,
         symmetry_points=np.isclose(points[:, 2], ref.width / 2) if (dim == 3 and half) else None,
     )
+
+
+def _check_sideways(units: Sequence[UnitSpec], text: str, dim: int, half: bool) -> None:
+    """Refuse a sideways unit (``layer_side``) in a 2D section or a half model: it bends out of their plane.
+
+    Raises
+    ------
+    GeometryError
+        Naming the design and what to mesh instead.
+    """
+    if not any(u.layer_side for u in units):
+        return
+    if dim == 2:
+        raise GeometryError(f"design {text!r} has a sideways unit (layer_side): it bends out of the 2D section's "
+                            "plane; mesh it in 3D")
+    if half:
+        raise GeometryError(f"design {text!r} has a sideways unit (layer_side): it is not symmetric across the width; "
+                            "mesh the full width (half=False)")
 
 
 def _passage_side(units: Sequence[UnitSpec], passage: float) -> float:
@@ -309,7 +342,7 @@ def _grid(library: UnitLibrary, units: Sequence[UnitSpec], starts: FloatArray, d
     xb = [float(starts[i]) + x for i, unit in enumerate(units) for x in section_breaks(unit)[0]]
     xb.append(float(starts[n]) + ref.end_cap)
     yb = [y for unit in library.units for y in section_breaks(unit)[1]]
-    zb = width_breaks(ref, half)
+    zb = [z for unit in library.units for z in width_breaks(unit, half)]
     if side:
         yb += [H / 2 - side / 2, H / 2 + side / 2]
         zb += [W / 2 - side / 2] if half else [W / 2 - side / 2, W / 2 + side / 2]
@@ -357,6 +390,12 @@ def _cavity_box(unit: UnitSpec, o: str, start: float, H: float) -> tuple[float, 
     return start + x0, start + x1, cy0, cy1
 
 
+def _cavity_z(unit: UnitSpec, o: str) -> tuple[float, float]:
+    """The cavity across the width (z0, z1) of a unit in orientation ``o`` (a sideways unit's turned over: mirrored)."""
+    z0, z1 = unit.cavity_z
+    return (z0, z1) if o == "0" or not unit.layer_side else (unit.width - z1, unit.width - z0)
+
+
 def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orientation: str,
                    starts: FloatArray, dim: int, side: float) -> BoolArray:
     """The points on the cavity walls (in 2D inside the filler too) and on the passages' walls.
@@ -377,7 +416,8 @@ def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec],
             & (points[:, 1] < cy1 + _TOL)
         )
         if dim == 3:
-            inside &= (points[:, 2] > ref.side_wall - _TOL) & (points[:, 2] < W - ref.side_wall + _TOL)
+            z0, z1 = _cavity_z(unit, o)
+            inside &= (points[:, 2] > z0 - _TOL) & (points[:, 2] < z1 + _TOL)
         cavity_points |= inside
     if side:  # the passages' walls are loaded by the pressure too
         for i in range(len(units) - 1):

@@ -112,7 +112,8 @@ def check_passage(spec: UnitSpec, diameter: float) -> float:
     between adjacent cavities. Mid-height lies in the common height of two cavities facing
     either way (orientation 0: ``wall .. wall + cavity_height``, orientation 1 mirrored),
     which is ``cavity_height - layer`` high; the passage must fit in it, and across the
-    cavity's width, and it cannot run through a slit (that would open the cavities to the
+    cavity's width (of a sideways unit: the common width of its cavities facing either way,
+    ``width - 2 side_wall - 2 layer``), and it cannot run through a slit (that would open the cavities to the
     outside).
 
     Raises
@@ -140,13 +141,17 @@ def check_passage(spec: UnitSpec, diameter: float) -> float:
     if spec.solid:
         raise GeometryError(f"a passage cannot run through the solid unit {spec.name!r}: it has no cavity to join")
     side = passage_side(diameter)
-    room = min(spec.cavity_height - spec.layer, spec.width - 2 * spec.side_wall)
+    # a sideways unit's cavities facing either way share the width less both side layers
+    room = min(spec.cavity_height - spec.top_layer, spec.width - 2 * spec.side_wall - 2 * spec.side_layer)
     if side >= room:
         most = room * 2 / math.sqrt(math.pi)
+        where = (f"height of two cavities facing either way, cavity_height {spec.cavity_height:g} mm - layer "
+                 f"{spec.layer:g} mm, and the cavity's width" if not spec.layer_side else
+                 f"width of two cavities facing either way, width {spec.width:g} mm - 2 side walls - 2 x side layer "
+                 f"{spec.layer:g} mm, and the cavity's height")
         raise GeometryError(
             f"a passage of {diameter:g} mm (a {side:.3g} mm square channel) is wider than the walls between cavities "
-            f"allow: at most {most:.4g} mm for this unit (the common height of two cavities facing either way, "
-            f"cavity_height {spec.cavity_height:g} mm - layer {spec.layer:g} mm, and the cavity's width)")
+            f"allow: at most {most:.4g} mm for this unit (the common {where})")
     return side
 
 

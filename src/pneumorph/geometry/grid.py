@@ -53,7 +53,7 @@ def section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
     """
     x0, x1, y0, y1 = spec.cavity
     xb = [0.0, x0, x1, x1 + spec.end_wall, spec.pitch]
-    yb = [0.0, y0, y1, spec.height - spec.layer, spec.height]
+    yb = [0.0, y0, y1, spec.height - spec.top_layer, spec.height]
     if spec.slit is not None:
         yb.append(spec.slit_depth)
     yb += [spec.height - y for y in yb]
@@ -61,16 +61,26 @@ def section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
 
 
 def width_breaks(spec: UnitSpec, half: bool = False) -> list[float]:
-    """The z breaks across the width: the side walls and the mid-plane (3D).
+    """The z breaks across the width (3D): the side walls, the mid-plane and a side layer in both orientations.
+
+    ``half``: those of the half ``0 <= z <= width / 2``. A sideways unit (``layer_side``) adds
+    its layer's and cavity's faces, at ``width - side_wall - layer`` and ``width - layer``
+    and (turned over) mirrored.
 
     Examples
     --------
     >>> from pneumorph.geometry.unit import UnitSpec
     >>> width_breaks(UnitSpec(), half=True)
     [0.0, 1.5, 7.5]
+    >>> width_breaks(UnitSpec(cavity_height=9.0, layer_side=True))
+    [0.0, 1.5, 7.5, 13.5, 15.0, 10.5, 12.0, 4.5, 3.0]
     """
     W = spec.width
-    return [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+    breaks = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+    if spec.layer_side:
+        side = [W - spec.side_wall - spec.layer, W - spec.layer]
+        breaks += [z for z in [*side, *(W - z for z in side)] if not half or z < W / 2]
+    return breaks
 
 
 def cross_section_lines(spec: UnitSpec) -> tuple[FloatArray, FloatArray]:

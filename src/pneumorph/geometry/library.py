@@ -394,17 +394,39 @@ def _entry_unit(value: Any, where: str, base: Path | None) -> UnitSpec:
     raise UnitLibraryError(f"{where}: unit must be a table of parameters or the path of a unit file, got {value!r}")
 
 
-def builtin_library() -> UnitLibrary:
-    """The library that ships with pneumorph (``geometry/data/units.toml``).
+#: The libraries that ship with pneumorph, by the name a setting gives (``--library builtin``), and their data files
+BUILTIN_LIBRARIES: dict[str, str] = {"builtin": "units.toml", "spatial": "spatial.toml"}
 
-    ``a`` the bending unit (the default :class:`UnitSpec`), ``e`` an extending unit, ``r``
-    a near-rigid one and ``s`` a short-pitch one (``docs/unit-library.md``).
 
+def builtin_library(name: str = "builtin") -> UnitLibrary:
+    """A library that ships with pneumorph (:data:`BUILTIN_LIBRARIES`, in ``geometry/data``).
+
+    ``"builtin"`` (``units.toml``, planar): ``a`` the bending unit (the default
+    :class:`UnitSpec`), ``e`` an extending unit, ``r`` a near-rigid one and ``s`` a
+    short-pitch one. ``"spatial"`` (``spatial.toml``): ``a`` and ``l``, a sideways unit
+    (``layer_side``) that bends out of the plane of ``a`` (``docs/unit-library.md``).
+
+    Raises
+    ------
+    UnitLibraryError
+        ``name`` is no built-in library (the message lists them).
+
+    Examples
+    --------
     >>> [f"{s}: {m}" for s, m in zip(builtin_library().symbols, builtin_library().modes)]
     ['a: bending', 'e: extending', 'r: near-rigid', 's: short-pitch']
+    >>> builtin_library("spatial").symbols, builtin_library("spatial")["l"].layer_side
+    (('a', 'l'), True)
+    >>> builtin_library("planar")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.UnitLibraryError: no built-in unit library 'planar'; the built-in ones: builtin, spatial
     """
-    text = resources.files("pneumorph.geometry").joinpath("data/units.toml").read_text("utf-8")
-    return UnitLibrary.from_dict(tomllib.loads(text), source="built-in unit library")
+    if name not in BUILTIN_LIBRARIES:
+        raise UnitLibraryError(f"no built-in unit library {name!r}; the built-in ones: {', '.join(BUILTIN_LIBRARIES)}")
+    text = resources.files("pneumorph.geometry").joinpath(f"data/{BUILTIN_LIBRARIES[name]}").read_text("utf-8")
+    where = "built-in unit library" if name == "builtin" else f"built-in unit library {name!r}"
+    return UnitLibrary.from_dict(tomllib.loads(text), source=where)
 
 
-__all__ = ["SYMBOLS", "UnitLibrary", "builtin_library", "check_joinable", "check_symbol"]
+__all__ = ["BUILTIN_LIBRARIES", "SYMBOLS", "UnitLibrary", "builtin_library", "check_joinable", "check_symbol"]

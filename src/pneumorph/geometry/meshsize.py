@@ -112,7 +112,8 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True,
         Units along the actuator.
     dim : {2, 3}
     half : bool
-        3D: the half model across the width (the models' default).
+        3D: the half model across the width (the models' default); a sideways unit
+        (``layer_side``) is always counted whole, as its models mesh it.
     base : BaseBlock, optional
         A meshed base block (appendix D.2) before the base face, with its margin (the
         sensitivity studies' variant, a config's ``[model.base_block]``).
@@ -128,9 +129,12 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True,
     >>> from pneumorph.geometry.features import BaseBlock
     >>> estimate_mesh(UnitSpec(), 15, 3, base=BaseBlock(length=1000.0)).describe()  # 7 times as long
     'about 155,466 nodes, 30,880 elements, 13.9 GB for one solve'
+    >>> estimate_mesh(UnitSpec(cavity_height=9.0, layer_side=True), 15, 3).nodes  # sideways: the full width
+    39757
     """
     from pneumorph.geometry.grid import section_breaks, width_breaks
 
+    half = half and not spec.layer_side
     h = spec.element_size
     xb, yb = section_breaks(spec)
     zb = width_breaks(spec, half)

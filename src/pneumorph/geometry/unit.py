@@ -20,7 +20,23 @@ of ``slit_width`` cut from the soft face to ``slit_depth`` at the end of the uni
 inflating end walls can push each other apart (as in Pneu-nets) instead of only bulging the
 soft wall. In 3D the cavity stops ``side_wall`` short of both sides; the slit goes through
 the whole width. Orientation 1 is the unit turned 180 degrees about the long axis: its
-section is mirrored, y -> height - y.
+section is mirrored, y -> height - y (and z -> width - z).
+
+A *sideways* unit (``layer_side = True``) has its stiff layer on the side face z = width
+instead of the top (orientation 1: on the face z = 0), ``layer`` thick, with a ``side_wall``
+between it and the cavity; its height is then ``2 wall + cavity_height``. Seen from above
+(x along the actuator, z across its width)::
+
+    z = width   +--------------------------------------------+
+                |  stiff layer, `layer` thick                 |
+                +--------------------------------------------+
+                | side wall                                   |
+                |   +---------------------------+             |
+                |   |          cavity           |             |
+                |   +---------------------------+             |
+    z = 0       +--------------------------------------------+
+
+It bends about the actuator's vertical (y) axis, out of the plane the other units bend in.
 
 Unit types
 ----------
@@ -33,7 +49,9 @@ The same parameters describe the deformation modes of a library of units (sectio
 - *near-rigid*: ``solid = True``, the cavity filled with the body material: no pressure
   acts in it, its box is still meshed and tracked (for the unit's centre);
 - *short-pitch* (section 8.3.1): a shorter ``pitch`` with thinner end walls, so more units
-  fit in the same length.
+  fit in the same length;
+- *sideways* (issue 25): ``layer_side = True``, the stiff layer on a side face, so the unit
+  bends out of the plane of the others (3D models only).
 
 Examples
 --------
@@ -43,6 +61,9 @@ Examples
 >>> extending = UnitSpec(wall=3.0, layer=0.0)
 >>> extending.height, extending.cavity
 (12.0, (3.0, 7.5, 3.0, 9.0))
+>>> sideways = UnitSpec(cavity_height=9.0, layer_side=True)
+>>> sideways.height, sideways.cavity_z
+(12.0, (1.5, 10.5))
 """
 
 from __future__ import annotations
@@ -127,6 +148,10 @@ class UnitSpec:
     solid : bool
         True: the cavity is filled with the body material (a near-rigid unit). Its box is
         still meshed with the same lines, and its vertices are still tracked.
+    layer_side : bool
+        True: the stiff layer lies on the side face z = width (a sideways unit, bending about
+        the vertical axis), with a side wall between it and the cavity; False (default): on
+        top. Needs a layer (``layer > 0``) and no slit; 3D models only.
 
     Raises
     ------
@@ -135,7 +160,8 @@ class UnitSpec:
 
     Notes
     -----
-    Fields added after the unit's first release (:data:`OPTIONAL_FIELDS`: ``solid``) are
+    Fields added after the unit's first release (:data:`OPTIONAL_FIELDS`: ``solid``,
+    ``layer_side``) are
     left out of :meth:`to_dict` while they hold their default, so the description of every
     earlier unit, and the fingerprints of models and chain tables built on it, stay the same.
 
@@ -166,10 +192,12 @@ class UnitSpec:
     filler_poisson_ratio: float = 0.3
     filler_source: str = ""
     solid: bool = False
+    layer_side: bool = False
 
     def __post_init__(self) -> None:
-        if not isinstance(self.solid, bool):
-            raise GeometryError(f"unit solid must be true or false, got {self.solid!r}")
+        for key in ("solid", "layer_side"):
+            if not isinstance(getattr(self, key), bool):
+                raise GeometryError(f"unit {key} must be true or false, got {getattr(self, key)!r}")
         object.__setattr__(self, "filler_coefficients", _numbers(self.filler_coefficients, "filler_coefficients"))
         object.__setattr__(self, "filler_range_kpa", _numbers(self.filler_range_kpa, "filler_range_kpa", 2))
         low, high = self.filler_range_kpa
@@ -208,25 +236,61 @@ class UnitSpec:
                 f"the walls leave no cavity: pitch {self.pitch} mm - 2 x end wall {self.end_wall} mm "
                 f"- slit {self.slit_width} mm = {self.cavity_length:g} mm"
             )
-        if 2 * self.side_wall >= self.width:
+        if 2 * self.side_wall + self.side_layer >= self.width:
+            layer = f" + side layer {self.side_layer:g} mm" if self.layer_side else ""
             raise GeometryError(
-                f"the side walls leave no cavity: 2 x {self.side_wall} mm >= width {self.width} mm"
+                f"the side walls leave no cavity: 2 x {self.side_wall} mm{layer} >= width {self.width} mm"
             )
+        self._check_side_layer()
         if (self.slit_width > 0) != (self.slit_depth > 0):
             raise GeometryError(
                 f"a slit needs both a width and a depth, got width {self.slit_width} mm and "
                 f"depth {self.slit_depth} mm"
             )
-        if self.slit_depth >= self.height - self.layer:
+        if self.slit_depth >= self.height - self.top_layer:
             raise GeometryError(
-                f"slit depth {self.slit_depth} mm reaches the stiff layer (at {self.height - self.layer} mm): "
+                f"slit depth {self.slit_depth} mm reaches the stiff layer (at {self.height - self.top_layer} mm): "
                 "the units would only be joined by the layer; make it shallower"
             )
 
+    def _check_side_layer(self) -> None:
+        """Refuse a sideways unit (``layer_side``) without a layer, or with a slit."""
+        if not self.layer_side:
+            return
+        if self.layer == 0:
+            raise GeometryError("unit layer_side = true needs a stiff layer to put on the side (layer > 0), got "
+                                "layer 0 mm")
+        if self.slit_width > 0:
+            raise GeometryError("a sideways unit (layer_side = true) takes no slit: the slit is cut from the bottom "
+                                "face, and a sideways unit's soft face is its side (slit_width = 0)")
+
     @property
     def height(self) -> float:
-        """Total height: bottom wall + cavity + top wall + stiff layer."""
-        return self.wall + self.cavity_height + self.wall + self.layer
+        """Total height: bottom wall + cavity + top wall + stiff layer (on top; a sideways unit's is on its side)."""
+        return self.wall + self.cavity_height + self.wall + self.top_layer
+
+    @property
+    def top_layer(self) -> float:
+        """Thickness of the stiff layer on top (0 for a sideways unit).
+
+        >>> UnitSpec().top_layer, UnitSpec(cavity_height=9.0, layer_side=True).top_layer
+        (3.0, 0.0)
+        """
+        return 0.0 if self.layer_side else self.layer
+
+    @property
+    def side_layer(self) -> float:
+        """Thickness of the stiff layer on the side face z = width (0 unless a sideways unit)."""
+        return self.layer if self.layer_side else 0.0
+
+    @property
+    def cavity_z(self) -> tuple[float, float]:
+        """The cavity across the width ``(z0, z1)`` in the unit's own frame (orientation 0; 3D).
+
+        >>> UnitSpec().cavity_z, UnitSpec(cavity_height=9.0, layer_side=True).cavity_z
+        ((1.5, 13.5), (1.5, 10.5))
+        """
+        return (self.side_wall, self.width - self.side_wall - self.side_layer)
 
     @property
     def cavity_length(self) -> float:
@@ -375,7 +439,7 @@ class UnitSpec:
 
 #: Fields added after the first release, with their defaults: :meth:`UnitSpec.to_dict` leaves
 #: them out while they hold these values (earlier descriptions and fingerprints stay valid).
-OPTIONAL_FIELDS: dict[str, Any] = {"solid": False}
+OPTIONAL_FIELDS: dict[str, Any] = {"solid": False, "layer_side": False}
 
 #: The filler law of the built-in unit: ``pneumorph calibrate`` (defaults: 15 units, 5-45 kPa
 #: in 5 kPa steps, three runs, seed 0, relative weighting) against the 3D model; the

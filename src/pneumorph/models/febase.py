@@ -307,16 +307,33 @@ class FEModel:
     def mesh(self, orientation: str | Design) -> ActuatorMesh:
         """The meshed design (no solver data): what :meth:`build` solves on.
 
+        A design with a sideways unit is meshed whole (:meth:`half_for`).
+
         >>> from pneumorph.models.full3d import Full3D
         >>> Full3D(2).mesh("01").cells.shape[1]
         20
         """
         if self.mixed:
-            return assemble(self.library, self.parse(orientation), self.dim, half=self.half, passage=self.passage,
+            design = self.parse(orientation)
+            return assemble(self.library, design, self.dim, half=self.half_for(design), passage=self.passage,
                             base=self.base_block)
         # today's call, to the last bit
         return assemble(self.unit, orientation if isinstance(orientation, str) else orientation.orientation,
-                        self.dim, half=self.half, passage=self.passage, base=self.base_block)
+                        self.dim, half=self.half and not self.unit.layer_side, passage=self.passage,
+                        base=self.base_block)
+
+    def half_for(self, design: str | Design) -> bool:
+        """Whether ``design`` is solved on the half width: a half model's design without a sideways unit.
+
+        A sideways unit (``layer_side``) bends across the width: no mid-plane symmetry.
+
+        >>> from pneumorph.geometry.library import builtin_library
+        >>> from pneumorph.models.full3d import Full3D
+        >>> model = Full3D(2, library=builtin_library("spatial"))
+        >>> model.half_for("aA"), model.half_for("aL")
+        (True, False)
+        """
+        return self.half and not any(u.layer_side for u in self.parse(design).units(self.library))
 
     def build(self, orientation: str | Design) -> tuple[ActuatorMesh, PressurisedBody, Any]:
         """The meshed design, its pressurised body and ``set_pressure(p)`` for a load level.
@@ -374,15 +391,16 @@ class FEModel:
         t0 = time.perf_counter()
         mesh, body, set_pressure = self.build(parsed if self.mixed else design)
         pressures = self.pressures()
-        x_end0 = mesh.points[mesh.end_points][:, :2]
+        axes = mesh.axes  # (x, y), or (x, y, z) on the full width
+        x_end0 = mesh.points[mesh.end_points][:, :axes]
         response = Response.empty(
             design,
             pressures,
-            mesh.unit_centres(),
+            mesh.unit_centres(axes=axes),
             x_end0.mean(axis=0),
             metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()},
         )
-        angle0 = _end_face_angle(x_end0)
+        angle0 = _end_face_angle(x_end0[:, :2])
         turned = {"total": 0.0, "last": angle0}  # end-face rotation, followed substep by substep
         displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
 
@@ -390,17 +408,17 @@ class FEModel:
             set_pressure(t * self.ramp.pressure)
 
         def follow(t: float) -> None:
-            angle = _end_face_angle(x_end0 + body.displacement[:, :2][mesh.end_points])
+            angle = _end_face_angle(x_end0[:, :2] + body.displacement[:, :2][mesh.end_points])
             step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
             turned["total"] += step
             turned["last"] = angle
 
         def tip_of(v: FloatArray) -> FloatArray:
-            return (x_end0 + v[mesh.end_points][:, :2]).mean(axis=0)
+            return (x_end0 + v[mesh.end_points][:, :axes]).mean(axis=0)
 
         def record(k: int, t: float) -> None:
             displacements[k] = body.displacement[:, : self.dim]
-            response.centres[k] = mesh.unit_centres(displacements[k])
+            response.centres[k] = mesh.unit_centres(displacements[k], axes)
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
             if on_level is not None:

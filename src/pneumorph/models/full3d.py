@@ -1,7 +1,8 @@
-"""The 3D model (chapter 4): quadratic hexahedra, empty cavities, optionally half the width.
+"""The 3D model (chapter 4): quadratic hexahedra, empty cavities, half the width or the full width.
 
 The machinery is :class:`~pneumorph.models.febase.FEModel`'s; this model adds the half
-model's symmetry, the temperature change, the air passages and the base block.
+model's symmetry (the full model for designs with a sideways unit, whose responses keep
+z), the temperature change, the air passages and the base block.
 """
 
 from __future__ import annotations
@@ -26,7 +27,10 @@ class Full3D(FEModel):
 
     half : bool
         Model half the width with u_z = 0 on the mid-plane (default): the same solution
-        as the full model for this symmetric actuator, with half the unknowns.
+        as the full model for an actuator of planar units, with half the unknowns. A design
+        with a sideways unit (``layer_side``, the ``spatial`` library) has no such symmetry
+        and is always solved on the full width, its response keeping (x, y, z)
+        (:meth:`half_for`); ``half=False``: every design on the full width.
     backend : {"fast", "felupe"}
         ``"fast"`` (default): :class:`pneumorph.fem.fast.system.SolidSystem3D` (the
         upper triangle of the symmetric tangent, PARDISO's symmetric indefinite solver in

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from pneumorph.errors import SettingsError
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.assembly import ActuatorMesh
 from pneumorph.geometry.features import BaseBlock
@@ -51,6 +52,9 @@ class Reduced2D(FEModel):
         Responses then include the sag under gravity (displacements from the unloaded
         mesh); the filler has no mass.
 
+    A library or unit with a sideways unit (``layer_side``) is refused: it bends out of the
+    section's plane (:class:`~pneumorph.models.full3d.Full3D` solves it).
+
     Examples
     --------
     >>> m = Reduced2D(2, ramp_spec=RampSpec(pressure=0.01))   # 10 kPa in 10 increments
@@ -81,6 +85,11 @@ class Reduced2D(FEModel):
         library: UnitLibrary | None = None,
     ) -> None:
         lib = model_library(unit, library)
+        sideways = [s for s, spec in zip(lib.symbols, lib.units, strict=True) if spec.layer_side]
+        if sideways:  # its layer lies outside the plane-strain section
+            what = "the unit is" if lib.is_single else f"unit type {', '.join(map(repr, sideways))} is"
+            raise SettingsError(f"{what} sideways (layer_side): it bends out of the 2D model's plane; solve it with "
+                                "the 3D model (fidelity \"3d\", --model 3d)")
         first = lib[lib.default]
         super().__init__(n_units, unit, ramp_spec, filler or first.filler_law() or get_filler(), backend, gravity,
                          base_block=base_block, materials=materials, library=library)

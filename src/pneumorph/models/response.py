@@ -2,7 +2,9 @@
 
 Coordinates: ``x`` along the actuator's long axis (the base at ``x = 0``), ``y`` in the
 bending plane (positive towards the side a unit of orientation 0 bends to), ``z`` across
-the width (3D only). Lengths in mm, pressures in MPa (kPa only at the edges).
+the width (3D only). Lengths in mm, pressures in MPa (kPa only at the edges). A response
+keeps (x, y) of its points, or (x, y, z) when its model can leave the plane (the full 3D
+model, which any design with a sideways unit needs: :attr:`Response.axes`).
 
 A model of any fidelity (2D reduced-order, 3D, a surrogate) turns an orientation vector
 into a :class:`Response`; the design search sees nothing else.
@@ -31,14 +33,16 @@ class Response:
         The design, base first (``"0101..."``).
     pressures : ndarray, shape (k,)
         The reported pressures (MPa), increasing; e.g. 4.5, 9, ..., 45 kPa.
-    centres : ndarray, shape (k, n, 2)
+    centres : ndarray, shape (k, n, 2) or (k, n, 3)
         Current (x, y) of every unit centre - the mean of the unit's four tracked nodes at
         the cavity's vertices (Fig 4.4) - at every reported pressure; NaN after a failure.
-    reference_centres : ndarray, shape (n, 2)
+        (x, y, z) from a model of the full width (3D, no mid-plane symmetry): z across the
+        width, the mesh's coordinate (the actuator's axis at ``z = width / 2``).
+    reference_centres : ndarray, shape (n, 2) or (n, 3)
         The unit centres of the undeformed actuator.
-    tip : ndarray, shape (k, 2)
-        Current (x, y) of the tip (centre of the free end face).
-    reference_tip : ndarray, shape (2,)
+    tip : ndarray, shape (k, 2) or (k, 3)
+        Current (x, y) or (x, y, z) of the tip (centre of the free end face).
+    reference_tip : ndarray, shape (2,) or (3,)
         The undeformed tip.
     curl : ndarray, shape (k,)
         Rotation of the free end face in degrees, counter-clockwise positive, unwrapped
@@ -57,8 +61,13 @@ class Response:
     >>> import numpy as np
     >>> r = Response.empty("01", np.array([0.0225, 0.045]), np.array([[5.0, 0.0], [15.0, 0.0]]),
     ...                    np.array([20.0, 0.0]))
-    >>> r.n_units, r.n_levels, bool(np.isnan(r.centres).all())
-    (2, 2, True)
+    >>> r.n_units, r.n_levels, bool(np.isnan(r.centres).all()), r.axes
+    (2, 2, True, 2)
+
+    Points in space (the full 3D model): three coordinates each.
+
+    >>> Response.empty("0", np.array([0.045]), np.array([[5.0, 6.0, 7.5]]), np.array([10.0, 6.0, 7.5])).tip.shape
+    (1, 3)
     """
 
     orientation: str
@@ -75,11 +84,12 @@ class Response:
 
     def __post_init__(self) -> None:
         k, n = len(self.pressures), len(self.orientation)
+        d = 3 if self.reference_tip.shape == (3,) else 2  # (x, y, z) from a model of the full width
         shapes = {
-            "centres": (self.centres.shape, (k, n, 2)),
-            "reference_centres": (self.reference_centres.shape, (n, 2)),
-            "tip": (self.tip.shape, (k, 2)),
-            "reference_tip": (self.reference_tip.shape, (2,)),
+            "centres": (self.centres.shape, (k, n, d)),
+            "reference_centres": (self.reference_centres.shape, (n, d)),
+            "tip": (self.tip.shape, (k, d)),
+            "reference_tip": (self.reference_tip.shape, (d,)),
             "curl": (self.curl.shape, (k,)),
         }
         for name, (got, want) in shapes.items():
@@ -95,14 +105,18 @@ class Response:
         reference_tip: FloatArray,
         **kwargs: Any,
     ) -> Response:
-        """A response with every level still unknown (NaN), to be filled level by level."""
+        """A response with every level still unknown (NaN), to be filled level by level.
+
+        Its points have the coordinates of ``reference_tip``: (x, y), or (x, y, z).
+        """
         k, n = len(pressures), len(orientation)
+        d = len(reference_tip)
         return cls(
             orientation=orientation,
             pressures=np.asarray(pressures, dtype=float),
-            centres=np.full((k, n, 2), np.nan),
+            centres=np.full((k, n, d), np.nan),
             reference_centres=np.asarray(reference_centres, dtype=float),
-            tip=np.full((k, 2), np.nan),
+            tip=np.full((k, d), np.nan),
             reference_tip=np.asarray(reference_tip, dtype=float),
             curl=np.full(k, np.nan),
             **kwargs,
@@ -117,13 +131,18 @@ class Response:
         return len(self.pressures)
 
     @property
+    def axes(self) -> int:
+        """The coordinates of every point: 2 (x, y) or 3 (x, y, z; a model of the full width)."""
+        return int(self.reference_tip.shape[0])
+
+    @property
     def displacements(self) -> FloatArray:
-        """Unit-centre displacements ``centres - reference_centres``, shape (k, n, 2)."""
+        """Unit-centre displacements ``centres - reference_centres``, shape (k, n, axes)."""
         return self.centres - self.reference_centres[None]
 
     def centreline(self, level: int) -> FloatArray:
-        """The polyline base -> unit centres -> tip at a reported level, shape (n + 2, 2)."""
-        base = np.array([[0.0, self.reference_centres[0, 1]]])
+        """The polyline base -> unit centres -> tip at a reported level, shape (n + 2, axes)."""
+        base = np.concatenate([[0.0], self.reference_centres[0, 1:]])[None]
         return np.concatenate([base, self.centres[level], self.tip[level][None]])
 
     def level_of(self, pressure: float) -> int:

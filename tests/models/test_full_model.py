@@ -1,0 +1,81 @@
+"""The full 3D model (issue 25, item 2): the half model's answer on planar designs; sideways units leave the plane."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.fem import StepSettings
+from pneumorph.geometry.library import UnitLibrary, builtin_library
+from pneumorph.models.fe import Full3D, RampSpec
+
+#: a short, low ramp: two levels to 10 kPa (seconds per solve)
+RAMP = RampSpec(pressure=0.01, steps=StepSettings(increments=2, substeps=1))
+#: solver tolerance on positions (mm): the ramp's relative residual 1e-8 moves the 2-3 unit actuators' points
+#: by far less; the half model's u_z = 0 is exact for a planar design
+ATOL = 1e-6
+
+
+@pytest.fixture(scope="module")
+def spatial() -> UnitLibrary:
+    """The built-in spatial library (its 1.5 mm mesh: the units share their section's lines only at this size)."""
+    return builtin_library("spatial")
+
+
+@pytest.fixture(scope="module")
+def sideways(spatial: UnitLibrary) -> dict[str, object]:
+    """Two 2-unit designs with a sideways unit, one the other's mirror across the width, and their meshes."""
+    model = Full3D(2, library=spatial, ramp_spec=RAMP)
+    return {design: (model.evaluate(design), model.mesh(design)) for design in ("al", "aL")}
+
+
+def test_the_full_model_equals_the_half_model_on_a_planar_design(spatial: UnitLibrary) -> None:
+    half_model, full_model = Full3D(2, library=spatial, ramp_spec=RAMP), Full3D(2, library=spatial, ramp_spec=RAMP,
+                                                                                  half=False)
+    assert half_model.half_for("aA") and not full_model.half_for("aA")
+    half, full = half_model.evaluate("aA"), full_model.evaluate("aA")
+    assert (half.axes, full.axes) == (2, 3) and half.metadata["dofs"] < 0.6 * full.metadata["dofs"]
+    assert np.abs(half.tip[-1] - half.reference_tip).max() > 0.1  # it moved: the comparison means something
+    np.testing.assert_allclose(full.centres[..., :2], half.centres, atol=ATOL, rtol=0)
+    np.testing.assert_allclose(full.tip[..., :2], half.tip, atol=ATOL, rtol=0)
+    np.testing.assert_allclose(full.curl, half.curl, atol=1e-5, rtol=0)
+    W = spatial["a"].width  # the full model's z stays on the mid-plane, where the half model holds it
+    np.testing.assert_allclose(full.centres[..., 2], W / 2, atol=ATOL, rtol=0)
+    np.testing.assert_allclose(full.tip[:, 2], W / 2, atol=ATOL, rtol=0)
+
+
+def test_a_sideways_unit_bends_out_of_the_plane_towards_its_layer(spatial: UnitLibrary,
+                                                                  sideways: dict[str, object]) -> None:
+    W = spatial["a"].width
+    for design, (response, mesh) in sideways.items():  # type: ignore[misc]
+        assert response.axes == 3 and response.converged and mesh.symmetry_points is None
+        layer = mesh.points[mesh.cells[mesh.regions["layer"], :8]].mean(axis=1)
+        in_unit_2 = layer[:, 0] > mesh.unit_bounds[1]
+        side = np.sign(layer[in_unit_2, 2].mean() - W / 2)  # the side the sideways unit's layer lies on
+        assert side == (1 if design == "al" else -1)
+        dz = response.tip[:, 2] - response.reference_tip[2]
+        assert (np.sign(dz) == side).all() and abs(dz[-1]) > 0.05  # towards its layer, and not by rounding
+
+
+def test_the_turned_over_sideways_unit_mirrors_the_response_across_the_width(sideways: dict[str, object]) -> None:
+    (left, _), (right, _) = sideways["al"], sideways["aL"]  # type: ignore[misc]
+    W = 2 * float(left.reference_tip[2])
+    np.testing.assert_allclose(right.tip[:, 2], W - left.tip[:, 2], atol=ATOL, rtol=0)
+    np.testing.assert_allclose(right.centres[..., 2], W - left.centres[..., 2], atol=ATOL, rtol=0)
+    np.testing.assert_allclose(right.tip[:, :2], left.tip[:, :2], atol=ATOL, rtol=0)  # in-plane the same
+    np.testing.assert_allclose(right.centres[..., :2], left.centres[..., :2], atol=ATOL, rtol=0)
+    np.testing.assert_allclose(right.curl, left.curl, atol=1e-5, rtol=0)
+
+
+def test_a_sideways_response_keeps_z_through_its_file(sideways: dict[str, object], tmp_path: object) -> None:
+    from pathlib import Path
+
+    from pneumorph.models.response import Response
+
+    response, _ = sideways["al"]  # type: ignore[misc]
+    response.save(Path(str(tmp_path)) / "r")
+    again = Response.load(Path(str(tmp_path)) / "r")
+    assert again.axes == 3
+    np.testing.assert_array_equal(again.centres, response.centres)
+    np.testing.assert_array_equal(again.centreline(-1)[1:-1], response.centres[-1])
+    assert again.centreline(0)[0].tolist() == [0.0, *response.reference_centres[0, 1:].tolist()]
