@@ -55,8 +55,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,
     "pneumorph.fem.stepping:ramp": 130,
     "pneumorph.identify.fit:identify": 186,
-    "pneumorph.models.chainfit:build_table": 115,
-    "pneumorph.models.chainfit:fit_table": 107,
 }
 
 

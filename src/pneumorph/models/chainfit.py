@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -125,10 +126,34 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         No responses, a failed one, mixed lengths or levels; over a library, training
         actuators whose undeformed centres are not where the library's units put them.
     """
+    longest, pressures = _check_training(responses)
+    n = longest.n_units
+    w = int(window)
+    alphabet = library.alphabet if library is not None else ()
+    means = _window_means(responses, w, mirror, alphabet, library.symmetric_types if library is not None else (),
+                          len(pressures))
+    if n < 2:
+        raise ChainTableError("a chain table needs training designs of at least 2 units")
+    fitted = dict(window=w, pressures=np.asarray(pressures, dtype=float), **means, source=dict(source),
+                  training=tuple(r.orientation for r in responses))
+    if alphabet:
+        assert library is not None
+        return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
+            **fitted, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0)))
+    return ChainTable(**fitted, **_binary_geometry(responses, longest, mirror))
+
+
+def _check_training(responses: Sequence[Response]) -> tuple[Response, FloatArray]:
+    """The longest training response and the pressure levels all share.
+
+    Raises
+    ------
+    ChainTableError
+        No responses, one that did not converge, or responses of different levels.
+    """
     if not responses:
         raise ChainTableError("a chain table needs at least one training response")
     longest = max(responses, key=lambda r: r.n_units)
-    n = longest.n_units
     pressures = responses[0].pressures
     for r in responses:
         if not r.converged or not np.isfinite(r.centres).all():
@@ -136,9 +161,22 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
                                   "every training design solved to the last level")
         if not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
             raise ChainTableError("training responses of different pressure levels")
-    w = int(window)
-    alphabet = library.alphabet if library is not None else ()
-    symmetric = library.symmetric_types if library is not None else ()
+    return longest, pressures
+
+
+def _window_means(responses: Sequence[Response], w: int, mirror: bool, alphabet: tuple[str, ...],
+                  symmetric: tuple[int, ...], levels: int) -> dict[str, Any]:
+    """Every window's mean turn and length, every end window's mean end turn, and the largest deviation.
+
+    The means are over the window's occurrences in ``responses`` (and, with ``mirror``, over
+    the mirrored occurrences with negated turns), per level.
+
+    Returns
+    -------
+    dict
+        :class:`ChainTable`'s ``codes``, ``turn``, ``length``, ``end_codes``, ``end`` and
+        ``spread``.
+    """
     k = max(1, len(alphabet))
     all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
     for r in responses:
@@ -156,33 +194,32 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     length = np.concatenate(all_len)
     uniq, inv = np.unique(codes, return_inverse=True)
     counts = np.bincount(inv)[:, None]
-    k = len(pressures)
-    mean_turn = np.zeros((len(uniq), k))
-    mean_len = np.zeros((len(uniq), k))
+    mean_turn = np.zeros((len(uniq), levels))
+    mean_len = np.zeros((len(uniq), levels))
     np.add.at(mean_turn, inv, turn)
     np.add.at(mean_len, inv, length)
     mean_turn /= counts
     mean_len /= counts
     spread = float(max(np.abs(turn - mean_turn[inv]).max(), np.abs(length - mean_len[inv]).max()))
-    ecodes = np.concatenate(e_codes)
-    end = np.concatenate(e_end)
-    euniq, einv = np.unique(ecodes, return_inverse=True)
-    mean_end = np.zeros((len(euniq), k))
-    np.add.at(mean_end, einv, end)
+    euniq, einv = np.unique(np.concatenate(e_codes), return_inverse=True)
+    mean_end = np.zeros((len(euniq), levels))
+    np.add.at(mean_end, einv, np.concatenate(e_end))
     mean_end /= np.bincount(einv)[:, None]
+    return {"codes": uniq, "turn": mean_turn, "length": mean_len, "end_codes": euniq, "end": mean_end,
+            "spread": spread}
 
-    ref = longest
-    xs = ref.reference_centres[:, 0]
-    if n < 2:
-        raise ChainTableError("a chain table needs training designs of at least 2 units")
-    if alphabet:
-        assert library is not None
-        return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
-            window=w, pressures=np.asarray(pressures, dtype=float), codes=uniq, turn=mean_turn, length=mean_len,
-            end_codes=euniq, end=mean_end, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0),
-            source=dict(source), training=tuple(r.orientation for r in responses), spread=spread))
+
+def _binary_geometry(responses: Sequence[Response], longest: Response, mirror: bool) -> dict[str, Any]:
+    """The undeformed geometry of a 0/1 table: pitch, both orientations' centre heights, first centre, tip.
+
+    Raises
+    ------
+    ChainTableError
+        Training designs without both orientations at fixed heights, or unevenly spaced units.
+    """
+    xs = longest.reference_centres[:, 0]
     pitch = float(np.mean(np.diff(xs)))
-    tip_y = float(ref.reference_tip[1])
+    tip_y = float(longest.reference_tip[1])
     heights: dict[int, list[float]] = {0: [], 1: []}
     for r in responses:
         for o, y in zip(r.orientation, r.reference_centres[:, 1], strict=False):
@@ -191,26 +228,11 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
                 heights[1 - int(o)].append(2 * tip_y - float(y))
     if not heights[0] or not heights[1] or max(np.ptp(heights[0]), np.ptp(heights[1])) > 1e-9:
         raise ChainTableError("the training designs do not show both unit orientations at fixed heights")
-    centre_y = (heights[0][0], heights[1][0])
     if not np.allclose(np.diff(xs), pitch, atol=1e-9):
         raise ChainTableError("the training actuator's unit centres are not evenly spaced; a chain table "
                               "needs identical units")
-    return ChainTable(
-        window=w,
-        pressures=np.asarray(pressures, dtype=float),
-        codes=uniq,
-        turn=mean_turn,
-        length=mean_len,
-        end_codes=euniq,
-        end=mean_end,
-        pitch=pitch,
-        centre_y=centre_y,
-        first_offset=float(xs[0]),
-        tip_ref=(float(ref.reference_tip[0] - xs[-1]), tip_y),
-        source=dict(source),
-        training=tuple(r.orientation for r in responses),
-        spread=spread,
-    )
+    return {"pitch": pitch, "centre_y": (heights[0][0], heights[1][0]), "first_offset": float(xs[0]),
+            "tip_ref": (float(longest.reference_tip[0] - xs[-1]), tip_y)}
 
 
 def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], library: UnitLibrary, mirror: bool,
@@ -293,19 +315,10 @@ def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
     return solve
 
 
-def build_table(
-    model: Any,
-    evaluator: Any,
-    window: int | None = None,
-    tolerance: float = DEFAULT_TOLERANCE,
-    heldout: int = 20,
-    seed: int = 1,
-    max_window: int = MAX_WINDOW,
-    on_progress: Callable[[str], None] | None = None,
-    short: bool = False,
-    first_window: int = 1,
-    early: bool = False,
-) -> ChainTable:
+def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance: float = DEFAULT_TOLERANCE,
+                heldout: int = 20, seed: int = 1, max_window: int = MAX_WINDOW,
+                on_progress: Callable[[str], None] | None = None, short: bool = False, first_window: int = 1,
+                early: bool = False) -> ChainTable:
     """Fit and validate a chain table to an FE model by solving covering and held-out designs.
 
     Parameters
@@ -352,59 +365,114 @@ def build_table(
     ChainTableError
         A training design failed to converge.
     """
-    if getattr(model, "gravity", None) is not None:
-        raise LocalityError("the chain model needs a free actuator: with gravity the weight makes moments along "
-                            "the chain, so a unit's response depends on the whole actuator; search with the FE "
-                            "model (--search ga or exhaustive)")
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ChainTableError(f"the tolerance must be a positive number of mm, got {tolerance!r}")
+    _check_buildable(model, tolerance)
     n = int(model.n_units)
     say = on_progress or (lambda text: None)
-    first = min(max(1, int(first_window)), max_window, max(1, (n - 1) // 2))
-    windows = [int(window)] if window is not None else list(range(first, max_window + 1))
-    if windows[0] < 1 or 2 * windows[-1] + 1 > n:
-        raise ChainTableError(f"a window of +-{windows[-1]} units needs training designs of at least "
-                              f"{2 * windows[-1] + 1} units; the model has {n}")
-    src = {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
-           "n_units": n, "description": source_description(model)}
+    windows = _windows(n, window, first_window, max_window)
     library = getattr(model, "library", None)
-    alphabet = library.alphabet if library is not None else ()
-    symmetric = library.symmetric_types if library is not None else ()
     solved: dict[str, Response] = {}
-
-    solve = _solver(model, evaluator, solved, say)
-
-    start = time.perf_counter()
+    build = _Build(model, evaluator, tolerance, heldout, seed, short, early, say, solved,
+                   _solver(model, evaluator, solved, say), library, _source(model), time.perf_counter())
     best: ChainTable | None = None
     for w in windows:
-        check_training_size(max(1, len(alphabet)), w, len(symmetric))
-        train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric,
-                                 short=short)
-        say(f"window +-{w}: {len(train)} covering designs")
-        tests = heldout_designs(n, heldout, exclude=train, seed=seed, alphabet=alphabet, symmetric=symmetric)
-        tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
-        # the held-out designs an early validation needs at least go in the covering designs' stream (no pause
-        # between the two); they serve the next window too, should this one be refused
-        ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if early else []
-        what = f"covering and {len(ahead)} held-out" if ahead else "covering"
-        table = fit_table(solve(train + ahead, what)[: len(train)], w, src, library=library if alphabet else None)
-        val = validate_in_rounds(table, tests, solve, tolerance, early, evaluator_workers(evaluator))
-        val.update(tolerance_mm=tolerance, seed=seed)
-        worst = max(val["centre_worst_mm"])
-        say(f"window +-{w}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
-            f"design(s){stop_note(val, tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
-        for symbol, errs in val.get("per_type", {}).items():
-            if errs["centres"]:
-                say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
-                    f"({errs['centres']} centres)")
-        meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - start)
-        table = ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})
-        best = table
-        if worst <= tolerance:
-            return table
+        best = _window_table(build, w)
+        if max(best.validation["centre_worst_mm"]) <= tolerance:
+            return best
     assert best is not None
     raise LocalityError(
         f"the chain model does not reproduce this model within {tolerance:g} mm: with window +-{best.window} "
         f"the worst held-out unit-centre error is {max(best.validation['centre_worst_mm']):.3g} mm; the units "
         "interact further than the window reaches, so search with the FE model (--search ga or exhaustive)"
     )
+
+
+def _check_buildable(model: Any, tolerance: float) -> None:
+    """Refuse a model with gravity (the chain needs a free actuator) and a tolerance that is no positive number."""
+    if getattr(model, "gravity", None) is not None:
+        raise LocalityError("the chain model needs a free actuator: with gravity the weight makes moments along "
+                            "the chain, so a unit's response depends on the whole actuator; search with the FE "
+                            "model (--search ga or exhaustive)")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ChainTableError(f"the tolerance must be a positive number of mm, got {tolerance!r}")
+
+
+def _windows(n: int, window: int | None, first_window: int, max_window: int) -> list[int]:
+    """The half-widths to try: ``window``, else ``first_window`` (clipped to fit ``n`` units) up to ``max_window``.
+
+    Raises
+    ------
+    ChainTableError
+        A window wider than ``n`` units allow.
+    """
+    first = min(max(1, int(first_window)), max_window, max(1, (n - 1) // 2))
+    windows = [int(window)] if window is not None else list(range(first, max_window + 1))
+    if windows[0] < 1 or 2 * windows[-1] + 1 > n:
+        raise ChainTableError(f"a window of +-{windows[-1]} units needs training designs of at least "
+                              f"{2 * windows[-1] + 1} units; the model has {n}")
+    return windows
+
+
+@dataclass(frozen=True)
+class _Build:
+    """What every window of a build shares: the model, the settings, the designs solved so far."""
+
+    model: Any
+    evaluator: Any
+    tolerance: float
+    heldout: int
+    seed: int
+    short: bool
+    early: bool
+    say: Callable[[str], None]
+    solved: dict[str, Response]
+    solve: Callable[..., list[Response]]
+    library: UnitLibrary | None
+    source: dict[str, Any]
+    start: float
+
+
+def _source(model: Any) -> dict[str, Any]:
+    """A table's ``source``: the model's fidelity, key, fingerprint, length and description."""
+    return {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
+            "n_units": int(model.n_units), "description": source_description(model)}
+
+
+def _window_table(build: _Build, w: int) -> ChainTable:
+    """The table of half-width ``w``, fitted to its covering designs and validated on held-out ones.
+
+    Held-out designs solved for a smaller window are validated first; with ``early``, the
+    first :data:`MIN_HELDOUT` go in the covering designs' stream (no pause between the
+    two; they serve the next window too, should this one be refused).
+
+    Raises
+    ------
+    LocalityError
+        Too many covering designs for the library (:func:`check_training_size`).
+    ChainTableError
+        A design failed to converge.
+    """
+    n, library, solved, say = int(build.model.n_units), build.library, build.solved, build.say
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
+    check_training_size(max(1, len(alphabet)), w, len(symmetric))
+    train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric,
+                             short=build.short)
+    say(f"window +-{w}: {len(train)} covering designs")
+    tests = heldout_designs(n, build.heldout, exclude=train, seed=build.seed, alphabet=alphabet, symmetric=symmetric)
+    tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
+    ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if build.early else []
+    what = f"covering and {len(ahead)} held-out" if ahead else "covering"
+    table = fit_table(build.solve(train + ahead, what)[: len(train)], w, build.source,
+                      library=library if alphabet else None)
+    val = validate_in_rounds(table, tests, build.solve, build.tolerance, build.early,
+                             evaluator_workers(build.evaluator))
+    val.update(tolerance_mm=build.tolerance, seed=build.seed)
+    worst = max(val["centre_worst_mm"])
+    say(f"window +-{w}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
+        f"design(s){stop_note(val, build.tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
+    for symbol, errs in val.get("per_type", {}).items():
+        if errs["centres"]:
+            say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
+                f"({errs['centres']} centres)")
+    meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - build.start)
+    return ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})
