@@ -8,7 +8,9 @@ The method (docs/identify.md):
 2. **Jacobian by FE.** At the current parameters, every scanned design is solved, and
    again with each free parameter moved by its step (forward differences; a thickness
    moved with the mesh grid kept, as the tolerance study keeps it, so that surface nodes
-   correspond): the nodes' sensitivities ``dQ/dtheta``.
+   correspond): the nodes' sensitivities ``dQ/dtheta``. A moved model starts from the
+   solved state at the top pressure (:func:`~pneumorph.models.warmstart.solve_near`: a few
+   Newton iterations to the ramp's own convergence test, not a ramp).
 3. **Gauss-Newton on the linearised shape.** The residual of a scan point is its signed
    distance to the model's surface (3D: the tangent plane at its nearest surface node;
    2D: its nearest outline segment). With the shape linear in the parameters, the
@@ -52,7 +54,7 @@ from pneumorph.identify.linear import (
     confounded,
 )
 from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
-from pneumorph.identify.probe import ShapeProbe, shape_of
+from pneumorph.identify.probe import JacobianProbe, ShapeProbe, shape_of, variant_shapes
 from pneumorph.identify.scans import ScanSpec
 from pneumorph.models.factory import make_model
 
@@ -276,6 +278,27 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         solves += len(cases)
         return out
 
+    def jacobian_at(values: FloatArray, trial: list[FloatArray]) -> tuple[list[ModelShape], list[list[ModelShape]]]:
+        """Every scan's shape at ``values`` and at each of the ``trial`` points (one case per scan: its ramp at
+        ``values``, the trial points warm-started from it, :class:`~pneumorph.identify.probe.JacobianProbe`)."""
+        nonlocal solves
+        points_of = [build_probes(observations, params, base, v) for v in trial]
+        cases = [(JacobianProbe(probe.model, [p[s].model for p in points_of]), observations[s].spec.design)
+                 for s, probe in enumerate(build_probes(observations, params, base, values))]
+        at: list[Any] = [None] * len(observations)
+        moved: list[list[Any]] = [[None] * len(observations) for _ in trial]
+        for s, outcome in evaluator.iter_cases(cases):
+            if not outcome.ok or outcome.response is None:
+                raise FitError(f"the fit's solve of design {observations[s].spec.design} at "
+                               f"{observations[s].spec.pressure_kpa:g} kPa (the Jacobian at "
+                               f"{', '.join(f'{n} {x:.6g}' for n, x in zip(NAMES, values, strict=True))}) failed: "
+                               f"{outcome.failure}; nothing is identified")
+            at[s] = shape_of(outcome.response)
+            for j, shape in enumerate(variant_shapes(outcome.response)):
+                moved[j][s] = shape
+        solves += len(cases) * (1 + len(trial))
+        return at, moved
+
     say(f"solving the nominal model of {len(observations)} scan(s)")
     (nominal_shapes,) = shapes_at([theta])
     transforms, before = [], []
@@ -308,11 +331,9 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
             v = theta.copy()
             v[i] += h
             trial.append(v)
-        say(f"iteration {iterations}: {len(trial) * len(observations)} solves for the Jacobian of {', '.join(free)}")
-        if iterations == 1:  # the nominal shapes are solved already
-            moved = shapes_at(trial) if trial else []
-        else:  # the new point and its Jacobian in one batch
-            base_shapes, *moved = shapes_at([theta, *trial])
+        say(f"iteration {iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} warm-started "
+            f"solves for the Jacobian of {', '.join(free)}")
+        base_shapes, moved = jacobian_at(theta, trial)
         derivatives = []
         for s in range(len(observations)):
             nodes, _ = _nodes(base_shapes[s], dim)

@@ -12,6 +12,7 @@ revision): a rerun answers from the cache, an interrupted fit resumes.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -68,6 +69,52 @@ class ShapeProbe(Probe):
         return shape_to_dict(model_shape(solution))
 
 
+class JacobianProbe(ShapeProbe):
+    """The shapes of a design at a point of the parameter space and at each of its Jacobian's steps.
+
+    The point's model solves its ramp; each step's model (``variants``: the same mesh grid, one
+    parameter moved) starts from that state at the top pressure
+    (:func:`~pneumorph.models.warmstart.solve_near`), a few Newton iterations instead of a
+    ramp each, converged to the ramp's own test. The response holds the point's shape as a
+    :class:`ShapeProbe`'s does, and the steps' shapes under ``"variants"`` (:func:`variant_shapes`);
+    the fingerprint digests every model.
+
+    Examples
+    --------
+    >>> from pneumorph.models.factory import make_model
+    >>> coarse = {"pressure_kpa": 10, "unit": {"element_size": 3.0}}
+    >>> probe = JacobianProbe(make_model(2, coarse), [make_model(2, {**coarse, "body_bulk_scale": 1.02})])
+    >>> r = probe.evaluate("01")
+    >>> moved = variant_shapes(r)[0]
+    >>> direct = shape_of(ShapeProbe(probe.variants[0]).evaluate("01"))
+    >>> float(np.abs(moved.outline - direct.outline).max()) < 1e-6
+    True
+    """
+
+    kind = "identify-jacobian"
+
+    def __init__(self, model: FEModel, variants: Any) -> None:
+        super().__init__(model)
+        self.variants = tuple(variants)
+
+    def describe(self) -> dict[str, Any]:
+        return {**super().describe(), "variants": [v.describe() for v in self.variants]}
+
+    def measure(self, solution: Any) -> dict[str, Any]:
+        """The point's shape and, under ``"variants"``, each step's (warm-started from ``solution``)."""
+        from pneumorph.models.warmstart import solve_near
+
+        design = solution.response.orientation
+        return {**super().measure(solution),
+                "variants": [shape_to_dict(model_shape(solve_near(v, design, solution))) for v in self.variants]}
+
+
+def variant_shapes(response: Response) -> list[ModelShape]:
+    """The steps' shapes a :class:`JacobianProbe` stored in ``response``, in its variants' order."""
+    return [shape_of(replace(response, metadata={"model_shape": d}))
+            for d in response.metadata["model_shape"]["variants"]]
+
+
 def shape_to_dict(shape: ModelShape) -> dict[str, Any]:
     """Plain lists of a :class:`ModelShape` (the outline's two end points per segment), for the cache."""
     return {"surface": shape.surface.tolist(), "side": shape.side.astype(int).tolist(),
@@ -91,4 +138,4 @@ def shape_of(response: Response) -> ModelShape:
                       np.asarray(d["normals"], dtype=float).reshape(-1, 3))
 
 
-__all__ = ["SHAPE_REVISION", "ShapeProbe", "shape_of", "shape_to_dict"]
+__all__ = ["SHAPE_REVISION", "JacobianProbe", "ShapeProbe", "shape_of", "shape_to_dict", "variant_shapes"]
