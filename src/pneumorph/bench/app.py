@@ -164,15 +164,13 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     Parameters
     ----------
     state_dir : path, optional
-        Jobs, FE shapes, uploaded units and the session key (default: ``bench/`` beside the
-        evaluation cache).
+        Jobs, FE shapes, uploaded units and the session key (default: ``bench/`` beside the evaluation cache).
     cache : path, optional
         The evaluation cache (default: the design command's, so both share solves).
     workers : int
         FE worker processes of a background job.
     answer_workers : int, optional
-        Processes that compute answers (default: one per core, at most 4); 0 computes them
-        on the server's threads.
+        Processes that compute answers (default: one per core, at most 4); 0: on the server's threads.
     allowed_hosts : sequence of str
         The host names (``Host`` header) served; any other is refused (DNS rebinding).
         Default: this machine's loopback names.

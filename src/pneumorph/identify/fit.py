@@ -278,27 +278,6 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         solves += len(cases)
         return out
 
-    def jacobian_at(values: FloatArray, trial: list[FloatArray]) -> tuple[list[ModelShape], list[list[ModelShape]]]:
-        """Every scan's shape at ``values`` and at each of the ``trial`` points (one case per scan: its ramp at
-        ``values``, the trial points warm-started from it, :class:`~pneumorph.identify.probe.JacobianProbe`)."""
-        nonlocal solves
-        points_of = [build_probes(observations, params, base, v) for v in trial]
-        cases = [(JacobianProbe(probe.model, [p[s].model for p in points_of]), observations[s].spec.design)
-                 for s, probe in enumerate(build_probes(observations, params, base, values))]
-        at: list[Any] = [None] * len(observations)
-        moved: list[list[Any]] = [[None] * len(observations) for _ in trial]
-        for s, outcome in evaluator.iter_cases(cases):
-            if not outcome.ok or outcome.response is None:
-                raise FitError(f"the fit's solve of design {observations[s].spec.design} at "
-                               f"{observations[s].spec.pressure_kpa:g} kPa (the Jacobian at "
-                               f"{', '.join(f'{n} {x:.6g}' for n, x in zip(NAMES, values, strict=True))}) failed: "
-                               f"{outcome.failure}; nothing is identified")
-            at[s] = shape_of(outcome.response)
-            for j, shape in enumerate(variant_shapes(outcome.response)):
-                moved[j][s] = shape
-        solves += len(cases) * (1 + len(trial))
-        return at, moved
-
     say(f"solving the nominal model of {len(observations)} scan(s)")
     (nominal_shapes,) = shapes_at([theta])
     transforms, before = [], []
@@ -333,7 +312,8 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
             trial.append(v)
         say(f"iteration {iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} warm-started "
             f"solves for the Jacobian of {', '.join(free)}")
-        base_shapes, moved = jacobian_at(theta, trial)
+        base_shapes, moved = jacobian_at(observations, params, base, evaluator, theta, trial)
+        solves += len(observations) * (1 + len(trial))
         derivatives = []
         for s in range(len(observations)):
             nodes, _ = _nodes(base_shapes[s], dim)
@@ -417,6 +397,33 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         residual_before=residual_before if residual_before is not None else np.full(len(points), np.nan),
         residual_after=_per_scan_rms(r_final, points), sigma=sigma, iterations=iterations, solves=solves,
         settings=settings, fingerprints=fingerprints, observations=tuple(observations))
+
+
+def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any], evaluator: Any,
+                values: FloatArray, trial: list[FloatArray]) -> tuple[list[ModelShape], list[list[ModelShape]]]:
+    """Every scan's shape at ``values`` and at each of the ``trial`` points: one case per scan, its ramp at
+    ``values`` and the trial points warm-started from it (:class:`~pneumorph.identify.probe.JacobianProbe`).
+
+    Raises
+    ------
+    FitError
+        A solve failed.
+    """
+    points_of = [build_probes(observations, params, base, v) for v in trial]
+    cases = [(JacobianProbe(probe.model, [p[s].model for p in points_of]), observations[s].spec.design)
+             for s, probe in enumerate(build_probes(observations, params, base, values))]
+    at: list[Any] = [None] * len(observations)
+    moved: list[list[Any]] = [[None] * len(observations) for _ in trial]
+    for s, outcome in evaluator.iter_cases(cases):
+        if not outcome.ok or outcome.response is None:
+            raise FitError(f"the fit's solve of design {observations[s].spec.design} at "
+                           f"{observations[s].spec.pressure_kpa:g} kPa (the Jacobian at "
+                           f"{', '.join(f'{n} {x:.6g}' for n, x in zip(NAMES, values, strict=True))}) failed: "
+                           f"{outcome.failure}; nothing is identified")
+        at[s] = shape_of(outcome.response)
+        for j, shape in enumerate(variant_shapes(outcome.response)):
+            moved[j][s] = shape
+    return at, moved
 
 
 def _linearised(problem: tuple[Any, ...], chosen: list[int], columns: list[int]
