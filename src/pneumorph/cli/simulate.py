@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 import time
+from typing import Any
 
 import click
 
@@ -42,27 +43,10 @@ def simulate(
     model_file: str | None = None,
 ) -> None:
     """Inflate one actuator design and report its shape at every pressure level."""
-    from pathlib import Path
-
-    from pneumorph.geometry import parse_orientation
-    from pneumorph.io import provenance, write_vtk_series
-    from pneumorph.io.files import strict_json, write_json
+    from pneumorph.io import provenance
     from pneumorph.models import make_model
 
-    if library is not None:
-        from pneumorph.geometry.alphabet import parse_design
-
-        units = P.library_option(library, unit_file)
-        with P.blame("--orientation"):
-            design = parse_design(orientation, units).text
-    else:
-        with P.blame("--orientation"):
-            design = parse_orientation(orientation)
-    if unit_file is not None:
-        from pneumorph.geometry.unit import UnitSpec
-
-        with P.blame("--unit"):
-            UnitSpec.from_toml(unit_file)
+    design = _check_design(orientation, library, unit_file)
     # the factory, as `design` and the API use it: the model class's tuned ramp, the same fingerprint
     settings: dict = {"fidelity": fidelity, "pressure_kpa": pressure, "increments": increments, "gravity": gravity}
     if unit_file is not None:
@@ -83,36 +67,77 @@ def simulate(
     click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa{weight})",
                err=True)
     solution = model.solve(design, on_level=progress)
-    resp = solution.response
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
-        from pneumorph.io.files import all_or_nothing
-
-        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
-            resp.save(folder / "response")
-            write_vtk_series(solution, folder / "vtk", meta=meta)
-            from pneumorph.plot.shape import plot_shape
-
-            plot_shape(solution, folder / "shape.png", levels=sorted({resp.n_levels // 2 - 1, resp.n_levels - 1}))
-            write_json(folder / "provenance.json", meta)
+        _write(out, solution, meta)
     if as_json:
-        levels = [
-            {
-                "pressure_kpa": float(p * 1e3),
-                "tip_mm": resp.tip[k].tolist(),
-                "curl_deg": float(resp.curl[k]),
-                "unit_centres_mm": resp.centres[k].tolist(),
-            }
-            for k, p in enumerate(resp.pressures)
-        ]
-        click.echo(strict_json({"orientation": design, "model": fidelity, "converged": resp.converged,
-                                "levels": levels, "metadata": resp.metadata}))
+        _print_json(design, fidelity, solution.response)
     else:
-        click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} {'curl [deg]':>11}")
-        for k, p in enumerate(resp.pressures):
-            click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {resp.curl[k]:11.2f}")
-        m = resp.metadata
-        click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
-                   f"{m['wall_time_s']:.2f} s")
-        if out:
-            click.echo(f"written to {Path(out)}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")
+        _print_table(solution.response, out)
+
+
+def _check_design(orientation: str, library: str | None, unit_file: str | None) -> str:
+    """The design's orientation string, read over --library's letters or as digits; --unit's file checked."""
+    from pneumorph.geometry import parse_orientation
+
+    if library is not None:
+        from pneumorph.geometry.alphabet import parse_design
+
+        units = P.library_option(library, unit_file)
+        with P.blame("--orientation"):
+            design = parse_design(orientation, units).text
+    else:
+        with P.blame("--orientation"):
+            design = parse_orientation(orientation)
+    if unit_file is not None:
+        from pneumorph.geometry.unit import UnitSpec
+
+        with P.blame("--unit"):
+            UnitSpec.from_toml(unit_file)
+    return design
+
+
+def _write(out: str, solution: Any, meta: dict) -> None:
+    """The response, the VTK series, the shape figure and the provenance, all or nothing."""
+    from pneumorph.io import write_vtk_series
+    from pneumorph.io.files import all_or_nothing, write_json
+
+    resp = solution.response
+    with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+        resp.save(folder / "response")
+        write_vtk_series(solution, folder / "vtk", meta=meta)
+        from pneumorph.plot.shape import plot_shape
+
+        plot_shape(solution, folder / "shape.png", levels=sorted({resp.n_levels // 2 - 1, resp.n_levels - 1}))
+        write_json(folder / "provenance.json", meta)
+
+
+def _print_json(design: str, fidelity: str, resp: Any) -> None:
+    """Tip, curl and unit centres of every level as JSON."""
+    from pneumorph.io.files import strict_json
+
+    levels = [
+        {
+            "pressure_kpa": float(p * 1e3),
+            "tip_mm": resp.tip[k].tolist(),
+            "curl_deg": float(resp.curl[k]),
+            "unit_centres_mm": resp.centres[k].tolist(),
+        }
+        for k, p in enumerate(resp.pressures)
+    ]
+    click.echo(strict_json({"orientation": design, "model": fidelity, "converged": resp.converged,
+                            "levels": levels, "metadata": resp.metadata}))
+
+
+def _print_table(resp: Any, out: str | None) -> None:
+    """Tip and curl of every level as a table, the solver's effort, and where the files went."""
+    from pathlib import Path
+
+    click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} {'curl [deg]':>11}")
+    for k, p in enumerate(resp.pressures):
+        click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {resp.curl[k]:11.2f}")
+    m = resp.metadata
+    click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
+               f"{m['wall_time_s']:.2f} s")
+    if out:
+        click.echo(f"written to {Path(out)}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")
