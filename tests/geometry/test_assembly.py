@@ -116,3 +116,19 @@ def test_bad_orientation_and_dimension() -> None:
         assemble(UnitSpec(), "012")
     with pytest.raises(GeometryError, match="dim must be 2 or 3"):
         assemble(UnitSpec(), "01", dim=1)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_unit_of_any_decimals_has_its_turned_over_units_mirrored_about_the_end_face(dim: int) -> None:
+    """The chain tables mirror a design about the end face's centre: a turned-over unit's centre must sit exactly
+    there (an identified unit's 1.591632525 mm wall and 2.96848611 mm layer put its grid lines 1e-6 mm off
+    symmetric when each was rounded on its own, and its table could not be built)."""
+    from pneumorph.geometry.unit import UnitSpec
+
+    unit = UnitSpec(wall=1.591632525, side_wall=1.527421929, layer=2.96848611, element_size=3.0)
+    mesh = assemble(unit, "0110", dim, half=True)
+    centres = mesh.unit_centres(axes=2)
+    tip_y = mesh.points[mesh.end_points][:, 1].mean()
+    assert abs(centres[0, 1] - (2 * tip_y - centres[1, 1])) < 1e-12
+    assert abs(centres[3, 1] - (2 * tip_y - centres[2, 1])) < 1e-12
+    assert abs(centres[0, 1] - centres[1, 1]) > 2.0  # the two orientations do differ

@@ -56,7 +56,11 @@ def section_breaks(spec: UnitSpec) -> tuple[list[float], list[float]]:
     yb = [0.0, y0, y1, spec.height - spec.top_layer, spec.height]
     if spec.slit is not None:
         yb.append(spec.slit_depth)
-    yb += [spec.height - y for y in yb]
+    # mirrored after rounding as the grid rounds (grid_lines): the lines of both orientations then lie exactly
+    # symmetric about mid-height whatever the unit's decimals (an identified unit's 1.591632525 mm wall)
+    yb = [round(y, 6) for y in yb]
+    top = round(spec.height, 6)
+    yb += [round(top - y, 6) for y in yb]
     return xb, yb
 
 
