@@ -258,28 +258,12 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     build_probes(observations, params, base, theta)  # every model refused now, before any solve
     solves = 0
 
-    def shapes_at(values_list: list[FloatArray]) -> list[list[ModelShape]]:
-        """The shapes of every scan's design at each parameter vector (one batch of the evaluator)."""
-        nonlocal solves
-        cases, where = [], []
-        for v_index, values in enumerate(values_list):
-            for s, probe in enumerate(build_probes(observations, params, base, values)):
-                cases.append((probe, observations[s].spec.design))
-                where.append((v_index, s))
-        out: list[list[Any]] = [[None] * len(observations) for _ in values_list]
-        for i, outcome in evaluator.iter_cases(cases):
-            v_index, s = where[i]
-            if not outcome.ok or outcome.response is None:
-                changed = ", ".join(f"{n} {x:.6g}" for n, x in zip(NAMES, values_list[v_index], strict=True))
-                raise FitError(f"the fit's solve of design {observations[s].spec.design} at "
-                               f"{observations[s].spec.pressure_kpa:g} kPa ({changed}) failed: {outcome.failure}; "
-                               "nothing is identified")
-            out[v_index][s] = shape_of(outcome.response)
-        solves += len(cases)
-        return out
-
-    say(f"solving the nominal model of {len(observations)} scan(s)")
-    (nominal_shapes,) = shapes_at([theta])
+    lower, upper = params.lower, params.upper
+    first = _trial(theta, [NAMES.index(n) for n in free], upper)
+    say(f"solving the nominal model of {len(observations)} scan(s) and its Jacobian ({len(first)} warm-started "
+        "solves each)")
+    nominal_shapes, first_moved = jacobian_at(observations, params, base, evaluator, theta, first)
+    solves += len(observations) * (1 + len(first))
     transforms, before = [], []
     for o, shape in zip(observations, nominal_shapes, strict=True):
         check_units(o.scan, shape)
@@ -292,7 +276,6 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     notes = {name: "" for name in NAMES}
     residual_before: FloatArray | None = None
     base_shapes: list[ModelShape] = nominal_shapes
-    lower, upper = params.lower, params.upper
     iterations = 0
     cov = np.zeros((0, 0))
     sigma = float("nan")
@@ -304,16 +287,14 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
                            "identified")
         iterations += 1
         idx = [NAMES.index(n) for n in free]
-        trial = []
-        for i in idx:  # forward differences, backwards at the top of the box
-            h = STEPS[NAMES[i]] if theta[i] + STEPS[NAMES[i]] <= upper[i] + 1e-12 else -STEPS[NAMES[i]]
-            v = theta.copy()
-            v[i] += h
-            trial.append(v)
-        say(f"iteration {iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} warm-started "
-            f"solves for the Jacobian of {', '.join(free)}")
-        base_shapes, moved = jacobian_at(observations, params, base, evaluator, theta, trial)
-        solves += len(observations) * (1 + len(trial))
+        trial = _trial(theta, idx, upper)
+        if iterations == 1:  # solved with the nominal shapes
+            moved = first_moved
+        else:
+            say(f"iteration {iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} "
+                f"warm-started solves for the Jacobian of {', '.join(free)}")
+            base_shapes, moved = jacobian_at(observations, params, base, evaluator, theta, trial)
+            solves += len(observations) * (1 + len(trial))
         derivatives = []
         for s in range(len(observations)):
             nodes, _ = _nodes(base_shapes[s], dim)
@@ -355,7 +336,8 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
             break
 
     say("confirming the fit by FE")
-    (final_shapes,) = shapes_at([theta])
+    final_shapes, _ = jacobian_at(observations, params, base, evaluator, theta, [])
+    solves += len(observations)
     after = []
     for o, shape in zip(observations, final_shapes, strict=True):
         c = correlate(o.scan, shape)
@@ -397,6 +379,17 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         residual_before=residual_before if residual_before is not None else np.full(len(points), np.nan),
         residual_after=_per_scan_rms(r_final, points), sigma=sigma, iterations=iterations, solves=solves,
         settings=settings, fingerprints=fingerprints, observations=tuple(observations))
+
+
+def _trial(theta: FloatArray, idx: list[int], upper: FloatArray) -> list[FloatArray]:
+    """The Jacobian's points: each parameter of ``idx`` moved by its step (backwards at the top of the box)."""
+    trial = []
+    for i in idx:
+        h = STEPS[NAMES[i]] if theta[i] + STEPS[NAMES[i]] <= upper[i] + 1e-12 else -STEPS[NAMES[i]]
+        v = theta.copy()
+        v[i] += h
+        trial.append(v)
+    return trial
 
 
 def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any], evaluator: Any,
