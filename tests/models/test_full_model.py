@@ -79,3 +79,21 @@ def test_a_sideways_response_keeps_z_through_its_file(sideways: dict[str, object
     np.testing.assert_array_equal(again.centres, response.centres)
     np.testing.assert_array_equal(again.centreline(-1)[1:-1], response.centres[-1])
     assert again.centreline(0)[0].tolist() == [0.0, *response.reference_centres[0, 1:].tolist()]
+
+
+def test_the_full_width_gets_the_half_models_single_precision_limit_per_half_width(
+        spatial: UnitLibrary, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The limit stands for an element size (the tangent's conditioning): twice the unknowns on the full width."""
+    from pneumorph.fem.fast import newton
+
+    model = Full3D(2, library=spatial, ramp_spec=RAMP)
+    half_body, full_body = model.build("aA")[1], model.build("aL")[1]
+    n_half, n_full = len(half_body.dof1), len(full_body.dof1)
+    assert half_body.half and not full_body.half and n_half < n_full < 2 * n_half
+    monkeypatch.setattr(newton, "SINGLE_PRECISION_MAX_DOFS", n_full // 2 + 1)  # below the full body's unknowns
+    assert full_body.stepper("fast", model.tangent_reuse, model.anderson_depth)[0].precision == "single"
+    monkeypatch.setattr(newton, "SINGLE_PRECISION_MAX_DOFS", n_full // 2 - 1)
+    assert full_body.stepper("fast", model.tangent_reuse, model.anderson_depth)[0].precision == "double"
+    for limit, precision in ((n_half, "single"), (n_half - 1, "double")):  # the half model's limit as it was
+        monkeypatch.setattr(newton, "SINGLE_PRECISION_MAX_DOFS", limit)
+        assert half_body.stepper("fast", model.tangent_reuse, model.anderson_depth)[0].precision == precision

@@ -88,6 +88,8 @@ class PressurisedBody:
         Dead loads per region (``force.update(g)``), for the regions given a density.
     dof0, dof1 : ndarray
         Prescribed (clamped base, symmetry plane) and active degrees of freedom.
+    half : bool
+        Held on a plane of symmetry (a 3D half model); False: the full width.
     """
 
     points: FloatArray
@@ -101,6 +103,7 @@ class PressurisedBody:
     forces: dict[str, Any]
     dof0: IntArray
     dof1: IntArray
+    half: bool = False
 
     @property
     def items(self) -> list[Any]:
@@ -133,7 +136,10 @@ class PressurisedBody:
             assembly and ``newtonraphson`` (:class:`~pneumorph.fem.stepping.FElupeSubstep`).
         reuse, depth
             The fast Newton method's tangent reuse and Anderson depth (see
-            :class:`~pneumorph.fem.fast.newton.FastSubstep`).
+            :class:`~pneumorph.fem.fast.newton.FastSubstep`). Its limit of unknowns for
+            single precision is :data:`~pneumorph.fem.fast.newton.SINGLE_PRECISION_MAX_DOFS`,
+            twice that for a 3D body of the full width (no plane of symmetry: the same
+            element size, twice the unknowns).
 
         Returns
         -------
@@ -147,14 +153,16 @@ class PressurisedBody:
 
         if check_backend(backend) == "felupe":
             return FElupeSubstep(self.items, self.dof1, self.dof0), lambda: cavity_volume(self.walls)
-        from pneumorph.fem.fast.newton import FastSubstep
+        from pneumorph.fem.fast.newton import SINGLE_PRECISION_MAX_DOFS, FastSubstep
         from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
 
         system = (PlaneStrainSystem if self.dim == 2 else SolidSystem3D)(self.items, self.field, self.dof1, self.dof0)
         def monitor() -> float:
             return float(system.cavity_volume(self.displacement.ravel()))
 
-        return FastSubstep(system, reuse=reuse, depth=depth), monitor
+        # single precision up to the limit measured on half models, per half width (the same element size)
+        limit = SINGLE_PRECISION_MAX_DOFS * (2 if self.dim == 3 and not self.half else 1)
+        return FastSubstep(system, reuse=reuse, depth=depth, single_max_dofs=limit), monitor
 
 
 def pressurised_body(
@@ -233,7 +241,8 @@ def pressurised_body(
     forces = {name: fem.SolidBodyForce(solids[name].field, values=np.zeros(dim), scale=float(rho))
               for name, rho in (densities or {}).items()}
     dof0, dof1 = clamped_dofs(global_field, base_points, symmetry_points)
-    return PressurisedBody(points, cells, cell_type, dim, global_field, solids, walls, pressure, forces, dof0, dof1)
+    return PressurisedBody(points, cells, cell_type, dim, global_field, solids, walls, pressure, forces, dof0, dof1,
+                           half=symmetry_points is not None)
 
 
 __all__ = ["BACKENDS", "PressurisedBody", "check_backend", "pressurised_body", "regions_of"]

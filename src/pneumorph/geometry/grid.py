@@ -81,9 +81,9 @@ def width_breaks(spec: UnitSpec, half: bool = False) -> list[float]:
     """
     W = spec.width
     breaks = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
-    if spec.layer_side:
-        side = [W - spec.side_wall - spec.layer, W - spec.layer]
-        breaks += [z for z in [*side, *(W - z for z in side)] if not half or z < W / 2]
+    if spec.layer_side:  # mirrored after rounding, as section_breaks does: `l` and `L` exact mirror images
+        side = [round(W - spec.side_wall - spec.layer, 6), round(W - spec.layer, 6)]
+        breaks += [z for z in [*side, *(round(round(W, 6) - z, 6) for z in side)] if not half or z < W / 2]
     return breaks
 
 

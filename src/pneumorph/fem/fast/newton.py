@@ -46,7 +46,9 @@ STALLED_FRESH = 2
 #: double precision: the 15-unit actuator at 1.0 mm elements (245,000) stalled in single
 #: precision on every design tried, the default mesh (58,500) and 3-unit actuators at 1.0 mm
 #: (50,000) never did. Waiting for the stall instead cost the 15-unit winner 407 s against
-#: about 225 s in double precision throughout.
+#: about 225 s in double precision throughout. Measured on half models: a body of the full
+#: width (no plane of symmetry) has twice the unknowns at the same element size, and gets
+#: twice the limit (:meth:`pneumorph.fem.body.PressurisedBody.stepper`).
 SINGLE_PRECISION_MAX_DOFS = 100_000
 
 
@@ -133,8 +135,11 @@ class FastSubstep:
     fresh_start : bool
         With ``reuse``: assemble a fresh tangent at the start of every substep (default)
         instead of carrying the last one over.
+    single_max_dofs : int, optional
+        The limit of active unknowns for single precision (default
+        :data:`SINGLE_PRECISION_MAX_DOFS`).
 
-    A system with more than :data:`SINGLE_PRECISION_MAX_DOFS` active unknowns factorises in
+    A system with more than ``single_max_dofs`` active unknowns factorises in
     double precision from the start. A single-precision factorisation (the 3D default) whose
     fresh tangents stop converging (:data:`STALLED_FRESH` in a row each gaining less than
     ``reuse``) is replaced by a
@@ -152,16 +157,18 @@ class FastSubstep:
     """
 
     def __init__(
-        self, system: Any, solver: Any = None, reuse: float | None = None, depth: int = 0, fresh_start: bool = True
+        self, system: Any, solver: Any = None, reuse: float | None = None, depth: int = 0, fresh_start: bool = True,
+        single_max_dofs: int | None = None,
     ) -> None:
         self.system = system
+        limit = SINGLE_PRECISION_MAX_DOFS if single_max_dofs is None else single_max_dofs
         self.solver = solver or pattern_solver(
             system.indptr,
             system.indices,
             getattr(system, "symmetric", False),
             getattr(system, "ordering", 0),
             single=(reuse is not None and getattr(system, "single_precision", False)
-                    and len(getattr(system, "dof1", ())) <= SINGLE_PRECISION_MAX_DOFS),
+                    and len(getattr(system, "dof1", ())) <= limit),
         )
         if getattr(self.solver, "dtype", None) == np.float32:
             # a tangent factorised in single precision may as well be assembled in it
