@@ -46,7 +46,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.bench.app:create_app": 206,
     "pneumorph.calibration.method:calibrate": 85,
     "pneumorph.calibration.workflow:run_calibration": 104,
-    "pneumorph.cli.unit:optimise": 85,
     "pneumorph.design.certified:certified_search": 131,
     "pneumorph.design.ga:run_ga": 83,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,

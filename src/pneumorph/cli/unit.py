@@ -52,19 +52,56 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
              overwrite: bool, as_json: bool) -> None:
     """Maximise the bending angle per unit (Omega) and minimise the ballooning height (h_b) within a
     strain limit (Ellis 2020, 8.3.2), NSGA-II on a 3-unit 3D actuator; resumable through the cache."""
-    from dataclasses import replace
-    from pathlib import Path
-    from types import SimpleNamespace
-
-    from pneumorph.design.planning import planned_workers
-    from pneumorph.geometry.unit import UnitSpec
-    from pneumorph.io import strict_json
     from pneumorph.io.files import all_or_nothing
     from pneumorph.io.lock import RunLock
     from pneumorph.unitopt.run import OptimiseSettings, check_folder, optimise, write_outputs
-    from pneumorph.unitopt.space import DesignSpace, parse_variable
 
     check_options(executor, workers, scheduler)
+    space = _check_space(variables, resolution, element_size, unit_file, strain_limit, n_units, executor, workers)
+    settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
+                                pop_size=pop_size, generations=generations, seed=seed)
+    check_folder(out, settings, overwrite)
+    click.echo(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
+               f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
+               f"{generations} generations, seed {seed}", err=True)
+    evaluator = open_evaluator(executor, workers, scheduler, cache)
+    t0 = time.perf_counter()
+
+    def on_generation(g: int, front: list[Any]) -> None:
+        click.echo(f"generation {g}: front of {len(front)}", err=True)
+
+    with all_or_nothing(out) as folder, RunLock(folder):  # stopped before its files are whole: nothing left
+        try:
+            result = optimise(settings, evaluator, _on_candidate(t0), on_generation)
+        finally:
+            evaluator.close()
+        if (line := cluster_line(evaluator)) is not None:
+            click.echo(line, err=True)
+        write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
+    if as_json:
+        _print_json(result, strain_limit, evaluator)
+    else:
+        _print_front(result, space.names, out, t0)
+
+
+def _check_space(variables: tuple[str, ...], resolution: float, element_size: float | None, unit_file: str | None,
+                 strain_limit: float, n_units: int, executor: str, workers: int | None) -> Any:
+    """The design space of the options (the base unit, its element size, the ``--var`` ranges), checked with the
+    optimisation's settings (:func:`pneumorph.unitopt.run.check_settings`) before anything is written.
+
+    The messages name what to change (the unit, a range, the resolution, the units, the memory per worker); a
+    corner of a box the user gave (``--var``) that makes no unit is a bad ``--var``.
+    """
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from pneumorph.design.planning import planned_workers
+    from pneumorph.errors import GeometryError
+    from pneumorph.geometry.limits import MeshLimitError
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.unitopt.run import check_settings
+    from pneumorph.unitopt.space import DesignSpace, parse_variable
+
     with P.blame("--unit"):
         base = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
     base = replace(base, name="unitopt")
@@ -74,16 +111,18 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     with P.blame("--var"):
         space = (DesignSpace(tuple(parse_variable(v) for v in variables), base, resolution) if variables
                  else replace(DesignSpace.default(base), resolution=resolution))
-    _check_space(space, strain_limit, n_units, planned_workers(SimpleNamespace(executor=executor, workers=workers)),
-                 bool(variables))
-    settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
-                                pop_size=pop_size, generations=generations, seed=seed)
-    check_folder(out, settings, overwrite)
-    click.echo(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
-               f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
-               f"{generations} generations, seed {seed}", err=True)
-    evaluator = open_evaluator(executor, workers, scheduler, cache)
-    t0 = time.perf_counter()
+    parallel = planned_workers(SimpleNamespace(executor=executor, workers=workers))
+    try:
+        check_settings(space, strain_limit, n_units, parallel=parallel)
+    except GeometryError as exc:
+        if isinstance(exc, MeshLimitError) or not variables:
+            raise
+        raise click.BadParameter(" ".join(str(exc).split()), param_hint="'--var'") from None
+    return space
+
+
+def _on_candidate(t0: float) -> Any:
+    """The progress line of each candidate (counted, timed from ``t0``), on standard error."""
     count = {"n": 0}
 
     def on_candidate(c: Any) -> None:
@@ -97,31 +136,30 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
                      + (" (cached)" if c.cached else ""))
         click.echo(f"  [{count['n']}] ({dims}): {state}  [{time.perf_counter() - t0:.0f} s]", err=True)
 
-    def on_generation(g: int, front: list[Any]) -> None:
-        click.echo(f"generation {g}: front of {len(front)}", err=True)
+    return on_candidate
 
-    with all_or_nothing(out) as folder, RunLock(folder):  # stopped before its files are whole: nothing left
-        try:
-            result = optimise(settings, evaluator, on_candidate, on_generation)
-        finally:
-            evaluator.close()
-        if (line := cluster_line(evaluator)) is not None:
-            click.echo(line, err=True)
-        write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
-    rows = [c.row(strain_limit) for c in result.front]
-    better = result.better()
-    if as_json:
-        cluster = cluster_report(evaluator)
-        click.echo(strict_json({"front": rows, "base": result.base.row(strain_limit),
-                                "better_than_base": [c.row(strain_limit) for c in better],
-                                **({"cluster": cluster} if cluster else {})}))
-        return
-    names = space.names
+
+def _print_json(result: Any, strain_limit: float, evaluator: Any) -> None:
+    """The front, the base unit and the units better than it (and the cluster's report) as JSON."""
+    from pneumorph.io import strict_json
+
+    cluster = cluster_report(evaluator)
+    click.echo(strict_json({"front": [c.row(strain_limit) for c in result.front],
+                            "base": result.base.row(strain_limit),
+                            "better_than_base": [c.row(strain_limit) for c in result.better()],
+                            **({"cluster": cluster} if cluster else {})}))
+
+
+def _print_front(result: Any, names: Any, out: str, t0: float) -> None:
+    """The front as a table (the base unit first), the best unit better than the base, the counts."""
+    from pathlib import Path
+
     click.echo(" ".join(f"{n:>13}" for n in names) + f" {'Omega [deg]':>11} {'h_b [mm]':>8} {'strain':>7}")
     for c, mark in listed(result, names):
         m = c.measures
         tail = "failed" if m is None else f"{m.omega_deg:11.2f} {m.balloon_mm:8.2f} {m.strain:7.2f}"
         click.echo(" ".join(f"{c.values[n]:13.2f}" for n in names) + f" {tail}{mark}")
+    better = result.better()
     if better:
         m = better[0].measures
         assert m is not None
@@ -131,25 +169,6 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
         click.echo("no unit bends more than the base unit at the same or a lower h_b within the strain limit")
     click.echo(f"{len(result.candidates)} candidates ({result.solves} solved, {result.hits} from the cache) in "
                f"{time.perf_counter() - t0:.0f} s; written to {Path(out)}/")
-
-
-
-def _check_space(space: Any, strain_limit: float, n_units: int, parallel: int, given: bool) -> None:
-    """The optimisation's checks before anything is written (:func:`pneumorph.unitopt.run.check_settings`).
-
-    The messages name what to change (the unit, a range, the resolution, the units, the memory per worker); a
-    corner of a box the user gave (``given``) that makes no unit is a bad ``--var``.
-    """
-    from pneumorph.errors import GeometryError
-    from pneumorph.geometry.limits import MeshLimitError
-    from pneumorph.unitopt.run import check_settings
-
-    try:
-        check_settings(space, strain_limit, n_units, parallel=parallel)
-    except GeometryError as exc:
-        if isinstance(exc, MeshLimitError) or not given:
-            raise
-        raise click.BadParameter(" ".join(str(exc).split()), param_hint="'--var'") from None
 
 
 def listed(result: Any, names: Any) -> list[tuple[Any, str]]:
