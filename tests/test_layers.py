@@ -47,7 +47,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.calibration.method:calibrate": 85,
     "pneumorph.calibration.workflow:run_calibration": 104,
     "pneumorph.design.certified:certified_search": 131,
-    "pneumorph.design.ga:run_ga": 83,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,

@@ -373,51 +373,70 @@ def run_ga(
     book = ScoreBook(model, objective, evaluator)
     rng = random.Random(config.seed)
     library = getattr(model, "library", None)  # the FE models' unit library; designs over several types
-    symbols: tuple[str, ...] = library.alphabet if library is not None else ()
-    symmetric = library.symmetric_types if library is not None else ()
-    toolbox = make_toolbox(model.n_units, objective.sense, config, rng, codes=2 * max(len(symbols), 1))
-    history: list[GenerationStats] = []
+    run = _Run(book, library.alphabet if library is not None else (),
+               library.symmetric_types if library is not None else (), on_generation)
+    toolbox = make_toolbox(model.n_units, objective.sense, config, rng, codes=2 * max(len(run.symbols), 1))
 
     start = time.perf_counter()
     population = toolbox.population(n=config.population)
     if on_message:  # the FE verification's estimate of a solve (pneumorph.design.certified)
         from pneumorph.design.certified import _solve_estimate
 
-        distinct = len({_design(ind, symbols, symmetric) for ind in population})
+        distinct = len({run.design(ind) for ind in population})
         on_message(f"evaluating generation 0: {distinct} designs{_solve_estimate(model, distinct)} ...")
-    counts = _evaluate(population, book, symbols, symmetric)
-    history.append(_stats(0, population, book, counts, time.perf_counter() - start, symbols, symmetric))
-    if on_generation:
-        on_generation(history[-1])
+    run.record(0, population, run.evaluate(population), start)
     stopped = "generations"
     for gen in range(1, config.generations + 1):
         start = time.perf_counter()
-        offspring = var_and(toolbox.select(population, len(population)), toolbox, config.cxpb, config.mutpb, rng)
-        if config.distinct:
-            _renew_repeats(offspring, [_design(ind, symbols, symmetric) for ind in population], toolbox, symbols,
-                           symmetric)
-        if config.budget is not None:
-            new = {_design(ind, symbols, symmetric) for ind in offspring if not ind.fitness.valid} - book.scores.keys()
-            if len(book.scores) + len(new) > config.budget:
-                stopped = "budget"
-                break
-        counts = _evaluate(offspring, book, symbols, symmetric)
+        offspring = _offspring(population, toolbox, config, rng, run)
+        if config.budget is not None and run.over_budget(offspring, config.budget):
+            stopped = "budget"
+            break
+        counts = run.evaluate(offspring)
         if config.elitism:
             _keep_elites(population, offspring, config.elitism, toolbox)
         population[:] = offspring
-        history.append(_stats(gen, population, book, counts, time.perf_counter() - start, symbols, symmetric))
-        if on_generation:
-            on_generation(history[-1])
-    return GAResult(
-        config,
-        objective.sense,
-        tuple(history),
-        book.hall_of_fame(config.hall_of_fame),
-        tuple(_design(ind, symbols, symmetric) for ind in population),
-        book.solves,
-        dict(book.scores),
-        stopped,
-    )
+        run.record(gen, population, counts, start)
+    return GAResult(config, objective.sense, tuple(run.history), book.hall_of_fame(config.hall_of_fame),
+                    tuple(run.design(ind) for ind in population), book.solves, dict(book.scores), stopped)
+
+
+@dataclass
+class _Run:
+    """A run's shared state: its score book, the library's letters, the generations so far."""
+
+    book: ScoreBook
+    symbols: tuple[str, ...]
+    symmetric: Sequence[int]
+    on_generation: Callable[[GenerationStats], None] | None
+    history: list[GenerationStats] = field(default_factory=list)
+
+    def design(self, ind: Sequence[int]) -> str:
+        return _design(ind, self.symbols, self.symmetric)
+
+    def evaluate(self, population: Sequence[Any]) -> tuple[int, int, int, int]:
+        return _evaluate(population, self.book, self.symbols, self.symmetric)
+
+    def record(self, gen: int, population: Sequence[Any], counts: tuple[int, int, int, int], start: float) -> None:
+        """Keep generation ``gen``'s statistics (its time since ``start``) and report them."""
+        wall = time.perf_counter() - start
+        self.history.append(_stats(gen, population, self.book, counts, wall, self.symbols, self.symmetric))
+        if self.on_generation:
+            self.on_generation(self.history[-1])
+
+    def over_budget(self, offspring: Sequence[Any], budget: int) -> bool:
+        """Whether the offspring's new designs take the run past ``budget`` distinct designs."""
+        new = {self.design(ind) for ind in offspring if not ind.fitness.valid} - self.book.scores.keys()
+        return len(self.book.scores) + len(new) > budget
+
+
+def _offspring(population: list[Any], toolbox: base.Toolbox, config: GAConfig, rng: random.Random,
+               run: _Run) -> list[Any]:
+    """One generation's offspring: selected, crossed over and mutated (``varAnd``), repeats mutated again."""
+    offspring = var_and(toolbox.select(population, len(population)), toolbox, config.cxpb, config.mutpb, rng)
+    if config.distinct:
+        _renew_repeats(offspring, [run.design(ind) for ind in population], toolbox, run.symbols, run.symmetric)
+    return offspring
 
 
 #: Most extra mutations of an offspring that repeats a design of its generation (``GAConfig.distinct``);
