@@ -97,3 +97,14 @@ def test_the_full_width_gets_the_half_models_single_precision_limit_per_half_wid
     for limit, precision in ((n_half, "single"), (n_half - 1, "double")):  # the half model's limit as it was
         monkeypatch.setattr(newton, "SINGLE_PRECISION_MAX_DOFS", limit)
         assert half_body.stepper("fast", model.tangent_reuse, model.anderson_depth)[0].precision == precision
+
+
+def test_no_planar_chain_table_is_planned_over_sideways_units(spatial: UnitLibrary) -> None:
+    """The chain tables hold turns in the x-y plane: a build over `l` is refused before any solve."""
+    from pneumorph.errors import ChainTableError
+    from pneumorph.models.buildplan import build_plan
+
+    with pytest.raises(ChainTableError) as exc:
+        build_plan(Full3D(15, library=spatial))
+    assert "\n" not in str(exc.value) and "unit type 'l' bends out of the plane" in str(exc.value)
+    assert build_plan(Full3D(15, library=UnitLibrary.single(spatial["a"]))).solves  # a planar one as before

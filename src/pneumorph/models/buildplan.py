@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.errors import PneumorphError
+from pneumorph.errors import ChainTableError, PneumorphError
 from pneumorph.models.chainfit import (
     DEFAULT_TOLERANCE,
     MAX_WINDOW,
@@ -180,6 +180,33 @@ def unit_text(model: Any) -> str:
     return f"{name} with {', '.join(differ[:4])}{', ...' if len(differ) > 4 else ''}" if differ else name
 
 
+def check_planar(model: Any) -> None:
+    """Refuse a model over sideways units (``layer_side``): the chain tables hold turns in the x-y plane only.
+
+    Raises
+    ------
+    ChainTableError
+        Naming the sideways unit types, before any solve.
+
+    Examples
+    --------
+    >>> from pneumorph.geometry.library import builtin_library
+    >>> from pneumorph.models.fe import Full3D
+    >>> check_planar(Full3D(15, library=builtin_library()))
+    >>> check_planar(Full3D(15, library=builtin_library("spatial")))
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.ChainTableError: unit type 'l' bends out of the plane (layer_side), and the chain tables are
+    planar (turns in the x-y plane): a chain in 3D is not built yet (issue 25); solve its designs with the 3D FE model
+    """
+    library = getattr(model, "library", None)
+    sideways = [s for s, u in zip(library.symbols, library.units, strict=True) if u.layer_side] if library else []
+    if sideways:
+        raise ChainTableError(f"unit type {', '.join(map(repr, sideways))} bends out of the plane (layer_side), and "
+                              "the chain tables are planar (turns in the x-y plane): a chain in 3D is not built yet "
+                              "(issue 25); solve its designs with the 3D FE model")
+
+
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
                window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False,
                first_window: int = 1, early: bool = False) -> BuildPlan:
@@ -208,6 +235,11 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, and whether
         the validation may stop after :data:`~pneumorph.models.chainfit.MIN_HELDOUT` designs.
 
+    Raises
+    ------
+    ChainTableError
+        A model over sideways units (:func:`check_planar`).
+
     Examples
     --------
     >>> from pneumorph.models.factory import make_model
@@ -220,6 +252,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     centre error of 20 held-out designs is within 0.2 mm; 22-59 FE solves, estimated 2.8 min to 7.5 min with 2
     workers (about 15 s a 3d solve of 15 units on one core, from BENCHMARKS.md; an estimate)
     """
+    check_planar(model)  # before anything is counted or solved
     n_units = int(model.n_units)
     library = getattr(model, "library", None)
     alphabet = library.alphabet if library is not None else ()
@@ -266,5 +299,5 @@ def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | N
     return count
 
 
-__all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "duration_text",
-           "estimate_text", "evaluator_workers", "solve_seconds", "unit_text"]
+__all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "check_planar",
+           "duration_text", "estimate_text", "evaluator_workers", "solve_seconds", "unit_text"]
