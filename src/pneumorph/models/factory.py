@@ -11,7 +11,7 @@ from pneumorph import checks
 from pneumorph.errors import GeometryError, SearchConfigError, SettingsError
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.features import BaseBlock
-from pneumorph.geometry.library import UnitLibrary, builtin_library
+from pneumorph.geometry.library import BUILTIN_LIBRARIES, UnitLibrary, builtin_library
 from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
@@ -25,7 +25,7 @@ SCALE_RANGE = (0.1, 10.0)
 
 def load_library(value: Any, where: str = "[model] library",
                  error: type[SettingsError] = SearchConfigError) -> UnitLibrary:
-    """A unit library named by a setting: ``"builtin"`` or the path of a library TOML file.
+    """A unit library named by a setting: a built-in one (``"builtin"``, ``"spatial"``) or the path of a library file.
 
     Raises
     ------
@@ -35,16 +35,16 @@ def load_library(value: Any, where: str = "[model] library",
 
     Examples
     --------
-    >>> load_library("builtin").symbols
-    ('a', 'e', 'r', 's')
+    >>> load_library("builtin").symbols, load_library("spatial").symbols
+    (('a', 'e', 'r', 's'), ('a', 'l'))
     >>> load_library("no-such-library.toml")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     pneumorph.errors.SearchConfigError: [model] library: ...no-such-library.toml...
     """
     name = checks.text(value, where, error=error)
-    if name == "builtin":
-        return builtin_library()
+    if name in BUILTIN_LIBRARIES:
+        return builtin_library(name)
     try:
         return UnitLibrary.from_toml(Path(name))
     except GeometryError as exc:

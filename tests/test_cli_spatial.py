@@ -1,0 +1,40 @@
+"""`--library spatial` on the command line (issue 25): sideways designs in 3D, refused in 2D and by the chain."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from pneumorph.cli import main
+
+
+def _simulate(design: str, capsys: pytest.CaptureFixture[str]) -> dict:
+    args = ["simulate", "-o", design, "--library", "spatial", "--model", "3d", "--pressure", "5", "--increments", "1",
+            "--json"]
+    assert main(args) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_simulate_solves_a_sideways_design_on_the_full_width(capsys: pytest.CaptureFixture[str]) -> None:
+    left, right = _simulate("al", capsys), _simulate("aL", capsys)
+    (tip_l,), (tip_r,) = [[level["tip_mm"] for level in r["levels"]] for r in (left, right)]
+    assert len(tip_l) == 3 and len(left["levels"][0]["unit_centres_mm"][0]) == 3  # (x, y, z)
+    mid = 7.5  # the axis: the mesh's mid-width, where the undeformed tip lies
+    assert tip_l[2] > mid + 0.01 and tip_r[2] < mid - 0.01  # towards the side of the layer
+    assert tip_l[2] - mid == pytest.approx(mid - tip_r[2], abs=1e-6)  # mirror images
+    assert tip_l[1] == pytest.approx(tip_r[1], abs=1e-6)
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["simulate", "-o", "aL", "--library", "spatial"], "unit type 'l' is sideways"),
+    (["chain", "build", "--model", "3d", "--library", "spatial"], "unit type 'l' bends out of the plane"),
+])
+def test_what_cannot_take_sideways_units_refuses_them_in_one_line(args: list[str], message: str, tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    extra = ["--out", str(tmp_path / "t.json"), "--cache", str(tmp_path / "c.sqlite")] if args[0] == "chain" else []
+    assert main([*args, *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "t.json").exists()
