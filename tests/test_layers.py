@@ -46,7 +46,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.bench.app:create_app": 206,
     "pneumorph.calibration.method:calibrate": 85,
     "pneumorph.calibration.workflow:run_calibration": 104,
-    "pneumorph.design.certified:certified_search": 131,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,

@@ -155,6 +155,33 @@ def certified_search(
     """
     start = time.perf_counter()
     say = on_progress or (lambda text: None)
+    _check_search(fe_model, chain, verify, margin, epsilon)
+    if chain.table.alphabet and isinstance(objective, ProfileTarget) and objective.length is None:
+        # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
+        # and the FE verifications alike
+        objective = replace(objective, length=chain.length)
+    scores = chain_scores(chain, objective, margin)
+    order = scores.order()
+    designs = chain.table.texts(scores.bits[order])
+    say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "
+        f"{time.perf_counter() - start:.2f} s; best {designs[0]}")
+    state = _Verification(ScoreBook(fe_model, objective, evaluator), designs, scores.optimistic[order],
+                          1.0 if objective.sense == "min" else -1.0, np.zeros(len(designs), dtype=bool))
+    _verify(state, fe_model, verify, certify, epsilon, max_verify, max_failures, say)
+    book, verified = state.book, state.verified
+    winner = min((book.candidate(d) for d in verified if not book.scores[d].failed),
+                 key=lambda c: (state.sign * c.value, c.design))
+    hof = tuple(chain_candidate(chain, objective, d) for d in designs[:hall_of_fame])
+    winner_chain = next((c for c in hof if c.design == winner.design), None) or \
+        chain_candidate(chain, objective, winner.design)
+    certificate = _certificate(state, scores, float(scores.bound[order[designs.index(winner.design)]]), epsilon,
+                               margin, objective.sense)
+    return CertifiedResult(winner, winner_chain, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
+                           solves=book.solves, wall_time=time.perf_counter() - start)
+
+
+def _check_search(fe_model: ActuatorModel, chain: ChainModel, verify: int, margin: float, epsilon: float) -> None:
+    """Refuse mismatched models and settings out of range (:class:`SearchConfigError`)."""
     if int(fe_model.n_units) != chain.n_units:
         raise SearchConfigError(f"the FE model has {fe_model.n_units} units, the chain model {chain.n_units}")
     if verify < 1:
@@ -166,77 +193,78 @@ def certified_search(
         raise SearchConfigError(f"the bound's margin must be a positive number, got {margin!r}")
     if not (np.isfinite(epsilon) and epsilon >= 0):
         raise SearchConfigError(f"the certificate's epsilon must be a number >= 0, got {epsilon!r}")
-    if chain.table.alphabet and isinstance(objective, ProfileTarget) and objective.length is None:
-        # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
-        # and the FE verifications alike
-        objective = replace(objective, length=chain.length)
-    scores = chain_scores(chain, objective, margin)
-    order = scores.order()
-    designs = chain.table.texts(scores.bits[order])
-    say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "
-        f"{time.perf_counter() - start:.2f} s; best {designs[0]}")
-    book = ScoreBook(fe_model, objective, evaluator)
-    sign = 1.0 if objective.sense == "min" else -1.0
-    optimistic = scores.optimistic[order]
-    done = np.zeros(len(designs), dtype=bool)
-    verified: list[str] = []
 
-    def winner_cost() -> float:
-        costs = [sign * book.scores[d].value for d in verified if not book.scores[d].failed]
+
+@dataclass
+class _Verification:
+    """The FE verification's state: the designs in chain order, their optimistic costs (``sign * value``,
+    lower is better), which are verified (``done``, and ``verified`` in the order solved)."""
+
+    book: ScoreBook
+    designs: list[str]
+    optimistic: np.ndarray
+    sign: float
+    done: np.ndarray
+    verified: list[str] = field(default_factory=list)
+
+    def winner_cost(self) -> float:
+        """The best cost of the converged verified designs (``inf`` while none converged)."""
+        costs = [self.sign * self.book.scores[d].value for d in self.verified if not self.book.scores[d].failed]
         return min(costs) if costs else float("inf")
 
+
+def _verify(state: _Verification, fe_model: ActuatorModel, verify: int, certify: bool, epsilon: float,
+            max_verify: int, max_failures: int, say: Callable[[str], None]) -> None:
+    """Verify designs by FE in chain order, ``verify`` at a time: until one converged, or with ``certify``
+    until no unverified design can beat the winner by more than ``epsilon`` (or ``max_verify`` solves)."""
+    book = state.book
     while True:
-        best = winner_cost()
+        best = state.winner_cost()
         if np.isfinite(best) and not certify:
             break  # one batch that converged
-        pending = np.flatnonzero(~done & (optimistic < best - epsilon)) if np.isfinite(best) else \
-            np.flatnonzero(~done)
+        pending = np.flatnonzero(~state.done & (state.optimistic < best - epsilon)) if np.isfinite(best) else \
+            np.flatnonzero(~state.done)
         if not len(pending):
             break
-        if len(verified) >= max_verify:
-            say(f"stopped after {len(verified)} FE verifications (max_verify)")
+        if len(state.verified) >= max_verify:
+            say(f"stopped after {len(state.verified)} FE verifications (max_verify)")
             break
-        if not np.isfinite(best) and len(verified) >= max_failures:
-            failures = "; ".join(f"{d}: {book.outcomes[d].failure}" for d in verified[:2])
-            raise SearchConfigError(f"the FE model did not converge for the chain's {len(verified)} best designs "
-                                    f"({failures}); check the model (units, pressure) with pneumorph simulate")
+        if not np.isfinite(best) and len(state.verified) >= max_failures:
+            failures = "; ".join(f"{d}: {book.outcomes[d].failure}" for d in state.verified[:2])
+            raise SearchConfigError(f"the FE model did not converge for the chain's {len(state.verified)} best "
+                                    f"designs ({failures}); check the model (units, pressure) with pneumorph simulate")
         batch = pending[:verify]
-        todo = [designs[i] for i in batch]
+        todo = [state.designs[i] for i in batch]
         say(f"verifying {', '.join(todo)} by FE{_solve_estimate(fe_model, len(todo))} ...")
         book.score_many(todo)
-        done[batch] = True
-        verified += todo
+        state.done[batch] = True
+        state.verified += todo
         say(f"verified {', '.join(todo)} by FE: " + ", ".join(f"{book.scores[d].value:.4g}" for d in todo))
-    if not any(not book.scores[d].failed for d in verified):
+    if not any(not book.scores[d].failed for d in state.verified):
         raise SearchConfigError("no design converged in the FE model")
-    best_cost = winner_cost()
-    rest = optimistic[~done]
+
+
+def _certificate(state: _Verification, scores: ChainScores, bound: float, epsilon: float, margin: float,
+                 sense: str) -> dict[str, Any]:
+    """The certificate (:class:`CertifiedResult`) of the verified winner, whose bound is ``bound``."""
+    best_cost = state.winner_cost()
+    rest = state.optimistic[~state.done]
     could_beat = int((rest < best_cost - epsilon).sum())
-    tied = int(((rest < best_cost) & (rest >= best_cost - epsilon)).sum())
-    beat_floor = scores.floor < best_cost - epsilon
-    gap = max(0.0, best_cost - min(float(rest.min()) if len(rest) else float("inf"), scores.floor))
-    winner = min((book.candidate(d) for d in verified if not book.scores[d].failed),
-                 key=lambda c: (sign * c.value, c.design))
-    hof = tuple(chain_candidate(chain, objective, d) for d in designs[:hall_of_fame])
-    winner_chain = next((c for c in hof if c.design == winner.design), None) or \
-        chain_candidate(chain, objective, winner.design)
-    certificate = {
-        "bound": float(scores.bound[order[designs.index(winner.design)]]),
+    return {
+        "bound": bound,
         "bound_worst": float(np.max(scores.bound)),
-        "gap": gap,
+        "gap": max(0.0, best_cost - min(float(rest.min()) if len(rest) else float("inf"), scores.floor)),
         "could_beat": could_beat,
         "epsilon": epsilon,
-        "tied": tied,
-        "certified": could_beat == 0 and not beat_floor,
-        "verified": list(verified),
-        "designs_scored": len(designs),
+        "tied": int(((rest < best_cost) & (rest >= best_cost - epsilon)).sum()),
+        "certified": could_beat == 0 and not scores.floor < best_cost - epsilon,
+        "verified": list(state.verified),
+        "designs_scored": len(state.designs),
         "complete": scores.complete,
-        "floor": None if scores.complete else sign * scores.floor,
+        "floor": None if scores.complete else state.sign * scores.floor,
         "margin": margin,
-        "sense": objective.sense,
+        "sense": sense,
     }
-    return CertifiedResult(winner, winner_chain, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
-                           solves=book.solves, wall_time=time.perf_counter() - start)
 
 
 __all__ = [
