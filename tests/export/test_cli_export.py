@@ -181,3 +181,13 @@ def test_a_model_file_gives_the_parts_its_unit_and_the_deck_its_materials(tmp_pa
     assert json.loads(result.output)["deck"]["fingerprint"] == scaled.fingerprint()
     assert scaled.fingerprint() != make_model(1, {"fidelity": "3d", "pressure_kpa": 20, "unit": {
         "pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}}).fingerprint()
+
+
+def test_a_sideways_unit_is_refused_before_anything_is_written(tmp_path):
+    # its stiff strip lies on a side face: the parts and moulds here would put it on the top or bottom face
+    unit = tmp_path / "side.toml"
+    unit.write_text("[unit]\nlayer_side = true\n")
+    for extra in ([], ["--mould"]):
+        result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), *extra)
+        assert result.exit_code == 2 and "sideways unit" in result.output, result.output
+        assert not (tmp_path / "out").exists()

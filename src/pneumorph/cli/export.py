@@ -112,6 +112,7 @@ def _check_request(ctx: click.Context, stl_dir: str | None, inp_file: str | None
 def _unit(settings: dict, unit_file: str | None, model_file: str | None) -> Any:
     """The unit of the parts: --unit's, the model file's, or the built-in one; its materials checked."""
     from pneumorph.export import check_materials
+    from pneumorph.export.parts import check_buildable
     from pneumorph.geometry.unit import UnitSpec
 
     with P.blame("--unit" if model_file is None or unit_file is not None else "--model-file"):
@@ -124,6 +125,7 @@ def _unit(settings: dict, unit_file: str | None, model_file: str | None) -> Any:
         else:
             unit = UnitSpec()
         check_materials(unit)  # the parts' materials, before anything is built
+        check_buildable(unit)
     return unit
 
 

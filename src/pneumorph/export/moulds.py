@@ -90,6 +90,7 @@ from pneumorph.export.parts import (
     _cavity_boxes,
     actuator_solids,
     box,
+    check_buildable,
     outline_solid,
     to_trimesh,
 )
@@ -165,6 +166,7 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     """
     mould = MouldSpec() if mould is None else mould
     orientation = parse_orientation(orientation)
+    check_buildable(spec)
     inset, tip = _check_fit(spec, mould)  # the same checks as MouldSpec.check
     holes = _hole_centres(spec, orientation, mould)
     n = len(orientation)

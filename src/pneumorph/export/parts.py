@@ -322,6 +322,21 @@ def check_materials(spec: UnitSpec, base_block: BaseBlock | None = DEFAULT_BLOCK
         get(name)
 
 
+def check_buildable(spec: UnitSpec) -> None:
+    """Refuse a unit whose parts these builders cannot make: a sideways unit (``layer_side``), whose stiff strip
+    lies on a side face (the parts, strips and moulds here put it on the top or bottom face).
+
+    >>> check_buildable(UnitSpec(layer_side=True))
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.GeometryError: the parts and moulds of a sideways unit (layer_side: its stiff strip on a side
+    face) are not built yet; export a planar unit
+    """
+    if spec.layer_side:
+        raise GeometryError("the parts and moulds of a sideways unit (layer_side: its stiff strip on a side face) "
+                            "are not built yet; export a planar unit")
+
+
 def actuator_solids(
     spec: UnitSpec, orientation: str, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, manifold3d.Manifold]:
@@ -331,9 +346,12 @@ def actuator_solids(
     ------
     UnknownMaterialError
         A part of a material the library does not know (:func:`check_materials`).
+    GeometryError
+        A unit these builders cannot make (:func:`check_buildable`).
     """
     import manifold3d as m3
 
+    check_buildable(spec)
     check_materials(spec, base_block)
     orientation = parse_orientation(orientation)
     cavities = [box(b) for b in _cavity_boxes(spec, orientation)]
