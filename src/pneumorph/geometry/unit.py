@@ -50,7 +50,7 @@ The same parameters describe the deformation modes of a library of units (sectio
   acts in it, its box is still meshed and tracked (for the unit's centre);
 - *short-pitch* (section 8.3.1): a shorter ``pitch`` with thinner end walls, so more units
   fit in the same length;
-- *sideways* (issue 25): ``layer_side = True``, the stiff layer on a side face, so the unit
+- *sideways*: ``layer_side = True``, the stiff layer on a side face, so the unit
   bends out of the plane of the others (3D models only).
 
 Examples

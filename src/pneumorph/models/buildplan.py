@@ -197,14 +197,15 @@ def check_planar(model: Any) -> None:
     Traceback (most recent call last):
     ...
     pneumorph.errors.ChainTableError: unit type 'l' bends out of the plane (layer_side), and the chain tables are
-    planar (turns in the x-y plane): a chain in 3D is not built yet (issue 25); solve its designs with the 3D FE model
+    planar (turns in the x-y plane): a chain in 3D is not built yet; solve its designs with the 3D FE model
+    (--search ga)
     """
     library = getattr(model, "library", None)
     sideways = [s for s, u in zip(library.symbols, library.units, strict=True) if u.layer_side] if library else []
     if sideways:
         raise ChainTableError(f"unit type {', '.join(map(repr, sideways))} bends out of the plane (layer_side), and "
-                              "the chain tables are planar (turns in the x-y plane): a chain in 3D is not built yet "
-                              "(issue 25); solve its designs with the 3D FE model")
+                              "the chain tables are planar (turns in the x-y plane): a chain in 3D is not built yet; "
+                              "solve its designs with the 3D FE model (--search ga)")
 
 
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
