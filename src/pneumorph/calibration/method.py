@@ -148,11 +148,22 @@ def calibrate(
     """
     if weighting not in WEIGHTINGS:
         raise SearchConfigError(f"weighting must be one of {', '.join(WEIGHTINGS)}, got {weighting!r}")
-    rng = np.random.default_rng(seed)
-    levels = np.asarray(pressures_kpa, dtype=float) / 1e3
     model3d = reference_model(unit, n_units, pressures_kpa, steps)
+    points = _points(model3d, unit, n_units, np.asarray(pressures_kpa, dtype=float) / 1e3, runs, seed, bounds,
+                     solve_3d or (lambda model, design: model.evaluate(design)), on_point, weighting)
+    prange = (0.0, model3d.ramp.pressure)
+    linear, quadratic, chosen = _fit_laws(points, prange, weighting)
+    return Calibration(tuple(points), linear, quadratic, chosen, prange, unit.filler_poisson_ratio,
+                       metadata={"n_units": n_units, "runs": runs, "seed": seed, "weighting": weighting,
+                                 "fingerprint_3d": model3d.fingerprint()})
+
+
+def _points(model3d: Any, unit: UnitSpec, n_units: int, levels: np.ndarray, runs: int, seed: int,
+            bounds: tuple[float, float], solve_3d: Solve3D, on_point: Callable[[FillerPoint], None] | None,
+            weighting: str) -> list[FillerPoint]:
+    """Every run's best filler modulus at every level (Eq 5.1), each from a random start."""
+    rng = np.random.default_rng(seed)
     steps, p_max = model3d.ramp.steps, model3d.ramp.pressure
-    solve_3d = solve_3d or (lambda model, design: model.evaluate(design))
     nu = unit.filler_poisson_ratio
 
     def make_2d(e: float, pressure: float) -> Reduced2D:
@@ -171,7 +182,13 @@ def calibrate(
             points.append(point)
             if on_point is not None:
                 on_point(point)
-    prange = (0.0, p_max)
+    return points
+
+
+def _fit_laws(points: Sequence[FillerPoint], prange: tuple[float, float], weighting: str
+              ) -> tuple[LawFit, LawFit, LawFit | None]:
+    """The linear and the quadratic law fitted to all points, and the chosen one; each problem warned of
+    (:class:`CalibrationWarning`, at the caller of :func:`calibrate`)."""
     ps = [pt.pressure for pt in points]
     es = [pt.modulus for pt in points]
     w = point_weights(points, weighting)
@@ -180,7 +197,5 @@ def calibrate(
     chosen = next((f for f in (quadratic, linear) if not f.problems), None)
     for f in (linear, quadratic):
         for problem in f.problems:
-            warnings.warn(f"filler law {problem}", CalibrationWarning, stacklevel=2)
-    return Calibration(tuple(points), linear, quadratic, chosen, prange, nu,
-                       metadata={"n_units": n_units, "runs": runs, "seed": seed, "weighting": weighting,
-                                 "fingerprint_3d": model3d.fingerprint()})
+            warnings.warn(f"filler law {problem}", CalibrationWarning, stacklevel=3)
+    return linear, quadratic, chosen
