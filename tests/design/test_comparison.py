@@ -60,6 +60,14 @@ def test_design_with_a_model_file_reports_the_nominal_design(tmp_path: Path) -> 
     assert comparison["reference_on_model"] == comparison["winner_value"] == out["best"]["fitness"]
     report = (tmp_path / "run" / "report.md").read_text(encoding="utf-8")
     assert f"the nominal model chose the same design {out['best']['design']}" in report
+    assert "warning" not in done.stderr  # not a file of pneumorph identify: nothing to say of its fit
     plain = runner.invoke(cli, args)  # again, from the cache: the comparison in words
     assert plain.exit_code == 0, plain.output
     assert "the nominal model chose the same design" in plain.stdout
+    # a file of pneumorph identify whose scans left parameters undetermined: said before the run
+    (tmp_path / "identified.toml").write_text('[model]\nfidelity = "2d"\nbody_bulk_scale = 1.0\n[provenance]\n'
+                                              'identified = ["wall", "layer"]\n', encoding="utf-8")
+    warned = runner.invoke(cli, args)
+    assert warned.exit_code == 0, warned.output
+    assert ("did not identify bulk_modulus_scale, shear_modulus_scale, side_wall (fixed at nominal or confounded)"
+            in warned.stderr)

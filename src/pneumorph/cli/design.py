@@ -116,6 +116,8 @@ def design(config_file: str | None, **options: Any) -> None:
     if fallback:  # said once every setting has been checked
         click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
                    "falling back to the genetic algorithm", err=True)
+    if o.model_file is not None:
+        _warn_unidentified(o.model_file)
     result, model = _run(config, model, o, fidelity_given)
     if result.rejected:
         click.echo(f"  {result.rejected} cache entries failed their checksum: solved again, not used", err=True)
@@ -191,6 +193,24 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
         nominal = nominal.with_options({}, model={"fidelity": config.fidelity,
                                                   "pressure_kpa": config.model.get("pressure_kpa")})
     return config.with_options({}, model=config.model_settings()), fallback, fidelity_given, nominal
+
+
+def _warn_unidentified(path: str) -> None:
+    """Say which parameters an identified model's scans left undetermined: its design is only as good as the fit
+    (BENCHMARKS.md: a redesign on a model whose bulk modulus the scans left confounded was worse on the truth)."""
+    from pneumorph.identify import NAMES
+    from pneumorph.io.files import read_toml
+
+    provenance = read_toml(path, "model file").get("provenance", {})
+    identified = provenance.get("identified") if isinstance(provenance, dict) else None
+    if not isinstance(identified, list):
+        return  # not a file of pneumorph identify
+    left = [n for n in NAMES if n not in identified]
+    if left:
+        click.echo(f"warning: the scans behind {path} did not identify {', '.join(left)} (fixed at nominal or "
+                   "confounded): a design for this model, and its comparison with the nominal design, are only as "
+                   "good as that fit; scans of designs that bend differently, or at a second pressure, tell them "
+                   "apart", err=True)
 
 
 def _check_run(config: Any, model: Any, o: Any) -> None:
