@@ -234,12 +234,11 @@ def run_calibration(
     CalibrationWarning
         For each problem of a fitted law.
     """
-    from pneumorph.design.config import to_toml
-
     levels = tuple(sorted({float(p) for p in pressures_kpa}))
     if len(levels) < 2:
         raise SearchConfigError(f"a calibration needs at least two different pressures, got {list(pressures_kpa)}")
     folder = check_writable_dir(out, "calibration folder")
+    plan = _Plan(unit, n_units, levels, runs, seed, n_validate)
     with open_cache(cache) as store:
         if evaluator is not None:
             solve_references(unit, n_units, levels, runs, seed, n_validate, store, on_reference, evaluator)
@@ -247,29 +246,55 @@ def run_calibration(
         result = calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point,
                            weighting=weighting)
         with all_or_nothing(folder):  # stopped while writing or validating (Ctrl-C, a full disk): no partial output
-            files = [plot_calibration(result, folder / "calibration.png")]
-            summary: dict[str, Any] = {
-                "points": [p.__dict__ for p in result.points],
-                "linear": result.linear.__dict__, "quadratic": result.quadratic.__dict__,
-                "chosen_degree": None if result.chosen is None else result.chosen.degree,
-                "provenance": provenance(unit=unit.to_dict(), calibration=result.metadata),
-            }
-            calibrated, check, comparison = None, None, None
-            if result.chosen is not None:
-                calibrated = result.unit_with_law(unit)
-                files.append(atomic_write_text(folder / "unit.toml", to_toml({"unit": calibrated.to_dict()})))
-                if n_validate > 0:
-                    taken = calibration_designs(n_units, runs, seed)
-                    designs = holdout_designs(n_units, n_validate, seed, taken)
-                    p_max = max(levels) / 1e3
-                    check = validate(calibrated, n_units, designs, RampSpec(pressure=p_max), solve_3d)
-                    summary["validation"] = check.to_dict()
-                    comparison = compare_laws(result, calibrated, n_units, designs[0], p_max, solve_3d)
-                    figures = [plot_law_profiles({**comparison.runs, "fitted law": comparison.fitted},
-                                                 comparison.reference, folder / "profiles.png"),
-                               plot_filler_paths({"E(P)": comparison.fitted, **comparison.constants},
-                                                 comparison.reference, folder / "filler_paths.png")]
-                    summary["figures"] = [str(f) for f in figures]
-                    files += figures
-            files.append(write_json(folder / "calibration.json", summary))
+            written = _write(plan, result, solve_3d, folder)
+    return written
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """A calibration's settings, as the steps after the fit use them (:func:`run_calibration`)."""
+
+    unit: UnitSpec
+    n_units: int
+    levels: tuple[float, ...]
+    runs: int
+    seed: int
+    n_validate: int
+
+
+def _write(plan: _Plan, result: Calibration, solve_3d: Solve3D, folder: Path) -> CalibrationRun:
+    """Fig 5.3, the calibrated unit, the held-out check with its figures, and ``calibration.json``."""
+    from pneumorph.design.config import to_toml
+
+    files = [plot_calibration(result, folder / "calibration.png")]
+    summary: dict[str, Any] = {
+        "points": [p.__dict__ for p in result.points],
+        "linear": result.linear.__dict__, "quadratic": result.quadratic.__dict__,
+        "chosen_degree": None if result.chosen is None else result.chosen.degree,
+        "provenance": provenance(unit=plan.unit.to_dict(), calibration=result.metadata),
+    }
+    calibrated, check, comparison = None, None, None
+    if result.chosen is not None:
+        calibrated = result.unit_with_law(plan.unit)
+        files.append(atomic_write_text(folder / "unit.toml", to_toml({"unit": calibrated.to_dict()})))
+        if plan.n_validate > 0:
+            check, comparison = _held_out(plan, result, calibrated, solve_3d)
+            summary["validation"] = check.to_dict()
+            figures = [plot_law_profiles({**comparison.runs, "fitted law": comparison.fitted},
+                                         comparison.reference, folder / "profiles.png"),
+                       plot_filler_paths({"E(P)": comparison.fitted, **comparison.constants},
+                                         comparison.reference, folder / "filler_paths.png")]
+            summary["figures"] = [str(f) for f in figures]
+            files += figures
+    files.append(write_json(folder / "calibration.json", summary))
     return CalibrationRun(result, folder, calibrated, check, comparison, tuple(files), summary)
+
+
+def _held_out(plan: _Plan, result: Calibration, calibrated: UnitSpec, solve_3d: Solve3D
+              ) -> tuple[Validation, LawComparison]:
+    """The calibrated unit checked on held-out designs, and the laws compared on the first of them."""
+    taken = calibration_designs(plan.n_units, plan.runs, plan.seed)
+    designs = holdout_designs(plan.n_units, plan.n_validate, plan.seed, taken)
+    p_max = max(plan.levels) / 1e3
+    check = validate(calibrated, plan.n_units, designs, RampSpec(pressure=p_max), solve_3d)
+    return check, compare_laws(result, calibrated, plan.n_units, designs[0], p_max, solve_3d)
