@@ -41,16 +41,20 @@ SIGMA = 0.05
 CHANGE = np.array([0.06, 0.0, 0.0, 0.08, 0.0])  # bulk x1.06, wall +0.08 mm
 
 
-def synthetic(params: ParameterSet, truth: np.ndarray, seed: int) -> list[Observation]:
+def synthetic(params: ParameterSet, truth: np.ndarray, seed: int,
+              pressures: tuple[float, ...] = (PRESSURE,)) -> list[Observation]:
     rng = np.random.default_rng(seed)
     out = []
-    for k, design in enumerate(DESIGNS):
-        model = make_model(len(design), params.settings(truth, {"fidelity": "3d", "pressure_kpa": PRESSURE}))
-        shape = model_shape(model.solve(design))
-        points = shape.surface[rng.choice(len(shape.surface), 3000, replace=False)]
-        moved = Transform(Rotation.from_rotvec([0.3, -0.2, 0.5 + 0.1 * k]).as_matrix(), np.array([5.0, -3.0, 7.0]))
-        scan = Scan(moved(points) + rng.normal(scale=SIGMA, size=points.shape), None, f"synthetic scan of {design}")
-        out.append(Observation(ScanSpec(f"synthetic-{design}.stl", design, PRESSURE), scan))
+    for pressure in pressures:
+        for k, design in enumerate(DESIGNS):
+            model = make_model(len(design), params.settings(truth, {"fidelity": "3d", "pressure_kpa": pressure}))
+            shape = model_shape(model.solve(design))
+            points = shape.surface[rng.choice(len(shape.surface), 3000, replace=False)]
+            turn = Rotation.from_rotvec([0.3, -0.2, 0.5 + 0.1 * k]).as_matrix()
+            moved = Transform(turn, np.array([5.0, -3.0, 7.0]))
+            scan = Scan(moved(points) + rng.normal(scale=SIGMA, size=points.shape), None,
+                        f"synthetic scan of {design} at {pressure:g} kPa")
+            out.append(Observation(ScanSpec(f"synthetic-{design}-{pressure:g}kPa.stl", design, pressure), scan))
     return out
 
 
@@ -60,13 +64,16 @@ def main() -> None:
     parser.add_argument("--cache", type=Path)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, help="write identified.toml and truth.toml here")
+    parser.add_argument("--pressures", type=float, nargs="+", default=[PRESSURE],
+                        help="scan each design at these pressures, kPa (default: 36)")
     args = parser.parse_args()
     params = ParameterSet(UnitSpec())
     truth = params.nominal + CHANGE
     t0 = time.perf_counter()
-    observations = synthetic(params, truth, args.seed)
+    observations = synthetic(params, truth, args.seed, tuple(args.pressures))
     making = time.perf_counter() - t0
-    print(f"two synthetic scans made ({making:.0f} s, 2 solves of the true model)", flush=True)
+    print(f"{len(observations)} synthetic scans made ({making:.0f} s, {len(observations)} solves of the true model)",
+          flush=True)
     cache = args.cache or Path(tempfile.mkdtemp()) / "identify.sqlite"
     runs = []
     for run in ("first", "again from the cache"):
