@@ -43,7 +43,6 @@ MAX_FUNCTION_LINES = 80
 # docs/architecture.md ("Sizes"). The lists may only shrink: an entry under its limit fails too.
 LONG_MODULES: dict[str, int] = {}
 LONG_FUNCTIONS: dict[str, int] = {
-    "pneumorph.bench.app:create_app": 206,
     "pneumorph.fem.fast.kernels:ogden_3d": 121,
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,

@@ -19,7 +19,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from fastapi import FastAPI, Request
+from fastapi import APIRouter, FastAPI, Request
 from fastapi.concurrency import run_in_threadpool
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
@@ -214,6 +214,22 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     app = FastAPI(title="pneumorph bench", version=__version__, docs_url=None, redoc_url=None, openapi_url=None,
                   lifespan=lifespan)
     app.state.bench, app.state.board = bench, board
+    _add_error_handlers(app)
+    app.add_middleware(Guard, signing=Signing(state), allowed_hosts=tuple(allowed_hosts))
+
+    @app.get("/", include_in_schema=False)
+    async def index() -> FileResponse:
+        return FileResponse(static_dir() / "index.html", headers={"Cache-Control": "no-cache"})
+
+    app.mount("/static", StaticFiles(directory=static_dir()), name="static")
+    app.include_router(_answers_router(bench, board, answers))
+    app.include_router(_units_router(bench, board))
+    app.include_router(_jobs_router(bench, board))
+    return app
+
+
+def _add_error_handlers(app: FastAPI) -> None:
+    """Every refusal as the bench's one error format (:func:`~pneumorph.bench.guard.error`)."""
 
     @app.exception_handler(QueryError)
     async def _query_error(request: Request, exc: QueryError) -> JSONResponse:
@@ -241,21 +257,29 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     async def _too_large(request: Request, exc: BodyTooLargeError) -> JSONResponse:
         return error(413, "body", str(exc), {"Connection": "close"})
 
-    app.add_middleware(Guard, signing=Signing(state), allowed_hosts=tuple(allowed_hosts))
 
-    async def body_of(request: Request) -> Any:
-        return load_json(await request.body())
+async def _body_of(request: Request) -> Any:
+    return load_json(await request.body())
 
-    def session_units(request: Request) -> tuple[str, ...]:
-        return board.unit_ids_of(request.state.session)
 
-    @app.get("/", include_in_schema=False)
-    async def index() -> FileResponse:
-        return FileResponse(static_dir() / "index.html", headers={"Cache-Control": "no-cache"})
+def _session_units(board: JobBoard, request: Request) -> tuple[str, ...]:
+    return board.unit_ids_of(request.state.session)
 
-    app.mount("/static", StaticFiles(directory=static_dir()), name="static")
 
-    @app.get("/api/info")
+def _check_model(bench: Bench, board: JobBoard, model: Any, unit: Any, request: Request) -> None:
+    """Refuse a model the bench does not have, or a unit this session does not know."""
+    choice(model, MODELS, "model", "model")
+    if not isinstance(unit, str) or unit not in _session_units(board, request) or not bench.knows(unit):
+        raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}")
+
+
+def _answers_router(bench: Bench, board: JobBoard, answers: AnswerPool) -> APIRouter:
+    """The answers: the bench's settings, a query's answer, a design's profiles and shape by the chain."""
+    from pneumorph import __version__
+
+    router = APIRouter()
+
+    @router.get("/api/info")
     async def info() -> dict[str, Any]:
         length = await run_in_threadpool(bench.length, "3d")
         chain = bench.chain("3d")
@@ -264,10 +288,10 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
                 "presets": list(PRESETS), "tip_goals": list(TIP_GOALS),
                 "defaults": {"kind": "preset", "name": "sin", "amplitude": 10.0, "periods": 1.0}}
 
-    @app.post("/api/design")
+    @router.post("/api/design")
     async def design(request: Request) -> Response:
-        body = await body_of(request)
-        query = bench.parse(body, session_units(request))  # a fraction of a millisecond
+        body = await _body_of(request)
+        query = bench.parse(body, _session_units(board, request))  # a fraction of a millisecond
         answer = bench.recall(query)
         if answer is None:
             answer = await answers.compute(query)
@@ -279,28 +303,30 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
             text = json.dumps(json_safe(answer), allow_nan=False)
         return Response(text, media_type="application/json")
 
-    def check_model(model: Any, unit: Any, request: Request) -> None:
-        choice(model, MODELS, "model", "model")
-        if not isinstance(unit, str) or unit not in session_units(request) or not bench.knows(unit):
-            raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}")
-
-    @app.get("/api/profiles")
+    @router.get("/api/profiles")
     async def profiles(design: str, request: Request, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
-        check_model(model, unit, request)
+        _check_model(bench, board, model, unit, request)
         return {"design": design, "profiles": await run_in_threadpool(bench.chain_profiles, design, model, unit)}
 
-    @app.get("/api/shape")
+    @router.get("/api/shape")
     async def shape(design: str, level: int, request: Request, model: str = "3d",
                     unit: str = "builtin") -> dict[str, Any]:
-        check_model(model, unit, request)
+        _check_model(bench, board, model, unit, request)
         return await run_in_threadpool(bench.chain_shape, design, model, level, unit)
 
-    @app.get("/api/units")
+    return router
+
+
+def _units_router(bench: Bench, board: JobBoard) -> APIRouter:
+    """The units: the session's list, and an uploaded unit file's chain table as a job."""
+    router = APIRouter()
+
+    @router.get("/api/units")
     async def units(request: Request) -> dict[str, Any]:
         return {"units": [{"id": "builtin", "name": bench.unit_spec().name, "model": "3d and 2d"},
                           *board.units_of(request.state.session)]}
 
-    @app.post("/api/jobs/table", status_code=202)
+    @router.post("/api/jobs/table", status_code=202)
     async def start_table(request: Request) -> dict[str, Any]:
         # the Guard has bounded the whole body to MAX_UPLOAD bytes: the form is parsed in memory
         form = await request.form(max_files=1, max_fields=4)
@@ -316,17 +342,24 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
             raise QueryError("unit", str(exc)) from None
         return {"job_id": board.table(request.state.session, spec, str(model)).id}
 
-    @app.post("/api/jobs", status_code=202)
+    return router
+
+
+def _jobs_router(bench: Bench, board: JobBoard) -> APIRouter:
+    """The jobs: started (a verification, an export), listed, looked at, cancelled, and their files."""
+    router = APIRouter()
+
+    @router.post("/api/jobs", status_code=202)
     async def start_job(request: Request) -> dict[str, Any]:
-        body = await body_of(request)
+        body = await _body_of(request)
         kind = body.get("kind") if isinstance(body, dict) else None
         session = request.state.session
         if kind == "verify":
-            query = await run_in_threadpool(bench.parse, body.get("query"), session_units(request))
+            query = await run_in_threadpool(bench.parse, body.get("query"), _session_units(board, request))
             job = board.verify(session, query)
         elif kind == "export":
             design, unit = body.get("design"), body.get("unit", "builtin")
-            check_model("3d", unit, request)
+            _check_model(bench, board, "3d", unit, request)
             try:
                 design = parse_orientation(design if isinstance(design, str) else "", bench.units)
             except PneumorphError as exc:
@@ -336,32 +369,32 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
             raise QueryError("kind", f"a job is 'verify' or 'export', got {str(kind)[:40]!r}")
         return {"job_id": job.id}
 
-    @app.get("/api/jobs")
+    @router.get("/api/jobs")
     async def jobs(request: Request) -> dict[str, Any]:
         return {"jobs": [j.to_dict() for j in board.of(request.state.session)]}
 
-    @app.get("/api/jobs/{job_id}")
+    @router.get("/api/jobs/{job_id}")
     async def job(job_id: str, request: Request) -> Any:
         found = board.get(request.state.session, job_id)
         if found is None:
             return error(404, "job", "no such job in this session")
         return found.to_dict()
 
-    @app.delete("/api/jobs/{job_id}")
+    @router.delete("/api/jobs/{job_id}")
     async def cancel_job(job_id: str, request: Request) -> Any:
         found = await run_in_threadpool(board.cancel, request.state.session, job_id)
         if found is None:
             return error(404, "job", "no such job in this session")
         return found.to_dict()
 
-    @app.get("/api/jobs/{job_id}/files/{name}")
+    @router.get("/api/jobs/{job_id}/files/{name}")
     async def job_file(job_id: str, name: str, request: Request) -> Any:
         path = board.file(request.state.session, job_id, name)
         if path is None:
             return error(404, "file", "no such file in this session's jobs")
         return FileResponse(path, filename=name)
 
-    return app
+    return router
 
 
 __all__ = ["Guard", "Signing", "create_app", "default_state_dir", "error_body", "static_dir"]
