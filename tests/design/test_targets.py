@@ -171,3 +171,4 @@ def test_more_periods_than_the_unit_centres_can_show_are_refused() -> None:
         DesignConfig(units=6, objective="stages", stage=({"pressure_kpa": 18, "objective": "sin"},
                                                          {"pressure_kpa": 45, "objective": "cos", "periods": 4}))
     assert DesignConfig(units=5, objective="y = sin(2*pi*40*x/L)").units == 5  # an expression says what it means
+    assert DesignConfig(units=1).periods == 1.0  # one period, the presets' default, whatever the units

@@ -164,10 +164,10 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
     check_options(o.executor or config.executor, config.workers if o.workers is None else o.workers,
                   o.scheduler or config.scheduler)
     units = o.units or config.units
-    if o.periods is not None and o.periods > units / 2:  # named as typed; the config refuses it for files
+    if o.periods is not None and o.periods > max(1.0, units / 2):  # named as typed; the config refuses it too
         raise click.UsageError(f"--periods {o.periods:g}: a sin or cos target over {units} unit centres shows at most "
-                               f"{units / 2:g} periods (Eq 4.1 samples it at the centres); give fewer periods or "
-                               "more units")
+                               f"{max(1.0, units / 2):g} periods (Eq 4.1 samples it at the centres); give fewer "
+                               "periods or more units")
     design = {key: getattr(o, key) for key in _DESIGN_OPTIONS}
     design["objective"] = o.target or o.objective
     design.update(_stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods, o.units))

@@ -187,15 +187,15 @@ class DesignConfig:
 
     def _check_periods(self) -> None:
         """Refuse a sin or cos target of more periods than its unit centres can show (Eq 4.1 samples the target at
-        the ``units`` centres: past ``units / 2`` periods it aliases)."""
+        the ``units`` centres: past ``units / 2`` periods it aliases; one period, the presets' default, always)."""
         presets = [("[design] periods", self.objective, self.periods)] if self.stage is None else [
             (f"[[design.stage]] {i} periods", s["objective"], s.get("periods", 1.0))
             for i, s in enumerate(self.stage, 1)]
         for where, name, periods in presets:
-            if name.strip().lower() in PRESETS and periods > self.units / 2:
+            if name.strip().lower() in PRESETS and periods > max(1.0, self.units / 2):
                 raise SearchConfigError(f"{where} = {periods:g}: a {name.strip().lower()} target over {self.units} "
-                                        f"unit centres shows at most {self.units / 2:g} periods (Eq 4.1 samples it at "
-                                        "the centres); give fewer periods or more units")
+                                        f"unit centres shows at most {max(1.0, self.units / 2):g} periods (Eq 4.1 "
+                                        "samples it at the centres); give fewer periods or more units")
 
     @property
     def fidelity(self) -> str:
