@@ -142,7 +142,7 @@ class Bench:
 
     # -- models -------------------------------------------------------------------------
     def model_settings(self, fidelity: str, unit: str = BUILTIN) -> dict[str, Any]:
-        """The model settings of a fidelity and unit: the bench's :attr:`settings` with the fidelity, and an
+        """The model settings of a fidelity and unit: the bench's ``settings`` with the fidelity, and an
         uploaded unit in place of their unit.
 
         >>> Bench(settings={"fidelity": "2d", "body_bulk_scale": 1.06}).model_settings("3d")
