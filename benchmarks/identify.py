@@ -64,11 +64,14 @@ def main() -> None:
     parser.add_argument("--cache", type=Path)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, help="write identified.toml and truth.toml here")
+    parser.add_argument("--change", type=float, nargs=5, default=CHANGE.tolist(), metavar="D",
+                        help="the truth's change from nominal: bulk scale, shear scale (added to 1), side wall, "
+                             "wall, layer (mm); default 0.06 0 0 0.08 0")
     parser.add_argument("--pressures", type=float, nargs="+", default=[PRESSURE],
                         help="scan each design at these pressures, kPa (default: 36)")
     args = parser.parse_args()
     params = ParameterSet(UnitSpec())
-    truth = params.nominal + CHANGE
+    truth = params.nominal + np.asarray(args.change)
     t0 = time.perf_counter()
     observations = synthetic(params, truth, args.seed, tuple(args.pressures))
     making = time.perf_counter() - t0
