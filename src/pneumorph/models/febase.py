@@ -359,6 +359,12 @@ class FEModel:
 
         return mesh, body, set_pressure
 
+    def empty_response(self, mesh: ActuatorMesh, design: str) -> Response:
+        """The response of ``design`` on its ``mesh``: its undeformed centres and tip, every level still unknown."""
+        x_end0 = mesh.points[mesh.end_points][:, : mesh.axes]
+        return Response.empty(design, self.pressures(), mesh.unit_centres(axes=mesh.axes), x_end0.mean(axis=0),
+                              metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()})
+
     # -- solving --------------------------------------------------------------------------
     def evaluate(self, orientation: str | Design, on_level: Any = None) -> Response:
         """Solve the pressure ramp of one design and return its :class:`Response`.
@@ -393,13 +399,7 @@ class FEModel:
         pressures = self.pressures()
         axes = mesh.axes  # (x, y), or (x, y, z) on the full width
         x_end0 = mesh.points[mesh.end_points][:, :axes]
-        response = Response.empty(
-            design,
-            pressures,
-            mesh.unit_centres(axes=axes),
-            x_end0.mean(axis=0),
-            metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()},
-        )
+        response = self.empty_response(mesh, design)
         angle0 = _end_face_angle(x_end0[:, :2])
         turned = {"total": 0.0, "last": angle0}  # end-face rotation, followed substep by substep
         displacements = np.full((len(pressures), *mesh.points.shape), np.nan)

@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 
 from pneumorph.models.febase import FEModel, Solution, _end_face_angle
-from pneumorph.models.response import Response
 
 
 def solve_near(model: FEModel, design: str, start: Solution) -> Solution:
@@ -60,9 +59,11 @@ def solve_near(model: FEModel, design: str, start: Solution) -> Solution:
     """
     t0 = time.perf_counter()
     u0 = start.displacements[-1]
+    if model.gravity is not None or not np.all(np.isfinite(u0)):
+        return model.solve(design)
     parsed = model.parse(design)
     mesh, body, set_pressure = model.build(parsed if model.mixed else parsed.text)
-    if model.gravity is not None or mesh.points.shape != u0.shape or not np.all(np.isfinite(u0)):
+    if mesh.points.shape != u0.shape:
         return model.solve(design)
     body.field[0].values[:] = u0  # the prescribed values (clamped base, symmetry plane) are zero in both
     set_pressure(float(model.ramp.pressure))
@@ -76,20 +77,17 @@ def solve_near(model: FEModel, design: str, start: Solution) -> Solution:
 def _last_level(model: FEModel, design: str, mesh: Any, u: Any, start: Solution, iterations: int,
                 t0: float) -> Solution:
     """The solution with only its last level known: centres, tip and curl (unwrapped from the start's)."""
-    pressures = model.pressures()
-    axes = mesh.axes
-    x_end0 = mesh.points[mesh.end_points][:, :axes]
-    response = Response.empty(design, pressures, mesh.unit_centres(axes=axes), x_end0.mean(axis=0),
-                              metadata={"fidelity": model.fidelity, "fingerprint": model.fingerprint()})
-    displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
+    response = model.empty_response(mesh, design)
+    displacements = np.full((len(response.pressures), *mesh.points.shape), np.nan)
     displacements[-1] = u
-    response.centres[-1] = mesh.unit_centres(u, axes)
-    response.tip[-1] = (x_end0 + u[mesh.end_points][:, :axes]).mean(axis=0)
+    response.centres[-1] = mesh.unit_centres(u, mesh.axes)
+    response.tip[-1] = response.reference_tip + u[mesh.end_points][:, : mesh.axes].mean(axis=0)
+    x_end0 = mesh.points[mesh.end_points][:, :2]
     before = float(start.response.curl[-1])
-    angle = np.degrees(_end_face_angle(x_end0[:, :2] + u[mesh.end_points][:, :2]) - _end_face_angle(x_end0[:, :2]))
+    angle = np.degrees(_end_face_angle(x_end0 + u[mesh.end_points][:, :2]) - _end_face_angle(x_end0))
     response.curl[-1] = before + (angle - before + 180.0) % 360.0 - 180.0  # the turn nearest the start's
     meta = {**response.metadata, "warm_start": int(iterations), "wall_time_s": time.perf_counter() - t0}
-    return Solution(replace(response, converged=True, reached=float(pressures[-1]), metadata=meta), mesh,
+    return Solution(replace(response, converged=True, reached=float(response.pressures[-1]), metadata=meta), mesh,
                     displacements)
 
 
