@@ -114,16 +114,13 @@ def _unit(settings: dict, unit_file: str | None, model_file: str | None) -> Any:
     from pneumorph.export import check_materials
     from pneumorph.export.parts import check_buildable
     from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.models.factory import unit_or_library
 
     with P.blame("--unit" if model_file is None or unit_file is not None else "--model-file"):
         if unit_file:
             unit = UnitSpec.from_toml(unit_file)
-        elif "unit_file" in settings:
-            unit = UnitSpec.from_toml(settings["unit_file"])
-        elif "unit" in settings:
-            unit = UnitSpec.from_dict(dict(settings["unit"]), source="[model.unit]")
-        else:
-            unit = UnitSpec()
+        else:  # the model file's unit, read as the model factory reads it (a library's file: the built-in unit)
+            unit = unit_or_library(settings)[0] or UnitSpec()
         check_materials(unit)  # the parts' materials, before anything is built
         check_buildable(unit)
     return unit

@@ -129,7 +129,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     unknown = sorted(set(s) - set(MODEL_KEYS))
     if unknown:
         raise SearchConfigError(f"unknown model setting(s) {', '.join(unknown)}; known: {', '.join(MODEL_KEYS)}")
-    unit, library = _unit_or_library(s)
+    unit, library = unit_or_library(s)
     fidelity = checks.text(s.get("fidelity", "2d"), "[model] fidelity", ("2d", "3d"), error=SearchConfigError)
     Model: type[Reduced2D | Full3D] = Reduced2D if fidelity == "2d" else Full3D
     free = available_memory()
@@ -161,7 +161,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     return Model(units, unit, ramp, gravity=gravity, **extra)
 
 
-def _unit_or_library(s: Mapping[str, Any]) -> tuple[UnitSpec | None, UnitLibrary | None]:
+def unit_or_library(s: Mapping[str, Any]) -> tuple[UnitSpec | None, UnitLibrary | None]:
     """The unit (``unit``, ``unit_file`` or the default) or the unit library (``library``) of the settings.
 
     Raises
