@@ -192,12 +192,12 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     {'error': {'field': 'content-type', 'message': 'this route takes application/json, not text/plain'}}
     """
     from pneumorph import __version__
-    from pneumorph.execution.cache import default_cache_path
+    from pneumorph.execution.cache import chain_table_dir, default_cache_path
 
     cache_path = Path(cache) if cache is not None else default_cache_path()
     state = Path(state_dir) if state_dir is not None else default_state_dir()
     state.mkdir(parents=True, exist_ok=True)
-    bench = Bench(table_dir=cache_path.parent / "chain-tables", unit_dir=state / "units", settings=model_settings)
+    bench = Bench(table_dir=chain_table_dir(cache_path), unit_dir=state / "units", settings=model_settings)
     bench.shape_dir = state / "shapes"
     board = JobBoard(bench, state, cache_path, workers, limits)
     answers = AnswerPool(bench, answer_workers)

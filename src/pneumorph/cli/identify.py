@@ -50,13 +50,14 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
 
     from pneumorph.cli.execution import check_options
     from pneumorph.errors import SettingsError
+    from pneumorph.execution.cache import chain_table_dir
     from pneumorph.geometry.unit import UnitSpec
     from pneumorph.identify import (
         NAMES,
         Observation,
         ParameterSet,
-        build_probes,
         load_scans,
+        precheck_designs,
         write_identified,
     )
     from pneumorph.identify import identify as fit
@@ -85,13 +86,14 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
         from pneumorph.errors import ScanError
 
         raise ScanError("a 3D scan needs the 3D model: leave out --model 2d")
-    build_probes(observations, params, base, params.nominal)
+    table_dir = chain_table_dir(cache)
+    precheck_designs(observations, params, base, table_dir)  # sizes against the chain's shapes, where a table serves
     click.echo(f"identifying {', '.join(names)} from {len(specs)} scan(s) ({fidelity} model, executor {executor})",
                err=True)
     evaluator = open_evaluator(executor, workers, scheduler, cache)
     try:
         result = fit(observations, params, evaluator, base, names, seed=seed,
-                     on_progress=lambda text: click.echo(f"  {text}", err=True))
+                     on_progress=lambda text: click.echo(f"  {text}", err=True), table_dir=table_dir)
     finally:
         evaluator.close()
     summary = {**result.to_dict(), "cluster": cluster_report(evaluator)}

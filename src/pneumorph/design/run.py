@@ -74,7 +74,7 @@ from pneumorph.design.problem import Algorithm, Outcome, Problem
 from pneumorph.design.report import RunResult, _write_outputs, _write_report
 from pneumorph.design.targets import StagedTarget
 from pneumorph.errors import OutputPathError, SearchConfigError
-from pneumorph.execution.cache import CachedEvaluator, EvaluationCache, default_cache_path
+from pneumorph.execution.cache import CachedEvaluator, EvaluationCache, chain_table_dir, default_cache_path
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
 from pneumorph.io.files import atomic_write_text, check_writable_dir
 from pneumorph.io.lock import RunLock
@@ -238,5 +238,4 @@ def _finish(claim: _Claim, algorithm: Algorithm, problem: Problem, status: str, 
 
 def _table_dir(config: DesignConfig, cache: EvaluationCache | None) -> Path | None:
     """The chain tables' folder beside the evaluation cache (None for a cache in memory)."""
-    path = cache.path if cache is not None else str(config.cache or default_cache_path())
-    return None if path == ":memory:" else Path(path).parent / "chain-tables"
+    return chain_table_dir(cache.path if cache is not None else config.cache)

@@ -11,6 +11,7 @@ Examples
 from pneumorph.execution.cache import (
     CachedEvaluator,
     EvaluationCache,
+    chain_table_dir,
     default_cache_path,
 )
 from pneumorph.execution.evaluators import (
@@ -32,6 +33,7 @@ __all__ = [
     "Outcome",
     "ProcessPoolEvaluator",
     "SerialEvaluator",
+    "chain_table_dir",
     "default_cache_path",
     "make_evaluator",
     "solve",

@@ -94,6 +94,16 @@ def default_cache_path() -> Path:
     return base / "pneumorph" / "evaluations.sqlite"
 
 
+def chain_table_dir(cache: str | Path | None = None) -> Path | None:
+    """The folder of the chain tables kept beside an evaluation cache (None for a cache in memory).
+
+    >>> chain_table_dir("/data/evaluations.sqlite").as_posix(), chain_table_dir(":memory:")
+    ('/data/chain-tables', None)
+    """
+    path = str(cache if cache is not None else default_cache_path())
+    return None if path == ":memory:" else Path(path).parent / "chain-tables"
+
+
 class EvaluationCache:
     """Outcomes of solved designs, persisted in an SQLite file.
 

@@ -7,6 +7,7 @@ mould thicknesses of Fig E.4 by least squares on the correlation distances
 and ``simulate`` take (:func:`identified_toml`).
 """
 
+from pneumorph.identify.extent import chain_shape, rigid_units
 from pneumorph.identify.fit import (
     MAX_CORRELATION,
     MAX_ITERATIONS,
@@ -17,6 +18,7 @@ from pneumorph.identify.fit import (
     build_probes,
     confounded,
     identify,
+    precheck_designs,
 )
 from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
 from pneumorph.identify.probe import SHAPE_REVISION, ShapeProbe, shape_of
@@ -40,12 +42,15 @@ __all__ = [
     "ScanSpec",
     "ShapeProbe",
     "build_probes",
+    "chain_shape",
     "confounded",
     "identified_toml",
     "identify",
     "load_scans",
     "parameter_indices",
+    "precheck_designs",
     "read_manifest",
+    "rigid_units",
     "shape_of",
     "write_identified",
 ]

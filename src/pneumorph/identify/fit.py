@@ -33,6 +33,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from itertools import pairwise
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -41,6 +42,7 @@ from numpy.typing import NDArray
 from pneumorph.correlation.compare import ModelShape, check_units, correlate
 from pneumorph.correlation.scans import Scan
 from pneumorph.errors import FitError, ScanError
+from pneumorph.identify.extent import chain_shape
 from pneumorph.identify.linear import (
     MAX_CORRELATION,
     MIN_EIGENVALUE,
@@ -66,6 +68,9 @@ MAX_POINTS = 4000
 TRUST = 3.0
 #: a scan spanning outside this times its design's model (solved at nominal) is not of that design
 MATCH_RANGE = (0.8, 1.25)
+#: the chain table's rigid units span up to 2 % less than the solved shape (docs/identify.md): the
+#: size check before any solve is widened by this
+CHAIN_MARGIN = 0.05
 #: the Gauss-Newton iterations (FE Jacobians) before the fit is declared not converged
 MAX_ITERATIONS = 6
 #: converged when every free parameter's step is below this fraction of its standard error ...
@@ -168,13 +173,14 @@ def _sample(scan: Scan, seed: int) -> FloatArray:
     return p[np.sort(np.random.default_rng(seed).choice(len(p), MAX_POINTS, replace=False))]
 
 
-def check_design(observation: Observation, shape: ModelShape) -> None:
+def check_design(observation: Observation, shape: ModelShape, margin: float = 0.0) -> None:
     """Refuse a scan whose size is not its design's (another unit count): before the fit's many solves.
 
     The scan must span within :data:`MATCH_RANGE` times the nominal model's deformed shape
     (the diagonal of the box along their principal axes, whichever way the scan lies);
     a cast off the model by the parameters the fit can change spans within a few percent
-    of it.
+    of it. ``margin`` widens the range both ways for a shape only estimated (before any
+    solve, :func:`~pneumorph.identify.extent.chain_shape`: :data:`CHAIN_MARGIN`).
 
     Raises
     ------
@@ -184,11 +190,39 @@ def check_design(observation: Observation, shape: ModelShape) -> None:
     model = shape.surface if len(shape.surface) else shape.samples
     scan, size = _size(observation.scan.points), _size(model)
     ratio = scan / max(size, 1e-12)
-    if not MATCH_RANGE[0] <= ratio <= MATCH_RANGE[1]:
+    if not MATCH_RANGE[0] / (1 + margin) <= ratio <= MATCH_RANGE[1] * (1 + margin):
         spec = observation.spec
+        how = " by its chain table" if margin else ""
         raise ScanError(f"scan {spec.file} spans {scan:.4g} mm but design {spec.design} "
-                        f"({len(spec.design)} units) spans {size:.4g} mm at {spec.pressure_kpa:g} kPa "
+                        f"({len(spec.design)} units) spans {size:.4g} mm at {spec.pressure_kpa:g} kPa{how} "
                         f"({ratio:.3g} times): is it the design scanned? (check its unit count and --scan-unit)")
+
+
+def precheck_designs(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any],
+                     table_dir: str | Path | None = None) -> int:
+    """Check each scan's size against its design's shape predicted by a chain table, before any solve.
+
+    Scans whose model has no chain table at their pressure (or is too short for its window)
+    are checked after their nominal solve only. Returns how many were checked.
+
+    Raises
+    ------
+    ScanError
+        A scan's unit or its design's unit count is wrong (:func:`check_design`, widened by
+        :data:`CHAIN_MARGIN`).
+    """
+    checked = 0
+    build_probes(observations, params, base, params.nominal)  # every model refused now
+    for o in observations:
+        # the unit as given (the fit meshes it a little coarser or finer to keep its grid): its table's model
+        nominal = make_model(len(o.spec.design), {**base, "pressure_kpa": o.spec.pressure_kpa,
+                                                  "unit": params.unit.to_dict()})
+        shape = chain_shape(nominal, o.spec.design, table_dir)
+        if shape is not None:
+            check_units(o.scan, shape)
+            check_design(o, shape, CHAIN_MARGIN)
+            checked += 1
+    return checked
 
 
 def _size(points: FloatArray) -> float:
@@ -214,8 +248,8 @@ def build_probes(observations: Sequence[Observation], params: ParameterSet, base
 
 def identify(observations: Sequence[Observation], params: ParameterSet, evaluator: Any,
              base: dict[str, Any] | None = None, parameters: Sequence[str] = NAMES, seed: int = 0,
-             max_iterations: int = MAX_ITERATIONS, on_progress: Callable[[str], None] | None = None
-             ) -> Identification:
+             max_iterations: int = MAX_ITERATIONS, on_progress: Callable[[str], None] | None = None,
+             table_dir: str | Path | None = None) -> Identification:
     """Fit ``parameters`` to the scans (see the module docstring).
 
     Parameters
@@ -232,6 +266,9 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         The parameters to fit; the others stay at nominal.
     seed : int
         Seed of the sample of a scan's points when it has more than :data:`MAX_POINTS`.
+    table_dir : path, optional
+        Chain tables kept beside the evaluation cache, looked in (after the shipped ones) for
+        the size check before any solve (:func:`precheck_designs`).
 
     Raises
     ------
@@ -255,7 +292,7 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         raise ScanError("a 3D scan needs the 3D model (--model 3d); a 2D model has no surface")
     points = [_sample(o.scan, seed + k) for k, o in enumerate(observations)]
     theta = params.nominal.copy()
-    build_probes(observations, params, base, theta)  # every model refused now, before any solve
+    precheck_designs(observations, params, base, table_dir)  # every model refused now, before any solve
     solves = 0
 
     lower, upper = params.lower, params.upper
@@ -445,6 +482,7 @@ def _per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
 
 
 __all__ = [
+    "CHAIN_MARGIN",
     "MATCH_RANGE",
     "MAX_CORRELATION",
     "MAX_ITERATIONS",
@@ -457,4 +495,5 @@ __all__ = [
     "check_design",
     "confounded",
     "identify",
+    "precheck_designs",
 ]

@@ -1,0 +1,88 @@
+"""A design's deformed shape before any solve: the chain table's centreline carrying rigid units.
+
+A scan whose design was typed with the wrong unit count is refused by its size
+(:func:`~pneumorph.identify.fit.check_design`). The deformed size depends on how far the
+design curls, which only a solve knows, unless a chain table of the model serves the scan's
+pressure: then the table's unit centres (exact to hundredths of a millimetre on the nominal
+model, :mod:`pneumorph.models.chain`) place every unit of the undeformed mesh as a rigid
+body, turned by the mean turn of the two chords at its centre. The walls do not balloon in
+this shape, so its size is a little smaller than the solved one's;
+:data:`~pneumorph.identify.fit.CHAIN_MARGIN` widens the size check by what that was measured
+to cost (docs/identify.md).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.correlation.compare import ModelShape, model_shape
+from pneumorph.geometry.assembly import ActuatorMesh, unit_starts
+from pneumorph.models.chain import ChainModel
+from pneumorph.models.chaintables import serve_table
+
+FloatArray = NDArray[np.float64]
+
+
+def chain_shape(model: Any, design: str, folder: str | Path | None = None) -> ModelShape | None:
+    """The deformed shape of ``design`` at ``model``'s top pressure from a chain table, or None.
+
+    None when no table (shipped, or kept in ``folder``) has a level at exactly the model's top
+    pressure, or when the actuator is too short for the table's window.
+
+    Examples
+    --------
+    >>> from pneumorph.models.factory import make_model
+    >>> shape = chain_shape(make_model(15, {"fidelity": "2d", "pressure_kpa": 36}), "001111010001001")
+    >>> round(float(shape.extent), 1)   # the solved 2D model's outline: 173.3 mm
+    172.9
+    >>> chain_shape(make_model(15, {"fidelity": "2d", "pressure_kpa": 37}), "001111010001001") is None
+    True
+    """
+    served = serve_table(model, folder)
+    if served is None or not np.isclose(served.table.pressures[-1], served.requested, rtol=0, atol=1e-9):
+        return None
+    n = len(design)
+    if n < 2 * served.table.window + 1:
+        return None
+    response = ChainModel(served.table, n).evaluate(design)
+    mesh = model.mesh(design)
+    return model_shape(SimpleNamespace(mesh=mesh, displacements=[rigid_units(mesh, response)]))
+
+
+def rigid_units(mesh: ActuatorMesh, response: Any, level: int = -1) -> FloatArray:
+    """Displacements that carry each unit of ``mesh`` rigidly to the response's centreline.
+
+    Unit ``i`` moves its reference centre to its centre at ``level`` and turns by the mean of
+    the turns of its two chords (base -> centre 1 -> ... -> centre n -> tip); the base block
+    stays, an end cap follows the last unit.
+    """
+    ref_c, ref_tip = np.asarray(response.reference_centres), np.asarray(response.reference_tip)
+    cur_c, cur_tip = np.asarray(response.centres[level]), np.asarray(response.tip[level])
+    base = np.array([0.0, ref_c[0, 1]])
+    chord_turns = _angles(np.vstack([base, cur_c, cur_tip])) - _angles(np.vstack([base, ref_c, ref_tip]))
+    turn = 0.5 * (chord_turns[:-1] + chord_turns[1:])
+    units = mesh.units or tuple(mesh.spec for _ in range(len(ref_c)))
+    starts = unit_starts(units)
+    x = mesh.points
+    unit = np.clip(np.searchsorted(starts, x[:, 0], side="right") - 1, 0, len(ref_c) - 1)
+    rel = x[:, :2] - ref_c[unit]
+    cos, sin = np.cos(turn[unit]), np.sin(turn[unit])
+    moved = cur_c[unit] + np.c_[cos * rel[:, 0] - sin * rel[:, 1], sin * rel[:, 0] + cos * rel[:, 1]]
+    u = np.zeros_like(x)
+    u[:, :2] = moved - x[:, :2]
+    u[x[:, 0] < 0.0] = 0.0  # the base block
+    return u
+
+
+def _angles(points: FloatArray) -> FloatArray:
+    """Unwrapped angles of the chords of a polyline."""
+    d = np.diff(points, axis=0)
+    return np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+
+
+__all__ = ["chain_shape", "rigid_units"]
