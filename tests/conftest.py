@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+
+# Tests that compare solves bit for bit assume one BLAS/OpenMP thread (as .ci/run sets): set
+# here, before numpy and the solvers load, so the README's test command alone is enough.
+for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 import pytest
 
