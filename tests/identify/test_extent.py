@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.correlation import model_shape
+from pneumorph.correlation import ModelShape, model_shape
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.identify import ParameterSet, chain_shape, precheck_designs
 from pneumorph.identify.fit import _size
@@ -17,7 +17,8 @@ from pneumorph.models.factory import make_model
 from tests.identify.conftest import synthetic
 
 
-def _cloud(shape):  # noqa: ANN001, ANN202 - the points a scan is compared with
+def _cloud(shape: ModelShape) -> np.ndarray:
+    """The points a scan is compared with."""
     return shape.surface if len(shape.surface) else shape.samples
 
 

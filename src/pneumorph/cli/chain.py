@@ -45,10 +45,15 @@ def chain() -> None:
 @click.option("--all-heldout", is_flag=True,
               help="Solve every held-out design, even when the first 6 show the table within half the tolerance "
                    "(as the shipped tables are validated).")
+@click.option("--far-terms/--no-far-terms", "far", default=None,
+              help="Without --window, try first the window one narrower than the first with far-field terms "
+                   "(documentation page chain-model, docs/chain-model.md in the source). Default: on for the 3d "
+                   "model of one unit type.")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
           window: int | None, tolerance: float, heldout: int, executor: str, workers: int | None,
-          scheduler: str | None, cache: str | None, out: str, short: bool, all_heldout: bool, as_json: bool) -> None:
+          scheduler: str | None, cache: str | None, out: str, short: bool, all_heldout: bool, far: bool | None,
+          as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with
@@ -61,7 +66,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pneumorph.io.files import all_or_nothing_file
     from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chainfit import build_table
-    from pneumorph.models.chaintables import start_window
+    from pneumorph.models.chaintables import build_options, start_window
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
@@ -85,7 +90,8 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     evaluator = open_evaluator(executor, workers, scheduler, cache)
     try:
         options: dict[str, Any] = {"heldout": heldout, "window": window, "tolerance": tolerance, "short": short,
-                   "first_window": start_window(model), "early": not all_heldout}
+                   "first_window": start_window(model), "early": not all_heldout,
+                   "far": build_options(model)["far"] if far is None else far}
         plan = build_plan(model, workers=evaluator_workers(evaluator), cached=cached_counter(evaluator, model),
                           **options)
         click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve

@@ -23,9 +23,11 @@ from pneumorph.models.chainfit import (
     MIN_HELDOUT,
     check_training_size,
     evaluator_workers,
+    fit_candidates,
+    fit_text,
     heldout_designs,
+    training_designs,
 )
-from pneumorph.models.windows import covering_designs
 
 #: held-out designs that validate a table built on first use
 HELDOUT = 20
@@ -96,6 +98,8 @@ class BuildPlan:
         The window half-widths tried in turn until the held-out error is within ``tolerance``.
     covering : tuple of int
         Covering designs of each window.
+    far : tuple of bool
+        Per window, whether it is fitted with far-field terms (empty: none is).
     solves : tuple of int
         Distinct FE solves if the build stops at each window (covering and held-out designs, cumulated).
     fewest : int
@@ -121,6 +125,7 @@ class BuildPlan:
     tolerance: float = DEFAULT_TOLERANCE
     cached: int = 0
     workers: int = 1
+    far: tuple[bool, ...] = ()
 
     def cost_text(self) -> str:
         """The FE solves (fewest to most, those cached not counted) and their estimated wall time."""
@@ -139,7 +144,9 @@ class BuildPlan:
         """The plan as one paragraph: what is built, the windows tried, the solves and the estimate."""
         p = np.asarray(self.pressures) * 1e3
         ramp = f"{p[0]:.4g}-{p[-1]:.4g} kPa in {len(p)} levels" if len(p) > 1 else f"{p[0]:.4g} kPa"
-        tries = ", ".join(f"+-{w} ({c} covering designs)" for w, c in zip(self.windows, self.covering, strict=True))
+        fars = self.far or (False,) * len(self.windows)
+        tries = ", ".join(f"{fit_text(w, f)[len('window '):]} ({c} covering designs)"
+                          for w, c, f in zip(self.windows, self.covering, fars, strict=True))
         grow = (f"windows {tries} tried in turn until" if len(self.windows) > 1 else f"window {tries}, checked that")
         cached = f" ({self.cached} designs already in the evaluation cache)" if self.cached else ""
         early = f" ({MIN_HELDOUT} if they are clearly within)" if self.fewest and self.fewest < self.solves[0] else ""
@@ -210,7 +217,7 @@ def check_planar(model: Any) -> None:
 
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
                window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False,
-               first_window: int = 1, early: bool = False) -> BuildPlan:
+               first_window: int = 1, early: bool = False, far: bool = False) -> BuildPlan:
     """What :func:`~pneumorph.models.chainfit.build_table` will solve to fit a table to ``model`` (the training
     actuator: its designs have ``model.n_units`` units), counted without a solve.
 
@@ -232,9 +239,10 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     short : bool
         The build learns the end windows from short actuators (``build_table(short=True)``); each
         short design counts as one solve (the estimate takes it at the full length's time).
-    first_window, early : int, bool
-        As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, and whether
-        the validation may stop after :data:`~pneumorph.models.chainfit.MIN_HELDOUT` designs.
+    first_window, early, far : int, bool, bool
+        As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, whether
+        the validation may stop after :data:`~pneumorph.models.chainfit.MIN_HELDOUT` designs,
+        and whether a narrower window with far-field terms is tried first.
 
     Raises
     ------
@@ -265,12 +273,18 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     seen: set[str] = set()
     first = min(max(1, int(first_window)), max(1, min(MAX_WINDOW, (n_units - 1) // 2)))
     fewest = 0
-    for w in [int(window)] if window is not None else range(first, min(MAX_WINDOW, (n_units - 1) // 2) + 1):
+    fars: list[bool] = []
+    try:
+        candidates = fit_candidates(n_units, window, first, MAX_WINDOW, far and types == 1)
+    except ChainTableError:
+        candidates = []
+    for w, with_far in candidates:
         try:
             check_training_size(types, w, len(symmetric))
         except PneumorphError:
             break
-        train = covering_designs(n_units, w, n_types=types, alphabet=alphabet, symmetric=symmetric, short=short)
+        train = training_designs(n_units, w, with_far, short, alphabet, symmetric)
+        fars.append(with_far)
         seen.update(train)
         tests = heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet, symmetric=symmetric)
         if not windows:
@@ -284,7 +298,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     held = int(cached(sorted(seen))) if cached is not None and seen else 0
     return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
                      tuple(float(p) for p in model.pressures()), int(n_units), tuple(windows), tuple(covering),
-                     tuple(solves), fewest, heldout, float(tolerance), held, max(1, int(workers)))
+                     tuple(solves), fewest, heldout, float(tolerance), held, max(1, int(workers)), tuple(fars))
 
 
 def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | None:

@@ -22,6 +22,7 @@ from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.chain import ChainTable, source_description, source_key
+from pneumorph.models.chainterms import far_designs, far_means
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
@@ -41,8 +42,8 @@ from pneumorph.models.windows import (
 )
 
 __all__ = ["CLEAR_FRACTION", "DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", "MIN_HELDOUT", "build_table",
-           "check_training_size", "evaluator_workers", "first_symbols", "fit_table", "heldout_designs",
-           "prediction_errors", "response_elements"]
+           "check_training_size", "evaluator_workers", "first_symbols", "fit_candidates", "fit_table", "fit_text",
+           "heldout_designs", "prediction_errors", "response_elements", "training_designs"]
 
 #: a level's worst held-out centre error above this is refused (mm, default)
 DEFAULT_TOLERANCE = 0.2
@@ -106,11 +107,13 @@ def response_elements(response: Response) -> tuple[FloatArray, FloatArray, Float
 
 # -- fitting --------------------------------------------------------------------------------
 def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
-              library: UnitLibrary | None = None) -> ChainTable:
+              library: UnitLibrary | None = None, far: bool = False) -> ChainTable:
     """Fit a table to converged training responses (of one ramp; of any lengths).
 
     Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
-    mirrored occurrences with negated turns).
+    mirrored occurrences with negated turns). With ``far``, each chord is the window's term
+    plus the far-field terms of the next unit on each side (:mod:`pneumorph.models.chainterms`),
+    written out as a table of window +-(``window`` + 1).
 
     Parameters
     ----------
@@ -130,8 +133,12 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     n = longest.n_units
     w = int(window)
     alphabet = library.alphabet if library is not None else ()
-    means = _window_means(responses, w, mirror, alphabet, library.symmetric_types if library is not None else (),
-                          len(pressures))
+    symmetric = library.symmetric_types if library is not None else ()
+    if far:
+        means = far_means(responses, w, mirror, alphabet, symmetric, len(pressures), n)
+        w += 1
+    else:
+        means = _window_means(responses, w, mirror, alphabet, symmetric, len(pressures))
     if n < 2:
         raise ChainTableError("a chain table needs training designs of at least 2 units")
     fitted = dict(window=w, pressures=np.asarray(pressures, dtype=float), **means, source=dict(source),
@@ -318,7 +325,7 @@ def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
 def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance: float = DEFAULT_TOLERANCE,
                 heldout: int = 20, seed: int = 1, max_window: int = MAX_WINDOW,
                 on_progress: Callable[[str], None] | None = None, short: bool = False, first_window: int = 1,
-                early: bool = False) -> ChainTable:
+                early: bool = False, far: bool = False) -> ChainTable:
     """Fit and validate a chain table to an FE model by solving covering and held-out designs.
 
     Parameters
@@ -357,6 +364,11 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
         level; the validation records how many designs it used (``heldout_solved``) and
         whether it stopped early. The first :data:`MIN_HELDOUT` held-out designs are then
         solved in one stream with the covering designs.
+    far : bool
+        Without a fixed ``window``, try first the window one narrower than ``first_window``
+        with far-field terms (:mod:`pneumorph.models.chainterms`: a table of window
+        ``first_window`` from end windows of the narrower one; :func:`fit_candidates`). One
+        unit type only.
 
     Raises
     ------
@@ -368,14 +380,14 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
     _check_buildable(model, tolerance)
     n = int(model.n_units)
     say = on_progress or (lambda text: None)
-    windows = _windows(n, window, first_window, max_window)
     library = getattr(model, "library", None)
+    candidates = fit_candidates(n, window, first_window, max_window, far and (library is None or library.is_single))
     solved: dict[str, Response] = {}
     build = _Build(model, evaluator, tolerance, heldout, seed, short, early, say, solved,
                    _solver(model, evaluator, solved, say), library, _source(model), time.perf_counter())
     best: ChainTable | None = None
-    for w in windows:
-        best = _window_table(build, w)
+    for w, with_far in candidates:
+        best = _window_table(build, w, with_far)
         if max(best.validation["centre_worst_mm"]) <= tolerance:
             return best
     assert best is not None
@@ -412,6 +424,37 @@ def _windows(n: int, window: int | None, first_window: int, max_window: int) -> 
     return windows
 
 
+def fit_candidates(n: int, window: int | None, first_window: int, max_window: int = MAX_WINDOW,
+                   far: bool = False) -> list[tuple[int, bool]]:
+    """The tables a build tries in turn: ``(w, far)``, window +-w, with far-field terms if ``far``.
+
+    With ``far`` and no fixed ``window``, window ``first - 1`` with far-field terms (a table
+    of window ``first``) comes first, then the plain windows.
+
+    >>> fit_candidates(15, None, 3, far=True), fit_candidates(15, 2, 3, far=True)
+    ([(2, True), (3, False)], [(2, False)])
+    """
+    windows = _windows(n, window, first_window, max_window)
+    plain = [(w, False) for w in windows]
+    if far and window is None and windows[0] >= 2:
+        return [(windows[0] - 1, True), *plain]
+    return plain
+
+
+def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str, ...] = (),
+                     symmetric: tuple[int, ...] = ()) -> list[str]:
+    """The covering designs of window +-w (:func:`~pneumorph.models.windows.covering_designs`), or with
+    far-field terms :func:`~pneumorph.models.chainterms.far_designs`."""
+    if far:
+        return far_designs(n, w)
+    return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short)
+
+
+def fit_text(w: int, far: bool) -> str:
+    """``window +-2 with far-field terms (+-3)`` or ``window +-3``."""
+    return f"window +-{w} with far-field terms (+-{w + 1})" if far else f"window +-{w}"
+
+
 @dataclass(frozen=True)
 class _Build:
     """What every window of a build shares: the model, the settings, the designs solved so far."""
@@ -437,8 +480,9 @@ def _source(model: Any) -> dict[str, Any]:
             "n_units": int(model.n_units), "description": source_description(model)}
 
 
-def _window_table(build: _Build, w: int) -> ChainTable:
-    """The table of half-width ``w``, fitted to its covering designs and validated on held-out ones.
+def _window_table(build: _Build, w: int, far: bool = False) -> ChainTable:
+    """The table of half-width ``w`` (with ``far``: and its far-field terms), fitted to its covering designs and
+    validated on held-out ones.
 
     Held-out designs solved for a smaller window are validated first; with ``early``, the
     first :data:`MIN_HELDOUT` go in the covering designs' stream (no pause between the
@@ -455,24 +499,24 @@ def _window_table(build: _Build, w: int) -> ChainTable:
     alphabet = library.alphabet if library is not None else ()
     symmetric = library.symmetric_types if library is not None else ()
     check_training_size(max(1, len(alphabet)), w, len(symmetric))
-    train = covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric,
-                             short=build.short)
-    say(f"window +-{w}: {len(train)} covering designs")
+    train = training_designs(n, w, far, build.short, alphabet, symmetric)
+    name = fit_text(w, far)
+    say(f"{name}: {len(train)} covering designs")
     tests = heldout_designs(n, build.heldout, exclude=train, seed=build.seed, alphabet=alphabet, symmetric=symmetric)
     tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
     ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if build.early else []
     what = f"covering and {len(ahead)} held-out" if ahead else "covering"
     table = fit_table(build.solve(train + ahead, what)[: len(train)], w, build.source,
-                      library=library if alphabet else None)
+                      library=library if alphabet else None, far=far)
     val = validate_in_rounds(table, tests, build.solve, build.tolerance, build.early,
                              evaluator_workers(build.evaluator))
     val.update(tolerance_mm=build.tolerance, seed=build.seed)
     worst = max(val["centre_worst_mm"])
-    say(f"window +-{w}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
+    say(f"{name}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
         f"design(s){stop_note(val, build.tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
     for symbol, errs in val.get("per_type", {}).items():
         if errs["centres"]:
             say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
                 f"({errs['centres']} centres)")
-    meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - build.start)
+    meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - build.start, fit=name)
     return ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})

@@ -73,13 +73,22 @@ def start_window(model: Any) -> int:
 
 def build_options(model: Any) -> dict[str, Any]:
     """How a table of ``model`` is built on first use: :func:`~pneumorph.models.chainfit.build_table`'s (and
-    :func:`~pneumorph.models.buildplan.build_plan`'s) ``heldout``, ``first_window`` and ``early``.
+    :func:`~pneumorph.models.buildplan.build_plan`'s) ``heldout``, ``first_window``, ``early`` and ``far``.
+
+    A 3D model of one unit type tries the window one narrower than its first with far-field
+    terms first (:mod:`pneumorph.models.chainterms`): it needs about half the unit solves of
+    the wider window's table. 2D solves are cheap, and 2D builds stay as they were.
 
     >>> from pneumorph.models.factory import make_model
     >>> build_options(make_model(15, {"fidelity": "3d"}))
-    {'heldout': 20, 'first_window': 3, 'early': True}
+    {'heldout': 20, 'first_window': 3, 'early': True, 'far': True}
+    >>> build_options(make_model(15, {"fidelity": "2d"}))["far"]
+    False
     """
-    return {"heldout": HELDOUT, "first_window": start_window(model), "early": True}
+    library = getattr(model, "library", None)
+    single = library is None or library.is_single
+    far = single and str(getattr(model, "fidelity", "")) == "3d"
+    return {"heldout": HELDOUT, "first_window": start_window(model), "early": True, "far": far}
 
 
 def table_file(folder: str | Path, model: Any) -> Path:

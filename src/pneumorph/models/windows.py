@@ -420,8 +420,8 @@ def every_design(n_units: int, codes: NDArray[np.uint8]) -> NDArray[np.uint8]:
 
 
 def end_designs(window: int, mirror: bool = True, n_types: int = 1, alphabet: Sequence[str] = (),
-                symmetric: Sequence[int] = ()) -> list[str]:
-    """Designs of ``2w`` units that together show every window holding the base or the tip.
+                symmetric: Sequence[int] = (), units: int | None = None) -> list[str]:
+    """Designs of ``2w`` units (or ``units``) that together show every window holding the base or the tip.
 
     Chord ``w`` of a ``2w``-unit design sees the base and all its units, chord ``w + 1`` all its
     units and the tip; the chords before and after see fewer units. Every sequence of ``2w``
@@ -432,7 +432,7 @@ def end_designs(window: int, mirror: bool = True, n_types: int = 1, alphabet: Se
     (['00', '01'], 32)
     """
     w, k = int(window), int(n_types)
-    every = every_design(2 * w, unit_codes(k, symmetric))
+    every = every_design(2 * w if units is None else int(units), unit_codes(k, symmetric))
     if mirror:
         flipped = np.asarray(canonical_codes(every ^ 1, symmetric))
         keys, mirrored = design_numbers(every, 2 * k), design_numbers(flipped, 2 * k)

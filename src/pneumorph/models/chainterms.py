@@ -1,0 +1,198 @@
+"""Chain elements as a window's element plus far-field terms (a table of window +-w reaching +-(w + 1)).
+
+A table of window +-w keys each chord's turn and length by the ``2w + 1`` units around it,
+and so misses the units just beyond: for the built-in unit's 3D model, window +-2 is off by
+0.2 mm at the tip, window +-3 by a hundredth, but a table of window +-3 needs every one of
+its windows solved, the ``2^6`` end windows alone on 32 actuators of 6 units. The units
+beyond the window act through the ones between (Saint-Venant: the self-equilibrated
+stresses of a pressurised cavity decay along the actuator), and the effects of the two sides
+add up. So the element of chord ``j`` is written as
+
+    E(j) = A(units j - w .. j + w) + R(units j .. j + w + 1) + L(units j - w - 1 .. j)
+
+with ``A`` the window's term and ``R``, ``L`` the *far-field terms* of the next unit on each
+side, read with the units between it and the chord. The three tables are fitted together
+to the training chords by backfitting (each in turn the mean of what the others leave,
+until they settle), over the mirrored chords too. The sum is then written out as an
+ordinary table of window +-(w + 1), one entry per window an actuator can show, so every
+reader of chain tables uses it unchanged.
+
+The training needs every key of the three terms: the end windows of +-w (actuators of
+``2w`` units, :func:`~pneumorph.models.windows.end_designs`) and the interior windows of
++-(w + 1) on full-length actuators (:func:`far_designs`). Measured on the built-in unit with
+a 2.5 mm layer (3D, 15 units, the 20 held-out designs of its table): window +-2 alone is off
+by 0.196 mm, the far-field terms on the same model type by 0.0077 mm, the table of window
++-3 by 0.0085 mm, trained on 167 unit solves instead of 312 (docs/chain-model.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.errors import ChainTableError
+from pneumorph.models.response import Response
+from pneumorph.models.windows import (
+    canonical_codes,
+    covering_designs,
+    design_array,
+    end_designs,
+    possible_codes,
+    window_symbols,
+)
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: backfitting rounds at most; they stop earlier once no term moves by more than :data:`SETTLED`
+ROUNDS = 200
+#: the change (rad, mm) under which the terms count as settled
+SETTLED = 1e-12
+
+
+def far_terms(window: int) -> tuple[tuple[int, int], ...]:
+    """The terms of a table of window +-w with far-field terms: unit offsets ``(lo, hi)`` from the chord.
+
+    >>> far_terms(2)
+    ((-2, 2), (0, 3), (-3, 0))
+    """
+    w = int(window)
+    return ((-w, w), (0, w + 1), (-(w + 1), 0))
+
+
+def far_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -> list[str]:
+    """Training designs of a table of window +-w with far-field terms (0/1 designs).
+
+    The end windows of +-w from actuators of ``2w`` units (``w + 2`` for ``w = 1``: the
+    last chord's far-field term on the base side reads ``w + 2`` units), and the interior
+    windows of +-(w + 1) from actuators of ``n_units``: together they show every key of the
+    three terms.
+
+    >>> designs = far_designs(15, 2)
+    >>> [len(d) for d in designs].count(4), len(designs) - 8
+    (8, 8)
+    """
+    n, w = int(n_units), int(window)
+    interior = [d for d in covering_designs(n, w + 1, mirror, seed, short=True) if len(d) == n]
+    return end_designs(w, mirror, units=max(2 * w, w + 2)) + interior
+
+
+def _term_codes(symbols: IntArray, width: int, lo: int, hi: int, radix: int) -> IntArray:
+    """Codes of the units ``lo .. hi`` from the chord, from symbols of window +-``width``, (..., )."""
+    cols = np.arange(lo + width, hi + width + 1)
+    return symbols[..., cols] @ (radix ** np.arange(len(cols), dtype=np.int64))
+
+
+def _observations(responses: Sequence[Response], width: int, mirror: bool, alphabet: tuple[str, ...],
+                  symmetric: tuple[int, ...]) -> tuple[IntArray, FloatArray, IntArray, FloatArray]:
+    """Symbols of window +-``width`` and elements of every chord (and end), mirrored too.
+
+    Returns chord symbols (N, 2 width + 1), chord values (N, 2 k: turns then lengths), end
+    symbols (M, 2 width + 1) and end turns (M, k).
+    """
+    k = max(1, len(alphabet))
+    k2 = 2 * k
+    syms, values, esyms, ends = [], [], [], []
+    for r in responses:
+        turn, length, end = _elements(r)
+        bits = design_array(r.orientation, alphabet=alphabet, symmetric=symmetric)
+        sym = window_symbols(bits, width, n_types=k)[0]
+        variants = [(sym, 1.0)]
+        if mirror:
+            flipped = np.where(sym < k2, sym ^ 1, sym)
+            variants.append((np.asarray(canonical_codes(flipped, symmetric), dtype=np.int64), -1.0))
+        for s, sign in variants:
+            syms.append(s)
+            values.append(np.concatenate([sign * turn.T, length.T], axis=1))
+            esyms.append(s[-1:])
+            ends.append(sign * end[None, :])
+    return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
+
+
+def _elements(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
+    from pneumorph.models.chainfit import response_elements  # the one definition of a chord's turn and length
+
+    return response_elements(response)
+
+
+def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[dict[int, FloatArray]], FloatArray]:
+    """Additive terms, one table per key array, fitted by backfitting; returns the tables and the fit."""
+    parts = [np.zeros_like(values) for _ in keys]
+    tables: list[dict[int, FloatArray]] = [{} for _ in keys]
+    groups = [np.unique(k, return_inverse=True) for k in keys]
+    for _ in range(ROUNDS if len(keys) > 1 else 1):
+        moved = 0.0
+        for t, (uniq, inv) in enumerate(groups):
+            rest = values - sum(p for s, p in enumerate(parts) if s != t)
+            sums = np.zeros((len(uniq), values.shape[1]))
+            np.add.at(sums, inv, rest)
+            means = sums / np.bincount(inv)[:, None]
+            new = means[inv]
+            moved = max(moved, float(np.abs(new - parts[t]).max()))
+            parts[t] = new
+            tables[t] = dict(zip(uniq.tolist(), means, strict=True))
+        if moved <= SETTLED:
+            break
+    return tables, np.sum(parts, axis=0)
+
+
+def _compile(tables: list[dict[int, FloatArray]], terms: Sequence[tuple[int, int]], symbols: IntArray, width: int,
+             radix: int, what: str) -> FloatArray:
+    """The sum of the terms at every window of ``symbols``; a :class:`ChainTableError` for a key never trained."""
+    total = np.zeros((len(symbols), len(next(iter(tables[0].values())))))
+    for table, (lo, hi) in zip(tables, terms, strict=True):
+        codes = _term_codes(symbols, width, lo, hi, radix)
+        for i, c in enumerate(codes.tolist()):
+            row = table.get(c)
+            if row is None:
+                raise ChainTableError(f"the training designs show no {what} of units {lo:+d} .. {hi:+d} like window "
+                                      f"{symbols[i].tolist()}; train on far_designs()")
+            total[i] += row
+    return total
+
+
+def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
+              symmetric: tuple[int, ...], levels: int, n_units: int) -> dict[str, Any]:
+    """:func:`~pneumorph.models.chainfit.fit_table`'s entries of a window +-w table with far-field terms.
+
+    Fitted at window +-w (:func:`far_terms`) and written out at window +-(w + 1) for every
+    window an actuator of at least ``2w + 3`` units shows.
+
+    Returns
+    -------
+    dict
+        ``codes``, ``turn``, ``length``, ``end_codes``, ``end`` (window +-(w + 1)) and
+        ``spread`` (the largest deviation of the fit from a training chord).
+
+    Raises
+    ------
+    ChainTableError
+        A key of a term that no training design shows.
+    """
+    w = int(window)
+    width = w + 1
+    k = max(1, len(alphabet))
+    radix = 2 * k + 2
+    terms = far_terms(w)
+    syms, values, esyms, ends = _observations(responses, width, mirror, alphabet, symmetric)
+    tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in terms], values)
+    etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in terms], ends)
+    spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
+    n = max(int(n_units), 2 * width + 2)
+    codes = np.union1d(possible_codes(2 * width + 1, width, k), possible_codes(n, width, k))
+    windows = (codes[:, None] // radix ** np.arange(2 * width + 1, dtype=np.int64)) % radix
+    keep = np.all(np.asarray(canonical_codes(windows, symmetric)) == windows, axis=1)
+    codes, windows = codes[keep], windows[keep]
+    chord = _compile(tables, terms, windows, width, radix, "chord")
+    # the windows of a last chord n: units n - w - 1 .. n (or the base), then w + 1 tip symbols
+    last = np.all(windows[:, width + 1:] == radix - 1, axis=1) & (windows[:, width] < radix - 2)
+    end_codes = codes[last]
+    end = _compile(etables, terms, windows[last], width, radix, "end")
+    return {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:], "end_codes": end_codes,
+            "end": end, "spread": spread}
+
+
+__all__ = ["ROUNDS", "SETTLED", "far_designs", "far_means", "far_terms"]

@@ -1,0 +1,119 @@
+"""Chain tables with far-field terms: exact on a chain whose elements are such sums, and on the FE model as
+close as the wider window's table from fewer unit solves."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.errors import ChainTableError
+from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.models.chain import ChainModel
+from pneumorph.models.chainfit import build_table, fit_table
+from pneumorph.models.chainterms import far_designs, far_terms
+from pneumorph.models.fe import RampSpec, Reduced2D
+from pneumorph.models.response import Response
+from pneumorph.models.validation import heldout_designs
+from pneumorph.models.windows import design_array, window_symbols
+
+LEVELS = 3
+PITCH = 10.0
+HEIGHT = (5.0, 2.0)  # undeformed centre height of a unit in orientation 0 and 1
+
+
+def _law(seed: int, w: int) -> dict[tuple[int, int], dict[int, np.ndarray]]:
+    """Random additive terms, turned over with their window: turns change sign, lengths do not."""
+    rng = np.random.default_rng(seed)
+    law: dict[tuple[int, int], dict[int, np.ndarray]] = {}
+    for lo, hi in far_terms(w):
+        width = hi - lo + 1
+        table: dict[int, np.ndarray] = {}
+        for code in range(4**width):
+            digits = [(code // 4**t) % 4 for t in range(width)]
+            mirror = sum((d ^ 1 if d < 2 else d) * 4**t for t, d in enumerate(digits))
+            if mirror in table:
+                turn, length = np.split(table[mirror], 2)
+                table[code] = np.concatenate([-turn, length])
+            elif mirror == code:  # only base and tip symbols: its own mirror, so no turn
+                table[code] = np.concatenate([np.zeros(LEVELS), rng.uniform(-0.2, 0.2, LEVELS)])
+            else:
+                table[code] = np.concatenate([rng.uniform(-0.08, 0.08, LEVELS), rng.uniform(-0.2, 0.2, LEVELS)])
+        law[(lo, hi)] = table
+    return law
+
+
+def _elements(law: dict, design: str, w: int) -> np.ndarray:
+    """Per chord (and the end, last row) the law's turns and lengths, shape (n + 2, 2 levels)."""
+    width = w + 1
+    sym = window_symbols(design_array(design), width)[0]  # (n + 1, 2 width + 1)
+    out = np.zeros((len(sym) + 1, 2 * LEVELS))
+    for (lo, hi), table in law.items():
+        cols = np.arange(lo + width, hi + width + 1)
+        codes = sym[:, cols] @ (4 ** np.arange(len(cols)))
+        values = np.array([table[int(c)] for c in codes])
+        out[:-1] += values
+        out[-1] += values[-1] * 0.5  # the end turn: another sum of the same terms at the last chord
+    out[:-1, LEVELS:] += PITCH
+    return out
+
+
+def _response(law: dict, design: str, w: int) -> Response:
+    n = len(design)
+    bits = [int(c) for c in design]
+    ref = np.array([[(i + 0.5) * PITCH, HEIGHT[b]] for i, b in enumerate(bits)])
+    ref_tip = np.array([n * PITCH, 3.5])
+    e = _elements(law, design, w)
+    turn, length = e[:-1, :LEVELS].T, e[:-1, LEVELS:].T  # (levels, n + 1)
+    angle = np.cumsum(turn, axis=1)
+    steps = np.stack([length * np.cos(angle), length * np.sin(angle)], -1)
+    points = np.array([0.0, ref[0, 1]]) + np.cumsum(steps, axis=1)  # centres 1..n, then the tip
+    curl = np.degrees(angle[:, -1] + e[-1, :LEVELS])
+    return Response(design, np.linspace(0.01, 0.03, LEVELS), points[:, :n], ref, points[:, n], ref_tip, curl,
+                    converged=True, reached=0.03)
+
+
+@pytest.mark.parametrize("w", [1, 2])
+def test_far_terms_are_exact_on_a_chain_of_such_sums(w: int) -> None:
+    """Elements that are a window's term plus the two far-field terms are fitted exactly from far_designs:
+    held-out designs of other lengths to 1e-9 mm (the plain table of the same training is not)."""
+    law = _law(seed=w, w=w)
+    n = 2 * w + 7
+    train = [_response(law, d, w) for d in far_designs(n, w)]
+    source = {"fidelity": "toy", "key": "additive", "n_units": n}
+    far = fit_table(train, w, source, far=True)
+    plain = fit_table(train, w, source)
+    assert far.window == w + 1 and plain.window == w
+    worst_far = worst_plain = 0.0
+    for length in (2 * w + 3, n, n + 6):
+        for design in heldout_designs(length, 6, seed=3):
+            truth = _response(law, design, w)
+            got = ChainModel(far, length).evaluate(design)
+            worst_far = max(worst_far, float(np.abs(got.centres - truth.centres).max()),
+                            float(np.abs(got.tip - truth.tip).max()), float(np.abs(got.curl - truth.curl).max()))
+            other = ChainModel(plain, length).evaluate(design)
+            worst_plain = max(worst_plain, float(np.abs(other.centres - truth.centres).max()))
+    assert worst_far < 1e-9
+    assert worst_plain > 1e-3
+
+
+def test_a_key_no_training_design_shows_is_refused() -> None:
+    law = _law(seed=1, w=1)
+    train = [_response(law, d, 1) for d in far_designs(9, 1) if len(d) == 9]  # without the end designs
+    with pytest.raises(ChainTableError, match="show no"):
+        fit_table(train, 1, {"fidelity": "toy", "key": "additive", "n_units": 9}, far=True)
+
+
+def test_far_terms_on_the_2d_model_match_the_wider_window_from_fewer_unit_solves() -> None:
+    """2D FE (coarse mesh, 12 units, 8 held-out designs): window +-1 with far-field terms (a table of window +-2)
+    against the table of window +-2, both built from short training designs."""
+    model = Reduced2D(12, UnitSpec(element_size=3.0), RampSpec(pressure=0.025))
+    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
+    far = build_table(model, evaluator, first_window=2, max_window=2, far=True, heldout=8)
+    wide = build_table(model, evaluator, window=2, heldout=8, short=True)
+    assert far.metadata["fit"] == "window +-1 with far-field terms (+-2)" and far.window == 2
+    assert far.training == tuple(far_designs(12, 1))
+    assert sum(map(len, far.training)) < 0.75 * sum(map(len, wide.training))
+    assert far.validation["designs"] == wide.validation["designs"]
+    worst_far, worst_wide = max(far.validation["centre_worst_mm"]), max(wide.validation["centre_worst_mm"])
+    assert worst_far <= 2 * worst_wide + 0.005, (worst_far, worst_wide)
