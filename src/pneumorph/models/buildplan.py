@@ -275,7 +275,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     fewest = 0
     fars: list[bool] = []
     try:
-        candidates = fit_candidates(n_units, window, first, MAX_WINDOW, far and types == 1)
+        candidates = fit_candidates(n_units, window, first, MAX_WINDOW, far)
     except ChainTableError:
         candidates = []
     for w, with_far in candidates:

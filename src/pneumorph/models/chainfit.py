@@ -381,7 +381,7 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
     n = int(model.n_units)
     say = on_progress or (lambda text: None)
     library = getattr(model, "library", None)
-    candidates = fit_candidates(n, window, first_window, max_window, far and (library is None or library.is_single))
+    candidates = fit_candidates(n, window, first_window, max_window, far)
     solved: dict[str, Response] = {}
     build = _Build(model, evaluator, tolerance, heldout, seed, short, early, say, solved,
                    _solver(model, evaluator, solved, say), library, _source(model), time.perf_counter())
@@ -429,14 +429,20 @@ def fit_candidates(n: int, window: int | None, first_window: int, max_window: in
     """The tables a build tries in turn: ``(w, far)``, window +-w, with far-field terms if ``far``.
 
     With ``far`` and no fixed ``window``, window ``first - 1`` with far-field terms (a table
-    of window ``first``) comes first, then the plain windows.
+    of window ``first``) comes first, then the plain windows; with a fixed ``window``, that
+    window with far-field terms.
 
     >>> fit_candidates(15, None, 3, far=True), fit_candidates(15, 2, 3, far=True)
-    ([(2, True), (3, False)], [(2, False)])
+    ([(2, True), (3, False)], [(2, True)])
     """
     windows = _windows(n, window, first_window, max_window)
     plain = [(w, False) for w in windows]
-    if far and window is None and windows[0] >= 2:
+    if far and window is not None:
+        if 2 * int(window) + 3 > n:
+            raise ChainTableError(f"far-field terms of window +-{window} make a table of +-{int(window) + 1}: it "
+                                  f"needs training designs of at least {2 * int(window) + 3} units; the model has {n}")
+        return [(int(window), True)]
+    if far and windows[0] >= 2:
         return [(windows[0] - 1, True), *plain]
     return plain
 
@@ -444,8 +450,9 @@ def fit_candidates(n: int, window: int | None, first_window: int, max_window: in
 def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str, ...] = (),
                      symmetric: tuple[int, ...] = ()) -> list[str]:
     """The covering designs of window +-w (:func:`~pneumorph.models.windows.covering_designs`), or with
-    far-field terms :func:`~pneumorph.models.chainterms.far_designs`."""
-    if far:
+    far-field terms :func:`~pneumorph.models.chainterms.far_designs` (one unit type; over several, the
+    covering designs of +-w show every key of the far-field terms many times)."""
+    if far and not alphabet:
         return far_designs(n, w)
     return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short)
 
