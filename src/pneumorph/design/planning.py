@@ -201,7 +201,7 @@ def missing_table_message(config: Any, model: Any, table_dir: str | Path | None,
     ... # doctest: +ELLIPSIS +NORMALIZE_WHITESPACE
     --no-build: no chain table serves the 3d model (the built-in unit, 0.3-3 kPa in 10 levels; source ...): none
     is shipped or kept in tables (the shipped table's levels start at 4.5 kPa); build it with `pneumorph chain
-    build --model 3d --pressure 3 --out tables/chain-3d-....json` (38-52 FE solves, estimated ...), or run without
+    build --model 3d --pressure 3 --out tables/chain-3d-....json` (22-68 FE solves, estimated ...), or run without
     --no-build
     """
     training = model.with_units(TRAINING_UNITS) if callable(getattr(model, "with_units", None)) else model

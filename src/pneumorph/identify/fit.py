@@ -250,7 +250,8 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
              base: dict[str, Any] | None = None, parameters: Sequence[str] = NAMES, seed: int = 0,
              max_iterations: int = MAX_ITERATIONS, on_progress: Callable[[str], None] | None = None,
              table_dir: str | Path | None = None) -> Identification:
-    """Fit ``parameters`` to the scans (see the module docstring).
+    """Fit ``parameters`` to the scans (see the module docstring; a fit solves the FE model many times, so
+    its examples are ``tests/identify/test_fit.py``).
 
     Parameters
     ----------
@@ -264,10 +265,8 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         Further model settings (``fidelity``, ...; not the unit: ``params`` holds it).
     parameters : sequence of str
         The parameters to fit; the others stay at nominal.
-    seed : int
-        Seed of the sample of a scan's points when it has more than :data:`MAX_POINTS`.
-    table_dir : path, optional
-        Chain tables kept beside the evaluation cache, looked in (after the shipped ones) for
+    seed, table_dir : int, path
+        Seed of the sample of a scan's points (over :data:`MAX_POINTS`); kept chain tables, for
         the size check before any solve (:func:`precheck_designs`).
 
     Raises
@@ -276,10 +275,6 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         A solve failed, or the fit did not converge in ``max_iterations``: nothing is identified.
     ScanError
         A scan far from its model's size (unit mistake), or a 3D scan against the 2D model.
-
-    Examples
-    --------
-    See ``tests/identify/test_fit.py`` (a fit solves the FE model several times).
     """
     base = dict(base or {})
     say = on_progress or (lambda text: None)

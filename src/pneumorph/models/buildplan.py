@@ -240,9 +240,8 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         The build learns the end windows from short actuators (``build_table(short=True)``); each
         short design counts as one solve (the estimate takes it at the full length's time).
     first_window, early, far : int, bool, bool
-        As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, whether
-        the validation may stop after :data:`~pneumorph.models.chainfit.MIN_HELDOUT` designs,
-        and whether a narrower window with far-field terms is tried first.
+        As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, an early stop
+        of the validation, a narrower window with far-field terms first.
 
     Raises
     ------
@@ -271,14 +270,11 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     covering: list[int] = []
     solves: list[int] = []
     seen: set[str] = set()
-    first = min(max(1, int(first_window)), max(1, min(MAX_WINDOW, (n_units - 1) // 2)))
+    widest = max(1, min(MAX_WINDOW, (n_units - 1) // 2))
+    first = min(max(1, int(first_window)), widest)
     fewest = 0
     fars: list[bool] = []
-    try:
-        candidates = fit_candidates(n_units, window, first, MAX_WINDOW, far)
-    except ChainTableError:
-        candidates = []
-    for w, with_far in candidates:
+    for w, with_far in fit_candidates(n_units, window, first, widest, far):
         try:
             check_training_size(types, w, len(symmetric))
         except PneumorphError:

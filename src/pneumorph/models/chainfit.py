@@ -22,8 +22,8 @@ from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.chain import ChainTable, source_description, source_key
-from pneumorph.models.chainterms import far_designs, far_means
-from pneumorph.models.response import FloatArray, Response
+from pneumorph.models.chainterms import far_means, fit_text, training_designs
+from pneumorph.models.response import FloatArray, Response, response_elements
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
     MIN_HELDOUT,
@@ -34,7 +34,6 @@ from pneumorph.models.validation import (
     validate_in_rounds,
 )
 from pneumorph.models.windows import (
-    covering_designs,
     design_array,
     design_strings,
     mirror_codes,
@@ -80,29 +79,6 @@ def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
             advice = f"a window of +-1 or {advice}"
         raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {need(n, w)} FE "
                             f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use {advice}")
-
-
-# -- elements of a response -----------------------------------------------------------------
-def _wrap(a: FloatArray) -> FloatArray:
-    return (a + np.pi) % (2 * np.pi) - np.pi
-
-
-def response_elements(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Turns (rad) and lengths (mm) of the ``n + 1`` chords, and the end turn, per level.
-
-    Returns
-    -------
-    turn, length : ndarray, shape (k, n + 1)
-    end : ndarray, shape (k,)
-    """
-    k = response.n_levels
-    pts = np.stack([response.centreline(i) for i in range(k)])  # (k, n + 2, 2)
-    chords = np.diff(pts, axis=1)
-    angle = np.unwrap(np.arctan2(chords[..., 1], chords[..., 0]), axis=-1)
-    turn = np.diff(angle, axis=-1, prepend=0.0)
-    length = np.hypot(chords[..., 0], chords[..., 1])
-    end = _wrap(np.radians(response.curl) - angle[:, -1])
-    return turn, length, end
 
 
 # -- fitting --------------------------------------------------------------------------------
@@ -445,21 +421,6 @@ def fit_candidates(n: int, window: int | None, first_window: int, max_window: in
     if far and windows[0] >= 2:
         return [(windows[0] - 1, True), *plain]
     return plain
-
-
-def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str, ...] = (),
-                     symmetric: tuple[int, ...] = ()) -> list[str]:
-    """The covering designs of window +-w (:func:`~pneumorph.models.windows.covering_designs`), or with
-    far-field terms :func:`~pneumorph.models.chainterms.far_designs` (one unit type; over several, the
-    covering designs of +-w show every key of the far-field terms many times)."""
-    if far and not alphabet:
-        return far_designs(n, w)
-    return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short)
-
-
-def fit_text(w: int, far: bool) -> str:
-    """``window +-2 with far-field terms (+-3)`` or ``window +-3``."""
-    return f"window +-{w} with far-field terms (+-{w + 1})" if far else f"window +-{w}"
 
 
 @dataclass(frozen=True)

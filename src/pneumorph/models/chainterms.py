@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError
-from pneumorph.models.response import Response
+from pneumorph.models.response import Response, response_elements
 from pneumorph.models.windows import (
     canonical_codes,
     covering_designs,
@@ -80,6 +80,21 @@ def far_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -
     return end_designs(w, mirror, units=max(2 * w, w + 2)) + interior
 
 
+def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str, ...] = (),
+                     symmetric: tuple[int, ...] = ()) -> list[str]:
+    """The covering designs of window +-w (:func:`~pneumorph.models.windows.covering_designs`), or with
+    far-field terms :func:`~pneumorph.models.chainterms.far_designs` (one unit type; over several, the
+    covering designs of +-w show every key of the far-field terms many times)."""
+    if far and not alphabet:
+        return far_designs(n, w)
+    return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short)
+
+
+def fit_text(w: int, far: bool) -> str:
+    """``window +-2 with far-field terms (+-3)`` or ``window +-3``."""
+    return f"window +-{w} with far-field terms (+-{w + 1})" if far else f"window +-{w}"
+
+
 def _term_codes(symbols: IntArray, width: int, lo: int, hi: int, radix: int) -> IntArray:
     """Codes of the units ``lo .. hi`` from the chord, from symbols of window +-``width``, (..., )."""
     cols = np.arange(lo + width, hi + width + 1)
@@ -97,7 +112,7 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     k2 = 2 * k
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
-        turn, length, end = _elements(r)
+        turn, length, end = response_elements(r)
         bits = design_array(r.orientation, alphabet=alphabet, symmetric=symmetric)
         sym = window_symbols(bits, width, n_types=k)[0]
         variants = [(sym, 1.0)]
@@ -110,12 +125,6 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
             esyms.append(s[-1:])
             ends.append(sign * end[None, :])
     return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
-
-
-def _elements(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
-    from pneumorph.models.chainfit import response_elements  # the one definition of a chord's turn and length
-
-    return response_elements(response)
 
 
 def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[dict[int, FloatArray]], FloatArray]:
@@ -195,4 +204,4 @@ def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet
             "end": end, "spread": spread}
 
 
-__all__ = ["ROUNDS", "SETTLED", "far_designs", "far_means", "far_terms"]
+__all__ = ["ROUNDS", "SETTLED", "far_designs", "far_means", "far_terms", "fit_text", "training_designs"]

@@ -223,3 +223,25 @@ class ActuatorModel(Protocol):
     def pressures(self) -> FloatArray: ...
 
     def evaluate(self, orientation: str) -> Response: ...
+
+
+def _wrap(a: FloatArray) -> FloatArray:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def response_elements(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Turns (rad) and lengths (mm) of the ``n + 1`` chords, and the end turn, per level.
+
+    Returns
+    -------
+    turn, length : ndarray, shape (k, n + 1)
+    end : ndarray, shape (k,)
+    """
+    k = response.n_levels
+    pts = np.stack([response.centreline(i) for i in range(k)])  # (k, n + 2, 2)
+    chords = np.diff(pts, axis=1)
+    angle = np.unwrap(np.arctan2(chords[..., 1], chords[..., 0]), axis=-1)
+    turn = np.diff(angle, axis=-1, prepend=0.0)
+    length = np.hypot(chords[..., 0], chords[..., 1])
+    end = _wrap(np.radians(response.curl) - angle[:, -1])
+    return turn, length, end
