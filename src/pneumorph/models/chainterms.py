@@ -21,8 +21,8 @@ The training needs every key of the three terms: the end windows of +-w (actuato
 ``2w`` units, :func:`~pneumorph.models.windows.end_designs`) and the interior windows of
 +-(w + 1) on full-length actuators (:func:`far_designs`). Measured on the built-in unit with
 a 2.5 mm layer (3D, 15 units, the 20 held-out designs of its table): window +-2 alone is off
-by 0.196 mm, the far-field terms on the same model type by 0.0077 mm, the table of window
-+-3 by 0.0085 mm, trained on 167 unit solves instead of 312 (docs/chain-model.md).
+by 0.196 mm, with far-field terms 0.0077 mm, the table of window
++-3 by 0.0085 mm, trained on 167 unit solves instead of 327 (docs/chain-model.md).
 """
 
 from __future__ import annotations
