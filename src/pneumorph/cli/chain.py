@@ -56,8 +56,8 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
           as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
-    The shipped tables of the built-in unit are regenerated with
-    `pneumorph chain build --model 3d --out src/pneumorph/models/data/chain-3d.json` (and 2d).
+    The shipped tables of the built-in unit are regenerated with `pneumorph chain build --model 3d --window 3
+    --all-heldout --out src/pneumorph/models/data/chain-3d.json` (and 2d with --window 2).
     """
     from pathlib import Path
 
