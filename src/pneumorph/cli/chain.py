@@ -66,7 +66,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pneumorph.io.files import all_or_nothing_file
     from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chainfit import build_table
-    from pneumorph.models.chaintables import build_options, start_window
+    from pneumorph.models.chaintables import build_options
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
@@ -89,9 +89,10 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
     evaluator = open_evaluator(executor, workers, scheduler, cache)
     try:
+        defaults = build_options(model)  # the first window and far-field terms a build on first use would take
         options: dict[str, Any] = {"heldout": heldout, "window": window, "tolerance": tolerance, "short": short,
-                   "first_window": start_window(model), "early": not all_heldout,
-                   "far": build_options(model)["far"] if far is None else far}
+                   "first_window": defaults["first_window"], "early": not all_heldout,
+                   "far": defaults["far"] if far is None else far}
         plan = build_plan(model, workers=evaluator_workers(evaluator), cached=cached_counter(evaluator, model),
                           **options)
         click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve

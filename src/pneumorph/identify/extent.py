@@ -61,11 +61,12 @@ def rigid_units(mesh: ActuatorMesh, response: Any, level: int = -1) -> FloatArra
     the turns of its two chords (base -> centre 1 -> ... -> centre n -> tip); the base block
     stays, an end cap follows the last unit.
     """
-    ref_c, ref_tip = np.asarray(response.reference_centres), np.asarray(response.reference_tip)
-    cur_c, cur_tip = np.asarray(response.centres[level]), np.asarray(response.tip[level])
-    base = np.array([0.0, ref_c[0, 1]])
-    chord_turns = _angles(np.vstack([base, cur_c, cur_tip])) - _angles(np.vstack([base, ref_c, ref_tip]))
-    turn = 0.5 * (chord_turns[:-1] + chord_turns[1:])
+    current = response.centreline(level)  # base -> centres -> tip
+    ref_c = np.asarray(response.reference_centres)
+    reference = np.vstack([current[:1], ref_c, np.asarray(response.reference_tip)[None]])
+    rotation = _angles(current) - _angles(reference)  # of every chord
+    turn = 0.5 * (rotation[:-1] + rotation[1:])
+    cur_c = current[1:-1]
     units = mesh.units or tuple(mesh.spec for _ in range(len(ref_c)))
     starts = unit_starts(units)
     x = mesh.points

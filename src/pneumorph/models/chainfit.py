@@ -343,8 +343,8 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
     far : bool
         Without a fixed ``window``, try first the window one narrower than ``first_window``
         with far-field terms (:mod:`pneumorph.models.chainterms`: a table of window
-        ``first_window`` from end windows of the narrower one; :func:`fit_candidates`). One
-        unit type only.
+        ``first_window`` from end windows of the narrower one); with a fixed ``window``, that
+        window with far-field terms (:func:`fit_candidates`).
 
     Raises
     ------

@@ -40,6 +40,7 @@ from pneumorph.models.windows import (
     covering_designs,
     design_array,
     end_designs,
+    mirror_symbols,
     possible_codes,
     window_symbols,
 )
@@ -109,16 +110,12 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     symbols (M, 2 width + 1) and end turns (M, k).
     """
     k = max(1, len(alphabet))
-    k2 = 2 * k
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
         turn, length, end = response_elements(r)
         bits = design_array(r.orientation, alphabet=alphabet, symmetric=symmetric)
         sym = window_symbols(bits, width, n_types=k)[0]
-        variants = [(sym, 1.0)]
-        if mirror:
-            flipped = np.where(sym < k2, sym ^ 1, sym)
-            variants.append((np.asarray(canonical_codes(flipped, symmetric), dtype=np.int64), -1.0))
+        variants = [(sym, 1.0)] + ([(mirror_symbols(sym, k, symmetric), -1.0)] if mirror else [])
         for s, sign in variants:
             syms.append(s)
             values.append(np.concatenate([sign * turn.T, length.T], axis=1))
@@ -127,13 +124,15 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
 
 
-def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[dict[int, FloatArray]], FloatArray]:
-    """Additive terms, one table per key array, fitted by backfitting; returns the tables and the fit."""
+def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[tuple[IntArray, FloatArray]], FloatArray]:
+    """Additive terms, one per key array, fitted by backfitting; returns each term's (sorted keys, values) and the
+    fit."""
     parts = [np.zeros_like(values) for _ in keys]
-    tables: list[dict[int, FloatArray]] = [{} for _ in keys]
     groups = [np.unique(k, return_inverse=True) for k in keys]
+    tables: list[tuple[IntArray, FloatArray]] = []
     for _ in range(ROUNDS if len(keys) > 1 else 1):
         moved = 0.0
+        tables = []
         for t, (uniq, inv) in enumerate(groups):
             rest = values - sum(p for s, p in enumerate(parts) if s != t)
             sums = np.zeros((len(uniq), values.shape[1]))
@@ -142,24 +141,24 @@ def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[dict[int, F
             new = means[inv]
             moved = max(moved, float(np.abs(new - parts[t]).max()))
             parts[t] = new
-            tables[t] = dict(zip(uniq.tolist(), means, strict=True))
+            tables.append((uniq, means))
         if moved <= SETTLED:
             break
     return tables, np.sum(parts, axis=0)
 
 
-def _compile(tables: list[dict[int, FloatArray]], terms: Sequence[tuple[int, int]], symbols: IntArray, width: int,
-             radix: int, what: str) -> FloatArray:
+def _compile(tables: list[tuple[IntArray, FloatArray]], terms: Sequence[tuple[int, int]], symbols: IntArray,
+             width: int, radix: int, what: str) -> FloatArray:
     """The sum of the terms at every window of ``symbols``; a :class:`ChainTableError` for a key never trained."""
-    total = np.zeros((len(symbols), len(next(iter(tables[0].values())))))
-    for table, (lo, hi) in zip(tables, terms, strict=True):
+    total = np.zeros((len(symbols), tables[0][1].shape[1]))
+    for (keys, means), (lo, hi) in zip(tables, terms, strict=True):
         codes = _term_codes(symbols, width, lo, hi, radix)
-        for i, c in enumerate(codes.tolist()):
-            row = table.get(c)
-            if row is None:
-                raise ChainTableError(f"the training designs show no {what} of units {lo:+d} .. {hi:+d} like window "
-                                      f"{symbols[i].tolist()}; train on far_designs()")
-            total[i] += row
+        rows = np.minimum(np.searchsorted(keys, codes), len(keys) - 1)
+        missing = np.flatnonzero(keys[rows] != codes)
+        if missing.size:
+            raise ChainTableError(f"the training designs show no {what} of units {lo:+d} .. {hi:+d} like window "
+                                  f"{symbols[missing[0]].tolist()}; train on far_designs()")
+        total += means[rows]
     return total
 
 
@@ -168,7 +167,7 @@ def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet
     """:func:`~pneumorph.models.chainfit.fit_table`'s entries of a window +-w table with far-field terms.
 
     Fitted at window +-w (:func:`far_terms`) and written out at window +-(w + 1) for every
-    window an actuator of at least ``2w + 3`` units shows.
+    window an actuator of at least ``2w + 3`` units shows (any such length shows the same ones).
 
     Returns
     -------
@@ -190,8 +189,7 @@ def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet
     tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in terms], values)
     etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in terms], ends)
     spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
-    n = max(int(n_units), 2 * width + 2)
-    codes = np.union1d(possible_codes(2 * width + 1, width, k), possible_codes(n, width, k))
+    codes = possible_codes(max(int(n_units), 2 * width + 1), width, k)  # every window of any longer actuator too
     windows = (codes[:, None] // radix ** np.arange(2 * width + 1, dtype=np.int64)) % radix
     keep = np.all(np.asarray(canonical_codes(windows, symmetric)) == windows, axis=1)
     codes, windows = codes[keep], windows[keep]

@@ -234,18 +234,26 @@ def window_codes(bits: NDArray[np.integer], window: int, chords: Sequence[int] |
     return sym @ weights
 
 
+def mirror_symbols(symbols: NDArray[np.integer], n_types: int = 1, symmetric: Sequence[int] = ()) -> IntArray:
+    """Symbols with every unit turned over (``2t <-> 2t + 1``; base and tip kept; a ``symmetric`` type stays ``2t``).
+
+    >>> mirror_symbols(np.array([2, 0, 1, 3])).tolist()
+    [2, 1, 0, 3]
+    """
+    s = np.asarray(symbols, dtype=np.int64)
+    return np.asarray(canonical_codes(np.where(s < 2 * int(n_types), s ^ 1, s), symmetric), dtype=np.int64)
+
+
 def mirror_codes(codes: IntArray, window: int, n_types: int = 1, symmetric: Sequence[int] = ()) -> IntArray:
     """Codes of the mirrored windows (every unit turned over: ``2t <-> 2t + 1``; base and tip kept).
 
     A unit of a ``symmetric`` type turned over is itself (code ``2t``).
     """
     codes = np.asarray(codes, dtype=np.int64)
-    radix, k2 = 2 * int(n_types) + 2, 2 * int(n_types)
+    radix = 2 * int(n_types) + 2
     out = np.zeros_like(codes)
     for t in range(2 * window + 1):
-        s = (codes // radix**t) % radix
-        s = canonical_codes(np.where(s < k2, s ^ 1, s), symmetric)
-        out += s * radix**t
+        out += mirror_symbols((codes // radix**t) % radix, n_types, symmetric) * radix**t
     return out
 
 
@@ -376,8 +384,9 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     index = np.searchsorted(needed, canon)
     chosen = _greedy_cover(index, len(needed), None, n)
     restarts = min(COVER_RESTARTS, COVER_RESTART_WORK // (len(chosen) * index.size))
+    fewest = _fewest_cover(index) if restarts else 0
     for _ in range(restarts):
-        if len(chosen) <= _fewest_cover(index):
+        if len(chosen) <= fewest:
             break
         other = _greedy_cover(index, len(needed), rng, n)
         chosen = other if len(other) < len(chosen) else chosen
