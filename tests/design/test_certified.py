@@ -14,7 +14,7 @@ from pneumorph.design.certified import (
     objective_bounds,
     score_designs,
 )
-from pneumorph.design.reach import _cos_range, _sin_range
+from pneumorph.design.reachbox import _cos_range, _sin_range
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror

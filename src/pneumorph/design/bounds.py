@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.design.fitness import profile_error_array, tip_value_array
-from pneumorph.design.reach import CurveRange
+from pneumorph.design.rest import CurveRange
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel

@@ -27,7 +27,9 @@ from pneumorph.design.bounds import (
 )
 from pneumorph.design.fitness import tip_value_array
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry, depths, seed_prefixes, tip_and_curl
-from pneumorph.design.reach import CurveRange, box_bound, profile_rest, reach_of, tip_goal_rest
+from pneumorph.design.reach import reach_of
+from pneumorph.design.reachbox import box_bound
+from pneumorph.design.rest import CurveRange, profile_rest, tip_goal_rest
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel
@@ -268,7 +270,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     Designs grow unit by unit, sharing their prefixes: a prefix of ``p`` units fixes the
     chords whose windows it covers, hence the first centres and the partial sums of Eq 4.1
     (which only grow), or the point where the remaining chords start (the tip then stays in
-    the box they can reach, :func:`~pneumorph.design.reach.box_bound`). Prefixes whose bound reaches ``threshold`` are
+    the box they can reach, :func:`~pneumorph.design.reachbox.box_bound`). Prefixes whose bound
+    reaches ``threshold`` are
     dropped (branch-and-bound); with no threshold this enumerates all ``2^n`` designs at
     about two chord placements per design. With ``beam``, only the ``beam`` prefixes of
     lowest bound are kept at every depth (a heuristic: no longer every design below the

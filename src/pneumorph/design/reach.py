@@ -31,12 +31,21 @@ because ``u`` is a non-negative combination of ``u_1`` and ``u_2``. Every shifte
 in the recursion and every query reads the grid through this inequality, so each value is an
 upper bound of the true support (never below it: the bound is *admissible*; it is loose by
 about ``R delta^2 / 8`` per step for a set of radius ``R``). Values are kept in float32,
-rounded up.
+rounded up. The programme runs level by level; each level's step is prepared once
+(:class:`_Kernel`: the shifted grid indices and weights of every window), so a step is two
+gathers, a sum and a grouped maximum.
 
-From the support in the four axis directions follows a box holding a centre or the tip; a
-profile target's term at that centre is at least the gap between the box's heights and the
-target's heights over the box's x range (:class:`CurveRange`), and a tip goal's value is at
-least the box's, or the distance from a point to the hull (:func:`tip_goal_bound`).
+A table of many windows (four unit types at window +-3: 823,543 windows of units) would
+need ``windows x levels x N`` values per step. Past :data:`MAX_ROWS` windows per level, the
+windows of one state pair whose turns fall in one bin of width ``eps`` are merged into a
+*cluster*, read at its middle turn ``t_c`` and mean length and widened so that it still
+bounds each of its windows from above: ``L cos(phi - t) <= L_c cos(phi - t_c) + dL + L eps / 2``
+and ``h(phi - t) <= h(phi - t_c) + R eps / 2``, since a support function moves by at most
+the set's greatest norm ``R`` per radian (``R <= max h / cos(delta / 2)`` on the grid). The
+bound stays admissible and is looser by about ``R eps / 2`` per step.
+
+From the support in the four axis directions follows a box holding a centre or the tip;
+:mod:`pneumorph.design.rest` turns the boxes into bounds on a profile's or a tip goal's cost.
 
 Examples
 --------
@@ -47,21 +56,18 @@ Examples
 >>> chain = ChainModel(find_table(make_model(15, {"fidelity": "2d"})), 15)
 >>> r = reach_of(chain, "centre")
 >>> r.memory, r.directions, len(r.centre), len(r.tip)
-(4, 360, 16, 0)
+(4, 360, 7, 0)
 """
 
 from __future__ import annotations
 
 import threading
 import weakref
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.targets import Objective, TipGoal
 from pneumorph.models.chain import ChainModel, ChainTable
 from pneumorph.models.windows import ends
 
@@ -76,7 +82,15 @@ MAX_STATES = 128
 AHEAD = 6
 #: what a kept float32 value may lie below the float64 it rounds (mm): added back at every query
 _ROUND = 1e-4
-_EMPTY = -1e30
+#: the support of an empty set (no window leaves the state)
+EMPTY = -1e30
+#: most chord rows per level the programme steps over; a table with more windows merges those of
+#: one state pair and close turns into clusters (:func:`_clusters`)
+MAX_ROWS = 60_000
+#: turn widths (rad) of the clusters, tried in order until the rows fit
+CLUSTER_WIDTHS = (2.5e-4, 5e-4, 1e-3, 2e-3, 4e-3, 8e-3)
+#: full states whose tip supports are formed at once
+_CHUNK = 8192
 
 
 def memory_of(table: ChainTable, max_states: int = MAX_STATES) -> int:
@@ -169,7 +183,7 @@ class Reach:
             h1 = values[s, lev, ji].astype(np.float64)
             h2 = values[s, lev, (ji + 1) % n].astype(np.float64)
             v = wa * h1 + wb * h2 + _ROUND
-            out.append(np.where((h1 <= _EMPTY / 2) | (h2 <= _EMPTY / 2), _EMPTY, v))
+            out.append(np.where((h1 <= EMPTY / 2) | (h2 <= EMPTY / 2), EMPTY, v))
         return out[0] if fan == 1 else np.stack(out)
 
     def box(self, which: str, a: int, state: IntArray, point: FloatArray, heading: FloatArray
@@ -180,25 +194,9 @@ class Reach:
         return x - west, x + east, y - south, y + north
 
 
-def _shifted(prev: NDArray[np.float64], rows_next: IntArray, turn: FloatArray, delta: float) -> FloatArray:
-    """``prev[s'](phi - t)`` on the grid, bounded from above by the wedge, per window row: (R, k, N).
-
-    ``phi_j - t`` lies ``-t / delta`` cells from grid angle ``j`` for every ``j``: one shift and one pair of
-    weights per row and level.
-    """
-    n = prev.shape[-1]
-    start, wa, wb = _wedge(prev, -turn, delta)
-    doubled = np.concatenate([prev, prev[..., :1 + n]], axis=-1)  # (S, k, 2n + 1): any run of n + 1 is a slice
-    runs = np.lib.stride_tricks.sliding_window_view(doubled, n + 1, axis=-1)  # (S, k, n + 1, n + 1)
-    block = runs[rows_next[:, None], np.arange(prev.shape[1])[None, :], start]  # (R, k, n + 1)
-    src, nxt = block[..., :n], block[..., 1:]
-    out = wa[:, :, None] * src + wb[:, :, None] * nxt
-    return np.where((src <= _EMPTY / 2) | (nxt <= _EMPTY / 2), _EMPTY, out)
-
-
 def _reduce(values: FloatArray, state: IntArray, n_states: int) -> FloatArray:
-    """Greatest value per state: rows grouped by ``state``; ``_EMPTY`` where a state has none."""
-    out = np.full((n_states, *values.shape[1:]), _EMPTY)
+    """Greatest value per state: rows grouped by ``state``; ``EMPTY`` where a state has none."""
+    out = np.full((n_states, *values.shape[1:]), EMPTY)
     order = np.argsort(state, kind="stable")
     s = state[order]
     starts = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])
@@ -213,8 +211,162 @@ def _round_up(values: FloatArray) -> NDArray[np.float32]:
     return np.where(out < values, np.nextafter(out, np.float32(np.inf)), out).astype(np.float32)
 
 
+@dataclass(frozen=True)
+class _Rows:
+    """The chords of one level the programme steps over: windows, or clusters of windows sharing a state.
+
+    A cluster holds windows of one ``(before, after)`` state pair whose turns lie within
+    ``turn +- half`` and lengths within ``length +- spread``; a single window has ``half`` and
+    ``spread`` zero.
+    """
+
+    before: IntArray
+    after: IntArray
+    turn: FloatArray
+    length: FloatArray
+    half: FloatArray
+    spread: FloatArray
+    top: FloatArray  # the greatest turn of the cluster (the curl's bound)
+
+
+def _clusters(pair: IntArray, before: IntArray, after: IntArray, turn: FloatArray, length: FloatArray,
+              max_rows: int) -> _Rows:
+    """The windows of one level as they are, or, past ``max_rows``, merged into clusters of close turns.
+
+    The clusters are the windows of one state pair (``pair``) whose turns fall in one bin of
+    width ``eps``, the first of :data:`CLUSTER_WIDTHS` that leaves at most ``max_rows`` rows.
+    """
+    if len(turn) <= max_rows:
+        zero = np.zeros(len(turn))
+        return _Rows(before, after, turn, length, zero, zero, turn)
+    for eps in CLUSTER_WIDTHS:
+        key = pair * 1_000_000 + np.floor(turn / eps).astype(np.int64)
+        uniq, inverse = np.unique(key, return_inverse=True)
+        if len(uniq) <= max_rows or eps == CLUSTER_WIDTHS[-1]:
+            break
+    n = len(uniq)
+    t_lo, t_hi, l_lo, l_hi = np.full(n, np.inf), np.full(n, -np.inf), np.full(n, np.inf), np.full(n, -np.inf)
+    np.minimum.at(t_lo, inverse, turn)
+    np.maximum.at(t_hi, inverse, turn)
+    np.minimum.at(l_lo, inverse, length)
+    np.maximum.at(l_hi, inverse, length)
+    first = np.zeros(n, dtype=np.int64)
+    first[inverse[::-1]] = np.arange(len(turn))[::-1]
+    return _Rows(before[first], after[first], (t_lo + t_hi) / 2, (l_lo + l_hi) / 2, (t_hi - t_lo) / 2,
+                 (l_hi - l_lo) / 2, t_hi)
+
+
+@dataclass(frozen=True)
+class _Kernel:
+    """One level's step of the programme, prepared once: ``h'(s) = max over rows of [base + shifted prev]``.
+
+    ``base`` (R, N) is ``L cos(phi - t)`` with the cluster's widening; ``src`` and ``nxt``
+    (R, N) index the flattened ``prev`` (S * N) at the two grid angles around ``phi - t``
+    (state ``s'`` of the row), with the wedge's weights ``wa``, ``wb`` (R, 1). Rows are sorted
+    by the state before them (``starts``, ``states``: the runs of one state).
+    """
+
+    base: FloatArray
+    src: IntArray
+    nxt: IntArray
+    wa: FloatArray
+    wb: FloatArray
+    after: IntArray
+    half: FloatArray
+    starts: IntArray
+    states: IntArray
+    top: FloatArray
+    delta: float
+
+    @classmethod
+    def of(cls, rows: _Rows, directions: int) -> _Kernel:
+        """The kernel of one level's rows (see :class:`_Rows`).
+
+        A cluster is read at its middle turn and widened: the length term by its spread and
+        ``L half`` (``L cos`` moves by at most ``L`` per radian of ``t``); the support term is
+        widened at each step by ``R half`` (:meth:`step`).
+        """
+        order = np.argsort(rows.before, kind="stable")
+        before = rows.before[order]
+        t, length, half = rows.turn[order], rows.length[order], rows.half[order]
+        delta = 2 * np.pi / directions
+        grid = np.arange(directions, dtype=np.float64) * delta
+        base = length[:, None] * np.cos(grid[None, :] - t[:, None]) + (rows.spread[order] + (length + rows.spread[
+            order]) * half)[:, None]
+        start, wa, wb = _wedge(np.empty(directions), -t, delta)
+        index = (start[:, None] + np.arange(directions)[None, :]) % directions
+        after = rows.after[order]
+        src = after[:, None] * directions + index
+        nxt = after[:, None] * directions + (index + 1) % directions
+        starts = np.flatnonzero(np.r_[True, before[1:] != before[:-1]])
+        return cls(base, src, nxt, wa[:, None], wb[:, None], after, half, starts, before[starts],
+                   rows.top[order], delta)
+
+    def step(self, prev: FloatArray) -> FloatArray:
+        """The next support (S, N) from ``prev`` (S, N); ``EMPTY`` for states no row leaves.
+
+        A row widened by ``half`` also adds ``R half``, ``R`` the greatest norm of the set of
+        ``s'`` (no less than ``max h``: a support function moves by at most ``R |d phi|``; the
+        grid's wedge bound of ``max h`` is ``max h_j / cos(delta / 2)``).
+        """
+        flat = prev.ravel()
+        vals = self.base + self.wa * flat[self.src] + self.wb * flat[self.nxt]
+        if self.half.any():
+            radius = np.maximum(prev.max(axis=-1), 0.0) / np.cos(self.delta / 2)
+            vals += (radius[self.after] * self.half)[:, None]
+        vals[prev[self.after, 0] <= EMPTY / 2] = EMPTY
+        out = np.full(prev.shape, EMPTY)
+        if len(self.starts):
+            out[self.states] = np.maximum.reduceat(vals, self.starts, axis=0)
+        return out
+
+    def turn(self, prev: FloatArray) -> FloatArray:
+        """The greatest summed turn (S,) after one more chord, from ``prev`` (S,)."""
+        vals = np.where(prev[self.after] <= EMPTY / 2, EMPTY, self.top + prev[self.after])
+        out = np.full(prev.shape, EMPTY)
+        if len(self.starts):
+            out[self.states] = np.maximum.reduceat(vals, self.starts)
+        return out
+
+
+def _tip_start(table: ChainTable, m: int, grid: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Support of the last ``w`` chords' displacement (S, k, N) and their summed turn with the end turn (S, k).
+
+    Per full state (the ``2w`` units before the tip), reduced to the ``m`` units kept, in chunks.
+    """
+    w, k = table.window, table.n_types
+    c, b = 2 * k, 2 * k + 2
+    n_states = c**m
+    tip_sym = ends(k)[1]
+    unit = (_digits(table.codes, b, 2 * w + 1) < c).all(axis=1)
+    full = np.unique(table.codes[unit] % b ** (2 * w))
+    disp = np.zeros((len(full), table.n_levels, 2))
+    angle = np.zeros((len(full), table.n_levels))
+    ok = np.ones(len(full), dtype=bool)
+    window = last = full.copy()
+    for _ in range(w):
+        window = window + tip_sym * b ** (2 * w)
+        rows, found = table.find(window)
+        ok &= found
+        angle = angle + table.turn[rows]
+        disp += table.length[rows][..., None] * np.stack([np.cos(angle), np.sin(angle)], -1)
+        last = window
+        window = window // b
+    erows, found = table.find(last, end=True)
+    ok &= found
+    angle = angle + table.end[erows]
+    fstate = _state_code(_digits(full, b, 2 * w)[:, 2 * w - m:], c)
+    support = np.full((n_states, table.n_levels, len(grid)), EMPTY)
+    for lo in range(0, len(full), _CHUNK):
+        part = slice(lo, lo + _CHUNK)
+        tip0 = disp[part, :, 0, None] * np.cos(grid) + disp[part, :, 1, None] * np.sin(grid)
+        tip0[~ok[part]] = EMPTY
+        support = np.maximum(support, _reduce(tip0, fstate[part], n_states))
+    return support, _reduce(np.where(ok[:, None], angle, EMPTY), fstate, n_states)
+
+
 def build_reach(table: ChainTable, units: int, memory: int | None = None, directions: int = DIRECTIONS,
-                families: tuple[str, ...] = ("centre", "tip")) -> Reach:
+                families: tuple[str, ...] = ("centre", "tip"), max_rows: int = MAX_ROWS) -> Reach:
     """The support functions of a table for up to ``units`` units still to place.
 
     Parameters
@@ -229,62 +381,45 @@ def build_reach(table: ChainTable, units: int, memory: int | None = None, direct
     families : tuple of str
         Which to compute: ``"centre"`` (profile targets) and/or ``"tip"`` (tip goals, with the
         curl); the other is left empty.
+    max_rows : int
+        Most chord rows per level; a table with more windows steps over clusters of windows of
+        close turns (:func:`_clusters`: a wider, still admissible bound).
     """
     w, k = table.window, table.n_types
     c = 2 * k
-    b = c + 2
-    tip_sym = ends(k)[1]
     m = memory_of(table) if memory is None else int(memory)
     if not 1 <= m <= 2 * w:
         raise ValueError(f"the state holds 1 to {2 * w} units, got {m}")
     n_states = c**m
     delta = 2 * np.pi / directions
-    grid = np.arange(directions) * delta
-    digits = _digits(table.codes, b, 2 * w + 1)
-    unit = (digits < c).all(axis=1)
-    ud = digits[unit]
+    grid: FloatArray = np.arange(directions, dtype=np.float64) * delta
+    ud = _digits(table.codes, c + 2, 2 * w + 1)
+    unit = (ud < c).all(axis=1)
+    ud = ud[unit]
     before = _state_code(ud[:, 2 * w - m: 2 * w], c)
     after = _state_code(ud[:, 2 * w - m + 1:], c)
+    pair = _state_code(ud[:, 2 * w - m:], c)
     t_u, l_u = table.turn[unit], table.length[unit]
-    step = l_u[:, :, None] * np.cos(grid[None, None, :] - t_u[:, :, None])  # (R, k, N)
-    kl = table.n_levels
-    seqs: dict[str, list[FloatArray]] = {}
-    turn: list[FloatArray] = []
+    kl, steps = table.n_levels, int(units) + 1
+    seqs: dict[str, FloatArray] = {}
+    turn = np.zeros((0, n_states, kl))
     if "centre" in families:
-        seqs["centre"] = [np.zeros((n_states, kl, directions))]
+        seqs["centre"] = np.full((steps, n_states, kl, directions), EMPTY)
+        seqs["centre"][0] = 0.0
     if "tip" in families:
-        # the last w chords (tip windows, no choice): displacement and summed turn per full state
-        full = np.unique(table.codes[unit] % b ** (2 * w))
-        disp = np.zeros((len(full), kl, 2))
-        angle = np.zeros((len(full), kl))
-        ok = np.ones(len(full), dtype=bool)
-        window = full.copy()
-        last = window
-        for _ in range(w):
-            window = window + tip_sym * b ** (2 * w)
-            rows, found = table.find(window)
-            ok &= found
-            angle = angle + table.turn[rows]
-            disp += table.length[rows][..., None] * np.stack([np.cos(angle), np.sin(angle)], -1)
-            last = window
-            window = window // b
-        erows, found = table.find(last, end=True)
-        ok &= found
-        angle = angle + table.end[erows]
-        fstate = _state_code(_digits(full, b, 2 * w)[:, 2 * w - m:], c)
-        tip0 = disp[..., 0][..., None] * np.cos(grid) + disp[..., 1][..., None] * np.sin(grid)
-        tip0[~ok] = _EMPTY
-        seqs["tip"] = [_reduce(tip0, fstate, n_states)]
-        turn = [_reduce(np.where(ok[:, None], angle, _EMPTY), fstate, n_states)]
-    for _ in range(1, int(units) + 1):
+        seqs["tip"] = np.full((steps, n_states, kl, directions), EMPTY)
+        seqs["tip"][0], turn0 = _tip_start(table, m, grid)
+        turn = np.full((steps, n_states, kl), EMPTY)
+        turn[0] = turn0
+    for lev in range(kl):
+        kernel = _Kernel.of(_clusters(pair, before, after, t_u[:, lev], l_u[:, lev], max_rows), directions)
         for seq in seqs.values():
-            vals = step + _shifted(seq[-1], after, t_u, delta)
-            seq.append(_reduce(np.where(vals <= _EMPTY / 2, _EMPTY, vals), before, n_states))
-        if turn:
-            nxt = t_u + turn[-1][after]
-            turn.append(_reduce(np.where(turn[-1][after] <= _EMPTY / 2, _EMPTY, nxt), before, n_states))
-    return Reach(m, c, directions, tuple(_round_up(v) for v in seqs.get("centre", [])),
-                 tuple(_round_up(v) for v in seqs.get("tip", [])), np.asarray(turn))
+            for a in range(1, len(seq)):
+                seq[a, :, lev] = kernel.step(seq[a - 1, :, lev])
+        for a in range(1, len(turn)):
+            turn[a, :, lev] = kernel.turn(turn[a - 1, :, lev])
+    return Reach(m, c, directions, tuple(_round_up(v) for v in seqs.get("centre", ())),
+                 tuple(_round_up(v) for v in seqs.get("tip", ())), turn)
 
 
 _REACH: weakref.WeakKeyDictionary[ChainModel, dict[str, Reach]] = weakref.WeakKeyDictionary()
@@ -300,201 +435,12 @@ def reach_of(chain: ChainModel, family: str) -> Reach:
         hit = _REACH.get(chain, {}).get(family)
     if hit is not None:
         return hit
-    out = build_reach(chain.table, chain.n_units, families=(family,))
+    units = min(chain.n_units, AHEAD) if family == "centre" else chain.n_units  # the profile bound looks AHEAD
+    out = build_reach(chain.table, units, families=(family,))
     with _LOCK:
         _REACH.setdefault(chain, {})[family] = out
     return out
 
 
-@dataclass(frozen=True)
-class CurveRange:
-    """Least and greatest value of ``y = f(x)`` over x intervals, from a fine grid and the slope.
-
-    A sparse table of the grid's minima and maxima over runs of ``2^i`` points answers an
-    interval in two look-ups; ``slope * step / 2`` covers the curve between grid points.
-    """
-
-    lo: float
-    step: float
-    slack: float
-    mins: tuple[FloatArray, ...]
-    maxs: tuple[FloatArray, ...]
-
-    @classmethod
-    def of(cls, f: Callable[[FloatArray], FloatArray], lo: float, hi: float, slope: float,
-           step: float = 0.05) -> CurveRange:
-        x = np.arange(lo, hi + step, step)
-        with np.errstate(all="ignore"):
-            v = np.asarray(f(x), dtype=float)
-        v = np.broadcast_to(v, x.shape)
-        mins = [np.where(np.isfinite(v), v, -np.inf)]
-        maxs = [np.where(np.isfinite(v), v, np.inf)]
-        span = 1
-        while 2 * span <= len(x):
-            mins.append(np.minimum(mins[-1][:-span], mins[-1][span:]))
-            maxs.append(np.maximum(maxs[-1][:-span], maxs[-1][span:]))
-            span *= 2
-        return cls(float(lo), float(step), float(slope) * step / 2 + 1e-9, tuple(mins), tuple(maxs))
-
-    def between(self, x_lo: FloatArray, x_hi: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Least and greatest ``f`` over ``[x_lo, x_hi]`` (arrays of one shape), widened by the slack."""
-        size = len(self.mins[0])
-        i = np.clip(np.floor((x_lo - self.lo) / self.step), 0, size - 1).astype(np.int64)
-        j = np.clip(np.ceil((x_hi - self.lo) / self.step), 0, size - 1).astype(np.int64)
-        j = np.maximum(i, j)
-        level = np.floor(np.log2(j - i + 1)).astype(np.int64)
-        lo = np.full(i.shape, np.inf)
-        hi = np.full(i.shape, -np.inf)
-        for lv in np.unique(level):
-            sel = level == lv
-            span = 1 << int(lv)
-            a, z = i[sel], j[sel] - span + 1
-            lo[sel] = np.minimum(self.mins[lv][a], self.mins[lv][z])
-            hi[sel] = np.maximum(self.maxs[lv][a], self.maxs[lv][z])
-        return lo - self.slack, hi + self.slack
-
-
-def profile_rest(reach: Reach, heights: FloatArray, curve: CurveRange, bits: NDArray[np.integer],
-                 point: FloatArray, heading: FloatArray, placed: int, n_units: int, window: int) -> FloatArray:
-    """A lower bound on the summed squared Eq 4.1 terms of the centres the prefixes have not fixed, (m, k).
-
-    Centre ``i`` (``placed < i <= n - w + 1``: its chords see no tip) lies in the box of the
-    ``i - placed`` chords from the prefixes' point; its term ``f(x) - (y - y_ref)`` is at least
-    the gap between the box's heights (less the unit's undeformed centre height, known for the
-    prefix's units, else its least and greatest) and the target's values over the box's x
-    range. The last ``w - 1`` centres add nothing, nor do those more than :data:`AHEAD` chords
-    ahead (their boxes are wide: they would cost more than they add).
-    """
-    state = reach.state(bits)
-    p = bits.shape[1]
-    total = np.zeros(heading.shape)
-    h_lo, h_hi = float(np.min(heights)), float(np.max(heights))
-    for i in range(placed + 1, min(n_units - window + 2, placed + 1 + AHEAD)):
-        x_lo, x_hi, y_lo, y_hi = reach.box("centre", i - placed, state, point, heading)
-        lo_ref: FloatArray | float = h_lo
-        hi_ref: FloatArray | float = h_hi
-        if i <= p:
-            lo_ref = hi_ref = heights[np.asarray(bits[:, i - 1], dtype=np.int64)][:, None]
-        f_lo, f_hi = curve.between(x_lo, x_hi)
-        gap = np.maximum(np.maximum(f_lo - (y_hi - lo_ref), (y_lo - hi_ref) - f_hi), 0.0)
-        total += np.where(y_lo <= _EMPTY / 2, 0.0, gap * gap)
-    return total
-
-
-#: directions in which the distance from a point to the tip's hull is bounded
-_DISTANCE_DIRECTIONS = 8
-
-
-def tip_goal_rest(reach: Reach, name: str, target: tuple[float, float] | None, tip_height: float,
-                  bits: NDArray[np.integer], point: FloatArray, heading: FloatArray, n_units: int) -> FloatArray:
-    """A lower bound on a tip goal's cost (its value; minus it when maximising) of every completion, (m, k).
-
-    The tip lies in the hull of the displacements of the chords still to place; the bound is
-    the hull's best x or y, its distance from the base or a point (at least ``u . (P - q) -
-    h(-u)`` for every unit vector ``u``), or the curl with the greatest remaining turn.
-    """
-    state = reach.state(bits)
-    a = n_units - bits.shape[1]
-    if name == "max-curl":
-        turn = reach.turn[a][state]
-        return np.where(turn <= _EMPTY / 2, np.inf, -np.degrees(heading + turn) - 1e-9)
-    x, y = point[..., 0], point[..., 1] - tip_height
-    if name in ("max-x", "min-x", "max-y", "min-y"):
-        phi = {"max-x": 0.0, "min-x": np.pi, "max-y": np.pi / 2, "min-y": -np.pi / 2}[name]
-        h = reach.support("tip", a, state, phi - heading)
-        if name == "max-x":
-            out = -(x + h)
-        elif name == "min-x":
-            out = x - h
-        elif name == "max-y":
-            out = -(y + h)
-        else:
-            out = y - h
-        return np.where(h <= _EMPTY / 2, np.inf, out)
-    q = (0.0, 0.0) if name == "min-distance" else target
-    assert q is not None
-    best = np.zeros(heading.shape)
-    toward = np.arctan2(y - q[1], x - q[0])  # from the point to the prefix's point, then a fan around it
-    h = reach.support("tip", a, state, toward + np.pi - heading, fan=_DISTANCE_DIRECTIONS)
-    for i in range(_DISTANCE_DIRECTIONS):
-        psi = toward + 2 * np.pi * i / _DISTANCE_DIRECTIONS
-        lb = np.cos(psi) * (x - q[0]) + np.sin(psi) * (y - q[1]) - h[i]
-        best = np.maximum(best, np.where(h[i] <= _EMPTY / 2, np.inf, lb))
-    return best
-
-
-# -- the cruder bound of the first units: a box from the chords' heading intervals ----------
-def _contains(lo: FloatArray, hi: FloatArray, phase: float) -> NDArray[np.bool_]:
-    """True where [lo, hi] contains ``phase + 2 pi m`` for some integer m."""
-    return 2 * np.pi * np.ceil((lo - phase) / (2 * np.pi)) + phase <= hi
-
-
-def _cos_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Least and greatest cosine over the angle intervals [lo, hi]."""
-    c_lo, c_hi = np.cos(lo), np.cos(hi)
-    top = np.where(_contains(lo, hi, 0.0), 1.0, np.maximum(c_lo, c_hi))
-    bottom = np.where(_contains(lo, hi, np.pi), -1.0, np.minimum(c_lo, c_hi))
-    return bottom, top
-
-
-def _sin_range(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Least and greatest sine over the angle intervals [lo, hi]."""
-    s_lo, s_hi = np.sin(lo), np.sin(hi)
-    top = np.where(_contains(lo, hi, np.pi / 2), 1.0, np.maximum(s_lo, s_hi))
-    bottom = np.where(_contains(lo, hi, -np.pi / 2), -1.0, np.minimum(s_lo, s_hi))
-    return bottom, top
-
-
-def _reach_box(table: Any, state: dict[str, Any], remaining: int, axes: str = "xy") -> tuple[FloatArray, ...]:
-    """A box (per prefix and level) holding every tip its remaining chords can reach.
-
-    Chord ``i`` of the remaining ones turns by ``i`` tabulated turns at most, so its angle
-    lies in ``[a + i t_min, a + i t_max]``; its length in ``[L_min, L_max]``. Only the
-    ``axes`` asked for are bounded (the others stay at the current point).
-    """
-    tmin, tmax = table.turn.min(axis=0), table.turn.max(axis=0)
-    lmin, lmax = table.length.min(axis=0), table.length.max(axis=0)
-    a = state["angle"]
-    x, y = state["point"][..., 0], state["point"][..., 1]
-    xlo, xhi, ylo, yhi = x.copy(), x.copy(), y.copy(), y.copy()
-    for i in range(1, remaining + 1):
-        lo, hi = a + i * tmin, a + i * tmax
-        if "x" in axes:
-            cmin, cmax = _cos_range(lo, hi)
-            xhi += np.where(cmax >= 0, lmax * cmax, lmin * cmax)
-            xlo += np.where(cmin <= 0, lmax * cmin, lmin * cmin)
-        if "y" in axes:
-            smin, smax = _sin_range(lo, hi)
-            yhi += np.where(smax >= 0, lmax * smax, lmin * smax)
-            ylo += np.where(smin <= 0, lmax * smin, lmin * smin)
-    return xlo, xhi, ylo, yhi
-
-
-def box_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], remaining: int) -> FloatArray:
-    """Per level, a lower bound on the cost of every completion from the chords' heading intervals (m, k)."""
-    table = chain.table
-    name = objective.name
-    if name == "max-curl":  # the rest of the turns and the end turn at their largest
-        turns = np.degrees(remaining * table.turn.max(axis=0) + table.end.max(axis=0))
-        return -(np.degrees(state["angle"]) + turns)
-    axes = {"max-x": "x", "min-x": "x", "max-y": "y", "min-y": "y"}.get(name, "xy")
-    xlo, xhi, ylo, yhi = _reach_box(table, state, remaining, axes)
-    ylo, yhi = ylo - table.tip_ref[1], yhi - table.tip_ref[1]
-    if name == "max-x":
-        return -xhi
-    if name == "min-x":
-        return xlo
-    if name == "max-y":
-        return -yhi
-    if name == "min-y":
-        return ylo
-    # distance to the base or to a point: from the point to the box
-    q = (0.0, 0.0) if name == "min-distance" else cast(TipGoal, objective).point
-    assert q is not None
-    dx = np.maximum(np.maximum(xlo - q[0], q[0] - xhi), 0.0)
-    dy = np.maximum(np.maximum(ylo - q[1], q[1] - yhi), 0.0)
-    return np.hypot(dx, dy)
-
-
-__all__ = ["DIRECTIONS", "CurveRange", "Reach", "box_bound", "build_reach", "memory_of", "profile_rest", "reach_of",
-           "tip_goal_rest"]
+__all__ = ["AHEAD", "CLUSTER_WIDTHS", "DIRECTIONS", "EMPTY", "MAX_ROWS", "Reach", "build_reach", "memory_of",
+           "reach_of"]
