@@ -186,3 +186,33 @@ def test_too_many_open_prefixes_answer_with_a_sound_floor() -> None:
         assert unlisted.sum() > 2**15
         assert np.all(every.optimistic[unlisted] >= partial.floor - 1e-9)
         assert partial.cost.min() >= every.cost.min() - 1e-12
+
+
+def test_a_probe_past_a_poor_beam_finds_the_optimum(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A beam of 2 prefixes misses the optimum; the probes (a branch-and-bound keeping the best open prefixes)
+    find it, and the last run lists every design within twice the bound of it (16 units, all 2^16 designs)."""
+    table = find_table(make_model(15, {"fidelity": "2d"}))
+    assert table is not None
+    chain = ChainModel(table, 16)
+    objective = make_objective("sin", 10.0, length=chain.length)
+    errors = cs.chain_errors(chain)
+    every = cs.grow_designs(chain, objective, errors)
+    monkeypatch.setattr(growth, "BEAM", 2)
+    beamed = cs.grow_designs(chain, objective, errors, beam=2)
+    assert beamed.cost.min() > every.cost.min() + 0.5
+    spilled = []
+    grow = growth.grow_designs
+
+    def counted(*args, **kwargs):
+        out = grow(*args, **kwargs)
+        spilled.append(np.isfinite(out.floor))
+        return out
+
+    monkeypatch.setattr(growth, "grow_designs", counted)
+    scores = cs.chain_scores(chain, objective, max_enumerate=10, max_nodes=250)  # probes keep 10
+    assert spilled == [False, True, True, False]  # the beam, two probes that spill, the last run
+    beta = float(scores.bound.max())
+    assert scores.cost.min() == pytest.approx(every.cost.min(), abs=1e-12)
+    within = every.cost < every.cost.min() + 2 * beta
+    assert len(scores.cost) == within.sum()
+    assert scores.floor == pytest.approx(every.cost.min() + beta, abs=1e-6)

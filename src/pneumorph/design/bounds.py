@@ -203,7 +203,7 @@ def _costs(values: FloatArray, beta: FloatArray, sense: str) -> tuple[FloatArray
     c[~np.isfinite(c)] = np.inf
     level = np.argmin(c, axis=1)
     cost = c[np.arange(len(c)), level]
-    if beta.ndim == 2 and beta.strides[0] == 0:  # the same bound for every design: one row
+    if beta.ndim == 2 and len(beta) and beta.strides[0] == 0:  # the same bound for every design: one row
         row = np.where(np.isfinite(beta[0]), beta[0], np.inf)
         optimistic = np.min(c - row, axis=1)
         bound = np.full(len(c), row.max())

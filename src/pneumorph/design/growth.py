@@ -33,7 +33,7 @@ from pneumorph.design.rest import CurveRange, profile_rest, tip_goal_rest
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel
-from pneumorph.models.windows import every_design
+from pneumorph.models.windows import design_numbers, every_design
 
 FloatArray = NDArray[np.float64]
 
@@ -45,6 +45,17 @@ MAX_ENUMERATE = 20
 
 MAX_NODES = 500_000
 """Most open prefixes the branch-and-bound keeps at one depth."""
+
+BEAM = 4096
+"""Prefixes the first search keeps at every depth (a good design, whose cost sets the threshold)."""
+
+SPILL_ROUNDS = 3
+"""Probing runs at most before the last: a probe is a branch-and-bound that keeps at most
+``MAX_NODES / SPILL_SHARE`` open prefixes (the best, when more stay open); while a probe finds a
+better design, the next starts from its lower threshold. The last run keeps up to :data:`MAX_NODES`."""
+
+SPILL_SHARE = 25
+"""The share of :data:`MAX_NODES` a probing run keeps."""
 
 REFINE_AT = 20_000
 """Open prefixes of a profile target above which the bound on the centres still to place is added
@@ -245,17 +256,26 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
 
 
 def _narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_nodes: int, p: int,
-            n: int) -> NDArray[np.bool_]:
+            n: int, spill: list[float] | None = None) -> NDArray[np.bool_]:
     """The open prefixes (``keep``) cut to the ``beam`` of lowest bound, if given.
+
+    With ``spill`` (a list), more than ``max_nodes`` open prefixes are cut to the ``max_nodes``
+    of lowest bound instead, and the least bound of those dropped is appended to ``spill``.
 
     Raises
     ------
     BranchOverflow
-        More than ``max_nodes`` stay open at depth ``p`` of ``n``.
+        More than ``max_nodes`` stay open at depth ``p`` of ``n`` (without ``spill``).
     """
     if beam is not None and keep.sum() > beam:
         keep = np.zeros(len(bound), dtype=bool)
         keep[np.argpartition(bound, beam)[:beam]] = True
+    if keep.sum() > max_nodes and spill is not None:
+        open_ = np.flatnonzero(keep)
+        order = np.argpartition(bound[open_], max_nodes)
+        spill.append(float(bound[open_[order[max_nodes:]]].min()))
+        keep = np.zeros(len(bound), dtype=bool)
+        keep[open_[order[:max_nodes]]] = True
     if keep.sum() > max_nodes:
         raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too many "
                              "designs come within the chain's error bound of the best to list them all - use "
@@ -264,7 +284,8 @@ def _narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_no
 
 
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
-                 threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None) -> ChainScores:
+                 threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None,
+                 spill: bool = False) -> ChainScores:
     """Chain scores of every design whose cost is below ``threshold`` (all designs for ``inf``).
 
     Designs grow unit by unit, sharing their prefixes: a prefix of ``p`` units fixes the
@@ -275,15 +296,17 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     dropped (branch-and-bound); with no threshold this enumerates all ``2^n`` designs at
     about two chord placements per design. With ``beam``, only the ``beam`` prefixes of
     lowest bound are kept at every depth (a heuristic: no longer every design below the
-    threshold).
+    threshold). With ``spill``, a depth with more than ``max_nodes`` open prefixes keeps the
+    ``max_nodes`` of lowest bound and goes on; the scores' ``floor`` is then the least bound
+    of the prefixes dropped (no design that is not listed costs less by the chain).
 
     Raises
     ------
     SearchConfigError
-        More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose).
+        More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose), without ``spill``.
     """
     if isinstance(objective, StagedTarget):
-        return _grow_staged(chain, objective, errors, threshold, max_nodes, beam)
+        return _grow_staged(chain, objective, errors, threshold, max_nodes, beam, spill)
     if not np.isfinite(threshold) and beam is None and _enumerable(chain, KEEP_GEOMETRY_UNITS):
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
@@ -295,6 +318,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     e = errors["centre"]
     slope = _target_slope(chain, prof, errors) if profile else 0.0
     bits, st = seed_prefixes(chain, polar)
+    spilled: list[float] | None = [] if spill else None
     curve, refine = None, False
     if profile and not polar and np.isfinite(slope) and (np.isfinite(threshold) or beam is not None):
         curve = _curve_range(chain, prof, errors, slope)
@@ -322,7 +346,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 bound[keep] = _prefix_bound(chain, objective, bits[keep], {key: v[keep] for key, v in st.items()},
                                             placed, curve)
                 keep = bound < threshold
-            keep = _narrow(keep, bound, beam, max_nodes, p, n)
+            keep = _narrow(keep, bound, beam, max_nodes, p, n, spilled)
             bits = bits[keep]
             st = {key: v[keep] for key, v in st.items()}
             growth.send((bits, st))
@@ -336,7 +360,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         else:
             beta = np.broadcast_to(_uniform_bound(chain, objective, errors, slope), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
-    return ChainScores(bits, values, cost, level, optimistic, bound, choices=_radix(chain))
+    return ChainScores(bits, values, cost, level, optimistic, bound, floor=min(spilled or [np.inf]),
+                       choices=_radix(chain))
 
 
 def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
@@ -344,37 +369,58 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     """Chain scores of every design that can matter, with a floor under the rest.
 
     Up to ``max_enumerate`` units: all ``2^n`` designs. Above: a beam search (the 4096
-    prefixes of lowest bound at every depth) gives a good cost ``c0``; branch-and-bound
+    prefixes of lowest bound at every depth, :data:`BEAM`) gives a good cost ``c0``; branch-and-bound
     then returns every design of chain cost below ``c0 + 2 beta`` (``beta`` the largest
     bound), the only ones whose FE value can beat a design of chain cost ``c0``; all others
     are at least ``c0 + 2 beta`` by the chain, so their optimistic value is at least
     ``c0 + beta``.
 
-    Where more than ``max_nodes`` prefixes stay open, the answer is the beam's designs with
-    the floor that the open prefixes' least bound gives (``lower - beta``): an answer whose
+    The branch-and-bound first runs as a probe that keeps at most ``max_nodes / SPILL_SHARE``
+    open prefixes, the best ones where more stay open (``spill``); while a probe finds a
+    design better than ``c0``, the next starts from its lower threshold (:data:`SPILL_ROUNDS`).
+    A probe that keeps every open prefix is the answer. Otherwise a last run keeps up to
+    ``max_nodes``; where that spills too, the answer is the best designs found with the floor
+    that the dropped prefixes' least bound gives (``lower - beta``): an answer whose
     certificate states how much better an unlisted design could be, not a failure.
     """
     errors = chain_errors(chain, margin)
     n = chain.n_units
     if _enumerable(chain, max_enumerate):
         return grow_designs(chain, objective, errors)
-    beamed = grow_designs(chain, objective, errors, beam=4096)
+    beamed = grow_designs(chain, objective, errors, beam=BEAM)
     c0 = float(beamed.cost.min())
     probe = score_designs(chain, objective, np.zeros((1, n), dtype=np.uint8), errors)
     beta = float(probe.bound.max()) if np.isfinite(probe.bound).all() else float(errors["centre"].max())
-    threshold = c0 + 2 * beta + 1e-9
-    try:
-        scores = grow_designs(chain, objective, errors, threshold, max_nodes=max_nodes)
-    except BranchOverflow as exc:
-        floor = min(exc.lower, threshold) - beta
-        return replace(beamed, floor=floor)
-    keep = scores.cost < threshold
-    return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
-                       scores.optimistic[keep], scores.bound[keep], floor=threshold - beta, choices=scores.choices)
+    found, probes = beamed, 0
+    while True:
+        final = probes == SPILL_ROUNDS
+        threshold = c0 + 2 * beta + 1e-9
+        scores = grow_designs(chain, objective, errors, threshold, spill=True,
+                              max_nodes=max_nodes if final else max(1, max_nodes // SPILL_SHARE))
+        if scores.complete:
+            keep = scores.cost < threshold
+            return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
+                               scores.optimistic[keep], scores.bound[keep], floor=threshold - beta,
+                               choices=scores.choices)
+        found = _union(scores, found)
+        if final:
+            return replace(found, floor=min(scores.floor, threshold) - beta)
+        # a probe: a better design lowers the threshold and probes again; none leaves the last, full run
+        probes = probes + 1 if float(found.cost.min()) < c0 - 1e-9 else SPILL_ROUNDS
+        c0 = float(found.cost.min())
+
+
+def _union(a: ChainScores, b: ChainScores) -> ChainScores:
+    """The designs of ``a`` and those of ``b`` that ``a`` lacks (their scores as they are)."""
+    extra = ~np.isin(design_numbers(b.bits, b.choices), design_numbers(a.bits, a.choices))
+    return ChainScores(np.concatenate([a.bits, b.bits[extra]]), np.concatenate([a.per_level, b.per_level[extra]]),
+                       np.concatenate([a.cost, b.cost[extra]]), np.concatenate([a.level, b.level[extra]]),
+                       np.concatenate([a.optimistic, b.optimistic[extra]]), np.concatenate([a.bound, b.bound[extra]]),
+                       floor=a.floor, choices=a.choices)
 
 
 def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, FloatArray], threshold: float,
-                 max_nodes: int, beam: int | None) -> ChainScores:
+                 max_nodes: int, beam: int | None, spill: bool = False) -> ChainScores:
     """:func:`grow_designs` for a staged target: every design below ``threshold`` (all ``(2k)^n`` for ``inf``).
 
     A prefix's bound is the weighted root-sum-square of its profile stages' partial sums of
@@ -393,6 +439,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     profiles = [(i, st.target, levels[i]) for i, st in enumerate(objective.stages)
                 if isinstance(st.target, ProfileTarget)]
     bits, state = seed_prefixes(chain)
+    spilled: list[float] | None = [] if spill else None
     state["ssum"] = np.zeros((len(bits), len(objective.stages)))
     with np.errstate(all="ignore"):
         growth = depths(chain, bits, state)
@@ -403,7 +450,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
             if p == n:
                 continue
             bound = np.sqrt(((weights**2) * state["ssum"]).sum(axis=1))
-            keep = _narrow(bound < threshold, bound, beam, max_nodes, p, n)
+            keep = _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled)
             bits = bits[keep]
             state = {key: v[keep] for key, v in state.items()}
             growth.send((bits, state))
@@ -417,4 +464,5 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
         values = objective.at_levels(per, chain.table.pressures)
     beta = np.broadcast_to(_staged_bound(chain, objective, errors), values.shape)
     cost, level, optimistic, bound = _costs(values, beta, objective.sense)
-    return ChainScores(bits, values, cost, level, optimistic, bound, choices=_radix(chain))
+    return ChainScores(bits, values, cost, level, optimistic, bound, floor=min(spilled or [np.inf]),
+                       choices=_radix(chain))

@@ -86,7 +86,7 @@ _ROUND = 1e-4
 EMPTY = -1e30
 #: most chord rows per level the programme steps over; a table with more windows merges those of
 #: one state pair and close turns into clusters (:func:`_clusters`)
-MAX_ROWS = 60_000
+MAX_ROWS = 30_000
 #: turn widths (rad) of the clusters, tried in order until the rows fit
 CLUSTER_WIDTHS = (2.5e-4, 5e-4, 1e-3, 2e-3, 4e-3, 8e-3)
 #: full states whose tip supports are formed at once
