@@ -9,8 +9,8 @@ import pytest
 
 from pneumorph.design import bounds, growth
 from pneumorph.design import certified as cs
-from pneumorph.design.prefixes import depths, seed_prefixes
 from pneumorph.design import reach as reach_module
+from pneumorph.design.prefixes import depths, seed_prefixes
 from pneumorph.design.reach import build_reach
 from pneumorph.design.rest import CurveRange
 from pneumorph.design.targets import ProfileTarget, make_objective, tip_goal
