@@ -3,14 +3,18 @@ close as the wider window's table from fewer unit solves."""
 
 from __future__ import annotations
 
+import json
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from pneumorph.errors import ChainTableError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import ChainModel
+from pneumorph.models.chain import ChainModel, ChainTable
 from pneumorph.models.chainfit import build_table, fit_table
+from pneumorph.models.chaintable import TABLE_FORMAT, TERMS_FORMAT
 from pneumorph.models.chainterms import far_designs, far_terms
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response
@@ -95,6 +99,27 @@ def test_far_terms_are_exact_on_a_chain_of_such_sums(w: int) -> None:
             worst_plain = max(worst_plain, float(np.abs(other.centres - truth.centres).max()))
     assert worst_far < 1e-9
     assert worst_plain > 1e-3
+
+
+def test_a_table_with_far_field_terms_is_written_as_its_terms(tmp_path) -> None:
+    """Its file holds the terms (format 3), and reading it writes the same table out (same fingerprint);
+    entries changed afterwards are written window by window; an edited term is refused."""
+    law = _law(seed=2, w=2)
+    train = [_response(law, d, 2) for d in far_designs(11, 2)]
+    far = fit_table(train, 2, {"fidelity": "toy", "key": "additive", "n_units": 11}, far=True)
+    path = far.save(tmp_path / "far.json")
+    data = json.loads(path.read_text())
+    assert data["format"] == TERMS_FORMAT and "windows" not in data
+    assert [t["units"] for t in data["terms"]["chord"]] == [[-2, 2], [0, 3], [-3, 0]]
+    back = ChainTable.load(path)
+    assert back.fingerprint() == far.fingerprint() and back.terms["digest"] == far.terms["digest"]
+    assert np.array_equal(back.codes, far.codes) and np.array_equal(back.turn, far.turn)
+    moved = replace(far, turn=far.turn * 1.01)
+    assert moved.to_dict()["format"] == TABLE_FORMAT and "terms" not in moved.to_dict()
+    data["terms"]["chord"][0]["values"][0][0] += 1e-6
+    path.write_text(json.dumps(data))
+    with pytest.raises(ChainTableError, match="fingerprint"):
+        ChainTable.load(path)
 
 
 def test_a_key_no_training_design_shows_is_refused() -> None:

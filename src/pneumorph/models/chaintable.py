@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError, UnitLibraryError
+from pneumorph.models.chainterms import compile_terms, entries_digest, terms_from_dict, terms_to_dict
 from pneumorph.models.response import FloatArray
 from pneumorph.models.windows import (
     design_array,
@@ -33,6 +34,9 @@ IntArray = NDArray[np.int64]
 TABLE_FORMAT = 1
 
 ALPHABET_FORMAT = 2
+
+#: a table with far-field terms whose file holds the terms, not the windows they write out
+TERMS_FORMAT = 3
 
 # -- the table --------------------------------------------------------------------------------
 @dataclass(frozen=True)
@@ -83,6 +87,11 @@ class ChainTable:
     symmetric : tuple of str
         The types whose unit turned over is the same body (:attr:`UnitSpec.symmetric`): one
         orientation, one letter (lower case) in designs, one set of windows; empty for none.
+    terms : dict
+        The far-field terms the entries were written out from
+        (:func:`~pneumorph.models.chainterms.fit_terms`); its file then holds them instead of
+        the windows (format :data:`TERMS_FORMAT`: four unit types at window +-3 are 1,097,600
+        windows, 542 MB written out). Empty for a table fitted window by window.
     """
 
     window: int
@@ -106,6 +115,7 @@ class ChainTable:
     type_offset: tuple[float, ...] = ()
     type_centre_y: tuple[float, ...] = ()
     symmetric: tuple[str, ...] = ()
+    terms: dict[str, Any] = field(default_factory=dict, compare=False)
 
     @property
     def n_levels(self) -> int:
@@ -268,17 +278,23 @@ class ChainTable:
                                for t, s in enumerate(self.alphabet)}}
             if self.symmetric:
                 extra["symmetric"] = list(self.symmetric)
-        return {
-            "format": ALPHABET_FORMAT if self.alphabet else TABLE_FORMAT,
-            "kind": "pneumorph chain table",
-            **extra,
-            "window": self.window,
-            "pressures_mpa": self.pressures.tolist(),
+        entries: dict[str, Any] = {
             "windows": [window_text(c, self.window, self.alphabet) for c in self.codes],
             "turn_rad": self.turn.tolist(),
             "length_mm": self.length.tolist(),
             "end_windows": [window_text(c, self.window, self.alphabet) for c in self.end_codes],
             "end_turn_rad": self.end.tolist(),
+        }
+        fmt = ALPHABET_FORMAT if self.alphabet else TABLE_FORMAT
+        if self.terms and self.terms.get("digest") == entries_digest(self.__dict__):  # still what they write out
+            entries, fmt = {"terms": terms_to_dict(self.terms)}, TERMS_FORMAT
+        return {
+            "format": fmt,
+            "kind": "pneumorph chain table",
+            **extra,
+            "window": self.window,
+            "pressures_mpa": self.pressures.tolist(),
+            **entries,
             "pitch_mm": self.pitch,
             "centre_y_mm": list(self.centre_y),
             "first_offset_mm": self.first_offset,
@@ -296,14 +312,15 @@ class ChainTable:
         """Read :meth:`to_dict`'s form, checking its layout and its fingerprint."""
         try:
             fmt = data.get("format")
-            if data.get("kind") != "pneumorph chain table" or fmt not in (TABLE_FORMAT, ALPHABET_FORMAT):
-                raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT} or "
-                                      f"{ALPHABET_FORMAT}")
+            if data.get("kind") != "pneumorph chain table" or fmt not in (TABLE_FORMAT, ALPHABET_FORMAT,
+                                                                           TERMS_FORMAT):
+                raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT}, "
+                                      f"{ALPHABET_FORMAT} or {TERMS_FORMAT}")
             w = int(data["window"])
             alphabet: tuple[str, ...] = ()
             symmetric: tuple[str, ...] = ()
-            geometry: dict[str, tuple[float, ...]] = {}
-            if fmt == ALPHABET_FORMAT:
+            geometry: dict[str, Any] = {}
+            if fmt == ALPHABET_FORMAT or (fmt == TERMS_FORMAT and "alphabet" in data):
                 from pneumorph.geometry.library import check_symbol
 
                 alphabet = tuple(check_symbol(a, where) for a in data["alphabet"])
@@ -326,14 +343,24 @@ class ChainTable:
                     out.append(window_code(t, alphabet))
                 return np.array(out, dtype=np.int64)
 
+            pressures = np.array(data["pressures_mpa"], dtype=float)
+            terms: dict[str, Any] = {}
+            arrays: dict[str, Any]
+            if fmt == TERMS_FORMAT:
+                terms = terms_from_dict(data["terms"])
+                if int(terms["window"]) + 1 != w:
+                    raise ChainTableError(f"far-field terms of window +-{terms['window']} in a table of +-{w}")
+                sym = tuple(alphabet.index(s) for s in symmetric)
+                arrays = compile_terms(terms, terms["n_units"], max(1, len(alphabet)), sym, len(pressures))
+            else:
+                arrays = {"codes": codes_of(data["windows"]), "turn": np.array(data["turn_rad"], dtype=float),
+                          "length": np.array(data["length_mm"], dtype=float),
+                          "end_codes": codes_of(data["end_windows"]),
+                          "end": np.array(data["end_turn_rad"], dtype=float)}
             table = cls(
                 window=w,
-                pressures=np.array(data["pressures_mpa"], dtype=float),
-                codes=codes_of(data["windows"]),
-                turn=np.array(data["turn_rad"], dtype=float),
-                length=np.array(data["length_mm"], dtype=float),
-                end_codes=codes_of(data["end_windows"]),
-                end=np.array(data["end_turn_rad"], dtype=float),
+                pressures=pressures,
+                **arrays,
                 pitch=float(data["pitch_mm"]),
                 centre_y=(float(data["centre_y_mm"][0]), float(data["centre_y_mm"][1])),
                 first_offset=float(data["first_offset_mm"]),
@@ -345,6 +372,7 @@ class ChainTable:
                 metadata=dict(data.get("metadata", {})),
                 alphabet=alphabet,
                 symmetric=symmetric,
+                terms=terms,
                 **geometry,
             )
         except ChainTableError as exc:

@@ -27,6 +27,7 @@ by 0.196 mm, with far-field terms 0.0077 mm, the table of window
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Sequence
 from typing import Any
 
@@ -162,44 +163,115 @@ def _compile(tables: list[tuple[IntArray, FloatArray]], terms: Sequence[tuple[in
     return total
 
 
-def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
-              symmetric: tuple[int, ...], levels: int, n_units: int) -> dict[str, Any]:
-    """:func:`~pneumorph.models.chainfit.fit_table`'s entries of a window +-w table with far-field terms.
-
-    Fitted at window +-w (:func:`far_terms`) and written out at window +-(w + 1) for every
-    window an actuator of at least ``2w + 3`` units shows (any such length shows the same ones).
+def fit_terms(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
+              symmetric: tuple[int, ...]) -> tuple[dict[str, Any], float]:
+    """The far-field terms of a window +-w table, fitted by backfitting, and the fit's spread.
 
     Returns
     -------
-    dict
-        ``codes``, ``turn``, ``length``, ``end_codes``, ``end`` (window +-(w + 1)) and
-        ``spread`` (the largest deviation of the fit from a training chord).
+    terms : dict
+        ``window`` (w) and, for the chords (``chord``) and the last chords' end turns
+        (``end``), one ``(keys, values)`` pair per term of :func:`far_terms`: sorted codes of
+        the term's units (radix ``2k + 2``, the first unit least significant) and its values
+        (chords: turns then lengths per level; ends: turns).
+    spread : float
+        The largest deviation of the fit from a training chord or end.
+    """
+    w = int(window)
+    width, radix = w + 1, 2 * max(1, len(alphabet)) + 2
+    syms, values, esyms, ends = _observations(responses, width, mirror, alphabet, symmetric)
+    offsets = far_terms(w)
+    tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in offsets], values)
+    etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in offsets], ends)
+    spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
+    return {"window": w, "chord": tables, "end": etables}, spread
+
+
+def compile_terms(terms: dict[str, Any], n_units: int, n_types: int, symmetric: tuple[int, ...],
+                  levels: int) -> dict[str, Any]:
+    """The table of window +-(w + 1) that far-field ``terms`` (:func:`fit_terms`) write out.
+
+    One entry for every window an actuator of at least ``2w + 3`` units shows (any such length
+    shows the same ones), canonical under mirroring; ``codes``, ``turn``, ``length``,
+    ``end_codes`` and ``end`` as :class:`~pneumorph.models.chaintable.ChainTable` holds them.
 
     Raises
     ------
     ChainTableError
         A key of a term that no training design shows.
     """
-    w = int(window)
-    width = w + 1
-    k = max(1, len(alphabet))
-    radix = 2 * k + 2
-    terms = far_terms(w)
-    syms, values, esyms, ends = _observations(responses, width, mirror, alphabet, symmetric)
-    tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in terms], values)
-    etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in terms], ends)
-    spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
-    codes = possible_codes(max(int(n_units), 2 * width + 1), width, k)  # every window of any longer actuator too
+    w = int(terms["window"])
+    width, radix = w + 1, 2 * n_types + 2
+    offsets = far_terms(w)
+    codes = possible_codes(max(int(n_units), 2 * width + 1), width, n_types)
     windows = (codes[:, None] // radix ** np.arange(2 * width + 1, dtype=np.int64)) % radix
     keep = np.all(np.asarray(canonical_codes(windows, symmetric)) == windows, axis=1)
     codes, windows = codes[keep], windows[keep]
-    chord = _compile(tables, terms, windows, width, radix, "chord")
+    chord = _compile(terms["chord"], offsets, windows, width, radix, "chord")
     # the windows of a last chord n: units n - w - 1 .. n (or the base), then w + 1 tip symbols
     last = np.all(windows[:, width + 1:] == radix - 1, axis=1) & (windows[:, width] < radix - 2)
-    end_codes = codes[last]
-    end = _compile(etables, terms, windows[last], width, radix, "end")
-    return {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:], "end_codes": end_codes,
-            "end": end, "spread": spread}
+    end = _compile(terms["end"], offsets, windows[last], width, radix, "end")
+    return {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:], "end_codes": codes[last],
+            "end": end}
 
 
-__all__ = ["ROUNDS", "SETTLED", "far_designs", "far_means", "far_terms", "fit_text", "training_designs"]
+def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
+              symmetric: tuple[int, ...], levels: int, n_units: int) -> dict[str, Any]:
+    """:func:`~pneumorph.models.chainfit.fit_table`'s entries of a window +-w table with far-field terms.
+
+    Fitted at window +-w (:func:`fit_terms`) and written out at window +-(w + 1)
+    (:func:`compile_terms`).
+
+    Returns
+    -------
+    dict
+        ``codes``, ``turn``, ``length``, ``end_codes``, ``end`` (window +-(w + 1)), ``spread``
+        (the largest deviation of the fit from a training chord) and ``terms`` (the fitted
+        terms, which the table's file holds instead of the windows).
+
+    Raises
+    ------
+    ChainTableError
+        A key of a term that no training design shows.
+    """
+    terms, spread = fit_terms(responses, window, mirror, alphabet, symmetric)
+    table = compile_terms(terms, n_units, max(1, len(alphabet)), symmetric, levels)
+    return {**table, "spread": spread, "terms": {**terms, "digest": entries_digest(table), "n_units": int(n_units)}}
+
+
+def entries_digest(entries: dict[str, Any]) -> str:
+    """A hash of a table's entries (``codes``, ``turn``, ``length``, ``end_codes``, ``end``): whether terms still
+    write out the table that holds them."""
+    h = hashlib.sha256()
+    for key in ("codes", "turn", "length", "end_codes", "end"):
+        h.update(np.ascontiguousarray(entries[key]).tobytes())
+    return h.hexdigest()[:16]
+
+
+def terms_to_dict(terms: dict[str, Any]) -> dict[str, Any]:
+    """JSON-ready form of :func:`fit_terms`'s terms (with their ``digest`` and ``n_units``)."""
+    offsets = far_terms(int(terms["window"]))
+    return {"window": int(terms["window"]), "n_units": int(terms["n_units"]), "digest": terms["digest"],
+            **{part: [{"units": list(units), "keys": keys.tolist(), "values": values.tolist()}
+                      for (keys, values), units in zip(terms[part], offsets, strict=True)]
+               for part in ("chord", "end")}}
+
+
+def terms_from_dict(data: dict[str, Any]) -> dict[str, Any]:
+    """:func:`terms_to_dict`'s form back as arrays; a :class:`ChainTableError` if the terms are not those of
+    :func:`far_terms`."""
+    w = int(data["window"])
+    out: dict[str, Any] = {"window": w, "n_units": int(data["n_units"]), "digest": str(data["digest"])}
+    for part in ("chord", "end"):
+        if [tuple(t["units"]) for t in data[part]] != list(far_terms(w)):
+            raise ChainTableError(f"far-field terms of units {[t['units'] for t in data[part]]}, not those of "
+                                  f"window +-{w}")
+        out[part] = [(np.asarray(t["keys"], dtype=np.int64), np.asarray(t["values"], dtype=float))
+                     for t in data[part]]
+        if any(len(k) != len(v) or np.any(np.diff(k) <= 0) for k, v in out[part]):
+            raise ChainTableError("far-field terms: keys not sorted or not one per value")
+    return out
+
+
+__all__ = ["ROUNDS", "SETTLED", "compile_terms", "entries_digest", "far_designs", "far_means", "far_terms", "fit_terms",
+           "fit_text", "terms_from_dict", "terms_to_dict", "training_designs"]

@@ -281,19 +281,29 @@ def window_code(text: str, alphabet: Sequence[str] = ()) -> int:
 
 
 def possible_codes(n_units: int, window: int, n_types: int = 1) -> IntArray:
-    """Every window code that occurs in some design of ``n_units`` units, sorted."""
+    """Every window code that occurs in some design of ``n_units`` units, sorted.
+
+    >>> possible_codes(3, 1).tolist()[:4]
+    [0, 1, 2, 4]
+    """
     n, w, k2 = int(n_units), int(window), 2 * int(n_types)
     radix = k2 + 2
     base, tip = ends(n_types)
     width = 2 * w + 1
-    found: set[int] = set()
+    found, seen = [], set()
     for j in range(n + 1):
-        units = [j - w + t for t in range(width)]  # 1-based unit numbers
-        inside = [t for t, u in enumerate(units) if 1 <= u <= n]
-        fixed = sum((base if u < 1 else tip) * radix**t for t, u in enumerate(units) if not 1 <= u <= n)
-        for k in range(k2 ** len(inside)):
-            found.add(fixed + sum(((k // k2**i) % k2) * radix**t for i, t in enumerate(inside)))
-    return np.array(sorted(found), dtype=np.int64)
+        units = np.arange(j - w, j - w + width)  # 1-based unit numbers
+        pattern = tuple(np.sign(units - 1).clip(-1, 0) + (units > n))  # -1 base, 0 a unit, 1 tip: one set each
+        if pattern in seen:
+            continue
+        seen.add(pattern)
+        inside = np.flatnonzero((units >= 1) & (units <= n))
+        outside = np.flatnonzero((units < 1) | (units > n))
+        fixed = int(sum((base if units[t] < 1 else tip) * radix ** int(t) for t in outside))
+        choice = np.arange(k2 ** len(inside), dtype=np.int64)
+        digits = (choice[:, None] // k2 ** np.arange(len(inside), dtype=np.int64)) % k2
+        found.append(fixed + digits @ (radix ** inside.astype(np.int64)))
+    return np.unique(np.concatenate(found))
 
 
 def random_designs(count: int, n_units: int, rng: np.random.Generator, n_types: int = 1,
