@@ -49,10 +49,12 @@ MAX_NODES = 500_000
 BEAM = 4096
 """Prefixes the first search keeps at every depth (a good design, whose cost sets the threshold)."""
 
-SPILL_ROUNDS = 3
+SPILL_ROUNDS = 1
 """Probing runs at most before the last: a probe is a branch-and-bound that keeps at most
 ``MAX_NODES / SPILL_SHARE`` open prefixes (the best, when more stay open); while a probe finds a
-better design, the next starts from its lower threshold. The last run keeps up to :data:`MAX_NODES`."""
+better design, the next starts from its lower threshold. The last run keeps up to :data:`MAX_NODES`.
+One probe: a second found nothing better in the cases measured and cost 10-20 % more
+(BENCHMARKS.md)."""
 
 SPILL_SHARE = 25
 """The share of :data:`MAX_NODES` a probing run keeps."""
