@@ -79,6 +79,44 @@ def test_a_drawn_sin_gets_the_presets_answer(client: TestClient) -> None:
     assert abs(a["winner"]["value"] - 7.405) <= np.sqrt(15) * gap + 5e-4
 
 
+STAGES = {"target": {"kind": "stages", "stages": [
+    {"pressure_kpa": 18, "target": {"kind": "expression", "expression": "y = 0.05*x"}},
+    {"pressure_kpa": 45, "target": {"kind": "preset", "name": "sin", "amplitude": 10}, "weight": 2}]}, "model": "2d"}
+
+
+def test_stages_get_the_certified_search_of_their_staged_target(client: TestClient) -> None:
+    """A target at each of two pressures: the answer is the chain search's optimum of the staged target, with each
+    stage's target and level for the page to draw over the ramp."""
+    a = client.post("/api/design", json=STAGES).json()
+    bench = Bench()
+    chain = bench.chain("2d")
+    objective = bench.parse(STAGES).objective(chain.length)
+    scores = chain_scores(chain, objective)
+    best = scores.order()[0]
+    assert a["winner"]["design"] == chain.table.texts(scores.bits[[best]])[0]
+    assert a["winner"]["value"] == pytest.approx(float(scores.cost[best]), abs=1e-9)
+    assert a["winner"]["pressure_kpa"] == pytest.approx(45.0) and a["target"] is None
+    assert [(s["pressure_kpa"], s["level"], s["weight"]) for s in a["stages"]] == [(18.0, 3, 1.0), (45.0, 9, 2.0)]
+    assert a["stages"][0]["target"]["y"][-1] == pytest.approx(0.05 * 157.5)
+    assert len(a["profiles"]) == 10  # the whole ramp
+
+
+@pytest.mark.parametrize(("stages", "message"), [
+    ([{"pressure_kpa": 20, "target": {"kind": "preset", "name": "sin"}}], "not a level of the ramp"),
+    ([{"pressure_kpa": 18, "target": {"kind": "tip", "goal": "max-x"}}], "is a maximum"),
+    ([{"target": {"kind": "preset", "name": "sin"}}], "pressure_kpa"),
+    ([{"pressure_kpa": 18, "target": {"kind": "stages"}}], "target kind"),
+    ([{"pressure_kpa": 18, "target": {"kind": "preset", "name": "sin"}},
+      {"pressure_kpa": 18, "target": {"kind": "preset", "name": "cos"}}], "two stages"),
+    ("18:sin", "list of 1 to"),
+])
+def test_bad_stages_are_a_stages_error(client: TestClient, stages: object, message: str) -> None:
+    r = client.post("/api/design", json={"target": {"kind": "stages", "stages": stages}})
+    assert r.status_code == 422
+    err = r.json()["error"]
+    assert err["field"] == "stages" and message in err["message"] and "\n" not in err["message"]
+
+
 def test_answers_are_remembered(client: TestClient) -> None:
     body = {"target": {"kind": "preset", "name": "sin", "amplitude": 12.5}}
     first = client.post("/api/design", json=body).json()
@@ -179,6 +217,18 @@ def test_verification_runs_the_design_command_and_is_private(client: TestClient,
     again = TestClient(create_app(state_dir=state / "state", cache=state / "cache.sqlite"), base_url=BASE,
                        cookies={"pneumorph_session": client.cookies["pneumorph_session"]})
     assert [j["id"] for j in again.get("/api/jobs").json()["jobs"]] == [job["id"]]
+
+
+def test_a_staged_verification_runs_the_design_command_with_its_stages(client: TestClient) -> None:
+    r = client.post("/api/jobs", json={"kind": "verify", "query": STAGES})
+    assert r.status_code == 202
+    job = _wait(client, r.json()["job_id"])
+    assert job["state"] == "done", job["message"]
+    answer = client.post("/api/design", json=STAGES).json()
+    assert job["result"]["design"] == answer["winner"]["design"]
+    assert job["result"]["fe_value"] == pytest.approx(answer["winner"]["value"], abs=0.3)
+    report = client.get(f"/api/jobs/{job['id']}/files/report.md")
+    assert report.status_code == 200 and "18 kPa" in report.text
 
 
 def test_a_bad_job_is_refused(client: TestClient) -> None:

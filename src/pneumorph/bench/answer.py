@@ -25,7 +25,7 @@ import numpy as np
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import best_scores
-from pneumorph.design.targets import ProfileTarget, TipGoal
+from pneumorph.design.targets import ProfileTarget, StagedTarget, TipGoal
 from pneumorph.geometry.assembly import assemble
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
@@ -206,7 +206,14 @@ class Bench:
         if not isinstance(unit, str) or (units is not None and unit not in units) or not self.knows(unit):
             raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}; upload its TOML file to build its chain "
                                      "table first")
-        return parse_query(body, self.length(model, unit), self.unit_ids if units is None else units)
+        query = parse_query(body, self.length(model, unit), self.unit_ids if units is None else units)
+        if query.stages is not None:  # each stage at a level of the ramp
+            kpa = self.chain(model, unit).pressures() * 1e3
+            for p, _, _ in query.stages:
+                if not np.any(np.abs(kpa - p) <= 1e-6 * p):
+                    raise QueryError("stages", f"stage at {p:g} kPa: not a level of the ramp; the levels are "
+                                               + ", ".join(f"{v:.4g}" for v in kpa) + " kPa")
+        return query
 
     def recall(self, query: Query) -> dict[str, Any] | None:
         """A remembered answer to ``query`` (marked ``memo``), or None."""
@@ -297,6 +304,7 @@ class Bench:
             "target": _target_samples(objective, length),
             "point": list(objective.point) if isinstance(objective, TipGoal) and objective.point is not None else None,
             "profiles": profiles(response),
+            "stages": _stage_samples(objective, chain.pressures(), length),
         }
 
     def chain_profiles(self, design: str, fidelity: str, unit: str = BUILTIN) -> list[list[list[float]]]:
@@ -373,6 +381,18 @@ def profiles(response: Any) -> list[list[list[float]]]:
     base = np.zeros((len(c), 1, 2))
     pts = np.concatenate([base, c, tip[:, None]], axis=1)
     return np.round(pts, 4).tolist()
+
+
+def _stage_samples(objective: Any, pressures: Any, length: float) -> list[dict[str, Any]] | None:
+    """Per stage of a staged target: its pressure (kPa), level, label, target samples and tip point; None otherwise."""
+    if not isinstance(objective, StagedTarget):
+        return None
+    levels = objective.levels(pressures)
+    return [{"pressure_kpa": round(stage.pressure * 1e3, 9), "level": int(k), "label": stage.label,
+             "weight": stage.weight, "target": _target_samples(stage.target, length),
+             "point": list(stage.target.point) if isinstance(stage.target, TipGoal) and stage.target.point is not None
+             else None}
+            for stage, k in zip(objective.stages, levels, strict=True)]
 
 
 def _target_samples(objective: Any, length: float) -> dict[str, list[float]] | None:

@@ -17,11 +17,21 @@ import numpy as np
 
 from pneumorph import checks
 from pneumorph.design.config import DesignConfig
-from pneumorph.design.targets import PRESETS, TIP_GOALS, Objective, make_objective, smooth_curve
+from pneumorph.design.targets import (
+    MAX_STAGES,
+    PRESETS,
+    TIP_GOALS,
+    Objective,
+    make_objective,
+    smooth_curve,
+    staged_target,
+)
 from pneumorph.errors import PneumorphError, SettingsError
 from pneumorph.io.files import nested_deeper
 
-KINDS = ("preset", "expression", "tip", "curve")
+KINDS = ("preset", "expression", "tip", "curve", "stages")
+#: the kinds of target a stage may hold (a stage's tip goal is ``reach``)
+STAGE_KINDS = ("preset", "expression", "tip", "curve")
 MODELS = ("3d", "2d")
 MAX_TOP = 100
 MAX_TEXT = 400
@@ -53,7 +63,7 @@ class Query:
 
     Attributes
     ----------
-    kind : {"preset", "expression", "tip", "curve"}
+    kind : {"preset", "expression", "tip", "curve", "stages"}
     spec : str
         The objective's text for :func:`~pneumorph.design.targets.make_objective` ("sin",
         "y = ...", "max-x", "curve").
@@ -67,6 +77,9 @@ class Query:
         Designs listed, best first.
     unit : str
         ``"builtin"`` or the id of a unit uploaded to the bench.
+    stages : tuple of (float, float, Query), optional
+        For ``kind = "stages"``: per stage its pressure (kPa), its weight and its target (a
+        query of one of :data:`STAGE_KINDS`).
     """
 
     kind: str
@@ -78,9 +91,12 @@ class Query:
     model: str = "3d"
     top: int = 10
     unit: str = "builtin"
+    stages: tuple[tuple[float, float, Query], ...] | None = None
 
     def objective(self, length: float) -> Objective:
-        """The objective, a profile checked along ``length`` mm."""
+        """The objective, a profile checked along ``length`` mm (stages: their staged target)."""
+        if self.stages is not None:
+            return staged_target([(p * 1e-3, q.objective(length), w) for p, w, q in self.stages])
         return make_objective(self.spec, self.amplitude, self.periods, self.point, length=length, curve=self.curve)
 
     def key(self) -> str:
@@ -97,9 +113,11 @@ class Query:
         >>> Query.from_dict(json.loads(q.key())) == q
         True
         """
-        point, curve = data.get("point"), data.get("curve")
+        point, curve, stages = data.get("point"), data.get("curve"), data.get("stages")
         return cls(**{**data, "point": None if point is None else (float(point[0]), float(point[1])),
-                      "curve": None if curve is None else tuple((float(x), float(y)) for x, y in curve)})
+                      "curve": None if curve is None else tuple((float(x), float(y)) for x, y in curve),
+                      "stages": None if stages is None else tuple((float(p), float(w), cls.from_dict(q))
+                                                                  for p, w, q in stages)})
 
     def config(self, units: int, model: dict[str, Any] | None = None, **settings: Any) -> DesignConfig:
         """The design run of this query (certified search on its model), as the CLI would run it.
@@ -108,6 +126,13 @@ class Query:
         fidelity of the built-in unit).
         """
         model = dict(model) if model is not None else {"fidelity": self.model}
+        if self.stages is not None:
+            stage = tuple({"pressure_kpa": p, "weight": w, "objective": q.spec, "amplitude": q.amplitude,
+                           "periods": q.periods, **({"point": list(q.point)} if q.point is not None else {}),
+                           **({"curve": [list(c) for c in q.curve]} if q.curve is not None else {})}
+                          for p, w, q in self.stages)
+            return DesignConfig(objective="stages", stage=stage, units=units, search="certified", model=model,
+                                **settings)
         return DesignConfig(objective=self.spec, amplitude=self.amplitude, periods=self.periods, point=self.point,
                             curve=self.curve, units=units, search="certified", model=model, **settings)
 
@@ -227,31 +252,12 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
         raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}; upload its TOML file to build its chain table "
                                  "first")
     fields: dict[str, Any] = {"kind": kind, "model": model, "top": top, "unit": unit}
-    if kind == "preset":
-        name = choice(target.get("name", "sin"), PRESETS, "preset", "the preset")
-        fields.update(spec=name, amplitude=_number(target, "amplitude", 10.0, 0.0, 1e4),
-                      periods=_number(target, "periods", 1.0, 0.0, 1000.0))
-        blame = "amplitude"
-    elif kind == "expression":
-        fields.update(spec=_text(target, "expression"), amplitude=_number(target, "amplitude", 10.0, 0.0, 1e4))
-        blame = "expression"
-    elif kind == "tip":
-        goal = choice(target.get("goal"), tuple(TIP_GOALS), "goal", "the tip goal")
-        point = target.get("point")
-        if goal == "reach":
-            try:
-                point = checks.pair(point, "point", unit="mm", error=SettingsError)
-            except SettingsError as exc:
-                raise QueryError("point", str(exc)) from None
-        fields.update(spec=goal, point=point if goal == "reach" else None)
-        blame = "point" if goal == "reach" else "goal"
+    if kind == "stages":
+        fields.update(spec="stages", stages=_stages(target.get("stages"), length, model, unit))
+        blame = "stages"
     else:
-        try:
-            knots = smooth_curve(target.get("points", []), length)
-        except PneumorphError as exc:
-            raise QueryError("points", str(exc)) from None
-        fields.update(spec="curve", curve=tuple((float(x), float(y)) for x, y in np.round(knots, 6)))
-        blame = "points"
+        target_fields, blame = _target_fields(kind, target, length)
+        fields.update(target_fields)
     query = Query(**fields)
     try:
         query.objective(length)
@@ -260,4 +266,56 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
     return query
 
 
-__all__ = ["KINDS", "MAX_DEPTH", "MODELS", "Query", "QueryError", "choice", "load_json", "parse_query"]
+def _target_fields(kind: str, target: dict[str, Any], length: float) -> tuple[dict[str, Any], str]:
+    """The :class:`Query` fields of one target (not stages) and the field to blame for a bad one."""
+    if kind == "preset":
+        name = choice(target.get("name", "sin"), PRESETS, "preset", "the preset")
+        return {"spec": name, "amplitude": _number(target, "amplitude", 10.0, 0.0, 1e4),
+                "periods": _number(target, "periods", 1.0, 0.0, 1000.0)}, "amplitude"
+    if kind == "expression":
+        return {"spec": _text(target, "expression"),
+                "amplitude": _number(target, "amplitude", 10.0, 0.0, 1e4)}, "expression"
+    if kind == "tip":
+        goal = choice(target.get("goal"), tuple(TIP_GOALS), "goal", "the tip goal")
+        point = target.get("point")
+        if goal == "reach":
+            try:
+                point = checks.pair(point, "point", unit="mm", error=SettingsError)
+            except SettingsError as exc:
+                raise QueryError("point", str(exc)) from None
+        return {"spec": goal, "point": point if goal == "reach" else None}, "point" if goal == "reach" else "goal"
+    try:
+        knots = smooth_curve(target.get("points", []), length)
+    except PneumorphError as exc:
+        raise QueryError("points", str(exc)) from None
+    return {"spec": "curve", "curve": tuple((float(x), float(y)) for x, y in np.round(knots, 6))}, "points"
+
+
+def _stages(stages: Any, length: float, model: str, unit: str) -> tuple[tuple[float, float, Query], ...]:
+    """The stages of a ``kind = "stages"`` target: ``[{"pressure_kpa": P, "target": {...}, "weight": w}, ...]``."""
+    if not isinstance(stages, list) or not 1 <= len(stages) <= MAX_STAGES:
+        raise QueryError("stages", f"stages must be a list of 1 to {MAX_STAGES} stages (a pressure and a target "
+                                   "each)")
+    out = []
+    for i, stage in enumerate(stages, 1):
+        if not isinstance(stage, dict) or not isinstance(stage.get("target"), dict) or "pressure_kpa" not in stage:
+            raise QueryError("stages", f"stage {i} must be an object with pressure_kpa (kPa, a level of the ramp) "
+                                       "and a target")
+        try:
+            pressure = _number(stage, "pressure_kpa", float("nan"), 0.0, 1e4)
+            weight = _number(stage, "weight", 1.0, 0.0, 1e6)
+        except QueryError as exc:
+            raise QueryError("stages", f"stage {i}: {exc.message}") from None
+        if not pressure > 0 or not weight > 0:
+            raise QueryError("stages", f"stage {i}: the pressure and the weight must be positive")
+        kind = choice(stage["target"].get("kind"), STAGE_KINDS, "stages", f"stage {i}'s target kind")
+        try:
+            fields, _ = _target_fields(kind, stage["target"], length)
+        except QueryError as exc:
+            raise QueryError("stages", f"stage {i}: {exc.message}") from None
+        out.append((pressure, weight, Query(kind=kind, model=model, unit=unit, **fields)))
+    return tuple(out)
+
+
+__all__ = ["KINDS", "MAX_DEPTH", "MODELS", "STAGE_KINDS", "Query", "QueryError", "choice", "load_json",
+           "parse_query"]
