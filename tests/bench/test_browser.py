@@ -151,6 +151,38 @@ def test_a_drawn_curve(browser) -> None:  # type: ignore[no-untyped-def]
     _shot(browser, "drawn")
 
 
+def _stroke(browser, canvas_id: str, rise: int) -> None:  # type: ignore[no-untyped-def]
+    canvas = _el(browser, canvas_id)
+    w = canvas.size["width"]
+    chain = ActionChains(browser).move_to_element_with_offset(canvas, -w // 2 + 12, 0).click_and_hold()
+    for _ in range(40):  # a straight stroke along the whole length, rising by `rise` px a step
+        chain = chain.move_by_offset((w - 30) // 40, -rise)
+    chain.release().perform()
+
+
+def test_stages_drawn_at_two_pressures(browser) -> None:  # type: ignore[no-untyped-def]
+    """Two drawn stages at 18 and 45 kPa: one design for both, each stage's target drawn over the ramp."""
+    browser.get_log("browser")  # the earlier tests' entries (a refused expression among them)
+    Select(_el(browser, "target-kind")).select_by_value("stages")
+    _el(browser, "stage-add").click()
+    assert "draw the stage's curve first" in _el(browser, "stages-error").text
+    _stroke(browser, "stage-canvas", 0)
+    Select(_el(browser, "stage-pressure")).select_by_visible_text("18 kPa")
+    _el(browser, "stage-add").click()
+    _stroke(browser, "stage-canvas", 2)
+    Select(_el(browser, "stage-pressure")).select_by_visible_text("45 kPa")
+    _el(browser, "stage-add").click()
+    items = browser.find_elements(By.CSS_SELECTOR, "#stage-list li")
+    assert [i.text.split(":")[0] for i in items] == ["18 kPa", "45 kPa"]
+    _wait(lambda: _el(browser, "winner-label").text.startswith("stages: 18 kPa") and "; 45 kPa" in
+          _el(browser, "winner-label").text and _answered(browser))
+    assert len(_el(browser, "winner-design").text) == 15 and "45.0 kPa" in _el(browser, "winner-pressure").text
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    _shot(browser, "stages")
+    items[0].find_element(By.TAG_NAME, "button").click()  # remove the 18 kPa stage
+    _wait(lambda: _el(browser, "winner-label").text.startswith("stages: 45 kPa") and _answered(browser))
+
+
 def test_switching_model_and_verifying_by_fe_survives_a_reload(browser) -> None:  # type: ignore[no-untyped-def]
     Select(_el(browser, "target-kind")).select_by_value("preset")
     _retype(_el(browser, "amplitude"), "10")

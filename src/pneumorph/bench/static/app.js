@@ -5,9 +5,11 @@ import { DrawArea } from "./draw.js";
 
 const $ = (id) => document.getElementById(id);
 const state = { info: null, answer: null, seq: 0, selected: null, profiles: null, curve: null, job: null,
-  polling: new Set(), shapeSeq: 0 };
+  polling: new Set(), shapeSeq: 0, stages: [], stageCurve: null };
 const ACTIVE = ["queued", "running"];
-const FIELDS = ["target", "preset", "amplitude", "periods", "expression", "goal", "point", "points", "model", "unit", "top"];
+const FIELDS = ["target", "preset", "amplitude", "periods", "expression", "goal", "point", "points", "stages", "model", "unit",
+  "top"];
+const STAGE_COLOURS = ["#e07b1a", "#8250df", "#1a7f37", "#cf222e", "#bf8700", "#0a7ea4"];
 
 async function api(path, options = {}) {
   const response = await fetch(path, { credentials: "same-origin", ...options });
@@ -35,6 +37,8 @@ function currentBody() {
   else if (kind === "tip") {
     target = { kind, goal: $("goal").value };
     if (target.goal === "reach") target.point = [number("point-x"), number("point-y")];
+  } else if (kind === "stages") {
+    target = { kind, stages: state.stages.map((st) => ({ pressure_kpa: st.pressure_kpa, target: { kind: "curve", points: st.points } })) };
   } else target = { kind, points: state.curve || [] };
   return { target, model: $("model").value, unit: $("unit").value, top: 10 };
 }
@@ -60,6 +64,7 @@ function schedule() {
 
 async function ask() {
   if ($("target-kind").value === "curve" && !state.curve) return;   // nothing drawn yet
+  if ($("target-kind").value === "stages" && !state.stages.length) return;   // no stage added yet
   const seq = ++state.seq;
   $("answer").dataset.state = "loading";
   try {
@@ -107,7 +112,18 @@ function redraw() {
   const k = Number($("pressure-slider").value);
   $("slider-value").textContent = `${a.pressures_kpa[k].toFixed(1)} kPa`;
   const target = a.target ? a.target.x.map((x, i) => [x, a.target.y[i]]) : null;
-  drawProfile($("profile-plot"), { target, point: a.point, profile: state.profiles[k], label: `design ${state.selected}` });
+  // stages: every stage's target (the one at this level drawn bold) and the whole ramp behind the profile
+  const stages = (a.stages || []).map((st, i) => ({
+    points: st.target ? st.target.x.map((x, j) => [x, st.target.y[j]]) : null, point: st.point,
+    colour: STAGE_COLOURS[i % STAGE_COLOURS.length], current: st.level === k, label: `${st.pressure_kpa} kPa target`,
+  }));
+  drawProfile($("profile-plot"), { target, point: a.point, profile: state.profiles[k], label: `design ${state.selected}`,
+    stages, ramp: a.stages ? state.profiles : null });
+}
+
+function renderStages() {
+  $("stage-list").innerHTML = state.stages.map((st, i) => `<li style="color:${STAGE_COLOURS[i % STAGE_COLOURS.length]}">` +
+    `${st.pressure_kpa} kPa: a drawn curve (${st.points.length} points) <button type="button" data-stage="${i}">remove</button></li>`).join("");
 }
 
 async function select(design) {
@@ -232,6 +248,7 @@ function showKind() {
 
 const viewer = new Viewer($("viewer"));
 let drawArea = null;
+let stageArea = null;
 
 async function main() {
   state.info = await api("/api/info");
@@ -244,6 +261,24 @@ async function main() {
     if ($(id).tagName === "SELECT") $(id).addEventListener("change", changed);
   }
   $("draw-clear").addEventListener("click", () => { drawArea.clear(); state.curve = null; });
+  stageArea = new DrawArea($("stage-canvas"), state.info.length_mm, (points) => { state.stageCurve = points; });
+  $("stage-pressure").innerHTML = state.info.pressures_kpa.map((p) => `<option value="${p}">${+p.toFixed(3)} kPa</option>`).join("");
+  $("stage-pressure").value = String(state.info.pressures_kpa[state.info.pressures_kpa.length - 1]);
+  $("stage-add").addEventListener("click", () => {
+    clearErrors();
+    if (!state.stageCurve) { showError("stages", "draw the stage's curve first"); return; }
+    const pressure = Number($("stage-pressure").value);
+    state.stages = state.stages.filter((st) => st.pressure_kpa !== pressure);   // one stage per pressure: the newest
+    state.stages.push({ pressure_kpa: pressure, points: state.stageCurve });
+    state.stages.sort((a, b) => a.pressure_kpa - b.pressure_kpa);
+    state.stageCurve = null; stageArea.clear(); renderStages(); schedule();
+  });
+  $("stage-clear").addEventListener("click", () => { state.stages = []; renderStages(); });
+  $("stage-list").addEventListener("click", (e) => {
+    const b = e.target.closest("button[data-stage]");
+    if (!b) return;
+    state.stages.splice(Number(b.dataset.stage), 1); renderStages(); schedule();
+  });
   $("pressure-slider").addEventListener("input", () => { redraw(); loadShape(); });
   $("top-table").addEventListener("click", (e) => { const tr = e.target.closest("tr[data-design]"); if (tr) select(tr.dataset.design); });
   $("verify-button").addEventListener("click", () => start({ kind: "verify", query: currentBody() }));

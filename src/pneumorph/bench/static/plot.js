@@ -22,14 +22,18 @@ function bounds(sets) {
 }
 
 // Draw on `canvas`: {target: [[x, y]...] or null, point: [x, y] or null,
-// profile: [[x, y]...] (base, centres, tip), label: string, clip: [xmin, xmax, ymin, ymax] optional}.
-export function drawProfile(canvas, { target, point, profile, label }) {
+// profile: [[x, y]...] (base, centres, tip), label: string,
+// stages: [{points, point, colour, current, label}] (a staged target's stages) and
+// ramp: the profiles of every level (drawn faint behind the profile), both optional}.
+export function drawProfile(canvas, { target, point, profile, label, stages = [], ramp = null }) {
   const ctx = canvas.getContext("2d");
   const W = canvas.width, H = canvas.height, pad = { l: 48, r: 14, t: 14, b: 34 };
   ctx.clearRect(0, 0, W, H);
   const sets = [profile || [], [[0, 0]]];
   if (target) sets.push(target);
   if (point) sets.push([point]);
+  for (const st of stages) { if (st.points) sets.push(st.points); if (st.point) sets.push([st.point]); }
+  if (ramp) ramp.forEach((pts) => sets.push(pts));
   let [x0, x1, y0, y1] = bounds(sets);
   const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
   const pw = W - pad.l - pad.r, ph = H - pad.t - pad.b;
@@ -68,11 +72,17 @@ export function drawProfile(canvas, { target, point, profile, label }) {
     pts.forEach(([x, y], i) => (i ? ctx.lineTo(X(x), Y(y)) : ctx.moveTo(X(x), Y(y))));
     ctx.stroke();
   };
-  if (target) line(target, "#e07b1a", 2.5);
-  if (point) {
-    ctx.strokeStyle = "#e07b1a"; ctx.lineWidth = 2;
-    const [px, py] = [X(point[0]), Y(point[1])];
+  const cross = (pt, colour) => {
+    ctx.strokeStyle = colour; ctx.lineWidth = 2;
+    const [px, py] = [X(pt[0]), Y(pt[1])];
     ctx.beginPath(); ctx.moveTo(px - 7, py); ctx.lineTo(px + 7, py); ctx.moveTo(px, py - 7); ctx.lineTo(px, py + 7); ctx.stroke();
+  };
+  if (ramp) ramp.forEach((pts) => line(pts, "#d0d7de", 1));
+  if (target) line(target, "#e07b1a", 2.5);
+  if (point) cross(point, "#e07b1a");
+  for (const st of stages) {
+    if (st.points) line(st.points, st.colour, st.current ? 3 : 1.5);
+    if (st.point) cross(st.point, st.colour);
   }
   if (profile && profile.length) {
     line(profile, "#0b6bcb", 2);
@@ -88,5 +98,7 @@ export function drawProfile(canvas, { target, point, profile, label }) {
     ctx.fillStyle = "#1f2328"; ctx.fillText(text, pad.l + 30, ly - 3); ly += 16;
   };
   if (target || point) legend("#e07b1a", target ? "target" : "tip goal");
+  for (const st of stages) legend(st.colour, st.current ? `${st.label} (this level)` : st.label);
+  if (ramp) legend("#d0d7de", "the ramp: every level");
   if (profile) legend("#0b6bcb", label || "unit centres");
 }
