@@ -140,11 +140,18 @@ def test_design_with_stages_on_the_command_line(tmp_path: Path, capsys: pytest.C
     assert config.stage is not None and config.stage[1]["amplitude"] == 4.0
 
 
-def test_branch_and_bound_over_stages_keeps_every_design_that_matters() -> None:
+@pytest.mark.parametrize("refine_at", [None, 0])
+def test_branch_and_bound_over_stages_keeps_every_design_that_matters(refine_at: int | None,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     """30-unit-style growth on 15 units of the shipped 3D table: forced past enumeration, it keeps every design
-    whose enumerated cost is below its threshold, with the same cost, and the same best design."""
+    whose enumerated cost is below its threshold, with the same cost, and the same best design; also with the
+    profile stages' bound on the centres still to place at every depth (``REFINE_AT = 0``)."""
+    from pneumorph.design import growth
     from pneumorph.models.chain import ChainTable
     from pneumorph.models.chaintables import shipped_path
+
+    if refine_at is not None:
+        monkeypatch.setattr(growth, "REFINE_AT", refine_at)
 
     chain = ChainModel(ChainTable.load(shipped_path("3d")), 15)
     staged = staged_target([(0.018, make_objective("y = 0.05*x")),
@@ -160,6 +167,34 @@ def test_branch_and_bound_over_stages_keeps_every_design_that_matters() -> None:
     assert must and must <= set(kept)
     assert all(abs(kept[d] - names[d]) < 1e-9 for d in kept)
     assert design_strings(grown.bits[grown.order()[:1]]) == design_strings(every.bits[every.order()[:1]])
+
+
+def test_the_stages_bound_on_the_centres_still_to_place_drops_no_design_below_the_threshold(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Admissible: with each profile stage's bound on its centres still to place at every depth (``REFINE_AT =
+    0``), branch-and-bound at thresholds across the enumerated costs (all 4^7 designs of the 3D bending and
+    near-rigid table) returns every design below the threshold."""
+    from pneumorph.design import growth
+    from pneumorph.models.chain import ChainTable
+
+    monkeypatch.setattr(growth, "REFINE_AT", 0)
+    table = ChainTable.load(Path(__file__).resolve().parents[2] / "examples" / "libraries"
+                            / "chain-3d-bending-rigid.json")
+    chain = ChainModel(table, 7)
+    staged = staged_target([(0.018, make_objective("y = 0.02*x", length=chain.length)),
+                            (0.045, make_objective("sin", amplitude=10.0, length=chain.length), 2.0)])
+    errors = chain_errors(chain)
+    every = growth.grow_designs(chain, staged, errors)
+    assert len(every.cost) == 4**7
+    names = dict(zip(table.texts(every.bits), every.cost, strict=True))
+    for q in (0.001, 0.01, 0.1, 0.5):
+        threshold = float(np.quantile(every.cost, q))
+        grown = growth.grow_designs(chain, staged, errors, threshold)
+        kept = set(table.texts(grown.bits))
+        must = {d for d, c in names.items() if c < threshold}
+        assert must and must <= kept
+        if q <= 0.01:
+            assert len(kept) < 4**7 / 4  # and the bound prunes
 
 
 def test_a_target_through_a_designs_own_centres_at_two_pressures_gives_it_back() -> None:

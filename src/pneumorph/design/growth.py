@@ -412,6 +412,22 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
         c0 = float(found.cost.min())
 
 
+def _staged_rest(chain: ChainModel, profiles: list[tuple[int, ProfileTarget, int]], ranges: dict[int, CurveRange],
+                 bits: NDArray[np.uint8], state: dict[str, Any], placed: int) -> FloatArray:
+    """Per prefix and stage, a lower bound on the squared Eq 4.1 terms of the centres not yet fixed (m, S): the
+    profile bound of :func:`~pneumorph.design.rest.profile_rest` at each Cartesian profile stage's level, 0 for
+    the other stages."""
+    rest = np.zeros((len(bits), len(state["ssum"][0])))
+    if not len(bits):
+        return rest
+    reach = reach_of(chain, "centre")
+    for i, _, k in profiles:
+        if i in ranges:
+            rest[:, i] = profile_rest(reach, chain.table.heights, ranges[i], bits, state["point"], state["angle"],
+                                      placed, chain.n_units, chain.table.window)[:, k]
+    return rest
+
+
 def _union(a: ChainScores, b: ChainScores) -> ChainScores:
     """The designs of ``a`` and those of ``b`` that ``a`` lacks (their scores as they are)."""
     extra = ~np.isin(design_numbers(b.bits, b.choices), design_numbers(a.bits, a.choices))
@@ -440,19 +456,29 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     weights = objective.weights
     profiles = [(i, st.target, levels[i]) for i, st in enumerate(objective.stages)
                 if isinstance(st.target, ProfileTarget)]
+    ranges = {i: _curve_range(chain, target, errors, slope) for i, target, _ in profiles
+              if target.coordinates == "cartesian" and np.isfinite(slope := _target_slope(chain, target, errors))}
+    refine = False
     bits, state = seed_prefixes(chain)
     spilled: list[float] | None = [] if spill else None
     state["ssum"] = np.zeros((len(bits), len(objective.stages)))
     with np.errstate(all="ignore"):
         growth = depths(chain, bits, state)
-        for p, _placed, bits, state, centres in growth:
+        for p, placed, bits, state, centres in growth:
             for _, x, y in centres:
                 for i, target, k in profiles:
                     state["ssum"][:, i] += (target.curve(x[:, k], length) - y[:, k]) ** 2
             if p == n:
                 continue
             bound = np.sqrt(((weights**2) * state["ssum"]).sum(axis=1))
-            keep = _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled)
+            keep = bound < threshold
+            if ranges and (refine or keep.sum() > REFINE_AT) and _uses_reach(chain, p):
+                refine = True  # each profile stage's centres still to place, at its level (module docstring)
+                rest = _staged_rest(chain, profiles, ranges, bits[keep], {key: v[keep] for key, v in state.items()},
+                                    placed)
+                bound[keep] = np.sqrt(((weights**2) * (state["ssum"][keep] + rest)).sum(axis=1))
+                keep = bound < threshold
+            keep = _narrow(keep, bound, beam, max_nodes, p, n, spilled)
             bits = bits[keep]
             state = {key: v[keep] for key, v in state.items()}
             growth.send((bits, state))
