@@ -317,46 +317,9 @@ class ChainTable:
                 raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT}, "
                                       f"{ALPHABET_FORMAT} or {TERMS_FORMAT}")
             w = int(data["window"])
-            alphabet: tuple[str, ...] = ()
-            symmetric: tuple[str, ...] = ()
-            geometry: dict[str, Any] = {}
-            if fmt == ALPHABET_FORMAT or (fmt == TERMS_FORMAT and "alphabet" in data):
-                from pneumorph.geometry.library import check_symbol
-
-                alphabet = tuple(check_symbol(a, where) for a in data["alphabet"])
-                if len(alphabet) < 2 or len(set(alphabet)) != len(alphabet):
-                    raise ChainTableError(f"{where}: a table over unit types needs two or more distinct symbols, "
-                                          f"got {list(alphabet)}")
-                types = data["types"]
-                symmetric = tuple(check_symbol(a, where) for a in data.get("symmetric", []))
-                geometry = {
-                    "type_pitch": tuple(float(types[a]["pitch_mm"]) for a in alphabet),
-                    "type_offset": tuple(float(types[a]["centre_offset_mm"]) for a in alphabet),
-                    "type_centre_y": tuple(float(y) for a in alphabet for y in types[a]["centre_y_mm"][:2]),
-                }
-
-            def codes_of(texts: list[str]) -> IntArray:
-                out = []
-                for t in texts:
-                    if not isinstance(t, str) or len(t) != 2 * w + 1:
-                        raise ChainTableError(f"{where}: bad window {t!r}")
-                    out.append(window_code(t, alphabet))
-                return np.array(out, dtype=np.int64)
-
+            alphabet, symmetric, geometry = _types_of(data, fmt, where)
             pressures = np.array(data["pressures_mpa"], dtype=float)
-            terms: dict[str, Any] = {}
-            arrays: dict[str, Any]
-            if fmt == TERMS_FORMAT:
-                terms = terms_from_dict(data["terms"])
-                if int(terms["window"]) + 1 != w:
-                    raise ChainTableError(f"far-field terms of window +-{terms['window']} in a table of +-{w}")
-                sym = tuple(alphabet.index(s) for s in symmetric)
-                arrays = compile_terms(terms, terms["n_units"], max(1, len(alphabet)), sym, len(pressures))
-            else:
-                arrays = {"codes": codes_of(data["windows"]), "turn": np.array(data["turn_rad"], dtype=float),
-                          "length": np.array(data["length_mm"], dtype=float),
-                          "end_codes": codes_of(data["end_windows"]),
-                          "end": np.array(data["end_turn_rad"], dtype=float)}
+            arrays = _entries_of(data, fmt, w, alphabet, symmetric, len(pressures), where)
             table = cls(
                 window=w,
                 pressures=pressures,
@@ -372,7 +335,6 @@ class ChainTable:
                 metadata=dict(data.get("metadata", {})),
                 alphabet=alphabet,
                 symmetric=symmetric,
-                terms=terms,
                 **geometry,
             )
         except ChainTableError as exc:
@@ -421,3 +383,47 @@ class ChainTable:
         if not isinstance(data, dict):
             raise ChainTableError(f"{path}: not a chain table")
         return cls.from_dict(data, where=str(path))
+
+
+def _types_of(data: dict[str, Any], fmt: Any, where: str) -> tuple[tuple[str, ...], tuple[str, ...], dict[str, Any]]:
+    """The alphabet, the symmetric types and the per-type geometry of a table file (empty for one unit type)."""
+    if not (fmt == ALPHABET_FORMAT or (fmt == TERMS_FORMAT and "alphabet" in data)):
+        return (), (), {}
+    from pneumorph.geometry.library import check_symbol
+
+    alphabet = tuple(check_symbol(a, where) for a in data["alphabet"])
+    if len(alphabet) < 2 or len(set(alphabet)) != len(alphabet):
+        raise ChainTableError(f"{where}: a table over unit types needs two or more distinct symbols, "
+                              f"got {list(alphabet)}")
+    types = data["types"]
+    symmetric = tuple(check_symbol(a, where) for a in data.get("symmetric", []))
+    geometry = {
+        "type_pitch": tuple(float(types[a]["pitch_mm"]) for a in alphabet),
+        "type_offset": tuple(float(types[a]["centre_offset_mm"]) for a in alphabet),
+        "type_centre_y": tuple(float(y) for a in alphabet for y in types[a]["centre_y_mm"][:2]),
+    }
+    return alphabet, symmetric, geometry
+
+
+def _entries_of(data: dict[str, Any], fmt: Any, w: int, alphabet: tuple[str, ...], symmetric: tuple[str, ...],
+                levels: int, where: str) -> dict[str, Any]:
+    """A table file's entries (``codes`` .. ``end``), from its windows or written out from its far-field terms
+    (then with ``terms``)."""
+    if fmt == TERMS_FORMAT:
+        terms = terms_from_dict(data["terms"])
+        if int(terms["window"]) + 1 != w:
+            raise ChainTableError(f"far-field terms of window +-{terms['window']} in a table of +-{w}")
+        sym = tuple(alphabet.index(s) for s in symmetric)
+        return {**compile_terms(terms, terms["n_units"], max(1, len(alphabet)), sym, levels), "terms": terms}
+
+    def codes_of(texts: list[str]) -> IntArray:
+        out = []
+        for t in texts:
+            if not isinstance(t, str) or len(t) != 2 * w + 1:
+                raise ChainTableError(f"{where}: bad window {t!r}")
+            out.append(window_code(t, alphabet))
+        return np.array(out, dtype=np.int64)
+
+    return {"codes": codes_of(data["windows"]), "turn": np.array(data["turn_rad"], dtype=float),
+            "length": np.array(data["length_mm"], dtype=float), "end_codes": codes_of(data["end_windows"]),
+            "end": np.array(data["end_turn_rad"], dtype=float)}
