@@ -11,7 +11,7 @@ import pytest
 from pneumorph.cli import main
 from pneumorph.correlation import ModelShape, model_shape
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.identify import ParameterSet, chain_shape, precheck_designs
+from pneumorph.identify import ParameterSet, chain_shape, chain_shapes, precheck_designs
 from pneumorph.identify.fit import _size
 from pneumorph.models.factory import make_model
 from tests.identify.conftest import synthetic
@@ -41,6 +41,20 @@ def test_no_chain_shape_without_a_table_level_at_the_pressure() -> None:
                        "0" * 9) is None  # another model: no table
 
 
+@pytest.mark.parametrize("design", ["001111010001001", "0101010101", "11111111"])
+@pytest.mark.parametrize("kpa", [20, 37])
+def test_between_two_levels_the_solved_size_lies_between_the_chain_shapes(design: str, kpa: float) -> None:
+    """2D, nominal unit, a pressure between two levels of the shipped table: the solved shape spans between the
+    chain shapes at the two levels, up to the 2.5 % the chain shape lacks (measured: 0.53 to 2.7 % above the
+    smaller, at most 1.75 % above the larger)."""
+    shapes = chain_shapes({"fidelity": "2d", "pressure_kpa": kpa}, design)
+    assert len(shapes) == 2
+    sizes = [_size(_cloud(s)) for s in shapes]
+    solved = _size(_cloud(model_shape(make_model(len(design), {"fidelity": "2d", "pressure_kpa": kpa}).solve(design))))
+    assert min(sizes) <= solved <= 1.025 * max(sizes)
+    assert chain_shapes({"fidelity": "2d", "pressure_kpa": 3}, design) == []  # below the table's first level
+
+
 def test_precheck_counts_the_scans_it_could_check(coarse: ParameterSet) -> None:
     params = ParameterSet(UnitSpec())
     right = synthetic(params, params.nominal, "0101010101", "2d", seed=1)
@@ -60,4 +74,20 @@ def test_another_unit_count_is_refused_before_any_solve(tmp_path: Path, capsys: 
                  "--executor", "serial", "--cache", str(cache), "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "by its chain table" in err[0] and "is it the design scanned" in err[0]
+    assert not cache.exists() and not out.exists()
+
+
+def test_another_unit_count_between_levels_is_refused_before_any_solve(tmp_path: Path,
+                                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """At 37 kPa (between the table's 36 and 40.5 kPa) a 15-unit trace given as 10 units: refused by the chain
+    shapes at both levels, before any solve."""
+    params = ParameterSet(UnitSpec())
+    obs = synthetic(params, params.nominal, "001111010001001", "2d", seed=3, pressure_kpa=37)
+    trace = tmp_path / "trace.csv"
+    np.savetxt(trace, obs.scan.points, delimiter=",", header="x,y", comments="")
+    cache, out = tmp_path / "c.sqlite", tmp_path / "out"
+    code = main(["identify", str(trace), "--design", "0011110100", "--pressure", "37", "--model", "2d",
+                 "--executor", "serial", "--cache", str(cache), "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "levels around it" in err[0] and "is it the design scanned" in err[0]
     assert not cache.exists() and not out.exists()

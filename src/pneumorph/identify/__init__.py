@@ -7,7 +7,7 @@ mould thicknesses of Fig E.4 by least squares on the correlation distances
 and ``simulate`` take (:func:`identified_toml`).
 """
 
-from pneumorph.identify.extent import chain_shape, rigid_units
+from pneumorph.identify.extent import chain_shape, chain_shapes, rigid_units
 from pneumorph.identify.fit import (
     MAX_CORRELATION,
     MAX_ITERATIONS,
@@ -43,6 +43,7 @@ __all__ = [
     "ShapeProbe",
     "build_probes",
     "chain_shape",
+    "chain_shapes",
     "confounded",
     "identified_toml",
     "identify",

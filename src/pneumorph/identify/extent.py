@@ -8,7 +8,8 @@ model, :mod:`pneumorph.models.chain`) place every unit of the undeformed mesh as
 body, turned by the mean turn of the two chords at its centre. The walls do not balloon in
 this shape, so its size is a little smaller than the solved one's;
 :data:`~pneumorph.identify.fit.CHAIN_MARGIN` widens the size check by what that was measured
-to cost (docs/identify.md).
+to cost (docs/identify.md). A pressure between two of a table's levels is checked against
+the shapes at both (:func:`chain_shapes`): the size between them.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from pneumorph.correlation.compare import ModelShape, model_shape
 from pneumorph.geometry.assembly import ActuatorMesh, unit_starts
 from pneumorph.models.chain import ChainModel
 from pneumorph.models.chaintables import serve_table
+from pneumorph.models.factory import make_model
 
 FloatArray = NDArray[np.float64]
 
@@ -52,6 +54,42 @@ def chain_shape(model: Any, design: str, folder: str | Path | None = None) -> Mo
     response = ChainModel(served.table, n).evaluate(design)
     mesh = model.mesh(design)
     return model_shape(SimpleNamespace(mesh=mesh, displacements=[rigid_units(mesh, response)]))
+
+
+def chain_shapes(settings: dict[str, Any], design: str, folder: str | Path | None = None) -> list[ModelShape]:
+    """The chain shapes that bracket ``design`` at the model ``settings``' pressure (``pressure_kpa``).
+
+    One shape where a table has a level at that pressure (:func:`chain_shape`); else the two at
+    the levels just below and above it, of the table of the same model on its default ramp;
+    none past the table's levels, below its first, or without a table.
+
+    Examples
+    --------
+    >>> shapes = chain_shapes({"fidelity": "2d", "pressure_kpa": 37}, "001111010001001")  # levels 36 and 40.5
+    >>> len(shapes), [round(float(s.extent), 1) for s in shapes]
+    (2, [172.9, 176.1])
+    """
+    n = len(design)
+    shape = chain_shape(make_model(n, settings), design, folder)
+    if shape is not None:
+        return [shape]
+    default = {k: v for k, v in settings.items() if k not in ("pressure_kpa", "increments")}
+    served = serve_table(make_model(n, default), folder)
+    if served is None:
+        return []
+    levels = served.table.pressures
+    p = float(settings.get("pressure_kpa", np.nan)) * 1e-3
+    below, above = np.flatnonzero(levels < p), np.flatnonzero(levels > p)
+    if not (len(below) and len(above)):
+        return []
+    out = []
+    for i in (below[-1], above[0]):
+        at_level = {**default, "pressure_kpa": float(levels[i]) * 1e3, "increments": int(i) + 1}
+        shape = chain_shape(make_model(n, at_level), design, folder)
+        if shape is None:
+            return []
+        out.append(shape)
+    return out
 
 
 def rigid_units(mesh: ActuatorMesh, response: Any, level: int = -1) -> FloatArray:

@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 from pneumorph.correlation.compare import ModelShape, check_units, correlate
 from pneumorph.correlation.scans import Scan
 from pneumorph.errors import FitError, ScanError
-from pneumorph.identify.extent import chain_shape
+from pneumorph.identify.extent import chain_shapes
 from pneumorph.identify.linear import (
     MAX_CORRELATION,
     MIN_EIGENVALUE,
@@ -173,28 +173,34 @@ def _sample(scan: Scan, seed: int) -> FloatArray:
     return p[np.sort(np.random.default_rng(seed).choice(len(p), MAX_POINTS, replace=False))]
 
 
-def check_design(observation: Observation, shape: ModelShape, margin: float = 0.0) -> None:
+def check_design(observation: Observation, shape: ModelShape | Sequence[ModelShape], margin: float = 0.0) -> None:
     """Refuse a scan whose size is not its design's (another unit count): before the fit's many solves.
 
     The scan must span within :data:`MATCH_RANGE` times the nominal model's deformed shape
     (the diagonal of the box along their principal axes, whichever way the scan lies);
     a cast off the model by the parameters the fit can change spans within a few percent
     of it. ``margin`` widens the range both ways for a shape only estimated (before any
-    solve, :func:`~pneumorph.identify.extent.chain_shape`: :data:`CHAIN_MARGIN`).
+    solve, :func:`~pneumorph.identify.extent.chain_shape`: :data:`CHAIN_MARGIN`). Given
+    several shapes (at the levels around the scan's pressure), the range runs from the
+    smallest one's to the largest one's.
 
     Raises
     ------
     ScanError
         The scan and the model differ in size beyond the range.
     """
-    model = shape.surface if len(shape.surface) else shape.samples
-    scan, size = _size(observation.scan.points), _size(model)
-    ratio = scan / max(size, 1e-12)
-    if not MATCH_RANGE[0] / (1 + margin) <= ratio <= MATCH_RANGE[1] * (1 + margin):
+    shapes = [shape] if isinstance(shape, ModelShape) else list(shape)
+    sizes = [_size(s.surface if len(s.surface) else s.samples) for s in shapes]
+    scan, lo, hi = _size(observation.scan.points), min(sizes), max(sizes)
+    within = MATCH_RANGE[0] / (1 + margin) <= scan / max(lo, 1e-12) and \
+        scan / max(hi, 1e-12) <= MATCH_RANGE[1] * (1 + margin)
+    if not within:
         spec = observation.spec
         how = " by its chain table" if margin else ""
+        size = f"{lo:.4g} mm" if len(shapes) == 1 else f"{lo:.4g} to {hi:.4g} mm (the table's levels around it)"
+        ratio = scan / (lo if scan < lo else hi)
         raise ScanError(f"scan {spec.file} spans {scan:.4g} mm but design {spec.design} "
-                        f"({len(spec.design)} units) spans {size:.4g} mm at {spec.pressure_kpa:g} kPa{how} "
+                        f"({len(spec.design)} units) spans {size} at {spec.pressure_kpa:g} kPa{how} "
                         f"({ratio:.3g} times): is it the design scanned? (check its unit count and --scan-unit)")
 
 
@@ -202,8 +208,10 @@ def precheck_designs(observations: Sequence[Observation], params: ParameterSet, 
                      table_dir: str | Path | None = None) -> int:
     """Check each scan's size against its design's shape predicted by a chain table, before any solve.
 
-    Scans whose model has no chain table at their pressure (or is too short for its window)
-    are checked after their nominal solve only. Returns how many were checked.
+    A pressure between two of a table's levels is checked against the shapes at both
+    (:func:`~pneumorph.identify.extent.chain_shapes`). Scans whose model has no chain table
+    around their pressure (or is too short for its window) are checked after their nominal
+    solve only. Returns how many were checked.
 
     Raises
     ------
@@ -215,12 +223,11 @@ def precheck_designs(observations: Sequence[Observation], params: ParameterSet, 
     build_probes(observations, params, base, params.nominal)  # every model refused now
     for o in observations:
         # the unit as given (the fit meshes it a little coarser or finer to keep its grid): its table's model
-        nominal = make_model(len(o.spec.design), {**base, "pressure_kpa": o.spec.pressure_kpa,
-                                                  "unit": params.unit.to_dict()})
-        shape = chain_shape(nominal, o.spec.design, table_dir)
-        if shape is not None:
-            check_units(o.scan, shape)
-            check_design(o, shape, CHAIN_MARGIN)
+        shapes = chain_shapes({**base, "pressure_kpa": o.spec.pressure_kpa, "unit": params.unit.to_dict()},
+                              o.spec.design, table_dir)
+        if shapes:
+            check_units(o.scan, shapes[0])
+            check_design(o, shapes, CHAIN_MARGIN)
             checked += 1
     return checked
 
