@@ -180,9 +180,8 @@ def check_design(observation: Observation, shape: ModelShape | Sequence[ModelSha
     (the diagonal of the box along their principal axes, whichever way the scan lies);
     a cast off the model by the parameters the fit can change spans within a few percent
     of it. ``margin`` widens the range both ways for a shape only estimated (before any
-    solve, :func:`~pneumorph.identify.extent.chain_shape`: :data:`CHAIN_MARGIN`). Given
-    several shapes (at the levels around the scan's pressure), the range runs from the
-    smallest one's to the largest one's.
+    solve, :func:`~pneumorph.identify.extent.chain_shape`: :data:`CHAIN_MARGIN`); given the
+    shapes at the levels around the scan's pressure, from the smallest one's to the largest's.
 
     Raises
     ------
