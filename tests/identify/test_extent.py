@@ -63,31 +63,18 @@ def test_precheck_counts_the_scans_it_could_check(coarse: ParameterSet) -> None:
     assert precheck_designs([other], coarse, {"fidelity": "2d"}) == 0
 
 
-def test_another_unit_count_is_refused_before_any_solve(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A trace of a 15-unit actuator given as a 10-unit design: one line, exit 2, no cache opened."""
+@pytest.mark.parametrize(("kpa", "said"), [(36, "by its chain table"), (37, "levels around it")])
+def test_another_unit_count_is_refused_before_any_solve(kpa: float, said: str, tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """A trace of a 15-unit actuator given as a 10-unit design: one line, exit 2, no cache opened; at a level of
+    the table (36 kPa) and between two (37 kPa: the chain shapes at 36 and 40.5 kPa)."""
     params = ParameterSet(UnitSpec())
-    obs = synthetic(params, params.nominal, "001111010001001", "2d", seed=3)
+    obs = synthetic(params, params.nominal, "001111010001001", "2d", seed=3, pressure_kpa=kpa)
     trace = tmp_path / "trace.csv"
     np.savetxt(trace, obs.scan.points, delimiter=",", header="x,y", comments="")
     cache, out = tmp_path / "c.sqlite", tmp_path / "out"
-    code = main(["identify", str(trace), "--design", "0011110100", "--pressure", "36", "--model", "2d",
+    code = main(["identify", str(trace), "--design", "0011110100", "--pressure", str(kpa), "--model", "2d",
                  "--executor", "serial", "--cache", str(cache), "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "by its chain table" in err[0] and "is it the design scanned" in err[0]
-    assert not cache.exists() and not out.exists()
-
-
-def test_another_unit_count_between_levels_is_refused_before_any_solve(tmp_path: Path,
-                                                                        capsys: pytest.CaptureFixture[str]) -> None:
-    """At 37 kPa (between the table's 36 and 40.5 kPa) a 15-unit trace given as 10 units: refused by the chain
-    shapes at both levels, before any solve."""
-    params = ParameterSet(UnitSpec())
-    obs = synthetic(params, params.nominal, "001111010001001", "2d", seed=3, pressure_kpa=37)
-    trace = tmp_path / "trace.csv"
-    np.savetxt(trace, obs.scan.points, delimiter=",", header="x,y", comments="")
-    cache, out = tmp_path / "c.sqlite", tmp_path / "out"
-    code = main(["identify", str(trace), "--design", "0011110100", "--pressure", "37", "--model", "2d",
-                 "--executor", "serial", "--cache", str(cache), "--out", str(out)])
-    err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "levels around it" in err[0] and "is it the design scanned" in err[0]
+    assert code == 2 and len(err) == 1 and said in err[0] and "is it the design scanned" in err[0]
     assert not cache.exists() and not out.exists()
