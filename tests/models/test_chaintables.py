@@ -180,3 +180,17 @@ def test_two_processes_that_need_the_same_table_build_it_once(tmp_path: Path) ->
     assert pid in {str(p.pid) for p in procs}
     assert waiter["lines"][1:] == [f"{name} was built meanwhile by pid {pid} on {socket.gethostname()}: reusing it"]
     assert [p.name for p in tables.iterdir()] == [name.removeprefix("chain table ")]  # and no lock file left
+
+
+def test_a_plan_with_short_designs_estimates_them_by_their_units() -> None:
+    """Short training designs count in the estimate by their units' share of a full-length solve (a solve's time
+    grows with the units): the built-in unit's 3D plan with short end designs (23-73 solves) costs 21.3-46.2
+    full-length solves; without short designs every solve is a full one."""
+    model = make_model(15, {"fidelity": "3d"})
+    short = build_plan(model, workers=2, short=True)
+    assert short.solves == (23, 33, 73) and short.work[-1] < short.solves[-1]
+    assert short.work == pytest.approx((21.2667, 25.4, 46.2), abs=1e-4)
+    assert "estimated 2.8 min to 6 min with 2 workers" in short.cost_text()  # 15 s x ceil(21.27 / 2) .. ceil(46.2 / 2)
+    assert "shorter designs by their units" in short.cost_text()
+    full = build_plan(model, workers=2)
+    assert full.work == tuple(float(s) for s in full.solves) and "shorter designs" not in full.cost_text()

@@ -111,6 +111,11 @@ class BuildPlan:
     cached : int
         Of the designs of the widest window, those the evaluation cache holds already.
     workers : int
+    work : tuple of float
+        Like ``solves``, in solves of ``n_units`` units: a short design counts by its units (a
+        solve's time grows with them); empty: as ``solves``.
+    fewest_work, cached_work : float
+        ``fewest`` and ``cached`` likewise.
     """
 
     fidelity: str
@@ -126,6 +131,9 @@ class BuildPlan:
     cached: int = 0
     workers: int = 1
     far: tuple[bool, ...] = ()
+    work: tuple[float, ...] = ()
+    fewest_work: float = 0.0
+    cached_work: float = 0.0
 
     def cost_text(self) -> str:
         """The FE solves (fewest to most, those cached not counted) and their estimated wall time."""
@@ -135,10 +143,14 @@ class BuildPlan:
         if per is None:
             return f"{count} (no measured solve time of the {self.fidelity} model to estimate the time from)"
         w = max(1, self.workers)
-        lo_s, hi_s = (per * math.ceil(s / w) for s in (lo, hi))
+        work = self.work or tuple(float(s) for s in self.solves)
+        lo_w, hi_w = (max(s - (self.cached_work if self.work else self.cached), 0.0)
+                      for s in ((self.fewest_work if self.work else self.fewest) or work[0], work[-1]))
+        lo_s, hi_s = (per * math.ceil(s / w - 1e-9) for s in (lo_w, hi_w))
         when = duration_text(lo_s) if lo == hi else f"{duration_text(lo_s)} to {duration_text(hi_s)}"
+        short = ", shorter designs by their units" if self.work and self.work[-1] < self.solves[-1] else ""
         return (f"{count}, estimated {when} with {w} worker{'s' if w > 1 else ''} (about {per:.2g} s a {self.fidelity} "
-                f"solve of {self.n_units} units on one core, from BENCHMARKS.md; an estimate)")
+                f"solve of {self.n_units} units on one core{short}, from BENCHMARKS.md; an estimate)")
 
     def text(self) -> str:
         """The plan as one paragraph: what is built, the windows tried, the solves and the estimate."""
@@ -237,8 +249,8 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     tolerance : float
         The worst held-out centre error the build accepts (mm).
     short : bool
-        The build learns the end windows from short actuators (``build_table(short=True)``); each
-        short design counts as one solve (the estimate takes it at the full length's time).
+        The build learns the end windows from short actuators (``build_table(short=True)``); the
+        estimate takes each short design at its units' share of the full length's time.
     first_window, early, far : int, bool, bool
         As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, an early stop
         of the validation, a narrower window with far-field terms first.
@@ -273,6 +285,8 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     widest = max(1, min(MAX_WINDOW, (n_units - 1) // 2))
     first = min(max(1, int(first_window)), widest)
     fewest = 0
+    fewest_work = 0.0
+    work: list[float] = []
     fars: list[bool] = []
     for w, with_far in fit_candidates(n_units, window, first, widest, far):
         try:
@@ -284,17 +298,36 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         seen.update(train)
         tests = heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet, symmetric=symmetric)
         if not windows:
-            fewest = len(seen) + (min(MIN_HELDOUT, len(tests)) if early else len(tests))
+            first_tests = min(MIN_HELDOUT, len(tests)) if early else len(tests)
+            fewest = len(seen) + first_tests
+            fewest_work = _work(seen, n_units) + first_tests
         seen.update(tests)
         windows.append(w)
         covering.append(len(train))
         solves.append(len(seen))
+        work.append(_work(seen, n_units))
     if not windows:  # not even the first window fits: the check's own refusal, with its advice
         check_training_size(types, first if window is None else int(window), len(symmetric))
     held = int(cached(sorted(seen))) if cached is not None and seen else 0
+    held_work = held if cached is None or not seen else sum(
+        int(cached(group)) * length / n_units for length, group in _by_length(seen).items())
     return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
                      tuple(float(p) for p in model.pressures()), int(n_units), tuple(windows), tuple(covering),
-                     tuple(solves), fewest, heldout, float(tolerance), held, max(1, int(workers)), tuple(fars))
+                     tuple(solves), fewest, heldout, float(tolerance), held, max(1, int(workers)), tuple(fars),
+                     tuple(work), fewest_work, float(held_work))
+
+
+def _by_length(designs: set[str]) -> dict[int, list[str]]:
+    """Designs grouped by their units (sorted within a group)."""
+    out: dict[int, list[str]] = {}
+    for d in sorted(designs):
+        out.setdefault(len(d), []).append(d)
+    return out
+
+
+def _work(designs: set[str], n_units: int) -> float:
+    """Designs counted in solves of ``n_units`` units: each by its units' share."""
+    return sum(len(d) for d in designs) / n_units
 
 
 def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | None:
