@@ -278,43 +278,40 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     alphabet = library.alphabet if library is not None else ()
     types = max(1, len(alphabet))
     symmetric = library.symmetric_types if library is not None else ()
-    windows: list[int] = []
-    covering: list[int] = []
-    solves: list[int] = []
     seen: set[str] = set()
     widest = max(1, min(MAX_WINDOW, (n_units - 1) // 2))
     first = min(max(1, int(first_window)), widest)
-    fewest = 0
-    fewest_work = 0.0
-    work: list[float] = []
-    fars: list[bool] = []
+    fewest, fewest_work = 0, 0.0
+    rows: list[tuple[int, int, int, float, bool]] = []  # window, covering designs, solves, work, far-field terms
     for w, with_far in fit_candidates(n_units, window, first, widest, far):
         try:
             check_training_size(types, w, len(symmetric))
         except PneumorphError:
             break
         train = training_designs(n_units, w, with_far, short, alphabet, symmetric)
-        fars.append(with_far)
         seen.update(train)
         tests = heldout_designs(n_units, heldout, exclude=train, seed=1, alphabet=alphabet, symmetric=symmetric)
-        if not windows:
+        if not rows:
             first_tests = min(MIN_HELDOUT, len(tests)) if early else len(tests)
-            fewest = len(seen) + first_tests
-            fewest_work = _work(seen, n_units) + first_tests
+            fewest, fewest_work = len(seen) + first_tests, _work(seen, n_units) + first_tests
         seen.update(tests)
-        windows.append(w)
-        covering.append(len(train))
-        solves.append(len(seen))
-        work.append(_work(seen, n_units))
-    if not windows:  # not even the first window fits: the check's own refusal, with its advice
+        rows.append((w, len(train), len(seen), _work(seen, n_units), with_far))
+    if not rows:  # not even the first window fits: the check's own refusal, with its advice
         check_training_size(types, first if window is None else int(window), len(symmetric))
-    held = int(cached(sorted(seen))) if cached is not None and seen else 0
-    held_work = held if cached is None or not seen else sum(
-        int(cached(group)) * length / n_units for length, group in _by_length(seen).items())
+    held, held_work = _cached(cached, seen, n_units)
+    windows, covering, solves, work, fars = (tuple(column) for column in zip(*rows, strict=True))
     return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
-                     tuple(float(p) for p in model.pressures()), int(n_units), tuple(windows), tuple(covering),
-                     tuple(solves), fewest, heldout, float(tolerance), held, max(1, int(workers)), tuple(fars),
-                     tuple(work), fewest_work, float(held_work))
+                     tuple(float(p) for p in model.pressures()), int(n_units), windows, covering, solves, fewest,
+                     heldout, float(tolerance), held, max(1, int(workers)), fars, work, fewest_work, held_work)
+
+
+def _cached(cached: Callable[[list[str]], int] | None, seen: set[str], n_units: int) -> tuple[int, float]:
+    """How many of the designs the cache holds, and as solves of ``n_units`` units (:func:`_work`)."""
+    if cached is None or not seen:
+        return 0, 0.0
+    groups = _by_length(seen)
+    counts = {length: int(cached(group)) for length, group in groups.items()}
+    return sum(counts.values()), sum(c * length / n_units for length, c in counts.items())
 
 
 def _by_length(designs: set[str]) -> dict[int, list[str]]:
