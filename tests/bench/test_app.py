@@ -102,7 +102,8 @@ def test_stages_get_the_certified_search_of_their_staged_target(client: TestClie
 
 
 @pytest.mark.parametrize(("stages", "message"), [
-    ([{"pressure_kpa": 20, "target": {"kind": "preset", "name": "sin"}}], "not a level of the ramp"),
+    ([{"pressure_kpa": 20, "target": {"kind": "preset", "name": "sin"}}],
+     "not a level of the model's ramp; the levels"),
     ([{"pressure_kpa": 18, "target": {"kind": "tip", "goal": "max-x"}}], "is a maximum"),
     ([{"target": {"kind": "preset", "name": "sin"}}], "pressure_kpa"),
     ([{"pressure_kpa": 18, "target": {"kind": "stages"}}], "target kind"),

@@ -26,6 +26,7 @@ from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import best_scores
 from pneumorph.design.targets import ProfileTarget, StagedTarget, TipGoal
+from pneumorph.errors import SearchConfigError
 from pneumorph.geometry.assembly import assemble
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
@@ -206,13 +207,14 @@ class Bench:
         if not isinstance(unit, str) or (units is not None and unit not in units) or not self.knows(unit):
             raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}; upload its TOML file to build its chain "
                                      "table first")
-        query = parse_query(body, self.length(model, unit), self.unit_ids if units is None else units)
-        if query.stages is not None:  # each stage at a level of the ramp
-            kpa = self.chain(model, unit).pressures() * 1e3
-            for p, _, _ in query.stages:
-                if not np.any(np.abs(kpa - p) <= 1e-6 * p):
-                    raise QueryError("stages", f"stage at {p:g} kPa: not a level of the ramp; the levels are "
-                                               + ", ".join(f"{v:.4g}" for v in kpa) + " kPa")
+        length = self.length(model, unit)
+        query = parse_query(body, length, self.unit_ids if units is None else units)
+        objective = query.objective(length)
+        if isinstance(objective, StagedTarget):  # each stage at a level of the ramp
+            try:
+                objective.levels(self.chain(model, unit).pressures(), how="")
+            except SearchConfigError as exc:
+                raise QueryError("stages", str(exc)) from None
         return query
 
     def recall(self, query: Query) -> dict[str, Any] | None:

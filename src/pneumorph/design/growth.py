@@ -69,15 +69,7 @@ the memory doubles with every unit)."""
 
 
 class BranchOverflow(SearchConfigError):
-    """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`).
-
-    ``lower`` is the least bound among the open prefixes: no design that was not listed has a
-    chain cost below ``min(lower, threshold)``.
-    """
-
-    def __init__(self, message: str, lower: float) -> None:
-        super().__init__(message)
-        self.lower = lower
+    """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`)."""
 
 
 def choices(chain: ChainModel) -> int:
@@ -281,7 +273,7 @@ def _narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_no
     if keep.sum() > max_nodes:
         raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too many "
                              "designs come within the chain's error bound of the best to list them all - use "
-                             "--search ga", float(bound[keep].min()))
+                             "--search ga")
     return keep
 
 
@@ -417,14 +409,15 @@ def _staged_rest(chain: ChainModel, profiles: list[tuple[int, ProfileTarget, int
     """Per prefix and stage, a lower bound on the squared Eq 4.1 terms of the centres not yet fixed (m, S): the
     profile bound of :func:`~pneumorph.design.rest.profile_rest` at each Cartesian profile stage's level, 0 for
     the other stages."""
-    rest = np.zeros((len(bits), len(state["ssum"][0])))
+    rest = np.zeros(state["ssum"].shape)
     if not len(bits):
         return rest
     reach = reach_of(chain, "centre")
     for i, _, k in profiles:
         if i in ranges:
-            rest[:, i] = profile_rest(reach, chain.table.heights, ranges[i], bits, state["point"], state["angle"],
-                                      placed, chain.n_units, chain.table.window)[:, k]
+            rest[:, i] = profile_rest(reach.at_level(k), chain.table.heights, ranges[i], bits,
+                                      state["point"][:, k:k + 1], state["angle"][:, k:k + 1], placed, chain.n_units,
+                                      chain.table.window)[:, 0]
     return rest
 
 

@@ -63,7 +63,7 @@ from __future__ import annotations
 
 import threading
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,13 +119,13 @@ def _state_code(digits: IntArray, c: int) -> IntArray:
         np.zeros(len(digits), dtype=np.int64)
 
 
-def _wedge(values: NDArray[np.floating], phi: FloatArray, delta: float) -> tuple[IntArray, FloatArray, FloatArray]:
-    """Grid index and the two weights of the wedge bound for angles ``phi``."""
+def _wedge(n: int, phi: FloatArray, delta: float) -> tuple[IntArray, FloatArray, FloatArray]:
+    """Grid index (of ``n`` angles ``delta`` apart) and the two weights of the wedge bound for angles ``phi``."""
     t = phi / delta
     j = np.floor(t)
     f = t - j
     s = np.sin(delta)
-    return j.astype(np.int64) % values.shape[-1], np.sin((1.0 - f) * delta) / s, np.sin(f * delta) / s
+    return j.astype(np.int64) % n, np.sin((1.0 - f) * delta) / s, np.sin(f * delta) / s
 
 
 @dataclass(frozen=True)
@@ -174,7 +174,7 @@ class Reach:
         """
         values = (self.centre if which == "centre" else self.tip)[a]
         n = values.shape[-1]
-        j, wa, wb = _wedge(values, phi, self.delta)
+        j, wa, wb = _wedge(n, phi, self.delta)
         lev = np.arange(values.shape[1])[None, :]
         s = state[:, None]
         out = []
@@ -185,6 +185,11 @@ class Reach:
             v = wa * h1 + wb * h2 + _ROUND
             out.append(np.where((h1 <= EMPTY / 2) | (h2 <= EMPTY / 2), EMPTY, v))
         return out[0] if fan == 1 else np.stack(out)
+
+    def at_level(self, k: int) -> Reach:
+        """The supports of level ``k`` alone (views): queries then take that level's points and headings, (m, 1)."""
+        return replace(self, centre=tuple(v[:, k:k + 1] for v in self.centre),
+                       tip=tuple(v[:, k:k + 1] for v in self.tip), turn=self.turn[:, :, k:k + 1])
 
     def box(self, which: str, a: int, state: IntArray, point: FloatArray, heading: FloatArray
             ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -291,9 +296,9 @@ class _Kernel:
         t, length, half = rows.turn[order], rows.length[order], rows.half[order]
         delta = 2 * np.pi / directions
         grid = np.arange(directions, dtype=np.float64) * delta
-        base = length[:, None] * np.cos(grid[None, :] - t[:, None]) + (rows.spread[order] + (length + rows.spread[
-            order]) * half)[:, None]
-        start, wa, wb = _wedge(np.empty(directions), -t, delta)
+        spread = rows.spread[order]
+        base = length[:, None] * np.cos(grid[None, :] - t[:, None]) + (spread + (length + spread) * half)[:, None]
+        start, wa, wb = _wedge(directions, -t, delta)
         index = (start[:, None] + np.arange(directions)[None, :]) % directions
         after = rows.after[order]
         src = after[:, None] * directions + index
@@ -315,17 +320,18 @@ class _Kernel:
             radius = np.maximum(prev.max(axis=-1), 0.0) / np.cos(self.delta / 2)
             vals += (radius[self.after] * self.half)[:, None]
         vals[prev[self.after, 0] <= EMPTY / 2] = EMPTY
-        out = np.full(prev.shape, EMPTY)
-        if len(self.starts):
-            out[self.states] = np.maximum.reduceat(vals, self.starts, axis=0)
-        return out
+        return self._max_by_state(vals, prev.shape)
 
     def turn(self, prev: FloatArray) -> FloatArray:
         """The greatest summed turn (S,) after one more chord, from ``prev`` (S,)."""
-        vals = np.where(prev[self.after] <= EMPTY / 2, EMPTY, self.top + prev[self.after])
-        out = np.full(prev.shape, EMPTY)
+        return self._max_by_state(np.where(prev[self.after] <= EMPTY / 2, EMPTY, self.top + prev[self.after]),
+                                  prev.shape)
+
+    def _max_by_state(self, vals: FloatArray, shape: tuple[int, ...]) -> FloatArray:
+        """The greatest of the rows' values per state before them; ``EMPTY`` for states no row leaves."""
+        out = np.full(shape, EMPTY)
         if len(self.starts):
-            out[self.states] = np.maximum.reduceat(vals, self.starts)
+            out[self.states] = np.maximum.reduceat(vals, self.starts, axis=0)
         return out
 
 

@@ -154,8 +154,10 @@ class StagedTarget:
     def weights(self) -> NDArray[np.float64]:
         return np.array([stage.weight for stage in self.stages], dtype=float)
 
-    def levels(self, pressures: ArrayLike) -> tuple[int, ...]:
-        """The level of each stage among a ramp's ``pressures`` (MPa).
+    def levels(self, pressures: ArrayLike, how: str = " (a stage's pressure, --stage KPA:... or pressure_kpa of "
+               "[[design.stage]], must be one of them)") -> tuple[int, ...]:
+        """The level of each stage among a ramp's ``pressures`` (MPa); ``how`` ends the refusal (where the pressure
+        is given: the command line's words by default).
 
         Raises
         ------
@@ -169,8 +171,7 @@ class StagedTarget:
             if not near.size:
                 levels = ", ".join(f"{v * 1e3:.4g}" for v in p)
                 raise SearchConfigError(f"stage at {stage.pressure * 1e3:g} kPa: not a level of the model's ramp; "
-                                        f"the levels are {levels} kPa (a stage's pressure, --stage KPA:... or "
-                                        "pressure_kpa of [[design.stage]], must be one of them)")
+                                        f"the levels are {levels} kPa{how}")
             out.append(int(near[0]))
         return tuple(out)
 

@@ -113,7 +113,7 @@ class BuildPlan:
     workers : int
     work : tuple of float
         Like ``solves``, in solves of ``n_units`` units: a short design counts by its units (a
-        solve's time grows with them); empty: as ``solves``.
+        solve's time grows with them).
     fewest_work, cached_work : float
         ``fewest`` and ``cached`` likewise.
     """
@@ -143,12 +143,10 @@ class BuildPlan:
         if per is None:
             return f"{count} (no measured solve time of the {self.fidelity} model to estimate the time from)"
         w = max(1, self.workers)
-        work = self.work or tuple(float(s) for s in self.solves)
-        lo_w, hi_w = (max(s - (self.cached_work if self.work else self.cached), 0.0)
-                      for s in ((self.fewest_work if self.work else self.fewest) or work[0], work[-1]))
+        lo_w, hi_w = (max(s - self.cached_work, 0.0) for s in (self.fewest_work or self.work[0], self.work[-1]))
         lo_s, hi_s = (per * math.ceil(s / w - 1e-9) for s in (lo_w, hi_w))
         when = duration_text(lo_s) if lo == hi else f"{duration_text(lo_s)} to {duration_text(hi_s)}"
-        short = ", shorter designs by their units" if self.work and self.work[-1] < self.solves[-1] else ""
+        short = ", shorter designs by their units" if self.work[-1] < self.solves[-1] else ""
         return (f"{count}, estimated {when} with {w} worker{'s' if w > 1 else ''} (about {per:.2g} s a {self.fidelity} "
                 f"solve of {self.n_units} units on one core{short}, from BENCHMARKS.md; an estimate)")
 
