@@ -47,6 +47,9 @@ def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.chdir(tmp_path)
     (tmp_path / "binary.bin").write_bytes(bytes(range(256)) * 4)
     (tmp_path / "a-file").write_text("not a folder\n", encoding="utf-8")
+    (tmp_path / "terms.json").write_text(  # a chain table of far-field terms (format 3) without its terms' keys
+        '{"format": 3, "kind": "pneumorph chain table", "window": 3, "pressures_mpa": [0.045], "terms": {"window": 2}}',
+        encoding="utf-8")
     (tmp_path / "folder").mkdir()
     (tmp_path / "stress.csv").write_text("stretch,stress\n1.0,0.0\n1.5,0.2\n2.0,0.35\n2.5,0.5\n", encoding="utf-8")
     (tmp_path / "dic.csv").write_text("axial_strain,transverse_strain\n0.1,-0.04\n0.2,-0.08\n", encoding="utf-8")
@@ -120,7 +123,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')"], "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
-        "--out": ["a-file", "a-file/sub", ""], "--chain-table": ["binary.bin", "folder", "missing.json", ""],
+        "--out": ["a-file", "a-file/sub", ""],
+        "--chain-table": ["binary.bin", "folder", "missing.json", "", "terms.json"],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
         "--stage": ["", "abc", "18", "18:", "x:sin", "nan:sin", "18:reach", "18:reach 1", "18:max-x", "20:sin",
                     "18:r = 20 + theta", "18:y = 1/0"],
@@ -323,6 +327,12 @@ def test_target_and_objective_together(sandbox: Path, capsys: pytest.CaptureFixt
 def test_reach_needs_a_point(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
     line = _refused(sandbox, capsys, [*BASE["design"], "--objective", "reach"])
     assert "--point" in line
+
+
+def test_far_field_terms_on_too_short_a_training_model(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--window 1 --far-terms`` makes a table of +-2, whose training designs need 5 units: 4 are refused."""
+    line = _refused(sandbox, capsys, [*BASE["chain"], "--window", "1", "--far-terms"])
+    assert "far-field terms of window +-1" in line and "at least 5 units" in line
 
 
 def test_unknown_command_and_option(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -456,9 +456,13 @@ def _check_library_run(config: Any, model: Any, tolerance: float | None) -> None
         raise SearchConfigError(f"{'--robust' if config.robust else '--tolerance'}: the mould tolerance report is of "
                                 "one unit type; over a unit library leave it out")
     if config.chain_table is not None:
+        from pneumorph.design.planning import given_table_error
         from pneumorph.models.chain import ChainTable
 
-        table = ChainTable.load(config.chain_table)
+        try:
+            table = ChainTable.load(config.chain_table)
+        except ChainTableError as exc:
+            raise given_table_error(config.chain_table, exc) from None
         missing = [s for s in model.library.symbols if s not in table.alphabet]
         if missing:
             covers = ", ".join(table.alphabet) if table.alphabet else "one unit type, written 0/1"

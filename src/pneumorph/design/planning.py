@@ -128,6 +128,21 @@ def serves(table: ChainTable, n_units: int) -> bool:
     return True
 
 
+def given_table_error(path: str | Path, exc: ChainTableError) -> ChainTableError:
+    """A given table's refusal naming the option that gave it: ``--chain-table PATH: ...``."""
+    return ChainTableError(f"--chain-table {path}: {str(exc).removeprefix(f'{path}: ')}")
+
+
+def _given_table(model: Any, table_dir: str | Path | None, path: str | Path | None) -> Any:
+    """:func:`serve_table`, a given table's refusal named by :func:`given_table_error`."""
+    try:
+        return serve_table(model, table_dir, path)
+    except ChainTableError as exc:
+        if path is None:
+            raise
+        raise given_table_error(path, exc) from None
+
+
 def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bool = True,
                 workers: int = 1) -> SearchPlan:
     """Choose the search of a certified run (see the module): no solve, no file written.
@@ -160,7 +175,7 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
     n = int(config.units)
     fidelity = str(getattr(model, "fidelity", "?"))
     mixed = bool(getattr(model, "mixed", False))
-    served = serve_table(model, table_dir, config.chain_table)
+    served = _given_table(model, table_dir, config.chain_table)
     if served is not None and config.chain_table is not None and not serves(served.table, n):
         w = served.table.window
         raise ChainTableError(
