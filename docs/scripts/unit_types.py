@@ -1,20 +1,25 @@
 """The built-in unit types' responses in 3D (docs/unit-library.md).
 
-For every type of the built-in library: a single unit's bending angle (the turn of its
+For every type of a built-in library: a single unit's bending angle (the turn of its
 free end face) and extension (the free end's displacement along the actuator) against
-pressure, and the curl of a 15-unit actuator of that type, all units aligned, at the
-design pressure. Solved through the evaluation cache, so a second run reads its results
-back; writes a figure and a JSON table with provenance.
+pressure, where the angle turns back and changes sign (the switch of a bimodal unit,
+:func:`pneumorph.bimodal.switch.find_switch`), and the curl of a 15-unit actuator of that
+type, all units aligned, at the design pressure. Solved through the evaluation cache, so
+a second run reads its results back; writes a figure and a JSON table with provenance.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/unit_types.py --out docs/figures/unit-types.png
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/unit_types.py --library modes --pressure 42 \
+        --increments 14 --out docs/figures/unit-modes.png
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import replace
 from pathlib import Path
 
+from pneumorph.bimodal.switch import find_switch
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator, default_cache_path
 from pneumorph.geometry.library import builtin_library
 from pneumorph.io.provenance import provenance
@@ -26,11 +31,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pressure", type=float, default=45.0, help="kPa")
     parser.add_argument("--units", type=int, default=15, help="units of the aligned actuator")
+    parser.add_argument("--library", default="builtin", help="a built-in library: builtin, spatial, modes")
+    parser.add_argument("--increments", type=int, default=Full3D.default_steps.increments, help="reported levels")
     parser.add_argument("--cache", default=str(default_cache_path()))
     parser.add_argument("--out", default="docs/figures/unit-types.png")
     args = parser.parse_args()
-    library = builtin_library()
-    ramp = RampSpec(pressure=args.pressure / 1e3, steps=Full3D.default_steps)
+    library = builtin_library(args.library)
+    ramp = RampSpec(pressure=args.pressure / 1e3, steps=replace(Full3D.default_steps, increments=args.increments))
     cases = []
     for symbol, spec in zip(library.symbols, library.units, strict=True):
         cases.append((symbol, "single", Full3D(1, unit=spec, ramp_spec=ramp), "0"))
@@ -51,6 +58,8 @@ def main() -> None:
                        "tip_dy_mm": (r.tip[:, 1] - r.reference_tip[1]).round(4).tolist(),
                        "reached_kpa": round(float(r.reached) * args.pressure, 3), "fingerprint": model.fingerprint(),
                        "seconds": outcome.wall_time}
+        if kind == "single":
+            entry[kind]["switch"] = find_switch(r.pressures, r.curl).to_dict()
         print(symbol, kind, f"curl {r.curl[-1]:.2f} deg, tip dx {r.tip[-1, 0] - r.reference_tip[0]:.3f} mm, "
               f"{outcome.wall_time:.1f} s", flush=True)
     evaluator.close()
@@ -62,6 +71,11 @@ def main() -> None:
             label = f"{symbol}: {entry['mode']}"
             ax_angle.plot(single["pressures_kpa"], single["curl_deg"], "o-", ms=3, label=label)
             ax_ext.plot(single["pressures_kpa"], single["tip_dx_mm"], "o-", ms=3, label=label)
+            switch = single.get("switch", {}).get("switch_kpa")
+            if switch is not None:  # where the unit's bending changes direction
+                ax_angle.plot([switch], [0.0], "kx", ms=8)
+                ax_angle.annotate(f"{symbol} switches at {switch:.1f} kPa", (switch, 0.0), textcoords="offset points",
+                                  xytext=(-60, 12), fontsize=7)
         aligned = entry.get("aligned")
         if isinstance(aligned, dict) and "curl_deg" in aligned:
             ax_curl.plot(aligned["pressures_kpa"], aligned["curl_deg"], "o-", ms=3, label=f"{symbol}")
@@ -72,8 +86,9 @@ def main() -> None:
         ax.grid(alpha=0.3)
     ax_angle.legend(fontsize=7)
     out = Path(args.out)
-    save_figure(fig, out, description="built-in unit types: single-unit response and aligned-actuator curl (3D)")
-    table = {"provenance": provenance(), "pressure_kpa": args.pressure, "types": results}
+    save_figure(fig, out, description=f"built-in unit types ({args.library}): single-unit response and aligned-actuator "
+                "curl (3D)")
+    table = {"provenance": provenance(), "library": args.library, "pressure_kpa": args.pressure, "types": results}
     out.with_suffix(".json").write_text(json.dumps(table, indent=1, default=str), encoding="utf-8")
     print(f"wrote {out} and {out.with_suffix('.json')}")
 

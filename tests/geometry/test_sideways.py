@@ -150,7 +150,7 @@ def test_the_library_checks_refuse_bad_sideways_entries_in_one_line(tmp_path: Pa
     assert "unit 'l' (entry 2)" in _one_line(exc) and "layer_side must be true or false" in str(exc.value)
     with pytest.raises(UnitLibraryError) as exc:
         builtin_library("sideways")
-    assert _one_line(exc) == "no built-in unit library 'sideways'; the built-in ones: builtin, spatial"
+    assert _one_line(exc) == "no built-in unit library 'sideways'; the built-in ones: builtin, spatial, modes"
 
 
 def test_the_2d_model_refuses_a_sideways_unit_in_one_line() -> None:

@@ -22,8 +22,9 @@ from pneumorph.cli import params as P
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="TOML file with a [unit] table (dimensions in mm, materials, element size).")
 @click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP)
-@click.option("--library", metavar="builtin|spatial|FILE", type=P.Text(),
-              help="A unit library ('builtin', 'spatial' (sideways units, --model 3d) or a library TOML file; "
+@click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
+              help="A unit library ('builtin', 'spatial' (sideways units, --model 3d), 'modes' (bimodal and "
+                   "low-bending units) or a library TOML file; "
                    "documentation page unit-library, "
                    "docs/unit-library.md in the source): the design's letters name its unit types; instead of --unit.")
 @click.option("--gravity", type=click.Choice(["none", "hanging", "horizontal"]), default="none", show_default=True,

@@ -137,6 +137,15 @@ def _check_model(model: Any) -> None:
         raise SettingsError("the CalculiX deck does not include gravity; export the model without gravity")
 
 
+def _set_name(region: str) -> str:
+    """A region's element-set name in the deck (a bottom wall's ``bottom:<material>`` without the colon).
+
+    >>> _set_name("layer"), _set_name("bottom:bilinear_0_2")
+    ('layer', 'bottom_bilinear_0_2')
+    """
+    return region.replace(":", "_")
+
+
 def _ogden_line(material: Any, role: str) -> list[str]:
     """The *MATERIAL block of one silicone in the deck's units."""
     model = material.model
@@ -248,6 +257,9 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True, residual
     out += _set_lines(mesh)
     out += _ogden_line(model.body, "body")
     out += _ogden_line(model.layer, "layer")
+    for region, material in model.bottoms.items():  # bottom walls of other materials, where the design has them
+        if len(mesh.regions[region]):
+            out += _ogden_line(material, _set_name(region))
     out += _step_lines(model, mesh, (elements, faces), full_output, residual_force)
     return "\n".join(out)
 
@@ -292,11 +304,12 @@ def _mesh_lines(points: FloatArray, cells: IntArray, etype: str) -> list[str]:
 
 
 def _set_lines(mesh: ActuatorMesh) -> list[str]:
-    """The element sets ``BODY`` and ``LAYER``; the node sets ``BASE``, ``SYMMETRY`` (a half model) and ``TIP``."""
+    """The element sets ``BODY``, ``LAYER`` and any bottom walls' (``BOTTOM_<MATERIAL>``); the node sets ``BASE``, ``SYMMETRY`` (a half model) and ``TIP``."""
     out = []
-    for region in ("body", "layer"):
+    bottoms = [r for r in mesh.regions if r.startswith("bottom:") and len(mesh.regions[r])]
+    for region in ("body", "layer", *bottoms):
         ids = [str(int(i) + 1) for i in mesh.regions[region]]
-        out += [f"*ELSET, ELSET={region.upper()}", *_rows(ids, 16)]
+        out += [f"*ELSET, ELSET={_set_name(region).upper()}", *_rows(ids, 16)]
     out += _nset("BASE", np.flatnonzero(mesh.base_points))
     if mesh.symmetry_points is not None:
         out += _nset("SYMMETRY", np.flatnonzero(mesh.symmetry_points))

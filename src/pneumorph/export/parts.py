@@ -324,7 +324,8 @@ def check_materials(spec: UnitSpec, base_block: BaseBlock | None = DEFAULT_BLOCK
 
 def check_buildable(spec: UnitSpec) -> None:
     """Refuse a unit whose parts these builders cannot make: a sideways unit (``layer_side``), whose stiff strip
-    lies on a side face (the parts, strips and moulds here put it on the top or bottom face).
+    lies on a side face (the parts, strips and moulds here put it on the top or bottom face), and a unit with a
+    bottom wall of another material (``bottom_material``).
 
     >>> check_buildable(UnitSpec(layer_side=True))
     Traceback (most recent call last):
@@ -335,6 +336,9 @@ def check_buildable(spec: UnitSpec) -> None:
     if spec.layer_side:
         raise GeometryError("the parts and moulds of a sideways unit (layer_side: its stiff strip on a side face) "
                             "are not built yet; export a planar unit")
+    if spec.bottom_material:
+        raise GeometryError(f"the parts and moulds of a unit with a bottom wall of {spec.bottom_material} "
+                            "(bottom_material) are not built yet; export a unit of one body material")
 
 
 def actuator_solids(

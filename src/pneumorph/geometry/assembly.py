@@ -36,6 +36,9 @@ BoolArray = NDArray[np.bool_]
 FloatArray = NDArray[np.float64]
 
 BODY, LAYER, CAVITY, SLIT, BASE, VOID = 0, 1, 2, 3, 4, 5
+#: The bottom walls of another material (:attr:`UnitSpec.bottom_material`): ``BOTTOM + i`` for
+#: the i-th of :func:`bottom_materials`, in region ``"bottom:<material>"``.
+BOTTOM = 6
 #: How near a point must lie to a cavity's wall or vertex to be on it (mm).
 _TOL = 1e-6
 
@@ -52,8 +55,9 @@ class ActuatorMesh:
         Quadratic cells (``quad8`` in 2D, ``hexahedron20`` in 3D) in FElupe's ordering.
     cell_type : str
     regions : dict of str to ndarray
-        Cell indices of ``"body"``, ``"layer"``, in 2D ``"filler"`` (the cavities), and
-        ``"base"`` (the base block) if there is one.
+        Cell indices of ``"body"``, ``"layer"``, ``"bottom:<material>"`` for each bottom-wall
+        material of the library (:func:`bottom_materials`), in 2D ``"filler"`` (the cavities),
+        and ``"base"`` (the base block) if there is one.
     cavity_points : ndarray of bool, shape (p,)
         Points on the cavity walls, passages included (and, in 2D, inside the filler).
     tracked : ndarray, shape (n, 4)
@@ -150,14 +154,24 @@ def unit_starts(units: Sequence[UnitSpec]) -> FloatArray:
     return np.array([math.fsum(pitches[:i]) for i in range(len(pitches) + 1)], dtype=float)
 
 
+def bottom_materials(units: Iterable[UnitSpec]) -> tuple[str, ...]:
+    """The materials of the units' bottom walls other than the body's, sorted: one region each.
+
+    >>> bottom_materials([UnitSpec(), UnitSpec(bottom_material="smooth_sil_950")])
+    ('smooth_sil_950',)
+    """
+    return tuple(sorted({u.bottom_material for u in units if u.bottom_material}))
+
+
 def _label(units: Sequence[UnitSpec], orientation: str, starts: FloatArray, centres: FloatArray,
-           passage: float = 0.0, base: BaseBlock | None = None) -> IntArray:
-    """Label of each linear cell from its centroid: BODY, LAYER, CAVITY, SLIT, BASE or VOID.
+           passage: float = 0.0, base: BaseBlock | None = None, bottoms: Sequence[str] = ()) -> IntArray:
+    """Label of each linear cell from its centroid: BODY, LAYER, CAVITY, SLIT, BASE, VOID or BOTTOM + i.
 
     Each cell belongs to the unit whose span holds its centroid (the end cap: to no unit,
     solid); ``units`` share height and width. ``passage`` is the side of the square channels
     between adjacent cavities (labelled CAVITY); cells outside the actuator's section (beside
-    a base block with a margin) are VOID.
+    a base block with a margin) are VOID. The bottom wall of a unit with a ``bottom_material``
+    (the i-th of ``bottoms``) is BOTTOM + i.
     """
     n, ref = len(orientation), units[0]
     H, W = ref.height, ref.width
@@ -181,6 +195,10 @@ def _label(units: Sequence[UnitSpec], orientation: str, starts: FloatArray, cent
         z0, z1 = per_unit(c for u in units for c in u.cavity_z).reshape(n, 2)[unit].T
         cavity &= (lz > z0) & (lz < z1)
         label = np.where(lz > W - per_unit(u.side_layer for u in units)[unit], LAYER, label)
+    if bottoms:  # the wall under the cavity, the unit's whole length and width, of its own material
+        which = per_unit(bottoms.index(u.bottom_material) if u.bottom_material else -1 for u in units)[unit]
+        wall = per_unit(u.wall for u in units)[unit]
+        label = np.where((which >= 0) & (label == BODY) & (ly < wall) & ~cap, BOTTOM + which, label)
     label = np.where(cavity, CAVITY, label)
     if any(u.slit is not None for u in units):
         slit = np.array([u.slit is not None for u in units], dtype=bool)[unit]
@@ -270,12 +288,13 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     side = _passage_side(units, passage)
     starts = unit_starts(units)
     grid = _grid(library, units, starts, dim, half, side, base)
-    label = _label(units, orientation, starts, grid.points[grid.cells].mean(axis=1), side, base)
+    bottoms = bottom_materials(library.units)
+    label = _label(units, orientation, starts, grid.points[grid.cells].mean(axis=1), side, base, bottoms)
     mesh, label = _kept_cells(grid, label, dim, ref.element_order)
     points = np.asarray(mesh.points, dtype=float)
     return ActuatorMesh(
         points=points, cells=np.asarray(mesh.cells, dtype=np.int64), cell_type=mesh.cell_type,
-        regions=_regions(label, dim, base),
+        regions=_regions(label, dim, base, bottoms),
         cavity_points=_cavity_points(points, ref, units, orientation, starts, dim, side),
         tracked=_tracked(points, ref, units, orientation, starts, dim),
         end_points=_end_points(points, ref, starts, dim), base_points=_clamped(points, ref.height, base),
@@ -363,7 +382,7 @@ def _kept_cells(grid: Any, label: IntArray, dim: int, order: int) -> tuple[Any, 
     """
     import felupe as fem
 
-    solid = (label == BODY) | (label == LAYER) | (label == BASE)
+    solid = (label == BODY) | (label == LAYER) | (label == BASE) | (label >= BOTTOM)
     keep = solid | (label == CAVITY) if dim == 2 else solid
     cells, label = grid.cells[keep], label[keep]
     used = np.unique(cells)
@@ -373,9 +392,15 @@ def _kept_cells(grid: Any, label: IntArray, dim: int, order: int) -> tuple[Any, 
     return (linear.add_midpoints_edges() if order == 2 else linear), label
 
 
-def _regions(label: IntArray, dim: int, base: BaseBlock | None) -> dict[str, IntArray]:
-    """The cells of each material region: body, layer, the 2D filler, the base block."""
+def _regions(label: IntArray, dim: int, base: BaseBlock | None, bottoms: Sequence[str] = ()) -> dict[str, IntArray]:
+    """The cells of each material region: body, layer, the bottom walls, the 2D filler, the base block.
+
+    A bottom material of the library has its region even where the design has no unit of it
+    (empty), so that every design of one library has the same regions.
+    """
     regions = {"body": np.flatnonzero(label == BODY), "layer": np.flatnonzero(label == LAYER)}
+    for i, material in enumerate(bottoms):
+        regions[f"bottom:{material}"] = np.flatnonzero(label == BOTTOM + i)
     if dim == 2:
         regions["filler"] = np.flatnonzero(label == CAVITY)
     if base is not None:
@@ -470,4 +495,5 @@ def _end_points(points: FloatArray, ref: UnitSpec, starts: FloatArray, dim: int)
     end_points = np.flatnonzero(on_end)
     return end_points[np.argsort(points[end_points, 1])]
 
-__all__ = ["BASE", "BODY", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "grid_lines", "unit_starts"]
+__all__ = ["BASE", "BODY", "BOTTOM", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "bottom_materials",
+           "grid_lines", "unit_starts"]

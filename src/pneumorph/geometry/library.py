@@ -395,7 +395,7 @@ def _entry_unit(value: Any, where: str, base: Path | None) -> UnitSpec:
 
 
 #: The libraries that ship with pneumorph, by the name a setting gives (``--library builtin``), and their data files
-BUILTIN_LIBRARIES: dict[str, str] = {"builtin": "units.toml", "spatial": "spatial.toml"}
+BUILTIN_LIBRARIES: dict[str, str] = {"builtin": "units.toml", "spatial": "spatial.toml", "modes": "modes.toml"}
 
 
 def builtin_library(name: str = "builtin") -> UnitLibrary:
@@ -404,7 +404,9 @@ def builtin_library(name: str = "builtin") -> UnitLibrary:
     ``"builtin"`` (``units.toml``, planar): ``a`` the bending unit (the default
     :class:`UnitSpec`), ``e`` an extending unit, ``r`` a near-rigid one and ``s`` a
     short-pitch one. ``"spatial"`` (``spatial.toml``): ``a`` and ``l``, a sideways unit
-    (``layer_side``) that bends out of the plane of ``a`` (``docs/unit-library.md``).
+    (``layer_side``) that bends out of the plane of ``a``. ``"modes"`` (``modes.toml``):
+    ``a``, ``b`` a bimodal unit and ``m`` a low-bending one (``bottom_material``)
+    (``docs/unit-library.md``).
 
     Raises
     ------
@@ -417,10 +419,12 @@ def builtin_library(name: str = "builtin") -> UnitLibrary:
     ['a: bending', 'e: extending', 'r: near-rigid', 's: short-pitch']
     >>> builtin_library("spatial").symbols, builtin_library("spatial")["l"].layer_side
     (('a', 'l'), True)
+    >>> builtin_library("modes").modes
+    ('bending', 'bimodal', 'low-bending')
     >>> builtin_library("planar")
     Traceback (most recent call last):
     ...
-    pneumorph.errors.UnitLibraryError: no built-in unit library 'planar'; the built-in ones: builtin, spatial
+    pneumorph.errors.UnitLibraryError: no built-in unit library 'planar'; the built-in ones: builtin, spatial, modes
     """
     if name not in BUILTIN_LIBRARIES:
         raise UnitLibraryError(f"no built-in unit library {name!r}; the built-in ones: {', '.join(BUILTIN_LIBRARIES)}")

@@ -51,7 +51,11 @@ The same parameters describe the deformation modes of a library of units (sectio
 - *short-pitch* (section 8.3.1): a shorter ``pitch`` with thinner end walls, so more units
   fit in the same length;
 - *sideways*: ``layer_side = True``, the stiff layer on a side face, so the unit
-  bends out of the plane of the others (3D models only).
+  bends out of the plane of the others (3D models only);
+- *low-bending*: a stiff ``bottom_material`` under the cavity as well as the layer above
+  it: the unit lengthens a little and bends about a tenth as much;
+- *bimodal* (section 8.4 mode 5): no layer, the bottom wall of the bilinear composite
+  (``bottom_material``): the unit bends one way, then back as the composite stiffens.
 
 Examples
 --------
@@ -152,6 +156,13 @@ class UnitSpec:
         True: the stiff layer lies on the side face z = width (a sideways unit, bending about
         the vertical axis), with a side wall between it and the cavity; False (default): on
         top. Needs a layer (``layer > 0``) and no slit; 3D models only.
+    bottom_material : str
+        Library name of the material of the soft (bottom) wall, the ``wall`` below the
+        cavity along the whole unit (turned over with it); empty (default): the body
+        material. A stiff material there lowers the unit's preferential bending; the
+        bilinear paper-silicone composite (``bilinear_0_2``) makes it bimodal: softer than
+        the body at first, the unit bends towards its top, then the composite stiffens
+        (its paper straightens) and the unit bends back (``docs/unit-library.md``).
 
     Raises
     ------
@@ -161,7 +172,7 @@ class UnitSpec:
     Notes
     -----
     Fields added after the unit's first release (:data:`OPTIONAL_FIELDS`: ``solid``,
-    ``layer_side``) are
+    ``layer_side``, ``bottom_material``) are
     left out of :meth:`to_dict` while they hold their default, so the description of every
     earlier unit, and the fingerprints of models and chain tables built on it, stay the same.
 
@@ -193,6 +204,7 @@ class UnitSpec:
     filler_source: str = ""
     solid: bool = False
     layer_side: bool = False
+    bottom_material: str = ""
 
     def __post_init__(self) -> None:
         for key in ("solid", "layer_side"):
@@ -211,6 +223,9 @@ class UnitSpec:
         for key in ("body_material", "layer_material", "name"):
             if not isinstance(getattr(self, key), str) or not getattr(self, key).strip():
                 raise GeometryError(f"unit {key} must be a non-empty text, got {getattr(self, key)!r}")
+        if not isinstance(self.bottom_material, str) or self.bottom_material != self.bottom_material.strip():
+            raise GeometryError(f"unit bottom_material must be a material's name (or empty: the body material), got "
+                                f"{self.bottom_material!r}")
         for key in UNIT_LENGTHS:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -325,8 +340,13 @@ class UnitSpec:
         (False, True)
         >>> UnitSpec(wall=3.0, layer=0.0, slit_width=0.5, slit_depth=2.0).symmetric
         False
+
+        A bottom wall of another material (:attr:`bottom_material`) has no mirror either:
+
+        >>> UnitSpec(layer=0.0, cavity_height=9.0, bottom_material="bilinear_0_2").symmetric
+        False
         """
-        return self.layer == 0.0 and self.slit is None
+        return self.layer == 0.0 and self.slit is None and not self.bottom_material
 
     def is_builtin_shape(self) -> bool:
         """True if the unit's dimensions and materials are the built-in unit's.
@@ -439,7 +459,7 @@ class UnitSpec:
 
 #: Fields added after the first release, with their defaults: :meth:`UnitSpec.to_dict` leaves
 #: them out while they hold these values (earlier descriptions and fingerprints stay valid).
-OPTIONAL_FIELDS: dict[str, Any] = {"solid": False, "layer_side": False}
+OPTIONAL_FIELDS: dict[str, Any] = {"solid": False, "layer_side": False, "bottom_material": ""}
 
 #: The filler law of the built-in unit: ``pneumorph calibrate`` (defaults: 15 units, 5-45 kPa
 #: in 5 kPa steps, three runs, seed 0, relative weighting) against the 3D model; the

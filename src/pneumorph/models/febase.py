@@ -27,7 +27,7 @@ from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.geometry.alphabet import Design, parse_design
-from pneumorph.geometry.assembly import ActuatorMesh, assemble
+from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
@@ -167,6 +167,8 @@ class FEModel:
         # the units of a library share the body material and the layer's (check_joinable)
         layered = [u for u in self.library.units if u.layer > 0] or [self.unit]
         self.layer = self._material(layered[0].layer_material)
+        # the bottom walls of other materials (UnitSpec.bottom_material), one region each
+        self.bottoms = {f"bottom:{name}": self._material(name) for name in bottom_materials(self.library.units)}
         self.gravity = gravity_vector(gravity, self.dim)
         self.temperature_change = checks.real(temperature_change, "temperature_change", -100.0, 100.0, unit="degC")
         if passage and self.dim != 3:
@@ -224,8 +226,8 @@ class FEModel:
 
     @property
     def silicones(self) -> dict[str, Any]:
-        """The material of every silicone region of the mesh: body, layer and base block if any."""
-        out = {"body": self.body, "layer": self.layer}
+        """The material of every silicone region of the mesh: body, layer, bottom walls and base block if any."""
+        out = {"body": self.body, "layer": self.layer, **self.bottoms}
         if self.base is not None:
             out["base"] = self.base
         return out
@@ -238,7 +240,8 @@ class FEModel:
             "revision": MODEL_REVISION,
             "n_units": self.n_units,
             "unit": self.unit.to_dict(),
-            "materials": {"body": self.body.to_dict(), "layer": self.layer.to_dict()},
+            "materials": {"body": self.body.to_dict(), "layer": self.layer.to_dict(),
+                          **{name: material.to_dict() for name, material in self.bottoms.items()}},
             "pressure_mpa": self.ramp.pressure,
             "steps": asdict(self.ramp.steps),
         }

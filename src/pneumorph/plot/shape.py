@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +16,22 @@ from pneumorph.plot.figure import new_figure, save_figure
 
 COLOURS = {"body": "#4daf4a", "layer": "#377eb8", "filler": "#d9d9d9", "base": "#a6d96a"}
 LABELS = {"body": "body", "layer": "stiff layer", "filler": "filler (2D model)", "base": "base block"}
+#: the bottom walls of other materials (regions ``bottom:<material>``), one colour each in turn
+BOTTOM_COLOURS = ("#e41a1c", "#984ea3", "#ff7f00")
+
+
+def region_style(name: str, regions: Iterable[str]) -> tuple[str, str]:
+    """Face colour and legend label of a mesh region (a bottom wall's by its material).
+
+    >>> region_style("layer", ["body", "layer"])
+    ('#377eb8', 'stiff layer')
+    >>> region_style("bottom:bilinear_0_2", ["body", "bottom:bilinear_0_2"])
+    ('#e41a1c', 'bottom wall: bilinear_0_2')
+    """
+    if name in COLOURS:
+        return COLOURS[name], LABELS[name]
+    bottoms = [r for r in regions if r.startswith("bottom:")]
+    return BOTTOM_COLOURS[bottoms.index(name) % len(BOTTOM_COLOURS)], f"bottom wall: {name.split(':', 1)[1]}"
 
 # quad8 outline through the mid-side nodes; corner faces of a hexahedron
 _QUAD8_OUTLINE = [0, 4, 1, 5, 2, 6, 3, 7]
@@ -27,7 +43,8 @@ def _section(ax: Any, solution: Any, level: int | None, outline: bool) -> None:
     for name, idx in mesh.regions.items():
         order = _QUAD8_OUTLINE if mesh.cells.shape[1] == 8 else [0, 1, 2, 3]
         polys = x[mesh.cells[idx]][:, order]
-        ax.add_collection(PolyCollection(polys, facecolor=COLOURS[name], edgecolor="k", lw=0.15, label=LABELS[name]))
+        colour, label = region_style(name, mesh.regions)
+        ax.add_collection(PolyCollection(polys, facecolor=colour, edgecolor="k", lw=0.15, label=label))
     if outline and level is not None:
         ref = mesh.points[mesh.cells][:, order]
         ax.add_collection(PolyCollection(ref, facecolor="none", edgecolor="0.6", lw=0.2))
@@ -45,7 +62,7 @@ def _surface(ax: Any, solution: Any, level: int | None) -> None:
     region_of = np.empty(len(mesh.cells), dtype=object)
     for name, idx in mesh.regions.items():
         region_of[idx] = name
-    colours = [COLOURS[region_of[c]] for c in owner]
+    colours = [region_style(region_of[c], mesh.regions)[0] for c in owner]
     ax.add_collection3d(Poly3DCollection(x[faces], facecolors=colours, edgecolor="k", linewidths=0.05))
     lo, hi = x.min(axis=0), x.max(axis=0)
     span = (hi - lo).max() / 2
