@@ -40,6 +40,8 @@ def main() -> None:
     ramp = RampSpec(pressure=args.pressure / 1e3, steps=replace(Full3D.default_steps, increments=args.increments))
     cases = []
     for symbol, spec in zip(library.symbols, library.units, strict=True):
+        if spec.solid:  # nothing to inflate: a solid unit alone is refused; it only follows its neighbours
+            continue
         cases.append((symbol, "single", Full3D(1, unit=spec, ramp_spec=ramp), "0"))
         cases.append((symbol, "aligned", Full3D(args.units, unit=spec, ramp_spec=ramp), "0" * args.units))
     evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(args.cache))
@@ -56,10 +58,11 @@ def main() -> None:
         entry[kind] = {"pressures_kpa": (r.pressures * 1e3).round(3).tolist(), "curl_deg": r.curl.round(3).tolist(),
                        "tip_dx_mm": (r.tip[:, 0] - r.reference_tip[0]).round(4).tolist(),
                        "tip_dy_mm": (r.tip[:, 1] - r.reference_tip[1]).round(4).tolist(),
-                       "reached_kpa": round(float(r.reached) * args.pressure, 3), "fingerprint": model.fingerprint(),
+                       "reached_kpa": round(float(r.reached) * 1e3, 3), "fingerprint": model.fingerprint(),
                        "seconds": outcome.wall_time}
         if kind == "single":
-            entry[kind]["switch"] = find_switch(r.pressures, r.curl).to_dict()
+            switch = find_switch(r.pressures, r.curl).to_dict()  # of the bending angle: its peak in degrees
+            entry[kind]["switch"] = {**switch, "peak_deg": switch.pop("peak_mm")}
         print(symbol, kind, f"curl {r.curl[-1]:.2f} deg, tip dx {r.tip[-1, 0] - r.reference_tip[0]:.3f} mm, "
               f"{outcome.wall_time:.1f} s", flush=True)
     evaluator.close()
@@ -75,7 +78,7 @@ def main() -> None:
             if switch is not None:  # where the unit's bending changes direction
                 ax_angle.plot([switch], [0.0], "kx", ms=8)
                 ax_angle.annotate(f"{symbol} switches at {switch:.1f} kPa", (switch, 0.0), textcoords="offset points",
-                                  xytext=(-60, 12), fontsize=7)
+                                  xytext=(-100, -14), fontsize=7)
         aligned = entry.get("aligned")
         if isinstance(aligned, dict) and "curl_deg" in aligned:
             ax_curl.plot(aligned["pressures_kpa"], aligned["curl_deg"], "o-", ms=3, label=f"{symbol}")

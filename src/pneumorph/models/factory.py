@@ -25,7 +25,7 @@ SCALE_RANGE = (0.1, 10.0)
 
 def load_library(value: Any, where: str = "[model] library",
                  error: type[SettingsError] = SearchConfigError) -> UnitLibrary:
-    """A unit library named by a setting: a built-in one (``"builtin"``, ``"spatial"``) or the path of a library file.
+    """A unit library named by a setting: a built-in one (``"builtin"``, ``"spatial"``, ``"modes"``) or a library file.
 
     Raises
     ------
