@@ -89,8 +89,8 @@ def main() -> None:
         ax.grid(alpha=0.3)
     ax_angle.legend(fontsize=7)
     out = Path(args.out)
-    save_figure(fig, out, description=f"built-in unit types ({args.library}): single-unit response and aligned-actuator "
-                "curl (3D)")
+    save_figure(fig, out, description=f"built-in unit types ({args.library}): single-unit response and "
+                "aligned-actuator curl (3D)")
     table = {"provenance": provenance(), "library": args.library, "pressure_kpa": args.pressure, "types": results}
     out.with_suffix(".json").write_text(json.dumps(table, indent=1, default=str), encoding="utf-8")
     print(f"wrote {out} and {out.with_suffix('.json')}")

@@ -23,7 +23,8 @@ def chain() -> None:
 @click.option("--unit", "unit_file", type=P.InputFile(),
               help="Unit TOML file (default: the built-in unit).")
 @click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
-              help="A unit library ('builtin', 'spatial', 'modes' or a library TOML file): the table covers its unit types "
+              help="A unit library ('builtin', 'spatial', 'modes' or a library TOML file): the table covers its unit "
+                   "types "
                    "(documentation page unit-library, docs/unit-library.md in the source); instead of --unit.")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
 @click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,

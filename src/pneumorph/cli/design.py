@@ -88,8 +88,9 @@ def _default_folder(config: Any) -> str:
                    "unit and material scales; --model, --pressure, --unit and --library still apply.")
 @click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
               help="Designs over a unit library ('builtin', 'spatial' (sideways units: the GA on the 3D model; no "
-                   "chain table yet), 'modes' (bimodal and low-bending units) or a library TOML file; documentation page unit-library, docs/unit-library.md "
-                   "in the source): certified search over every type and orientation per unit; instead of --unit.")
+                   "chain table yet), 'modes' (bimodal and low-bending units) or a library TOML file; documentation "
+                   "page unit-library, docs/unit-library.md in the source): certified search over every type and "
+                   "orientation per unit; instead of --unit.")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
 @click.option("--out", metavar="DIR", type=P.OutputDir(),

@@ -304,7 +304,8 @@ def _mesh_lines(points: FloatArray, cells: IntArray, etype: str) -> list[str]:
 
 
 def _set_lines(mesh: ActuatorMesh) -> list[str]:
-    """The element sets ``BODY``, ``LAYER`` and any bottom walls' (``BOTTOM_<MATERIAL>``); the node sets ``BASE``, ``SYMMETRY`` (a half model) and ``TIP``."""
+    """The element sets ``BODY``, ``LAYER`` and any bottom walls' (``BOTTOM_<MATERIAL>``); the node sets ``BASE``,
+    ``SYMMETRY`` (a half model) and ``TIP``."""
     out = []
     bottoms = [r for r in mesh.regions if r.startswith("bottom:") and len(mesh.regions[r])]
     for region in ("body", "layer", *bottoms):
