@@ -112,6 +112,19 @@ def test_a_table_survives_its_file_and_refuses_tampering(small, tmp_path: Path) 
         ChainTable.load(tmp_path / "binary.json")
 
 
+def test_a_table_read_again_is_the_one_read_unless_its_file_changed(small, tmp_path: Path) -> None:
+    """The last table read is kept (a run checks a given table, then serves it); a rewritten file is read anew."""
+    _model, table, _ = small
+    path = table.save(tmp_path / "t.json")
+    first = ChainTable.load(path)
+    assert ChainTable.load(path) is first
+    data = json.loads(path.read_text())
+    data["turn_rad"][3][5] += 0.01
+    path.write_text(json.dumps(data))
+    with pytest.raises(ChainTableError, match="fingerprint"):
+        ChainTable.load(path)
+
+
 def test_a_table_of_another_model_or_too_short_an_actuator_is_refused(small) -> None:
     _model, table, _ = small
     check_source(table, Reduced2D(12, COARSE, RAMP))  # same unit, model and ramp: any length

@@ -38,6 +38,10 @@ ALPHABET_FORMAT = 2
 #: a table with far-field terms whose file holds the terms, not the windows they write out
 TERMS_FORMAT = 3
 
+#: the last table :meth:`ChainTable.load` read, and its file's key
+_LAST_LOADED: dict[str, Any] = {}
+
+
 # -- the table --------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class ChainTable:
@@ -372,8 +376,27 @@ class ChainTable:
 
     @classmethod
     def load(cls, path: str | Path) -> ChainTable:
-        """Read a table written by :meth:`save`; :class:`ChainTableError` if it is not one."""
+        """Read a table written by :meth:`save`; :class:`ChainTableError` if it is not one.
+
+        The last table read is kept, keyed by its file's path, size and modification time: a
+        run that checks a given table and then serves it reads a large file (four types: 4 s)
+        once.
+        """
         path = Path(path)
+        try:
+            stat = path.stat()
+            key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+        except OSError:
+            key = None
+        if key is not None and _LAST_LOADED.get("key") == key:
+            return _LAST_LOADED["table"]  # type: ignore[no-any-return]
+        table = cls._read(path)
+        if key is not None:
+            _LAST_LOADED.update(key=key, table=table)
+        return table
+
+    @classmethod
+    def _read(cls, path: Path) -> ChainTable:
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
         except FileNotFoundError:
