@@ -220,7 +220,7 @@ class UnknownObjectiveError(UnknownNameError):
     def __str__(self) -> str:
         return (
             f"unknown objective {self.name!r}; known objectives: {', '.join(self.known)}, "
-            "or a profile 'y = f(x)' / 'r = f(theta)'"
+            "or a profile 'y = f(x)' / 'r = f(theta)' / 'y = f(x), z = g(x)'"
         )
 
 

@@ -57,13 +57,17 @@ def _target_slope(chain: ChainModel, objective: ProfileTarget, errors: dict[str,
     """The largest slope of a profile target wherever the actuator can reach.
 
     ``|df/dx|`` over every x within the chords' summed greatest length of the base, or
-    ``|df/dtheta|`` over two turns either way.
+    ``|df/dtheta|`` over two turns either way; for a space curve ``sqrt(f'^2 + g'^2)`` (the
+    chain is planar: its centres lie at z = 0 exactly, so only their x error moves the z term).
     """
     length = chain.length
     if objective.coordinates == "polar":
         return _max_slope(lambda t: objective.curve(t, length), -4 * np.pi, 4 * np.pi)
     reach = _x_reach(chain, errors)
-    return _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+    slope = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+    if objective.spatial:  # a centre's x error moves its z term by |dg/dx| too: |(dy, dz)| <= e sqrt(1 + f'^2 + g'^2)
+        slope = float(np.hypot(slope, _max_slope(lambda x: objective.curve_z(x, length), -reach, reach)))
+    return slope
 
 
 def _x_reach(chain: ChainModel, errors: dict[str, FloatArray]) -> float:

@@ -94,8 +94,8 @@ class DesignConfig:
     objective: str = "sin"
     amplitude: float = 10.0
     periods: float = 1.0
-    point: tuple[float, float] | None = None
-    curve: tuple[tuple[float, float], ...] | None = None
+    point: tuple[float, ...] | None = None
+    curve: tuple[tuple[float, ...], ...] | None = None
     anchored: bool = True
     stage: tuple[dict[str, Any], ...] | None = None
     units: int = 15
@@ -168,7 +168,7 @@ class DesignConfig:
         if self.ga.seed != self.seed:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
-            object.__setattr__(self, "point", _pair(self.point, "[design] point", unit="mm"))
+            object.__setattr__(self, "point", _point(self.point, "[design] point"))
         if self.curve is not None:
             object.__setattr__(self, "curve", _curve(self.curve, "[design] curve"))
         object.__setattr__(self, "stage", _stages(self.objective, self.stage))
@@ -352,14 +352,30 @@ STAGE_KEYS = ("pressure_kpa", "objective", "amplitude", "periods", "curve", "poi
 _STAGE_NEEDS = ("pressure_kpa", "objective")
 
 
-def _curve(points: Any, name: str) -> tuple[tuple[float, float], ...]:
-    """A drawn curve's points as numbers (mm), refusing text and true/false."""
+def _curve(points: Any, name: str) -> tuple[tuple[float, ...], ...]:
+    """A drawn curve's points as numbers (mm): all ``[x, y]`` or all ``[x, y, z]`` (a space curve), refusing text and
+    true/false."""
     try:
         if any(isinstance(v, (bool, str, bytes)) for xy in points for v in xy):
             raise TypeError("text or true/false")
-        return tuple((float(x), float(y)) for x, y in points)
-    except (TypeError, ValueError):
-        raise SearchConfigError(f"{name} must be a list of [x, y] points in mm, got {points!r}") from None
+        out = tuple(tuple(float(v) for v in xy) for xy in points)
+        if len({len(xy) for xy in out}) != 1 or len(out[0]) not in (2, 3):
+            raise ValueError("mixed or wrong point sizes")
+        return out
+    except (TypeError, ValueError, IndexError):
+        raise SearchConfigError(f"{name} must be a list of [x, y] (or all [x, y, z]) points in mm, got "
+                                f"{points!r}") from None
+
+
+def _point(value: Any, name: str) -> tuple[float, ...]:
+    """A tip point: ``[x, y]``, or ``[x, y, z]`` off the plane of bending (mm).
+
+    >>> _point([60, 40, -10], "[design] point")
+    (60.0, 40.0, -10.0)
+    """
+    if isinstance(value, (list, tuple)) and len(value) == 3:
+        return (*_pair(value[:2], name, unit="mm"), checks.real(value[2], name, unit="mm", error=SearchConfigError))
+    return _pair(value, name, unit="mm")
 
 
 def _stages(objective: str, stages: Any) -> tuple[dict[str, Any], ...] | None:
@@ -395,7 +411,7 @@ def _stages(objective: str, stages: Any) -> tuple[dict[str, Any], ...] | None:
         if "anchored" in s:
             _flag(s["anchored"], f"{where} anchored")
         if "point" in s:
-            s["point"] = _pair(s["point"], f"{where} point", unit="mm")
+            s["point"] = _point(s["point"], f"{where} point")
         if "curve" in s:
             s["curve"] = _curve(s["curve"], f"{where} curve")
         out.append(s)

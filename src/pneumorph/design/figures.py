@@ -49,21 +49,7 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
         return plot_stages(candidate, objective, path)
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
-    curves: list[tuple[np.ndarray, np.ndarray, dict[str, Any]]] = []
-    if isinstance(objective, ProfileTarget):
-        if objective.coordinates == "cartesian":
-            xs = np.linspace(0.0, max(length, float(np.nanmax(pts[:, 0]))), 300)
-            ys = objective.curve(xs, length)
-        else:
-            th = np.unwrap(np.arctan2(pts[1:-1, 1], pts[1:-1, 0]))
-            ts = np.linspace(min(th.min(), 0.0), max(th.max(), 0.0), 300)
-            rs = objective.curve(ts, length)
-            xs, ys = rs * np.cos(ts), rs * np.sin(ts)
-        curves.append((xs, np.broadcast_to(ys, xs.shape), {"color": "C1", "lw": 2,
-                                                           "label": f"target {objective.display}"}))
-        what = f"Eq 4.1 error {candidate.value:.3g} {unit}"
-    else:
-        what = f"{objective.label}: {candidate.value:.4g} {objective.unit}"
+    curves, what = _target_curves(candidate, objective, pts, length, unit)
     others = []
     for name, other in compare:
         o = Candidate(other.design, other.value, candidate.level, candidate.pressure, None, other.response)
@@ -71,7 +57,7 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     # true proportions (equal axes) on a figure as tall as the shape needs: a flat profile gets a flat figure
     # with its legend below, not a square of empty space
     point = None if isinstance(objective, ProfileTarget) else objective.point
-    marks = [np.array([point], dtype=float)] if point is not None else []
+    marks = [np.array([point[:2]], dtype=float)] if point is not None else []
     everything = np.vstack([pts, *[np.column_stack([x, y]) for x, y, _ in curves], *[q for _, q in others], *marks])
     finite = everything[np.all(np.isfinite(everything), axis=1)]
     lo, hi = finite.min(axis=0), finite.max(axis=0)
@@ -79,13 +65,14 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     pad = 0.06 * max(span)
     width = 7.0
     axes_height = float(np.clip((width - 1.0) * (span[1] + 2 * pad) / (span[0] + 2 * pad), 1.1, 6.0))
-    fig = new_figure(width, axes_height + 2.2, layout="constrained")
-    ax = fig.add_subplot()
+    spatial = _in_space(candidate, objective)
+    fig = new_figure(width, axes_height + 2.2 + (3.0 if spatial else 0.0), layout="constrained")
+    ax = fig.add_subplot(2, 1, 1) if spatial else fig.add_subplot()
     ax.axhline(0.0, color="0.8", lw=0.8, ls="--", label="undeformed axis")
     for xs, ys, style in curves:
         ax.plot(xs, ys, **style)
     if point is not None:
-        ax.plot(*point, "x", color="C1", ms=10, mew=2, label="point to reach")
+        ax.plot(*point[:2], "x", color="C1", ms=10, mew=2, label="point to reach")
     fidelity = (r.metadata or {}).get("fidelity")
     ax.plot(pts[:, 0], pts[:, 1], "-", color="C0", lw=1.5,
             label="actuator centreline" + (f" ({fidelity} FE)" if compare and fidelity else ""))
@@ -102,7 +89,64 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     ax.set_title(f"{candidate.design} at {pressure:.4g} kPa - {what}", fontsize=9)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, frameon=False)
     ax.grid(alpha=0.3)
+    if spatial:
+        _top_view(fig.add_subplot(2, 1, 2, sharex=ax), candidate, objective, length)
     return save_figure(fig, path)
+
+
+def _target_curves(candidate: Candidate, objective: Objective, pts: np.ndarray, length: float,
+                   unit: str) -> tuple[list[tuple[np.ndarray, np.ndarray, dict[str, Any]]], str]:
+    """The target drawn in the side view (x, y) and the title's value."""
+    if not isinstance(objective, ProfileTarget):
+        return [], f"{objective.label}: {candidate.value:.4g} {objective.unit}"
+    if objective.coordinates == "cartesian":
+        xs = np.linspace(0.0, max(length, float(np.nanmax(pts[:, 0]))), 300)
+        ys = objective.curve(xs, length)
+    else:
+        th = np.unwrap(np.arctan2(pts[1:-1, 1], pts[1:-1, 0]))
+        ts = np.linspace(min(th.min(), 0.0), max(th.max(), 0.0), 300)
+        rs = objective.curve(ts, length)
+        xs, ys = rs * np.cos(ts), rs * np.sin(ts)
+    return [(xs, np.broadcast_to(ys, xs.shape), {"color": "C1", "lw": 2, "label": f"target {objective.display}"})], \
+        f"Eq 4.1 error {candidate.value:.3g} {unit}"
+
+
+def _space_point(objective: Objective) -> tuple[float, ...] | None:
+    """A tip goal's point off the plane ``(x, y, z)``, else None."""
+    point = None if isinstance(objective, (ProfileTarget, StagedTarget)) else objective.point
+    return point if point is not None and len(point) == 3 else None
+
+
+def _in_space(candidate: Candidate, objective: Objective) -> bool:
+    """Whether the run leaves the plane: a space-curve target, a tip point off it, or centres with a z."""
+    r = candidate.response
+    return bool((isinstance(objective, ProfileTarget) and objective.spatial) or _space_point(objective) is not None
+                or (r is not None and r.centres.shape[-1] == 3))
+
+
+def _top_view(ax: Any, candidate: Candidate, objective: Objective, length: float) -> None:
+    """The view from above (x, z): the target's z and the centreline's (z = 0 for a planar design)."""
+    r, k = candidate.response, candidate.level
+    assert r is not None and k is not None
+    z = r.centres[k, :, 2] - r.reference_centres[:, 2] if r.centres.shape[-1] == 3 else np.zeros(r.centres.shape[1])
+    tip_z = r.tip[k, 2] - r.reference_tip[2] if r.tip.shape[-1] == 3 else 0.0
+    xs = np.concatenate([[0.0], r.centres[k, :, 0], [r.tip[k, 0]]])
+    zs = np.concatenate([[0.0], z, [tip_z]])
+    ax.axhline(0.0, color="0.8", lw=0.8, ls="--")
+    if isinstance(objective, ProfileTarget):
+        grid = np.linspace(0.0, max(length, float(np.nanmax(xs))), 300)
+        ax.plot(grid, np.broadcast_to(objective.curve_z(grid, length), grid.shape), color="C1", lw=2,
+                label="target z")
+    elif (point := _space_point(objective)) is not None:
+        ax.plot(point[0], point[2], "x", color="C1", ms=10, mew=2)
+    ax.plot(xs, zs, "-", color="C0", lw=1.5, label="actuator centreline")
+    ax.plot(xs[1:-1], zs[1:-1], "o", color="C0", ms=4)
+    ax.plot(xs[-1], zs[-1], "s", color="C3", ms=6)
+    ax.set_xlabel("x along the actuator (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.set_title("seen from above (x, z)", fontsize=9)
+    ax.legend(fontsize=7, frameon=False)
+    ax.grid(alpha=0.3)
 
 
 def plot_stages(candidate: Candidate, objective: StagedTarget, path: str | Path) -> Path:

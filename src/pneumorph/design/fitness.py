@@ -78,17 +78,20 @@ class Score:
 def profile_error_array(
     centres: FloatArray, reference_centres: FloatArray, target: ProfileTarget, length: float
 ) -> FloatArray:
-    """Eq 4.1 for stacked centres ``(..., n, 2)`` against their references ``(..., n, 2)``.
+    """Eq 4.1 for stacked centres ``(..., n, 2)`` (or ``(..., n, 3)``) against their references.
 
-    Returns the error over the last two axes, shape ``centres.shape[:-2]``.
+    Returns the error over the last two axes, shape ``centres.shape[:-2]``. A Cartesian target
+    counts a centre's distance in y and z (:meth:`ProfileTarget.squared_error`): centres of
+    two columns lie at ``z = 0``, and a planar target is ``z = 0``.
     """
     x = centres[..., 0]
     y = centres[..., 1] - reference_centres[..., 1]
     if target.coordinates == "cartesian":
-        want, got = target.curve(x, length), y
-    else:
-        theta = np.unwrap(np.arctan2(y, x), axis=-1)
-        want, got = target.curve(theta, length), np.hypot(x, y)
+        z = centres[..., 2] - reference_centres[..., 2] if centres.shape[-1] == 3 else None
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(np.sum(target.squared_error(x, y, length, z), axis=-1))
+    theta = np.unwrap(np.arctan2(y, x), axis=-1)
+    want, got = target.curve(theta, length), np.hypot(x, y)
     with np.errstate(invalid="ignore"):
         return np.sqrt(np.sum((want - got) ** 2, axis=-1))
 
@@ -111,8 +114,15 @@ def profile_errors(response: Response, target: ProfileTarget) -> FloatArray:
 
 
 def tip_value_array(tip: FloatArray, reference_tip: FloatArray, curl: FloatArray, name: str,
-                    point: tuple[float, float] | None = None) -> FloatArray:
-    """The quantity a tip goal optimises for stacked tips ``(..., 2)`` and curls ``(...)``."""
+                    point: tuple[float, ...] | None = None) -> FloatArray:
+    """The quantity a tip goal optimises for stacked tips ``(..., 2)`` (or ``(..., 3)``) and curls ``(...)``.
+
+    ``reach`` with a point ``(x, y, z)`` or a tip of three columns is the distance in space (a
+    tip of two columns, and a point of two, lie at z = 0).
+
+    >>> tip_value_array(np.array([3.0, 4.0]), np.zeros(2), np.zeros(()), "reach", (0.0, 0.0, 12.0)).item()
+    13.0
+    """
     x = tip[..., 0]
     y = tip[..., 1] - reference_tip[..., 1]
     if name in ("max-x", "min-x"):
@@ -123,12 +133,16 @@ def tip_value_array(tip: FloatArray, reference_tip: FloatArray, curl: FloatArray
         return np.hypot(x, y)
     if name == "max-curl":
         return np.array(curl, dtype=float, copy=True)
+    if name == "reach" and point is not None and (len(point) == 3 or tip.shape[-1] == 3):
+        z = tip[..., 2] - reference_tip[..., 2] if tip.shape[-1] == 3 else np.zeros_like(x)
+        pz = point[2] if len(point) == 3 else 0.0  # a point (x, y) lies in the plane z = 0
+        return np.sqrt((x - point[0]) ** 2 + (y - point[1]) ** 2 + (z - pz) ** 2)
     if name == "reach" and point is not None:
         return np.hypot(x - point[0], y - point[1])
     raise ValueError(f"no tip quantity for goal {name!r}")
 
 
-def tip_values(response: Response, name: str, point: tuple[float, float] | None = None) -> FloatArray:
+def tip_values(response: Response, name: str, point: tuple[float, ...] | None = None) -> FloatArray:
     """The quantity a tip goal optimises, at every reported level, shape (k,)."""
     return tip_value_array(response.tip, response.reference_tip, response.curl, name, point)
 

@@ -148,6 +148,8 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
                     d = prof.curve(g.x[j], length)
                     d -= g.y[j]
                 d *= d
+                if prof.spatial:  # the planar chain's centres lie at z = 0: the target's z counts in full
+                    d += prof.curve_z(g.x[j], length) ** 2
                 total += d
             if at < n:
                 total = np.repeat(total, c ** (n - at), axis=0)
@@ -183,6 +185,8 @@ def _accumulate(g: ChainGeometry, objective: ProfileTarget, length: float, alive
         d = objective.curve(g.x[j][alive], length)
         d -= g.y[j][alive]
         d *= d
+        if objective.spatial:  # the planar chain's centres lie at z = 0
+            d += objective.curve_z(g.x[j][alive], length) ** 2
         total += d
         if prune is not None:
             keep = ~prune(total)
@@ -326,7 +330,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
             for _, x, y in centres:
                 if profile:
                     if not polar:
-                        st["sum"] = st["sum"] + (prof.curve(x, length) - y) ** 2
+                        st["sum"] = st["sum"] + prof.squared_error(x, y, length)
                     else:
                         st["sum"] = st["sum"] + (prof.curve(st["theta"], length) - st["r"]) ** 2
                         st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
@@ -460,7 +464,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
         for p, placed, bits, state, centres in growth:
             for _, x, y in centres:
                 for i, target, k in profiles:
-                    state["ssum"][:, i] += (target.curve(x[:, k], length) - y[:, k]) ** 2
+                    state["ssum"][:, i] += target.squared_error(x[:, k], y[:, k], length)
             if p == n:
                 continue
             bound = np.sqrt(((weights**2) * state["ssum"]).sum(axis=1))

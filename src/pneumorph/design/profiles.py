@@ -73,8 +73,9 @@ class Polyline:
         return np.interp(np.asarray(values["x"], dtype=float), self.xs, self.ys)
 
 
-def _curve_points(points: ArrayLike) -> NDArray[np.float64]:
-    """Points as a checked (n, 2) array of finite mm values (numbers only: not text, not true/false)."""
+def _curve_points(points: ArrayLike, columns: tuple[int, ...] = (2,)) -> NDArray[np.float64]:
+    """Points as a checked (n, 2) (or, where ``columns`` allows, (n, 3)) array of finite mm values (numbers only:
+    not text, not true/false)."""
     if not isinstance(points, np.ndarray):
         try:
             rows = list(points)  # type: ignore[arg-type]
@@ -88,8 +89,10 @@ def _curve_points(points: ArrayLike) -> NDArray[np.float64]:
         p = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
         raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
-    if p.ndim != 2 or p.shape[1] != 2:
-        raise TargetExpressionError(f"a curve is a list of [x, y] points in mm, got an array of shape {p.shape}")
+    if p.ndim != 2 or p.shape[1] not in columns:
+        kinds = " or [x, y, z]" if 3 in columns else ""
+        raise TargetExpressionError(f"a curve is a list of [x, y]{kinds} points in mm, got an array of shape "
+                                    f"{p.shape}")
     if not 2 <= len(p) <= MAX_CURVE_POINTS:
         raise TargetExpressionError(f"a curve needs 2 to {MAX_CURVE_POINTS} points, got {len(p)}")
     if not np.isfinite(p).all() or np.abs(p).max() > MAX_TARGET_MM:
@@ -151,10 +154,11 @@ def _check_span(xs: ArrayLike, length: float) -> None:
 
 
 def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarget:
-    """A profile target through the points ``(x, y)`` (mm): the polyline joining them.
+    """A profile target through the points ``(x, y)`` or ``(x, y, z)`` (mm): the polyline joining them.
 
     Points are sorted by x; repeated x are averaged. The target is level beyond the first
-    and last point.
+    and last point. Three columns make a space curve (:attr:`ProfileTarget.depth`: ``z``
+    of the polyline too).
 
     Examples
     --------
@@ -163,16 +167,23 @@ def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarge
     [5.0, 10.0, 0.0]
     >>> t.label
     'curve: y = curve through 3 points'
+    >>> s = curve_target([[0, 0, 0], [100, 10, -20]])
+    >>> s.curve_z([50.0], length=100.0).tolist(), s.spatial
+    ([-10.0], True)
     """
-    p = _curve_points(points)
+    p = _curve_points(points, (2, 3))
     xs, inverse = np.unique(p[:, 0], return_inverse=True)
-    ys = np.bincount(inverse, weights=p[:, 1]) / np.bincount(inverse)
     if len(xs) < 2:
         raise TargetExpressionError("a curve needs points at two different x at least")
     if length is not None:
         _check_span(xs, length)
-    line = Polyline(tuple(float(v) for v in xs), tuple(float(v) for v in ys))
-    return ProfileTarget(line, "cartesian", 0.0, length, "curve")
+
+    def polyline(column: int) -> Polyline:
+        values = np.bincount(inverse, weights=p[:, column]) / np.bincount(inverse)
+        return Polyline(tuple(float(v) for v in xs), tuple(float(v) for v in values))
+
+    depth = polyline(2) if p.shape[1] == 3 else None
+    return ProfileTarget(polyline(1), "cartesian", 0.0, length, "curve", depth=depth)
 
 
 @dataclass(frozen=True)
@@ -191,6 +202,16 @@ class ProfileTarget:
         The value of ``L`` (mm); None takes the undeformed length of the actuator.
     name : str
         A short label ("sin", "cos" or the expression).
+    depth : Expression or Polyline or None
+        ``z = g(x)``: the target leaves the plane of the actuator's bending (a *space
+        curve*, Cartesian only); None (default): a planar target, ``z = 0``.
+
+    Notes
+    -----
+    Eq 4.1 of a space curve sums, over the unit centres, the squared distance from the
+    target at the centre's current x in y and in z (:meth:`squared_error`). A planar design
+    has every centre at ``z = 0``, so a planar target keeps its value exactly and a space
+    curve adds ``g(x)^2`` for each of its centres.
 
     Examples
     --------
@@ -207,14 +228,47 @@ class ProfileTarget:
     amplitude: float = 10.0
     length: float | None = None
     name: str = ""
+    depth: Expression | Polyline | None = None
     sense: Sense = field(default="min", init=False)
     unit: str = field(default="mm", init=False)
+
+    def __post_init__(self) -> None:
+        if self.depth is not None and self.coordinates != "cartesian":
+            raise TargetExpressionError("a space curve (z = g(x)) is Cartesian: a polar target r = f(theta) has no z")
+
+    @property
+    def spatial(self) -> bool:
+        """True for a space curve (a ``z = g(x)``)."""
+        return self.depth is not None
 
     def curve(self, s: ArrayLike, length: float) -> NDArray[np.float64]:
         """The target at ``s`` (x in mm, or theta in rad) for an actuator of ``length`` mm."""
         L = self.length if self.length is not None else length
         var = "x" if self.coordinates == "cartesian" else "theta"
         return self.expression(**{var: np.asarray(s, dtype=float)}, L=L, A=self.amplitude)
+
+    def curve_z(self, x: ArrayLike, length: float) -> NDArray[np.float64]:
+        """The target's ``z`` at ``x`` (mm): ``g(x)``, zero for a planar target."""
+        x = np.asarray(x, dtype=float)
+        if self.depth is None:
+            return np.zeros_like(x)
+        L = self.length if self.length is not None else length
+        return np.broadcast_to(self.depth(x=x, L=L, A=self.amplitude), x.shape)
+
+    def squared_error(self, x: ArrayLike, y: ArrayLike, length: float, z: ArrayLike | None = None,
+                      ) -> NDArray[np.float64]:
+        """A centre's term of Eq 4.1 (Cartesian): ``(f(x) - y)^2``, plus ``(g(x) - z)^2`` for a space curve or a
+        centre off the plane (``z``; None: 0).
+
+        >>> from pneumorph.design.targets import profile_target
+        >>> t = profile_target("y = 0.1*x, z = -0.2*x")
+        >>> t.squared_error([10.0], [1.0], 100.0).tolist(), t.squared_error([10.0], [1.0], 100.0, z=[-1.0]).tolist()
+        ([4.0], [1.0])
+        """
+        out = (self.curve(x, length) - np.asarray(y, dtype=float)) ** 2
+        if self.depth is None and z is None:
+            return out
+        return out + (self.curve_z(x, length) - (0.0 if z is None else np.asarray(z, dtype=float))) ** 2
 
     def check(self, length: float) -> ProfileTarget:
         """Refuse a target that is not finite somewhere on the actuator's range.
@@ -242,23 +296,32 @@ class ProfileTarget:
         with np.errstate(all="ignore"):
             try:
                 values = np.broadcast_to(np.asarray(self.curve(s, length), dtype=float), s.shape)
+                depth = None if self.depth is None else np.asarray(self.curve_z(s, length), dtype=float)
             except (ArithmeticError, ValueError) as exc:
                 raise TargetExpressionError(f"the target {self.label} cannot be evaluated: {exc}") from None
+        for coordinate, v in (("", values), *((("z ", depth),) if depth is not None else ())):
+            self._check_values(s, v, length, coordinate)
+        return self
+
+    def _check_values(self, s: NDArray[np.float64], values: NDArray[np.float64], length: float,
+                      coordinate: str) -> None:
+        """Refuse values (of y or r, or with ``coordinate`` "z ", of z) not finite or too large (:meth:`check`)."""
+        polar = self.coordinates == "polar"
         bad = np.flatnonzero(~np.isfinite(values))
         large = np.flatnonzero(np.abs(np.where(np.isfinite(values), values, 0.0)) > MAX_TARGET_MM)
         if large.size and not bad.size:
             where = f"theta = {s[large[0]]:.4g} rad" if polar else f"x = {s[large[0]]:.4g}"
             raise TargetExpressionError(
-                f"the target {self.label} is {values[large[0]]:.4g} mm at {where}, beyond {MAX_TARGET_MM:g} mm "
-                "(MAX_TARGET_MM): no actuator reaches it"
+                f"the target {self.label} is {values[large[0]]:.4g} mm {coordinate}at {where}, beyond "
+                f"{MAX_TARGET_MM:g} mm (MAX_TARGET_MM): no actuator reaches it"
             )
         if bad.size:
             where = f"theta = {s[bad[0]]:.4g} rad" if polar else f"x = {s[bad[0]]:.4g}"
             span = "0 <= theta <= pi" if polar else f"0 <= x <= L = {length:g} mm"
             raise TargetExpressionError(
-                f"the target {self.label} is not finite at {where} ({values[bad[0]]}); it must be finite for {span}"
+                f"the target {self.label} is not finite {coordinate}at {where} ({values[bad[0]]}); it must be finite "
+                f"for {span}"
             )
-        return self
 
     @property
     def display(self) -> str:
@@ -275,7 +338,10 @@ class ProfileTarget:
         text = text.replace("**", "^").replace("*", "·").replace("theta", "θ")
         text = re.sub(r"\bpi\b", "π", text)
         text = f"{lhs} = {text}"
-        if "A" in self.expression.used:
+        if self.depth is not None:
+            text += ", z = " + self.depth.text.replace("**", "^").replace("*", "·")
+            text = re.sub(r"\bpi\b", "π", text)
+        if "A" in self.expression.used or (self.depth is not None and "A" in self.depth.used):
             text += f", A = {self.amplitude:g} mm"
         return text
 
@@ -283,6 +349,9 @@ class ProfileTarget:
     def label(self) -> str:
         lhs = "y" if self.coordinates == "cartesian" else "r"
         text = f"{lhs} = {self.expression.text}"
-        if "A" in self.expression.used:
+        if self.depth is not None:
+            text += f", z = {self.depth.text}"
+        if "A" in self.expression.used or (self.depth is not None and "A" in self.depth.used):
             text += f", A = {self.amplitude:g} mm"
-        return text if not self.name or self.name == self.expression.text else f"{self.name}: {text}"
+        own = self.expression.text if self.depth is None else f"{self.expression.text}, z = {self.depth.text}"
+        return text if not self.name or self.name == own else f"{self.name}: {text}"

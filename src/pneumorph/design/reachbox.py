@@ -96,6 +96,8 @@ def box_bound(chain: ChainModel, objective: Objective, state: dict[str, Any], re
     assert q is not None
     dx = np.maximum(np.maximum(xlo - q[0], q[0] - xhi), 0.0)
     dy = np.maximum(np.maximum(ylo - q[1], q[1] - yhi), 0.0)
+    if len(q) == 3:  # a point off the plane: the planar chain's tip lies at z = 0
+        return np.hypot(np.hypot(dx, dy), q[2])
     return np.hypot(dx, dy)
 
 

@@ -107,7 +107,7 @@ def profile_rest(reach: Reach, heights: FloatArray, curve: CurveRange, bits: NDA
 _DISTANCE_DIRECTIONS = 8
 
 
-def tip_goal_rest(reach: Reach, name: str, target: tuple[float, float] | None, tip_height: float,
+def tip_goal_rest(reach: Reach, name: str, target: tuple[float, ...] | None, tip_height: float,
                   bits: NDArray[np.integer], point: FloatArray, heading: FloatArray, n_units: int) -> FloatArray:
     """A lower bound on a tip goal's cost (its value; minus it when maximising) of every completion, (m, k).
 
@@ -142,6 +142,8 @@ def tip_goal_rest(reach: Reach, name: str, target: tuple[float, float] | None, t
         psi = toward + 2 * np.pi * i / _DISTANCE_DIRECTIONS
         lb = np.cos(psi) * (x - q[0]) + np.sin(psi) * (y - q[1]) - h[i]
         best = np.maximum(best, np.where(h[i] <= EMPTY / 2, np.inf, lb))
+    if len(q) == 3:  # a point off the plane: the planar chain's tip lies at z = 0, q[2] away from it
+        return np.hypot(best, q[2])
     return best
 
 

@@ -17,6 +17,9 @@ follows the polyline through them (:class:`Polyline`, held level beyond its ends
 
 Presets (section 6.3): ``sin`` is ``A*sin(2*pi*m*x/L)`` and ``cos`` is
 ``A*(cos(2*pi*m*x/L) - 1)``, ``m`` periods over the actuator length (one by default).
+``helix`` is the space curve ``y = A*(1 - cos(2*pi*m*x/L))``, ``z = -A*sin(2*pi*m*x/L)``
+(right-handed about x, radius ``A``, ``m`` turns; ``helix-left`` has ``+A*sin``); any space
+curve is ``y = f(x), z = g(x)`` or a drawn curve of ``(x, y, z)`` points.
 The dissertation does not print its cos formula; the actuator's base is clamped at
 ``y = 0``, so the preset is shifted to pass through the base (``anchored=False`` gives the
 plain ``A*cos(...)``).
@@ -65,7 +68,8 @@ class TipGoal:
     sense : {"min", "max"}
         Whether the value is minimised or maximised.
     point : tuple of float or None
-        The tip point to reach (mm, relative to the base), for ``reach`` only.
+        The tip point to reach (mm, relative to the base), for ``reach`` only: ``(x, y)``, or
+        ``(x, y, z)`` off the plane of bending.
 
     Examples
     --------
@@ -75,7 +79,7 @@ class TipGoal:
 
     name: str
     sense: Sense
-    point: tuple[float, float] | None = None
+    point: tuple[float, ...] | None = None
 
     @property
     def unit(self) -> str:
@@ -84,7 +88,7 @@ class TipGoal:
     @property
     def label(self) -> str:
         if self.name == "reach" and self.point is not None:
-            return f"reach the tip point ({self.point[0]:g}, {self.point[1]:g}) mm"
+            return f"reach the tip point ({', '.join(f'{v:g}' for v in self.point)}) mm"
         return TIP_GOALS[self.name][1]
 
 
@@ -257,15 +261,16 @@ TIP_GOALS: dict[str, tuple[Sense, str]] = {
     "reach": ("min", "distance of the tip to a given point"),
 }
 _ALIASES = {"min-radius": "min-distance", "min-dist": "min-distance", "curl": "max-curl"}
-#: The target profiles known by name (:func:`profile_target`); any other profile is an expression.
-PRESETS = ("sin", "cos")
+#: The target profiles known by name (:func:`profile_target`); any other profile is an expression. The helices
+#: are space curves.
+PRESETS = ("sin", "cos", "helix", "helix-left")
 
 
 def _normalise(name: str) -> str:
     return re.sub(r"[\s_]+", "-", name.strip().lower())
 
 
-def tip_goal(name: str, point: tuple[float, float] | None = None) -> TipGoal:
+def tip_goal(name: str, point: tuple[float, ...] | None = None) -> TipGoal:
     """The tip goal called ``name`` (case, spaces and underscores do not matter).
 
     Raises
@@ -279,10 +284,10 @@ def tip_goal(name: str, point: tuple[float, float] | None = None) -> TipGoal:
     if key not in TIP_GOALS:
         raise UnknownObjectiveError(name, [*TIP_GOALS, *PRESETS])
     if key == "reach":
-        if point is None or len(point) != 2 or not np.all(np.isfinite(point)):
-            raise SearchConfigError("the objective 'reach' needs a tip point (x, y) in mm: --point X Y "
+        if point is None or len(point) not in (2, 3) or not np.all(np.isfinite(point)):
+            raise SearchConfigError("the objective 'reach' needs a tip point (x, y) or (x, y, z) in mm: --point X Y "
                                     "(point = [x, y] in [design] of a config file), e.g. --point 60 40")
-        point = (float(point[0]), float(point[1]))
+        point = tuple(float(v) for v in point)
     elif point is not None:
         raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {key!r}")
     return TipGoal(key, TIP_GOALS[key][0], point)
@@ -300,12 +305,13 @@ def profile_target(
     Parameters
     ----------
     spec : str
-        ``"sin"``, ``"cos"``, ``"y = <expression in x>"``, ``"r = <expression in theta>"``
-        or a bare expression (polar if it uses ``theta``).
+        ``"sin"``, ``"cos"``, ``"helix"``, ``"helix-left"``, ``"y = <expression in x>"``,
+        ``"r = <expression in theta>"``, a space curve ``"y = <expression>, z = <expression>"``
+        (both in x) or a bare expression (polar if it uses ``theta``).
     amplitude : float
-        ``A`` in mm (presets: the amplitude).
+        ``A`` in mm (presets: the amplitude; a helix's radius).
     periods : float
-        Presets: the number of periods over the actuator length.
+        Presets: the number of periods (a helix's turns) over the actuator length.
     length : float, optional
         ``L`` in mm; by default the undeformed length of the actuator evaluated.
     anchored : bool
@@ -315,6 +321,18 @@ def profile_target(
     ------
     TargetExpressionError
         An expression outside the whitelist, or non-positive periods.
+
+    Examples
+    --------
+    A helix of radius ``A`` about an axis parallel to x through ``(0, A, 0)``, right-handed
+    (``helix-left``: left-handed), ``periods`` turns over the actuator:
+
+    >>> h = profile_target("helix", amplitude=25.0)
+    >>> x = [0.0, 25.0, 50.0]
+    >>> h.curve(x, 100.0).round(6).tolist(), h.curve_z(x, 100.0).round(6).tolist()
+    ([0.0, 25.0, 50.0], [-0.0, -25.0, -0.0])
+    >>> profile_target("y = 0.1*x, z = x**2/L").label
+    'y = 0.1*x, z = x**2/L'
     """
     if not np.isfinite(amplitude):
         raise TargetExpressionError(f"the amplitude must be a finite number of mm, got {amplitude!r}")
@@ -323,8 +341,17 @@ def profile_target(
         if not (np.isfinite(periods) and periods > 0):
             raise TargetExpressionError(f"the number of periods must be positive, got {periods!r}")
         arg = f"2*pi*{periods:.17g}*x/L"
+        if key.startswith("helix"):  # radius A, `periods` turns about an axis parallel to x, through (0, A, 0)
+            sign = "-" if key == "helix" else ""
+            return ProfileTarget(parse_expression(f"A*(1 - cos({arg}))", _CARTESIAN), "cartesian", amplitude, length,
+                                 key, depth=parse_expression(f"{sign}A*sin({arg})", _CARTESIAN))
         text = f"A*sin({arg})" if key == "sin" else (f"A*(cos({arg}) - 1)" if anchored else f"A*cos({arg})")
         return ProfileTarget(parse_expression(text, _CARTESIAN), "cartesian", amplitude, length, key)
+    space = re.match(r"^\s*y\s*=(?P<y>.+?),\s*z\s*=(?P<z>.+)$", spec)
+    if space:  # a space curve: y = f(x), z = g(x)
+        y = parse_expression(space["y"], _CARTESIAN, _HINTS_CARTESIAN)
+        z = parse_expression(space["z"], _CARTESIAN, _HINTS_CARTESIAN)
+        return ProfileTarget(y, "cartesian", amplitude, length, f"{y.text}, z = {z.text}", depth=z)
     lhs, _, rhs = spec.partition("=")
     if rhs:
         side = lhs.strip().lower()
@@ -345,7 +372,7 @@ def make_objective(
     spec: str,
     amplitude: float = 10.0,
     periods: float = 1.0,
-    point: tuple[float, float] | None = None,
+    point: tuple[float, ...] | None = None,
     anchored: bool = True,
     length: float | None = None,
     curve: ArrayLike | None = None,
@@ -366,7 +393,8 @@ def make_objective(
     Traceback (most recent call last):
     ...
     pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y,
-    min-y, min-distance, max-curl, reach, sin, cos, or a profile 'y = f(x)' / 'r = f(theta)'
+    min-y, min-distance, max-curl, reach, sin, cos, helix, helix-left, or a profile 'y = f(x)' / 'r = f(theta)'
+    / 'y = f(x), z = g(x)'
     """
     key = _ALIASES.get(_normalise(spec), _normalise(spec))
     if (key == "curve") != (curve is not None):

@@ -389,7 +389,7 @@ class ChainTable:
         except OSError:
             key = None
         if key is not None and _LAST_LOADED.get("key") == key:
-            return _LAST_LOADED["table"]  # type: ignore[no-any-return]
+            return _LAST_LOADED["table"]
         table = cls._read(path)
         if key is not None:
             _LAST_LOADED.update(key=key, table=table)
