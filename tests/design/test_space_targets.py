@@ -10,12 +10,8 @@ from pneumorph.design.certified import certified_search, chain_scores
 from pneumorph.design.fitness import profile_errors, tip_values
 from pneumorph.design.targets import profile_target, tip_goal
 from pneumorph.errors import SearchConfigError, TargetExpressionError
-from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
-from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.chain import ChainModel, ChainTable, design_strings
-from pneumorph.models.chainfit import build_table
 from pneumorph.models.chaintables import shipped_path
-from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response
 
 
@@ -83,15 +79,13 @@ def test_config_takes_points_and_curves_in_space() -> None:
         DesignConfig(objective="curve", curve=[[0, 0, 0], [80, 2]])
 
 
-N = 6
+N = 6  # the units of the coarse_2d fixture (conftest.py)
 
 
 @pytest.fixture(scope="module")
-def setup() -> tuple[Reduced2D, ChainModel, CachedEvaluator]:
-    """The real 2D model (coarse mesh, 25 kPa, 6 units) and its chain."""
-    model = Reduced2D(N, UnitSpec(element_size=3.0), RampSpec(pressure=0.025))
-    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
-    return model, ChainModel(build_table(model, evaluator, window=2, heldout=8), N), evaluator
+def setup(coarse_2d):  # type: ignore[no-untyped-def]
+    """The real 2D model (coarse mesh, 25 kPa, 6 units) and its chain (tests/design/conftest.py)."""
+    return coarse_2d
 
 
 def test_the_certified_search_for_a_space_curve_equals_the_fe_exhaustive_search(setup) -> None:

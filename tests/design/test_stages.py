@@ -16,21 +16,16 @@ from pneumorph.design.fitness import objective_values, stage_values
 from pneumorph.design.targets import StagedTarget, staged_target, tip_goal
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
-from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.chain import ChainModel, design_strings
-from pneumorph.models.chainfit import build_table
-from pneumorph.models.fe import RampSpec, Reduced2D
+from pneumorph.models.fe import Reduced2D
 
-N = 6
-RAMP = RampSpec(pressure=0.025)  # levels 2.5, 5, ..., 25 kPa
+N = 6  # the units of the coarse_2d fixture (conftest.py)
 
 
 @pytest.fixture(scope="module")
-def setup() -> tuple[Reduced2D, ChainModel, CachedEvaluator]:
-    """The real 2D model (coarse mesh, 25 kPa, 6 units) and its chain."""
-    model = Reduced2D(N, UnitSpec(element_size=3.0), RAMP)
-    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
-    return model, ChainModel(build_table(model, evaluator, window=2, heldout=8), N), evaluator
+def setup(coarse_2d):  # type: ignore[no-untyped-def]
+    """The real 2D model (coarse mesh, 25 kPa, 6 units) and its chain (tests/design/conftest.py)."""
+    return coarse_2d
 
 
 def _staged(length: float) -> StagedTarget:
