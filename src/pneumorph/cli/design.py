@@ -44,8 +44,9 @@ def _default_folder(config: Any) -> str:
               help="Tip point (mm) for --objective reach.")
 @click.option("--stage", "stages", metavar="KPA:TARGET", type=P.Text(), multiple=True,
               help="A target at one pressure of the ramp (repeat for several): 'KPA:sin', 'KPA:y = <expr>', or "
-                   "'KPA:reach X Y' (a tip point, mm); --amplitude and --periods shape the presets. The cost is "
-                   "the root-sum-square of the stages (weights: [[design.stage]] in a config file).")
+                   "'KPA:reach X Y' (a tip point, mm; X Y Z off the plane); --amplitude and --periods shape the "
+                   "presets. The cost is the root-sum-square of the stages (weights: [[design.stage]] in a config "
+                   "file).")
 @click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
 @click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"),
               help="GA population (default 100; also the GA a certified search falls back to).")
@@ -384,11 +385,13 @@ def _stage_option(text: str, amplitude: float | None, periods: float | None) -> 
     words = target.split()
     if words[0].lower() == "reach":
         try:
-            x, y = (float(v) for v in words[1:])
+            point = tuple(float(v) for v in words[1:])
         except ValueError:
-            raise click.BadParameter(f"{text!r}: reach needs the tip point X Y in mm, e.g. '45:reach 60 40'",
-                                     param_hint="'--stage'") from None
-        return {"pressure_kpa": pressure, "objective": "reach", "point": (x, y)}
+            point = ()
+        if len(point) not in (2, 3):
+            raise click.BadParameter(f"{text!r}: reach needs the tip point X Y (or X Y Z) in mm, e.g. "
+                                     "'45:reach 60 40'", param_hint="'--stage'")
+        return {"pressure_kpa": pressure, "objective": "reach", "point": point}
     stage: dict[str, Any] = {"pressure_kpa": pressure, "objective": target.strip()}
     stage.update({k: v for k, v in (("amplitude", amplitude), ("periods", periods)) if v is not None})
     return stage
