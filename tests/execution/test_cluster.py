@@ -173,7 +173,7 @@ def test_a_lost_scheduler_is_one_line_and_the_rerun_resumes_from_the_cache(tmp_p
     cluster = Cluster(tmp_path)
     cache = tmp_path / "c.sqlite"
     args = ["chain", "build", "--model", "2d", "--unit", str(coarse_unit(tmp_path)), "--pressure", "20", "--units",
-            "7", "--heldout", "40", "--executor", "dask", "--scheduler", cluster.address, "--cache", str(cache),
+            "7", "--heldout", "16", "--executor", "dask", "--scheduler", cluster.address, "--cache", str(cache),
             "--out", str(tmp_path / "t.json")]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     try:
@@ -297,7 +297,7 @@ def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: C
     unit = tmp_path / "fine.toml"
     unit.write_text("[unit]\nelement_size = 0.5\n")
     common = ["chain", "build", "--model", "2d", "--unit", str(unit), "--pressure", "20",
-              "--units", "7", "--heldout", "40", "--window", "2", "--json"]
+              "--units", "7", "--heldout", "12", "--window", "2", "--json"]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     build = subprocess.Popen([sys.executable, "-m", "pneumorph", *common, "--executor", "dask", "--scheduler",
                               cluster.address, "--cache", str(tmp_path / "d.sqlite"), "--out",
