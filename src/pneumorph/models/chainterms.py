@@ -86,10 +86,17 @@ def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str
                      symmetric: tuple[int, ...] = ()) -> list[str]:
     """The covering designs of window +-w (:func:`~pneumorph.models.windows.covering_designs`), or with
     far-field terms :func:`~pneumorph.models.chainterms.far_designs` (one unit type; over several, the
-    covering designs of +-w show every key of the far-field terms many times)."""
+    covering designs of +-w show every key of the far-field terms many times, and short end designs have
+    ``max(2w, w + 2)`` units, as :func:`far_designs`'s: a far-field term at an end reads ``w + 2`` units).
+
+    >>> [len(d) for d in training_designs(7, 1, True, True, ("a", "r"))][:3]
+    [3, 3, 3]
+    """
     if far and not alphabet:
         return far_designs(n, w)
-    return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short)
+    end_units = max(2 * w, w + 2) if far else None
+    return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short,
+                            end_units=end_units)
 
 
 def fit_text(w: int, far: bool) -> str:

@@ -325,7 +325,8 @@ COVER_RESTART_WORK = 20_000_000
 
 
 def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0, n_types: int = 1,
-                     alphabet: Sequence[str] = (), symmetric: Sequence[int] = (), short: bool = False) -> list[str]:
+                     alphabet: Sequence[str] = (), symmetric: Sequence[int] = (), short: bool = False,
+                     end_units: int | None = None) -> list[str]:
     """A small set of designs in which every window of ``n_units`` units occurs.
 
     Greedy set cover: each pick is the design that shows the most windows not yet seen
@@ -357,6 +358,9 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
         Cover the windows that hold the base or the tip with the designs of :func:`end_designs`
         (``2w`` units each, every end window of ``n_units`` units in one of them), and only the
         interior windows with designs of ``n_units`` units; first the short designs.
+    end_units : int, optional
+        With ``short``, the end designs' units instead of ``2w`` (far-field terms of ``w = 1``
+        read ``w + 2`` units at an end).
 
     Examples
     --------
@@ -387,7 +391,7 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     ends_first: list[str] = []
     codes = window_codes(pool, w, n_types=k)
     if short and n > 2 * w:
-        ends_first = end_designs(w, mirror, k, alphabet, symmetric)
+        ends_first = end_designs(w, mirror, k, alphabet, symmetric, units=end_units)
         codes = codes[:, w + 1 : n - w + 1]  # the chords whose windows hold neither the base nor the tip
     canon = np.minimum(codes, mirror_codes(codes, w, k, symmetric)) if mirror else codes
     needed = np.unique(canon)
