@@ -22,7 +22,7 @@ from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.chain import ChainTable, source_description, source_key
-from pneumorph.models.chainterms import far_means, fit_text, training_designs
+from pneumorph.models.chainterms import check_far_training, far_means, fit_text, training_designs
 from pneumorph.models.response import FloatArray, Response, response_elements
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
@@ -468,6 +468,8 @@ def _window_table(build: _Build, w: int, far: bool = False) -> ChainTable:
     symmetric = library.symmetric_types if library is not None else ()
     check_training_size(max(1, len(alphabet)), w, len(symmetric))
     train = training_designs(n, w, far, build.short, alphabet, symmetric)
+    if far:  # every far-field key shown, checked before the solves
+        check_far_training(train, w, True, alphabet, symmetric, n)
     name = fit_text(w, far)
     say(f"{name}: {len(train)} covering designs")
     tests = heldout_designs(n, build.heldout, exclude=train, seed=build.seed, alphabet=alphabet, symmetric=symmetric)

@@ -132,6 +132,43 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
 
 
+def check_far_training(designs: Sequence[str], window: int, mirror: bool, alphabet: tuple[str, ...],
+                       symmetric: tuple[int, ...], n_units: int) -> None:
+    """Refuse, before any solve, training designs that leave a key of a far-field term unseen.
+
+    The keys the designs show (mirrored too) against those an actuator of ``n_units`` units
+    needs, as :func:`compile_terms` looks them up after the fit.
+
+    Raises
+    ------
+    ChainTableError
+        Naming a window whose term no training design shows.
+
+    Examples
+    --------
+    >>> check_far_training(far_designs(9, 1), 1, True, (), (), 9)
+    >>> check_far_training([d for d in far_designs(9, 1) if len(d) == 9], 1, True, (), (), 9)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.ChainTableError: the training designs show no end of units -2 .. +0 like window [1, 0, 0, 3,
+    3]; train on far_designs()
+    """
+    k = max(1, len(alphabet))
+    width, radix = int(window) + 1, 2 * k + 2
+    syms = []
+    for d in designs:
+        sym = window_symbols(design_array(d, alphabet=alphabet, symmetric=symmetric), width, n_types=k)[0]
+        syms += [sym, mirror_symbols(sym, k, symmetric)] if mirror else [sym]
+    chord = np.concatenate(syms)
+    end = np.concatenate([s[-1:] for s in syms])
+
+    def seen(symbols: IntArray) -> list[tuple[IntArray, FloatArray]]:
+        keys = [np.unique(_term_codes(symbols, width, lo, hi, radix)) for lo, hi in far_terms(window)]
+        return [(u, np.zeros((len(u), 1))) for u in keys]
+
+    compile_terms({"window": int(window), "chord": seen(chord), "end": seen(end)}, n_units, k, symmetric, 1)
+
+
 def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[tuple[IntArray, FloatArray]], FloatArray]:
     """Additive terms, one per key array, fitted by backfitting; returns each term's (sorted keys, values) and the
     fit."""
