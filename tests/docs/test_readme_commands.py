@@ -25,6 +25,7 @@ BIN = Path(sys.executable).parent
 # Commands that do not finish in seconds, by their text after `.venv/bin/pneumorph `: the reason.
 SKIPPED = {
     "simulate -o aRRa --library builtin --model 3d": "a 3D solve",
+    "simulate -o bbbbb --library modes --model 3d --pressure 40": "a 3D solve",
     "unit optimise --out unitopt/": "unit optimisation: minutes",
     "design --target cos --amplitude 20 --certify": "a 3D design run: minutes",
     "design --units 8 --search ga --pressure 25": "a 3D GA run: minutes",
@@ -34,6 +35,9 @@ SKIPPED = {
     "design --robust worst --tolerance 0.1": "a 3D design run",
     "design --refine 1.0 --out runs/refined": "a 3D design run and a finer mesh: minutes",
     'design --stage "18:y = 0.05*x" --stage 45:sin --out runs/stages': "a 3D design run at two stages",
+    ('design --library examples/libraries/units-bending-bimodal.toml --chain-table '
+     'examples/libraries/chain-3d-bending-bimodal-40kpa-far.json --pressure 40 --stage "16:y = 0.0015*x**2" '
+     '--stage "40:y = -0.0015*x**2" --certify'): "a 3D design run with 6 FE verifications: minutes",
     "sensitivity mesh --units 1 --size 1.5 --size 0.75": "3D solves on a fine mesh",
     "sensitivity tolerances --samples 30 --out tol/": "30 3D solves: minutes",
     "sensitivity simplifications --design 001111010001001": "3D solves of a 15-unit design: minutes",

@@ -287,8 +287,7 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     ref = library[library.default]  # the cross-section, mesh size and end cap all units share
     side = _passage_side(units, passage)
     starts = unit_starts(units)
-    grid = _grid(library, units, starts, dim, half, side, base)
-    bottoms = bottom_materials(library.units)
+    grid, bottoms = _grid(library, units, starts, dim, half, side, base), bottom_materials(library.units)
     label = _label(units, orientation, starts, grid.points[grid.cells].mean(axis=1), side, base, bottoms)
     mesh, label = _kept_cells(grid, label, dim, ref.element_order)
     points = np.asarray(mesh.points, dtype=float)

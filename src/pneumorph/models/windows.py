@@ -391,8 +391,7 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     ends_first: list[str] = []
     codes = window_codes(pool, w, n_types=k)
     if short and n > 2 * w:
-        ends_first = end_designs(w, mirror, k, alphabet, symmetric, units=end_units)
-        codes = codes[:, w + 1 : n - w + 1]  # the chords whose windows hold neither the base nor the tip
+        ends_first, codes = end_designs(w, mirror, k, alphabet, symmetric, units=end_units), codes[:, w + 1 : n - w + 1]
     canon = np.minimum(codes, mirror_codes(codes, w, k, symmetric)) if mirror else codes
     needed = np.unique(canon)
     index = np.searchsorted(needed, canon)
