@@ -30,7 +30,7 @@ seed = 3
 
 [ga]
 population = 10
-generations = 20
+generations = 8
 
 [model]
 fidelity = "2d"
