@@ -124,3 +124,22 @@ def test_branch_and_bound_in_space_keeps_every_design_that_matters(target, keeps
     values = objective_values(chain.evaluate(best), target)
     assert names[best] == pytest.approx(float(np.nanmin(values) if target.sense == "min" else np.nanmax(values)),
                                         rel=1e-9)
+
+
+@pytest.mark.parametrize("target", [profile_target("helix", amplitude=5.0), tip_goal("reach", (20.0, 2.0, 3.0))])
+def test_the_profile_figure_of_a_run_in_space_has_the_view_from_above_and_in_space(target, tmp_path) -> None:
+    from matplotlib.image import imread
+
+    from pneumorph.design.figures import plot_profile
+    from pneumorph.design.scoring import Candidate
+
+    ref3 = np.array([[5.0, 0.0, 7.5], [15.0, 0.0, 7.5]])
+    r = _response(np.array([[5.0, 1.0, 8.5], [15.0, 2.0, 10.5]]), ref3, np.array([20.0, 2.0, 10.5]),
+                  np.array([20.0, 0.0, 7.5]))
+    path = plot_profile(Candidate("lL", 1.0, 0, 0.01, None, r), target, tmp_path / "profile.png")
+    flat = plot_profile(Candidate("lL", 1.0, 0, 0.01, None, _response(np.array([[5.0, 1.0], [15.0, 2.0]]),
+                                                                        ref3[:, :2], np.array([20.0, 2.0]),
+                                                                        np.array([20.0, 0.0]))),
+                        make_objective("y = 0.1*x"), tmp_path / "flat.png")
+    # the side view, the view from above and the view in space: a figure much taller than the planar one's
+    assert imread(path).shape[0] > 2 * imread(flat).shape[0]

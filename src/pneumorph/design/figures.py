@@ -66,8 +66,8 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     width = 7.0
     axes_height = float(np.clip((width - 1.0) * (span[1] + 2 * pad) / (span[0] + 2 * pad), 1.1, 6.0))
     spatial = _in_space(candidate, objective)
-    fig = new_figure(width, axes_height + 2.2 + (3.0 if spatial else 0.0), layout="constrained")
-    ax = fig.add_subplot(2, 1, 1) if spatial else fig.add_subplot()
+    fig = new_figure(width, axes_height + 2.2 + (7.0 if spatial else 0.0), layout="constrained")
+    ax = fig.add_subplot(3, 1, 1) if spatial else fig.add_subplot()
     ax.axhline(0.0, color="0.8", lw=0.8, ls="--", label="undeformed axis")
     for xs, ys, style in curves:
         ax.plot(xs, ys, **style)
@@ -90,7 +90,8 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, frameon=False)
     ax.grid(alpha=0.3)
     if spatial:
-        _top_view(fig.add_subplot(2, 1, 2, sharex=ax), candidate, objective, length)
+        _top_view(fig.add_subplot(3, 1, 2, sharex=ax), candidate, objective, length)
+        _space_view(fig.add_subplot(3, 1, 3, projection="3d"), candidate, objective, length)
     return save_figure(fig, path)
 
 
@@ -124,14 +125,43 @@ def _in_space(candidate: Candidate, objective: Objective) -> bool:
                 or (r is not None and r.centres.shape[-1] == 3))
 
 
-def _top_view(ax: Any, candidate: Candidate, objective: Objective, length: float) -> None:
-    """The view from above (x, z): the target's z and the centreline's (z = 0 for a planar design)."""
+def _centreline(candidate: Candidate) -> np.ndarray:
+    """Base, unit centres and tip at the candidate's level as (x, y, z) from their undeformed heights and mid-width
+    (z = 0 for a planar response)."""
     r, k = candidate.response, candidate.level
     assert r is not None and k is not None
-    z = r.centres[k, :, 2] - r.reference_centres[:, 2] if r.centres.shape[-1] == 3 else np.zeros(r.centres.shape[1])
-    tip_z = r.tip[k, 2] - r.reference_tip[2] if r.tip.shape[-1] == 3 else 0.0
-    xs = np.concatenate([[0.0], r.centres[k, :, 0], [r.tip[k, 0]]])
-    zs = np.concatenate([[0.0], z, [tip_z]])
+
+    def off(points: np.ndarray, ref: np.ndarray) -> np.ndarray:
+        out = np.zeros((len(points), 3))
+        out[:, 0] = points[:, 0]
+        out[:, 1:points.shape[1]] = points[:, 1:] - ref[..., 1:points.shape[1]]
+        return out
+
+    return np.vstack([np.zeros((1, 3)), off(r.centres[k], r.reference_centres), off(r.tip[k][None], r.reference_tip)])
+
+
+def _space_view(ax: Any, candidate: Candidate, objective: Objective, length: float) -> None:
+    """The centreline and the target in space, drawn as (x, z, y) so that the height points up."""
+    line = _centreline(candidate)
+    if isinstance(objective, ProfileTarget) and objective.coordinates == "cartesian":
+        grid = np.linspace(0.0, max(length, float(np.nanmax(line[:, 0]))), 300)
+        ax.plot(grid, np.broadcast_to(objective.curve_z(grid, length), grid.shape),
+                np.broadcast_to(objective.curve(grid, length), grid.shape), color="C1", lw=2, label="target")
+    elif (point := _space_point(objective)) is not None:
+        ax.plot([point[0]], [point[2]], [point[1]], "x", color="C1", ms=10, mew=2, label="point to reach")
+    ax.plot(line[:, 0], line[:, 2], line[:, 1], "-o", color="C0", ms=3, lw=1.5, label="actuator centreline")
+    ax.plot([line[-1, 0]], [line[-1, 2]], [line[-1, 1]], "s", color="C3", ms=6)
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.set_zlabel("y (mm)")
+    ax.set_title("in space", fontsize=9)
+    ax.legend(fontsize=7, frameon=False)
+
+
+def _top_view(ax: Any, candidate: Candidate, objective: Objective, length: float) -> None:
+    """The view from above (x, z): the target's z and the centreline's (z = 0 for a planar design)."""
+    line = _centreline(candidate)
+    xs, zs = line[:, 0], line[:, 2]
     ax.axhline(0.0, color="0.8", lw=0.8, ls="--")
     if isinstance(objective, ProfileTarget):
         grid = np.linspace(0.0, max(length, float(np.nanmax(xs))), 300)
