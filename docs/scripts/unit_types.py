@@ -61,8 +61,10 @@ def main() -> None:
                        "reached_kpa": round(float(r.reached) * 1e3, 3), "fingerprint": model.fingerprint(),
                        "seconds": outcome.wall_time}
         if kind == "single":
-            switch = find_switch(r.pressures, r.curl).to_dict()  # of the bending angle: its peak in degrees
-            entry[kind]["switch"] = {**switch, "peak_deg": switch.pop("peak_mm")}
+            # of the bending angle (its peak in degrees), to 1e-6 deg: a symmetric unit's rounding noise is no switch
+            switch = find_switch(r.pressures, r.curl.round(6)).to_dict()
+            switch["peak_deg"] = switch.pop("peak_mm")
+            entry[kind]["switch"] = switch
         print(symbol, kind, f"curl {r.curl[-1]:.2f} deg, tip dx {r.tip[-1, 0] - r.reference_tip[0]:.3f} mm, "
               f"{outcome.wall_time:.1f} s", flush=True)
     evaluator.close()
