@@ -79,7 +79,13 @@ def far_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -
     """
     n, w = int(n_units), int(window)
     interior = [d for d in covering_designs(n, w + 1, mirror, seed, short=True) if len(d) == n]
-    return end_designs(w, mirror, units=max(2 * w, w + 2)) + interior
+    return end_designs(w, mirror, units=_end_units(w)) + interior
+
+
+def _end_units(w: int) -> int:
+    """The units of the end designs of a table of window +-w with far-field terms: ``2w``, and ``w + 2`` for
+    ``w = 1`` (the last chord's far-field term on the base side reads ``w + 2`` units)."""
+    return max(2 * w, w + 2)
 
 
 def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str, ...] = (),
@@ -94,9 +100,8 @@ def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str
     """
     if far and not alphabet:
         return far_designs(n, w)
-    end_units = max(2 * w, w + 2) if far else None
     return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short,
-                            end_units=end_units)
+                            end_units=_end_units(w) if far else None)
 
 
 def fit_text(w: int, far: bool) -> str:
@@ -110,6 +115,15 @@ def _term_codes(symbols: IntArray, width: int, lo: int, hi: int, radix: int) -> 
     return symbols[..., cols] @ (radix ** np.arange(len(cols), dtype=np.int64))
 
 
+def _symbols(design: str, width: int, mirror: bool, alphabet: tuple[str, ...],
+             symmetric: tuple[int, ...]) -> list[tuple[IntArray, float]]:
+    """A design's window symbols of +-``width`` at every chord (and, with ``mirror``, its mirror's), each with the
+    sign its turns take (-1 mirrored)."""
+    k = max(1, len(alphabet))
+    sym = window_symbols(design_array(design, alphabet=alphabet, symmetric=symmetric), width, n_types=k)[0]
+    return [(sym, 1.0)] + ([(mirror_symbols(sym, k, symmetric), -1.0)] if mirror else [])
+
+
 def _observations(responses: Sequence[Response], width: int, mirror: bool, alphabet: tuple[str, ...],
                   symmetric: tuple[int, ...]) -> tuple[IntArray, FloatArray, IntArray, FloatArray]:
     """Symbols of window +-``width`` and elements of every chord (and end), mirrored too.
@@ -117,14 +131,10 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     Returns chord symbols (N, 2 width + 1), chord values (N, 2 k: turns then lengths), end
     symbols (M, 2 width + 1) and end turns (M, k).
     """
-    k = max(1, len(alphabet))
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
         turn, length, end = response_elements(r)
-        bits = design_array(r.orientation, alphabet=alphabet, symmetric=symmetric)
-        sym = window_symbols(bits, width, n_types=k)[0]
-        variants = [(sym, 1.0)] + ([(mirror_symbols(sym, k, symmetric), -1.0)] if mirror else [])
-        for s, sign in variants:
+        for s, sign in _symbols(r.orientation, width, mirror, alphabet, symmetric):
             syms.append(s)
             values.append(np.concatenate([sign * turn.T, length.T], axis=1))
             esyms.append(s[-1:])
@@ -155,10 +165,7 @@ def check_far_training(designs: Sequence[str], window: int, mirror: bool, alphab
     """
     k = max(1, len(alphabet))
     width, radix = int(window) + 1, 2 * k + 2
-    syms = []
-    for d in designs:
-        sym = window_symbols(design_array(d, alphabet=alphabet, symmetric=symmetric), width, n_types=k)[0]
-        syms += [sym, mirror_symbols(sym, k, symmetric)] if mirror else [sym]
+    syms = [sym for d in designs for sym, _ in _symbols(d, width, mirror, alphabet, symmetric)]
     chord = np.concatenate(syms)
     end = np.concatenate([s[-1:] for s in syms])
 
