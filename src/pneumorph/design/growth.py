@@ -143,13 +143,10 @@ def _score_all(chain: ChainModel, objective: Objective, errors: dict[str, FloatA
                 if polar:
                     d = prof.curve(g.theta[j], length)
                     d -= g.r[j]
+                    d *= d
                     bsum += _polar_term(g.r[j], e, slope) ** 2  # type: ignore[operator]
-                else:
-                    d = prof.curve(g.x[j], length)
-                    d -= g.y[j]
-                d *= d
-                if prof.spatial:  # the planar chain's centres lie at z = 0: the target's z counts in full
-                    d += prof.curve_z(g.x[j], length) ** 2
+                else:  # a space curve's z counts in full: the planar chain's centres lie at z = 0
+                    d = prof.squared_error(g.x[j], g.y[j], length)
                 total += d
             if at < n:
                 total = np.repeat(total, c ** (n - at), axis=0)
@@ -182,12 +179,7 @@ def _accumulate(g: ChainGeometry, objective: ProfileTarget, length: float, alive
         p = g.depth[j]
         if p > at:
             alive, total, at = _children(alive, p - at, c), np.repeat(total, c ** (p - at), axis=0), p
-        d = objective.curve(g.x[j][alive], length)
-        d -= g.y[j][alive]
-        d *= d
-        if objective.spatial:  # the planar chain's centres lie at z = 0
-            d += objective.curve_z(g.x[j][alive], length) ** 2
-        total += d
+        total += objective.squared_error(g.x[j][alive], g.y[j][alive], length)
         if prune is not None:
             keep = ~prune(total)
             alive, total = alive[keep], total[keep]
