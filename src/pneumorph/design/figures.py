@@ -17,11 +17,7 @@ from pneumorph.plot.figure import new_figure, save_figure
 
 def profile_points(candidate: Candidate, level: int | None = None) -> np.ndarray:
     """Base, unit centres and tip at the best level (or ``level``), heights above their undeformed positions."""
-    r, k = candidate.response, candidate.level if level is None else level
-    assert r is not None and k is not None
-    centres = np.column_stack([r.centres[k, :, 0], r.centres[k, :, 1] - r.reference_centres[:, 1]])
-    tip = np.array([r.tip[k, 0], r.tip[k, 1] - r.reference_tip[1]])
-    return np.vstack([[0.0, 0.0], centres, tip])
+    return _centreline(candidate, level)[:, :2]
 
 
 def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, unit: str = "mm",
@@ -125,10 +121,10 @@ def _in_space(candidate: Candidate, objective: Objective) -> bool:
                 or (r is not None and r.centres.shape[-1] == 3))
 
 
-def _centreline(candidate: Candidate) -> np.ndarray:
-    """Base, unit centres and tip at the candidate's level as (x, y, z) from their undeformed heights and mid-width
-    (z = 0 for a planar response)."""
-    r, k = candidate.response, candidate.level
+def _centreline(candidate: Candidate, level: int | None = None) -> np.ndarray:
+    """Base, unit centres and tip at the best level (or ``level``) as (x, y, z) from their undeformed heights and
+    mid-width (z = 0 for a planar response)."""
+    r, k = candidate.response, candidate.level if level is None else level
     assert r is not None and k is not None
 
     def off(points: np.ndarray, ref: np.ndarray) -> np.ndarray:

@@ -333,25 +333,25 @@ class ProfileTarget:
         >>> profile_target("y = 0.5*x**2/L").display
         'y = 0.5·x^2/L'
         """
+        def shown(expression: str) -> str:
+            text = re.sub(r"2\*pi\*1\*(x|theta)", r"2*pi*\1", expression)
+            text = text.replace("**", "^").replace("*", "·").replace("theta", "θ")
+            return re.sub(r"\bpi\b", "π", text)
+
         lhs = "y" if self.coordinates == "cartesian" else "r"
-        text = re.sub(r"2\*pi\*1\*(x|theta)", r"2*pi*\1", self.expression.text)
-        text = text.replace("**", "^").replace("*", "·").replace("theta", "θ")
-        text = re.sub(r"\bpi\b", "π", text)
-        text = f"{lhs} = {text}"
+        text = f"{lhs} = {shown(self.expression.text)}"
         if self.depth is not None:
-            text += ", z = " + self.depth.text.replace("**", "^").replace("*", "·")
-            text = re.sub(r"\bpi\b", "π", text)
-        if "A" in self.expression.used or (self.depth is not None and "A" in self.depth.used):
-            text += f", A = {self.amplitude:g} mm"
-        return text
+            text += f", z = {shown(self.depth.text)}"
+        return text + self._amplitude_text
 
     @property
     def label(self) -> str:
-        lhs = "y" if self.coordinates == "cartesian" else "r"
-        text = f"{lhs} = {self.expression.text}"
-        if self.depth is not None:
-            text += f", z = {self.depth.text}"
-        if "A" in self.expression.used or (self.depth is not None and "A" in self.depth.used):
-            text += f", A = {self.amplitude:g} mm"
         own = self.expression.text if self.depth is None else f"{self.expression.text}, z = {self.depth.text}"
+        text = f"{'y' if self.coordinates == 'cartesian' else 'r'} = {own}{self._amplitude_text}"
         return text if not self.name or self.name == own else f"{self.name}: {text}"
+
+    @property
+    def _amplitude_text(self) -> str:
+        """``, A = 10 mm`` where the expressions use ``A``, else nothing."""
+        used = self.expression.used | (self.depth.used if self.depth is not None else frozenset())
+        return f", A = {self.amplitude:g} mm" if "A" in used else ""
