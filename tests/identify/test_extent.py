@@ -12,7 +12,7 @@ from pneumorph.cli import main
 from pneumorph.correlation import ModelShape, model_shape
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.identify import ParameterSet, chain_shape, chain_shapes, precheck_designs
-from pneumorph.identify.fit import _size
+from pneumorph.identify.match import _size
 from pneumorph.models.factory import make_model
 from tests.identify.conftest import synthetic
 

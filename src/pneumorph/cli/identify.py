@@ -87,7 +87,7 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
 
         raise ScanError("a 3D scan needs the 3D model: leave out --model 2d")
     table_dir = chain_table_dir(cache)
-    precheck_designs(observations, params, base, table_dir)  # sizes against the chain's shapes, where a table serves
+    precheck_designs(observations, params, base, table_dir)  # size and units, where a table serves
     click.echo(f"identifying {', '.join(names)} from {len(specs)} scan(s) ({fidelity} model, executor {executor})",
                err=True)
     evaluator = open_evaluator(executor, workers, scheduler, cache)

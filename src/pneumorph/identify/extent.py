@@ -1,13 +1,13 @@
 """A design's deformed shape before any solve: the chain table's centreline carrying rigid units.
 
 A scan whose design was typed with the wrong unit count is refused by its size
-(:func:`~pneumorph.identify.fit.check_design`). The deformed size depends on how far the
+(:func:`~pneumorph.identify.match.check_size`). The deformed size depends on how far the
 design curls, which only a solve knows, unless a chain table of the model serves the scan's
 pressure: then the table's unit centres (exact to hundredths of a millimetre on the nominal
 model, :mod:`pneumorph.models.chain`) place every unit of the undeformed mesh as a rigid
 body, turned by the mean turn of the two chords at its centre. The walls do not balloon in
 this shape, so its size is a little smaller than the solved one's;
-:data:`~pneumorph.identify.fit.CHAIN_MARGIN` widens the size check by what that was measured
+:data:`~pneumorph.identify.match.CHAIN_MARGIN` widens the size check by what that was measured
 to cost (docs/identify.md). A pressure between two of a table's levels is checked against
 the shapes at both (:func:`chain_shapes`): the size between them.
 """

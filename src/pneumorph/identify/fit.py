@@ -55,6 +55,7 @@ from pneumorph.identify.linear import (
     _system,
     confounded,
 )
+from pneumorph.identify.match import check_coverage, check_size
 from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
 from pneumorph.identify.probe import JacobianProbe, ShapeProbe, shape_of, variant_shapes
 from pneumorph.identify.scans import ScanSpec
@@ -66,11 +67,6 @@ FloatArray = NDArray[np.float64]
 MAX_POINTS = 4000
 #: a Gauss-Newton step moves each parameter by at most this many plausible changes (its trust region)
 TRUST = 3.0
-#: a scan spanning outside this times its design's model (solved at nominal) is not of that design
-MATCH_RANGE = (0.8, 1.25)
-#: the chain table's rigid units span up to 2 % less than the solved shape (docs/identify.md): the
-#: size check before any solve is widened by this
-CHAIN_MARGIN = 0.05
 #: the Gauss-Newton iterations (FE Jacobians) before the fit is declared not converged
 MAX_ITERATIONS = 6
 #: converged when every free parameter's step is below this fraction of its standard error ...
@@ -173,41 +169,13 @@ def _sample(scan: Scan, seed: int) -> FloatArray:
     return p[np.sort(np.random.default_rng(seed).choice(len(p), MAX_POINTS, replace=False))]
 
 
-def check_design(observation: Observation, shape: ModelShape | Sequence[ModelShape], margin: float = 0.0) -> None:
-    """Refuse a scan whose size is not its design's (another unit count): before the fit's many solves.
-
-    The scan must span within :data:`MATCH_RANGE` times the nominal model's deformed shape
-    (the diagonal of the box along their principal axes, whichever way the scan lies);
-    a cast off the model by the parameters the fit can change spans within a few percent
-    of it. ``margin`` widens the range both ways for a shape only estimated (before any
-    solve, :func:`~pneumorph.identify.extent.chain_shape`: :data:`CHAIN_MARGIN`); given the
-    shapes at the levels around the scan's pressure, from the smallest one's to the largest's.
-
-    Raises
-    ------
-    ScanError
-        The scan and the model differ in size beyond the range.
-    """
-    shapes = [shape] if isinstance(shape, ModelShape) else list(shape)
-    sizes = [_size(s.surface if len(s.surface) else s.samples) for s in shapes]
-    scan, lo, hi = _size(observation.scan.points), min(sizes), max(sizes)
-    within = MATCH_RANGE[0] / (1 + margin) <= scan / max(lo, 1e-12) and \
-        scan / max(hi, 1e-12) <= MATCH_RANGE[1] * (1 + margin)
-    if not within:
-        spec = observation.spec
-        how = " by its chain table" if margin else ""
-        size = f"{lo:.4g} mm" if len(shapes) == 1 else f"{lo:.4g} to {hi:.4g} mm (the table's levels around it)"
-        ratio = scan / (lo if scan < lo else hi)
-        raise ScanError(f"scan {spec.file} spans {scan:.4g} mm but design {spec.design} "
-                        f"({len(spec.design)} units) spans {size} at {spec.pressure_kpa:g} kPa{how} "
-                        f"({ratio:.3g} times): is it the design scanned? (check its unit count and --scan-unit)")
-
-
 def precheck_designs(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any],
                      table_dir: str | Path | None = None) -> int:
-    """Check each scan's size against its design's shape predicted by a chain table, before any solve.
+    """Check each scan against its design's shape predicted by a chain table, before any solve.
 
-    A pressure between two of a table's levels is checked against the shapes at both
+    Its size and its units (:func:`~pneumorph.identify.match.check_size`,
+    :func:`~pneumorph.identify.match.check_coverage`). A pressure between two of a table's
+    levels is checked against the shapes at both
     (:func:`~pneumorph.identify.extent.chain_shapes`). Scans whose model has no chain table
     around their pressure (or is too short for its window) are checked after their nominal
     solve only. Returns how many were checked.
@@ -215,8 +183,7 @@ def precheck_designs(observations: Sequence[Observation], params: ParameterSet, 
     Raises
     ------
     ScanError
-        A scan's unit or its design's unit count is wrong (:func:`check_design`, widened by
-        :data:`CHAIN_MARGIN`).
+        A scan's unit or its design's unit count is wrong.
     """
     checked = 0
     build_probes(observations, params, base, params.nominal)  # every model refused now
@@ -226,16 +193,10 @@ def precheck_designs(observations: Sequence[Observation], params: ParameterSet, 
                               o.spec.design, table_dir)
         if shapes:
             check_units(o.scan, shapes[0])
-            check_design(o, shapes, CHAIN_MARGIN)
+            check_size(o.scan, o.spec, shapes, predicted=True)
+            check_coverage(o.scan, o.spec, shapes, predicted=True)
             checked += 1
     return checked
-
-
-def _size(points: FloatArray) -> float:
-    """The diagonal of the points' box along their principal axes (independent of their orientation)."""
-    centred = points - points.mean(axis=0)
-    _, _, vt = np.linalg.svd(centred, full_matrices=False)
-    return float(np.linalg.norm(np.ptp(centred @ vt.T, axis=0)))
 
 
 def build_probes(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any],
@@ -305,7 +266,8 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     transforms, before = [], []
     for o, shape in zip(observations, nominal_shapes, strict=True):
         check_units(o.scan, shape)
-        check_design(o, shape)
+        check_size(o.scan, o.spec, [shape])
+        check_coverage(o.scan, o.spec, [shape])
         c = correlate(o.scan, shape)
         transforms.append(c.alignment.transform)
         before.append(c.surface.rms if dim == 3 else c.outline.rms)
@@ -483,8 +445,6 @@ def _per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
 
 
 __all__ = [
-    "CHAIN_MARGIN",
-    "MATCH_RANGE",
     "MAX_CORRELATION",
     "MAX_ITERATIONS",
     "MAX_POINTS",
@@ -493,7 +453,6 @@ __all__ = [
     "Identification",
     "Observation",
     "build_probes",
-    "check_design",
     "confounded",
     "identify",
     "precheck_designs",
