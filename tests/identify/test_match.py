@@ -39,6 +39,8 @@ def test_the_right_design_shows_every_unit(cast_2d: Observation) -> None:
     c = coverage(correlate(cast_2d.scan, shape).aligned, shape)
     assert c.beyond == 0.0 and np.all(np.abs(c.shares - 1) < 0.2) and c.problem() == ""
     assert precheck_designs([cast_2d], ParameterSet(UnitSpec()), {"fidelity": "2d"}) == 1
+    # a photo trace against the 3D model: compared with its outline
+    assert precheck_designs([cast_2d], ParameterSet(UnitSpec()), {"fidelity": "3d"}) == 1
 
 
 @pytest.mark.parametrize(("design", "said"), [(DESIGN[:-1], "more units than the design"),

@@ -77,7 +77,8 @@ class Coverage:
         """What the coverage says is wrong ("" when the scan shows the design's units)."""
         if self.beyond > BEYOND_SHARE / self.units:
             return (f"{100 * self.beyond:.2g} % of the scan lies more than half a unit from the design's shape "
-                    f"(a unit holds {100 / self.units:.2g} %): the cast has more units than the design?")
+                    f"(a unit holds {100 / self.units:.2g} %): the cast has more units than the design, or was scanned "
+                    "at another pressure?")
         ends = {"first": float(self.shares[0]), "last": float(self.shares[-1])}
         low = {k: v for k, v in ends.items() if v < MIN_END_SHARE}
         if low:
@@ -89,6 +90,8 @@ class Coverage:
 
 def coverage(points: FloatArray, shape: ModelShape) -> Coverage:
     """The :class:`Coverage` of ``shape`` by scan ``points`` aligned to it (mm).
+
+    A 3D scan is compared with the shape's surface, a 2D trace with its outline.
 
     Examples
     --------
@@ -102,7 +105,7 @@ def coverage(points: FloatArray, shape: ModelShape) -> Coverage:
     >>> coverage(short, shape).problem()[:43]   # the points within 8 mm of its centre lost
     'the scan hardly reaches its last unit (0.19'
     """
-    model = shape.surface if len(shape.surface) else shape.samples
+    model = shape.surface if points.shape[1] == 3 else shape.samples  # a photo trace: the outline
     dist, _ = cKDTree(model).query(points)
     tree = cKDTree(shape.centres)
     n = len(shape.centres)
@@ -158,7 +161,7 @@ def check_coverage(scan: Scan, spec: ScanSpec, shapes: Sequence[ModelShape], pre
             return
         problems.append(problem)
     raise ScanError(f"scan {spec.file} is not design {spec.design} ({len(spec.design)} units) at "
-                    f"{spec.pressure_kpa:g} kPa{_how(predicted)}: {problems[0]} (check its unit count)")
+                    f"{spec.pressure_kpa:g} kPa{_how(predicted)}: {problems[0]} (check its unit count and pressure)")
 
 
 def _how(predicted: bool) -> str:
