@@ -81,7 +81,8 @@ def main() -> None:
     print(summary)
     out = ROOT / "docs" / "figures" / f"design-mismatch-{args.model}.json"
     out.write_text(json.dumps({"command": f"python docs/scripts/design_mismatch.py --model {args.model}",
-                               "design": DESIGN, "pressure_kpa": 36.0, "summary": summary, "rows": rows, "levels": levels}, indent=1))
+                               "design": DESIGN, "pressure_kpa": 36.0, "summary": summary, "rows": rows,
+                               "levels": levels}, indent=1))
 
 
 if __name__ == "__main__":

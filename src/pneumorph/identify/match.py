@@ -11,14 +11,14 @@ shape after the nominal solve.
   can, once the scan is aligned to it (:func:`~pneumorph.correlation.compare.correlate`):
 
   - *points beyond the design*: a design with fewer units than the cast leaves about half a
-    unit's share of the scan farther than half a pitch from its shape (measured: 3-9 % of the
-    points at 15 units; a right design: none). More than :data:`BEYOND_SHARE` of one unit's
+    unit's share of the scan farther than half a pitch from its shape (measured: 2.8-15 % of
+    the points at 15 units; a right design: none). More than :data:`BEYOND_SHARE` of one unit's
     share so far refuses the design;
   - *an end unit the scan does not reach*: a design with more units than the cast has an end
     unit that few scan points are nearest to. Each unit's share of the scan's points (nearest
     unit centre in the bending plane) over its share of the model's own points is about 1 for
-    every unit of a right design (measured 0.86-1.16); an end unit below
-    :data:`MIN_END_SHARE` refuses the design (measured 0-0.48 for one or two units more). A
+    every unit of a right design (measured 0.87-1.14 for the end units); an end unit below
+    :data:`MIN_END_SHARE` refuses the design (measured 0-0.46 for one or two units more). A
     scan cut short of an end looks the same, so the message names both.
 
 With the shapes at the two levels around the scan's pressure, a scan is refused only if it
