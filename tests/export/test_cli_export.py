@@ -183,11 +183,18 @@ def test_a_model_file_gives_the_parts_its_unit_and_the_deck_its_materials(tmp_pa
         "pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}}).fingerprint()
 
 
-def test_a_sideways_unit_is_refused_before_anything_is_written(tmp_path):
-    # its stiff strip lies on a side face: the parts and moulds here would put it on the top or bottom face
+def test_a_sideways_unit_exports_its_parts_and_refuses_its_mould(tmp_path):
+    """Its stiff strip lies on a side face: the right one as built, the left one turned over (9 mm high: two walls
+    and the cavity). Its mould is not built: refused before anything is written."""
     unit = tmp_path / "side.toml"
     unit.write_text("[unit]\nlayer_side = true\n")
-    for extra in ([], ["--mould"]):
-        result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), *extra)
-        assert result.exit_code == 2 and "sideways unit" in result.output, result.output
-        assert not (tmp_path / "out").exists()
+    result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--json")
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    # per unit: 10.5 x 9 x 12 mm of body (the strip's 3 mm off the width) less the cavity 4.5 x 6 x 9
+    assert summary["volumes_mm3"]["body"] == pytest.approx(2 * (10.5 * 9 * 12 - 4.5 * 6 * 9), rel=1e-12)
+    assert [(p["side"], p["length_mm"]) for p in summary["layer_pieces"]] == [("right", 10.5), ("left", 10.5)]
+    assert summary["volumes_mm3"]["layer_1"] == pytest.approx(10.5 * 9 * 3, rel=1e-12)
+    result = run("01", "--stl", str(tmp_path / "mould"), "--unit", str(unit), "--mould")
+    assert result.exit_code == 2 and "mould of a sideways unit" in result.output, result.output
+    assert not (tmp_path / "mould").exists()

@@ -17,6 +17,7 @@ from pneumorph.export import (
 )
 from pneumorph.export.parts import box, to_manifold
 from pneumorph.geometry.assembly import assemble
+from pneumorph.geometry.library import builtin_library
 from pneumorph.geometry.unit import UnitSpec
 
 DEFAULT = "001111010001001"
@@ -79,17 +80,29 @@ def test_parts_are_the_regions_of_the_assembled_mesh():
     """The union of the 3D mesh's body (layer) cells is the body (the layer pieces), exactly."""
     for spec in (UnitSpec(element_size=20.0, element_order=1),
                  UnitSpec(slit_width=1.0, slit_depth=4.0, end_cap=2.0, element_size=20.0, element_order=1)):
-        mesh = assemble(spec, DEFAULT, dim=3)
-        solids = actuator_solids(spec, DEFAULT)
-        for region, names in (("body", ["body"]), ("layer", [k for k in solids if k.startswith("layer_")])):
-            corners = mesh.points[mesh.cells[mesh.regions[region]]]
-            lo, hi = corners.min(axis=1), corners.max(axis=1)
-            boxes = [box((a[0], b[0], a[1], b[1], a[2], b[2])) for a, b in zip(lo, hi, strict=True)]
-            cells = m3.Manifold.batch_boolean(boxes,
-                                              m3.OpType.Add)
-            mine = m3.Manifold.batch_boolean([solids[k] for k in names], m3.OpType.Add)
-            assert (cells - mine).volume() < 1e-9 and (mine - cells).volume() < 1e-9, region
-            assert cells.volume() == pytest.approx(mine.volume(), rel=1e-12)
+        _assert_regions(assemble(spec, DEFAULT, dim=3), actuator_solids(spec, DEFAULT))
+
+
+@pytest.mark.parametrize(("name", "design"), [("spatial", "aLlAl"), ("builtin", "aResA")])
+def test_library_parts_are_the_regions_of_the_assembled_mesh(name, design):
+    """Mixed designs: sideways units' strips on the right (as built) and left (turned) faces, a near-rigid unit
+    without a cavity, an extending one without a strip, a short one; watertight, and the mesh's regions exactly."""
+    library = builtin_library(name)
+    solids = actuator_solids(library, design)
+    for part, solid in actuator_parts(library, design).items():
+        assert solid.is_watertight and solid.is_volume, part
+    _assert_regions(assemble(library, design, dim=3), solids)
+
+
+def _assert_regions(mesh, solids):
+    for region, names in (("body", ["body"]), ("layer", [k for k in solids if k.startswith("layer_")])):
+        corners = mesh.points[mesh.cells[mesh.regions[region]]]
+        lo, hi = corners.min(axis=1), corners.max(axis=1)
+        boxes = [box((a[0], b[0], a[1], b[1], a[2], b[2])) for a, b in zip(lo, hi, strict=True)]
+        cells = m3.Manifold.batch_boolean(boxes, m3.OpType.Add)
+        mine = m3.Manifold.batch_boolean([solids[k] for k in names], m3.OpType.Add)
+        assert (cells - mine).volume() < 1e-9 and (mine - cells).volume() < 1e-9, region
+        assert cells.volume() == pytest.approx(mine.volume(), rel=1e-12)
 
 
 def test_parts_do_not_overlap_and_fill_the_actuator():

@@ -263,7 +263,11 @@ def _hole_centres(spec: UnitSpec, orientation: str, mould: MouldSpec) -> list[tu
 
 
 def _check_fit(spec: UnitSpec, mould: MouldSpec) -> tuple[float, float]:
-    """Unit-dependent limits: the tenon's inset and the cores' tip inset."""
+    """Unit-dependent limits: the tenon's inset and the cores' tip inset (a sideways unit: refused)."""
+    if spec.layer_side:
+        raise GeometryError("the mould of a sideways unit (its strip on a side face) is not built yet: this mould "
+                            "casts the body on its side in two pieces, and a side strip's recess would lie across "
+                            "their seam; export its parts (--stl) without --mould")
     x0, x1, y0, y1 = spec.cavity
     smaller = min(x1 - x0, y1 - y0)
     inset = smaller / 4

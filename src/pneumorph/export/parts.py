@@ -65,15 +65,17 @@ True
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pneumorph.errors import GeometryError, interrupts_kept
+from pneumorph.export.strips import LayerPiece, layer_pieces
+from pneumorph.geometry.alphabet import parse_design
+from pneumorph.geometry.assembly import cavity_box, unit_starts
 from pneumorph.geometry.features import BaseBlock, Box
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -111,91 +113,20 @@ _BOX_FACES = np.array(
 )
 
 
-@dataclass(frozen=True)
-class LayerPiece:
-    """One piece of the Smooth-Sil strip: a run of units facing the same way.
-
-    Attributes
-    ----------
-    first, last : int
-        The first and last unit it covers (0-based, base first, inclusive).
-    side : {"top", "bottom"}
-        ``"top"``: ``height - layer <= y <= height`` (units as built, ``"0"``);
-        ``"bottom"``: ``0 <= y <= layer`` (units turned, ``"1"``).
-    x0, x1 : float
-        Its extent along the actuator, mm (the last piece includes the end cap).
-    """
-
-    first: int
-    last: int
-    side: str
-    x0: float
-    x1: float
-
-    @property
-    def length(self) -> float:
-        """The length to cut from the strip, mm."""
-        return self.x1 - self.x0
-
-    def box(self, spec: UnitSpec) -> Box:
-        """The piece ``(x0, x1, y0, y1, z0, z1)`` in the actuator's frame."""
-        y0, y1 = (spec.height - spec.layer, spec.height) if self.side == "top" else (0.0, spec.layer)
-        return (self.x0, self.x1, y0, y1, 0.0, spec.width)
-
-
-def layer_pieces(spec: UnitSpec, orientation: str) -> list[LayerPiece]:
-    """The pieces the Smooth-Sil strip is cut into, base first.
-
-    Consecutive units with the same orientation share one piece: their layers lie on the
-    same side, end to end. A design whose units all face the same way has one piece, the
-    strip cut to the actuator's length.
-
-    Parameters
-    ----------
-    spec : UnitSpec
-    orientation : str
-        The design, base first (``"0"`` layer on top, ``"1"`` at the bottom).
-
-    Returns
-    -------
-    list of LayerPiece
-
-    Examples
-    --------
-    >>> [(p.first, p.last, p.side, p.length) for p in layer_pieces(UnitSpec(), "00111")]
-    [(0, 1, 'top', 21.0), (2, 4, 'bottom', 31.5)]
-    >>> layer_pieces(UnitSpec(end_cap=2.0), "0")[0].length
-    12.5
-    >>> layer_pieces(UnitSpec(wall=3.0, layer=0.0), "01")   # no stiff layer: no pieces
-    []
-    """
-    orientation = parse_orientation(orientation)
-    n, P = len(orientation), spec.pitch
-    pieces: list[LayerPiece] = []
-    if spec.layer == 0:  # a unit without a stiff layer (an extending unit): no strip to cut
-        return pieces
-    start = 0
-    for i in range(1, n + 1):
-        if i == n or orientation[i] != orientation[start]:
-            x1 = i * P + (spec.end_cap if i == n else 0.0)
-            side = "top" if orientation[start] == "0" else "bottom"
-            pieces.append(LayerPiece(first=start, last=i - 1, side=side, x0=start * P, x1=x1))
-            start = i
-    return pieces
-
-
-def _cavity_boxes(spec: UnitSpec, orientation: str) -> list[Box]:
-    """Each unit's cavity in the actuator's frame (mirrored in y for orientation 1); none for a solid unit
+def _cavity_boxes(spec: UnitSpec | UnitLibrary, design: str) -> list[Box]:
+    """Each unit's cavity in the actuator's frame (turned over as the unit is); none for a solid unit
     (``solid = true``: its cavity is filled with the body material)."""
-    if spec.solid:
-        return []
-    x0, x1, y0, y1 = spec.cavity
-    H, W, P = spec.height, spec.width, spec.pitch
-    out = []
-    for i, o in enumerate(orientation):
-        cy0, cy1 = (y0, y1) if o == "0" else (H - y1, H - y0)
-        out.append((i * P + x0, i * P + x1, cy0, cy1, spec.side_wall, W - spec.side_wall))
-    return out
+    library, units, orientation = _units(spec, design)
+    starts, H = unit_starts(units), library[library.default].height
+    return [cavity_box(u, o, float(starts[i]), H)
+            for i, (u, o) in enumerate(zip(units, orientation, strict=True)) if not u.solid]
+
+
+def _units(spec: UnitSpec | UnitLibrary, design: str) -> tuple[UnitLibrary, tuple[UnitSpec, ...], str]:
+    """The library, every unit's type and the orientation of a design (0/1 for one unit)."""
+    library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
+    parsed = parse_design(design, library)
+    return library, parsed.units(library), parsed.orientation
 
 
 def box(bounds: Iterable[float]) -> manifold3d.Manifold:
@@ -266,11 +197,11 @@ def to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
-def outline_solid(spec: UnitSpec, orientation: str, z0: float, z1: float) -> manifold3d.Manifold:
+def outline_solid(spec: UnitSpec | UnitLibrary, design: str, z0: float, z1: float) -> manifold3d.Manifold:
     """The body without its cavities between two planes z = ``z0`` and z = ``z1``.
 
-    The body's longitudinal section (the box minus the layer pieces and the slits),
-    extruded across the width: what a mould's walls enclose.
+    The bar minus the layer pieces and the slits; for planar units, the body's longitudinal
+    section extruded across the width: what a mould's walls enclose.
 
     Examples
     --------
@@ -279,28 +210,26 @@ def outline_solid(spec: UnitSpec, orientation: str, z0: float, z1: float) -> man
     """
     import manifold3d as m3
 
-    orientation = parse_orientation(orientation)
-    n, P, H = len(orientation), spec.pitch, spec.height
-    L = n * P + spec.end_cap
+    library, units, orientation = _units(spec, design)
+    ref = library[library.default]
+    starts, H = unit_starts(units), ref.height
+    n, L = len(units), float(starts[-1]) + ref.end_cap
     out = 1.0  # cutters reach past the outer faces, so no cut face coincides with one
-    cutters = []
-    for piece in layer_pieces(spec, orientation):
-        _, _, y0, y1, _, _ = piece.box(spec)
-        ya, yb = (y0, H + out) if piece.side == "top" else (-out, y1)
-        xa = -out if piece.first == 0 else piece.x0
-        xb = L + out if piece.last == n - 1 else piece.x1
-        cutters.append(box((xa, xb, ya, yb, z0 - out, z1 + out)))
-    if spec.slit is not None:
-        sx0, sx1, _, sy1 = spec.slit
-        for i, o in enumerate(orientation):
+    cutters = [box(p.cutter(ref, n, z0, z1, out)) for p in layer_pieces(library, design)]
+    for i, (u, o) in enumerate(zip(units, orientation, strict=True)):
+        if u.slit is not None:
+            sx0, sx1, _, sy1 = u.slit
             ya, yb = (-out, sy1) if o == "0" else (H - sy1, H + out)
-            xb = i * P + sx1 if (i < n - 1 or spec.end_cap > 0) else L + out
-            cutters.append(box((i * P + sx0, xb, ya, yb, z0 - out, z1 + out)))
+            xb = float(starts[i]) + sx1 if (i < n - 1 or ref.end_cap > 0) else L + out
+            cutters.append(box((float(starts[i]) + sx0, xb, ya, yb, z0 - out, z1 + out)))
     return m3.Manifold.batch_boolean([box((0.0, L, 0.0, H, z0, z1)), *cutters], m3.OpType.Subtract)
 
 
-def check_materials(spec: UnitSpec, base_block: BaseBlock | None = DEFAULT_BLOCK) -> None:
+def check_materials(spec: UnitSpec | UnitLibrary, base_block: BaseBlock | None = DEFAULT_BLOCK,
+                    design: str | None = None) -> None:
     """Refuse parts of a material the material library does not know (the body's, the layer's, the block's).
+
+    Over a library, of every type (or of those ``design`` uses).
 
     Raises
     ------
@@ -317,32 +246,38 @@ def check_materials(spec: UnitSpec, base_block: BaseBlock | None = DEFAULT_BLOCK
     """
     from pneumorph.materials.library import get
 
-    for name in (spec.body_material, *([spec.layer_material] if spec.layer > 0 else []),
-                 *([base_block.material] if base_block is not None else [])):
-        get(name)
+    for unit in _types(spec, design):
+        for name in (unit.body_material, *([unit.layer_material] if unit.layer > 0 else [])):
+            get(name)
+    if base_block is not None:
+        get(base_block.material)
 
 
-def check_buildable(spec: UnitSpec) -> None:
-    """Refuse a unit whose parts these builders cannot make: a sideways unit (``layer_side``), whose stiff strip
-    lies on a side face (the parts, strips and moulds here put it on the top or bottom face), and a unit with a
-    bottom wall of another material (``bottom_material``).
+def check_buildable(spec: UnitSpec | UnitLibrary, design: str | None = None) -> None:
+    """Refuse a unit whose parts these builders cannot make: one with a bottom wall of another material
+    (``bottom_material``). Over a library, every type (or those ``design`` uses).
 
-    >>> check_buildable(UnitSpec(layer_side=True))
+    >>> check_buildable(UnitSpec(bottom_material="smooth_sil_950"))
     Traceback (most recent call last):
     ...
-    pneumorph.errors.GeometryError: the parts and moulds of a sideways unit (layer_side: its stiff strip on a side
-    face) are not built yet; export a planar unit
+    pneumorph.errors.GeometryError: the parts and moulds of a unit with a bottom wall of smooth_sil_950
+    (bottom_material) are not built yet; export a unit of one body material
     """
-    if spec.layer_side:
-        raise GeometryError("the parts and moulds of a sideways unit (layer_side: its stiff strip on a side face) "
-                            "are not built yet; export a planar unit")
-    if spec.bottom_material:
-        raise GeometryError(f"the parts and moulds of a unit with a bottom wall of {spec.bottom_material} "
-                            "(bottom_material) are not built yet; export a unit of one body material")
+    for unit in _types(spec, design):
+        if unit.bottom_material:
+            raise GeometryError(f"the parts and moulds of a unit with a bottom wall of {unit.bottom_material} "
+                                "(bottom_material) are not built yet; export a unit of one body material")
+
+
+def _types(spec: UnitSpec | UnitLibrary, design: str | None) -> tuple[UnitSpec, ...]:
+    """The unit types of ``spec`` (a library's: all, or those ``design`` uses)."""
+    if isinstance(spec, UnitSpec):
+        return (spec,)
+    return spec.units if design is None else tuple(dict.fromkeys(_units(spec, design)[1]))
 
 
 def actuator_solids(
-    spec: UnitSpec, orientation: str, base_block: BaseBlock | None = DEFAULT_BLOCK
+    spec: UnitSpec | UnitLibrary, design: str, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, manifold3d.Manifold]:
     """The actuator's parts as manifold3d solids (see :func:`actuator_parts`).
 
@@ -355,33 +290,34 @@ def actuator_solids(
     """
     import manifold3d as m3
 
-    check_buildable(spec)
-    check_materials(spec, base_block)
-    orientation = parse_orientation(orientation)
-    cavities = [box(b) for b in _cavity_boxes(spec, orientation)]
-    body = m3.Manifold.batch_boolean([outline_solid(spec, orientation, 0.0, spec.width), *cavities],
+    library, _, _ = _units(spec, design)  # the design checked first
+    check_buildable(library, design)
+    check_materials(library, base_block, design)
+    ref = library[library.default]  # the section all units share
+    cavities = [box(b) for b in _cavity_boxes(library, design)]
+    body = m3.Manifold.batch_boolean([outline_solid(library, design, 0.0, ref.width), *cavities],
                                      m3.OpType.Subtract)
     solids = {"body": body}
-    pieces = layer_pieces(spec, orientation)
+    pieces = layer_pieces(library, design)
     digits = len(str(len(pieces)))
     for k, piece in enumerate(pieces, start=1):
-        solids[f"layer_{k:0{digits}d}"] = box(piece.box(spec))
+        solids[f"layer_{k:0{digits}d}"] = box(piece.box(ref))
     if base_block is not None:
-        solids["base_block"] = box(base_block.box(spec))
+        solids["base_block"] = box(base_block.box(ref))
     return solids
 
 
 def actuator_parts(
-    spec: UnitSpec, orientation: str, base_block: BaseBlock | None = DEFAULT_BLOCK
+    spec: UnitSpec | UnitLibrary, design: str, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, trimesh.Trimesh]:
     """Watertight meshes of the body, the layer pieces and the base block.
 
     Parameters
     ----------
-    spec : UnitSpec
-        The articulating unit.
-    orientation : str
-        The design, base first (e.g. ``"001111010001001"``).
+    spec : UnitSpec or UnitLibrary
+        The articulating unit, or a library of unit types (they share the section).
+    design : str
+        The design, base first (e.g. ``"001111010001001"``; over a library its symbols).
     base_block : BaseBlock or None
         The block at the base (None: no block).
 
@@ -389,21 +325,29 @@ def actuator_parts(
     -------
     dict of str to trimesh.Trimesh
         ``"body"``, ``"layer_1"``... (zero-padded when there are ten or more, base first;
-        :func:`layer_pieces` gives their sides and lengths) and ``"base_block"``, in the
-        actuator's frame, mm. Each mesh is watertight with outward normals.
+        :func:`~pneumorph.export.strips.layer_pieces` gives their faces and lengths) and
+        ``"base_block"``, in the actuator's frame, mm. Each mesh is watertight with outward
+        normals.
 
     Raises
     ------
     OrientationError
-        A design that is not a string of 0/1.
+        A design that is not one over the unit's (0/1) or the library's symbols.
 
     Examples
     --------
     >>> parts = actuator_parts(UnitSpec(), "001111010001001")
     >>> len(parts), float(parts["body"].volume)   # 15 x (10.5 x 9 x 15 - 4.5 x 6 x 12)
     (10, 16402.5)
+
+    A sideways unit's strip lies on a side face:
+
+    >>> from pneumorph.geometry.library import builtin_library
+    >>> parts = actuator_parts(builtin_library("spatial"), "alL")
+    >>> sorted(parts), float(parts["layer_2"].volume)   # 10.5 x 12 x 3
+    (['base_block', 'body', 'layer_1', 'layer_2', 'layer_3'], 378.0)
     """
-    return {name: to_trimesh(solid) for name, solid in actuator_solids(spec, orientation, base_block).items()}
+    return {name: to_trimesh(solid) for name, solid in actuator_solids(spec, design, base_block).items()}
 
 
 def write_stl(parts: Mapping[str, trimesh.Trimesh], folder: str | Path) -> list[Path]:

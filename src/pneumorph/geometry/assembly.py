@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError
 from pneumorph.geometry.alphabet import Design, parse_design
-from pneumorph.geometry.features import BaseBlock, check_passage
+from pneumorph.geometry.features import BaseBlock, Box, check_passage
 from pneumorph.geometry.grid import grid_lines, section_breaks, width_breaks
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
@@ -407,17 +407,20 @@ def _regions(label: IntArray, dim: int, base: BaseBlock | None, bottoms: Sequenc
     return regions
 
 
-def _cavity_box(unit: UnitSpec, o: str, start: float, H: float) -> tuple[float, float, float, float]:
-    """The cavity of a unit starting at ``start`` in orientation ``o`` (of height ``H``): x0, x1, y0, y1 (mm)."""
+def cavity_box(unit: UnitSpec, o: str, start: float, H: float) -> Box:
+    """A unit's cavity ``(x0, x1, y0, y1, z0, z1)`` in the actuator's frame (mm): starting at ``start``, in
+    orientation ``o``, in a section of height ``H``; turned over it is mirrored (a sideways unit across the
+    width too).
+
+    >>> cavity_box(UnitSpec(), "1", 10.5, 12.0)
+    (13.5, 18.0, 4.5, 10.5, 1.5, 13.5)
+    """
     x0, x1, y0, y1 = unit.cavity
-    cy0, cy1 = (y0, y1) if o == "0" else (H - y1, H - y0)
-    return start + x0, start + x1, cy0, cy1
-
-
-def _cavity_z(unit: UnitSpec, o: str) -> tuple[float, float]:
-    """The cavity across the width (z0, z1) of a unit in orientation ``o`` (a sideways unit's turned over: mirrored)."""
     z0, z1 = unit.cavity_z
-    return (z0, z1) if o == "0" or not unit.layer_side else (unit.width - z1, unit.width - z0)
+    if o == "1":
+        y0, y1 = H - y1, H - y0
+        z0, z1 = (unit.width - z1, unit.width - z0) if unit.layer_side else (z0, z1)
+    return start + x0, start + x1, y0, y1, z0, z1
 
 
 def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orientation: str,
@@ -432,7 +435,7 @@ def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec],
     for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
         if unit.solid:
             continue
-        x0, x1, cy0, cy1 = _cavity_box(unit, o, float(starts[i]), H)
+        x0, x1, cy0, cy1, z0, z1 = cavity_box(unit, o, float(starts[i]), H)
         inside = (
             (points[:, 0] > x0 - _TOL)
             & (points[:, 0] < x1 + _TOL)
@@ -440,7 +443,6 @@ def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec],
             & (points[:, 1] < cy1 + _TOL)
         )
         if dim == 3:
-            z0, z1 = _cavity_z(unit, o)
             inside &= (points[:, 2] > z0 - _TOL) & (points[:, 2] < z1 + _TOL)
         cavity_points |= inside
     if side:  # the passages' walls are loaded by the pressure too
@@ -466,7 +468,7 @@ def _tracked(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orien
     H, W = ref.height, ref.width
     tracked = np.zeros((len(units), 4), dtype=np.int64)
     for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
-        x0, x1, cy0, cy1 = _cavity_box(unit, o, float(starts[i]), H)
+        x0, x1, cy0, cy1, _, _ = cavity_box(unit, o, float(starts[i]), H)
         corners = [(x0, cy0), (x1, cy0), (x1, cy1), (x0, cy1)]
         for k, (cx, cy) in enumerate(corners):
             d = (points[:, 0] - cx) ** 2 + (points[:, 1] - cy) ** 2
@@ -495,4 +497,4 @@ def _end_points(points: FloatArray, ref: UnitSpec, starts: FloatArray, dim: int)
     return end_points[np.argsort(points[end_points, 1])]
 
 __all__ = ["BASE", "BODY", "BOTTOM", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "bottom_materials",
-           "grid_lines", "unit_starts"]
+           "cavity_box", "grid_lines", "unit_starts"]
