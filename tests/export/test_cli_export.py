@@ -198,3 +198,29 @@ def test_a_sideways_unit_exports_its_parts_and_refuses_its_mould(tmp_path):
     result = run("01", "--stl", str(tmp_path / "mould"), "--unit", str(unit), "--mould")
     assert result.exit_code == 2 and "mould of a sideways unit" in result.output, result.output
     assert not (tmp_path / "mould").exists()
+
+
+def test_a_mixed_design_over_a_library_exports_its_parts_and_deck(tmp_path):
+    """Over the spatial library: the strips on the top, left, right and bottom faces, each 10.5 mm long; the deck of
+    the model that solves it (the full width: a sideways unit), under its design's letters."""
+    result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "out"), "--inp", str(tmp_path / "d.inp"),
+                 "--json")
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert [p["side"] for p in summary["layer_pieces"]] == ["top", "left", "right", "bottom", "right"]
+    assert summary["length_mm"] == 52.5 and summary["unit"] == "spatial"
+    # 5 x (10.5 x 12 x 15 less the cavity 4.5 x 6 x 12 (a) or 4.5 x 9 x 9 (l)), less the strips
+    cavities = 2 * 4.5 * 6 * 12 + 3 * 4.5 * 9 * 9
+    strips = 2 * 10.5 * 3 * 15 + 3 * 10.5 * 12 * 3
+    assert summary["volumes_mm3"]["body"] == pytest.approx(5 * 10.5 * 12 * 15 - cavities - strips, rel=1e-12)
+    from pneumorph.models.factory import make_model
+
+    model = make_model(5, {"fidelity": "3d", "library": "spatial", "pressure_kpa": 45.0})
+    assert summary["deck"]["fingerprint"] == model.fingerprint()
+    deck = (tmp_path / "d.inp").read_text()
+    assert "** design aLlAl (5 units), full model" in deck and "SYMMETRY" not in deck
+    assert deck.count("\n*NODE\n") == 1 and len(model.mesh("aLlAl").points) == \
+        int(deck.split("*ELEMENT")[0].strip().splitlines()[-1].split(",")[0])
+    result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "m"), "--mould")
+    assert result.exit_code == 2 and "mould of a design over a unit library" in result.output
+    assert not (tmp_path / "m").exists()

@@ -25,6 +25,9 @@ _DECK_ONLY = ("pressure",)
 @click.option("--mould", "with_mould", is_flag=True,
               help="Also the body's casting mould: its parts' STL and an exploded drawing in DIR/mould/.")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
+              help="A unit library ('builtin', 'spatial' (sideways units), 'modes' or a library TOML file): DESIGN's "
+                   "letters name its unit types; instead of --unit. Its parts only (no --mould yet).")
 @click.option("--clearance", type=P.Real(0.0, 5.0, unit="mm"), default=0.2, show_default=True,
               help="Mould: gap between mating printed parts (pins, core tenons), mm.")
 @click.option("--draft", type=P.Real(0.0, 45.0, high_open=True, unit="degrees"), default=0.0, show_default=True,
@@ -34,7 +37,7 @@ _DECK_ONLY = ("pressure",)
 @click.pass_context
 def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str | None, pressure: float,
            with_mould: bool, unit_file: str | None, clearance: float, draft: float, as_json: bool,
-           model_file: str | None = None) -> None:
+           model_file: str | None = None, library: str | None = None) -> None:
     """Write DESIGN's parts (the Mold Star body with its cavities, the Smooth-Sil layer
     pieces, the base block) as watertight STL files, with --mould the printable casting
     mould of the body, and with --inp the 3D model as a CalculiX/Abaqus deck
@@ -42,17 +45,25 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     """
     from pathlib import Path
 
-    from pneumorph.export import BaseBlock
+    from pneumorph.export import BaseBlock, check_materials
+    from pneumorph.export.parts import check_buildable
     from pneumorph.geometry import parse_orientation
+    from pneumorph.geometry.alphabet import parse_design
     from pneumorph.io import strict_json
 
     # everything is checked before anything is built or written
+    _check_request(ctx, stl_dir, inp_file, with_mould, library)
+    units = P.library_option(library, unit_file) if library is not None else None
     with P.blame("DESIGN"):
-        orientation = parse_orientation(design)
-    _check_request(ctx, stl_dir, inp_file, with_mould)
-    settings = {"fidelity": "3d", "pressure_kpa": pressure, **({"unit_file": unit_file} if unit_file else {})}
+        orientation = parse_orientation(design) if units is None else parse_design(design, units).text
+    settings = {"fidelity": "3d", "pressure_kpa": pressure, **({"unit_file": unit_file} if unit_file else {}),
+                **({"library": library} if library else {})}
     settings = P.model_file_option(settings, model_file, {"pressure_kpa": "pressure"})
-    unit = _unit(settings, unit_file, model_file)
+    if units is not None:
+        with P.blame("--library"):
+            check_buildable(units, orientation)
+            check_materials(units, BaseBlock(), orientation)
+    unit = units if units is not None else _unit(settings, unit_file, model_file)
     folder = Path(stl_dir) if stl_dir is not None else Path()
     mould_spec = _mould_spec(unit, orientation, clearance, draft, folder) if with_mould else None
     model = None
@@ -74,7 +85,8 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         click.echo(strict_json(summary))
         return
     n, length = len(orientation), summary["length_mm"]
-    click.echo(f"design {orientation}: {n} unit{'s' if n > 1 else ''}, {length:g} mm long (unit {unit.name!r})")
+    kind = "library" if library else "unit"
+    click.echo(f"design {orientation}: {n} unit{'s' if n > 1 else ''}, {length:g} mm long ({kind} {unit.name!r})")
     if inp_file is not None:
         click.echo(f"wrote the CalculiX deck at {pressure:g} kPa to {inp_file}")
     click.echo(f"wrote {len(paths)} STL files (mm) to {folder}/:")
@@ -85,10 +97,14 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         _print_mould(mould, mould_spec, folder)
 
 
-def _check_request(ctx: click.Context, stl_dir: str | None, inp_file: str | None, with_mould: bool) -> None:
+def _check_request(ctx: click.Context, stl_dir: str | None, inp_file: str | None, with_mould: bool,
+                   library: str | None) -> None:
     """Refuse what would write nothing, collide, or ignore an option (before anything is built)."""
     from pathlib import Path
 
+    if with_mould and library is not None:
+        raise click.UsageError("the mould of a design over a unit library is not built yet: its units' sections "
+                               "differ along the body; export its parts (--stl) without --mould")
     if stl_dir is None and inp_file is None:
         raise click.UsageError("nothing to export: give --stl DIR (the parts' STL files) and/or --inp FILE "
                                "(a CalculiX deck)")
@@ -181,19 +197,25 @@ def _parts_summary(summary: dict, unit: Any, orientation: str, block: Any, parts
                    mould_spec: Any, folder: Any) -> dict:
     """The parts (files, volumes, layer pieces) and the mould into ``summary``; each part in words."""
     from pneumorph.export import layer_pieces
+    from pneumorph.geometry.alphabet import parse_design
+    from pneumorph.geometry.assembly import unit_starts
+    from pneumorph.geometry.library import UnitLibrary
 
-    n = len(orientation)
-    pieces = layer_pieces(unit, orientation)
-    cavities = "no cavities (solid unit)" if unit.solid else f"{n} cavit{'y' if n == 1 else 'ies'}"
-    describe = {"body": f"{unit.body_material} body, {cavities}",
-                "base_block": f"base block {block.length:g} x {unit.height + 2 * block.margin:g} x "
-                              f"{unit.width + 2 * block.margin:g} mm, {block.material}"}
+    library = unit if isinstance(unit, UnitLibrary) else UnitLibrary.single(unit)
+    types = parse_design(orientation, library).units(library)
+    ref, pieces = library[library.default], layer_pieces(unit, orientation)
+    k = sum(not u.solid for u in types)
+    solid = f"solid unit{'s' if len(set(types)) > 1 else ''}"
+    cavities = f"{k} cavit{'y' if k == 1 else 'ies'}" if k else f"no cavities ({solid})"
+    describe = {"body": f"{ref.body_material} body, {cavities}",
+                "base_block": f"base block {block.length:g} x {ref.height + 2 * block.margin:g} x "
+                              f"{ref.width + 2 * block.margin:g} mm, {block.material}"}
     layer_names = [k for k in parts if k.startswith("layer_")]
     for name, p in zip(layer_names, pieces, strict=False):
         units = f"unit {p.first + 1}" if p.first == p.last else f"units {p.first + 1}-{p.last + 1}"
-        describe[name] = f"{unit.layer_material} strip, {units}, {p.side}, cut {p.length:g} mm"
+        describe[name] = f"{p.material} strip, {units}, {p.side}, cut {p.length:g} mm"
     summary.update({
-        "length_mm": n * unit.pitch + unit.end_cap,
+        "length_mm": float(unit_starts(types)[-1]) + ref.end_cap,
         "unit": unit.name,
         "files": [str(p) for p in paths],
         "volumes_mm3": {name: float(mesh.volume) for name, mesh in parts.items()},

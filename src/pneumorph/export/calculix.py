@@ -193,8 +193,18 @@ def _nset(name: str, indices: Iterable[int]) -> list[str]:
 
 
 def calculix_mesh(model: Any, design: str) -> ActuatorMesh:
-    """The mesh :meth:`Full3D.build` would solve for ``design`` (without FElupe's objects)."""
+    """The mesh :meth:`Full3D.build` would solve for ``design`` (without FElupe's objects).
+
+    Over a unit library, the model's own mesh (a design with a sideways unit: the full
+    width); its types must share one layer material (the deck's ``layer`` set).
+    """
     _check_model(model)
+    if getattr(model, "mixed", False):
+        layers = {u.layer_material for u in model.library.units if u.layer > 0}
+        if len(layers) > 1:
+            raise GeometryError(f"the deck's layer set has one material; library {model.library.name!r} has "
+                                f"{len(layers)} ({', '.join(sorted(layers))})")
+        return model.mesh(design)
     design = parse_orientation(design, model.n_units)
     return assemble(model.unit, design, 3, half=model.half)
 
@@ -266,10 +276,10 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True, residual
 
 def _heading(model: Any, mesh: ActuatorMesh) -> list[str]:
     """The deck's comments (design, fingerprint, units, the volumetric term) and ``*HEADING``."""
-    halves = "half model, u_z = 0 on z = width/2" if model.half else "full model"
+    halves = "half model, u_z = 0 on z = width/2" if mesh.symmetry_points is not None else "full model"
     return [
         f"** pneumorph {__version__}: CalculiX/Abaqus deck of the 3D model (Full3D)",
-        f"** design {mesh.orientation} ({mesh.n_units} unit{'s' if mesh.n_units > 1 else ''}), {halves}",
+        f"** design {mesh.design or mesh.orientation} ({mesh.n_units} unit{'s' if mesh.n_units > 1 else ''}), {halves}",
         f"** model fingerprint {model.fingerprint()}",
         f"** units: mm, Pa, micronewtons; pressure {model.ramp.pressure * 1e3:g} kPa in "
         f"{len(model.ramp.steps.levels())} levels",
@@ -277,7 +287,7 @@ def _heading(model: Any, mesh: ActuatorMesh) -> list[str]:
         "** volumetric term: CalculiX (J-1)^2/D1, pneumorph 9/2 K (J^(1/3)-1)^2 (Eq 2.12);",
         "** CalculiX's tip moves about 5 % less (see pneumorph.export.calculix)",
         "*HEADING",
-        f"pneumorph design {mesh.orientation}",
+        f"pneumorph design {mesh.design or mesh.orientation}",
     ]
 
 
