@@ -15,7 +15,8 @@ base face x = 0, y across its height, z across its width):
     The Smooth-Sil 950 strip cut into pieces, base first: one piece per run of units with
     the same orientation (the whole strip, cut to the actuator's length, when all units face
     the same way), each ``layer`` thick and ``width`` wide; the last piece also covers the
-    end cap. :func:`layer_pieces` lists their cut lengths and sides.
+    end cap. :func:`~pneumorph.export.strips.layer_pieces` lists their cut lengths and
+    faces. Over a unit library (a mixed design) a sideways unit's piece lies on a side face.
 ``base_block``
     A solid silicone slab glued to the clamped base face, through which the syringe is
     pushed into the first cavity (section 6.4.2: the thick slab keeps the air from escaping
