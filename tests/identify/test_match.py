@@ -28,7 +28,7 @@ CAST = [0.06, 0.0, 0.0, 0.08, 0.0]  # bulk x1.06, wall +0.08 mm: what a cast may
 @pytest.fixture(scope="module")
 def cast_2d() -> Observation:
     params = ParameterSet(UnitSpec())
-    return synthetic(params, params.nominal + np.array(CAST), DESIGN, "2d", seed=2, points=3000)
+    return synthetic(params, params.nominal + np.array(CAST), DESIGN, "2d", seed=2, points=1500)
 
 
 def test_the_right_design_shows_every_unit(cast_2d: Observation) -> None:
@@ -65,7 +65,7 @@ def test_a_3d_scan_one_unit_off_is_refused_before_any_solve() -> None:
     """3D surface of a cast 8-unit actuator (the shipped 3D table serves 7 units or more): its own design passes,
     one unit more or less is refused, each by what it lacks."""
     params = ParameterSet(UnitSpec())
-    cast = synthetic(params, params.nominal + np.array(CAST), "00111100", "3d", seed=4, points=3000)
+    cast = synthetic(params, params.nominal + np.array(CAST), "00111100", "3d", seed=4, points=1500)
     assert precheck_designs([cast], params, {"fidelity": "3d"}) == 1
     for design, said in (("001111000", "hardly reaches its last unit"), ("0011110", "more units than the design")):
         with pytest.raises(ScanError, match=said):
