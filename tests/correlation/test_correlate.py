@@ -243,3 +243,34 @@ def test_correlate_with_a_model_file_compares_with_that_model(tmp_path: Path, ca
         assert data["model"] == "2d"  # the file's fidelity: the 3D default is not used
         rms[name] = data["outline"]["rms_mm"]
     assert rms["identified"] < 0.01 < rms["nominal"], rms
+
+
+def test_a_scan_of_a_sideways_design_is_measured_on_its_surface(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """A design that leaves the bending plane (`aL` over the spatial library, full model): a moved scan of its own
+    surface with 0.05 mm noise comes back to the noise (RMS 0.05 sqrt 3 = 0.087 mm) and the move; the bending
+    plane's outline and centreline are not measured; the figure shows two views. A 2D trace of it is refused
+    before any solve."""
+    from pneumorph.models.factory import make_model
+
+    shape = model_shape(make_model(2, {"fidelity": "3d", "library": "spatial", "pressure_kpa": 36}).solve("aL"))
+    assert np.ptp(shape.surface[:, 2]) > 15.5  # it leaves the width of the straight actuator (15 mm)
+    rng = np.random.default_rng(3)
+    true = Transform(Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix(), np.array([5.0, -3.0, 7.0]))
+    points = true(shape.surface) + rng.normal(scale=0.05, size=shape.surface.shape)
+    scan = tmp_path / "side.xyz"
+    np.savetxt(scan, points)
+    out = tmp_path / "out"
+    assert main(["correlate", str(scan), "--design", "aL", "--library", "spatial", "--pressure", "36",
+                 "--out", str(out), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert 0.07 < result["surface"]["rms_mm"] < 0.1
+    assert result["outline"]["points"] == 0 and result["centreline"]["points"] == 0
+    t = result["transform"]
+    back = true.then(Transform(np.array(t["rotation"]), np.array(t["translation_mm"]), t["scale"]))
+    assert back.angle_deg < 0.05 and np.linalg.norm(back.translation) < 0.05
+    assert (out / "correlation.png").stat().st_size > 0
+    trace = tmp_path / "trace.csv"
+    np.savetxt(trace, points[:, :2], delimiter=",", header="x,y", comments="")
+    assert main(["correlate", str(trace), "--design", "aL", "--library", "spatial", "--pressure", "36"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "needs a 3D scan" in err[0] and "solving" not in err[0]

@@ -14,6 +14,9 @@ from pneumorph.cli import params as P
 @click.option("--model", "fidelity", type=click.Choice(["3d", "2d"]), default="3d", show_default=True,
               help="The model to compare with (a 3D scan needs 3d).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
+@click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
+              help="A unit library: the design's letters name its unit types; instead of --unit. A design with a "
+                   "sideways unit ('spatial') is measured on its surface only (a 3D scan).")
 @click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP)
 @click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]), default="mm", show_default=True,
               help="The unit of the scan's coordinates.")
@@ -25,7 +28,7 @@ from pneumorph.cli import params as P
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file: str | None, scan_unit: str,
               scale: float | None, fit_scale: bool, photo: str | None, out: str | None, as_json: bool,
-              model_file: str | None = None) -> None:
+              model_file: str | None = None, library: str | None = None) -> None:
     """Align SCAN (STL, PLY, OBJ, OFF, XYZ, or a CSV of x,y traced on a photo) to the model's
     inflated shape by least squares, and report RMS and maximum distances on the surface,
     along the outline and along the centreline.
@@ -34,15 +37,22 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
 
     from pneumorph.correlation import correlate as align_and_measure
     from pneumorph.correlation import model_shape, plot_correlation, read_scan
-    from pneumorph.correlation.compare import check_length, check_units
+    from pneumorph.correlation.compare import SIDEWAYS_TRACE, check_length, check_units
     from pneumorph.errors import ScanError
     from pneumorph.geometry import parse_orientation
+    from pneumorph.geometry.alphabet import parse_design
+    from pneumorph.geometry.assembly import unit_starts
     from pneumorph.io import provenance, strict_json, write_json
     from pneumorph.models.factory import make_model
 
+    units = P.library_option(library, unit_file) if library is not None else None
     with P.blame("--design"):
-        orientation = parse_orientation(design)
+        orientation = parse_orientation(design) if units is None else parse_design(design, units).text
+    types = parse_design(orientation, units).units(units) if units is not None else ()
+    planar = not any(u.layer_side for u in types)
     data = read_scan(scan, scan_unit, scale)  # a bad scan is refused before the model is solved
+    if not planar and data.dim != 3:
+        raise ScanError(SIDEWAYS_TRACE)
     if photo is not None and data.dim != 2:
         raise click.BadParameter("a photo goes with a 2D trace (a CSV of x,y), not a 3D scan", param_hint="'--photo'")
     if photo is not None:
@@ -54,6 +64,8 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
     if unit_file:
         P.unit_option(unit_file)
         settings["unit_file"] = unit_file
+    if library is not None:
+        settings["library"] = library
     settings = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure"})
     fidelity = str(settings["fidelity"])
     if data.dim == 3 and fidelity == "2d":
@@ -61,7 +73,7 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
                         f"a 3D scan needs the 3D model, but --model-file {model_file} is of the 2D model: "
                         "give --model 3d")
     model = make_model(len(orientation), settings)
-    check_length(data, len(orientation) * model.unit.pitch)
+    check_length(data, float(unit_starts(types)[-1]) if types else len(orientation) * model.unit.pitch)
     click.echo(f"solving design {orientation} at {pressure:g} kPa ({fidelity} model)", err=True)
     solution = model.solve(orientation)
     shape = model_shape(solution)
@@ -71,7 +83,7 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
 
     click.echo(f"aligning {len(data.points):,} scan points to the model (about "
                f"{duration_text(align_seconds(len(data.points)))}) ...", err=True)
-    result = align_and_measure(data, shape, scale=fit_scale)
+    result = align_and_measure(data, shape, scale=fit_scale, planar=planar)
     summary = {"scan": str(scan), "design": orientation, "pressure_kpa": pressure, "model": fidelity,
                "scan_points": len(data.points), **result.to_dict()}
     if out:

@@ -33,6 +33,8 @@ FloatArray = NDArray[np.float64]
 SPACING = 0.05  # mm between outline samples
 UNIT_RANGE = (0.25, 4.0)  # scan extent / model extent outside this: a unit mistake
 LENGTH_RANGE = (0.12, 3.0)  # scan extent / undeformed length, checked before solving
+SIDEWAYS_TRACE = ("a design that leaves the bending plane (a sideways unit) needs a 3D scan: a 2D trace shows one "
+                  "view only")
 
 
 @dataclass(frozen=True)
@@ -195,15 +197,21 @@ def _slab_mids(points: FloatArray, centres: FloatArray, pitch: float) -> FloatAr
     return out
 
 
-def correlate(scan: Scan, shape: ModelShape, scale: bool = False) -> Correlation:
+def correlate(scan: Scan, shape: ModelShape, scale: bool = False, planar: bool = True) -> Correlation:
     """Align ``scan`` to the model and measure the distances (see the module docstring).
+
+    ``planar=False`` (a design that leaves the bending plane: a sideways unit) measures the
+    surface only: the outline and centreline measures are those of the bending plane.
 
     Raises
     ------
     ScanError
-        A scan of the wrong size (unit), or a 3D scan against a 2D model.
+        A scan of the wrong size (unit), a 3D scan against a 2D model, a 2D trace of a
+        design that leaves the plane.
     """
     check_units(scan, shape)
+    if not planar and scan.dim != 3:
+        raise ScanError(SIDEWAYS_TRACE)
     if scan.dim == 3:
         if not len(shape.surface):
             raise ScanError("a 3D scan needs the 3D model (--model 3d); a 2D model has no surface")
@@ -217,6 +225,10 @@ def correlate(scan: Scan, shape: ModelShape, scale: bool = False) -> Correlation
         aligned = alignment.transform(scan.points)
         surface = Measure.of(np.empty(0))
         outline_pts = aligned
+    if not planar:
+        empty = Measure.of(np.empty(0))
+        offsets = np.full(len(shape.centres), np.nan)
+        return Correlation(alignment, surface, empty, empty, offsets, aligned, np.empty((0, 2)))
     samples = shape.samples
     outline_d, _ = cKDTree(samples).query(outline_pts)
     mids_scan = _slab_mids(outline_pts, shape.centres, shape.pitch)

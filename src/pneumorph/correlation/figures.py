@@ -30,6 +30,8 @@ def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | 
     photo_scale : float, optional
         mm per pixel of the photo (the scan's ``--scale``).
     """
+    if not result.outline.count and result.surface.count:  # a design that leaves the plane: its surface only
+        return _plot_surface(result, shape, path, title)
     fig = new_figure(8, 4.5, layout=None)
     ax = fig.add_subplot()
     if photo is not None:
@@ -45,6 +47,31 @@ def plot_correlation(result: Correlation, shape: ModelShape, path: str | Path | 
     ax.set_title(title or f"outline RMS {o.rms:.3g} mm, max {o.max:.3g} mm; centreline RMS {c.rms:.3g} mm, "
                           f"max {c.max:.3g} mm", fontsize=9)
     ax.legend(loc="best", fontsize=7)
+    fig.text(0.99, 0.01, f"pneumorph {__version__}", ha="right", fontsize=6, color="0.5")
+    if path is not None:
+        save_figure(fig, path, bbox_inches="tight")
+    return fig
+
+
+def _plot_surface(result: Correlation, shape: ModelShape, path: str | Path | None, title: str) -> Figure:
+    """The aligned scan's points over the model's surface, seen from the side (x, y) and from above (x, z),
+    coloured by their distance from the surface (a design that leaves the bending plane)."""
+    from scipy.spatial import cKDTree
+
+    dist, _ = cKDTree(shape.surface).query(result.aligned)
+    fig = new_figure(8, 6.5, layout=None)
+    for k, (j, name) in enumerate(((1, "y"), (2, "z"))):
+        ax = fig.add_subplot(2, 1, k + 1)
+        ax.plot(shape.surface[:, 0], shape.surface[:, j], ".", color="0.75", ms=1, label="model surface")
+        dots = ax.scatter(result.aligned[:, 0], result.aligned[:, j], c=dist, s=2, cmap="viridis",
+                          label="scan (aligned)")
+        ax.set_aspect("equal")
+        ax.set(xlabel="x (mm)", ylabel=f"{name} (mm)")
+        ax.legend(loc="best", fontsize=7)
+    fig.colorbar(dots, ax=fig.axes, label="distance from the surface (mm)", shrink=0.8)
+    s = result.surface
+    fig.axes[0].set_title(title or f"surface RMS {s.rms:.3g} mm, max {s.max:.3g} mm (from the side and from above)",
+                          fontsize=9)
     fig.text(0.99, 0.01, f"pneumorph {__version__}", ha="right", fontsize=6, color="0.5")
     if path is not None:
         save_figure(fig, path, bbox_inches="tight")
