@@ -1,0 +1,103 @@
+"""Chords of a space polyline as twist-free turns and lengths: the chain's elements in 3D.
+
+The chain model (:mod:`pneumorph.models.chain`) describes a planar response by the turn and
+length of each chord of the polyline base -> unit centres -> tip. In space, a chord's
+direction relative to the one before is a rotation, and the chords alone do not say how the
+frame rolls about them. Here each chord carries the frame transported from the base without
+twist (a *discrete parallel transport*, or Bishop frame): chord ``j``'s frame is chord
+``j - 1``'s turned by the smallest rotation that takes one direction to the other. That
+rotation's axis is normal to chord ``j - 1``, so in its frame it has two components: the
+turn about the frame's y axis and the turn about its z axis. The base's frame is the
+actuator's own (x along it, y up, z across the width), and chord ``-1`` points along x.
+
+Why twist-free. A unit of the built-in kinds bends about one of its section's axes and its
+section is symmetric about the plane of that bend (a planar unit: the mid-width plane; a
+sideways unit: the mid-height plane), so by symmetry it does not twist: its material frame
+turns with the transported frame. Where two kinds meet, neither symmetry holds, and a small
+twist the chords cannot show is the chain's error there (measured by the held-out designs).
+
+A planar polyline (z = 0) has no turn about y and its turn about z is the planar chain's
+turn (:func:`~pneumorph.models.response.response_elements`), to rounding.
+
+Examples
+--------
+>>> import numpy as np
+>>> up = np.array([[0, 0, 0], [10, 0, 0], [20, 10, 0.0]])      # a turn of 45 degrees in the plane
+>>> side = np.array([[0, 0, 0], [10, 0, 0], [20, 0, 10.0]])    # the same towards +z: about y, negative
+>>> np.degrees(space_elements(up)[0][1]).round(9).tolist(), np.degrees(space_elements(side)[0][1]).round(9).tolist()
+([0.0, 45.0], [-45.0, 0.0])
+>>> points = np.array([[0, 0, 0], [10, 0, 0], [20, 1, 0], [29, 2, 3.0]])
+>>> turns, lengths = space_elements(points)
+>>> bool(np.allclose(space_polyline(turns, lengths, points[0]), points, rtol=0, atol=1e-12))
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+def space_elements(points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The twist-free turns (about the frame's y and z, rad) and the lengths (mm) of a polyline's chords.
+
+    Parameters
+    ----------
+    points : ndarray, shape (..., m + 1, 3)
+        Polylines (base first); leading axes are kept (levels, designs).
+
+    Returns
+    -------
+    turns : ndarray, shape (..., m, 2)
+    lengths : ndarray, shape (..., m)
+    """
+    chords = np.diff(np.asarray(points, dtype=float), axis=-2)
+    lengths = np.linalg.norm(chords, axis=-1)
+    d = chords / lengths[..., None]
+    frame = np.broadcast_to(np.eye(3), (*d.shape[:-2], 3, 3)).copy()  # columns: the frame's axes
+    turns = np.zeros((*d.shape[:-1], 2))
+    for j in range(d.shape[-2]):
+        before = frame[..., :, 0]
+        axis = np.cross(before, d[..., j, :])
+        sin, cos = np.linalg.norm(axis, axis=-1), np.sum(before * d[..., j, :], axis=-1)
+        angle = np.arctan2(sin, cos)
+        unit = np.divide(axis, sin[..., None], out=np.zeros_like(axis), where=sin[..., None] > 0)
+        local = np.einsum("...ki,...k->...i", frame, unit * angle[..., None])  # in the frame: (0, turn_y, turn_z)
+        turns[..., j, :] = local[..., 1:]
+        frame = frame @ _rotation(local)
+    return turns, lengths
+
+
+def space_polyline(turns: FloatArray, lengths: FloatArray, start: FloatArray) -> FloatArray:
+    """The polyline of chords with twist-free ``turns`` (about the frame's y and z) and ``lengths`` from ``start``.
+
+    The inverse of :func:`space_elements`: shapes ``(..., m, 2)``, ``(..., m)`` and
+    ``(..., 3)``; returns ``(..., m + 1, 3)``.
+    """
+    turns, lengths = np.asarray(turns, dtype=float), np.asarray(lengths, dtype=float)
+    frame = np.broadcast_to(np.eye(3), (*turns.shape[:-2], 3, 3)).copy()
+    points = [np.broadcast_to(np.asarray(start, dtype=float), (*turns.shape[:-2], 3))]
+    for j in range(turns.shape[-2]):
+        local = np.concatenate([np.zeros((*turns.shape[:-2], 1)), turns[..., j, :]], axis=-1)
+        frame = frame @ _rotation(local)
+        points.append(points[-1] + lengths[..., j, None] * frame[..., :, 0])
+    return np.stack(points, axis=-2)
+
+
+def _rotation(vector: FloatArray) -> FloatArray:
+    """Rotation matrices of rotation vectors (Rodrigues), shape (..., 3) -> (..., 3, 3)."""
+    angle = np.linalg.norm(vector, axis=-1)[..., None, None]
+    k = np.zeros((*vector.shape[:-1], 3, 3))
+    x, y, z = vector[..., 0], vector[..., 1], vector[..., 2]
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 0] = -z, y, z
+    k[..., 1, 2], k[..., 2, 0], k[..., 2, 1] = -x, -y, x
+    small = angle < 1e-12
+    a = np.where(small, 1.0, angle)
+    s = np.where(small, 1.0, np.sin(a) / a)
+    c = np.where(small, 0.5, (1 - np.cos(a)) / a**2)
+    return np.eye(3) + s * k + c * (k @ k)
+
+
+__all__ = ["space_elements", "space_polyline"]
