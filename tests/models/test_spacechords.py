@@ -37,7 +37,7 @@ def test_a_planar_response_has_the_planar_chains_turns() -> None:
     response = ChainModel(served.table, 15).evaluate("001111010001001")
     turn, length, _ = response_elements(response)
     plane = np.stack([response.centreline(k) for k in range(response.n_levels)])
-    turns, lengths = space_elements(np.concatenate([plane, np.zeros((*plane.shape[:2], 1))], axis=-1))
+    turns, lengths = space_elements(plane)  # (x, y): in the plane z = 0
     assert np.all(turns[..., 0] == 0.0)
     assert np.abs(turns[..., 1] - turn).max() < 1e-12 and np.abs(lengths - length).max() < 1e-12
 

@@ -45,15 +45,19 @@ def space_elements(points: FloatArray) -> tuple[FloatArray, FloatArray]:
 
     Parameters
     ----------
-    points : ndarray, shape (..., m + 1, 3)
-        Polylines (base first); leading axes are kept (levels, designs).
+    points : ndarray, shape (..., m + 1, 3) or (..., m + 1, 2)
+        Polylines (base first); leading axes are kept (levels, designs). Planar points
+        (x, y) lie in the plane z = 0.
 
     Returns
     -------
     turns : ndarray, shape (..., m, 2)
     lengths : ndarray, shape (..., m)
     """
-    chords = np.diff(np.asarray(points, dtype=float), axis=-2)
+    points = np.asarray(points, dtype=float)
+    if points.shape[-1] == 2:
+        points = np.concatenate([points, np.zeros((*points.shape[:-1], 1))], axis=-1)
+    chords = np.diff(points, axis=-2)
     lengths = np.linalg.norm(chords, axis=-1)
     d = chords / lengths[..., None]
     frame = np.broadcast_to(np.eye(3), (*d.shape[:-2], 3, 3)).copy()  # columns: the frame's axes
