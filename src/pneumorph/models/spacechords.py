@@ -10,11 +10,13 @@ rotation's axis is normal to chord ``j - 1``, so in its frame it has two compone
 turn about the frame's y axis and the turn about its z axis. The base's frame is the
 actuator's own (x along it, y up, z across the width), and chord ``-1`` points along x.
 
-Why twist-free. A unit of the built-in kinds bends about one of its section's axes and its
-section is symmetric about the plane of that bend (a planar unit: the mid-width plane; a
-sideways unit: the mid-height plane), so by symmetry it does not twist: its material frame
-turns with the transported frame. Where two kinds meet, neither symmetry holds, and a small
-twist the chords cannot show is the chain's error there (measured by the held-out designs).
+Twist. A unit of the built-in kinds bends about one of its section's axes and its section is
+symmetric about the plane of that bend (a planar unit: the mid-width plane; a sideways unit:
+the mid-height plane), so by symmetry it does not twist alone. Where the two kinds meet,
+neither symmetry holds: measured, the units' frames roll by about 1.2-1.5 deg at each such
+junction and keep that roll after it (docs/unit-library.md, "A chain in space"). The chords
+cannot show a roll, so these twist-free elements are not local in designs that mix the two
+kinds; a chain table in space must key each unit's frame, roll included.
 
 A planar polyline (z = 0) has no turn about y and its turn about z is the planar chain's
 turn (:func:`~pneumorph.models.response.response_elements`), to rounding.
