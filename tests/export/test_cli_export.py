@@ -222,5 +222,5 @@ def test_a_mixed_design_over_a_library_exports_its_parts_and_deck(tmp_path):
     assert deck.count("\n*NODE\n") == 1 and len(model.mesh("aLlAl").points) == \
         int(deck.split("*ELEMENT")[0].strip().splitlines()[-1].split(",")[0])
     result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "m"), "--mould")
-    assert result.exit_code == 2 and "mould of a design over a unit library" in result.output
+    assert result.exit_code == 2 and "mould of a design over a unit library" in result.output, result.output
     assert not (tmp_path / "m").exists()

@@ -52,8 +52,11 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     from pneumorph.io import strict_json
 
     # everything is checked before anything is built or written
-    _check_request(ctx, stl_dir, inp_file, with_mould, library)
+    _check_request(ctx, stl_dir, inp_file, with_mould)
     units = P.library_option(library, unit_file) if library is not None else None
+    if with_mould and units is not None:
+        raise click.UsageError("--mould over a --library: the mould of a design over a unit library is not built "
+                               "yet (its units' sections differ along the body); export its parts without --mould")
     with P.blame("DESIGN"):
         orientation = parse_orientation(design) if units is None else parse_design(design, units).text
     settings = {"fidelity": "3d", "pressure_kpa": pressure, **({"unit_file": unit_file} if unit_file else {}),
@@ -97,14 +100,11 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         _print_mould(mould, mould_spec, folder)
 
 
-def _check_request(ctx: click.Context, stl_dir: str | None, inp_file: str | None, with_mould: bool,
-                   library: str | None) -> None:
+def _check_request(ctx: click.Context, stl_dir: str | None, inp_file: str | None, with_mould: bool) -> None:
     """Refuse what would write nothing, collide, or ignore an option (before anything is built)."""
     from pathlib import Path
 
-    if with_mould and library is not None:
-        raise click.UsageError("the mould of a design over a unit library is not built yet: its units' sections "
-                               "differ along the body; export its parts (--stl) without --mould")
+
     if stl_dir is None and inp_file is None:
         raise click.UsageError("nothing to export: give --stl DIR (the parts' STL files) and/or --inp FILE "
                                "(a CalculiX deck)")
