@@ -350,3 +350,15 @@ def test_serve_refuses_a_bad_model_file_before_it_starts(tmp_path: Path) -> None
     done = CliRunner().invoke(cli, ["serve", "--model-file", str(bad), "--state", str(tmp_path / "s")])
     assert done.exit_code == 2 and "body_bulk_scale" in done.output and "Traceback" not in done.output
     assert not (tmp_path / "s").exists()
+
+
+def test_a_space_curve_answers_with_its_view_from_above(client: TestClient) -> None:
+    """A helix (radius A about an axis along x through (0, A, 0)): its target samples carry z = -A sin(2 pi x / L),
+    y = A (1 - cos(2 pi x / L)); a planar target has no z."""
+    r = client.post("/api/design", json={"target": {"kind": "preset", "name": "helix", "amplitude": 20}})
+    assert r.status_code == 200, r.text
+    a = r.json()
+    x, y, z = (np.array(a["target"][k]) for k in ("x", "y", "z"))
+    phase = 2 * np.pi * x / a["length_mm"]
+    assert np.abs(z + 20 * np.sin(phase)).max() < 1e-3 and np.abs(y - 20 * (1 - np.cos(phase))).max() < 1e-3
+    assert "z" not in client.post("/api/design", json=SIN).json()["target"]

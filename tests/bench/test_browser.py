@@ -121,6 +121,23 @@ def test_a_new_amplitude_is_answered_within_a_second(browser) -> None:  # type: 
     assert "A = 20 mm" in _el(browser, "winner-label").text
 
 
+def test_a_helix_shows_the_view_from_above(browser) -> None:  # type: ignore[no-untyped-def]
+    """A space curve opens the view from above (the target's z against the planar actuator's); sin closes it."""
+    assert not _el(browser, "top-view").is_displayed()
+    Select(_el(browser, "preset")).select_by_value("helix")
+    _wait(lambda: "helix" in _el(browser, "winner-label").text and _answered(browser))
+    _wait(lambda: _el(browser, "top-view").is_displayed())
+    drawn = browser.execute_script("const c = document.getElementById('top-plot');"
+                                   "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+                                   "let n = 0; for (let i = 0; i < d.length; i += 4)"
+                                   "  if (d[i] === 224 && d[i + 1] === 123) n++;"
+                                   "return n;")
+    assert drawn > 50  # the target's orange (#e07b1a) line
+    _shot(browser, "helix")
+    Select(_el(browser, "preset")).select_by_value("sin")
+    _wait(lambda: not _el(browser, "top-view").is_displayed() and _answered(browser))
+
+
 def test_an_expression_and_a_bad_one(browser) -> None:  # type: ignore[no-untyped-def]
     Select(_el(browser, "target-kind")).select_by_value("expression")
     field = _el(browser, "expression")

@@ -403,6 +403,9 @@ def _target_samples(objective: Any, length: float) -> dict[str, list[float]] | N
     if objective.coordinates == "cartesian":
         x = np.linspace(0.0, length, TARGET_SAMPLES)
         y = objective.curve(x, length)
+        if objective.spatial:  # a space curve: its z too, for the view from above
+            z = objective.curve_z(x, length)
+            return {"x": np.round(x, 4).tolist(), "y": np.round(y, 4).tolist(), "z": np.round(z, 4).tolist()}
     else:
         th = np.linspace(0.0, np.pi, TARGET_SAMPLES)
         r = objective.curve(th, length)

@@ -119,6 +119,13 @@ function redraw() {
   }));
   drawProfile($("profile-plot"), { target, point: a.point, profile: state.profiles[k], label: `design ${state.selected}`,
     stages, ramp: a.stages ? state.profiles : null });
+  // a space curve: the view from above, the target's z against the actuator's (z = 0: it bends in its plane)
+  const space = Boolean(a.target && a.target.z);
+  $("top-view").hidden = !space;
+  if (space) {
+    drawProfile($("top-plot"), { target: a.target.x.map((x, i) => [x, a.target.z[i]]),
+      profile: state.profiles[k].map(([x]) => [x, 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
+  }
 }
 
 function renderStages() {

@@ -24,8 +24,9 @@ function bounds(sets) {
 // Draw on `canvas`: {target: [[x, y]...] or null, point: [x, y] or null,
 // profile: [[x, y]...] (base, centres, tip), label: string,
 // stages: [{points, point, colour, current, label}] (a staged target's stages) and
-// ramp: the profiles of every level (drawn faint behind the profile), both optional}.
-export function drawProfile(canvas, { target, point, profile, label, stages = [], ramp = null }) {
+// ramp: the profiles of every level (drawn faint behind the profile), both optional;
+// vertical: the vertical axis's label, "y (mm)" unless a view from above}.
+export function drawProfile(canvas, { target, point, profile, label, stages = [], ramp = null, vertical = "y (mm)" }) {
   const ctx = canvas.getContext("2d");
   const W = canvas.width, H = canvas.height, pad = { l: 48, r: 14, t: 14, b: 34 };
   ctx.clearRect(0, 0, W, H);
@@ -61,7 +62,7 @@ export function drawProfile(canvas, { target, point, profile, label, stages = []
   }
   ctx.textAlign = "center";
   ctx.fillText("x (mm)", pad.l + pw / 2, H - 4);
-  ctx.save(); ctx.translate(12, pad.t + ph / 2); ctx.rotate(-Math.PI / 2); ctx.fillText("y (mm)", 0, 0); ctx.restore();
+  ctx.save(); ctx.translate(12, pad.t + ph / 2); ctx.rotate(-Math.PI / 2); ctx.fillText(vertical, 0, 0); ctx.restore();
   ctx.strokeStyle = "#b8c0c8";
   ctx.setLineDash([4, 4]);
   ctx.beginPath(); ctx.moveTo(pad.l, Y(0)); ctx.lineTo(pad.l + pw, Y(0)); ctx.stroke();
