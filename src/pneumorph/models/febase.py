@@ -35,6 +35,7 @@ from pneumorph.io.provenance import digest
 from pneumorph.materials import get
 from pneumorph.materials.filler import FillerLaw
 from pneumorph.materials.material import Material
+from pneumorph.models.frames import unit_frames
 from pneumorph.models.gravity import gravity_vector
 from pneumorph.models.response import FloatArray, Response
 
@@ -137,18 +138,10 @@ class FEModel:
     default_steps = StepSettings(increments=10, substeps=2)
 
     def __init__(
-        self,
-        n_units: int,
-        unit: UnitSpec | None = None,
-        ramp_spec: RampSpec | None = None,
-        filler: FillerLaw | None = None,
-        backend: str | None = None,
-        gravity: str | Sequence[float] | None = None,
-        temperature_change: float = 0.0,
-        passage: float = 0.0,
-        base_block: BaseBlock | None = None,
-        materials: Mapping[str, Material] | None = None,
-        library: UnitLibrary | None = None,
+        self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None,
+        filler: FillerLaw | None = None, backend: str | None = None, gravity: str | Sequence[float] | None = None,
+        temperature_change: float = 0.0, passage: float = 0.0, base_block: BaseBlock | None = None,
+        materials: Mapping[str, Material] | None = None, library: UnitLibrary | None = None,
     ) -> None:
         self.backend = check_backend(backend or self.backends[0], self.backends)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
@@ -422,6 +415,8 @@ class FEModel:
         def record(k: int, t: float) -> None:
             displacements[k] = body.displacement[:, : self.dim]
             response.centres[k] = mesh.unit_centres(displacements[k], axes)
+            if response.frames is not None:  # the full width: each unit's frame, its roll included
+                response.frames[k] = unit_frames(mesh, displacements[k])
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
             if on_level is not None:

@@ -55,6 +55,9 @@ class Response:
         Why the ramp stopped, if it did.
     metadata : dict
         Provenance: model fidelity and fingerprint, solver statistics, wall time, versions.
+    frames : ndarray, shape (k, n, 3), or None
+        Each unit's rotation (a rotation vector, rad) per level: the full 3D model's
+        responses (points in space) keep it (:mod:`pneumorph.models.frames`); None otherwise.
 
     Examples
     --------
@@ -81,6 +84,7 @@ class Response:
     reached: float = float("nan")
     failure: str | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
+    frames: FloatArray | None = None
 
     def __post_init__(self) -> None:
         k, n = len(self.pressures), len(self.orientation)
@@ -92,6 +96,8 @@ class Response:
             "reference_tip": (self.reference_tip.shape, (d,)),
             "curl": (self.curl.shape, (k,)),
         }
+        if self.frames is not None:  # each unit's rotation vector, per level (a full-width response)
+            shapes["frames"] = (self.frames.shape, (k, n, 3))
         for name, (got, want) in shapes.items():
             if tuple(got) != want:
                 raise ValueError(f"Response.{name} has shape {tuple(got)}, expected {want}")
@@ -111,6 +117,8 @@ class Response:
         """
         k, n = len(pressures), len(orientation)
         d = len(reference_tip)
+        if d == 3:  # a full-width response keeps each unit's frame too (pneumorph.models.frames)
+            kwargs.setdefault("frames", np.full((k, n, 3), np.nan))
         return cls(
             orientation=orientation,
             pressures=np.asarray(pressures, dtype=float),
@@ -174,6 +182,8 @@ class Response:
         out.update({name: clean(getattr(self, name)) for name in self._ARRAYS})
         out.update(converged=self.converged, reached=self.reached, failure=self.failure)
         out["metadata"] = self.metadata
+        if self.frames is not None:
+            out["frames"] = clean(self.frames)
         return out
 
     @classmethod
@@ -187,6 +197,7 @@ class Response:
             reached=float(data["reached"]),
             failure=data.get("failure"),
             metadata=dict(data.get("metadata", {})),
+            frames=None if data.get("frames") is None else np.array(data["frames"], dtype=float),
             **arrays,
         )
 
@@ -195,7 +206,10 @@ class Response:
         base = Path(path)
         base.parent.mkdir(parents=True, exist_ok=True)
         npz, js = base.with_suffix(".npz"), base.with_suffix(".json")
-        np.savez(npz, **{name: getattr(self, name) for name in self._ARRAYS})
+        arrays = {name: getattr(self, name) for name in self._ARRAYS}
+        if self.frames is not None:
+            arrays["frames"] = self.frames
+        np.savez(npz, **arrays)
         js.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
         return npz, js
 
