@@ -11,7 +11,7 @@ from pneumorph.models.chain import ChainModel
 from pneumorph.models.chaintables import serve_table
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import response_elements
-from pneumorph.models.spacechords import space_elements, space_polyline
+from pneumorph.models.spacechords import frame_elements, frame_polyline, space_elements, space_polyline
 
 
 def _curves(seed: int, shape: tuple[int, ...], m: int) -> np.ndarray:
@@ -53,3 +53,16 @@ def test_turning_the_actuator_about_its_axis_turns_its_turns(degrees: float) -> 
     c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
     expected = np.stack([c * turns[..., 0] - s * turns[..., 1], s * turns[..., 0] + c * turns[..., 1]], axis=-1)
     assert np.abs(again - expected).max() < 1e-10 and np.abs(same - lengths).max() < 1e-10
+
+
+def test_the_frame_elements_compose_back_and_keep_the_roll() -> None:
+    """Chords in their units' frames and each frame in the one before: composing them gives the polyline back,
+    whatever the frames (rolled too)."""
+    rng = np.random.default_rng(2)
+    points = _curves(3, (2, 5), 9)  # 8 units: base, 8 centres, tip
+    frames = rng.normal(scale=0.3, size=(2, 5, 8, 3))
+    chords, turns = frame_elements(points, frames)
+    assert chords.shape == (2, 5, 9, 3) and turns.shape == (2, 5, 8, 3)
+    assert np.abs(frame_polyline(chords, turns, points[..., 0, :]) - points).max() < 1e-10
+    # the first unit's frame in the base's is its own rotation
+    assert np.abs(turns[..., 0, :] - frames[..., 0, :]).max() < 1e-12

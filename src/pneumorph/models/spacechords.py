@@ -92,6 +92,65 @@ def space_polyline(turns: FloatArray, lengths: FloatArray, start: FloatArray) ->
     return np.stack(points, axis=-2)
 
 
+def frame_elements(points: FloatArray, frames: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The chords in the frames of the units they start from, and each unit's frame in the one before.
+
+    The roll these keep is what the twist-free elements lose (module docstring).
+
+    Parameters
+    ----------
+    points : ndarray, shape (..., n + 2, 3)
+        Base, the ``n`` unit centres, tip.
+    frames : ndarray, shape (..., n, 3)
+        Each unit's rotation vector (:attr:`~pneumorph.models.response.Response.frames`);
+        the base's frame is the actuator's own.
+
+    Returns
+    -------
+    chords : ndarray, shape (..., n + 1, 3)
+        Chord ``j`` (from point ``j``) in the frame of point ``j`` (the base's, then unit ``j``'s).
+    turns : ndarray, shape (..., n, 3)
+        Unit ``j``'s frame in the frame of point ``j - 1``, as a rotation vector.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pts = np.array([[0, 0, 0], [10, 0, 0], [20, 1, 0], [30, 3, 0.0]])
+    >>> fr = np.array([[0, 0, 0.05], [0, 0, 0.15]])    # two planar units turned about z
+    >>> chords, turns = frame_elements(pts, fr)
+    >>> turns.round(6).tolist()
+    [[0.0, 0.0, 0.05], [0.0, 0.0, 0.1]]
+    >>> bool(np.allclose(frame_polyline(chords, turns, pts[..., 0, :]), pts))
+    True
+    """
+    points, frames = np.asarray(points, dtype=float), np.asarray(frames, dtype=float)
+    eye = np.broadcast_to(np.eye(3), (*frames.shape[:-2], 1, 3, 3))
+    m = np.concatenate([eye, _rotation(frames)], axis=-3)  # the base's frame, then each unit's
+    chords = np.einsum("...ji,...j->...i", m, np.diff(points, axis=-2))
+    relative = np.einsum("...ji,...jk->...ik", m[..., :-1, :, :], m[..., 1:, :, :])
+    return chords, _rotvec(relative)
+
+
+def frame_polyline(chords: FloatArray, turns: FloatArray, start: FloatArray) -> FloatArray:
+    """The polyline of :func:`frame_elements`' ``chords`` and ``turns`` from ``start`` (its inverse)."""
+    chords, turns = np.asarray(chords, dtype=float), np.asarray(turns, dtype=float)
+    frame = np.broadcast_to(np.eye(3), (*chords.shape[:-2], 3, 3)).copy()
+    points = [np.broadcast_to(np.asarray(start, dtype=float), (*chords.shape[:-2], 3))]
+    for j in range(chords.shape[-2]):
+        points.append(points[-1] + np.einsum("...ij,...j->...i", frame, chords[..., j, :]))
+        if j < turns.shape[-2]:
+            frame = frame @ _rotation(turns[..., j, :])
+    return np.stack(points, axis=-2)
+
+
+def _rotvec(matrix: FloatArray) -> FloatArray:
+    """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3)."""
+    from scipy.spatial.transform import Rotation
+
+    flat = matrix.reshape(-1, 3, 3)
+    return Rotation.from_matrix(flat).as_rotvec().reshape(*matrix.shape[:-2], 3)
+
+
 def _rotation(vector: FloatArray) -> FloatArray:
     """Rotation matrices of rotation vectors (Rodrigues), shape (..., 3) -> (..., 3, 3)."""
     angle = np.linalg.norm(vector, axis=-1)[..., None, None]
@@ -106,4 +165,4 @@ def _rotation(vector: FloatArray) -> FloatArray:
     return np.eye(3) + s * k + c * (k @ k)
 
 
-__all__ = ["space_elements", "space_polyline"]
+__all__ = ["frame_elements", "frame_polyline", "space_elements", "space_polyline"]
