@@ -44,8 +44,8 @@ def main() -> None:
                "twist_free_turn_difference_deg": float(np.degrees(np.abs(ea["free"] - eb["free"]).max())),
                "frame_turn_deg": [np.degrees(ea["turn"]).tolist(), np.degrees(eb["turn"]).tolist()]}
         rows.append(row)
-        print(f"{a} / {b}: chord {CHORD} in its unit's frame differs by {row['chord_difference_mm']:.4f} mm, the unit's "
-              f"frame in the one before by {row['frame_turn_difference_deg']:.4f} deg (twist-free turns: "
+        print(f"{a} / {b}: chord {CHORD} in its unit's frame differs by {row['chord_difference_mm']:.4f} mm, "
+              f"the unit's frame in the one before by {row['frame_turn_difference_deg']:.4f} deg (twist-free turns: "
               f"{row['twist_free_turn_difference_deg']:.4f} deg)", flush=True)
     OUT.write_text(json.dumps({"command": "python docs/scripts/space_frames.py", "pressure_kpa": PRESSURE,
                                "pairs": rows}, indent=1))
