@@ -34,7 +34,7 @@ PRESSURE = 36.0
 # twist: sideways units first, then planar ones (both ways), against the planar design alone
 TWIST = ("aaaaaaa", "lllaaaa", "LLLaaaa", "lLlaAaa", "aaaaAaa")
 # locality: the same units around chord 4 (units 2-6 of 7), different units 1 and 7
-PAIRS = (("aalAlaa", "lalAlaL"), ("aaLaaaa", "LaLaaal"), ("llaAall", "aLaAalA"))
+PAIRS = (("aalAlaa", "lalAlaL"), ("aaLaaaa", "LaLaaal"), ("llaAall", "alaAalA"))
 
 
 def solve(design: str) -> tuple[np.ndarray, np.ndarray, float]:

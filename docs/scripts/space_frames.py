@@ -21,7 +21,7 @@ from pneumorph.models.spacechords import frame_elements, space_elements
 
 OUT = Path(__file__).resolve().parents[1] / "figures" / "space-frames.json"
 PRESSURE = 36.0
-PAIRS = (("aalAlaa", "lalAlaL"), ("aaLaaaa", "LaLaaal"), ("llaAall", "aLaAalA"))
+PAIRS = (("aalAlaa", "lalAlaL"), ("aaLaaaa", "LaLaaal"), ("llaAall", "alaAalA"))
 CHORD = 4  # from unit 4's centre (1-based): units 2-6 around it are shared
 
 
