@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 FloatArray = NDArray[np.float64]
 
@@ -148,24 +149,12 @@ def frame_polyline(chords: FloatArray, turns: FloatArray, start: FloatArray) -> 
 
 def _rotvec(matrix: FloatArray) -> FloatArray:
     """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3)."""
-    from scipy.spatial.transform import Rotation
-
-    flat = matrix.reshape(-1, 3, 3)
-    return Rotation.from_matrix(flat).as_rotvec().reshape(*matrix.shape[:-2], 3)
+    return Rotation.from_matrix(matrix.reshape(-1, 3, 3)).as_rotvec().reshape(*matrix.shape[:-2], 3)
 
 
 def _rotation(vector: FloatArray) -> FloatArray:
-    """Rotation matrices of rotation vectors (Rodrigues), shape (..., 3) -> (..., 3, 3)."""
-    angle = np.linalg.norm(vector, axis=-1)[..., None, None]
-    k = np.zeros((*vector.shape[:-1], 3, 3))
-    x, y, z = vector[..., 0], vector[..., 1], vector[..., 2]
-    k[..., 0, 1], k[..., 0, 2], k[..., 1, 0] = -z, y, z
-    k[..., 1, 2], k[..., 2, 0], k[..., 2, 1] = -x, -y, x
-    small = angle < 1e-12
-    a = np.where(small, 1.0, angle)
-    s = np.where(small, 1.0, np.sin(a) / a)
-    c = np.where(small, 0.5, (1 - np.cos(a)) / a**2)
-    return np.eye(3) + s * k + c * (k @ k)
+    """Rotation matrices of rotation vectors (..., 3) -> (..., 3, 3)."""
+    return Rotation.from_rotvec(vector.reshape(-1, 3)).as_matrix().reshape(*vector.shape[:-1], 3, 3)
 
 
 __all__ = ["frame_elements", "frame_polyline", "space_elements", "space_polyline"]
