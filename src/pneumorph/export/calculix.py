@@ -196,14 +196,11 @@ def calculix_mesh(model: Any, design: str) -> ActuatorMesh:
     """The mesh :meth:`Full3D.build` would solve for ``design`` (without FElupe's objects).
 
     Over a unit library, the model's own mesh (a design with a sideways unit: the full
-    width); its types must share one layer material (the deck's ``layer`` set).
+    width); a library's types share one body and one layer material (the library refuses
+    others), so the deck's ``body`` and ``layer`` sets each have one.
     """
     _check_model(model)
     if getattr(model, "mixed", False):
-        layers = {u.layer_material for u in model.library.units if u.layer > 0}
-        if len(layers) > 1:
-            raise GeometryError(f"the deck's layer set has one material; library {model.library.name!r} has "
-                                f"{len(layers)} ({', '.join(sorted(layers))})")
         return model.mesh(design)
     design = parse_orientation(design, model.n_units)
     return assemble(model.unit, design, 3, half=model.half)
