@@ -202,8 +202,8 @@ def tip_positions(results: Sequence[NodalDisplacements], mesh: ActuatorMesh) -> 
     Returns
     -------
     times : ndarray, shape (k,)
-    tip : ndarray, shape (k, 2)
-        mm, as :attr:`pneumorph.models.response.Response.tip`.
+    tip : ndarray, shape (k, 2) or (k, 3)
+        mm, as :attr:`pneumorph.models.response.Response.tip` ((x, y, z) on the full width).
 
     Raises
     ------
@@ -211,17 +211,18 @@ def tip_positions(results: Sequence[NodalDisplacements], mesh: ActuatorMesh) -> 
         If a result lacks one of the end-face nodes.
     """
     wanted = mesh.end_points + 1
-    x0 = mesh.points[mesh.end_points][:, :2]
+    axes = mesh.axes  # (x, y), or (x, y, z) on the full width
+    x0 = mesh.points[mesh.end_points][:, :axes]
     times, tips = [], []
     for r in results:
         where = {int(n): k for k, n in enumerate(r.nodes)}
         missing = [int(n) for n in wanted if int(n) not in where]
         if missing:
             raise DataFormatError(f"the results at time {r.time:g} lack end-face node(s) {missing[:5]}")
-        u = r.values[[where[int(n)] for n in wanted]][:, :2]
+        u = r.values[[where[int(n)] for n in wanted]][:, :axes]
         times.append(r.time)
         tips.append((x0 + u).mean(axis=0))
-    return np.asarray(times, dtype=float), np.asarray(tips, dtype=float).reshape(-1, 2)
+    return np.asarray(times, dtype=float), np.asarray(tips, dtype=float).reshape(-1, axes)
 
 
 # -- running CalculiX -------------------------------------------------------------------
@@ -288,7 +289,10 @@ def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, exe
     exe = shutil.which(executable)
     if exe is None:
         raise SettingsError(f"CalculiX ({executable!r}) is not on the PATH; on Debian: apt-get install calculix-ccx")
-    design = parse_orientation(design, getattr(model, "n_units", None))
+    if getattr(model, "mixed", False):  # a design over a unit library, in its letters
+        design = model.parse(design).text
+    else:
+        design = parse_orientation(design, getattr(model, "n_units", None))
     out_dir = Path(folder)
     out_dir.mkdir(parents=True, exist_ok=True)
     deck = write_calculix_deck(model, design, out_dir / f"design_{design}.inp", full_output=full_output,
@@ -309,7 +313,8 @@ def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, exe
     wall = time.perf_counter() - t0
     log = proc.stdout + proc.stderr
     mesh = calculix_mesh(model, design)
-    times, tip = tip_positions(read_dat_displacements(dat), mesh) if dat.exists() else (np.zeros(0), np.zeros((0, 2)))
+    times, tip = tip_positions(read_dat_displacements(dat), mesh) if dat.exists() else (np.zeros(0),
+                                                                                        np.zeros((0, mesh.axes)))
     reached = float(times[-1]) if times.size else 0.0
     errors = [line.strip() for line in log.splitlines() if "*ERROR" in line]
     if proc.returncode != 0 or errors or not np.isclose(reached, 1.0):
