@@ -104,7 +104,6 @@ def _check_request(ctx: click.Context, stl_dir: str | None, inp_file: str | None
     """Refuse what would write nothing, collide, or ignore an option (before anything is built)."""
     from pathlib import Path
 
-
     if stl_dir is None and inp_file is None:
         raise click.UsageError("nothing to export: give --stl DIR (the parts' STL files) and/or --inp FILE "
                                "(a CalculiX deck)")
@@ -197,12 +196,11 @@ def _parts_summary(summary: dict, unit: Any, orientation: str, block: Any, parts
                    mould_spec: Any, folder: Any) -> dict:
     """The parts (files, volumes, layer pieces) and the mould into ``summary``; each part in words."""
     from pneumorph.export import layer_pieces
-    from pneumorph.geometry.alphabet import parse_design
+    from pneumorph.geometry.alphabet import library_design
     from pneumorph.geometry.assembly import unit_starts
-    from pneumorph.geometry.library import UnitLibrary
 
-    library = unit if isinstance(unit, UnitLibrary) else UnitLibrary.single(unit)
-    types = parse_design(orientation, library).units(library)
+    library, parsed = library_design(unit, orientation)
+    types = parsed.units(library)
     ref, pieces = library[library.default], layer_pieces(unit, orientation)
     k = sum(not u.solid for u in types)
     solid = f"solid unit{'s' if len(set(types)) > 1 else ''}"

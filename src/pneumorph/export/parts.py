@@ -73,7 +73,7 @@ import numpy as np
 
 from pneumorph.errors import GeometryError, interrupts_kept
 from pneumorph.export.strips import LayerPiece, layer_pieces
-from pneumorph.geometry.alphabet import parse_design
+from pneumorph.geometry.alphabet import library_design
 from pneumorph.geometry.assembly import cavity_box, unit_starts
 from pneumorph.geometry.features import BaseBlock, Box
 from pneumorph.geometry.library import UnitLibrary
@@ -125,8 +125,7 @@ def _cavity_boxes(spec: UnitSpec | UnitLibrary, design: str) -> list[Box]:
 
 def _units(spec: UnitSpec | UnitLibrary, design: str) -> tuple[UnitLibrary, tuple[UnitSpec, ...], str]:
     """The library, every unit's type and the orientation of a design (0/1 for one unit)."""
-    library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
-    parsed = parse_design(design, library)
+    library, parsed = library_design(spec, design)
     return library, parsed.units(library), parsed.orientation
 
 

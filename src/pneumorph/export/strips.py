@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pneumorph.geometry.alphabet import parse_design
+from pneumorph.geometry.alphabet import library_design
 from pneumorph.geometry.assembly import unit_starts
 from pneumorph.geometry.features import Box
 from pneumorph.geometry.library import UnitLibrary
@@ -112,8 +112,7 @@ def layer_pieces(spec: UnitSpec | UnitLibrary, design: str) -> list[LayerPiece]:
     >>> layer_pieces(UnitSpec(wall=3.0, layer=0.0), "01")   # no stiff layer: no pieces
     []
     """
-    library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
-    parsed = parse_design(design, library)
+    library, parsed = library_design(spec, design)
     units, orientation = parsed.units(library), parsed.orientation
     starts, cap = unit_starts(units), library[library.default].end_cap
     faces = [_face(u, o) for u, o in zip(units, orientation, strict=True)]

@@ -156,4 +156,15 @@ def parse_design(design: str | Iterable[int] | Design, library: UnitLibrary, n_u
     return Design(symbols, orientation, _text(symbols, orientation, digits))
 
 
-__all__ = ["Design", "parse_design"]
+def library_design(spec: UnitSpec | UnitLibrary, design: str | Iterable[int] | Design) -> tuple[UnitLibrary, Design]:
+    """The library of ``spec`` (a unit: its one-type library) and ``design`` parsed over it (:func:`parse_design`).
+
+    >>> library, design = library_design(UnitSpec(), "0110")
+    >>> library.is_single, [u.name for u in design.units(library)][:2]
+    (True, ['unit', 'unit'])
+    """
+    library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
+    return library, parse_design(design, library)
+
+
+__all__ = ["Design", "library_design", "parse_design"]

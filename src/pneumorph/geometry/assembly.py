@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError
-from pneumorph.geometry.alphabet import Design, parse_design
+from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.features import BaseBlock, Box, check_passage
 from pneumorph.geometry.grid import grid_lines, section_breaks, width_breaks
 from pneumorph.geometry.library import UnitLibrary
@@ -277,8 +277,7 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     """
     if dim not in (2, 3):
         raise GeometryError(f"dim must be 2 or 3, got {dim!r}")
-    library = spec if isinstance(spec, UnitLibrary) else UnitLibrary.single(spec)
-    design = parse_design(orientation, library)
+    library, design = library_design(spec, orientation)
     orientation = design.orientation
     if passage and dim != 3:
         raise GeometryError("a passage between cavities is a 3D feature: the 2D section would be cut in two")
