@@ -47,8 +47,9 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
 
     units = P.library_option(library, unit_file) if library is not None else None
     with P.blame("--design"):
-        orientation = parse_orientation(design) if units is None else parse_design(design, units).text
-    types = parse_design(orientation, units).units(units) if units is not None else ()
+        parsed = parse_design(design, units) if units is not None else None
+        orientation = parse_orientation(design) if parsed is None else parsed.text
+    types = parsed.units(units) if parsed is not None and units is not None else ()
     planar = not any(u.layer_side for u in types)
     data = read_scan(scan, scan_unit, scale)  # a bad scan is refused before the model is solved
     if not planar and data.dim != 3:

@@ -267,8 +267,8 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     for o, shape in zip(observations, nominal_shapes, strict=True):
         check_units(o.scan, shape)
         check_size(o.scan, o.spec, [shape])
-        check_coverage(o.scan, o.spec, [shape])
         c = correlate(o.scan, shape)
+        check_coverage(o.scan, o.spec, [shape], aligned=[c.aligned])
         transforms.append(c.alignment.transform)
         before.append(c.surface.rms if dim == 3 else c.outline.rms)
     rms_before = np.array(before)

@@ -142,12 +142,14 @@ def check_size(scan: Scan, spec: ScanSpec, shapes: Sequence[ModelShape], predict
                         f"({ratio:.3g} times): is it the design scanned? (check its unit count and --scan-unit)")
 
 
-def check_coverage(scan: Scan, spec: ScanSpec, shapes: Sequence[ModelShape], predicted: bool = False) -> None:
+def check_coverage(scan: Scan, spec: ScanSpec, shapes: Sequence[ModelShape], predicted: bool = False,
+                   aligned: Sequence[FloatArray] | None = None) -> None:
     """Refuse a scan that does not show its design's units (see the module docstring).
 
     ``shapes``: the design's shape (solved, or ``predicted`` by a chain table), or the shapes
     at the two levels around the scan's pressure; the scan is refused only if it fails
-    against each of them.
+    against each of them. ``aligned``: the scan's points already aligned to each shape
+    (:func:`~pneumorph.correlation.compare.correlate`'s ``aligned``), else aligned here.
 
     Raises
     ------
@@ -155,8 +157,9 @@ def check_coverage(scan: Scan, spec: ScanSpec, shapes: Sequence[ModelShape], pre
         The scan does not show the design's units.
     """
     problems = []
-    for shape in shapes:
-        problem = coverage(correlate(scan, shape).aligned, shape).problem()
+    for k, shape in enumerate(shapes):
+        points = correlate(scan, shape).aligned if aligned is None else aligned[k]
+        problem = coverage(points, shape).problem()
         if not problem:
             return
         problems.append(problem)
