@@ -5,8 +5,9 @@ how each unit's frame has turned, its roll about the actuator's axis included: w
 sideways and planar units meet, the frames roll by a degree or more, and the chords alone
 cannot show it. A unit's frame is the rotation that best carries the four corners of its
 cavity on the mid-width plane (the points its centre is the mean of, ``ActuatorMesh.tracked``)
-from the undeformed mesh to the deformed one (least squares, Kabsch). A full-width response
-keeps it per level and unit as a rotation vector (:attr:`Response.frames`).
+from the undeformed mesh to the deformed one (least squares, Kabsch: scipy's
+``Rotation.align_vectors``). A full-width response keeps it per level and unit as a rotation
+vector (:attr:`Response.frames`).
 
 Examples
 --------
@@ -39,12 +40,10 @@ def unit_frames(mesh: Any, displacement: FloatArray) -> FloatArray:
     """
     p = mesh.points[mesh.tracked]  # (n, 4, 3): the cavity's corners on the mid-width plane
     q = p + displacement[mesh.tracked][..., :3]
-    a, b = p - p.mean(axis=1, keepdims=True), q - q.mean(axis=1, keepdims=True)
-    u, _, vt = np.linalg.svd(np.einsum("nki,nkj->nij", a, b))
-    d = np.sign(np.linalg.det(np.einsum("nji,nkj->nik", vt, u)))  # a proper rotation, never a reflection
-    fix = np.stack([np.ones_like(d), np.ones_like(d), d], axis=-1)
-    rotation = np.einsum("nji,nj,nkj->nik", vt, fix, u)  # V diag(1, 1, d) U^T
-    return Rotation.from_matrix(rotation).as_rotvec()
-
+    out = np.empty((len(p), 3))
+    for i, (a, b) in enumerate(zip(p - p.mean(axis=1, keepdims=True), q - q.mean(axis=1, keepdims=True),
+                                   strict=True)):
+        out[i] = Rotation.align_vectors(b, a)[0].as_rotvec()  # the rotation that best takes a onto b
+    return out
 
 __all__ = ["unit_frames"]
