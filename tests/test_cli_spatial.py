@@ -29,7 +29,6 @@ def test_simulate_solves_a_sideways_design_on_the_full_width(capsys: pytest.Capt
 
 @pytest.mark.parametrize(("args", "message"), [
     (["simulate", "-o", "aL", "--library", "spatial"], "unit type 'l' is sideways"),
-    (["chain", "build", "--model", "3d", "--library", "spatial"], "unit type 'l' bends out of the plane"),
 ])
 def test_what_cannot_take_sideways_units_refuses_them_in_one_line(args: list[str], message: str, tmp_path: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:

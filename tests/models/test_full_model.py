@@ -99,12 +99,15 @@ def test_the_full_width_gets_the_half_models_single_precision_limit_per_half_wid
         assert half_body.stepper("fast", model.tangent_reuse, model.anderson_depth)[0].precision == precision
 
 
-def test_no_planar_chain_table_is_planned_over_sideways_units(spatial: UnitLibrary) -> None:
-    """The chain tables hold turns in the x-y plane: a build over `l` is refused before any solve."""
-    from pneumorph.errors import ChainTableError
-    from pneumorph.models.buildplan import build_plan
+def test_a_chain_table_over_sideways_units_is_planned_on_the_full_width(spatial: UnitLibrary) -> None:
+    """A chain in space: every training design on the full width, estimated at the full model's solve time."""
+    from pneumorph.models.buildplan import FULL_WIDTH, build_plan
+    from pneumorph.models.chain import source_key, training_model
 
-    with pytest.raises(ChainTableError) as exc:
-        build_plan(Full3D(15, library=spatial))
-    assert "\n" not in str(exc.value) and "unit type 'l' bends out of the plane" in str(exc.value)
-    assert build_plan(Full3D(15, library=UnitLibrary.single(spatial["a"]))).solves  # a planar one as before
+    model = Full3D(15, library=spatial)
+    plan = build_plan(model, window=1, short=True)
+    assert plan.fidelity == FULL_WIDTH and "3d full-width model" in plan.text()
+    assert training_model(model).half is False and model.half is True  # the user's model is left as it was
+    assert source_key(training_model(model)) == source_key(model)  # a table of either serves both
+    planar = Full3D(15, library=UnitLibrary.single(spatial["a"]))
+    assert training_model(planar) is planar and build_plan(planar).fidelity == "3d"  # a planar one as before

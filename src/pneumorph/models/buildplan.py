@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.errors import ChainTableError, PneumorphError
+from pneumorph.errors import PneumorphError
+from pneumorph.models.chain import in_space
 from pneumorph.models.chainfit import (
     DEFAULT_TOLERANCE,
     MAX_WINDOW,
@@ -29,13 +30,16 @@ from pneumorph.models.chainfit import (
     training_designs,
 )
 
+#: the full 3D model on the full width (designs with a sideways unit, and a chain in space's training designs):
+#: 58-68 s for a 15-unit design on one core (BENCHMARKS.md, benchmarks/full_model.py)
+FULL_WIDTH = "3d full-width"
 #: held-out designs that validate a table built on first use
 HELDOUT = 20
 #: measured wall time of one FE solve of a 15-unit design (:data:`SOLVE_UNITS`) on one core, seconds, per
 #: fidelity (BENCHMARKS.md, dev-2c: a random 3D design 14.2-15.8 s, a 2D one 0.55 s; strongly curled
 #: designs take up to three times as long); the estimates of a build or a search scale it by the units
 #: and divide it among the workers
-SOLVE_SECONDS = {"3d": 15.0, "2d": 0.55}
+SOLVE_SECONDS = {"3d": 15.0, "2d": 0.55, FULL_WIDTH: 60.0}
 SOLVE_UNITS = 15
 
 
@@ -48,6 +52,13 @@ def solve_seconds(fidelity: str, n_units: int) -> float | None:
     """
     per = SOLVE_SECONDS.get(str(fidelity))
     return None if per is None else per * int(n_units) / SOLVE_UNITS
+
+
+def cost_fidelity(model: Any) -> str:
+    """The key of :data:`SOLVE_SECONDS` a model's build is estimated by: its fidelity, or :data:`FULL_WIDTH` for a 3D
+    model over sideways units (its training designs are solved on the full width)."""
+    fidelity = str(getattr(model, "fidelity", "?"))
+    return FULL_WIDTH if fidelity == "3d" and in_space(model) else fidelity
 
 
 def duration_text(seconds: float) -> str:
@@ -197,34 +208,6 @@ def unit_text(model: Any) -> str:
     return f"{name} with {', '.join(differ[:4])}{', ...' if len(differ) > 4 else ''}" if differ else name
 
 
-def check_planar(model: Any) -> None:
-    """Refuse a model over sideways units (``layer_side``): the chain tables hold turns in the x-y plane only.
-
-    Raises
-    ------
-    ChainTableError
-        Naming the sideways unit types, before any solve.
-
-    Examples
-    --------
-    >>> from pneumorph.geometry.library import builtin_library
-    >>> from pneumorph.models.fe import Full3D
-    >>> check_planar(Full3D(15, library=builtin_library()))
-    >>> check_planar(Full3D(15, library=builtin_library("spatial")))
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.ChainTableError: unit type 'l' bends out of the plane (layer_side), and the chain tables are
-    planar (turns in the x-y plane): a chain in 3D is not built yet; solve its designs with the 3D FE model
-    (--search ga)
-    """
-    library = getattr(model, "library", None)
-    sideways = [s for s, u in zip(library.symbols, library.units, strict=True) if u.layer_side] if library else []
-    if sideways:
-        raise ChainTableError(f"unit type {', '.join(map(repr, sideways))} bends out of the plane (layer_side), and "
-                              "the chain tables are planar (turns in the x-y plane): a chain in 3D is not built yet; "
-                              "solve its designs with the 3D FE model (--search ga)")
-
-
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
                window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False,
                first_window: int = 1, early: bool = False, far: bool = False) -> BuildPlan:
@@ -253,11 +236,6 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, an early stop
         of the validation, a narrower window with far-field terms first.
 
-    Raises
-    ------
-    ChainTableError
-        A model over sideways units (:func:`check_planar`).
-
     Examples
     --------
     >>> from pneumorph.models.factory import make_model
@@ -270,7 +248,6 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     centre error of 20 held-out designs is within 0.2 mm; 22-59 FE solves, estimated 2.8 min to 7.5 min with 2
     workers (about 15 s a 3d solve of 15 units on one core, from BENCHMARKS.md; an estimate)
     """
-    check_planar(model)  # before anything is counted or solved
     n_units = int(model.n_units)
     library = getattr(model, "library", None)
     alphabet = library.alphabet if library is not None else ()
@@ -298,7 +275,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         check_training_size(types, first if window is None else int(window), len(symmetric))
     held, held_work = _cached(cached, seen, n_units)
     windows, covering, solves, work, fars = (tuple(column) for column in zip(*rows, strict=True))
-    return BuildPlan(str(getattr(model, "fidelity", "?")), unit_text(model),
+    return BuildPlan(cost_fidelity(model), unit_text(model),
                      tuple(float(p) for p in model.pressures()), int(n_units), windows, covering, solves, fewest,
                      heldout, float(tolerance), held, max(1, int(workers)), fars, work, fewest_work, held_work)
 
@@ -338,5 +315,5 @@ def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | N
     return count
 
 
-__all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "check_planar",
+__all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "cost_fidelity",
            "duration_text", "estimate_text", "evaluator_workers", "solve_seconds", "unit_text"]

@@ -35,6 +35,7 @@ The table is fitted from FE solves and validated on held-out designs by
 
 from __future__ import annotations
 
+import copy
 import hashlib
 from typing import Any
 
@@ -69,10 +70,12 @@ __all__ = [
     "covering_designs",
     "design_array",
     "design_strings",
+    "in_space",
     "mirror_codes",
     "possible_codes",
     "source_description",
     "source_key",
+    "training_model",
     "window_codes",
     "window_symbols",
     "window_text",
@@ -80,11 +83,47 @@ __all__ = [
 
 
 # -- identity of the source model -------------------------------------------------------------
+def in_space(model: Any) -> bool:
+    """Whether ``model``'s designs can leave the plane: it has a sideways unit type (``layer_side``).
+
+    Its chain table is then a chain in space (:attr:`ChainTable.space`), fitted to every
+    training design solved on the full width (:func:`training_model`).
+
+    >>> from pneumorph.geometry.library import builtin_library
+    >>> from pneumorph.models.fe import Full3D
+    >>> in_space(Full3D(15, library=builtin_library())), in_space(Full3D(15, library=builtin_library("spatial")))
+    (False, True)
+    """
+    library = getattr(model, "library", None)
+    units = library.units if library is not None else [getattr(model, "unit", None)]
+    return any(getattr(u, "layer_side", False) for u in units)
+
+
+def training_model(model: Any) -> Any:
+    """The model a chain table is fitted to: a model over sideways units solves every design on the full width.
+
+    A chain in space needs each unit's frame, which the full-width response keeps; a design
+    of planar units has the same response on either width, to the solver's tolerance
+    (tests/models/test_full_model.py). Any other model is returned as it is.
+    """
+    if in_space(model) and getattr(model, "half", False):
+        whole = copy.copy(model)
+        whole.half = False
+        return whole
+    return model
+
+
 def source_description(model: Any) -> dict[str, Any]:
-    """What a model's results depend on, except its number of units."""
+    """What a model's results depend on, except its number of units.
+
+    A model over sideways units is described as solved on the full width, as its table's
+    training model is (:func:`training_model`).
+    """
     describe = getattr(model, "describe", None)
     desc = dict(describe()) if callable(describe) else {"fingerprint": model.fingerprint()}
     desc.pop("n_units", None)
+    if in_space(model) and "half_model" in desc:
+        desc["half_model"] = False
     return desc
 
 

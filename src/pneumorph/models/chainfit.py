@@ -21,9 +21,10 @@ import numpy as np
 from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
-from pneumorph.models.chain import ChainTable, source_description, source_key
+from pneumorph.models.chain import ChainTable, source_description, source_key, training_model
 from pneumorph.models.chainterms import check_far_training, far_means, fit_text, training_designs
 from pneumorph.models.response import FloatArray, Response, response_elements
+from pneumorph.models.spacechords import space_rows
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
     MIN_HELDOUT,
@@ -119,6 +120,8 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         raise ChainTableError("a chain table needs training designs of at least 2 units")
     fitted = dict(window=w, pressures=np.asarray(pressures, dtype=float), **means, source=dict(source),
                   training=tuple(r.orientation for r in responses))
+    if "space" in means:  # the axis the centres lie on, undeformed
+        fitted["centre_z"] = float(longest.reference_centres[0, 2])
     if alphabet:
         assert library is not None
         return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
@@ -144,6 +147,10 @@ def _check_training(responses: Sequence[Response]) -> tuple[Response, FloatArray
                                   "every training design solved to the last level")
         if not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
             raise ChainTableError("training responses of different pressure levels")
+        if (r.frames is None) != (longest.frames is None):
+            where = "in" if r.frames is None else "out of"
+            raise ChainTableError(f"training design {r.orientation} was solved {where} the plane and others the other "
+                                  "way; a chain in space needs every training design solved on the full width")
     return longest, pressures
 
 
@@ -161,35 +168,33 @@ def _window_means(responses: Sequence[Response], w: int, mirror: bool, alphabet:
         ``spread``.
     """
     k = max(1, len(alphabet))
-    all_codes, all_turn, all_len, e_codes, e_end = [], [], [], [], []
+    all_codes, all_values, e_codes, e_end = [], [], [], []
     for r in responses:
         turn, length, end = response_elements(r)
         codes = window_codes(design_array(r.orientation, alphabet=alphabet, symmetric=symmetric), w, n_types=k)[0]
         variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k, symmetric), -1.0)] if mirror else [])
         for c, sign in variants:
             all_codes.append(c)
-            all_turn.append(sign * turn.T)
-            all_len.append(length.T)
+            all_values.append(np.concatenate([sign * turn.T, length.T, *space_rows(r, sign)], axis=1))
             e_codes.append(c[-1:])
             e_end.append(sign * end[None])
     codes = np.concatenate(all_codes)
-    turn = np.concatenate(all_turn)
-    length = np.concatenate(all_len)
+    values = np.concatenate(all_values)  # turns, lengths (and the elements in space) per level
     uniq, inv = np.unique(codes, return_inverse=True)
-    counts = np.bincount(inv)[:, None]
-    mean_turn = np.zeros((len(uniq), levels))
-    mean_len = np.zeros((len(uniq), levels))
-    np.add.at(mean_turn, inv, turn)
-    np.add.at(mean_len, inv, length)
-    mean_turn /= counts
-    mean_len /= counts
-    spread = float(max(np.abs(turn - mean_turn[inv]).max(), np.abs(length - mean_len[inv]).max()))
+    means = np.zeros((len(uniq), values.shape[1]))
+    np.add.at(means, inv, values)
+    means /= np.bincount(inv)[:, None]
+    mean_turn, mean_len = means[:, :levels], means[:, levels:2 * levels]
+    # a chain in space is told by its elements in space (the planar columns, its view in the x-y plane, are not local)
+    spread = float(np.abs(values - means[inv])[:, 2 * levels if values.shape[1] > 2 * levels else 0:].max())
     euniq, einv = np.unique(np.concatenate(e_codes), return_inverse=True)
     mean_end = np.zeros((len(euniq), levels))
     np.add.at(mean_end, einv, np.concatenate(e_end))
     mean_end /= np.bincount(einv)[:, None]
-    return {"codes": uniq, "turn": mean_turn, "length": mean_len, "end_codes": euniq, "end": mean_end,
-            "spread": spread}
+    out = {"codes": uniq, "turn": mean_turn, "length": mean_len, "end_codes": euniq, "end": mean_end, "spread": spread}
+    if values.shape[1] > 2 * levels:  # a chain in space
+        out["space"] = means[:, 2 * levels:].reshape(len(uniq), levels, 6)
+    return out
 
 
 def _binary_geometry(responses: Sequence[Response], longest: Response, mirror: bool) -> dict[str, Any]:
@@ -354,6 +359,7 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
         A training design failed to converge.
     """
     _check_buildable(model, tolerance)
+    model = training_model(model)  # over sideways units: every design on the full width, a chain in space
     n = int(model.n_units)
     say = on_progress or (lambda text: None)
     library = getattr(model, "library", None)

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from pneumorph.errors import ChainTableError, UnitLibraryError
 from pneumorph.models.chainterms import compile_terms, entries_digest, terms_from_dict, terms_to_dict
 from pneumorph.models.response import FloatArray
+from pneumorph.models.spacechords import chain_points, rotation_matrices
 from pneumorph.models.windows import (
     design_array,
     design_strings,
@@ -37,6 +38,9 @@ ALPHABET_FORMAT = 2
 
 #: a table with far-field terms whose file holds the terms, not the windows they write out
 TERMS_FORMAT = 3
+
+#: a chain in space (:attr:`ChainTable.space`): any of the layouts above plus its elements in space
+SPACE_FORMAT = 4
 
 #: ``"last"``: the file key and the table of the last :meth:`ChainTable.load` (one tuple, read and written at once)
 _LAST_LOADED: dict[str, Any] = {}
@@ -96,6 +100,15 @@ class ChainTable:
         (:func:`~pneumorph.models.chainterms.fit_terms`); its file then holds them instead of
         the windows (format :data:`TERMS_FORMAT`: four unit types at window +-3 are 1,097,600
         windows, 542 MB written out). Empty for a table fitted window by window.
+    space : ndarray, shape (K, k, 6)
+        A chain in space (fitted to the full 3D model's responses,
+        :func:`~pneumorph.models.spacechords.response_space_elements`): per window and level,
+        the chord in the frame of the point it starts from and that frame's turn from the one
+        before (a rotation vector). The predictions are then points in space composed from
+        these; ``turn``, ``length`` and ``end`` keep the chain's view in the x-y plane (its
+        curl). Empty (K = 0) for a planar table.
+    centre_z : float
+        The undeformed z of the unit centres (the actuator's axis) of a chain in space.
     """
 
     window: int
@@ -120,6 +133,13 @@ class ChainTable:
     type_centre_y: tuple[float, ...] = ()
     symmetric: tuple[str, ...] = ()
     terms: dict[str, Any] = field(default_factory=dict, compare=False)
+    space: FloatArray = field(default_factory=lambda: np.zeros((0, 0, 6)), compare=False)
+    centre_z: float = 0.0
+
+    @property
+    def axes(self) -> int:
+        """3 for a chain in space (:attr:`space`), 2 for a planar one."""
+        return 3 if len(self.space) else 2
 
     @property
     def n_levels(self) -> int:
@@ -170,9 +190,13 @@ class ChainTable:
                         type_offset=list(self.type_offset), type_centre_y=list(self.type_centre_y))
         if self.symmetric:  # likewise absent without symmetric types
             head["symmetric"] = list(self.symmetric)
+        if len(self.space):  # likewise absent from planar tables
+            head["centre_z"] = self.centre_z
         h.update(json.dumps(head, sort_keys=True).encode())
         for a in (self.pressures, self.codes, self.turn, self.length, self.end_codes, self.end):
             h.update(np.ascontiguousarray(a).tobytes())
+        if len(self.space):
+            h.update(np.ascontiguousarray(self.space).tobytes())
         return h.hexdigest()[:16]
 
     # -- lookup and prediction ----------------------------------------------------------
@@ -235,12 +259,18 @@ class ChainTable:
             # the end cap (shared by all types) beyond the last unit's end
             cap = self.tip_ref[0] - self.type_pitch[0] + self.type_offset[0]
             tips = np.stack([starts[:, -1] + pitch[:, -1] + cap, np.full(m, self.tip_ref[1])], axis=-1)
-            return centres, tips
+            return self._in_space(centres), self._in_space(tips)
         x = self.first_offset + self.pitch * np.arange(n)
         y = np.asarray(self.centre_y)[bits]
         centres = np.stack([np.broadcast_to(x, (m, n)), y], axis=-1)
         tip = np.array([x[-1] + self.tip_ref[0], self.tip_ref[1]])
-        return centres, tip
+        return self._in_space(centres), self._in_space(tip)
+
+    def _in_space(self, points: FloatArray) -> FloatArray:
+        """Planar points with the axis' z appended for a chain in space (unchanged for a planar table)."""
+        if not len(self.space):
+            return points
+        return np.concatenate([points, np.full((*points.shape[:-1], 1), self.centre_z)], axis=-1)
 
     def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Centres (m, k, n, 2), tip (m, k, 2) and curl in degrees (m, k) of designs (m, n).
@@ -256,14 +286,26 @@ class ChainTable:
         rows = self.lookup(codes)
         erows = self.lookup(codes[:, -1], end=True)
         angle = np.cumsum(self.turn[rows], axis=1)  # (m, n + 1, k)
+        curl = np.degrees(angle[:, -1, :] + self.end[erows])
+        if len(self.space):
+            centres, tip = self._space_points(bits, rows)
+            return centres, tip, curl
         length = self.length[rows]
         steps = np.stack([length * np.cos(angle), length * np.sin(angle)], axis=-1)  # (m, n + 1, k, 2)
         base = np.stack([np.zeros(m), self.heights[bits[:, 0]]], axis=-1)  # (m, 2)
         pts = np.cumsum(steps, axis=1) + base[:, None, None, :]
         pts = pts.transpose(0, 2, 1, 3)  # (m, k, n + 1, 2)
         centres, tip = pts[:, :, :-1], pts[:, :, -1]
-        curl = np.degrees(angle[:, -1, :] + self.end[erows])
         return centres, tip, curl
+
+    def _space_points(self, bits: NDArray[np.integer], rows: IntArray) -> tuple[FloatArray, FloatArray]:
+        """Centres (m, k, n, 3) and tip (m, k, 3) of a chain in space: its elements composed from the base."""
+        m = len(bits)
+        chords = self.space[rows][..., :3].transpose(0, 2, 1, 3)  # (m, k, n + 1, 3)
+        turns = rotation_matrices(self.space[rows][..., 3:]).transpose(0, 2, 1, 3, 4)
+        base = np.stack([np.zeros(m), self.heights[bits[:, 0]], np.full(m, self.centre_z)], axis=-1)
+        pts = chain_points(chords, turns, base[:, None, :])[:, :, 1:]  # (m, k, n + 1, 3)
+        return pts[:, :, :-1], pts[:, :, -1]
 
     # -- persistence ----------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -292,6 +334,11 @@ class ChainTable:
         fmt = ALPHABET_FORMAT if self.alphabet else TABLE_FORMAT
         if self.terms and self.terms.get("digest") == entries_digest(self.__dict__):  # still what they write out
             entries, fmt = {"terms": terms_to_dict(self.terms)}, TERMS_FORMAT
+        if len(self.space):  # a chain in space: its entries' layout, its elements in space (unless the terms hold them)
+            extra.update(layout=fmt, centre_z_mm=self.centre_z)
+            if fmt != TERMS_FORMAT:
+                entries.update(space_chord_mm=self.space[..., :3].tolist(), space_turn_rad=self.space[..., 3:].tolist())
+            fmt = SPACE_FORMAT
         return {
             "format": fmt,
             "kind": "pneumorph chain table",
@@ -316,14 +363,20 @@ class ChainTable:
         """Read :meth:`to_dict`'s form, checking its layout and its fingerprint."""
         try:
             fmt = data.get("format")
-            if data.get("kind") != "pneumorph chain table" or fmt not in (TABLE_FORMAT, ALPHABET_FORMAT,
-                                                                           TERMS_FORMAT):
+            layouts = (TABLE_FORMAT, ALPHABET_FORMAT, TERMS_FORMAT)
+            if data.get("kind") != "pneumorph chain table" or fmt not in (*layouts, SPACE_FORMAT):
                 raise ChainTableError(f"{where}: not a pneumorph chain table of format {TABLE_FORMAT}, "
-                                      f"{ALPHABET_FORMAT} or {TERMS_FORMAT}")
+                                      f"{ALPHABET_FORMAT}, {TERMS_FORMAT} or {SPACE_FORMAT}")
+            space = fmt == SPACE_FORMAT
+            if space and data.get("layout") not in layouts:
+                raise ChainTableError(f"{where}: a chain in space with entries of an unknown layout")
+            fmt = data["layout"] if space else fmt
             w = int(data["window"])
             alphabet, symmetric, geometry = _types_of(data, fmt, where)
             pressures = np.array(data["pressures_mpa"], dtype=float)
-            arrays = _entries_of(data, fmt, w, alphabet, symmetric, len(pressures), where)
+            arrays = _entries_of(data, fmt, w, alphabet, symmetric, len(pressures), where, space)
+            if space:
+                geometry["centre_z"] = float(data["centre_z_mm"])
             table = cls(
                 window=w,
                 pressures=pressures,
@@ -358,7 +411,9 @@ class ChainTable:
             raise ChainTableError(f"{where}: symmetric unit types {list(table.symmetric)} outside the alphabet")
         if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
             raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
-        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures)):
+        if len(table.space) and table.space.shape != (K, k, 6):
+            raise ChainTableError(f"{where}: damaged chain table (elements in space of another shape)")
+        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures, table.space)):
             raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
         if data.get("fingerprint") != table.fingerprint():
             raise ChainTableError(f"{where}: the chain table's contents do not match its fingerprint "
@@ -430,15 +485,18 @@ def _types_of(data: dict[str, Any], fmt: Any, where: str) -> tuple[tuple[str, ..
 
 
 def _entries_of(data: dict[str, Any], fmt: Any, w: int, alphabet: tuple[str, ...], symmetric: tuple[str, ...],
-                levels: int, where: str) -> dict[str, Any]:
-    """A table file's entries (``codes`` .. ``end``), from its windows or written out from its far-field terms
-    (then with ``terms``)."""
+                levels: int, where: str, space: bool = False) -> dict[str, Any]:
+    """A table file's entries (``codes`` .. ``end``, and ``space`` for a chain in space), from its windows or written
+    out from its far-field terms (then with ``terms``)."""
     if fmt == TERMS_FORMAT:
         terms = terms_from_dict(data["terms"])
         if int(terms["window"]) + 1 != w:
             raise ChainTableError(f"far-field terms of window +-{terms['window']} in a table of +-{w}")
         sym = tuple(alphabet.index(s) for s in symmetric)
-        return {**compile_terms(terms, terms["n_units"], max(1, len(alphabet)), sym, levels), "terms": terms}
+        entries = compile_terms(terms, terms["n_units"], max(1, len(alphabet)), sym, levels)
+        if space != ("space" in entries):
+            raise ChainTableError(f"{where}: far-field terms {'without' if space else 'with'} elements in space")
+        return {**entries, "terms": terms}
 
     def codes_of(texts: list[str]) -> IntArray:
         out = []
@@ -448,6 +506,10 @@ def _entries_of(data: dict[str, Any], fmt: Any, w: int, alphabet: tuple[str, ...
             out.append(window_code(t, alphabet))
         return np.array(out, dtype=np.int64)
 
-    return {"codes": codes_of(data["windows"]), "turn": np.array(data["turn_rad"], dtype=float),
-            "length": np.array(data["length_mm"], dtype=float), "end_codes": codes_of(data["end_windows"]),
-            "end": np.array(data["end_turn_rad"], dtype=float)}
+    out = {"codes": codes_of(data["windows"]), "turn": np.array(data["turn_rad"], dtype=float),
+           "length": np.array(data["length_mm"], dtype=float), "end_codes": codes_of(data["end_windows"]),
+           "end": np.array(data["end_turn_rad"], dtype=float)}
+    if space:
+        out["space"] = np.concatenate([np.array(data["space_chord_mm"], dtype=float),
+                                       np.array(data["space_turn_rad"], dtype=float)], axis=-1)
+    return out

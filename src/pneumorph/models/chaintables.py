@@ -177,8 +177,8 @@ def restrict_table(table: ChainTable, levels: int) -> ChainTable:
                      else value for name, value in errs.items()}
             for symbol, errs in validation["per_type"].items()}
     return replace(table, pressures=table.pressures[:m].copy(), turn=table.turn[:, :m].copy(),
-                   length=table.length[:, :m].copy(), end=table.end[:, :m].copy(), source=source,
-                   validation=validation)
+                   length=table.length[:, :m].copy(), end=table.end[:, :m].copy(), space=table.space[:, :m].copy(),
+                   source=source, validation=validation)
 
 
 def level_pressure(table: ChainTable, levels: int) -> float:

@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError
 from pneumorph.models.response import Response, response_elements
+from pneumorph.models.spacechords import space_rows
 from pneumorph.models.windows import (
     canonical_codes,
     covering_designs,
@@ -128,15 +129,16 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
                   symmetric: tuple[int, ...]) -> tuple[IntArray, FloatArray, IntArray, FloatArray]:
     """Symbols of window +-``width`` and elements of every chord (and end), mirrored too.
 
-    Returns chord symbols (N, 2 width + 1), chord values (N, 2 k: turns then lengths), end
-    symbols (M, 2 width + 1) and end turns (M, k).
+    Returns chord symbols (N, 2 width + 1), chord values (N, 2 k: turns then lengths; for a
+    chain in space, then the six elements in space per level: 8 k), end symbols
+    (M, 2 width + 1) and end turns (M, k).
     """
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
         turn, length, end = response_elements(r)
         for s, sign in _symbols(r.orientation, width, mirror, alphabet, symmetric):
             syms.append(s)
-            values.append(np.concatenate([sign * turn.T, length.T], axis=1))
+            values.append(np.concatenate([sign * turn.T, length.T, *space_rows(r, sign)], axis=1))
             esyms.append(s[-1:])
             ends.append(sign * end[None, :])
     return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
@@ -234,7 +236,11 @@ def fit_terms(responses: Sequence[Response], window: int, mirror: bool, alphabet
     offsets = far_terms(w)
     tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in offsets], values)
     etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in offsets], ends)
-    spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
+    levels = ends.shape[1]
+    if values.shape[1] > 2 * levels:  # a chain in space is told by its elements in space (as in chainfit)
+        spread = float(np.abs(values - fit)[:, 2 * levels:].max())
+    else:
+        spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
     return {"window": w, "chord": tables, "end": etables}, spread
 
 
@@ -262,8 +268,11 @@ def compile_terms(terms: dict[str, Any], n_units: int, n_types: int, symmetric: 
     # the windows of a last chord n: units n - w - 1 .. n (or the base), then w + 1 tip symbols
     last = np.all(windows[:, width + 1:] == radix - 1, axis=1) & (windows[:, width] < radix - 2)
     end = _compile(terms["end"], offsets, windows[last], width, radix, "end")
-    return {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:], "end_codes": codes[last],
-            "end": end}
+    out = {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:2 * levels], "end_codes": codes[last],
+           "end": end}
+    if chord.shape[1] > 2 * levels:  # a chain in space: its elements per level after the planar ones
+        out["space"] = chord[:, 2 * levels:].reshape(len(codes), levels, 6)
+    return out
 
 
 def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
@@ -296,6 +305,8 @@ def entries_digest(entries: dict[str, Any]) -> str:
     h = hashlib.sha256()
     for key in ("codes", "turn", "length", "end_codes", "end"):
         h.update(np.ascontiguousarray(entries[key]).tobytes())
+    if len(entries.get("space", ())):  # a chain in space
+        h.update(np.ascontiguousarray(entries["space"]).tobytes())
     return h.hexdigest()[:16]
 
 

@@ -39,6 +39,8 @@ True
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
@@ -147,6 +149,87 @@ def frame_polyline(chords: FloatArray, turns: FloatArray, start: FloatArray) -> 
     return np.stack(points, axis=-2)
 
 
+#: the signs of a space element's six values (its chord in its frame, then its frame's turn as a rotation vector)
+#: when every unit is turned over: the actuator turned half a turn about its axis (y and z change sign; a rotation
+#: vector is turned as a vector)
+MIRROR_SIGNS = np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
+
+
+def response_space_elements(response: Any) -> FloatArray:
+    """The chain's elements in space of a full-width response, per level: shape (k, n + 1, 6).
+
+    Element ``j`` (``j = 0 .. n``, the chord from point ``j``: the base, then unit ``j``'s
+    centre) holds the chord in the frame of point ``j`` and the turn of that frame from the
+    one before it (a rotation vector; zero for the base, whose frame is the actuator's own):
+    :func:`frame_elements`, keyed by the same window as the planar chain's turn and length of
+    chord ``j``. :func:`chain_points` composes them back.
+
+    Raises
+    ------
+    ValueError
+        A response without its units' frames (not of the full-width model).
+    """
+    if response.frames is None or response.reference_tip.shape != (3,):
+        raise ValueError(f"design {response.orientation}: a chain in space needs the full 3D model's response "
+                         "(points in space and each unit's frame)")
+    points = np.stack([response.centreline(i) for i in range(response.n_levels)])  # (k, n + 2, 3)
+    chords, turns = frame_elements(points, response.frames)
+    turns = np.concatenate([np.zeros_like(turns[:, :1]), turns], axis=1)
+    return np.concatenate([chords, turns], axis=-1)
+
+
+def space_rows(response: Any, sign: float = 1.0) -> list[FloatArray]:
+    """A response's elements in space as one row per chord, the levels' six values side by side: ``[(n + 1, 6 k)]``.
+
+    Mirrored (:data:`MIRROR_SIGNS`) for ``sign`` -1; an empty list for a planar response
+    (without its units' frames), so that a planar table's values stay as they were.
+    """
+    if response.frames is None:
+        return []
+    e = response_space_elements(response)
+    if sign < 0:
+        e = e * MIRROR_SIGNS
+    return [e.transpose(1, 0, 2).reshape(e.shape[1], -1)]
+
+
+def chain_points(chords: FloatArray, turns: FloatArray, start: FloatArray) -> FloatArray:
+    """The polyline of the chain's elements in space from ``start``: the inverse of :func:`response_space_elements`.
+
+    Parameters
+    ----------
+    chords : ndarray, shape (..., n + 1, 3)
+        Each chord in the frame of the point it starts from.
+    turns : ndarray, shape (..., n + 1, 3, 3)
+        Each point's frame in the one before, as rotation matrices (the base's: its frame in the
+        actuator's own).
+    start : ndarray, shape (..., 3)
+
+    Returns
+    -------
+    ndarray, shape (..., n + 2, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> chords = np.array([[10.0, 0, 0], [10.0, 0, 0]])
+    >>> quarter = Rotation.from_rotvec([[0, 0, 0], [0, np.pi / 2, 0]]).as_matrix()   # the second frame turned about y
+    >>> chain_points(chords, quarter, np.zeros(3)).round(9).tolist()
+    [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 0.0, -10.0]]
+    """
+    chords, turns = np.asarray(chords, dtype=float), np.asarray(turns, dtype=float)
+    frame = np.broadcast_to(np.eye(3), (*chords.shape[:-2], 3, 3))
+    points = [np.broadcast_to(np.asarray(start, dtype=float), (*chords.shape[:-2], 3))]
+    for j in range(chords.shape[-2]):
+        frame = frame @ turns[..., j, :, :]
+        points.append(points[-1] + np.einsum("...ij,...j->...i", frame, chords[..., j, :]))
+    return np.stack(points, axis=-2)
+
+
+def rotation_matrices(vectors: FloatArray) -> FloatArray:
+    """Rotation matrices (..., 3, 3) of rotation vectors (..., 3)."""
+    return _rotation(np.asarray(vectors, dtype=float))
+
+
 def _rotvec(matrix: FloatArray) -> FloatArray:
     """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3)."""
     return Rotation.from_matrix(matrix.reshape(-1, 3, 3)).as_rotvec().reshape(*matrix.shape[:-2], 3)
@@ -157,4 +240,5 @@ def _rotation(vector: FloatArray) -> FloatArray:
     return Rotation.from_rotvec(vector.reshape(-1, 3)).as_matrix().reshape(*vector.shape[:-1], 3, 3)
 
 
-__all__ = ["frame_elements", "frame_polyline", "space_elements", "space_polyline"]
+__all__ = ["MIRROR_SIGNS", "chain_points", "frame_elements", "frame_polyline", "response_space_elements",
+           "rotation_matrices", "space_elements", "space_polyline", "space_rows"]

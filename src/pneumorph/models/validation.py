@@ -40,10 +40,10 @@ def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[
         bits = table.designs(r.orientation)
         types.append(bits[0] // 2)
         c, t, cu = table.predict(bits)
-        e = np.hypot(*(c[0] - r.centres).transpose(2, 0, 1))  # (k, n)
+        e = np.linalg.norm(c[0] - r.centres, axis=-1)  # (k, n); in space for a chain in space
         centre_err.append(e)
         norm_err.append(np.sqrt((e**2).sum(axis=1)))
-        tip_err.append(np.hypot(*(t[0] - r.tip).T))
+        tip_err.append(np.linalg.norm(t[0] - r.tip, axis=-1))
         curl_err.append(np.abs(cu[0] - r.curl))
     if not responses:
         nan = [float("nan")] * k
