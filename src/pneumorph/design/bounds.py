@@ -72,7 +72,7 @@ def _target_slope(chain: ChainModel, objective: ProfileTarget, errors: dict[str,
 
 def _x_reach(chain: ChainModel, errors: dict[str, FloatArray]) -> float:
     """How far from the base any centre can be (mm): the chords' summed greatest length plus the chain's error."""
-    return float(chain.table.length.max()) * (chain.n_units + 1) + float(errors["centre"].max())
+    return chain.table.longest_chord * (chain.n_units + 1) + float(errors["centre"].max())
 
 
 def _curve_range(chain: ChainModel, objective: ProfileTarget, errors: dict[str, FloatArray],
@@ -192,7 +192,7 @@ def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integ
         # tip's undeformed height, which every design shares
         if isinstance(o, ProfileTarget):
             return profile_error_array(centres, ref_c[:, None], o, chain.length)
-        return tip_value_array(tip, np.asarray(chain.table.tip_ref), curl, o.name, o.point)
+        return tip_value_array(tip, chain.table.tip_reference, curl, o.name, o.point)
 
     if isinstance(objective, StagedTarget):
         levels = objective.levels(chain.table.pressures)

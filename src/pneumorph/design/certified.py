@@ -43,6 +43,7 @@ from pneumorph.design.fitness import score
 from pneumorph.design.growth import best_scores, chain_scores, grow_designs
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry
 from pneumorph.design.scoring import Candidate, ScoreBook
+from pneumorph.design.spacegrowth import space_scores
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
@@ -160,7 +161,7 @@ def certified_search(
         # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
         # and the FE verifications alike
         objective = replace(objective, length=chain.length)
-    scores = chain_scores(chain, objective, margin)
+    scores = space_scores(chain, objective, margin) if chain.table.axes == 3 else chain_scores(chain, objective, margin)
     order = scores.order()
     designs = chain.table.texts(scores.bits[order])
     say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "

@@ -70,11 +70,14 @@ def place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any],
             yield j, x, y
 
 
-def depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], polar: bool = False) -> Any:
+def depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], polar: bool = False,
+           place: Any = None) -> Any:
     """Grow the prefixes unit by unit: yields ``(p, placed, bits, st, centres)`` at every depth ``p``.
 
-    ``centres`` iterates over the chords placed at this depth (:func:`place_chords`); the
-    caller consumes it, and may then ``send`` back pruned ``(bits, st)`` for the next depth.
+    ``centres`` iterates over the chords placed at this depth (:func:`place_chords`, or
+    ``place(chain, bits, st, placed, upto)``: a chain in space,
+    :mod:`pneumorph.design.spacegrowth`); the caller consumes it, and may then ``send`` back
+    pruned ``(bits, st)`` for the next depth.
     """
     n, w = chain.n_units, chain.table.window
     placed = 0
@@ -82,7 +85,9 @@ def depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], polar
         if p > 1:
             bits, st = grow(bits, st, chain.table.unit_codes)
         upto = n + 1 if p == n else max(p - w + 1, 0)
-        pruned = yield p, max(placed, upto), bits, st, place_chords(chain, bits, st, placed, upto, polar)
+        centres = place_chords(chain, bits, st, placed, upto, polar) if place is None else \
+            place(chain, bits, st, placed, upto)
+        pruned = yield p, max(placed, upto), bits, st, centres
         placed = max(placed, upto)
         if pruned is not None:
             bits, st = pruned

@@ -142,6 +142,19 @@ class ChainTable:
         return 3 if len(self.space) else 2
 
     @property
+    def tip_reference(self) -> FloatArray:
+        """The undeformed tip's (x from the last centre, height), and its z for a chain in space: the reference of a
+        tip goal's value (:func:`~pneumorph.design.fitness.tip_value_array` reads the height and z)."""
+        return np.array([*self.tip_ref, *([self.centre_z] if len(self.space) else [])], dtype=float)
+
+    @property
+    def longest_chord(self) -> float:
+        """The longest chord of any window at any level (mm): in space for a chain in space."""
+        if len(self.space):
+            return float(np.linalg.norm(self.space[..., :3], axis=-1).max())
+        return float(self.length.max())
+
+    @property
     def n_levels(self) -> int:
         return len(self.pressures)
 

@@ -1,0 +1,210 @@
+"""Certified search over a chain in space: designs grown unit by unit with each prefix's point and frame.
+
+A chain in space (:attr:`~pneumorph.models.chaintable.ChainTable.space`, a library with
+sideways units) places chord ``j`` in the frame of the point it starts from, after turning
+that frame by the window's frame turn. A prefix of ``p`` units fixes the chords whose
+windows it covers, as in the plane (:mod:`pneumorph.design.prefixes`), so designs share
+their prefixes' placements here too; each prefix carries its point and frame per level.
+
+Bounds (admissible: no design of a dropped prefix can cost less than the bound):
+
+- a Cartesian profile or space curve (Eq 4.1 with a centre's distance in y and z,
+  :meth:`~pneumorph.design.profiles.ProfileTarget.squared_error`): the partial sums only grow,
+  so ``min_k sqrt(partial_k)`` bounds every completion;
+- a tip goal: the tip lies within ``r L_k`` of the prefix's last point, with ``r`` chords
+  still to place and ``L_k`` the longest chord of the table at level ``k``; every goal is
+  1-Lipschitz in the tip (``min-distance`` in its projection on the x-y plane), so it moves by
+  at most that.
+
+The chain's own error bound (``beta``) is the planar one (:mod:`pneumorph.design.certified`):
+a centre error of norm ``e`` in space changes a centre's term of a space curve,
+``|(f(x) - y, g(x) - z)|``, by at most ``e sqrt(1 + f'^2 + g'^2)`` (the largest singular value
+of ``[[f', -1, 0], [g', 0, -1]]``), and a tip goal by at most the tip's error. Polar
+profiles, the curl and staged targets have no chain in space yet and are refused.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import replace
+from typing import Any, cast
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pneumorph.design.bounds import ChainScores, _costs, _radix, _target_slope, chain_errors
+from pneumorph.design.fitness import tip_value_array
+from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union, designs_of
+from pneumorph.design.prefixes import depths
+from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
+from pneumorph.errors import SearchConfigError
+from pneumorph.models.chain import ChainModel, window_codes
+from pneumorph.models.spacechords import rotation_matrices
+
+FloatArray = NDArray[np.float64]
+
+
+def check_space_objective(objective: Objective) -> None:
+    """Refuse an objective the chain in space cannot score yet.
+
+    Raises
+    ------
+    SearchConfigError
+        A polar profile, the curl or a staged target.
+    """
+    if isinstance(objective, ProfileTarget) and objective.coordinates == "cartesian":
+        return
+    if isinstance(objective, TipGoal) and objective.name != "max-curl":
+        return
+    what = getattr(objective, "label", None) or getattr(objective, "name", type(objective).__name__)
+    raise SearchConfigError(f"the certified search over units that leave the plane scores Cartesian profiles, space "
+                            f"curves and tip goals other than the curl, not {what!r}; use --search ga")
+
+
+def _elements(chain: ChainModel) -> tuple[FloatArray, FloatArray]:
+    """The table's chords (K, k, 3) and frame turns as rotation matrices (K, k, 3, 3)."""
+    space = chain.table.space
+    return space[..., :3], rotation_matrices(space[..., 3:])
+
+
+def _seed(chain: ChainModel) -> tuple[NDArray[np.uint8], dict[str, Any]]:
+    """The one-unit prefixes and their state: the base point (its height that of the first unit) and frame."""
+    table = chain.table
+    bits = table.unit_codes[:, None].copy()
+    c, k = len(bits), table.n_levels
+    point = np.zeros((c, k, 3))
+    point[..., 1] = table.heights[bits[:, 0]][:, None]
+    point[..., 2] = table.centre_z
+    return bits, {"point": point, "frame": np.broadcast_to(np.eye(3), (c, k, 3, 3)).copy(), "sum": np.zeros((c, k))}
+
+
+def _placer(chain: ChainModel) -> Any:
+    """``place(chain, bits, st, placed, upto)`` of :func:`~pneumorph.design.prefixes.depths`, in space: yields
+    ``(j, x, y, z)`` of every centre ``j + 1`` it fixes (y and z from the undeformed axis)."""
+    chords, turns = _elements(chain)
+    table = chain.table
+
+    def place(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], placed: int,
+              upto: int) -> Iterator[tuple[int, FloatArray, FloatArray, FloatArray]]:
+        n, w = chain.n_units, table.window
+        if upto <= placed:
+            return
+        codes = window_codes(bits, w, range(placed, upto), n_types=table.n_types)
+        for j in range(placed, upto):
+            rows = table.lookup(codes[:, j - placed])
+            st["frame"] = st["frame"] @ turns[rows]
+            st["point"] = st["point"] + np.einsum("mkij,mkj->mki", st["frame"], chords[rows])
+            if j + 1 <= n:
+                p = st["point"]
+                yield j, p[..., 0], p[..., 1] - table.heights[bits[:, j]][:, None], p[..., 2] - table.centre_z
+
+    return place
+
+
+def _tip_bound(chain: ChainModel, goal: TipGoal, point: FloatArray, remaining: int) -> FloatArray:
+    """A lower bound on the cost of a tip goal of every completion, shape (m,): the tip within ``remaining`` of the
+    longest chords of the current ``point`` (module docstring)."""
+    table = chain.table
+    radius = remaining * np.linalg.norm(table.space[..., :3], axis=-1).max(axis=0)  # (k,)
+    x = point[..., 0]
+    y = point[..., 1] - table.tip_ref[1]
+    if goal.name == "max-x":
+        cost = -(x + radius)
+    elif goal.name == "min-x":
+        cost = x - radius
+    elif goal.name == "max-y":
+        cost = -(y + radius)
+    elif goal.name == "min-y":
+        cost = y - radius
+    elif goal.name == "min-distance":
+        cost = np.maximum(np.hypot(x, y) - radius, 0.0)
+    else:  # reach
+        assert goal.point is not None
+        target = np.array([*goal.point, 0.0][:3])
+        d = point - np.array([0.0, table.tip_ref[1], table.centre_z]) - target
+        cost = np.maximum(np.linalg.norm(d, axis=-1) - radius, 0.0)
+    return np.asarray(cost.min(axis=1), dtype=float)
+
+
+def _beta(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]) -> FloatArray:
+    """The chain's bound on the objective per level (k,) (module docstring)."""
+    if isinstance(objective, ProfileTarget):
+        slope = _target_slope(chain, objective, errors)
+        return errors["centre"] * np.sqrt(chain.n_units * (1.0 + slope**2))
+    return errors["tip"]
+
+
+def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, threshold: float = float("inf"),
+               max_nodes: int = MAX_NODES, beam: int | None = None, spill: bool = False) -> ChainScores:
+    """Chain scores of every design of a chain in space whose cost is below ``threshold``.
+
+    As :func:`~pneumorph.design.growth.grow_designs` (``beam``, ``spill``, ``max_nodes`` alike), with
+    the bounds of the module docstring.
+    """
+    check_space_objective(objective)
+    table = chain.table
+    n = chain.n_units
+    length = chain.length
+    profile = isinstance(objective, ProfileTarget)
+    prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
+    bits, st = _seed(chain)
+    spilled: list[float] | None = [] if spill else None
+    place = _placer(chain)
+    with np.errstate(all="ignore"):
+        growth = depths(chain, bits, st, place=place)
+        for p, placed, bits, st, centres in growth:
+            for _, x, y, z in centres:
+                if profile:
+                    st["sum"] = st["sum"] + prof.squared_error(x, y, length, z)
+            if p == n or (not np.isfinite(threshold) and beam is None):
+                continue
+            if profile:
+                bound = np.sqrt(st["sum"].min(axis=1))
+            else:
+                bound = _tip_bound(chain, goal, st["point"], n + 1 - placed)
+            keep = _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled)
+            bits = bits[keep]
+            st = {key: v[keep] for key, v in st.items()}
+            growth.send((bits, st))
+        if profile:
+            values = np.sqrt(st["sum"])
+        else:
+            values = tip_value_array(st["point"], table.tip_reference, np.zeros(st["point"].shape[:2]), goal.name,
+                                     goal.point)
+    cost, level, optimistic, bound = _costs(values, np.broadcast_to(beta, values.shape), objective.sense)
+    return ChainScores(bits, values, cost, level, optimistic, bound, floor=min(spilled or [np.inf]),
+                       choices=_radix(chain))
+
+
+def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, max_nodes: int = MAX_NODES,
+                 max_enumerate: int = MAX_ENUMERATE) -> ChainScores:
+    """Chain scores of every design of a chain in space that can matter, with a floor under the rest.
+
+    As :func:`~pneumorph.design.growth.chain_scores`: every design while there are at most
+    ``2^max_enumerate``; above, a beam search (:data:`~pneumorph.design.growth.BEAM` prefixes
+    per depth) gives a good cost ``c0``, and branch-and-bound returns every design of chain
+    cost below ``c0 + 2 beta``. Where more than ``max_nodes`` prefixes stay open, the best are
+    kept and the floor says how much better an unlisted design could be.
+
+    Raises
+    ------
+    SearchConfigError
+        An objective :func:`check_space_objective` refuses.
+    """
+    check_space_objective(objective)
+    errors = chain_errors(chain, margin)
+    beta = np.asarray(_beta(chain, objective, errors), dtype=float)
+    if designs_of(chain) <= 2.0**max_enumerate:
+        return grow_space(chain, objective, beta)
+    beamed = grow_space(chain, objective, beta, beam=BEAM)
+    threshold = float(beamed.cost.min()) + 2 * float(beta.max()) + 1e-9
+    scores = grow_space(chain, objective, beta, threshold, max_nodes=max_nodes, spill=True)
+    if scores.complete:
+        keep = scores.cost < threshold
+        return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
+                           scores.optimistic[keep], scores.bound[keep], floor=threshold - float(beta.max()),
+                           choices=scores.choices)
+    return replace(_union(scores, beamed), floor=min(scores.floor, threshold) - float(beta.max()))
+
+
+__all__ = ["check_space_objective", "grow_space", "space_scores"]

@@ -1,0 +1,80 @@
+"""The certified search over a chain in space: its scores against every design scored one by one, and its
+bounds against enumeration (no design left out could beat the floor it states)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from pneumorph.design import spacegrowth
+from pneumorph.design.bounds import chain_errors, score_designs
+from pneumorph.design.spacegrowth import check_space_objective, space_scores
+from pneumorph.design.targets import make_objective, tip_goal
+from pneumorph.errors import SearchConfigError
+from pneumorph.models.chain import ChainModel
+from pneumorph.models.chainfit import fit_table
+from pneumorph.models.chainfit import training_designs as covering
+from pneumorph.models.windows import design_numbers, every_design
+from tests.spacelaw import ALPHABET, LEVELS, LIBRARY, W, _law, _response, _source, undeformed_of
+
+N = 7
+
+
+@pytest.fixture(scope="module")
+def chain() -> ChainModel:
+    law, undeformed = _law(11), undeformed_of()
+    table = fit_table([_response(d, law, undeformed) for d in covering(N, W, False, True, ALPHABET)], W, _source(),
+                      library=LIBRARY)
+    errors = {"centre_worst_mm": [0.05] * LEVELS, "tip_worst_mm": [0.08] * LEVELS, "curl_worst_deg": [1.0] * LEVELS}
+    return ChainModel(replace(table, validation=errors), N)
+
+
+@pytest.fixture(scope="module")
+def every(chain: ChainModel) -> np.ndarray:
+    return every_design(N, np.asarray(chain.table.unit_codes, dtype=np.uint8))
+
+
+def _objectives(chain: ChainModel) -> list:
+    length = chain.length
+    return [make_objective("helix", 6.0, length=length), make_objective("sin", 4.0, length=length),
+            make_objective("y = 0.05*x, z = -0.002*x**2", length=length), tip_goal("reach", (60.0, 8.0, -12.0)),
+            tip_goal("max-x"), tip_goal("min-y"), tip_goal("min-distance")]
+
+
+@pytest.mark.parametrize("which", range(7))
+def test_every_design_scored_in_space_is_its_own_chain_value(chain: ChainModel, every: np.ndarray, which: int) -> None:
+    objective = _objectives(chain)[which]
+    grown = space_scores(chain, objective)
+    assert grown.complete and len(grown.bits) == 4**N
+    one_by_one = score_designs(chain, objective, every, chain_errors(chain))
+    order = np.argsort(design_numbers(grown.bits, grown.choices))
+    np.testing.assert_array_equal(grown.bits[order], one_by_one.bits)
+    np.testing.assert_allclose(grown.per_level[order], one_by_one.per_level, atol=1e-9, rtol=0)
+    np.testing.assert_allclose(grown.bound[order], one_by_one.bound, atol=1e-12, rtol=0)
+
+
+@pytest.mark.parametrize("which", range(7))
+@pytest.mark.parametrize("max_nodes", [500_000, 40])
+def test_no_design_the_branch_and_bound_leaves_out_beats_its_floor(chain: ChainModel, every: np.ndarray, which: int,
+                                                                   max_nodes: int,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    objective = _objectives(chain)[which]
+    monkeypatch.setattr(spacegrowth, "BEAM", 16)  # the first search's beam: not every prefix of so short a chain
+    found = space_scores(chain, objective, max_enumerate=8, max_nodes=max_nodes)  # 4^7 designs: branch-and-bound
+    assert not found.complete
+    truth = score_designs(chain, objective, every, chain_errors(chain))
+    listed = np.isin(design_numbers(truth.bits, 4), design_numbers(found.bits, 4))
+    assert listed.sum() < len(every)  # it pruned
+    assert truth.optimistic[~listed].min() >= found.floor - 1e-9  # the stated floor holds for all others
+    if max_nodes == 500_000:  # nothing spilled: the best and every design within twice the bound of it are listed
+        assert truth.cost[listed].min() == pytest.approx(truth.cost.min(), abs=1e-12)
+        assert (truth.cost[~listed] >= truth.cost.min() + 2 * found.bound.max() - 1e-9).all()
+
+
+def test_what_the_chain_in_space_cannot_score_is_refused_in_one_line() -> None:
+    for objective in (make_objective("r = 50 + 0*theta"), tip_goal("max-curl")):
+        with pytest.raises(SearchConfigError, match="--search ga") as exc:
+            check_space_objective(objective)
+        assert "\n" not in str(exc.value)
