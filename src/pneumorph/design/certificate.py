@@ -80,7 +80,14 @@ def certificate_text(certificate: Mapping[str, Any], unit: str, winner: str | No
              + f" (the chain's validated centre errors x {float(certificate['margin']):g}).")
     shown = ", ".join(verified[:show]) + (", ..." if len(verified) > show else "")
     fe = f"Verified by FE{f' ({fidelity})' if fidelity else ''}: {_designs(len(verified))} ({shown})."
-    return [verdict, bound, fe]
+    lines = [verdict, bound, fe]
+    planar = certificate.get("planar")
+    if planar:  # a library with sideways units: what the units that bend in the plane alone can do
+        fe_value = planar.get("fe")
+        value = "did not converge in the FE model" if fe_value is None else f"FE {float(fe_value):.4g} {unit}"
+        lines.append(f"In the plane: the best design without sideways units is {planar['design']} (chain "
+                     f"{float(planar['chain']):.4g} {unit}; {value}).")
+    return lines
 
 
 __all__ = ["certificate_text"]

@@ -177,8 +177,37 @@ def certified_search(
         chain_candidate(chain, objective, winner.design)
     certificate = _certificate(state, scores, float(scores.bound[order[designs.index(winner.design)]]), epsilon,
                                margin, objective.sense)
+    if chain.table.axes == 3 and (planar := _planar_best(fe_model, chain, objective, margin, book, say)):
+        certificate["planar"] = planar
     return CertifiedResult(winner, winner_chain, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
                            solves=book.solves, wall_time=time.perf_counter() - start)
+
+
+def planar_codes(fe_model: ActuatorModel, chain: ChainModel) -> np.ndarray | None:
+    """The unit codes of the types that bend in the plane, of a library with sideways ones too (else None)."""
+    library = getattr(fe_model, "library", None)
+    if library is None or library.is_single:
+        return None
+    flat = {2 * t + o for t, unit in enumerate(library.units) if not unit.layer_side for o in (0, 1)}
+    codes = np.array([c for c in chain.table.unit_codes if int(c) in flat], dtype=np.uint8)
+    return codes if 0 < len(codes) < len(chain.table.unit_codes) else None
+
+
+def _planar_best(fe_model: ActuatorModel, chain: ChainModel, objective: Objective, margin: float, book: ScoreBook,
+                 say: Callable[[str], None]) -> dict[str, Any] | None:
+    """The best design without sideways units by the chain, verified by FE: what the plane alone can do (None for a
+    library without both kinds)."""
+    codes = planar_codes(fe_model, chain)
+    if codes is None:
+        return None
+    scores = space_scores(chain, objective, margin, codes=codes)
+    best = scores.order()[0]
+    design = chain.table.texts(scores.bits[best : best + 1])[0]
+    say(f"the best design that stays in the plane, by the chain: {design}; verifying it by FE ...")
+    book.score_many([design])
+    fe = book.scores[design]
+    return {"design": design, "chain": float(scores.per_level[best, scores.level[best]]),
+            "fe": None if fe.failed else float(fe.value), "designs_scored": len(scores.bits)}
 
 
 def _check_search(fe_model: ActuatorModel, chain: ChainModel, verify: int, margin: float, epsilon: float) -> None:

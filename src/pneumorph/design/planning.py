@@ -44,7 +44,7 @@ from pneumorph.models.chaintables import (
     build_options,
     same_source,
     serve_table,
-    shipped_path,
+    shipped_for,
     table_file,
 )
 
@@ -224,7 +224,7 @@ def missing_table_message(config: Any, model: Any, table_dir: str | Path | None,
     p = model.pressures() * 1e3
     fidelity = str(getattr(model, "fidelity", "?"))
     where = f"kept in {table_dir}" if table_dir is not None else "kept (the evaluation cache is in memory)"
-    shipped = shipped_path(fidelity)
+    shipped = shipped_for(model)
     reach = ""
     if shipped.is_file():
         table = ChainTable.load(shipped)

@@ -71,19 +71,20 @@ def place_chords(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any],
 
 
 def depths(chain: ChainModel, bits: NDArray[np.uint8], st: dict[str, Any], polar: bool = False,
-           place: Any = None) -> Any:
+           place: Any = None, codes: NDArray[np.uint8] | None = None) -> Any:
     """Grow the prefixes unit by unit: yields ``(p, placed, bits, st, centres)`` at every depth ``p``.
 
     ``centres`` iterates over the chords placed at this depth (:func:`place_chords`, or
     ``place(chain, bits, st, placed, upto)``: a chain in space,
     :mod:`pneumorph.design.spacegrowth`); the caller consumes it, and may then ``send`` back
-    pruned ``(bits, st)`` for the next depth.
+    pruned ``(bits, st)`` for the next depth. ``codes``: the unit codes a prefix grows by (default every
+    code of the table).
     """
     n, w = chain.n_units, chain.table.window
     placed = 0
     for p in range(1, n + 1):
         if p > 1:
-            bits, st = grow(bits, st, chain.table.unit_codes)
+            bits, st = grow(bits, st, chain.table.unit_codes if codes is None else codes)
         upto = n + 1 if p == n else max(p - w + 1, 0)
         centres = place_chords(chain, bits, st, placed, upto, polar) if place is None else \
             place(chain, bits, st, placed, upto)

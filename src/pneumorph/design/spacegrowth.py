@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from pneumorph.design.bounds import ChainScores, _costs, _radix, _target_slope, chain_errors
 from pneumorph.design.fitness import tip_value_array
-from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union, designs_of
+from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union
 from pneumorph.design.prefixes import depths
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
@@ -67,10 +67,11 @@ def _elements(chain: ChainModel) -> tuple[FloatArray, FloatArray]:
     return space[..., :3], rotation_matrices(space[..., 3:])
 
 
-def _seed(chain: ChainModel) -> tuple[NDArray[np.uint8], dict[str, Any]]:
-    """The one-unit prefixes and their state: the base point (its height that of the first unit) and frame."""
+def _seed(chain: ChainModel, codes: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], dict[str, Any]]:
+    """The one-unit prefixes of ``codes`` and their state: the base point (its height that of the first unit) and
+    frame."""
     table = chain.table
-    bits = table.unit_codes[:, None].copy()
+    bits = np.asarray(codes, dtype=np.uint8)[:, None].copy()
     c, k = len(bits), table.n_levels
     point = np.zeros((c, k, 3))
     point[..., 1] = table.heights[bits[:, 0]][:, None]
@@ -135,23 +136,26 @@ def _beta(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]
 
 
 def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, threshold: float = float("inf"),
-               max_nodes: int = MAX_NODES, beam: int | None = None, spill: bool = False) -> ChainScores:
+               max_nodes: int = MAX_NODES, beam: int | None = None, spill: bool = False,
+               codes: NDArray[np.uint8] | None = None) -> ChainScores:
     """Chain scores of every design of a chain in space whose cost is below ``threshold``.
 
     As :func:`~pneumorph.design.growth.grow_designs` (``beam``, ``spill``, ``max_nodes`` alike), with
-    the bounds of the module docstring.
+    the bounds of the module docstring; ``codes``: the unit codes designs are made of (default every
+    code of the table; e.g. the planar units only).
     """
+    codes = np.asarray(chain.table.unit_codes if codes is None else codes, dtype=np.uint8)
     check_space_objective(objective)
     table = chain.table
     n = chain.n_units
     length = chain.length
     profile = isinstance(objective, ProfileTarget)
     prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
-    bits, st = _seed(chain)
+    bits, st = _seed(chain, codes)
     spilled: list[float] | None = [] if spill else None
     place = _placer(chain)
     with np.errstate(all="ignore"):
-        growth = depths(chain, bits, st, place=place)
+        growth = depths(chain, bits, st, place=place, codes=codes)
         for p, placed, bits, st, centres in growth:
             for _, x, y, z in centres:
                 if profile:
@@ -177,14 +181,15 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
 
 
 def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, max_nodes: int = MAX_NODES,
-                 max_enumerate: int = MAX_ENUMERATE) -> ChainScores:
+                 max_enumerate: int = MAX_ENUMERATE, codes: NDArray[np.uint8] | None = None) -> ChainScores:
     """Chain scores of every design of a chain in space that can matter, with a floor under the rest.
 
     As :func:`~pneumorph.design.growth.chain_scores`: every design while there are at most
     ``2^max_enumerate``; above, a beam search (:data:`~pneumorph.design.growth.BEAM` prefixes
     per depth) gives a good cost ``c0``, and branch-and-bound returns every design of chain
     cost below ``c0 + 2 beta``. Where more than ``max_nodes`` prefixes stay open, the best are
-    kept and the floor says how much better an unlisted design could be.
+    kept and the floor says how much better an unlisted design could be. ``codes``: the unit
+    codes designs are made of (:func:`grow_space`).
 
     Raises
     ------
@@ -194,11 +199,12 @@ def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, m
     check_space_objective(objective)
     errors = chain_errors(chain, margin)
     beta = np.asarray(_beta(chain, objective, errors), dtype=float)
-    if designs_of(chain) <= 2.0**max_enumerate:
-        return grow_space(chain, objective, beta)
-    beamed = grow_space(chain, objective, beta, beam=BEAM)
+    choices = len(chain.table.unit_codes if codes is None else codes)
+    if float(choices) ** chain.n_units <= 2.0**max_enumerate:
+        return grow_space(chain, objective, beta, codes=codes)
+    beamed = grow_space(chain, objective, beta, beam=BEAM, codes=codes)
     threshold = float(beamed.cost.min()) + 2 * float(beta.max()) + 1e-9
-    scores = grow_space(chain, objective, beta, threshold, max_nodes=max_nodes, spill=True)
+    scores = grow_space(chain, objective, beta, threshold, max_nodes=max_nodes, spill=True, codes=codes)
     if scores.complete:
         keep = scores.cost < threshold
         return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],

@@ -45,9 +45,23 @@ TRAINING_UNITS = 15
 _LEVEL_KEYS = ("centre_mean_mm", "centre_worst_mm", "tip_worst_mm", "curl_worst_deg", "norm_worst_mm")
 
 
-def shipped_path(fidelity: str) -> Path:
-    """The shipped table of the built-in unit for a fidelity ("2d" or "3d")."""
-    return Path(str(resources.files("pneumorph.models") / "data" / f"chain-{fidelity}.json"))
+def shipped_path(fidelity: str, library: str | None = None) -> Path:
+    """The shipped table of the built-in unit for a fidelity ("2d" or "3d"), or of a built-in library by its name."""
+    name = f"chain-{fidelity}.json" if library is None else f"chain-{fidelity}-{library}.json"
+    return Path(str(resources.files("pneumorph.models") / "data" / name))
+
+
+def shipped_for(model: Any) -> Path:
+    """Where the shipped table of ``model`` would be: its fidelity's, or over a library of several types that of
+    the library's name (``chain-3d-spatial.json``: the table must still fit the model's source to serve it).
+
+    >>> from pneumorph.models.factory import make_model
+    >>> shipped_for(make_model(15, {"fidelity": "3d", "library": "spatial"})).name
+    'chain-3d-spatial.json'
+    """
+    library = getattr(model, "library", None)
+    fidelity = str(getattr(model, "fidelity", ""))
+    return shipped_path(fidelity, None if library is None or library.is_single else library.name)
 
 
 def start_window(model: Any) -> int:
@@ -101,7 +115,7 @@ def find_table(model: Any, folder: str | Path | None = None) -> ChainTable | Non
 
     :func:`serve_table` also finds a table of a longer ramp that serves the model's pressure.
     """
-    candidates = [shipped_path(str(getattr(model, "fidelity", "")))]
+    candidates = [shipped_for(model)]
     if folder is not None:
         candidates.append(table_file(folder, model))
     for path in candidates:
@@ -276,9 +290,10 @@ class ServedTable:
                 f"{self.requested * 1e3:.4g} kPa")
 
 
-def _kept_tables(folder: str | Path | None, fidelity: str) -> list[Path]:
-    """The shipped table of a fidelity and the chain tables kept in ``folder`` (no tolerance tables)."""
-    paths = [shipped_path(fidelity)]
+def _kept_tables(folder: str | Path | None, model: Any) -> list[Path]:
+    """The shipped table of a model and the chain tables of its fidelity kept in ``folder`` (no tolerance tables)."""
+    fidelity = str(getattr(model, "fidelity", ""))
+    paths = [shipped_for(model)]
     if folder is not None and Path(folder).is_dir():
         paths += sorted(p for p in Path(folder).glob(f"chain-{fidelity}-*.json") if "tolerance" not in p.name)
     return [p for p in paths if p.is_file()]
@@ -319,7 +334,7 @@ def serve_table(model: Any, folder: str | Path | None = None, path: str | Path |
     found = find_table(model, folder)
     if found is not None:
         return ServedTable(found, model, requested)
-    for candidate in _kept_tables(folder, str(getattr(model, "fidelity", ""))):
+    for candidate in _kept_tables(folder, model):
         try:
             table = ChainTable.load(candidate)
         except ChainTableError:  # a damaged kept table serves nothing
