@@ -78,3 +78,16 @@ def test_what_the_chain_in_space_cannot_score_is_refused_in_one_line() -> None:
         with pytest.raises(SearchConfigError, match="--search ga") as exc:
             check_space_objective(objective)
         assert "\n" not in str(exc.value)
+
+
+def test_a_search_over_some_unit_codes_finds_the_best_design_made_of_them(chain: ChainModel, every: np.ndarray) -> None:
+    objective = _objectives(chain)[0]
+    planar = np.array([0, 1], dtype=np.uint8)  # a and A: the designs that stay in the plane
+    found = space_scores(chain, objective, codes=planar)
+    assert found.complete and len(found.bits) == 2**N and set(np.unique(found.bits)) == {0, 1}
+    truth = score_designs(chain, objective, every, chain_errors(chain))
+    flat = np.all(truth.bits < 2, axis=1)
+    assert found.cost.min() == pytest.approx(truth.cost[flat].min(), abs=1e-12)
+    assert truth.cost.min() < found.cost.min()  # the helix is better followed out of the plane
+    bnb = space_scores(chain, objective, codes=planar, max_enumerate=4)
+    assert not bnb.complete and bnb.cost.min() == pytest.approx(found.cost.min(), abs=1e-12)

@@ -46,10 +46,11 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
     curves, what = _target_curves(candidate, objective, pts, length, unit)
-    others = []
+    others, lines = [], []
     for name, other in compare:
         o = Candidate(other.design, other.value, candidate.level, candidate.pressure, None, other.response)
         others.append((name, profile_points(o)))
+        lines.append((name, _centreline(o)))
     # true proportions (equal axes) on a figure as tall as the shape needs: a flat profile gets a flat figure
     # with its legend below, not a square of empty space
     point = None if isinstance(objective, ProfileTarget) else objective.point
@@ -83,10 +84,12 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     ax.set_ylabel("y (mm)")
     pressure = candidate.pressure * 1e3 if candidate.pressure is not None else float("nan")
     ax.set_title(f"{candidate.design} at {pressure:.4g} kPa - {what}", fontsize=9)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, frameon=False)
+    # below the x label: a flat panel (the side view of a design that leaves the plane) needs a longer way down
+    below = -0.22 if not spatial or axes_height > 2.5 else -0.3 - 0.3 / axes_height
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, below), ncol=3, frameon=False)
     ax.grid(alpha=0.3)
     if spatial:
-        _top_view(fig.add_subplot(3, 1, 2, sharex=ax), candidate, objective, length)
+        _top_view(fig.add_subplot(3, 1, 2, sharex=ax), candidate, objective, length, lines)
         _space_view(fig.add_subplot(3, 1, 3, projection="3d"), candidate, objective, length)
     return save_figure(fig, path)
 
@@ -154,8 +157,10 @@ def _space_view(ax: Any, candidate: Candidate, objective: Objective, length: flo
     ax.legend(fontsize=7, frameon=False)
 
 
-def _top_view(ax: Any, candidate: Candidate, objective: Objective, length: float) -> None:
-    """The view from above (x, z): the target's z and the centreline's (z = 0 for a planar design)."""
+def _top_view(ax: Any, candidate: Candidate, objective: Objective, length: float,
+              others: Sequence[tuple[str, np.ndarray]] = ()) -> None:
+    """The view from above (x, z): the target's z and the centreline's (z = 0 for a planar design), and the
+    centrelines ``others`` (name, points) it is compared with, as in the side view."""
     line = _centreline(candidate)
     xs, zs = line[:, 0], line[:, 2]
     ax.axhline(0.0, color="0.8", lw=0.8, ls="--")
@@ -168,6 +173,8 @@ def _top_view(ax: Any, candidate: Candidate, objective: Objective, length: float
     ax.plot(xs, zs, "-", color="C0", lw=1.5, label="actuator centreline")
     ax.plot(xs[1:-1], zs[1:-1], "o", color="C0", ms=4)
     ax.plot(xs[-1], zs[-1], "s", color="C3", ms=6)
+    for i, (name, q) in enumerate(others):
+        ax.plot(q[:, 0], q[:, 2], ":", marker="x", ms=6, color=f"C{i + 4}", lw=1.2, zorder=5, label=name)
     ax.set_xlabel("x along the actuator (mm)")
     ax.set_ylabel("z (mm)")
     ax.set_title("seen from above (x, z)", fontsize=9)
