@@ -88,8 +88,9 @@ def _default_folder(config: Any) -> str:
               help="A model's [model] table (an identified model, identified.toml from pneumorph identify): its "
                    "unit and material scales; --model, --pressure, --unit and --library still apply.")
 @click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
-              help="Designs over a unit library ('builtin', 'spatial' (sideways units: the GA on the 3D model; no "
-                   "chain table yet), 'modes' (bimodal and low-bending units) or a library TOML file; documentation "
+              help="Designs over a unit library ('builtin', 'spatial' (sideways units that bend out of the plane: "
+                   "a chain in space, 3D only), 'modes' (bimodal and low-bending units) or a library TOML file; "
+                   "documentation "
                    "page unit-library, docs/unit-library.md in the source): certified search over every type and "
                    "orientation per unit; instead of --unit.")
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
