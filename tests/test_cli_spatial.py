@@ -37,3 +37,13 @@ def test_what_cannot_take_sideways_units_refuses_them_in_one_line(args: list[str
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not (tmp_path / "t.json").exists()
+
+
+def test_what_the_chain_in_space_cannot_score_is_refused_before_any_table(tmp_path: Path,
+                                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    out, cache = tmp_path / "run", tmp_path / "c.sqlite"
+    assert main(["design", "--library", "spatial", "--objective", "max-curl", "--out", str(out),
+                 "--cache", str(cache)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "scores Cartesian profiles, space curves and tip goals" in err and len(err.splitlines()) == 1
+    assert not out.exists() and not (tmp_path / "chain-tables").exists()

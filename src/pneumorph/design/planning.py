@@ -34,9 +34,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pneumorph.design.spacegrowth import check_space_objective
 from pneumorph.errors import ChainTableError, MissingTableError, SearchConfigError
 from pneumorph.models.buildplan import build_plan, estimate_text
-from pneumorph.models.chain import ChainTable, source_key
+from pneumorph.models.chain import ChainTable, in_space, source_key
 from pneumorph.models.chainfit import MAX_WINDOW
 from pneumorph.models.chaintables import (
     TRAINING_UNITS,
@@ -170,11 +171,13 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
         the command that builds it.
     SearchConfigError
         A short actuator over a unit library of several types (no exhaustive search lists
-        their designs).
+        their designs); an objective the chain in space cannot score, over sideways units.
     """
     n = int(config.units)
     fidelity = str(getattr(model, "fidelity", "?"))
     mixed = bool(getattr(model, "mixed", False))
+    if in_space(model):  # before a table is served or built: what a chain in space cannot score
+        check_space_objective(config.make_objective())
     served = _given_table(model, table_dir, config.chain_table)
     if served is not None and config.chain_table is not None and not serves(served.table, n):
         w = served.table.window
