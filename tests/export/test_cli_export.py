@@ -183,9 +183,9 @@ def test_a_model_file_gives_the_parts_its_unit_and_the_deck_its_materials(tmp_pa
         "pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}}).fingerprint()
 
 
-def test_a_sideways_unit_exports_its_parts_and_refuses_its_mould(tmp_path):
+def test_a_sideways_unit_exports_its_parts_and_its_mould(tmp_path):
     """Its stiff strip lies on a side face: the right one as built, the left one turned over (9 mm high: two walls
-    and the cavity). Its mould is not built: refused before anything is written."""
+    and the cavity). Its mould stands the turned-over unit's core on a plinth (docs/manufacturing.md)."""
     unit = tmp_path / "side.toml"
     unit.write_text("[unit]\nlayer_side = true\n")
     result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--json")
@@ -195,9 +195,12 @@ def test_a_sideways_unit_exports_its_parts_and_refuses_its_mould(tmp_path):
     assert summary["volumes_mm3"]["body"] == pytest.approx(2 * (10.5 * 9 * 12 - 4.5 * 6 * 9), rel=1e-12)
     assert [(p["side"], p["length_mm"]) for p in summary["layer_pieces"]] == [("right", 10.5), ("left", 10.5)]
     assert summary["volumes_mm3"]["layer_1"] == pytest.approx(10.5 * 9 * 3, rel=1e-12)
-    result = run("01", "--stl", str(tmp_path / "mould"), "--unit", str(unit), "--mould")
-    assert result.exit_code == 2 and "mould of a sideways unit" in result.output, result.output
-    assert not (tmp_path / "mould").exists()
+    result = run("01", "--stl", str(tmp_path / "mould"), "--unit", str(unit), "--mould", "--json")
+    assert result.exit_code == 0, result.output
+    mould = json.loads(result.output)["mould"]
+    assert mould["check"]["ok"] and mould["check"]["reassembly_error_mm3"] < 1e-6
+    # the sheet: 1.5 mm under both units' footprints, 21 x 9 mm (the turned-over unit's piece is its wall)
+    assert mould["cast_mm3"]["side_sheet"] == pytest.approx(21 * 9 * 1.5, rel=1e-9)
 
 
 def test_a_mixed_design_over_a_library_exports_its_parts_and_deck(tmp_path):
@@ -221,6 +224,12 @@ def test_a_mixed_design_over_a_library_exports_its_parts_and_deck(tmp_path):
     assert "** design aLlAl (5 units), full model" in deck and "SYMMETRY" not in deck
     assert deck.count("\n*NODE\n") == 1 and len(model.mesh("aLlAl").points) == \
         int(deck.split("*ELEMENT")[0].strip().splitlines()[-1].split(",")[0])
-    result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "m"), "--mould")
-    assert result.exit_code == 2 and "mould of a design over a unit library" in result.output, result.output
-    assert not (tmp_path / "m").exists()
+    result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "m"), "--mould", "--json")
+    assert result.exit_code == 0, result.output
+    mould = json.loads(result.output)["mould"]  # the L unit's core on a plinth (tests/export/test_moulds.py)
+    assert mould["check"]["ok"] and (tmp_path / "m" / "mould" / "base_plate.stl").is_file()
+    assert mould["cast_mm3"]["side_sheet"] + mould["cast_mm3"]["open_body"] == pytest.approx(
+        summary["volumes_mm3"]["body"], rel=1e-12)
+    result = run("ll", "--library", "spatial", "--stl", str(tmp_path / "n"), "--mould")
+    assert result.exit_code == 2 and "no unit's face on z = width is free" in result.output, result.output
+    assert not (tmp_path / "n").exists()

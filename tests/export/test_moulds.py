@@ -154,3 +154,67 @@ def test_exploded_drawing(tmp_path):
     assert len(fig.axes[0].collections[0].get_facecolors()) == n_triangles
     # the lid is drawn highest: 3 mould heights (3 x 20 mm) up
     assert mould.explode["lid"] == (0.0, 0.0, 60.0) and mould.explode["base_plate"] == (0.0, 0.0, -20.0)
+
+
+def check_library_negative(library, design: str, ms: MouldSpec) -> dict:
+    """The empty space of a mixed design's mould, pocket by pocket, from its units by hand: above z = 1.5 the open
+    body, except under a turned-over sideways unit (its strip on z = 0..3, then a 1.5 mm wall): above z = 4.5 there,
+    the wall cast in the sheet."""
+    from pneumorph.geometry.alphabet import parse_design
+
+    mould = casting_mould(library, design, ms)
+    parts = {name: solid(mesh) for name, mesh in mould.parts.items()}
+    names = list(parts)
+    assert max((parts[a] ^ parts[b]).volume() for i, a in enumerate(names) for b in names[i + 1:]) < 1e-9
+    empty = m3.Manifold.batch_boolean([box(mould.outer), *parts.values()], m3.OpType.Subtract)
+    ref = library[library.default]
+    s, W, H, P = ref.side_wall, ref.width, ref.height, ref.pitch
+    body = actuator_solids(library, design)["body"]
+    turned = [i for i, c in enumerate(parse_design(design, library).text) if c == "L"]
+    below = m3.Manifold.batch_boolean([box((-1.0, len(design) * P + 1, -1.0, H + 1, -1.0, s)),
+                                       *[box((i * P, (i + 1) * P, -1.0, H + 1, -1.0, 4.5)) for i in turned]],
+                                      m3.OpType.Add)
+    upper, pieces = body - below, body ^ below
+    lifted = [box((i * P, (i + 1) * P, -1.0, H + 1, 2.0, 5.0)) for i in turned]  # the walls of the L units
+    flat = m3.Manifold.batch_boolean([m3.Manifold.batch_boolean([pieces, *lifted], m3.OpType.Subtract),
+                                      *[(pieces ^ b).translate((0.0, 0.0, -3.0)) for b in lifted]], m3.OpType.Add)
+    dx, dy, dz = mould.sheet_offset
+    in_body_pocket = empty ^ box((0.0, len(design) * P, 0.0, H, s, W))
+    for i in turned:  # a plinth holds its core's tenon and the clearance gap around it: not the cast
+        in_body_pocket -= box((i * P, (i + 1) * P, -1.0, H + 1, 0.0, 4.5))
+    in_sheet_pocket = empty ^ box((0.0, len(design) * P, dy, dy + H, W - s, W))
+    return {"mould": mould, "body_pocket": xor(in_body_pocket, upper),
+            "sheet_pocket": xor(in_sheet_pocket, flat.translate((dx, dy, dz))), "upper": upper.volume(),
+            "sheet": pieces.volume()}
+
+
+@pytest.mark.parametrize(("library", "design", "sheet"), [
+    ("spatial", "aLlAl", 10.5 * 1.5 * (9 + 12 + 12 + 9 + 12)),  # the sheet: each unit's footprint, 1.5 mm
+    ("spatial", "LLa", 10.5 * 1.5 * (12 + 12 + 9)),
+    ("builtin", "aResA", 1.5 * (10.5 * (9 + 9 + 12 + 9) + 7.0 * 9)),  # s: the short unit, 7 mm
+])
+def test_a_mixed_design_is_cast_with_its_turned_over_sideways_units_on_plinths(library: str, design: str,
+                                                                                sheet: float) -> None:
+    from pneumorph.geometry.library import builtin_library
+
+    out = check_library_negative(builtin_library(library), design, MouldSpec())
+    mould, c = out["mould"], out["mould"].check
+    assert c.ok and c.reassembly_error < 1e-9 and c.cavity_error < 1e-9 and c.cavity_volume_change == 0.0
+    assert out["body_pocket"] < 1e-7 and out["sheet_pocket"] < 1e-7  # the empty space is the cast, by hand
+    assert mould.cast["side_sheet"].volume == pytest.approx(sheet, rel=1e-12) == out["sheet"]
+    assert mould.cast["open_body"].volume == pytest.approx(out["upper"], rel=1e-12)
+    plate = solid(mould.parts["base_plate"])
+    for i, unit in enumerate(design):  # a plinth of the base plate, z = 1.5..4.5, under each L only
+        probe = box((i * 10.5 + 0.2, i * 10.5 + 0.6, 0.2, 0.6, 2.0, 4.0))
+        assert ((plate ^ probe).volume() > 0) == (unit == "L"), (design, i)
+
+
+def test_a_mould_the_side_sheet_or_the_lid_cannot_serve_is_refused_in_one_line() -> None:
+    from pneumorph.geometry.library import builtin_library
+
+    with pytest.raises(GeometryError, match="no unit's face on z = width is free of its strip"):
+        casting_mould(builtin_library("spatial"), "ll")
+    thick = UnitSpec(layer_side=True, wall=3.0, cavity_height=6.0)  # turned over: a 3 mm wall under its cavity
+    with pytest.raises(GeometryError, match=r"would be 1\.5 and 3 mm thick") as exc:
+        MouldSpec().check(thick, "01")
+    assert "\n" not in str(exc.value)

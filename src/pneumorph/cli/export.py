@@ -54,9 +54,6 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
     # everything is checked before anything is built or written
     _check_request(ctx, stl_dir, inp_file, with_mould)
     units = P.library_option(library, unit_file) if library is not None else None
-    if with_mould and units is not None:
-        raise click.UsageError("--mould over a --library: the mould of a design over a unit library is not built "
-                               "yet (its units' sections differ along the body); export its parts without --mould")
     with P.blame("DESIGN"):
         orientation = parse_orientation(design) if units is None else parse_design(design, units).text
     settings = {"fidelity": "3d", "pressure_kpa": pressure, **({"unit_file": unit_file} if unit_file else {}),
@@ -146,6 +143,8 @@ def _mould_spec(unit: Any, orientation: str, clearance: float, draft: float, fol
     from pneumorph.export import MouldSpec
     from pneumorph.io import check_writable_dir
 
+    with P.blame("DESIGN"):  # what the design asks of any mould: a face to pour through, a flat side sheet
+        MouldSpec().check_design(unit, orientation)
     with P.blame("--clearance"):
         MouldSpec(clearance=clearance).check(unit, orientation)
     with P.blame("--draft"):

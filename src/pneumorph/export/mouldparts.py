@@ -10,7 +10,11 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from pneumorph.errors import GeometryError
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.export.mouldlayout import pour_face, unit_castings
+from pneumorph.export.parts import _cavity_boxes
+from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.assembly import unit_starts
+from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -108,7 +112,7 @@ class MouldSpec:
         """How deep each core's tenon sits in the base plate: half the plate, mm."""
         return self.plate / 2
 
-    def check(self, spec: UnitSpec, orientation: str) -> None:
+    def check(self, spec: UnitSpec | UnitLibrary, orientation: str) -> None:
         """Refuse settings that do not fit this unit and design, before anything is built.
 
         Raises
@@ -127,8 +131,19 @@ class MouldSpec:
         pneumorph.errors.GeometryError: mould draft 8 degrees narrows each side of the 12 mm deep cores by
         1.69 mm, more than a quarter of the cavity's smaller side (4.5 mm); use at most 5.36 degrees
         """
-        _check_fit(spec, self)
-        _hole_centres(spec, parse_orientation(orientation), self)
+        _check_fit(spec, orientation, self)
+        self.check_design(spec, orientation)
+
+    def check_design(self, spec: UnitSpec | UnitLibrary, orientation: str) -> None:
+        """Refuse a design no mould of these settings can cast: no unit's face on z = width free of its strip for
+        the pour and vent holes (or holes that do not fit on it), or side-sheet pieces of different thicknesses.
+
+        Raises
+        ------
+        GeometryError
+        """
+        _hole_centres(spec, orientation, self)
+        unit_castings(spec, orientation)  # the side sheet's pieces all as thick
 
 
 @dataclass(frozen=True)
@@ -220,8 +235,10 @@ class Mould:
         The mould's outer box ``(x0, x1, y0, y1, z0, z1)``.
     check : MouldCheck
     spec : MouldSpec
-    unit : UnitSpec
+    unit : UnitSpec or UnitLibrary
+        The unit, or the library of the design's unit types.
     orientation : str
+        The design (0/1, or over the library's symbols).
     """
 
     parts: dict[str, trimesh.Trimesh]
@@ -232,21 +249,35 @@ class Mould:
     outer: tuple[float, float, float, float, float, float]
     check: MouldCheck
     spec: MouldSpec = field(repr=False)
-    unit: UnitSpec = field(repr=False)
+    unit: UnitSpec | UnitLibrary = field(repr=False)
     orientation: str = ""
 
 
-def _hole_centres(spec: UnitSpec, orientation: str, mould: MouldSpec) -> list[tuple[str, float, float, float]]:
-    """The pour and vent holes of the body's pocket: (name, x, y, radius), checked to fit."""
-    n, P, H = len(orientation), spec.pitch, spec.height
-    span = P - spec.slit_width  # the unit's top face along x, without its slit
+def _hole_centres(spec: UnitSpec | UnitLibrary, design: str,
+                  mould: MouldSpec) -> list[tuple[str, float, float, float]]:
+    """The pour and vent holes of the body's pocket: (name, x, y, radius), checked to fit.
+
+    Over the first and the last unit whose face on z = width is the body's (not a sideways
+    unit's strip: :func:`~pneumorph.export.mouldlayout.pour_face`).
+    """
+    library, parsed = library_design(spec, design)
+    units, orientation = parsed.units(library), parsed.orientation
+    H = library[library.default].height
+    starts = unit_starts(units)
+    free = [i for i, (u, o) in enumerate(zip(units, orientation, strict=True)) if pour_face(u, o, H) is not None]
+    if not free:
+        raise GeometryError("no unit's face on z = width is free of its strip for the mould's pour and vent holes "
+                            "(every unit is sideways with its strip on that face); turn one over")
     out = []
-    for name, unit, frac, diameter in (("pour_diameter", 0, 0.3, mould.pour_diameter),
-                                       ("vent_diameter", n - 1, 0.75, mould.vent_diameter)):
-        r = diameter / 2
-        y0, y1 = (0.0, H - spec.layer) if orientation[unit] == "0" else (spec.layer, H)
-        x = unit * P + frac * span
-        lo, hi = unit * P, unit * P + span
+    for name, unit, frac, diameter in (("pour_diameter", free[0], 0.3, mould.pour_diameter),
+                                       ("vent_diameter", free[-1], 0.75, mould.vent_diameter)):
+        u, r = units[unit], diameter / 2
+        span = u.pitch - u.slit_width  # the unit's top face along x, without its slit
+        face = pour_face(u, orientation[unit], H)
+        assert face is not None
+        y0, y1 = face
+        lo = float(starts[unit])
+        x, hi = lo + frac * span, lo + span
         if x - r < lo or x + r > hi or 2 * r > (y1 - y0):
             raise GeometryError(
                 f"mould {name} {diameter:g} mm does not fit on the top face of unit {unit + 1} "
@@ -262,27 +293,27 @@ def _hole_centres(spec: UnitSpec, orientation: str, mould: MouldSpec) -> list[tu
     return out
 
 
-def _check_fit(spec: UnitSpec, mould: MouldSpec) -> tuple[float, float]:
-    """Unit-dependent limits: the tenon's inset and the cores' tip inset (a sideways unit: refused)."""
-    if spec.layer_side:
-        raise GeometryError("the mould of a sideways unit (its strip on a side face) is not built yet: this mould "
-                            "casts the body on its side in two pieces, and a side strip's recess would lie across "
-                            "their seam; export its parts (--stl) without --mould")
-    x0, x1, y0, y1 = spec.cavity
-    smaller = min(x1 - x0, y1 - y0)
-    inset = smaller / 4
-    if mould.clearance >= inset:
-        raise GeometryError(
-            f"mould clearance {mould.clearance:g} mm is not smaller than the core tenon's setback {inset:g} mm "
-            f"(a quarter of the cavity's smaller side, {smaller:g} mm): silicone would run into the tenon pockets"
-        )
-    depth = spec.width - 2 * spec.side_wall
-    tip = depth * math.tan(math.radians(mould.draft))
-    if tip > smaller / 4:
-        raise GeometryError(
-            f"mould draft {mould.draft:g} degrees narrows each side of the {depth:g} mm deep cores by {tip:.3g} mm, "
-            f"more "
-            f"than a quarter of the cavity's smaller side ({smaller:g} mm); use at most "
-            f"{math.degrees(math.atan(smaller / 4 / depth)):.3g} degrees"
-        )
-    return inset, tip
+def _check_fit(spec: UnitSpec | UnitLibrary, design: str,
+               mould: MouldSpec) -> tuple[list[float], list[float]]:
+    """Per cavity: the tenon's inset (a quarter of the cavity's smaller side across z) and the core's tip inset
+    (its depth times the draft's tangent), checked against the clearance and the cavity."""
+    insets, tips = [], []
+    for x0, x1, y0, y1, z0, z1 in _cavity_boxes(spec, design):
+        smaller = min(x1 - x0, y1 - y0)
+        inset = smaller / 4
+        if mould.clearance >= inset:
+            raise GeometryError(
+                f"mould clearance {mould.clearance:g} mm is not smaller than the core tenon's setback {inset:g} mm "
+                f"(a quarter of the cavity's smaller side, {smaller:g} mm): silicone would run into the tenon pockets"
+            )
+        depth = z1 - z0
+        tip = depth * math.tan(math.radians(mould.draft))
+        if tip > smaller / 4:
+            raise GeometryError(
+                f"mould draft {mould.draft:g} degrees narrows each side of the {depth:g} mm deep cores by {tip:.3g} "
+                f"mm, more than a quarter of the cavity's smaller side ({smaller:g} mm); use at most "
+                f"{math.degrees(math.atan(smaller / 4 / depth)):.3g} degrees"
+            )
+        insets.append(inset)
+        tips.append(tip)
+    return insets, tips

@@ -85,6 +85,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pneumorph.errors import GeometryError
+from pneumorph.export.mouldlayout import UnitCasting, unit_castings
 from pneumorph.export.mouldparts import _OUT, Mould, MouldCheck, MouldSpec, _check_fit, _hole_centres
 from pneumorph.export.parts import (
     _cavity_boxes,
@@ -94,7 +95,8 @@ from pneumorph.export.parts import (
     outline_solid,
     to_trimesh,
 )
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -126,15 +128,17 @@ def _core(cavity: tuple[float, ...], tip_inset: float, tenon_inset: float, tenon
     return body + tenon
 
 
-def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = None, check: bool = True) -> Mould:
+def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSpec | None = None,
+                  check: bool = True) -> Mould:
     """Build the casting mould of the body and check that its parts fit.
 
     Parameters
     ----------
-    spec : UnitSpec
-        The articulating unit.
+    spec : UnitSpec or UnitLibrary
+        The articulating unit, or a library of unit types (a mixed design; a sideways unit
+        turned over stands on a plinth: :mod:`pneumorph.export.mouldlayout`).
     orientation : str
-        The design, base first.
+        The design, base first (0/1, or over the library's symbols).
     mould : MouldSpec, optional
         Clearance, draft and sizes (default :class:`MouldSpec`'s).
     check : bool
@@ -165,13 +169,17 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     mm (a quarter of the cavity's smaller side, 4.5 mm): silicone would run into the tenon pockets
     """
     mould = MouldSpec() if mould is None else mould
-    orientation = parse_orientation(orientation)
-    check_buildable(spec)
-    inset, tip = _check_fit(spec, mould)  # the same checks as MouldSpec.check
+    library, parsed = library_design(spec, orientation)
+    orientation = parsed.text if not library.is_single else parsed.orientation
+    spec = library if not library.is_single else library[library.default]
+    check_buildable(spec, orientation)
+    inset, tip = _check_fit(spec, orientation, mould)  # the same checks as MouldSpec.check
     holes = _hole_centres(spec, orientation, mould)
-    n = len(orientation)
-    s, W, H = spec.side_wall, spec.width, spec.height
-    L = n * spec.pitch + spec.end_cap
+    castings = unit_castings(spec, orientation)
+    ref = library[library.default]
+    n = len(castings)
+    s, W, H = ref.side_wall, ref.width, ref.height
+    L = castings[-1].x1
     w, t = mould.wall, mould.plate
     dy = H + w  # the side sheet's pocket beside the body's, in y
     sheet_offset = (0.0, dy, W - s)
@@ -180,33 +188,35 @@ def casting_mould(spec: UnitSpec, orientation: str, mould: MouldSpec | None = No
     cores, pockets = _cores(spec, orientation, mould, inset, tip)
     pins, pin_holes = _pins(mould, L, Y, s, W)
     hole_cutters, openings = _holes(holes, mould, dy, W, outer[5])
-    solids = _plates(spec, orientation, outer, dy, pockets, pin_holes, hole_cutters)
+    plinths = [box((c.x0, c.x1, 0.0, H, s, c.split)) for c in castings if c.plinth]
+    solids = _plates(spec, orientation, outer, dy, pockets, pin_holes, hole_cutters, plinths)
     digits = len(str(n))
     solids.update({f"core_{k:0{digits}d}": core for k, core in enumerate(cores, start=1)})
     solids.update({f"pin_{k}": pin for k, pin in enumerate(pins, start=1)})
-    cast, opening = _cast(spec, orientation, cores, sheet_offset, openings)
-    result = (_checked(spec, orientation, solids, cast, opening, [pins, pin_holes, pockets, cores], sheet_offset,
-                       outer) if check else _unchecked())
+    cast, opening, in_place = _cast(spec, orientation, cores, sheet_offset, openings, castings)
+    result = (_checked(spec, orientation, solids, cast, opening, [pins, pin_holes, pockets, cores, plinths],
+                       in_place, outer, castings) if check else _unchecked())
     return Mould(parts={name: to_trimesh(solid) for name, solid in solids.items()},
                  cast={name: to_trimesh(solid) for name, solid in cast.items()}, openings=to_trimesh(opening),
                  sheet_offset=sheet_offset, explode=_explode(solids, W + t), outer=outer, check=result, spec=mould,
                  unit=spec, orientation=orientation)
 
 
-def _cores(spec: UnitSpec, orientation: str, mould: MouldSpec, inset: float,
-           tip: float) -> tuple[list[manifold3d.Manifold], list[manifold3d.Manifold]]:
-    """The cores (exact cavities on tenons) and the tenons' pockets in the base plate.
+def _cores(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSpec, inset: list[float],
+           tip: list[float]) -> tuple[list[manifold3d.Manifold], list[manifold3d.Manifold]]:
+    """The cores (exact cavities on tenons) and the tenons' pockets in the base plate (or its plinths).
 
     Parameters
     ----------
-    inset, tip : float
-        The tenon's setback from the cavity's sides and the core tip's inset (:func:`_check_fit`).
+    inset, tip : list of float
+        Per cavity: the tenon's setback from its sides and the core tip's inset (:func:`_check_fit`).
     """
-    s, c, td = spec.side_wall, mould.clearance, mould.tenon_depth
+    c, td = mould.clearance, mould.tenon_depth
     cavities = _cavity_boxes(spec, orientation)
-    cores = [_core(cav, tip, inset, td) for cav in cavities]
-    pockets = [box((a + inset - c, b - inset + c, p + inset - c, q - inset + c, s - td - c, s + _OUT))
-               for a, b, p, q, _, _ in cavities]
+    cores = [_core(cav, tp, i, td) for cav, tp, i in zip(cavities, tip, inset, strict=True)]
+    # each core's root is its cavity's open face: the side wall's, or a plinth's top
+    pockets = [box((a + i - c, b - i + c, p + i - c, q - i + c, z - td - c, z + _OUT))
+               for (a, b, p, q, z, _), i in zip(cavities, inset, strict=True)]
     return cores, pockets
 
 
@@ -232,19 +242,25 @@ def _holes(holes: list[tuple[str, float, float, float]], mould: MouldSpec, dy: f
     return hole_cutters, openings
 
 
-def _plates(spec: UnitSpec, orientation: str, outer: tuple[float, ...], dy: float,
+def _plates(spec: UnitSpec | UnitLibrary, orientation: str, outer: tuple[float, ...], dy: float,
             pockets: list[manifold3d.Manifold], pin_holes: list[manifold3d.Manifold],
-            hole_cutters: list[manifold3d.Manifold]) -> dict[str, manifold3d.Manifold]:
-    """The base plate (tenon pockets), the side walls (the body's and the sheet's pockets) and the lid (holes)."""
+            hole_cutters: list[manifold3d.Manifold],
+            plinths: list[manifold3d.Manifold]) -> dict[str, manifold3d.Manifold]:
+    """The base plate (its plinths, the tenon pockets), the side walls (the body's and the sheet's pockets) and the
+    lid (holes)."""
     import manifold3d as m3
 
-    s, W = spec.side_wall, spec.width
+    ref = _section(spec)
+    s, W = ref.side_wall, ref.width
     X0, X1, Y0, Y1, Z0, Z1 = outer
-    body_pocket = outline_solid(spec, orientation, s - _OUT, W + _OUT)
-    sheet_pocket = outline_solid(spec, orientation, W - s, W + _OUT).translate((0.0, dy, 0.0))
+    # the body's pocket over the plinths too (their strips are cast elsewhere); the side sheet's across every unit
+    body_pocket = outline_solid(spec, orientation, s - _OUT, W + _OUT, keep=("left",))
+    sheet_pocket = outline_solid(spec, orientation, W - s, W + _OUT, keep=("left", "right")).translate((0.0, dy, 0.0))
+    plate = box((X0, X1, Y0, Y1, Z0, s))
+    if plinths:
+        plate = m3.Manifold.batch_boolean([plate, *plinths], m3.OpType.Add)
     return {
-        "base_plate": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, Z0, s)), *pockets, *pin_holes],
-                                                m3.OpType.Subtract),
+        "base_plate": m3.Manifold.batch_boolean([plate, *pockets, *pin_holes], m3.OpType.Subtract),
         "side_walls": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, s, W)), body_pocket, sheet_pocket,
                                                  *pin_holes], m3.OpType.Subtract),
         "lid": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, W, Z1)), *hole_cutters, *pin_holes],
@@ -252,16 +268,33 @@ def _plates(spec: UnitSpec, orientation: str, outer: tuple[float, ...], dy: floa
     }
 
 
-def _cast(spec: UnitSpec, orientation: str, cores: list[manifold3d.Manifold], sheet_offset: tuple[float, ...],
-          openings: list[manifold3d.Manifold]) -> tuple[dict[str, manifold3d.Manifold], manifold3d.Manifold]:
-    """What is cast: the open body (around the cores) and the side sheet at its pocket; the holes' openings."""
+def _cast(spec: UnitSpec | UnitLibrary, orientation: str, cores: list[manifold3d.Manifold],
+          sheet_offset: tuple[float, ...], openings: list[manifold3d.Manifold],
+          castings: list[UnitCasting]) -> tuple[dict[str, manifold3d.Manifold], manifold3d.Manifold, Any]:
+    """What is cast: the open body (around the cores) and the side sheet at its pocket; the holes' openings; the
+    sheet's pieces in their places on the body (each at its unit's depth, :mod:`pneumorph.export.mouldlayout`)."""
     import manifold3d as m3
 
-    s, W = spec.side_wall, spec.width
-    open_body = m3.Manifold.batch_boolean([outline_solid(spec, orientation, s, W), *cores], m3.OpType.Subtract)
-    sheet = outline_solid(spec, orientation, 0.0, s)
+    ref = _section(spec)
+    s, W, H = ref.side_wall, ref.width, ref.height
+    sheet = outline_solid(spec, orientation, 0.0, s, keep=("left", "right"))
+    raised = [c for c in castings if c.bottom > 0]
+    in_place, above = sheet, [outline_solid(spec, orientation, s, W), *cores]
+    if raised:  # the pieces under turned-over sideways units lie on their strips, not on z = 0
+        moved = [(sheet ^ box((c.x0, c.x1, -_OUT, H + _OUT, -_OUT, s + _OUT))).translate((0.0, 0.0, c.bottom))
+                 for c in raised]
+        flat = m3.Manifold.batch_boolean([sheet, *[box((c.x0, c.x1, -_OUT, H + _OUT, -_OUT, s + _OUT))
+                                                   for c in raised]], m3.OpType.Subtract)
+        in_place = m3.Manifold.batch_boolean([flat, *moved], m3.OpType.Add)
+        above.extend(moved)
+    open_body = m3.Manifold.batch_boolean(above, m3.OpType.Subtract)
     cast = {"open_body": open_body, "side_sheet": sheet.translate(sheet_offset)}
-    return cast, m3.Manifold.batch_boolean(openings, m3.OpType.Add)
+    return cast, m3.Manifold.batch_boolean(openings, m3.OpType.Add), in_place
+
+
+def _section(spec: UnitSpec | UnitLibrary) -> UnitSpec:
+    """The unit whose section every unit of the design shares (a library's default type)."""
+    return spec[spec.default] if isinstance(spec, UnitLibrary) else spec
 
 
 def _explode(solids: dict[str, Any], e: float) -> dict[str, tuple[float, float, float]]:
@@ -279,13 +312,14 @@ def _unchecked() -> MouldCheck:
     return MouldCheck({}, nan, 0, nan, nan, nan, nan, nan, nan, nan, nan)
 
 
-def _checked(spec: UnitSpec, orientation: str, solids: dict[str, Any], cast: dict[str, Any], opening: Any,
-             parts: list[list[manifold3d.Manifold]], sheet_offset: tuple[float, ...],
-             outer: tuple[float, ...]) -> MouldCheck:
+def _checked(spec: UnitSpec | UnitLibrary, orientation: str, solids: dict[str, Any], cast: dict[str, Any],
+             opening: Any, parts: list[list[manifold3d.Manifold]], in_place: Any, outer: tuple[float, ...],
+             castings: list[UnitCasting]) -> MouldCheck:
     """The measured assembly (:func:`_measure`).
 
-    ``parts`` are the pins, their holes, the tenon pockets and the cores, whose
-    clearance gaps are measured too.
+    ``parts`` are the pins, their holes, the tenon pockets, the cores and the plinths; the
+    clearance gaps of the first four are measured too. ``in_place``: the sheet's pieces on the
+    body.
 
     Raises
     ------
@@ -294,16 +328,22 @@ def _checked(spec: UnitSpec, orientation: str, solids: dict[str, Any], cast: dic
     """
     import manifold3d as m3
 
-    pins, pin_holes, pockets, cores = parts
+    pins, pin_holes, pockets, cores, plinths = parts
     X0, X1, Y0, Y1, Z0, _ = outer
-    s, W = spec.side_wall, spec.width
+    ref = _section(spec)
+    s, W = ref.side_wall, ref.width
+    plate = m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, Z0, s)), *plinths], m3.OpType.Add)
     gaps = [hole - pin for hole, pin in zip(pin_holes, pins, strict=False)]
-    gaps += [(pocket ^ box((X0, X1, Y0, Y1, Z0, s))) - core for pocket, core in zip(pockets, cores, strict=False)]
+    gaps += [(pocket ^ plate) - core for pocket, core in zip(pockets, cores, strict=False)]
     body = actuator_solids(spec, orientation, base_block=None)["body"]
-    core_tops = m3.Manifold.batch_boolean(cores, m3.OpType.Add) ^ box((X0, X1, Y0, Y1, s, W))
+    # the cores above their roots (the side wall's face, or a plinth's top): the cavities as cast
+    roots = [c[4] for c in _cavity_boxes(spec, orientation)]
+    core_tops = m3.Manifold.batch_boolean([core ^ box((X0, X1, Y0, Y1, z, W)) for core, z in zip(cores, roots,
+                                                                                                   strict=True)],
+                                          m3.OpType.Add) if cores else m3.Manifold()
     as_cast = outline_solid(spec, orientation, 0.0, W) - core_tops
     result = _measure(solids, cast, opening, m3.Manifold.batch_boolean(gaps, m3.OpType.Add), body, as_cast,
-                      sheet_offset, outer)
+                      in_place, outer)
     if not result.ok:
         raise GeometryError(_failure(result))
     return result
@@ -319,7 +359,7 @@ def _xor_volume(a: manifold3d.Manifold, b: manifold3d.Manifold) -> float:
 
 
 def _measure(solids: dict[str, Any], cast: dict[str, Any], opening: Any, gaps: Any, body: Any, as_cast: Any,
-             sheet_offset: tuple[float, ...], outer: tuple[float, ...]) -> MouldCheck:
+             in_place: Any, outer: tuple[float, ...]) -> MouldCheck:
     """The checks of :class:`MouldCheck`, on manifold3d solids."""
     import manifold3d as m3
 
@@ -341,7 +381,7 @@ def _measure(solids: dict[str, Any], cast: dict[str, Any], opening: Any, gaps: A
     expected = m3.Manifold.batch_boolean([cast_all, opening, gaps], m3.OpType.Add)
     reach = 10.0  # mm: min_gap reports at most this
     gap_distance = gaps.min_gap(cast_all + opening, reach) if not gaps.is_empty() else reach
-    back = cast["open_body"] + cast["side_sheet"].translate(tuple(-v for v in sheet_offset))
+    back = cast["open_body"] + in_place
     return MouldCheck(
         watertight=watertight,
         max_overlap=max_overlap,

@@ -197,11 +197,14 @@ def to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
-def outline_solid(spec: UnitSpec | UnitLibrary, design: str, z0: float, z1: float) -> manifold3d.Manifold:
+def outline_solid(spec: UnitSpec | UnitLibrary, design: str, z0: float, z1: float,
+                  keep: tuple[str, ...] = ()) -> manifold3d.Manifold:
     """The body without its cavities between two planes z = ``z0`` and z = ``z1``.
 
     The bar minus the layer pieces and the slits; for planar units, the body's longitudinal
-    section extruded across the width: what a mould's walls enclose.
+    section extruded across the width: what a mould's walls enclose. ``keep``: the faces whose
+    strips are not cut out (``"left"``, ``"right"``: the sideways units' footprint across the
+    width, as a mould's plinth or its side sheet sees it).
 
     Examples
     --------
@@ -215,7 +218,7 @@ def outline_solid(spec: UnitSpec | UnitLibrary, design: str, z0: float, z1: floa
     starts, H = unit_starts(units), ref.height
     n, L = len(units), float(starts[-1]) + ref.end_cap
     out = 1.0  # cutters reach past the outer faces, so no cut face coincides with one
-    cutters = [box(p.cutter(ref, n, z0, z1, out)) for p in layer_pieces(library, design)]
+    cutters = [box(p.cutter(ref, n, z0, z1, out)) for p in layer_pieces(library, design) if p.side not in keep]
     for i, (u, o) in enumerate(zip(units, orientation, strict=True)):
         if u.slit is not None:
             sx0, sx1, _, sy1 = u.slit
