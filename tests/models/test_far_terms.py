@@ -142,3 +142,16 @@ def test_far_terms_on_the_2d_model_match_the_wider_window_from_fewer_unit_solves
     assert far.validation["designs"] == wide.validation["designs"]
     worst_far, worst_wide = max(far.validation["centre_worst_mm"]), max(wide.validation["centre_worst_mm"])
     assert worst_far <= 2 * worst_wide + 0.005, (worst_far, worst_wide)
+
+
+@pytest.mark.parametrize(("w", "far", "plain"), [(1, "5d51d6257643f1d9", "8eddc44a541b039e"),
+                                                 (2, "ca37ec03af43b844", "2ff74b63a22e8e51")])
+def test_planar_tables_are_fitted_bit_for_bit_as_before_the_chain_in_space(w: int, far: str, plain: str) -> None:
+    """The fingerprints (every entry's bytes) of the two fits of the same training, recorded with the code before
+    tables learnt elements in space: a planar fit has no such columns and must not change by a bit."""
+    law = _law(seed=w, w=w)
+    n = 2 * w + 7
+    train = [_response(law, d, w) for d in far_designs(n, w)]
+    source = {"fidelity": "toy", "key": "additive", "n_units": n}
+    assert fit_table(train, w, source, far=True).fingerprint() == far
+    assert fit_table(train, w, source).fingerprint() == plain
