@@ -273,6 +273,12 @@ def _narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_no
     return keep
 
 
+def kept(bits: NDArray[np.uint8], state: dict[str, Any],
+         keep: NDArray[np.bool_]) -> tuple[NDArray[np.uint8], dict[str, Any]]:
+    """The prefixes ``keep`` marks and their state (what a depth sends back to the growth)."""
+    return bits[keep], {key: v[keep] for key, v in state.items()}
+
+
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
                  threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None,
                  spill: bool = False) -> ChainScores:
@@ -336,9 +342,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 bound[keep] = _prefix_bound(chain, objective, bits[keep], {key: v[keep] for key, v in st.items()},
                                             placed, curve)
                 keep = bound < threshold
-            keep = _narrow(keep, bound, beam, max_nodes, p, n, spilled)
-            bits = bits[keep]
-            st = {key: v[keep] for key, v in st.items()}
+            bits, st = kept(bits, st, _narrow(keep, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
         if profile:
             values = np.sqrt(st["sum"])
@@ -467,9 +471,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
                                     placed)
                 bound[keep] = np.sqrt(((weights**2) * (state["ssum"][keep] + rest)).sum(axis=1))
                 keep = bound < threshold
-            keep = _narrow(keep, bound, beam, max_nodes, p, n, spilled)
-            bits = bits[keep]
-            state = {key: v[keep] for key, v in state.items()}
+            bits, state = kept(bits, state, _narrow(keep, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, state))
         tip, curl = tip_and_curl(chain, bits, state)
         per = np.sqrt(state["ssum"])

@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from pneumorph.design.bounds import ChainScores, _costs, _radix, _target_slope, chain_errors
 from pneumorph.design.fitness import tip_value_array
-from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union
+from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union, kept
 from pneumorph.design.prefixes import depths
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
@@ -166,9 +166,7 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
                 bound = np.sqrt(st["sum"].min(axis=1))
             else:
                 bound = _tip_bound(chain, goal, st["point"], n + 1 - placed)
-            keep = _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled)
-            bits = bits[keep]
-            st = {key: v[keep] for key, v in st.items()}
+            bits, st = kept(bits, st, _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
         if profile:
             values = np.sqrt(st["sum"])
