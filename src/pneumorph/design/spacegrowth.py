@@ -10,7 +10,11 @@ Bounds (admissible: no design of a dropped prefix can cost less than the bound):
 
 - a Cartesian profile or space curve (Eq 4.1 with a centre's distance in y and z,
   :meth:`~pneumorph.design.profiles.ProfileTarget.squared_error`): the partial sums only grow,
-  so ``min_k sqrt(partial_k)`` bounds every completion;
+  so ``min_k sqrt(partial_k)`` bounds every completion; and each of the next
+  :data:`~pneumorph.design.reach.AHEAD` centres still to place lies within ``r L_k`` of the
+  prefix's last point (``r`` chords on), in a box whose x range bounds the target's y and z
+  there (:class:`~pneumorph.design.rest.CurveRange`) and whose y and z ranges bound the
+  centre's: its term is at least the squared gaps (:func:`space_rest`);
 - a tip goal: the tip lies within ``r L_k`` of the prefix's last point, with ``r`` chords
   still to place and ``L_k`` the longest chord of the table at level ``k``; every goal is
   1-Lipschitz in the tip (``min-distance`` in its projection on the x-y plane), so it moves by
@@ -32,10 +36,12 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.bounds import ChainScores, _costs, _radix, _target_slope, chain_errors
+from pneumorph.design.bounds import ChainScores, _costs, _max_slope, _radix, _target_slope, chain_errors
 from pneumorph.design.fitness import tip_value_array
 from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union, kept
 from pneumorph.design.prefixes import depths
+from pneumorph.design.reach import AHEAD
+from pneumorph.design.rest import CurveRange
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel, window_codes
@@ -127,6 +133,54 @@ def _tip_bound(chain: ChainModel, goal: TipGoal, point: FloatArray, remaining: i
     return np.asarray(cost.min(axis=1), dtype=float)
 
 
+def _longest(chain: ChainModel) -> FloatArray:
+    """The longest chord of the table at each level (k,), mm."""
+    return np.asarray(np.linalg.norm(chain.table.space[..., :3], axis=-1).max(axis=0), dtype=float)
+
+
+def space_rest(chain: ChainModel, curves: tuple[CurveRange, CurveRange], bits: NDArray[np.uint8], point: FloatArray,
+               placed: int) -> FloatArray:
+    """A lower bound on the summed squared Eq 4.1 terms of the next centres the prefixes have not fixed, (m, k).
+
+    Centre ``i`` (``placed < i``, at most :data:`~pneumorph.design.reach.AHEAD` on) lies within
+    ``(i - placed) L_k`` of the prefix's point in x, y and z; its term is at least the squared
+    gap between that box's heights (less the unit's undeformed centre height: the prefix's
+    unit's if it holds it, else the least and greatest of any) and the target's ``f`` over its
+    x range, plus the same in z with ``g``.
+    """
+    table = chain.table
+    f, g = curves
+    heights = table.heights
+    h_lo, h_hi = float(np.min(heights)), float(np.max(heights))
+    longest = _longest(chain)
+    total = np.zeros(point.shape[:2])
+    x, y, z = point[..., 0], point[..., 1], point[..., 2] - table.centre_z
+    for i in range(placed + 1, min(chain.n_units, placed + AHEAD) + 1):
+        r = (i - placed) * longest
+        lo_ref: FloatArray | float = h_lo
+        hi_ref: FloatArray | float = h_hi
+        if i <= bits.shape[1]:
+            lo_ref = hi_ref = heights[np.asarray(bits[:, i - 1], dtype=np.int64)][:, None]
+        f_lo, f_hi = f.between(x - r, x + r)
+        g_lo, g_hi = g.between(x - r, x + r)
+        gap_y = np.maximum(np.maximum(f_lo - (y + r - lo_ref), (y - r - hi_ref) - f_hi), 0.0)
+        gap_z = np.maximum(np.maximum(g_lo - (z + r), (z - r) - g_hi), 0.0)
+        total += gap_y * gap_y + gap_z * gap_z
+    return total
+
+
+def _curves(chain: ChainModel, objective: ProfileTarget, errors: dict[str, FloatArray]) -> tuple[CurveRange,
+                                                                                                  CurveRange]:
+    """The target's ``f`` and ``g`` over x intervals wherever the actuator can reach (:class:`CurveRange`)."""
+    reach = chain.table.longest_chord * (chain.n_units + 1) + float(errors["centre"].max())
+    length = chain.length
+    slope_f = _max_slope(lambda x: objective.curve(x, length), -reach, reach)
+    slope_g = _max_slope(lambda x: objective.curve_z(x, length), -reach, reach)
+    return (CurveRange.of(lambda x: objective.curve(x, length), -reach, reach, slope_f),
+            CurveRange.of(lambda x: np.broadcast_to(objective.curve_z(x, length), np.shape(x)), -reach, reach,
+                          slope_g))
+
+
 def _beta(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]) -> FloatArray:
     """The chain's bound on the objective per level (k,) (module docstring)."""
     if isinstance(objective, ProfileTarget):
@@ -137,12 +191,14 @@ def _beta(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]
 
 def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, threshold: float = float("inf"),
                max_nodes: int = MAX_NODES, beam: int | None = None, spill: bool = False,
-               codes: NDArray[np.uint8] | None = None) -> ChainScores:
+               codes: NDArray[np.uint8] | None = None,
+               curves: tuple[CurveRange, CurveRange] | None = None) -> ChainScores:
     """Chain scores of every design of a chain in space whose cost is below ``threshold``.
 
     As :func:`~pneumorph.design.growth.grow_designs` (``beam``, ``spill``, ``max_nodes`` alike), with
     the bounds of the module docstring; ``codes``: the unit codes designs are made of (default every
-    code of the table; e.g. the planar units only).
+    code of the table; e.g. the planar units only); ``curves``: the target's ranges, for the bound
+    on the centres still to place (:func:`space_rest`; without them the partial sums alone).
     """
     codes = np.asarray(chain.table.unit_codes if codes is None else codes, dtype=np.uint8)
     check_space_objective(objective)
@@ -163,7 +219,9 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
             if profile:
-                bound = np.sqrt(st["sum"].min(axis=1))
+                total = st["sum"] if curves is None else st["sum"] + space_rest(chain, curves, bits, st["point"],
+                                                                                 placed)
+                bound = np.sqrt(total.min(axis=1))
             else:
                 bound = _tip_bound(chain, goal, st["point"], n + 1 - placed)
             bits, st = kept(bits, st, _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled))
@@ -200,9 +258,11 @@ def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, m
     choices = len(chain.table.unit_codes if codes is None else codes)
     if float(choices) ** chain.n_units <= 2.0**max_enumerate:
         return grow_space(chain, objective, beta, codes=codes)
-    beamed = grow_space(chain, objective, beta, beam=BEAM, codes=codes)
+    curves = _curves(chain, objective, errors) if isinstance(objective, ProfileTarget) else None
+    beamed = grow_space(chain, objective, beta, beam=BEAM, codes=codes, curves=curves)
     threshold = float(beamed.cost.min()) + 2 * float(beta.max()) + 1e-9
-    scores = grow_space(chain, objective, beta, threshold, max_nodes=max_nodes, spill=True, codes=codes)
+    scores = grow_space(chain, objective, beta, threshold, max_nodes=max_nodes, spill=True, codes=codes,
+                        curves=curves)
     if scores.complete:
         keep = scores.cost < threshold
         return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
