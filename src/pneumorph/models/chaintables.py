@@ -69,8 +69,10 @@ def start_window(model: Any) -> int:
 
     A unit of the same family interacts about as far along the chain as the built-in unit, so
     smaller windows would only cost their covering designs before they are refused (the
-    built-in unit's 3D table needs +-3: +-1 and +-2 are off by mm and tenths of a mm). Tables
-    over several unit types and models without a shipped table start at +-1.
+    built-in unit's 3D table needs +-3: +-1 and +-2 are off by mm and tenths of a mm). A model
+    over a built-in library starts where that library's shipped table ended (the spatial
+    library's 3D table: :func:`shipped_for`); other tables over several unit types and models
+    without a shipped table start at +-1.
 
     >>> from pneumorph.models.factory import make_model
     >>> start_window(make_model(15, {"fidelity": "3d"})), start_window(make_model(15, {"fidelity": "2d"}))
@@ -78,20 +80,18 @@ def start_window(model: Any) -> int:
     >>> start_window(make_model(15, {"fidelity": "2d", "library": "builtin"}))
     1
     """
-    library = getattr(model, "library", None)
-    path = shipped_path(str(getattr(model, "fidelity", "")))
-    if (library is not None and not library.is_single) or not path.is_file():
-        return 1
-    return ChainTable.load(path).window
+    path = shipped_for(model)
+    return ChainTable.load(path).window if path.is_file() else 1
 
 
 def build_options(model: Any) -> dict[str, Any]:
     """How a table of ``model`` is built on first use: :func:`~pneumorph.models.chainfit.build_table`'s (and
     :func:`~pneumorph.models.buildplan.build_plan`'s) ``heldout``, ``first_window``, ``early`` and ``far``.
 
-    A 3D model of one unit type tries the window one narrower than its first with far-field
-    terms first (:mod:`pneumorph.models.chainterms`): it needs about half the unit solves of
-    the wider window's table. 2D solves are cheap, and 2D builds stay as they were.
+    A 3D model of one unit type, or over a built-in library with a shipped 3D table, tries the
+    window one narrower than its first with far-field terms first
+    (:mod:`pneumorph.models.chainterms`): it needs about half the unit solves of the wider
+    window's table. 2D solves are cheap, and 2D builds stay as they were.
 
     >>> from pneumorph.models.factory import make_model
     >>> build_options(make_model(15, {"fidelity": "3d"}))
@@ -101,7 +101,7 @@ def build_options(model: Any) -> dict[str, Any]:
     """
     library = getattr(model, "library", None)
     single = library is None or library.is_single
-    far = single and str(getattr(model, "fidelity", "")) == "3d"
+    far = (single or shipped_for(model).is_file()) and str(getattr(model, "fidelity", "")) == "3d"
     return {"heldout": HELDOUT, "first_window": start_window(model), "early": True, "far": far}
 
 
