@@ -14,7 +14,7 @@ Each result has the certificate's best design that stays in the plane beside the
 Writes ``docs/figures/space-targets.json`` and the runs' shape figures
 ``docs/figures/space-{helix,s-curve,own}.png``.
 
-    OMP_NUM_THREADS=1 .venv/bin/python docs/scripts/space_targets.py [--table FILE] [--workers 2]
+    OMP_NUM_THREADS=1 .venv/bin/python docs/scripts/space_targets.py --certify [--table FILE] [--workers 2]
 """
 
 from __future__ import annotations
@@ -61,6 +61,8 @@ def run(name: str, design: dict, args: argparse.Namespace, out: Path) -> dict:
                "--overwrite", "--cache", str(args.cache), "--workers", str(args.workers)]
     if args.table:
         command += ["--chain-table", str(args.table)]
+    if args.certify:
+        command.append("--certify")
     t0 = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - t0
@@ -81,6 +83,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--table", type=Path, help="the spatial library's chain table (default: the shipped one)")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--certify", action="store_true", help="verify by FE until no design can beat the winner")
     parser.add_argument("--cache", type=Path, default=ROOT / ".cache" / "space-targets.sqlite")
     parser.add_argument("--out", type=Path, default=ROOT / ".cache" / "space-targets")
     args = parser.parse_args()
@@ -93,8 +96,8 @@ def main() -> None:
     }
     results = {name: run(name, design, args, args.out) for name, design in cases.items()}
     results["own"]["drawn_through"] = {"design": OWN, "pressure_kpa": OWN_KPA}
-    out = {"command": "OMP_NUM_THREADS=1 python docs/scripts/space_targets.py" + (f" --table {args.table}" if args.table
-                                                                                  else ""),
+    command = "OMP_NUM_THREADS=1 python docs/scripts/space_targets.py" + (" --certify" if args.certify else "")
+    out = {"command": command + (f" --table {args.table}" if args.table else ""),
            "results": results}
     (FIGURES / "space-targets.json").write_text(json.dumps(out, indent=1))
 
