@@ -13,8 +13,8 @@ from pneumorph.errors import ChainTableError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.chain import ChainModel, ChainTable
+from pneumorph.models.chainfile import TABLE_FORMAT, TERMS_FORMAT
 from pneumorph.models.chainfit import build_table, fit_table
-from pneumorph.models.chaintable import TABLE_FORMAT, TERMS_FORMAT
 from pneumorph.models.chainterms import far_designs, far_terms
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response

@@ -17,8 +17,8 @@ import pytest
 
 from pneumorph.errors import ChainTableError
 from pneumorph.models.chain import ChainModel, ChainTable
+from pneumorph.models.chainfile import SPACE_FORMAT
 from pneumorph.models.chainfit import fit_table, training_designs
-from pneumorph.models.chaintable import SPACE_FORMAT
 from pneumorph.models.chaintables import restrict_table
 from pneumorph.models.response import Response
 from pneumorph.models.validation import heldout_designs

@@ -44,7 +44,8 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError
 from pneumorph.io.provenance import digest
-from pneumorph.models.chaintable import ALPHABET_FORMAT, TABLE_FORMAT, ChainTable
+from pneumorph.models.chainfile import ALPHABET_FORMAT, TABLE_FORMAT
+from pneumorph.models.chaintable import ChainTable
 from pneumorph.models.response import FloatArray, Response
 from pneumorph.models.windows import (
     BASE,
