@@ -58,7 +58,9 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with `pneumorph chain build --model 3d --window 3
-    --all-heldout --out src/pneumorph/models/data/chain-3d.json` (and 2d with --window 2).
+    --all-heldout --out src/pneumorph/models/data/chain-3d.json` (and 2d with --window 2); the spatial library's
+    chain in space with `pneumorph chain build --model 3d --library spatial --window 2 --far-terms --short
+    --all-heldout --out src/pneumorph/models/data/chain-3d-spatial.json` (about an hour on 2 workers).
     """
     from pathlib import Path
 
