@@ -362,3 +362,19 @@ def test_a_space_curve_answers_with_its_view_from_above(client: TestClient) -> N
     phase = 2 * np.pi * x / a["length_mm"]
     assert np.abs(z + 20 * np.sin(phase)).max() < 1e-3 and np.abs(y - 20 * (1 - np.cos(phase))).max() < 1e-3
     assert "z" not in client.post("/api/design", json=SIN).json()["target"]
+
+
+def test_a_curve_drawn_in_two_views_is_a_space_curve(client: TestClient) -> None:
+    """The side view (x, y) and the view from above (x, z), each a smoothed stroke: the target's z at the side view's
+    knots is the stroke from above; Eq 4.1 counts it (the planar winner's value grows by the z terms)."""
+    x = np.linspace(0.0, 157.5, 120)
+    side = np.c_[x, 10 * np.sin(2 * np.pi * x / 157.5)]
+    above = np.c_[x, -0.05 * x]  # a straight line: smoothing keeps it, so z = -0.05 x at every knot
+    a = client.post("/api/design", json={"target": {"kind": "curve", "points": side.tolist(),
+                                                    "top_points": above.tolist()}}).json()
+    tx, tz = np.array(a["target"]["x"]), np.array(a["target"]["z"])
+    assert np.abs(tz + 0.05 * tx).max() < 1e-3
+    flat = client.post("/api/design", json={"target": {"kind": "curve", "points": side.tolist()}}).json()
+    assert "z" not in flat["target"] and a["winner"]["value"] > flat["winner"]["value"] + 5.0
+    r = client.post("/api/design", json={"target": {"kind": "curve", "points": side.tolist(), "top_points": [[0, 1]]}})
+    assert r.status_code == 422 and "seen from above" in r.text and r.json()["error"]["field"] == "points"

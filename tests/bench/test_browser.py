@@ -168,6 +168,18 @@ def test_a_drawn_curve(browser) -> None:  # type: ignore[no-untyped-def]
     _shot(browser, "drawn")
 
 
+def test_a_curve_drawn_in_two_views(browser) -> None:  # type: ignore[no-untyped-def]
+    """The side view and, below it, the view from above: the answer draws its view from above (the target's z)."""
+    Select(_el(browser, "target-kind")).select_by_value("curve")
+    _el(browser, "draw-clear").click()
+    _stroke(browser, "draw-canvas", 1)
+    _wait(lambda: _answered(browser) and not _el(browser, "top-view").is_displayed())  # planar: no view from above
+    _stroke(browser, "draw-top-canvas", 1)
+    _wait(lambda: _answered(browser) and _el(browser, "top-view").is_displayed())
+    assert "curve" in _el(browser, "winner-label").text and len(_el(browser, "winner-design").text) == 15
+    _shot(browser, "drawn-two-views")
+
+
 def _stroke(browser, canvas_id: str, rise: int) -> None:  # type: ignore[no-untyped-def]
     canvas = _el(browser, canvas_id)
     w = canvas.size["width"]

@@ -70,8 +70,8 @@ class Query:
     amplitude, periods : float
     point : (float, float) or None
         The tip point of the goal "reach" (mm).
-    curve : tuple of (x, y) or None
-        A drawn curve's smoothed knots (mm).
+    curve : tuple of (x, y) or (x, y, z), or None
+        A drawn curve's smoothed knots (mm; with z when it was drawn seen from above too).
     model : {"3d", "2d"}
     top : int
         Designs listed, best first.
@@ -87,7 +87,7 @@ class Query:
     amplitude: float = 10.0
     periods: float = 1.0
     point: tuple[float, float] | None = None
-    curve: tuple[tuple[float, float], ...] | None = None
+    curve: tuple[tuple[float, ...], ...] | None = None
     model: str = "3d"
     top: int = 10
     unit: str = "builtin"
@@ -115,7 +115,7 @@ class Query:
         """
         point, curve, stages = data.get("point"), data.get("curve"), data.get("stages")
         return cls(**{**data, "point": None if point is None else (float(point[0]), float(point[1])),
-                      "curve": None if curve is None else tuple((float(x), float(y)) for x, y in curve),
+                      "curve": None if curve is None else tuple(tuple(float(v) for v in c) for c in curve),
                       "stages": None if stages is None else tuple((float(p), float(w), cls.from_dict(q))
                                                                   for p, w, q in stages)})
 
@@ -214,7 +214,8 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
         ``{"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}``,
         ``{"kind": "expression", "expression": "y = ...", "amplitude": 10}``,
         ``{"kind": "tip", "goal": "max-x", "point": [x, y]}`` or
-        ``{"kind": "curve", "points": [[x, y], ...]}`` (a drawn stroke, mm).
+        ``{"kind": "curve", "points": [[x, y], ...]}`` (a drawn stroke, mm; with
+        ``"top_points": [[x, z], ...]``, the same curve drawn seen from above: a space curve).
     length : float
         The undeformed actuator length (mm): profiles must be finite on it, strokes are
         smoothed over it.
@@ -288,7 +289,15 @@ def _target_fields(kind: str, target: dict[str, Any], length: float) -> tuple[di
         knots = smooth_curve(target.get("points", []), length)
     except PneumorphError as exc:
         raise QueryError("points", str(exc)) from None
-    return {"spec": "curve", "curve": tuple((float(x), float(y)) for x, y in np.round(knots, 6))}, "points"
+    if target.get("top_points") is None:
+        return {"spec": "curve", "curve": tuple((float(x), float(y)) for x, y in np.round(knots, 6))}, "points"
+    try:  # the same curve seen from above: its z at the side view's knots
+        top = smooth_curve(target["top_points"], length)
+    except PneumorphError as exc:
+        raise QueryError("points", f"seen from above: {exc}") from None
+    z = np.interp(knots[:, 0], top[:, 0], top[:, 1])  # held at the ends beyond the stroke from above
+    space = np.round(np.column_stack([knots, z]), 6)
+    return {"spec": "curve", "curve": tuple(tuple(float(v) for v in row) for row in space)}, "points"
 
 
 def _stages(stages: Any, length: float, model: str, unit: str) -> tuple[tuple[float, float, Query], ...]:

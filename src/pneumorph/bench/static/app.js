@@ -39,7 +39,10 @@ function currentBody() {
     if (target.goal === "reach") target.point = [number("point-x"), number("point-y")];
   } else if (kind === "stages") {
     target = { kind, stages: state.stages.map((st) => ({ pressure_kpa: st.pressure_kpa, target: { kind: "curve", points: st.points } })) };
-  } else target = { kind, points: state.curve || [] };
+  } else {
+    target = { kind, points: state.curve || [] };
+    if (state.curveTop) target.top_points = state.curveTop;   // the view from above: the curve's z
+  }
   return { target, model: $("model").value, unit: $("unit").value, top: 10 };
 }
 
@@ -255,19 +258,23 @@ function showKind() {
 
 const viewer = new Viewer($("viewer"));
 let drawArea = null;
+let topArea = null;
 let stageArea = null;
 
 async function main() {
   state.info = await api("/api/info");
   $("goal").innerHTML = state.info.tip_goals.map((g) => `<option value="${g}">${g}</option>`).join("");
   drawArea = new DrawArea($("draw-canvas"), state.info.length_mm, (points) => { state.curve = points; schedule(); });
+  topArea = new DrawArea($("draw-top-canvas"), state.info.length_mm, (points) => { state.curveTop = points; schedule(); });
   const changed = () => { showKind(); schedule(); };
   for (const id of ["target-kind", "preset", "amplitude", "periods", "expression", "expr-amplitude", "goal", "point-x",
     "point-y", "model", "unit"]) {
     $(id).addEventListener("input", changed);
     if ($(id).tagName === "SELECT") $(id).addEventListener("change", changed);
   }
-  $("draw-clear").addEventListener("click", () => { drawArea.clear(); state.curve = null; });
+  $("draw-clear").addEventListener("click", () => {
+    drawArea.clear(); topArea.clear(); state.curve = null; state.curveTop = null;
+  });
   stageArea = new DrawArea($("stage-canvas"), state.info.length_mm, (points) => { state.stageCurve = points; });
   $("stage-pressure").innerHTML = state.info.pressures_kpa.map((p) => `<option value="${p}">${+p.toFixed(3)} kPa</option>`).join("");
   $("stage-pressure").value = String(state.info.pressures_kpa[state.info.pressures_kpa.length - 1]);
