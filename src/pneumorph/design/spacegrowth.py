@@ -251,6 +251,18 @@ def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, m
     ------
     SearchConfigError
         An objective :func:`check_space_objective` refuses.
+
+    Examples
+    --------
+    Every design of 7 units of the spatial library (4^7) for a helix, by its shipped table:
+
+    >>> from pneumorph.design.targets import make_objective
+    >>> from pneumorph.models.chaintables import find_table
+    >>> from pneumorph.models.factory import make_model
+    >>> chain = ChainModel(find_table(make_model(7, {"fidelity": "3d", "library": "spatial"})), 7)
+    >>> s = space_scores(chain, make_objective("helix", 10.0, length=chain.length))
+    >>> s.complete, len(s.bits), bool(set(chain.table.texts(s.bits[s.order()[:1]])[0]) & set("lL"))
+    (True, 16384, True)
     """
     check_space_objective(objective)
     errors = chain_errors(chain, margin)
