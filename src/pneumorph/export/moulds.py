@@ -188,14 +188,14 @@ def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSp
     cores, pockets = _cores(spec, orientation, mould, inset, tip)
     pins, pin_holes = _pins(mould, L, Y, s, W)
     hole_cutters, openings = _holes(holes, mould, dy, W, outer[5])
-    plinths = [box((c.x0, c.x1, 0.0, H, s, c.split)) for c in castings if c.plinth]
-    solids = _plates(spec, orientation, outer, dy, pockets, pin_holes, hole_cutters, plinths)
+    plate = _plate(outer, s, [box((c.x0, c.x1, 0.0, H, s, c.split)) for c in castings if c.plinth])
+    solids = _plates(spec, orientation, outer, dy, pockets, pin_holes, hole_cutters, plate)
     digits = len(str(n))
     solids.update({f"core_{k:0{digits}d}": core for k, core in enumerate(cores, start=1)})
     solids.update({f"pin_{k}": pin for k, pin in enumerate(pins, start=1)})
     cast, opening, in_place = _cast(spec, orientation, cores, sheet_offset, openings, castings)
-    result = (_checked(spec, orientation, solids, cast, opening, [pins, pin_holes, pockets, cores, plinths],
-                       in_place, outer, castings) if check else _unchecked())
+    result = (_checked(spec, orientation, solids, cast, opening, [pins, pin_holes, pockets, cores], plate,
+                       in_place, outer) if check else _unchecked())
     return Mould(parts={name: to_trimesh(solid) for name, solid in solids.items()},
                  cast={name: to_trimesh(solid) for name, solid in cast.items()}, openings=to_trimesh(opening),
                  sheet_offset=sheet_offset, explode=_explode(solids, W + t), outer=outer, check=result, spec=mould,
@@ -242,23 +242,29 @@ def _holes(holes: list[tuple[str, float, float, float]], mould: MouldSpec, dy: f
     return hole_cutters, openings
 
 
+def _plate(outer: tuple[float, ...], top: float, plinths: list[manifold3d.Manifold]) -> manifold3d.Manifold:
+    """The base plate before its pockets and pin holes: the mould's footprint up to z = ``top`` (the side wall's
+    face) and the ``plinths`` on it (under turned-over sideways units, :mod:`pneumorph.export.mouldlayout`)."""
+    import manifold3d as m3
+
+    X0, X1, Y0, Y1, Z0, _ = outer
+    plate = box((X0, X1, Y0, Y1, Z0, top))
+    return m3.Manifold.batch_boolean([plate, *plinths], m3.OpType.Add) if plinths else plate
+
+
 def _plates(spec: UnitSpec | UnitLibrary, orientation: str, outer: tuple[float, ...], dy: float,
             pockets: list[manifold3d.Manifold], pin_holes: list[manifold3d.Manifold],
-            hole_cutters: list[manifold3d.Manifold],
-            plinths: list[manifold3d.Manifold]) -> dict[str, manifold3d.Manifold]:
-    """The base plate (its plinths, the tenon pockets), the side walls (the body's and the sheet's pockets) and the
-    lid (holes)."""
+            hole_cutters: list[manifold3d.Manifold], plate: manifold3d.Manifold) -> dict[str, manifold3d.Manifold]:
+    """The base plate (``plate``, :func:`_plate`, less the tenon pockets), the side walls (the body's and the sheet's
+    pockets) and the lid (holes)."""
     import manifold3d as m3
 
     ref = _section(spec)
     s, W = ref.side_wall, ref.width
-    X0, X1, Y0, Y1, Z0, Z1 = outer
+    X0, X1, Y0, Y1, _, Z1 = outer
     # the body's pocket over the plinths too (their strips are cast elsewhere); the side sheet's across every unit
     body_pocket = outline_solid(spec, orientation, s - _OUT, W + _OUT, keep=("left",))
     sheet_pocket = outline_solid(spec, orientation, W - s, W + _OUT, keep=("left", "right")).translate((0.0, dy, 0.0))
-    plate = box((X0, X1, Y0, Y1, Z0, s))
-    if plinths:
-        plate = m3.Manifold.batch_boolean([plate, *plinths], m3.OpType.Add)
     return {
         "base_plate": m3.Manifold.batch_boolean([plate, *pockets, *pin_holes], m3.OpType.Subtract),
         "side_walls": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, s, W)), body_pocket, sheet_pocket,
@@ -281,10 +287,9 @@ def _cast(spec: UnitSpec | UnitLibrary, orientation: str, cores: list[manifold3d
     raised = [c for c in castings if c.bottom > 0]
     in_place, above = sheet, [outline_solid(spec, orientation, s, W), *cores]
     if raised:  # the pieces under turned-over sideways units lie on their strips, not on z = 0
-        moved = [(sheet ^ box((c.x0, c.x1, -_OUT, H + _OUT, -_OUT, s + _OUT))).translate((0.0, 0.0, c.bottom))
-                 for c in raised]
-        flat = m3.Manifold.batch_boolean([sheet, *[box((c.x0, c.x1, -_OUT, H + _OUT, -_OUT, s + _OUT))
-                                                   for c in raised]], m3.OpType.Subtract)
+        spans = [box((c.x0, c.x1, -_OUT, H + _OUT, -_OUT, s + _OUT)) for c in raised]
+        moved = [(sheet ^ span).translate((0.0, 0.0, c.bottom)) for span, c in zip(spans, raised, strict=True)]
+        flat = m3.Manifold.batch_boolean([sheet, *spans], m3.OpType.Subtract)
         in_place = m3.Manifold.batch_boolean([flat, *moved], m3.OpType.Add)
         above.extend(moved)
     open_body = m3.Manifold.batch_boolean(above, m3.OpType.Subtract)
@@ -313,13 +318,13 @@ def _unchecked() -> MouldCheck:
 
 
 def _checked(spec: UnitSpec | UnitLibrary, orientation: str, solids: dict[str, Any], cast: dict[str, Any],
-             opening: Any, parts: list[list[manifold3d.Manifold]], in_place: Any, outer: tuple[float, ...],
-             castings: list[UnitCasting]) -> MouldCheck:
+             opening: Any, parts: list[list[manifold3d.Manifold]], plate: Any, in_place: Any,
+             outer: tuple[float, ...]) -> MouldCheck:
     """The measured assembly (:func:`_measure`).
 
-    ``parts`` are the pins, their holes, the tenon pockets, the cores and the plinths; the
-    clearance gaps of the first four are measured too. ``in_place``: the sheet's pieces on the
-    body.
+    ``parts`` are the pins, their holes, the tenon pockets and the cores, whose clearance gaps
+    are measured too (the pockets' within ``plate``, :func:`_plate`). ``in_place``: the sheet's
+    pieces on the body.
 
     Raises
     ------
@@ -328,11 +333,9 @@ def _checked(spec: UnitSpec | UnitLibrary, orientation: str, solids: dict[str, A
     """
     import manifold3d as m3
 
-    pins, pin_holes, pockets, cores, plinths = parts
-    X0, X1, Y0, Y1, Z0, _ = outer
-    ref = _section(spec)
-    s, W = ref.side_wall, ref.width
-    plate = m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, Z0, s)), *plinths], m3.OpType.Add)
+    pins, pin_holes, pockets, cores = parts
+    X0, X1, Y0, Y1, _, _ = outer
+    W = _section(spec).width
     gaps = [hole - pin for hole, pin in zip(pin_holes, pins, strict=False)]
     gaps += [(pocket ^ plate) - core for pocket, core in zip(pockets, cores, strict=False)]
     body = actuator_solids(spec, orientation, base_block=None)["body"]
