@@ -138,15 +138,16 @@ def frame_elements(points: FloatArray, frames: FloatArray) -> tuple[FloatArray, 
 
 
 def frame_polyline(chords: FloatArray, turns: FloatArray, start: FloatArray) -> FloatArray:
-    """The polyline of :func:`frame_elements`' ``chords`` and ``turns`` from ``start`` (its inverse)."""
-    chords, turns = np.asarray(chords, dtype=float), np.asarray(turns, dtype=float)
-    frame = np.broadcast_to(np.eye(3), (*chords.shape[:-2], 3, 3)).copy()
-    points = [np.broadcast_to(np.asarray(start, dtype=float), (*chords.shape[:-2], 3))]
-    for j in range(chords.shape[-2]):
-        points.append(points[-1] + np.einsum("...ij,...j->...i", frame, chords[..., j, :]))
-        if j < turns.shape[-2]:
-            frame = frame @ _rotation(turns[..., j, :])
-    return np.stack(points, axis=-2)
+    """The polyline of :func:`frame_elements`' ``chords`` and ``turns`` from ``start`` (its inverse).
+
+    :func:`chain_points` with the base's frame (the actuator's own) before the units' turns.
+    """
+    return chain_points(chords, _rotation(_with_base(np.asarray(turns, dtype=float))), start)
+
+
+def _with_base(turns: FloatArray) -> FloatArray:
+    """The units' turns (..., n, 3) after the base's, which is none: (..., n + 1, 3), one per chord."""
+    return np.concatenate([np.zeros_like(turns[..., :1, :]), turns], axis=-2)
 
 
 #: the signs of a space element's six values (its chord in its frame, then its frame's turn as a rotation vector)
@@ -174,8 +175,7 @@ def response_space_elements(response: Any) -> FloatArray:
                          "(points in space and each unit's frame)")
     points = np.stack([response.centreline(i) for i in range(response.n_levels)])  # (k, n + 2, 3)
     chords, turns = frame_elements(points, response.frames)
-    turns = np.concatenate([np.zeros_like(turns[:, :1]), turns], axis=1)
-    return np.concatenate([chords, turns], axis=-1)
+    return np.concatenate([chords, _with_base(turns)], axis=-1)
 
 
 def space_rows(response: Any, sign: float = 1.0) -> list[FloatArray]:
