@@ -22,9 +22,15 @@ from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.chain import ChainTable, source_description, source_key, training_model
-from pneumorph.models.chainterms import check_far_training, far_means, fit_text, training_designs
+from pneumorph.models.chainterms import (
+    check_far_training,
+    chord_spread,
+    chord_values,
+    far_means,
+    fit_text,
+    training_designs,
+)
 from pneumorph.models.response import FloatArray, Response, response_elements
-from pneumorph.models.spacechords import space_rows
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
     MIN_HELDOUT,
@@ -119,9 +125,8 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     if n < 2:
         raise ChainTableError("a chain table needs training designs of at least 2 units")
     fitted = dict(window=w, pressures=np.asarray(pressures, dtype=float), **means, source=dict(source),
-                  training=tuple(r.orientation for r in responses))
-    if "space" in means:  # the axis the centres lie on, undeformed
-        fitted["centre_z"] = float(longest.reference_centres[0, 2])
+                  training=tuple(r.orientation for r in responses),  # a chain in space: its axis, undeformed
+                  **({"centre_z": float(longest.reference_centres[0, 2])} if "space" in means else {}))
     if alphabet:
         assert library is not None
         return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
@@ -170,12 +175,12 @@ def _window_means(responses: Sequence[Response], w: int, mirror: bool, alphabet:
     k = max(1, len(alphabet))
     all_codes, all_values, e_codes, e_end = [], [], [], []
     for r in responses:
-        turn, length, end = response_elements(r)
+        chords, signs, end = chord_values(r)
         codes = window_codes(design_array(r.orientation, alphabet=alphabet, symmetric=symmetric), w, n_types=k)[0]
         variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k, symmetric), -1.0)] if mirror else [])
         for c, sign in variants:
             all_codes.append(c)
-            all_values.append(np.concatenate([sign * turn.T, length.T, *space_rows(r, sign)], axis=1))
+            all_values.append(chords if sign > 0 else chords * signs)
             e_codes.append(c[-1:])
             e_end.append(sign * end[None])
     codes = np.concatenate(all_codes)
@@ -184,17 +189,14 @@ def _window_means(responses: Sequence[Response], w: int, mirror: bool, alphabet:
     means = np.zeros((len(uniq), values.shape[1]))
     np.add.at(means, inv, values)
     means /= np.bincount(inv)[:, None]
-    mean_turn, mean_len = means[:, :levels], means[:, levels:2 * levels]
-    # a chain in space is told by its elements in space (the planar columns, its view in the x-y plane, are not local)
-    spread = float(np.abs(values - means[inv])[:, 2 * levels if values.shape[1] > 2 * levels else 0:].max())
+    spread = chord_spread(values - means[inv], levels)
     euniq, einv = np.unique(np.concatenate(e_codes), return_inverse=True)
     mean_end = np.zeros((len(euniq), levels))
     np.add.at(mean_end, einv, np.concatenate(e_end))
     mean_end /= np.bincount(einv)[:, None]
-    out = {"codes": uniq, "turn": mean_turn, "length": mean_len, "end_codes": euniq, "end": mean_end, "spread": spread}
-    if values.shape[1] > 2 * levels:  # a chain in space
-        out["space"] = means[:, 2 * levels:].reshape(len(uniq), levels, 6)
-    return out
+    space = {"space": means[:, 2 * levels:].reshape(len(uniq), levels, 6)} if values.shape[1] > 2 * levels else {}
+    return {"codes": uniq, "turn": means[:, :levels], "length": means[:, levels:2 * levels], "end_codes": euniq,
+            "end": mean_end, "spread": spread, **space}
 
 
 def _binary_geometry(responses: Sequence[Response], longest: Response, mirror: bool) -> dict[str, Any]:

@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError
 from pneumorph.models.response import Response, response_elements
-from pneumorph.models.spacechords import space_rows
+from pneumorph.models.spacechords import MIRROR_SIGNS, space_rows
 from pneumorph.models.windows import (
     canonical_codes,
     covering_designs,
@@ -110,6 +110,34 @@ def fit_text(w: int, far: bool) -> str:
     return f"window +-{w} with far-field terms (+-{w + 1})" if far else f"window +-{w}"
 
 
+def chord_values(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """What a table averages per chord of ``response``, the levels side by side, and how it turns over.
+
+    Returns
+    -------
+    values : ndarray, shape (n + 1, 2 k), or (n + 1, 8 k) for a chain in space
+        The turns, the lengths, and a full-width response's six elements in space per level
+        (:func:`~pneumorph.models.spacechords.space_rows`).
+    signs : ndarray, shape (2 k,) or (8 k,)
+        What ``values`` are multiplied by when every unit is turned over: the turns change sign,
+        the lengths do not, the elements in space take
+        :data:`~pneumorph.models.spacechords.MIRROR_SIGNS`.
+    end : ndarray, shape (k,)
+        The end turn (it changes sign turned over).
+    """
+    turn, length, end = response_elements(response)
+    space = space_rows(response)
+    k = len(end)
+    signs = np.concatenate([-np.ones(k), np.ones(k), *[np.tile(MIRROR_SIGNS, k) for _ in space]])
+    return np.concatenate([turn.T, length.T, *space], axis=1), signs, end
+
+
+def chord_spread(deviation: FloatArray, levels: int) -> float:
+    """The largest deviation from a fit of the chord values that tell a chain (:func:`chord_values`' columns):
+    a chain in space's elements in space (its planar columns, the view of its projection, are not local), else all."""
+    return float(np.abs(deviation[:, 2 * levels if deviation.shape[1] > 2 * levels else 0:]).max())
+
+
 def _term_codes(symbols: IntArray, width: int, lo: int, hi: int, radix: int) -> IntArray:
     """Codes of the units ``lo .. hi`` from the chord, from symbols of window +-``width``, (..., )."""
     cols = np.arange(lo + width, hi + width + 1)
@@ -135,10 +163,10 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     """
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
-        turn, length, end = response_elements(r)
+        chords, signs, end = chord_values(r)
         for s, sign in _symbols(r.orientation, width, mirror, alphabet, symmetric):
             syms.append(s)
-            values.append(np.concatenate([sign * turn.T, length.T, *space_rows(r, sign)], axis=1))
+            values.append(chords if sign > 0 else chords * signs)
             esyms.append(s[-1:])
             ends.append(sign * end[None, :])
     return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
@@ -237,10 +265,9 @@ def fit_terms(responses: Sequence[Response], window: int, mirror: bool, alphabet
     tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in offsets], values)
     etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in offsets], ends)
     levels = ends.shape[1]
-    if values.shape[1] > 2 * levels:  # a chain in space is told by its elements in space (as in chainfit)
-        spread = float(np.abs(values - fit)[:, 2 * levels:].max())
-    else:
-        spread = float(max(np.abs(values - fit).max(), np.abs(ends - efit).max()))
+    spread = chord_spread(values - fit, levels)
+    if values.shape[1] == 2 * levels:  # a planar chain: its end turns tell it too
+        spread = max(spread, float(np.abs(ends - efit).max()))
     return {"window": w, "chord": tables, "end": etables}, spread
 
 
@@ -335,5 +362,5 @@ def terms_from_dict(data: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-__all__ = ["ROUNDS", "SETTLED", "compile_terms", "entries_digest", "far_designs", "far_means", "far_terms", "fit_terms",
-           "fit_text", "terms_from_dict", "terms_to_dict", "training_designs"]
+__all__ = ["ROUNDS", "SETTLED", "chord_spread", "chord_values", "compile_terms", "entries_digest", "far_designs",
+           "far_means", "far_terms", "fit_terms", "fit_text", "terms_from_dict", "terms_to_dict", "training_designs"]

@@ -178,17 +178,15 @@ def response_space_elements(response: Any) -> FloatArray:
     return np.concatenate([chords, _with_base(turns)], axis=-1)
 
 
-def space_rows(response: Any, sign: float = 1.0) -> list[FloatArray]:
+def space_rows(response: Any) -> list[FloatArray]:
     """A response's elements in space as one row per chord, the levels' six values side by side: ``[(n + 1, 6 k)]``.
 
-    Mirrored (:data:`MIRROR_SIGNS`) for ``sign`` -1; an empty list for a planar response
-    (without its units' frames), so that a planar table's values stay as they were.
+    An empty list for a planar response (without its units' frames), so that a planar
+    table's values stay as they were; turned over, they take :data:`MIRROR_SIGNS` per level.
     """
     if response.frames is None:
         return []
     e = response_space_elements(response)
-    if sign < 0:
-        e = e * MIRROR_SIGNS
     return [e.transpose(1, 0, 2).reshape(e.shape[1], -1)]
 
 
