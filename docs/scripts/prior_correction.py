@@ -29,7 +29,7 @@ from far_terms import errors, responses
 
 from pneumorph.geometry.library import UnitLibrary, builtin_library
 from pneumorph.models.chain import ChainTable
-from pneumorph.models.chainterms import _observations, _term_codes
+from pneumorph.models.chainterms import _observations, term_codes
 from pneumorph.models.response import Response
 
 
@@ -54,13 +54,13 @@ def corrected(prior: ChainTable, train: list[Response], w: int, library: UnitLib
     rows, ok = prior.find(syms @ weights)
     erows, eok = prior.find(esyms @ weights, end=True)
     assert ok.all() and eok.all(), "the prior lacks a window of the training designs"
-    chord = _means(_term_codes(syms, width, -w, w, radix),
+    chord = _means(term_codes(syms, width, -w, w, radix),
                    values - np.concatenate([prior.turn[rows], prior.length[rows]], axis=1))
-    end = _means(_term_codes(esyms, width, -w, w, radix), ends - prior.end[erows])
+    end = _means(term_codes(esyms, width, -w, w, radix), ends - prior.end[erows])
     digits = (prior.codes[:, None] // weights) % radix
-    d, missing = _lookup(*chord, _term_codes(digits, width, -w, w, radix))
+    d, missing = _lookup(*chord, term_codes(digits, width, -w, w, radix))
     edigits = (prior.end_codes[:, None] // weights) % radix
-    de, _ = _lookup(*end, _term_codes(edigits, width, -w, w, radix))
+    de, _ = _lookup(*end, term_codes(edigits, width, -w, w, radix))
     k = prior.n_levels
     return replace(prior, turn=prior.turn + d[:, :k], length=prior.length + d[:, k:], end=prior.end + de), missing
 

@@ -15,7 +15,7 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.chain import ChainModel, ChainTable
 from pneumorph.models.chainfile import TABLE_FORMAT, TERMS_FORMAT
 from pneumorph.models.chainfit import build_table, fit_table
-from pneumorph.models.chainterms import far_designs, far_terms
+from pneumorph.models.chainterms import end_terms, far_designs, far_terms
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response
 from pneumorph.models.validation import heldout_designs
@@ -26,25 +26,30 @@ PITCH = 10.0
 HEIGHT = (5.0, 2.0)  # undeformed centre height of a unit in orientation 0 and 1
 
 
-def _law(seed: int, w: int) -> dict[tuple[int, int], dict[int, np.ndarray]]:
-    """Random additive terms, turned over with their window: turns change sign, lengths do not."""
+def _law(seed: int, w: int, layout: str = "far") -> dict[tuple[int, int] | tuple[str, int, int], dict[int, np.ndarray]]:
+    """Random additive terms, turned over with their window: turns change sign, lengths do not. With ``split``,
+    the end turn's own terms (keys ``("end", lo, hi)``) after the chords'."""
     rng = np.random.default_rng(seed)
-    law: dict[tuple[int, int], dict[int, np.ndarray]] = {}
-    for lo, hi in far_terms(w):
-        width = hi - lo + 1
-        table: dict[int, np.ndarray] = {}
-        for code in range(4**width):
-            digits = [(code // 4**t) % 4 for t in range(width)]
-            mirror = sum((d ^ 1 if d < 2 else d) * 4**t for t, d in enumerate(digits))
-            if mirror in table:
-                turn, length = np.split(table[mirror], 2)
-                table[code] = np.concatenate([-turn, length])
-            elif mirror == code:  # only base and tip symbols: its own mirror, so no turn
-                table[code] = np.concatenate([np.zeros(LEVELS), rng.uniform(-0.2, 0.2, LEVELS)])
-            else:
-                table[code] = np.concatenate([rng.uniform(-0.08, 0.08, LEVELS), rng.uniform(-0.2, 0.2, LEVELS)])
-        law[(lo, hi)] = table
+    law: dict = {units: _table(rng, units[1] - units[0] + 1) for units in far_terms(w, layout)}
+    if layout == "split":
+        law.update({("end", lo, hi): _table(rng, hi - lo + 1) for lo, hi in end_terms(w, layout)})
     return law
+
+
+def _table(rng: np.random.Generator, width: int) -> dict[int, np.ndarray]:
+    """One term's values per key of ``width`` symbols, mirror-consistent."""
+    table: dict[int, np.ndarray] = {}
+    for code in range(4**width):
+        digits = [(code // 4**t) % 4 for t in range(width)]
+        mirror = sum((d ^ 1 if d < 2 else d) * 4**t for t, d in enumerate(digits))
+        if mirror in table:
+            turn, length = np.split(table[mirror], 2)
+            table[code] = np.concatenate([-turn, length])
+        elif mirror == code:  # only base and tip symbols: its own mirror, so no turn
+            table[code] = np.concatenate([np.zeros(LEVELS), rng.uniform(-0.2, 0.2, LEVELS)])
+        else:
+            table[code] = np.concatenate([rng.uniform(-0.08, 0.08, LEVELS), rng.uniform(-0.2, 0.2, LEVELS)])
+    return table
 
 
 def _elements(law: dict, design: str, w: int) -> np.ndarray:
@@ -52,12 +57,18 @@ def _elements(law: dict, design: str, w: int) -> np.ndarray:
     width = w + 1
     sym = window_symbols(design_array(design), width)[0]  # (n + 1, 2 width + 1)
     out = np.zeros((len(sym) + 1, 2 * LEVELS))
-    for (lo, hi), table in law.items():
+    own_end = any(len(units) == 3 for units in law)
+    for units, table in law.items():
+        lo, hi = units[-2:]
         cols = np.arange(lo + width, hi + width + 1)
         codes = sym[:, cols] @ (4 ** np.arange(len(cols)))
         values = np.array([table[int(c)] for c in codes])
+        if len(units) == 3:  # a term of the end turn only
+            out[-1] += values[-1]
+            continue
         out[:-1] += values
-        out[-1] += values[-1] * 0.5  # the end turn: another sum of the same terms at the last chord
+        if not own_end:
+            out[-1] += values[-1] * 0.5  # the end turn: another sum of the same terms at the last chord
     out[:-1, LEVELS:] += PITCH
     return out
 

@@ -50,11 +50,15 @@ def chain() -> None:
               help="Without --window, try first the window one narrower than the first with far-field terms "
                    "(documentation page chain-model, docs/chain-model.md in the source). Default: on for the 3d "
                    "model of one unit type.")
+@click.option("--split-terms", "split", is_flag=True,
+              help="Far-field terms as every run of 2w units within +-(w + 1) (documentation page chain-model, "
+                   "docs/chain-model.md in the source): far fewer training designs over several unit types. "
+                   "Default: as the shipped table of a built-in library.")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
 def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
           window: int | None, tolerance: float, heldout: int, executor: str, workers: int | None,
           scheduler: str | None, cache: str | None, out: str, short: bool, all_heldout: bool, far: bool | None,
-          as_json: bool) -> None:
+          split: bool, as_json: bool) -> None:
     """Fit and validate the chain table of a unit and model (resumable through the cache).
 
     The shipped tables of the built-in unit are regenerated with `pneumorph chain build --model 3d --window 3
@@ -85,6 +89,8 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     target = Path(out)
     if window is not None and (window < 1 or 2 * window + 1 > n_units):
         raise ChainTableError(f"--window {window} needs 1 <= window and 2 window + 1 <= --units ({n_units})")
+    if split and far is False:
+        raise ChainTableError("--split-terms lays out the far-field terms: not with --no-far-terms")
     model = make_model(n_units, settings)
     if getattr(model, "mixed", False):
         from pneumorph.models.chainfit import check_training_size
@@ -95,7 +101,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         defaults = build_options(model)  # the first window and far-field terms a build on first use would take
         options: dict[str, Any] = {"heldout": heldout, "window": window, "tolerance": tolerance, "short": short,
                    "first_window": defaults["first_window"], "early": not all_heldout,
-                   "far": defaults["far"] if far is None else far}
+                   "far": "split" if split else defaults["far"] if far is None else far}
         plan = build_plan(model, workers=evaluator_workers(evaluator), cached=cached_counter(evaluator, model),
                           **options)
         click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve

@@ -109,8 +109,9 @@ class BuildPlan:
         The window half-widths tried in turn until the held-out error is within ``tolerance``.
     covering : tuple of int
         Covering designs of each window.
-    far : tuple of bool
-        Per window, whether it is fitted with far-field terms (empty: none is).
+    far : tuple of bool or str
+        Per window, whether it is fitted with far-field terms, or their layout (``"split"``;
+        empty: none is).
     solves : tuple of int
         Distinct FE solves if the build stops at each window (covering and held-out designs, cumulated).
     fewest : int
@@ -141,7 +142,7 @@ class BuildPlan:
     tolerance: float = DEFAULT_TOLERANCE
     cached: int = 0
     workers: int = 1
-    far: tuple[bool, ...] = ()
+    far: tuple[bool | str, ...] = ()
     work: tuple[float, ...] = ()
     fewest_work: float = 0.0
     cached_work: float = 0.0
@@ -210,7 +211,7 @@ def unit_text(model: Any) -> str:
 
 def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Callable[[list[str]], int] | None = None,
                window: int | None = None, tolerance: float = DEFAULT_TOLERANCE, short: bool = False,
-               first_window: int = 1, early: bool = False, far: bool = False) -> BuildPlan:
+               first_window: int = 1, early: bool = False, far: bool | str = False) -> BuildPlan:
     """What :func:`~pneumorph.models.chainfit.build_table` will solve to fit a table to ``model`` (the training
     actuator: its designs have ``model.n_units`` units), counted without a solve.
 
@@ -232,7 +233,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     short : bool
         The build learns the end windows from short actuators (``build_table(short=True)``); the
         estimate takes each short design at its units' share of the full length's time.
-    first_window, early, far : int, bool, bool
+    first_window, early, far : int, bool, bool or str
         As :func:`~pneumorph.models.chainfit.build_table`'s: the first window tried, an early stop
         of the validation, a narrower window with far-field terms first.
 
@@ -257,7 +258,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     widest = max(1, min(MAX_WINDOW, (n_units - 1) // 2))
     first = min(max(1, int(first_window)), widest)
     fewest, fewest_work = 0, 0.0
-    rows: list[tuple[int, int, int, float, bool]] = []  # window, covering designs, solves, work, far-field terms
+    rows: list[tuple[int, int, int, float, bool | str]] = []  # window, covering designs, solves, work, far-field terms
     for w, with_far in fit_candidates(n_units, window, first, widest, far):
         try:
             check_training_size(types, w, len(symmetric))

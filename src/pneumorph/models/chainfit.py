@@ -28,9 +28,9 @@ from pneumorph.models.chainterms import (
     chord_values,
     far_means,
     fit_text,
-    training_designs,
 )
 from pneumorph.models.response import FloatArray, Response, response_elements
+from pneumorph.models.termdesigns import training_designs
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
     MIN_HELDOUT,
@@ -90,13 +90,14 @@ def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
 
 # -- fitting --------------------------------------------------------------------------------
 def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
-              library: UnitLibrary | None = None, far: bool = False) -> ChainTable:
+              library: UnitLibrary | None = None, far: bool | str = False) -> ChainTable:
     """Fit a table to converged training responses (of one ramp; of any lengths).
 
     Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
     mirrored occurrences with negated turns). With ``far``, each chord is the window's term
     plus the far-field terms of the next unit on each side (:mod:`pneumorph.models.chainterms`),
-    written out as a table of window +-(``window`` + 1).
+    written out as a table of window +-(``window`` + 1); ``far="split"``: the sum of every run of
+    ``2w`` units within +-(``window`` + 1) (:func:`~pneumorph.models.chainterms.far_terms`).
 
     Parameters
     ----------
@@ -118,7 +119,7 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     alphabet = library.alphabet if library is not None else ()
     symmetric = library.symmetric_types if library is not None else ()
     if far:
-        means = far_means(responses, w, mirror, alphabet, symmetric, len(pressures), n)
+        means = far_means(responses, w, mirror, alphabet, symmetric, len(pressures), n, far)
         w += 1
     else:
         means = _window_means(responses, w, mirror, alphabet, symmetric, len(pressures))
@@ -308,7 +309,7 @@ def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
 def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance: float = DEFAULT_TOLERANCE,
                 heldout: int = 20, seed: int = 1, max_window: int = MAX_WINDOW,
                 on_progress: Callable[[str], None] | None = None, short: bool = False, first_window: int = 1,
-                early: bool = False, far: bool = False) -> ChainTable:
+                early: bool = False, far: bool | str = False) -> ChainTable:
     """Fit and validate a chain table to an FE model by solving covering and held-out designs.
 
     Parameters
@@ -351,7 +352,8 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
         Without a fixed ``window``, try first the window one narrower than ``first_window``
         with far-field terms (:mod:`pneumorph.models.chainterms`: a table of window
         ``first_window`` from end windows of the narrower one); with a fixed ``window``, that
-        window with far-field terms (:func:`fit_candidates`).
+        window with far-field terms (:func:`fit_candidates`); ``"split"``: with the terms of every
+        run of ``2w`` units instead (:func:`~pneumorph.models.chainterms.far_terms`).
 
     Raises
     ------
@@ -409,7 +411,7 @@ def _windows(n: int, window: int | None, first_window: int, max_window: int) -> 
 
 
 def fit_candidates(n: int, window: int | None, first_window: int, max_window: int = MAX_WINDOW,
-                   far: bool = False) -> list[tuple[int, bool]]:
+                   far: bool | str = False) -> list[tuple[int, bool | str]]:
     """The tables a build tries in turn: ``(w, far)``, window +-w, with far-field terms if ``far``.
 
     With ``far`` and no fixed ``window``, window ``first - 1`` with far-field terms (a table
@@ -420,14 +422,14 @@ def fit_candidates(n: int, window: int | None, first_window: int, max_window: in
     ([(2, True), (3, False)], [(2, True)])
     """
     windows = _windows(n, window, first_window, max_window)
-    plain = [(w, False) for w in windows]
+    plain: list[tuple[int, bool | str]] = [(w, False) for w in windows]
     if far and window is not None:
         if 2 * int(window) + 3 > n:
             raise ChainTableError(f"far-field terms of window +-{window} make a table of +-{int(window) + 1}: it "
                                   f"needs training designs of at least {2 * int(window) + 3} units; the model has {n}")
-        return [(int(window), True)]
+        return [(int(window), far)]
     if far and windows[0] >= 2:
-        return [(windows[0] - 1, True), *plain]
+        return [(windows[0] - 1, far), *plain]
     return plain
 
 
@@ -456,7 +458,7 @@ def _source(model: Any) -> dict[str, Any]:
             "n_units": int(model.n_units), "description": source_description(model)}
 
 
-def _window_table(build: _Build, w: int, far: bool = False) -> ChainTable:
+def _window_table(build: _Build, w: int, far: bool | str = False) -> ChainTable:
     """The table of half-width ``w`` (with ``far``: and its far-field terms), fitted to its covering designs and
     validated on held-out ones.
 
@@ -477,7 +479,7 @@ def _window_table(build: _Build, w: int, far: bool = False) -> ChainTable:
     check_training_size(max(1, len(alphabet)), w, len(symmetric))
     train = training_designs(n, w, far, build.short, alphabet, symmetric)
     if far:  # every far-field key shown, checked before the solves
-        check_far_training(train, w, True, alphabet, symmetric, n)
+        check_far_training(train, w, True, alphabet, symmetric, n, far)
     name = fit_text(w, far)
     say(f"{name}: {len(train)} covering designs")
     tests = heldout_designs(n, build.heldout, exclude=train, seed=build.seed, alphabet=alphabet, symmetric=symmetric)

@@ -91,7 +91,8 @@ def build_options(model: Any) -> dict[str, Any]:
     A 3D model of one unit type, or over a built-in library with a shipped 3D table, tries the
     window one narrower than its first with far-field terms first
     (:mod:`pneumorph.models.chainterms`): it needs about half the unit solves of the wider
-    window's table. 2D solves are cheap, and 2D builds stay as they were.
+    window's table. Over a built-in library the terms are laid out as its shipped table's
+    (``"far"`` or ``"split"``). 2D solves are cheap, and 2D builds stay as they were.
 
     >>> from pneumorph.models.factory import make_model
     >>> build_options(make_model(15, {"fidelity": "3d"}))
@@ -101,7 +102,10 @@ def build_options(model: Any) -> dict[str, Any]:
     """
     library = getattr(model, "library", None)
     single = library is None or library.is_single
-    far = (single or shipped_for(model).is_file()) and str(getattr(model, "fidelity", "")) == "3d"
+    path = shipped_for(model)
+    far: bool | str = single and str(getattr(model, "fidelity", "")) == "3d"
+    if not single and path.is_file() and str(getattr(model, "fidelity", "")) == "3d":  # the shipped table's layout
+        far = ChainTable.load(path).terms.get("layout", "far") or True
     return {"heldout": HELDOUT, "first_window": start_window(model), "early": True, "far": far}
 
 

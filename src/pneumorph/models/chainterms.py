@@ -56,14 +56,52 @@ ROUNDS = 200
 SETTLED = 1e-12
 
 
-def far_terms(window: int) -> tuple[tuple[int, int], ...]:
+#: the layouts of a table's terms: ``far`` (the window's term and one far-field term per side) and ``split``
+#: (every run of ``2w`` units within +-(w + 1), :func:`far_terms`)
+LAYOUTS = ("far", "split")
+
+
+def term_layout(far: bool | str) -> str:
+    """The layout a build's ``far`` names: ``""`` (a plain window), ``"far"`` (``True``) or ``"split"``.
+
+    >>> term_layout(True), term_layout(False), term_layout("split")
+    ('far', '', 'split')
+    """
+    if far is True or far is False:
+        return "far" if far else ""
+    if far in ("", *LAYOUTS):
+        return str(far)
+    raise ChainTableError(f"unknown layout of chain terms {far!r}: one of {', '.join(LAYOUTS)}")
+
+
+def far_terms(window: int, layout: bool | str = "far") -> tuple[tuple[int, int], ...]:
     """The terms of a table of window +-w with far-field terms: unit offsets ``(lo, hi)`` from the chord.
+
+    ``far``: the window's units and, per side, the next unit with those between it and the
+    chord. ``split``: every run of ``2w`` units within +-(w + 1); no term reads ``2w + 1``
+    units, so the training shows fewer keys (over ``c`` unit codes, ``c^(2w)`` instead of
+    ``c^(2w + 1)``), at the price of the interactions of units ``2w`` apart at most.
 
     >>> far_terms(2)
     ((-2, 2), (0, 3), (-3, 0))
+    >>> far_terms(2, "split")
+    ((-3, 0), (-2, 1), (-1, 2), (0, 3))
     """
     w = int(window)
+    if term_layout(layout) == "split":
+        return tuple((lo, lo + 2 * w - 1) for lo in range(-(w + 1), 3 - w))
     return ((-w, w), (0, w + 1), (-(w + 1), 0))
+
+
+def end_terms(window: int, layout: bool | str = "far") -> tuple[tuple[int, int], ...]:
+    """The terms of the last chord's end turn: those of :func:`far_terms`, or with ``split`` one term, the last
+    ``2w - 1`` units (the end face turns with the units next to it; one key per run of them).
+
+    >>> end_terms(2, "split")
+    ((-2, 3),)
+    """
+    w = int(window)
+    return ((-(2 * w - 2), w + 1),) if term_layout(layout) == "split" else far_terms(w)
 
 
 def far_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -> list[str]:
@@ -80,34 +118,25 @@ def far_designs(n_units: int, window: int, mirror: bool = True, seed: int = 0) -
     """
     n, w = int(n_units), int(window)
     interior = [d for d in covering_designs(n, w + 1, mirror, seed, short=True) if len(d) == n]
-    return end_designs(w, mirror, units=_end_units(w)) + interior
+    return end_designs(w, mirror, units=end_units(w)) + interior
 
 
-def _end_units(w: int) -> int:
+def end_units(w: int) -> int:
     """The units of the end designs of a table of window +-w with far-field terms: ``2w``, and ``w + 2`` for
     ``w = 1`` (the last chord's far-field term on the base side reads ``w + 2`` units)."""
     return max(2 * w, w + 2)
 
 
-def training_designs(n: int, w: int, far: bool, short: bool, alphabet: tuple[str, ...] = (),
-                     symmetric: tuple[int, ...] = ()) -> list[str]:
-    """The covering designs of window +-w (:func:`~pneumorph.models.windows.covering_designs`), or with
-    far-field terms :func:`~pneumorph.models.chainterms.far_designs` (one unit type; over several, the
-    covering designs of +-w show every key of the far-field terms many times, and short end designs have
-    ``max(2w, w + 2)`` units, as :func:`far_designs`'s: a far-field term at an end reads ``w + 2`` units).
+def fit_text(w: int, far: bool | str) -> str:
+    """``window +-2 with far-field terms (+-3)``, ``window +-3 from 4-unit terms`` or ``window +-3``.
 
-    >>> [len(d) for d in training_designs(7, 1, True, True, ("a", "r"))][:3]
-    [3, 3, 3]
+    >>> fit_text(2, "split")
+    'window +-3 from 4-unit terms'
     """
-    if far and not alphabet:
-        return far_designs(n, w)
-    return covering_designs(n, w, n_types=max(1, len(alphabet)), alphabet=alphabet, symmetric=symmetric, short=short,
-                            end_units=_end_units(w) if far else None)
-
-
-def fit_text(w: int, far: bool) -> str:
-    """``window +-2 with far-field terms (+-3)`` or ``window +-3``."""
-    return f"window +-{w} with far-field terms (+-{w + 1})" if far else f"window +-{w}"
+    layout = term_layout(far)
+    if layout == "split":
+        return f"window +-{w + 1} from {2 * w}-unit terms"
+    return f"window +-{w} with far-field terms (+-{w + 1})" if layout else f"window +-{w}"
 
 
 def chord_values(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -138,13 +167,13 @@ def chord_spread(deviation: FloatArray, levels: int) -> float:
     return float(np.abs(deviation[:, 2 * levels if deviation.shape[1] > 2 * levels else 0:]).max())
 
 
-def _term_codes(symbols: IntArray, width: int, lo: int, hi: int, radix: int) -> IntArray:
+def term_codes(symbols: IntArray, width: int, lo: int, hi: int, radix: int) -> IntArray:
     """Codes of the units ``lo .. hi`` from the chord, from symbols of window +-``width``, (..., )."""
     cols = np.arange(lo + width, hi + width + 1)
     return symbols[..., cols] @ (radix ** np.arange(len(cols), dtype=np.int64))
 
 
-def _symbols(design: str, width: int, mirror: bool, alphabet: tuple[str, ...],
+def symbols_of(design: str, width: int, mirror: bool, alphabet: tuple[str, ...],
              symmetric: tuple[int, ...]) -> list[tuple[IntArray, float]]:
     """A design's window symbols of +-``width`` at every chord (and, with ``mirror``, its mirror's), each with the
     sign its turns take (-1 mirrored)."""
@@ -164,7 +193,7 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
         chords, signs, end = chord_values(r)
-        for s, sign in _symbols(r.orientation, width, mirror, alphabet, symmetric):
+        for s, sign in symbols_of(r.orientation, width, mirror, alphabet, symmetric):
             syms.append(s)
             values.append(chords if sign > 0 else chords * signs)
             esyms.append(s[-1:])
@@ -173,7 +202,7 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
 
 
 def check_far_training(designs: Sequence[str], window: int, mirror: bool, alphabet: tuple[str, ...],
-                       symmetric: tuple[int, ...], n_units: int) -> None:
+                       symmetric: tuple[int, ...], n_units: int, layout: bool | str = "far") -> None:
     """Refuse, before any solve, training designs that leave a key of a far-field term unseen.
 
     The keys the designs show (mirrored too) against those an actuator of ``n_units`` units
@@ -195,15 +224,17 @@ def check_far_training(designs: Sequence[str], window: int, mirror: bool, alphab
     """
     k = max(1, len(alphabet))
     width, radix = int(window) + 1, 2 * k + 2
-    syms = [sym for d in designs for sym, _ in _symbols(d, width, mirror, alphabet, symmetric)]
+    syms = [sym for d in designs for sym, _ in symbols_of(d, width, mirror, alphabet, symmetric)]
     chord = np.concatenate(syms)
     end = np.concatenate([s[-1:] for s in syms])
 
-    def seen(symbols: IntArray) -> list[tuple[IntArray, FloatArray]]:
-        keys = [np.unique(_term_codes(symbols, width, lo, hi, radix)) for lo, hi in far_terms(window)]
+    def seen(symbols: IntArray, terms: tuple[tuple[int, int], ...]) -> list[tuple[IntArray, FloatArray]]:
+        keys = [np.unique(term_codes(symbols, width, lo, hi, radix)) for lo, hi in terms]
         return [(u, np.zeros((len(u), 1))) for u in keys]
 
-    compile_terms({"window": int(window), "chord": seen(chord), "end": seen(end)}, n_units, k, symmetric, 1)
+    layout = term_layout(layout)
+    compile_terms({"window": int(window), "layout": layout, "chord": seen(chord, far_terms(window, layout)),
+                   "end": seen(end, end_terms(window, layout))}, n_units, k, symmetric, 1)
 
 
 def _backfit(keys: list[IntArray], values: FloatArray) -> tuple[list[tuple[IntArray, FloatArray]], FloatArray]:
@@ -234,7 +265,7 @@ def _compile(tables: list[tuple[IntArray, FloatArray]], terms: Sequence[tuple[in
     """The sum of the terms at every window of ``symbols``; a :class:`ChainTableError` for a key never trained."""
     total = np.zeros((len(symbols), tables[0][1].shape[1]))
     for (keys, means), (lo, hi) in zip(tables, terms, strict=True):
-        codes = _term_codes(symbols, width, lo, hi, radix)
+        codes = term_codes(symbols, width, lo, hi, radix)
         rows = np.minimum(np.searchsorted(keys, codes), len(keys) - 1)
         missing = np.flatnonzero(keys[rows] != codes)
         if missing.size:
@@ -245,7 +276,7 @@ def _compile(tables: list[tuple[IntArray, FloatArray]], terms: Sequence[tuple[in
 
 
 def fit_terms(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
-              symmetric: tuple[int, ...]) -> tuple[dict[str, Any], float]:
+              symmetric: tuple[int, ...], layout: bool | str = "far") -> tuple[dict[str, Any], float]:
     """The far-field terms of a window +-w table, fitted by backfitting, and the fit's spread.
 
     Returns
@@ -261,14 +292,27 @@ def fit_terms(responses: Sequence[Response], window: int, mirror: bool, alphabet
     w = int(window)
     width, radix = w + 1, 2 * max(1, len(alphabet)) + 2
     syms, values, esyms, ends = _observations(responses, width, mirror, alphabet, symmetric)
-    offsets = far_terms(w)
-    tables, fit = _backfit([_term_codes(syms, width, lo, hi, radix) for lo, hi in offsets], values)
-    etables, efit = _backfit([_term_codes(esyms, width, lo, hi, radix) for lo, hi in offsets], ends)
+    layout = term_layout(layout)
+    tables, fit = _backfit([term_codes(syms, width, lo, hi, radix) for lo, hi in far_terms(w, layout)], values)
+    etables, efit = _backfit([term_codes(esyms, width, lo, hi, radix) for lo, hi in end_terms(w, layout)], ends)
     levels = ends.shape[1]
     spread = chord_spread(values - fit, levels)
     if values.shape[1] == 2 * levels:  # a planar chain: its end turns tell it too
         spread = max(spread, float(np.abs(ends - efit).max()))
-    return {"window": w, "chord": tables, "end": etables}, spread
+    return {"window": w, "layout": layout, "chord": tables, "end": etables}, spread
+
+
+def written_windows(n_units: int, width: int, n_types: int, symmetric: tuple[int, ...]) -> IntArray:
+    """The symbols (rows) of every window of +-``width`` that an actuator of at least ``2 width + 1`` units (and of
+    ``n_units``) shows, canonical under mirroring, in the order of their codes: the windows a table writes out.
+
+    >>> written_windows(5, 1, 1, ()).shape
+    (20, 3)
+    """
+    radix = 2 * int(n_types) + 2
+    codes = possible_codes(max(int(n_units), 2 * width + 1), width, n_types)
+    windows = (codes[:, None] // radix ** np.arange(2 * width + 1, dtype=np.int64)) % radix
+    return windows[np.all(np.asarray(canonical_codes(windows, symmetric)) == windows, axis=1)]
 
 
 def compile_terms(terms: dict[str, Any], n_units: int, n_types: int, symmetric: tuple[int, ...],
@@ -284,17 +328,14 @@ def compile_terms(terms: dict[str, Any], n_units: int, n_types: int, symmetric: 
     ChainTableError
         A key of a term that no training design shows.
     """
-    w = int(terms["window"])
+    w, layout = int(terms["window"]), terms.get("layout", "far")
     width, radix = w + 1, 2 * n_types + 2
-    offsets = far_terms(w)
-    codes = possible_codes(max(int(n_units), 2 * width + 1), width, n_types)
-    windows = (codes[:, None] // radix ** np.arange(2 * width + 1, dtype=np.int64)) % radix
-    keep = np.all(np.asarray(canonical_codes(windows, symmetric)) == windows, axis=1)
-    codes, windows = codes[keep], windows[keep]
-    chord = _compile(terms["chord"], offsets, windows, width, radix, "chord")
+    windows = written_windows(n_units, width, n_types, symmetric)
+    codes = windows @ radix ** np.arange(2 * width + 1, dtype=np.int64)
+    chord = _compile(terms["chord"], far_terms(w, layout), windows, width, radix, "chord")
     # the windows of a last chord n: units n - w - 1 .. n (or the base), then w + 1 tip symbols
     last = np.all(windows[:, width + 1:] == radix - 1, axis=1) & (windows[:, width] < radix - 2)
-    end = _compile(terms["end"], offsets, windows[last], width, radix, "end")
+    end = _compile(terms["end"], end_terms(w, layout), windows[last], width, radix, "end")
     out = {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:2 * levels], "end_codes": codes[last],
            "end": end}
     if chord.shape[1] > 2 * levels:  # a chain in space: its elements per level after the planar ones
@@ -303,7 +344,7 @@ def compile_terms(terms: dict[str, Any], n_units: int, n_types: int, symmetric: 
 
 
 def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet: tuple[str, ...],
-              symmetric: tuple[int, ...], levels: int, n_units: int) -> dict[str, Any]:
+              symmetric: tuple[int, ...], levels: int, n_units: int, layout: bool | str = "far") -> dict[str, Any]:
     """:func:`~pneumorph.models.chainfit.fit_table`'s entries of a window +-w table with far-field terms.
 
     Fitted at window +-w (:func:`fit_terms`) and written out at window +-(w + 1)
@@ -321,7 +362,7 @@ def far_means(responses: Sequence[Response], window: int, mirror: bool, alphabet
     ChainTableError
         A key of a term that no training design shows.
     """
-    terms, spread = fit_terms(responses, window, mirror, alphabet, symmetric)
+    terms, spread = fit_terms(responses, window, mirror, alphabet, symmetric, layout)
     table = compile_terms(terms, n_units, max(1, len(alphabet)), symmetric, levels)
     return {**table, "spread": spread, "terms": {**terms, "digest": entries_digest(table), "n_units": int(n_units)}}
 
@@ -339,20 +380,24 @@ def entries_digest(entries: dict[str, Any]) -> str:
 
 def terms_to_dict(terms: dict[str, Any]) -> dict[str, Any]:
     """JSON-ready form of :func:`fit_terms`'s terms (with their ``digest`` and ``n_units``)."""
-    offsets = far_terms(int(terms["window"]))
-    return {"window": int(terms["window"]), "n_units": int(terms["n_units"]), "digest": terms["digest"],
+    w, layout = int(terms["window"]), terms.get("layout", "far")
+    offsets = {"chord": far_terms(w, layout), "end": end_terms(w, layout)}
+    return {"window": w, **({"layout": layout} if layout != "far" else {}), "n_units": int(terms["n_units"]),
+            "digest": terms["digest"],
             **{part: [{"units": list(units), "keys": keys.tolist(), "values": values.tolist()}
-                      for (keys, values), units in zip(terms[part], offsets, strict=True)]
+                      for (keys, values), units in zip(terms[part], offsets[part], strict=True)]
                for part in ("chord", "end")}}
 
 
 def terms_from_dict(data: dict[str, Any]) -> dict[str, Any]:
     """:func:`terms_to_dict`'s form back as arrays; a :class:`ChainTableError` if the terms are not those of
     :func:`far_terms`."""
-    w = int(data["window"])
-    out: dict[str, Any] = {"window": w, "n_units": int(data["n_units"]), "digest": str(data["digest"])}
+    w, layout = int(data["window"]), term_layout(data.get("layout", "far"))
+    out: dict[str, Any] = {"window": w, "layout": layout, "n_units": int(data["n_units"]),
+                           "digest": str(data["digest"])}
+    offsets = {"chord": far_terms(w, layout), "end": end_terms(w, layout)}
     for part in ("chord", "end"):
-        if [tuple(t["units"]) for t in data[part]] != list(far_terms(w)):
+        if [tuple(t["units"]) for t in data[part]] != list(offsets[part]):
             raise ChainTableError(f"far-field terms of units {[t['units'] for t in data[part]]}, not those of "
                                   f"window +-{w}")
         out[part] = [(np.asarray(t["keys"], dtype=np.int64), np.asarray(t["values"], dtype=float))
@@ -362,5 +407,7 @@ def terms_from_dict(data: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-__all__ = ["ROUNDS", "SETTLED", "chord_spread", "chord_values", "compile_terms", "entries_digest", "far_designs",
-           "far_means", "far_terms", "fit_terms", "fit_text", "terms_from_dict", "terms_to_dict", "training_designs"]
+__all__ = ["LAYOUTS", "ROUNDS", "SETTLED", "chord_spread", "chord_values", "compile_terms", "end_terms",
+           "end_units", "entries_digest", "far_designs", "far_means", "far_terms", "fit_terms", "fit_text",
+           "symbols_of", "term_codes", "term_layout", "terms_from_dict", "terms_to_dict",
+           "written_windows"]

@@ -380,21 +380,37 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
     if k > 1 and len(alphabet) != k:
         raise ChainTableError(f"a covering set over {k} unit types needs their {k} symbols, got {alphabet!r}")
     rng = np.random.default_rng(seed)
-    if len(allowed := unit_codes(k, symmetric)) ** n <= 2**16:
-        pool = every_design(n, allowed)
-        pool = pool[rng.permutation(len(pool))]
-    elif k == 1:
-        pool = rng.integers(0, 2, size=(20000, n), dtype=np.uint8)
-    else:
-        windows = len(possible_codes(n, w, k))
-        pool = random_designs(max(20000, 8 * windows // max(n, 1)), n, rng, k, symmetric)
+    pool = design_pool(n, k, symmetric, rng, len(possible_codes(n, w, k)) if k > 1 else 0)
     ends_first: list[str] = []
     codes = window_codes(pool, w, n_types=k)
     if short and n > 2 * w:
         ends_first, codes = end_designs(w, mirror, k, alphabet, symmetric, units=end_units), codes[:, w + 1 : n - w + 1]
     canon = np.minimum(codes, mirror_codes(codes, w, k, symmetric)) if mirror else codes
-    needed = np.unique(canon)
-    index = np.searchsorted(needed, canon)
+    return ends_first + design_strings(pool[cover_rows(canon, rng)], alphabet if k > 1 else ())
+
+
+def design_pool(n_units: int, n_types: int, symmetric: Sequence[int], rng: np.random.Generator,
+                n_keys: int = 0) -> NDArray[np.uint8]:
+    """The candidate designs of a covering set: every design up to 2^16 of them (shuffled), else random ones
+    (20,000 of one type; over several, ``max(20000, 8 K / n)`` for ``K`` keys to cover)."""
+    n, k = int(n_units), int(n_types)
+    if len(allowed := unit_codes(k, symmetric)) ** n <= 2**16:
+        pool = every_design(n, allowed)
+        return pool[rng.permutation(len(pool))]
+    if k == 1:
+        return rng.integers(0, 2, size=(20000, n), dtype=np.uint8)
+    return random_designs(max(20000, 8 * int(n_keys) // max(n, 1)), n, rng, k, symmetric)
+
+
+def cover_rows(keys: IntArray, rng: np.random.Generator) -> list[int]:
+    """The rows of a small set in which every key of ``keys`` (rows: candidate designs) occurs.
+
+    Greedy set cover, then up to :data:`COVER_RESTARTS` greedy covers with seeded random
+    ties, as many as :data:`COVER_RESTART_WORK` allows; the first smallest is kept.
+    """
+    needed = np.unique(keys)
+    index = np.searchsorted(needed, keys)
+    n = keys.shape[1]
     chosen = _greedy_cover(index, len(needed), None, n)
     restarts = min(COVER_RESTARTS, COVER_RESTART_WORK // (len(chosen) * index.size))
     fewest = _fewest_cover(index) if restarts else 0
@@ -403,7 +419,7 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
             break
         other = _greedy_cover(index, len(needed), rng, n)
         chosen = other if len(other) < len(chosen) else chosen
-    return ends_first + design_strings(pool[chosen], alphabet if k > 1 else ())
+    return chosen
 
 
 def _fewest_cover(index: IntArray) -> int:
