@@ -337,6 +337,11 @@ def test_far_field_terms_on_too_short_a_training_model(sandbox: Path, capsys: py
     assert "far-field terms of window +-1" in line and "at least 5 units" in line
 
 
+def test_split_terms_without_far_field_terms(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line = _refused(sandbox, capsys, [*BASE["chain"], "--split-terms", "--no-far-terms"])
+    assert "--split-terms" in line and "--no-far-terms" in line
+
+
 def test_unknown_command_and_option(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
     _refused(sandbox, capsys, ["nope"])
     _refused(sandbox, capsys, ["design", "--nope"])

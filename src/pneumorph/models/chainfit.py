@@ -96,8 +96,7 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
     Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
     mirrored occurrences with negated turns). With ``far``, each chord is the window's term
     plus the far-field terms of the next unit on each side (:mod:`pneumorph.models.chainterms`),
-    written out as a table of window +-(``window`` + 1); ``far="split"``: the sum of every run of
-    ``2w`` units within +-(``window`` + 1) (:func:`~pneumorph.models.chainterms.far_terms`).
+    written out as a table of window +-(``window`` + 1); ``"split"``: their split layout.
 
     Parameters
     ----------
@@ -352,8 +351,7 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
         Without a fixed ``window``, try first the window one narrower than ``first_window``
         with far-field terms (:mod:`pneumorph.models.chainterms`: a table of window
         ``first_window`` from end windows of the narrower one); with a fixed ``window``, that
-        window with far-field terms (:func:`fit_candidates`); ``"split"``: with the terms of every
-        run of ``2w`` units instead (:func:`~pneumorph.models.chainterms.far_terms`).
+        window with far-field terms (:func:`fit_candidates`); ``"split"``: in their split layout.
 
     Raises
     ------

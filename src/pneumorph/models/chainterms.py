@@ -307,7 +307,7 @@ def written_windows(n_units: int, width: int, n_types: int, symmetric: tuple[int
     ``n_units``) shows, canonical under mirroring, in the order of their codes: the windows a table writes out.
 
     >>> written_windows(5, 1, 1, ()).shape
-    (20, 3)
+    (18, 3)
     """
     radix = 2 * int(n_types) + 2
     codes = possible_codes(max(int(n_units), 2 * width + 1), width, n_types)
