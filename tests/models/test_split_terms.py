@@ -54,7 +54,7 @@ def test_a_cover_of_the_keys_alone_leaves_windows_unfixed() -> None:
     pool = design_pool(n, 2, (), rng, 4**4)
     from pneumorph.models.termdesigns import _split_keys
 
-    cover = [d for d in split_designs(n, w, alphabet)[: len(cover_rows(_split_keys(pool, w, 2, (), False), rng))]]
+    cover = split_designs(n, w, alphabet)[: len(cover_rows(_split_keys(pool, w, 2, (), False), rng))]
     assert unfixed_error(cover, w, alphabet, (), n) > 0.1
     full = split_designs(n, w, alphabet)
     assert len(full) > len(cover) and unfixed_error(full, w, alphabet, (), n) < FIXED

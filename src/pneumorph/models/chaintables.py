@@ -101,11 +101,12 @@ def build_options(model: Any) -> dict[str, Any]:
     False
     """
     library = getattr(model, "library", None)
-    single = library is None or library.is_single
-    path = shipped_for(model)
-    far: bool | str = single and str(getattr(model, "fidelity", "")) == "3d"
-    if not single and path.is_file() and str(getattr(model, "fidelity", "")) == "3d":  # the shipped table's layout
-        far = ChainTable.load(path).terms.get("layout", "far") or True
+    far: bool | str = False
+    if str(getattr(model, "fidelity", "")) == "3d":
+        if library is None or library.is_single:
+            far = True
+        elif (path := shipped_for(model)).is_file():  # the layout of the library's shipped table
+            far = ChainTable.load(path).terms.get("layout", "far")
     return {"heldout": HELDOUT, "first_window": start_window(model), "early": True, "far": far}
 
 

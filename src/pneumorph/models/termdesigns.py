@@ -162,8 +162,9 @@ def unfixed_error(designs: Sequence[str], window: int, alphabet: tuple[str, ...]
     cols, keys, offset = [], [], 0
     for lo, hi in terms:
         seen = np.unique(term_codes(rows, width, lo, hi, radix))
-        at = np.searchsorted(seen, term_codes(windows, width, lo, hi, radix))
-        if np.any(seen[np.minimum(at, len(seen) - 1)] != term_codes(windows, width, lo, hi, radix)):
+        wanted = term_codes(windows, width, lo, hi, radix)
+        at = np.searchsorted(seen, wanted)
+        if np.any(seen[np.minimum(at, len(seen) - 1)] != wanted):
             return float("inf")
         cols.append(np.searchsorted(seen, term_codes(rows, width, lo, hi, radix)) + offset)
         keys.append(at + offset)

@@ -410,14 +410,13 @@ def cover_rows(keys: IntArray, rng: np.random.Generator) -> list[int]:
     """
     needed = np.unique(keys)
     index = np.searchsorted(needed, keys)
-    n = keys.shape[1]
-    chosen = _greedy_cover(index, len(needed), None, n)
+    chosen = _greedy_cover(index, len(needed), None)
     restarts = min(COVER_RESTARTS, COVER_RESTART_WORK // (len(chosen) * index.size))
     fewest = _fewest_cover(index) if restarts else 0
     for _ in range(restarts):
         if len(chosen) <= fewest:
             break
-        other = _greedy_cover(index, len(needed), rng, n)
+        other = _greedy_cover(index, len(needed), rng)
         chosen = other if len(other) < len(chosen) else chosen
     return chosen
 
@@ -432,14 +431,14 @@ def _fewest_cover(index: IntArray) -> int:
     return max(exclusive, -(-n_keys // index.shape[1]))
 
 
-def _greedy_cover(index: IntArray, n_keys: int, rng: np.random.Generator | None, n: int) -> list[int]:
+def _greedy_cover(index: IntArray, n_keys: int, rng: np.random.Generator | None) -> list[int]:
     """Greedy set cover of the keys by the rows of ``index``: ties to the first row, or to a random one of ``rng``."""
     seen = np.zeros(n_keys, dtype=bool)
     chosen: list[int] = []
     while not seen.all():
         counts = _distinct_counts(index, ~seen[index], n_keys)
         if counts.max() == 0:  # pragma: no cover - a random pool that misses a window
-            raise ChainTableError(f"no design of the pool shows the remaining windows of {n} units")
+            raise ChainTableError("no design of the pool shows the remaining windows")
         ties = np.flatnonzero(counts == counts.max())
         best = int(ties[0] if rng is None else rng.choice(ties))
         chosen.append(best)
