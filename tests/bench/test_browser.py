@@ -134,6 +134,29 @@ def test_a_helix_shows_the_view_from_above(browser) -> None:  # type: ignore[no-
                                    "return n;")
     assert drawn > 50  # the target's orange (#e07b1a) line
     _shot(browser, "helix")
+    # the spatial library's sideways units: a design that leaves the plane, seen from above, in 3D
+    _retype(_el(browser, "amplitude"), "25")
+    _wait(lambda: "A = 25 mm" in _el(browser, "winner-label").text and _answered(browser))
+    before = _el(browser, "answer").get_attribute("data-query-id")
+    Select(_el(browser, "unit")).select_by_value("spatial")
+    _wait(lambda: _el(browser, "answer").get_attribute("data-query-id") != before and _answered(browser), timeout=30)
+    assert _el(browser, "winner-design").text == "LaaaAlllAlAAAAa"  # the certified search's (BENCHMARKS.md)
+    assert "optimum is one of 16 designs of all 1,073,741,824" in _el(browser, "certificate").text
+    assert browser.find_elements(By.CSS_SELECTOR, "#design-boxes span.bl, #design-boxes span.bL")
+    _wait(lambda: "chain" in _el(browser, "shape-source").text)
+    actuator = browser.execute_script("const c = document.getElementById('top-plot');"
+                                      "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+                                      "let n = 0, lo = c.height, hi = 0;"
+                                      "for (let i = 0; i < d.length; i += 4) if (d[i] === 11 && d[i + 1] === 107) {"
+                                      "  n++; const y = Math.floor(i / 4 / c.width); lo = Math.min(lo, y); hi = Math.max(hi, y); }"
+                                      "return [n, hi - lo];")
+    assert actuator[0] > 50 and actuator[1] > 40  # the actuator's blue (#0b6bcb) line climbs across the width
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    _shot(browser, "helix-spatial")
+    Select(_el(browser, "unit")).select_by_value("builtin")
+    _wait(lambda: _el(browser, "winner-design").text != "LaaaAlllAlAAAAa" and _answered(browser), timeout=30)
+    _retype(_el(browser, "amplitude"), "20")
+    _wait(lambda: "A = 20 mm" in _el(browser, "winner-label").text and _answered(browser))
     Select(_el(browser, "preset")).select_by_value("sin")
     _wait(lambda: not _el(browser, "top-view").is_displayed() and _answered(browser))
 

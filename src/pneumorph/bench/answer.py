@@ -25,19 +25,21 @@ import numpy as np
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import best_scores
+from pneumorph.design.growth import designs_of
+from pneumorph.design.spacegrowth import check_space_objective
 from pneumorph.design.targets import ProfileTarget, StagedTarget, TipGoal
-from pneumorph.errors import SearchConfigError
-from pneumorph.geometry.assembly import assemble
-from pneumorph.geometry.orientation import parse_orientation
+from pneumorph.errors import PneumorphError, SearchConfigError
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import atomic_write_text
-from pneumorph.models.chain import ChainModel, design_strings
+from pneumorph.models.chain import ChainModel
 from pneumorph.models.chaintables import find_table
 from pneumorph.models.factory import make_model
 from pneumorph.models.windows import design_numbers
 
 TARGET_SAMPLES = 201
 BUILTIN = "builtin"
+LIBRARIES = {"spatial": "spatial library: a, l (sideways)"}
+"""The built-in unit libraries the bench serves, by id (their shipped 3D tables), and their names."""
 UNIT_ID = re.compile(r"u[0-9a-f]{15,16}")
 """An uploaded unit's id: ``u`` and 16 random hex digits (15: the hashed ids of earlier versions)."""
 
@@ -91,14 +93,14 @@ class Bench:
     # -- units --------------------------------------------------------------------------
     @property
     def unit_ids(self) -> tuple[str, ...]:
-        """The units queries may name: ``"builtin"`` and the uploaded ones."""
-        return tuple(self._specs)
+        """The units queries may name: ``"builtin"``, the built-in libraries and the uploaded units."""
+        return (BUILTIN, *LIBRARIES, *(u for u in self._specs if u != BUILTIN))
 
     def knows(self, unit: str) -> bool:
         """True for a unit queries may name (one added by another process is read from ``unit_dir``)."""
         if not isinstance(unit, str):
             return False
-        if unit in self._specs:
+        if unit in self._specs or unit in LIBRARIES:
             return True
         if self.unit_dir is None or UNIT_ID.fullmatch(unit) is None:
             return False
@@ -152,7 +154,10 @@ class Bench:
         settings: dict[str, Any] = {**self.settings, "fidelity": fidelity}
         if unit != BUILTIN:
             settings = {k: v for k, v in settings.items() if k not in ("unit", "unit_file", "library")}
-            settings["unit"] = self._specs[unit].to_dict()
+            if unit in LIBRARIES:
+                settings["library"] = unit
+            else:
+                settings["unit"] = self._specs[unit].to_dict()
         return settings
 
     def model(self, fidelity: str, unit: str = BUILTIN) -> Any:
@@ -170,6 +175,8 @@ class Bench:
         QueryError
             No table exists for the model (field ``model``).
         """
+        if unit in LIBRARIES and fidelity != "3d":
+            raise QueryError("model", f"the {unit} library's units bend out of the plane: choose the 3D model")
         model = self.model(fidelity, unit)
         with self._lock:
             if (fidelity, unit) not in self._chains:
@@ -210,6 +217,12 @@ class Bench:
         length = self.length(model, unit)
         query = parse_query(body, length, self.unit_ids if units is None else units)
         objective = query.objective(length)
+        if self.chain(model, unit).table.axes == 3:  # a chain in space scores fewer kinds of target
+            try:
+                check_space_objective(objective)
+            except SearchConfigError:
+                raise QueryError("target", f"the {unit} library's chain scores profiles, space curves and tip "
+                                           "goals other than the curl, not this target") from None
         if isinstance(objective, StagedTarget):  # each stage at a level of the ramp
             try:
                 objective.levels(self.chain(model, unit).pressures(), how="")
@@ -267,8 +280,9 @@ class Bench:
         sign = 1.0 if objective.sense == "min" else -1.0
         k = min(query.top, len(scores.cost))
         top = np.argpartition(scores.cost, k - 1)[:k]
-        top = top[np.lexsort((design_numbers(scores.bits[top]), scores.cost[top]))]  # ties: the smaller design first
-        designs = design_strings(scores.bits[top])
+        numbers = design_numbers(scores.bits[top], scores.choices)
+        top = top[np.lexsort((numbers, scores.cost[top]))]  # ties: the smaller design first
+        designs = chain.table.texts(scores.bits[top])
         kpa = chain.pressures() * 1e3
         best = int(top[0])
         worst_case = float(scores.cost[best] + scores.bound[best])  # the winner's FE value is at least this good
@@ -277,16 +291,19 @@ class Bench:
         response = chain.evaluate(winner)
         level = int(scores.level[best])
         unit = objective.unit
+        every = round(designs_of(chain))
+        # the designs left unlisted are bounded below by the floor: at or above the winner's worst case, none of
+        # them can beat it; below it (a branch-and-bound that had to drop open prefixes) the answer is not certain
+        certain = bool(scores.floor >= worst_case)
         certificate = {
             "bound": float(scores.bound[best]),
             "candidates": candidates,
-            "designs": 2**self.units,
+            "designs": every,
             "scored": len(scores.cost),  # the others are bounded above the threshold (floor)
             "complete": bool(scores.complete),
-            "statement": (f"Within the chain's validated error bound ({float(scores.bound[best]):.3g} {unit}), the "
-                          f"{query.model.upper()} model's optimum is "
-                          f"{'this design' if candidates == 1 else f'one of {candidates} designs'}"
-                          f" of all {2**self.units:,}; an FE verification certifies it."),
+            "certified": certain,
+            "statement": _statement(query.model, float(scores.bound[best]), unit, candidates, every, certain,
+                                    sign * float(scores.floor)),
         }
         return {
             "query_id": key_id(query.key()),
@@ -312,20 +329,13 @@ class Bench:
     def chain_profiles(self, design: str, fidelity: str, unit: str = BUILTIN) -> list[list[list[float]]]:
         """A design's predicted centrelines at every level (see :func:`profiles`)."""
         chain = self.chain(fidelity, unit)
-        try:
-            design = parse_orientation(design, self.units)
-        except Exception as exc:  # a pneumorph error naming the bad character or length
-            raise QueryError("design", str(exc)) from None
-        return profiles(chain.evaluate(design))
+        return profiles(chain.evaluate(_design(chain, design)))
 
     def chain_shape(self, design: str, fidelity: str, level: int, unit: str = BUILTIN) -> dict[str, Any]:
         """The 3D surface of a design at ``level``: its FE solution if one was kept, else laid along its
         predicted centreline."""
         chain = self.chain(fidelity, unit)
-        try:
-            design = parse_orientation(design, self.units)
-        except Exception as exc:
-            raise QueryError("design", str(exc)) from None
+        design = _design(chain, design)
         k = len(chain.pressures())
         if isinstance(level, bool) or not isinstance(level, int) or not 0 <= level < k:
             raise QueryError("level", f"level must be a whole number from 0 to {k - 1}, got {level!r}")
@@ -338,12 +348,13 @@ class Bench:
 
     # -- FE shapes of verified designs --------------------------------------------------
     def _mesh(self, design: str, unit: str) -> Any:
-        """The 3D half mesh of a design (the last few kept: a pressure slider asks for the same one)."""
+        """The 3D mesh of a design as its 3D model meshes it: the half width where the design is planar (the last
+        few kept: a pressure slider asks for the same one)."""
         key = f"{unit}:{design}"
         with self._lock:
             mesh = self._meshes.get(key)
         if mesh is None:
-            mesh = assemble(self.model("3d", unit).unit, design, 3, half=True)
+            mesh = self.model("3d", unit).mesh(design)
             with self._lock:
                 self._meshes[key] = mesh
                 while len(self._meshes) > 16:
@@ -367,6 +378,31 @@ class Bench:
         return path
 
 
+def _statement(model: str, bound: float, unit: str, candidates: int, every: int, certain: bool, floor: float) -> str:
+    """What the chain proves about the winner, in words: certain, or how far an unlisted design could go."""
+    within = f"Within the chain's validated error bound ({bound:.3g} {unit}), the {model.upper()} model's optimum is "
+    if certain:
+        return (f"{within}{'this design' if candidates == 1 else f'one of {candidates} designs'} of all {every:,}; "
+                "an FE verification certifies it.")
+    return (f"Not certified: too many of all {every:,} designs come within the chain's error bound ({bound:.3g} "
+            f"{unit}) to list; the search kept the best and bounds the others only by {floor:.4g} {unit}, so an "
+            "unlisted design could still beat this one. An FE verification checks the listed ones.")
+
+
+def _design(chain: ChainModel, design: str) -> str:
+    """A design's canonical text over the chain's units (0/1, or letters of a library).
+
+    Raises
+    ------
+    QueryError
+        Field ``design``: a design of the wrong length or with characters that are no units.
+    """
+    try:
+        return chain.table.texts(chain.table.designs(design, chain.n_units))[0]
+    except PneumorphError as exc:  # the message names the bad character or length
+        raise QueryError("design", str(exc)) from None
+
+
 def key_id(key: str) -> str:
     """A short stable id of a query key."""
     import hashlib
@@ -375,12 +411,13 @@ def key_id(key: str) -> str:
 
 
 def profiles(response: Any) -> list[list[list[float]]]:
-    """Base, unit centres and tip at every level, heights above the undeformed axis (mm)."""
+    """Base, unit centres and tip at every level, heights above the undeformed axis (mm); a response in space
+    (x, y, z) also gives each point's z off the undeformed axis."""
     c = response.centres.copy()
-    c[..., 1] -= response.reference_centres[None, :, 1]
+    c[..., 1:] -= response.reference_centres[None, :, 1:]
     tip = response.tip.copy()
-    tip[:, 1] -= response.reference_tip[1]
-    base = np.zeros((len(c), 1, 2))
+    tip[:, 1:] -= response.reference_tip[1:]
+    base = np.zeros((len(c), 1, c.shape[-1]))
     pts = np.concatenate([base, c, tip[:, None]], axis=1)
     return np.round(pts, 4).tolist()
 

@@ -26,7 +26,7 @@ from fastapi.responses import FileResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from pneumorph.bench.answer import Bench
+from pneumorph.bench.answer import LIBRARIES, Bench
 from pneumorph.bench.guard import (
     LOCAL_HOSTS,
     MAX_UNIT_FILE,
@@ -41,7 +41,6 @@ from pneumorph.design.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
 from pneumorph.geometry.limits import MeshLimitError
 from pneumorph.geometry.meshsize import check_mesh
-from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import json_safe
 
@@ -324,6 +323,7 @@ def _units_router(bench: Bench, board: JobBoard) -> APIRouter:
     @router.get("/api/units")
     async def units(request: Request) -> dict[str, Any]:
         return {"units": [{"id": "builtin", "name": bench.unit_spec().name, "model": "3d and 2d"},
+                          *({"id": k, "name": name, "model": "3d"} for k, name in LIBRARIES.items()),
                           *board.units_of(request.state.session)]}
 
     @router.post("/api/jobs/table", status_code=202)
@@ -361,7 +361,7 @@ def _jobs_router(bench: Bench, board: JobBoard) -> APIRouter:
             design, unit = body.get("design"), body.get("unit", "builtin")
             _check_model(bench, board, "3d", unit, request)
             try:
-                design = parse_orientation(design if isinstance(design, str) else "", bench.units)
+                design = bench.model("3d", unit).parse(design if isinstance(design, str) else "").text
             except PneumorphError as exc:
                 raise QueryError("design", str(exc)) from None
             job = board.export(session, design, unit)

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from pneumorph.bench.answer import Bench
+from pneumorph.bench.answer import LIBRARIES, Bench
 from pneumorph.bench.query import Query
 from pneumorph.errors import JobLimitError, StateQuotaError
 from pneumorph.io.files import atomic_write_text, json_safe
@@ -284,8 +284,8 @@ class JobBoard:
                 for j in self.of(session) if j.kind == "table" and j.state == "done" and j.result]
 
     def unit_ids_of(self, session: str) -> tuple[str, ...]:
-        """The unit ids ``session`` may name: the built-in unit and its own uploaded ones."""
-        return ("builtin", *(u["id"] for u in self.units_of(session) if u["id"] != "builtin"))
+        """The unit ids ``session`` may name: the built-in unit, the built-in libraries and its own uploaded units."""
+        return ("builtin", *LIBRARIES, *(u["id"] for u in self.units_of(session) if u["id"] != "builtin"))
 
     def cancel(self, session: str, job_id: str) -> Job | None:
         """Cancel a queued or running job of ``session`` (its processes end at once); delete a finished one.

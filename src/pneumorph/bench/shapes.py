@@ -3,8 +3,8 @@
 :func:`surface` triangulates the outer faces of a 3D mesh (a half model mirrored to the
 full width). :func:`chain_placement` moves the undeformed nodes onto the centreline the
 chain model predicts: every cross-section turns with the interpolated tangent of the
-centreline and keeps its shape (no ballooning) - an approximate picture until an FE solve
-gives the real one.
+centreline (in the plane or in space) and keeps its shape (no ballooning) - an approximate
+picture until an FE solve gives the real one.
 """
 
 from __future__ import annotations
@@ -57,40 +57,49 @@ def surface(mesh: ActuatorMesh, x: FloatArray) -> dict[str, Any]:
 def chain_placement(mesh: ActuatorMesh, response: Response, level: int) -> FloatArray:
     """The mesh's nodes laid along a predicted centreline at ``level`` (approximate shape).
 
-    The centreline runs through the base (fixed), the unit centres and the tip; its tangent
-    angle is the chord direction at the base, the centres (central differences) and the
-    tip's curl, linear in between. A node at ``(X, Y, Z)`` goes to the centreline point at
-    arc ``X`` plus its height ``Y`` above the undeformed axis, turned with the tangent.
+    The centreline is the polyline base -> unit centres -> tip (a planar response's in the
+    plane z = 0). Each chord turns from its undeformed direction by the rotation between the
+    two chords' frames transported along the polylines without twist
+    (:func:`~pneumorph.models.spacechords.transported_frames`). A centre turns halfway between
+    its two chords (spherical linear interpolation), the base not at all, the tip as its
+    end face (a planar response's curl) or, in space, as the last chord; a node at arc ``X``
+    turns as interpolated between them. It goes to the centreline point at ``X`` plus its
+    offset from the undeformed centreline, turned. Cross-sections keep their shape (no
+    ballooning).
 
     Examples
     --------
     >>> from pneumorph.geometry.assembly import assemble
-    >>> from pneumorph.geometry.unit import UnitSpec
+    >>> from pneumorph.geometry.library import builtin_library
     >>> from pneumorph.models.response import Response
-    >>> m = assemble(UnitSpec(element_size=3.0), "00", dim=3, half=True)
-    >>> ref = m.unit_centres(); tip = np.array([m.points[:, 0].max(), ref[0, 1]])
-    >>> r = Response("00", np.array([0.01]), ref[None], ref, tip[None], tip, np.zeros(1))
-    >>> bool(np.allclose(chain_placement(m, r, 0), m.points))  # straight: nothing moves
+    >>> m = assemble(builtin_library("spatial"), "al", dim=3, half=False)   # centres at two heights
+    >>> ref = m.unit_centres(axes=3); tip = np.array([m.points[:, 0].max(), 6.0, 7.5])
+    >>> r = Response("al", np.array([0.01]), ref[None], ref, tip[None], tip, np.zeros(1))
+    >>> bool(np.allclose(chain_placement(m, r, 0), m.points))  # undeformed: nothing moves
     True
     """
-    ref_c, ref_t = response.reference_centres, response.reference_tip
-    c, tip, curl = response.centres[level], response.tip[level], np.radians(response.curl[level])
-    s = np.concatenate([[0.0], ref_c[:, 0], [ref_t[0]]])
-    axis_y = np.concatenate([[ref_c[0, 1]], ref_c[:, 1], [ref_t[1]]])
-    base = np.array([0.0, ref_c[0, 1]])
-    pts = np.vstack([base, c, tip])
-    chords = np.diff(pts, axis=0)
-    along = np.unwrap(np.arctan2(chords[:, 1], chords[:, 0]))
-    angle = np.concatenate([[0.0], 0.5 * (along[:-1] + along[1:]), [curl]])
-    angle[-1] = angle[-2] + (angle[-1] - angle[-2] + np.pi) % (2 * np.pi) - np.pi
-    X = mesh.points[:, 0]
-    cx, cy = np.interp(X, s, pts[:, 0]), np.interp(X, s, pts[:, 1])
-    a = np.interp(X, s, angle)
-    h = mesh.points[:, 1] - np.interp(X, s, axis_y)
-    out = mesh.points.astype(float).copy()
-    out[:, 0] = cx - h * np.sin(a)
-    out[:, 1] = cy + h * np.cos(a)
-    return out
+    from scipy.spatial.transform import Rotation, Slerp
+
+    from pneumorph.models.spacechords import space_elements, transported_frames
+
+    def polyline(centres: FloatArray, tip: FloatArray) -> FloatArray:
+        out = np.vstack([response.reference_centres[:1], centres, tip[None]]).astype(float)
+        out[0, 0] = 0.0  # the base: the first centre's height and width at x = 0
+        return out if out.shape[1] == 3 else np.column_stack([out, np.zeros(len(out))])
+
+    ref = polyline(response.reference_centres, response.reference_tip)
+    pts = polyline(response.centres[level], response.tip[level])
+    undeformed, deformed = (transported_frames(space_elements(p)[0]) for p in (ref, pts))
+    chords = Rotation.from_matrix(deformed @ np.swapaxes(undeformed, -1, -2))
+    halves = [Slerp([0.0, 1.0], chords[[j, j + 1]])(0.5) for j in range(len(chords) - 1)]
+    end = (Rotation.from_rotvec([0.0, 0.0, np.radians(response.curl[level])])
+           if response.centres.shape[-1] == 2 else chords[-1])
+    s = ref[:, 0]
+    X = np.clip(mesh.points[:, 0], s[0], s[-1])
+    turn = Slerp(s, Rotation.concatenate([Rotation.identity(), *halves, end]))(X)
+    along = np.column_stack([np.interp(X, s, pts[:, i]) for i in range(3)])
+    offset = mesh.points - np.column_stack([np.interp(X, s, ref[:, i]) for i in range(3)])
+    return np.asarray(along + turn.apply(offset), dtype=float)
 
 
 __all__ = ["chain_placement", "surface"]

@@ -203,7 +203,7 @@ def export(job: dict[str, Any], bench: Bench, report: Reporter) -> dict[str, Any
     design, unit_id = job["params"]["design"], job["params"]["unit"]
     folder = Path(job["folder"])
     model = bench.model("3d", unit_id)
-    unit = model.unit
+    unit = model.library if model.mixed else model.unit  # a library's design: its units and their strips
     out = folder / "export"
     report.say(f"parts of {design}", 0.1)
     write_stl(actuator_parts(unit, design, BaseBlock()), out / "parts")

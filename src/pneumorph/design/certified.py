@@ -161,7 +161,7 @@ def certified_search(
         # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
         # and the FE verifications alike
         objective = replace(objective, length=chain.length)
-    scores = space_scores(chain, objective, margin) if chain.table.axes == 3 else chain_scores(chain, objective, margin)
+    scores = chain_scores(chain, objective, margin)
     order = scores.order()
     designs = chain.table.texts(scores.bits[order])
     say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "

@@ -1,5 +1,5 @@
 """Every design scored by the chain model, grown unit by unit over shared prefixes; above
-:data:`MAX_ENUMERATE` units (or ``2^MAX_ENUMERATE`` designs of a unit library), a
+:data:`~pneumorph.design.branching.MAX_ENUMERATE` units (or ``2^MAX_ENUMERATE`` designs of a unit library), a
 branch-and-bound over the same growth that returns every design within reach of the best and
 a floor under all others (:mod:`pneumorph.design.certified`).
 """
@@ -25,29 +25,20 @@ from pneumorph.design.bounds import (
     chain_errors,
     score_designs,
 )
+from pneumorph.design.branching import BEAM, MAX_ENUMERATE, MAX_NODES, kept, narrow, union
 from pneumorph.design.fitness import tip_value_array
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry, depths, seed_prefixes, tip_and_curl
 from pneumorph.design.reach import reach_of
 from pneumorph.design.reachbox import box_bound
 from pneumorph.design.rest import CurveRange, profile_rest, tip_goal_rest
+from pneumorph.design.spacegrowth import space_scores
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel
-from pneumorph.models.windows import design_numbers, every_design
+from pneumorph.models.windows import every_design
 
 FloatArray = NDArray[np.float64]
 
-
-MAX_ENUMERATE = 20
-"""Longest actuator whose 2^n designs are all scored; longer ones go through branch-and-bound
-(over ``2k`` choices per unit: while ``(2k)^n <= 2^MAX_ENUMERATE``)."""
-
-
-MAX_NODES = 500_000
-"""Most open prefixes the branch-and-bound keeps at one depth."""
-
-BEAM = 4096
-"""Prefixes the first search keeps at every depth (a good design, whose cost sets the threshold)."""
 
 SPILL_ROUNDS = 1
 """Probing runs at most before the last: a probe is a branch-and-bound that keeps at most
@@ -66,10 +57,6 @@ REFINE_AT = 20_000
 KEEP_GEOMETRY_UNITS = 15
 """Longest actuator whose prefix geometry is kept between queries (15 units: about 50 MB;
 the memory doubles with every unit)."""
-
-
-class BranchOverflow(SearchConfigError):
-    """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`)."""
 
 
 def choices(chain: ChainModel) -> int:
@@ -198,7 +185,8 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     beta)``. Every dropped design then has an optimistic value ``>= T``: it is neither among
     the ``top`` best nor able to beat the best design's worst case (cost + bound). The
     answer lists the survivors with ``floor = T``. Other objectives score every design
-    (:func:`chain_scores`).
+    (:func:`chain_scores`), and a chain in space goes to
+    :func:`~pneumorph.design.spacegrowth.space_scores`.
 
     Examples
     --------
@@ -210,6 +198,8 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     >>> chain.table.texts(s.bits[s.order()[:1]]), bool(len(s.bits) < 2**15), s.complete
     (['001111010001001'], True, False)
     """
+    if chain.table.axes == 3:
+        return space_scores(chain, objective, margin)
     errors = chain_errors(chain, margin)
     n = chain.n_units
     if (not isinstance(objective, ProfileTarget) or objective.coordinates != "cartesian"
@@ -243,40 +233,6 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
         values = np.sqrt(total)
     cost, level, opt, bound = _costs(values, np.broadcast_to(beta, values.shape), objective.sense)
     return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold, choices=_radix(chain))
-
-
-def _narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_nodes: int, p: int,
-            n: int, spill: list[float] | None = None) -> NDArray[np.bool_]:
-    """The open prefixes (``keep``) cut to the ``beam`` of lowest bound, if given.
-
-    With ``spill`` (a list), more than ``max_nodes`` open prefixes are cut to the ``max_nodes``
-    of lowest bound instead, and the least bound of those dropped is appended to ``spill``.
-
-    Raises
-    ------
-    BranchOverflow
-        More than ``max_nodes`` stay open at depth ``p`` of ``n`` (without ``spill``).
-    """
-    if beam is not None and keep.sum() > beam:
-        keep = np.zeros(len(bound), dtype=bool)
-        keep[np.argpartition(bound, beam)[:beam]] = True
-    if keep.sum() > max_nodes and spill is not None:
-        open_ = np.flatnonzero(keep)
-        order = np.argpartition(bound[open_], max_nodes)
-        spill.append(float(bound[open_[order[max_nodes:]]].min()))
-        keep = np.zeros(len(bound), dtype=bool)
-        keep[open_[order[:max_nodes]]] = True
-    if keep.sum() > max_nodes:
-        raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too many "
-                             "designs come within the chain's error bound of the best to list them all - use "
-                             "--search ga")
-    return keep
-
-
-def kept(bits: NDArray[np.uint8], state: dict[str, Any],
-         keep: NDArray[np.bool_]) -> tuple[NDArray[np.uint8], dict[str, Any]]:
-    """The prefixes ``keep`` marks and their state (what a depth sends back to the growth)."""
-    return bits[keep], {key: v[keep] for key, v in state.items()}
 
 
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
@@ -342,7 +298,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 bound[keep] = _prefix_bound(chain, objective, bits[keep], {key: v[keep] for key, v in st.items()},
                                             placed, curve)
                 keep = bound < threshold
-            bits, st = kept(bits, st, _narrow(keep, bound, beam, max_nodes, p, n, spilled))
+            bits, st = kept(bits, st, narrow(keep, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
         if profile:
             values = np.sqrt(st["sum"])
@@ -362,7 +318,9 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
                  max_enumerate: int = MAX_ENUMERATE, max_nodes: int = MAX_NODES) -> ChainScores:
     """Chain scores of every design that can matter, with a floor under the rest.
 
-    Up to ``max_enumerate`` units: all ``2^n`` designs. Above: a beam search (the 4096
+    A chain in space (``chain.table.axes == 3``) is scored by
+    :func:`~pneumorph.design.spacegrowth.space_scores`. Up to ``max_enumerate`` units: all
+    ``2^n`` designs. Above: a beam search (the 4096
     prefixes of lowest bound at every depth, :data:`BEAM`) gives a good cost ``c0``; branch-and-bound
     then returns every design of chain cost below ``c0 + 2 beta`` (``beta`` the largest
     bound), the only ones whose FE value can beat a design of chain cost ``c0``; all others
@@ -377,6 +335,8 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
     that the dropped prefixes' least bound gives (``lower - beta``): an answer whose
     certificate states how much better an unlisted design could be, not a failure.
     """
+    if chain.table.axes == 3:
+        return space_scores(chain, objective, margin, max_nodes, max_enumerate)
     errors = chain_errors(chain, margin)
     n = chain.n_units
     if _enumerable(chain, max_enumerate):
@@ -396,7 +356,7 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
             return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
                                scores.optimistic[keep], scores.bound[keep], floor=threshold - beta,
                                choices=scores.choices)
-        found = _union(scores, found)
+        found = union(scores, found)
         if final:
             return replace(found, floor=min(scores.floor, threshold) - beta)
         # a probe: a better design lowers the threshold and probes again; none leaves the last, full run
@@ -419,15 +379,6 @@ def _staged_rest(chain: ChainModel, profiles: list[tuple[int, ProfileTarget, int
                                       state["point"][:, k:k + 1], state["angle"][:, k:k + 1], placed, chain.n_units,
                                       chain.table.window)[:, 0]
     return rest
-
-
-def _union(a: ChainScores, b: ChainScores) -> ChainScores:
-    """The designs of ``a`` and those of ``b`` that ``a`` lacks (their scores as they are)."""
-    extra = ~np.isin(design_numbers(b.bits, b.choices), design_numbers(a.bits, a.choices))
-    return ChainScores(np.concatenate([a.bits, b.bits[extra]]), np.concatenate([a.per_level, b.per_level[extra]]),
-                       np.concatenate([a.cost, b.cost[extra]]), np.concatenate([a.level, b.level[extra]]),
-                       np.concatenate([a.optimistic, b.optimistic[extra]]), np.concatenate([a.bound, b.bound[extra]]),
-                       floor=a.floor, choices=a.choices)
 
 
 def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, FloatArray], threshold: float,
@@ -471,7 +422,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
                                     placed)
                 bound[keep] = np.sqrt(((weights**2) * (state["ssum"][keep] + rest)).sum(axis=1))
                 keep = bound < threshold
-            bits, state = kept(bits, state, _narrow(keep, bound, beam, max_nodes, p, n, spilled))
+            bits, state = kept(bits, state, narrow(keep, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, state))
         tip, curl = tip_and_curl(chain, bits, state)
         per = np.sqrt(state["ssum"])

@@ -37,8 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.design.bounds import ChainScores, _costs, _max_slope, _radix, _target_slope, chain_errors
+from pneumorph.design.branching import BEAM, MAX_ENUMERATE, MAX_NODES, kept, narrow, union
 from pneumorph.design.fitness import tip_value_array
-from pneumorph.design.growth import BEAM, MAX_ENUMERATE, MAX_NODES, _narrow, _union, kept
 from pneumorph.design.prefixes import depths
 from pneumorph.design.reach import AHEAD
 from pneumorph.design.rest import CurveRange
@@ -224,7 +224,7 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
                 bound = np.sqrt(total.min(axis=1))
             else:
                 bound = _tip_bound(chain, goal, st["point"], n + 1 - placed)
-            bits, st = kept(bits, st, _narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled))
+            bits, st = kept(bits, st, narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
         if profile:
             values = np.sqrt(st["sum"])
@@ -241,7 +241,7 @@ def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, m
     """Chain scores of every design of a chain in space that can matter, with a floor under the rest.
 
     As :func:`~pneumorph.design.growth.chain_scores`: every design while there are at most
-    ``2^max_enumerate``; above, a beam search (:data:`~pneumorph.design.growth.BEAM` prefixes
+    ``2^max_enumerate``; above, a beam search (:data:`~pneumorph.design.branching.BEAM` prefixes
     per depth) gives a good cost ``c0``, and branch-and-bound returns every design of chain
     cost below ``c0 + 2 beta``. Where more than ``max_nodes`` prefixes stay open, the best are
     kept and the floor says how much better an unlisted design could be. ``codes``: the unit
@@ -280,7 +280,7 @@ def space_scores(chain: ChainModel, objective: Objective, margin: float = 1.0, m
         return ChainScores(scores.bits[keep], scores.per_level[keep], scores.cost[keep], scores.level[keep],
                            scores.optimistic[keep], scores.bound[keep], floor=threshold - float(beta.max()),
                            choices=scores.choices)
-    return replace(_union(scores, beamed), floor=min(scores.floor, threshold) - float(beta.max()))
+    return replace(union(scores, beamed), floor=min(scores.floor, threshold) - float(beta.max()))
 
 
 __all__ = ["check_space_objective", "grow_space", "space_scores"]

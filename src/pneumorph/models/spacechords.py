@@ -88,14 +88,28 @@ def space_polyline(turns: FloatArray, lengths: FloatArray, start: FloatArray) ->
     The inverse of :func:`space_elements`: shapes ``(..., m, 2)``, ``(..., m)`` and
     ``(..., 3)``; returns ``(..., m + 1, 3)``.
     """
-    turns, lengths = np.asarray(turns, dtype=float), np.asarray(lengths, dtype=float)
+    lengths = np.asarray(lengths, dtype=float)
+    steps = lengths[..., None] * transported_frames(turns)[..., :, 0]  # each chord along its frame's x axis
+    start = np.broadcast_to(np.asarray(start, dtype=float), (*lengths.shape[:-1], 3))
+    return np.concatenate([start[..., None, :], start[..., None, :] + np.cumsum(steps, axis=-2)], axis=-2)
+
+
+def transported_frames(turns: FloatArray) -> FloatArray:
+    """Each chord's twist-free frame (columns: its axes; x along the chord) from :func:`space_elements`' turns.
+
+    Shapes ``(..., m, 2)`` -> ``(..., m, 3, 3)``; the frame before the first chord is the actuator's own.
+
+    >>> transported_frames(np.radians([[0.0, 90.0]]))[0].round(12).tolist()   # a quarter turn about z
+    [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    turns = np.asarray(turns, dtype=float)
     frame = np.broadcast_to(np.eye(3), (*turns.shape[:-2], 3, 3)).copy()
-    points = [np.broadcast_to(np.asarray(start, dtype=float), (*turns.shape[:-2], 3))]
+    frames = []
     for j in range(turns.shape[-2]):
         local = np.concatenate([np.zeros((*turns.shape[:-2], 1)), turns[..., j, :]], axis=-1)
         frame = frame @ _rotation(local)
-        points.append(points[-1] + lengths[..., j, None] * frame[..., :, 0])
-    return np.stack(points, axis=-2)
+        frames.append(frame)
+    return np.stack(frames, axis=-3)
 
 
 def frame_elements(points: FloatArray, frames: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -239,4 +253,4 @@ def _rotation(vector: FloatArray) -> FloatArray:
 
 
 __all__ = ["MIRROR_SIGNS", "chain_points", "frame_elements", "frame_polyline", "response_space_elements",
-           "rotation_matrices", "space_elements", "space_polyline", "space_rows"]
+           "rotation_matrices", "space_elements", "space_polyline", "space_rows", "transported_frames"]

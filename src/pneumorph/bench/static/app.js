@@ -122,12 +122,14 @@ function redraw() {
   }));
   drawProfile($("profile-plot"), { target, point: a.point, profile: state.profiles[k], label: `design ${state.selected}`,
     stages, ramp: a.stages ? state.profiles : null });
-  // a space curve: the view from above, the target's z against the actuator's (z = 0: it bends in its plane)
-  const space = Boolean(a.target && a.target.z);
+  // a space curve or a design that leaves the plane: the view from above, the target's z against the
+  // actuator's (z = 0 where the chain is planar: it bends in its plane)
+  const targetZ = Boolean(a.target && a.target.z);
+  const space = targetZ || state.profiles[k][0].length === 3;
   $("top-view").hidden = !space;
   if (space) {
-    drawProfile($("top-plot"), { target: a.target.x.map((x, i) => [x, a.target.z[i]]),
-      profile: state.profiles[k].map(([x]) => [x, 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
+    drawProfile($("top-plot"), { target: targetZ ? a.target.x.map((x, i) => [x, a.target.z[i]]) : null,
+      profile: state.profiles[k].map(([x, , z]) => [x, z || 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
   }
 }
 
