@@ -25,6 +25,17 @@ def test_simulate_solves_a_sideways_design_on_the_full_width(capsys: pytest.Capt
     assert tip_l[2] > mid + 0.01 and tip_r[2] < mid - 0.01  # towards the side of the layer
     assert tip_l[2] - mid == pytest.approx(mid - tip_r[2], abs=1e-6)  # mirror images
     assert tip_l[1] == pytest.approx(tip_r[1], abs=1e-6)
+    twist_l, twist_r = left["levels"][0]["twist_deg"], right["levels"][0]["twist_deg"]
+    assert twist_l == pytest.approx(-twist_r, abs=1e-6)  # the end face twists the other way in the mirror image
+
+
+def test_simulate_prints_the_tip_z_and_the_twist_of_a_full_width_design(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simulate", "-o", "al", "--library", "spatial", "--model", "3d", "--pressure", "5",
+                 "--increments", "1"]) == 0
+    header, row = capsys.readouterr().out.splitlines()[:2]
+    assert header.split() == ["p", "[kPa]", "tip", "x", "[mm]", "tip", "y", "[mm]", "tip", "z", "[mm]", "curl", "[deg]",
+                              "twist", "[deg]"]
+    assert len(row.split()) == 6 and float(row.split()[0]) == pytest.approx(5.0)
 
 
 @pytest.mark.parametrize(("args", "message"), [

@@ -148,7 +148,8 @@ def test_a_helix_shows_the_view_from_above(browser) -> None:  # type: ignore[no-
                                       "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
                                       "let n = 0, lo = c.height, hi = 0;"
                                       "for (let i = 0; i < d.length; i += 4) if (d[i] === 11 && d[i + 1] === 107) {"
-                                      "  n++; const y = Math.floor(i / 4 / c.width); lo = Math.min(lo, y); hi = Math.max(hi, y); }"
+                                      "  n++; const y = Math.floor(i / 4 / c.width);"
+                                      "  lo = Math.min(lo, y); hi = Math.max(hi, y); }"
                                       "return [n, hi - lo];")
     assert actuator[0] > 50 and actuator[1] > 40  # the actuator's blue (#0b6bcb) line climbs across the width
     assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]

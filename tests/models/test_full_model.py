@@ -42,6 +42,11 @@ def test_the_full_model_equals_the_half_model_on_a_planar_design(spatial: UnitLi
     W = spatial["a"].width  # the full model's z stays on the mid-plane, where the half model holds it
     np.testing.assert_allclose(full.centres[..., 2], W / 2, atol=ATOL, rtol=0)
     np.testing.assert_allclose(full.tip[:, 2], W / 2, atol=ATOL, rtol=0)
+    # the end face turns about z by the curl, without twist; the half model keeps no end frame
+    assert half.end_frame is None and half.twist is None and full.end_frame is not None
+    np.testing.assert_allclose(full.end_frame, np.column_stack([0 * full.curl, 0 * full.curl, np.radians(full.curl)]),
+                               atol=1e-7, rtol=0)
+    np.testing.assert_allclose(full.twist, 0.0, atol=1e-6)
 
 
 def test_a_sideways_unit_bends_out_of_the_plane_towards_its_layer(spatial: UnitLibrary,
@@ -65,6 +70,10 @@ def test_the_turned_over_sideways_unit_mirrors_the_response_across_the_width(sid
     np.testing.assert_allclose(right.tip[:, :2], left.tip[:, :2], atol=ATOL, rtol=0)  # in-plane the same
     np.testing.assert_allclose(right.centres[..., :2], left.centres[..., :2], atol=ATOL, rtol=0)
     np.testing.assert_allclose(right.curl, left.curl, atol=1e-5, rtol=0)
+    # mirrored across the width, the end face tilts and twists the other way: rotation vector (-x, -y, z)
+    np.testing.assert_allclose(right.end_frame, left.end_frame * [-1, -1, 1], atol=1e-7, rtol=0)
+    np.testing.assert_allclose(right.twist, -left.twist, atol=1e-5, rtol=0)
+    assert abs(left.end_frame[-1, 1]) > 1e-3  # the sideways unit tilts the face about y: it bends across the width
 
 
 def test_a_sideways_response_keeps_z_through_its_file(sideways: dict[str, object], tmp_path: object) -> None:
@@ -77,6 +86,7 @@ def test_a_sideways_response_keeps_z_through_its_file(sideways: dict[str, object
     again = Response.load(Path(str(tmp_path)) / "r")
     assert again.axes == 3
     np.testing.assert_array_equal(again.centres, response.centres)
+    np.testing.assert_array_equal(again.end_frame, response.end_frame)
     np.testing.assert_array_equal(again.centreline(-1)[1:-1], response.centres[-1])
     assert again.centreline(0)[0].tolist() == [0.0, *response.reference_centres[0, 1:].tolist()]
 

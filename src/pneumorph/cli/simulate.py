@@ -118,11 +118,13 @@ def _print_json(design: str, fidelity: str, resp: Any) -> None:
     """Tip, curl and unit centres of every level as JSON."""
     from pneumorph.io.files import strict_json
 
+    twist = resp.twist
     levels = [
         {
             "pressure_kpa": float(p * 1e3),
             "tip_mm": resp.tip[k].tolist(),
             "curl_deg": float(resp.curl[k]),
+            **({} if twist is None else {"twist_deg": float(twist[k])}),  # the full width: the end face's twist
             "unit_centres_mm": resp.centres[k].tolist(),
         }
         for k, p in enumerate(resp.pressures)
@@ -135,9 +137,14 @@ def _print_table(resp: Any, out: str | None) -> None:
     """Tip and curl of every level as a table, the solver's effort, and where the files went."""
     from pathlib import Path
 
-    click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} {'curl [deg]':>11}")
+    space = resp.axes == 3 and resp.twist is not None  # the full width: the tip's z and the end face's twist too
+    click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} "
+               + (f"{'tip z [mm]':>11} " if space else "") + f"{'curl [deg]':>11}"
+               + (f" {'twist [deg]':>12}" if space else ""))
     for k, p in enumerate(resp.pressures):
-        click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {resp.curl[k]:11.2f}")
+        z = f"{resp.tip[k, 2]:11.3f} " if space else ""
+        tw = f" {resp.twist[k]:12.3f}" if space else ""
+        click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {z}{resp.curl[k]:11.2f}{tw}")
     m = resp.metadata
     click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
                f"{m['wall_time_s']:.2f} s")

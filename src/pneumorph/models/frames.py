@@ -46,4 +46,61 @@ def unit_frames(mesh: Any, displacement: FloatArray) -> FloatArray:
         out[i] = Rotation.align_vectors(b, a)[0].as_rotvec()  # the rotation that best takes a onto b
     return out
 
-__all__ = ["unit_frames"]
+def end_frame(mesh: Any, displacement: FloatArray) -> FloatArray:
+    """The free end face's rotation (a rotation vector, rad) from the undeformed ``mesh`` by ``displacement``, (3,).
+
+    The face's frame is its line up the height - from the lowest to the highest of the
+    section's end points (``ActuatorMesh.end_points``), the line whose angle is the curl - and
+    its line across the width, from the mean of its nodes on one side face to the other's,
+    made normal to the first; the third axis completes them. The rotation takes the
+    undeformed frame to the deformed one, so a planar bend turns it about z by the curl.
+
+    >>> from pneumorph.geometry.assembly import assemble
+    >>> from pneumorph.geometry.unit import UnitSpec
+    >>> mesh = assemble(UnitSpec(element_size=3.0), "0", dim=3, half=False)
+    >>> turn = Rotation.from_rotvec([0.2, 0.0, 0.5])
+    >>> end_frame(mesh, turn.apply(mesh.points) - mesh.points).round(12).tolist()
+    [0.2, 0.0, 0.5]
+    """
+    points = np.asarray(mesh.points, dtype=float)[:, :3]
+    ends = mesh.end_points
+    face = np.flatnonzero(np.isclose(points[:, 0], points[ends[0], 0]))
+    z = points[face, 2]
+    sides = face[np.isclose(z, z.min())], face[np.isclose(z, z.max())]
+
+    def frame(x: FloatArray) -> FloatArray:
+        up = x[ends[-1]] - x[ends[0]]
+        up /= np.linalg.norm(up)
+        across = x[sides[1]].mean(axis=0) - x[sides[0]].mean(axis=0)
+        across -= np.dot(across, up) * up
+        across /= np.linalg.norm(across)
+        return np.column_stack([np.cross(up, across), up, across])
+
+    turned = frame(points + displacement[:, :3]) @ frame(points).T
+    return np.asarray(Rotation.from_matrix(turned).as_rotvec())
+
+
+def twist(rotations: FloatArray) -> FloatArray:
+    """The twist (deg) of end-face rotations about the face's own normal, the actuator's axis x.
+
+    A rotation splits into a *swing*, whose axis is normal to x (it tilts the face: the
+    curl and the sideways bend), followed by a *twist* about x: ``R = swing * twist`` with
+    the twist's angle ``2 atan2(q_x, q_w)`` of the rotation's unit quaternion ``q``, in
+    (-180, 180]. Rotations (..., 3) as rotation vectors; NaN stays NaN.
+
+    >>> twist(np.radians([[0.0, 0.0, 90.0], [30.0, 0.0, 0.0]])).round(9).tolist()  # a pure curl, a pure twist
+    [0.0, 30.0]
+    """
+    r = np.asarray(rotations, dtype=float)
+    flat = r.reshape(-1, 3)
+    out = np.full(len(flat), np.nan)
+    ok = np.isfinite(flat).all(axis=1)
+    if ok.any():
+        q = Rotation.from_rotvec(flat[ok]).as_quat()  # (x, y, z, w)
+        angle = np.degrees(2.0 * np.arctan2(q[:, 0], q[:, 3]))
+        out[ok] = (angle + 180.0) % 360.0 - 180.0
+        out[ok & np.isclose(out, -180.0)] = 180.0
+    return out.reshape(r.shape[:-1])
+
+
+__all__ = ["end_frame", "twist", "unit_frames"]

@@ -58,6 +58,10 @@ class Response:
     frames : ndarray, shape (k, n, 3), or None
         Each unit's rotation (a rotation vector, rad) per level: the full 3D model's
         responses (points in space) keep it (:mod:`pneumorph.models.frames`); None otherwise.
+    end_frame : ndarray, shape (k, 3), or None
+        The free end face's rotation (a rotation vector, rad) per level, of the full 3D
+        model's responses (:func:`pneumorph.models.frames.end_frame`); its :attr:`twist` about
+        the face's normal. None for planar responses and chains.
 
     Examples
     --------
@@ -85,6 +89,7 @@ class Response:
     failure: str | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
     frames: FloatArray | None = None
+    end_frame: FloatArray | None = None
 
     def __post_init__(self) -> None:
         k, n = len(self.pressures), len(self.orientation)
@@ -98,6 +103,8 @@ class Response:
         }
         if self.frames is not None:  # each unit's rotation vector, per level (a full-width response)
             shapes["frames"] = (self.frames.shape, (k, n, 3))
+        if self.end_frame is not None:
+            shapes["end_frame"] = (self.end_frame.shape, (k, 3))
         for name, (got, want) in shapes.items():
             if tuple(got) != want:
                 raise ValueError(f"Response.{name} has shape {tuple(got)}, expected {want}")
@@ -119,6 +126,7 @@ class Response:
         d = len(reference_tip)
         if d == 3:  # a full-width response keeps each unit's frame too (pneumorph.models.frames)
             kwargs.setdefault("frames", np.full((k, n, 3), np.nan))
+            kwargs.setdefault("end_frame", np.full((k, 3), np.nan))
         return cls(
             orientation=orientation,
             pressures=np.asarray(pressures, dtype=float),
@@ -142,6 +150,14 @@ class Response:
     def axes(self) -> int:
         """The coordinates of every point: 2 (x, y) or 3 (x, y, z; a model of the full width)."""
         return int(self.reference_tip.shape[0])
+
+    @property
+    def twist(self) -> FloatArray | None:
+        """The end face's twist about its own normal (deg) per level (:func:`pneumorph.models.frames.twist`), or
+        None without the end face's frame."""
+        from pneumorph.models.frames import twist
+
+        return None if self.end_frame is None else twist(self.end_frame)
 
     @property
     def displacements(self) -> FloatArray:
@@ -184,6 +200,8 @@ class Response:
         out["metadata"] = self.metadata
         if self.frames is not None:
             out["frames"] = clean(self.frames)
+        if self.end_frame is not None:
+            out["end_frame"] = clean(self.end_frame)
         return out
 
     @classmethod
@@ -198,6 +216,7 @@ class Response:
             failure=data.get("failure"),
             metadata=dict(data.get("metadata", {})),
             frames=None if data.get("frames") is None else np.array(data["frames"], dtype=float),
+            end_frame=None if data.get("end_frame") is None else np.array(data["end_frame"], dtype=float),
             **arrays,
         )
 
@@ -209,6 +228,8 @@ class Response:
         arrays = {name: getattr(self, name) for name in self._ARRAYS}
         if self.frames is not None:
             arrays["frames"] = self.frames
+        if self.end_frame is not None:
+            arrays["end_frame"] = self.end_frame
         np.savez(npz, **arrays)
         js.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
         return npz, js
