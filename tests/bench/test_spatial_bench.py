@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import io
+import time
+import zipfile
 from dataclasses import replace
 
 import numpy as np
@@ -110,3 +113,17 @@ def test_the_api_offers_the_spatial_library_and_exports_a_sideways_design(tmp_pa
     assert np.shape(r.json()["profiles"]) == (10, 17, 3)
     bad = client.post("/api/jobs", json={"kind": "export", "design": "LllAAaaaaLlLllx", "unit": "spatial"})
     assert bad.status_code == 422 and bad.json()["error"]["field"] == "design"
+    r = client.post("/api/jobs", json={"kind": "export", "design": "LaaaAlllAlAAAAa", "unit": "spatial"})
+    assert r.status_code == 202
+    job_id = r.json()["job_id"]
+    for _ in range(600):
+        job = client.get(f"/api/jobs/{job_id}").json()
+        if job["state"] in ("done", "failed"):
+            break
+        time.sleep(0.1)
+    assert job["state"] == "done", job["message"]
+    assert {"body.stl", "base_block.stl"} <= set(job["result"]["parts"]) and job["result"]["mould_parts"] > 0
+    archive = client.get(f"/api/jobs/{job_id}/files/export-LaaaAlllAlAAAAa.zip")
+    with zipfile.ZipFile(io.BytesIO(archive.content)) as z:
+        names = z.namelist()
+    assert "LaaaAlllAlAAAAa.inp" in names and any(n.startswith("parts/layer_") for n in names)
