@@ -10,6 +10,7 @@ import pytest
 
 from pneumorph.design import spacegrowth
 from pneumorph.design.bounds import chain_errors, score_designs
+from pneumorph.design.prefixes import depths
 from pneumorph.design.spacegrowth import check_space_objective, space_scores
 from pneumorph.design.targets import make_objective, tip_goal
 from pneumorph.errors import SearchConfigError
@@ -40,10 +41,11 @@ def _objectives(chain: ChainModel) -> list:
     length = chain.length
     return [make_objective("helix", 6.0, length=length), make_objective("sin", 4.0, length=length),
             make_objective("y = 0.05*x, z = -0.002*x**2", length=length), tip_goal("reach", (60.0, 8.0, -12.0)),
-            tip_goal("max-x"), tip_goal("min-y"), tip_goal("min-distance")]
+            tip_goal("max-x"), tip_goal("min-y"), tip_goal("min-distance"), tip_goal("max-y"), tip_goal("min-x"),
+            tip_goal("reach", (20.0, 30.0, 25.0))]
 
 
-@pytest.mark.parametrize("which", range(7))
+@pytest.mark.parametrize("which", range(10))
 def test_every_design_scored_in_space_is_its_own_chain_value(chain: ChainModel, every: np.ndarray, which: int) -> None:
     objective = _objectives(chain)[which]
     grown = space_scores(chain, objective)
@@ -55,7 +57,7 @@ def test_every_design_scored_in_space_is_its_own_chain_value(chain: ChainModel, 
     np.testing.assert_allclose(grown.bound[order], one_by_one.bound, atol=1e-12, rtol=0)
 
 
-@pytest.mark.parametrize("which", range(7))
+@pytest.mark.parametrize("which", range(10))
 @pytest.mark.parametrize("max_nodes", [500_000, 40])
 def test_no_design_the_branch_and_bound_leaves_out_beats_its_floor(chain: ChainModel, every: np.ndarray, which: int,
                                                                    max_nodes: int,
@@ -91,3 +93,31 @@ def test_a_search_over_some_unit_codes_finds_the_best_design_made_of_them(chain:
     assert truth.cost.min() < found.cost.min()  # the helix is better followed out of the plane
     bnb = space_scores(chain, objective, codes=planar, max_enumerate=4)
     assert not bnb.complete and bnb.cost.min() == pytest.approx(found.cost.min(), abs=1e-12)
+
+
+@pytest.mark.parametrize("which", [3, 4, 5, 6, 7, 8, 9])
+def test_the_cone_of_the_chords_turns_bounds_every_prefix_tighter_than_the_ball(chain: ChainModel, every: np.ndarray,
+                                                                              which: int) -> None:
+    """Every prefix's tip-goal bound with its frame (the chords still to place turn at most so far from its x axis)
+    lies between the ball's bound and the best cost of its completions, and is tighter than the ball somewhere."""
+    objective = _objectives(chain)[which]
+    truth = score_designs(chain, objective, every, chain_errors(chain))
+    numbers = design_numbers(truth.bits, 4)
+    codes = np.asarray(chain.table.unit_codes, dtype=np.uint8)
+    bits, st = spacegrowth._seed(chain, codes)
+    growth = depths(chain, bits, st, place=spacegrowth._placer(chain), codes=codes)
+    tighter = 0
+    for p, placed, bits, st, centres in growth:
+        for _ in centres:
+            pass
+        if p < N:
+            remaining = N + 1 - placed
+            ball = spacegrowth._tip_bound(chain, objective, st["point"], remaining)
+            cone = spacegrowth._tip_bound(chain, objective, st["point"], remaining, st["frame"])
+            best = np.full(4**p, np.inf)  # the best cost of every completion, per prefix
+            np.minimum.at(best, numbers // 4 ** (N - p), truth.cost)
+            assert (cone >= ball - 1e-9).all()
+            assert (cone <= best[design_numbers(bits, 4)] + 1e-9).all()  # admissible
+            tighter += int((cone > ball + 1e-6).sum())
+            growth.send((bits, st))
+    assert tighter > 0

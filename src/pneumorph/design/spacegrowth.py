@@ -18,7 +18,15 @@ Bounds (admissible: no design of a dropped prefix can cost less than the bound):
 - a tip goal: the tip lies within ``r L_k`` of the prefix's last point, with ``r`` chords
   still to place and ``L_k`` the longest chord of the table at level ``k``; every goal is
   1-Lipschitz in the tip (``min-distance`` in its projection on the x-y plane), so it moves by
-  at most that.
+  at most that. Tighter, with the prefix's last frame: each window turns a frame by at most
+  ``theta_k`` (the largest frame turn of the table) and its chord lies within ``alpha_k`` of
+  its frame's x axis, so chord ``i`` still to place lies within ``phi_i = min(i theta_k +
+  alpha_k, pi)`` of the prefix's frame's x axis ``u``. Along a direction ``e`` at angle ``psi``
+  from ``u`` the chords take the tip at most ``h(e) = sum_i L_k cos(max(psi - phi_i, 0))`` (the
+  shortest chord where that cosine is negative): the support function of a set holding every
+  completion's tip. A coordinate goal moves by at most ``min(r L_k, h(+-e_x or e_y))``; the
+  distance to a point ``d`` away is at least ``|d| - h(d / |d|)`` (and ``min-distance`` the
+  same in the x-y plane).
 
 The chain's own error bound (``beta``) is the planar one (:mod:`pneumorph.design.certified`):
 a centre error of norm ``e`` in space changes a centre's term of a space curve,
@@ -108,28 +116,73 @@ def _placer(chain: ChainModel) -> Any:
     return place
 
 
-def _tip_bound(chain: ChainModel, goal: TipGoal, point: FloatArray, remaining: int) -> FloatArray:
+def _cone(chain: ChainModel, remaining: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """How far the ``remaining`` chords still to place turn from the prefix's last frame's x axis, per level: the
+    angle ``phi`` (r, k) that chord ``i`` stays within (module docstring), and the shortest and longest chord (k,)."""
+    space = chain.table.space
+    lengths = np.linalg.norm(space[..., :3], axis=-1)  # (K, k)
+    turn = np.linalg.norm(space[..., 3:], axis=-1).max(axis=0)  # the largest frame turn of a window
+    off = np.arccos(np.clip(space[..., 0] / np.maximum(lengths, 1e-300), -1.0, 1.0)).max(axis=0)  # chord off x
+    i = np.arange(1, remaining + 1)[:, None]
+    return np.minimum(i * turn[None] + off[None], np.pi), lengths.min(axis=0), lengths.max(axis=0)
+
+
+def _support(cos_psi: FloatArray, phi: FloatArray, shortest: FloatArray, longest: FloatArray) -> FloatArray:
+    """The most the chords still to place can take the tip along a direction at angle ``psi`` from the frame's x
+    axis (``cos_psi``, (m, k)): chord ``i`` within ``phi[i]`` of that axis gives at most ``L cos(max(psi - phi_i,
+    0))`` (the shortest chord where that is negative)."""
+    psi = np.arccos(np.clip(cos_psi, -1.0, 1.0))
+    free = phi >= np.pi  # chords that may point anywhere: each adds its longest length
+    total = np.broadcast_to(free.sum(axis=0) * longest, np.shape(cos_psi)).copy()
+    for i in np.flatnonzero(~free.all(axis=1)):  # per chord still to place that is held in a cone at some level
+        c = np.cos(np.maximum(psi - phi[i], 0.0))
+        total += np.where(free[i], 0.0, np.where(c >= 0.0, longest * c, shortest * c))
+    return total
+
+
+def _tip_bound(chain: ChainModel, goal: TipGoal, point: FloatArray, remaining: int,
+               frame: FloatArray | None = None) -> FloatArray:
     """A lower bound on the cost of a tip goal of every completion, shape (m,): the tip within ``remaining`` of the
-    longest chords of the current ``point`` (module docstring)."""
+    longest chords of the current ``point`` and, with the prefix's ``frame``, where chords that turn at most so far
+    from its x axis can take it (module docstring)."""
     table = chain.table
     radius = remaining * np.linalg.norm(table.space[..., :3], axis=-1).max(axis=0)  # (k,)
     x = point[..., 0]
     y = point[..., 1] - table.tip_ref[1]
+    u = None if frame is None else frame[..., :, 0]  # (m, k, 3): the prefix's last frame's x axis
+    cone = None if u is None else _cone(chain, remaining)
+
+    def reach_along(axis: int, sign: float) -> FloatArray:
+        """The most the tip can move along ``sign`` times coordinate ``axis``."""
+        if u is None or cone is None:
+            return np.broadcast_to(radius, x.shape)
+        return np.minimum(radius, _support(sign * u[..., axis], *cone))
+
     if goal.name == "max-x":
-        cost = -(x + radius)
+        cost = -(x + reach_along(0, 1.0))
     elif goal.name == "min-x":
-        cost = x - radius
+        cost = x - reach_along(0, -1.0)
     elif goal.name == "max-y":
-        cost = -(y + radius)
+        cost = -(y + reach_along(1, 1.0))
     elif goal.name == "min-y":
-        cost = y - radius
-    elif goal.name == "min-distance":
-        cost = np.maximum(np.hypot(x, y) - radius, 0.0)
+        cost = y - reach_along(1, -1.0)
+    elif goal.name == "min-distance":  # |tip_xy| is at least its part along the point's own direction in x-y
+        r_xy = np.hypot(x, y)
+        cost = r_xy - radius
+        if u is not None and cone is not None:
+            cos_psi = -(u[..., 0] * x + u[..., 1] * y) / np.maximum(r_xy, 1e-300)
+            cost = np.maximum(cost, r_xy - _support(cos_psi, *cone))
+        cost = np.maximum(cost, 0.0)
     else:  # reach
         assert goal.point is not None
         target = np.array([*goal.point, 0.0][:3])
-        d = point - np.array([0.0, table.tip_ref[1], table.centre_z]) - target
-        cost = np.maximum(np.linalg.norm(d, axis=-1) - radius, 0.0)
+        d = target + np.array([0.0, table.tip_ref[1], table.centre_z]) - point  # from the point to the target
+        norm = np.linalg.norm(d, axis=-1)
+        cost = norm - radius
+        if u is not None and cone is not None:  # the distance to a set is at least d.e less its support along e
+            cos_psi = np.einsum("mki,mki->mk", d, u) / np.maximum(norm, 1e-300)
+            cost = np.maximum(cost, norm - _support(cos_psi, *cone))
+        cost = np.maximum(cost, 0.0)
     return np.asarray(cost.min(axis=1), dtype=float)
 
 
@@ -223,7 +276,7 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
                                                                                  placed)
                 bound = np.sqrt(total.min(axis=1))
             else:
-                bound = _tip_bound(chain, goal, st["point"], n + 1 - placed)
+                bound = _tip_bound(chain, goal, st["point"], n + 1 - placed, st["frame"])
             bits, st = kept(bits, st, narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
         if profile:
