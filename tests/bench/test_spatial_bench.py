@@ -127,3 +127,16 @@ def test_the_api_offers_the_spatial_library_and_exports_a_sideways_design(tmp_pa
     with zipfile.ZipFile(io.BytesIO(archive.content)) as z:
         names = z.namelist()
     assert "LaaaAlllAlAAAAa.inp" in names and any(n.startswith("parts/layer_") for n in names)
+
+
+def test_a_tip_point_off_the_plane_is_reached_in_space(bench: Bench) -> None:
+    """A planar actuator's tip stays at z = 0, so a point z off the plane adds z in quadrature to every design's
+    distance: the same winner, its value the hypotenuse."""
+    flat = bench.answer(bench.parse({"target": {"kind": "tip", "goal": "reach", "point": [100, 40]}}))
+    off = bench.answer(bench.parse({"target": {"kind": "tip", "goal": "reach", "point": [100, 40, 12]}}))
+    assert off["point"] == [100.0, 40.0, 12.0] and off["winner"]["design"] == flat["winner"]["design"]
+    assert off["winner"]["value"] == pytest.approx(float(np.hypot(flat["winner"]["value"], 12.0)), abs=1e-9)
+    for bad in ([100, 40, "x"], [100, 40, 1, 2]):
+        with pytest.raises(QueryError) as info:
+            bench.parse({"target": {"kind": "tip", "goal": "reach", "point": bad}})
+        assert info.value.field == "point"

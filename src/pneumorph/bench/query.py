@@ -68,8 +68,8 @@ class Query:
         The objective's text for :func:`~pneumorph.design.targets.make_objective` ("sin",
         "y = ...", "max-x", "curve").
     amplitude, periods : float
-    point : (float, float) or None
-        The tip point of the goal "reach" (mm).
+    point : (float, float), (float, float, float) or None
+        The tip point of the goal "reach" (mm): (x, y), or (x, y, z) off the plane of bending.
     curve : tuple of (x, y) or (x, y, z), or None
         A drawn curve's smoothed knots (mm; with z when it was drawn seen from above too).
     model : {"3d", "2d"}
@@ -86,7 +86,7 @@ class Query:
     spec: str
     amplitude: float = 10.0
     periods: float = 1.0
-    point: tuple[float, float] | None = None
+    point: tuple[float, ...] | None = None
     curve: tuple[tuple[float, ...], ...] | None = None
     model: str = "3d"
     top: int = 10
@@ -114,7 +114,7 @@ class Query:
         True
         """
         point, curve, stages = data.get("point"), data.get("curve"), data.get("stages")
-        return cls(**{**data, "point": None if point is None else (float(point[0]), float(point[1])),
+        return cls(**{**data, "point": None if point is None else tuple(float(v) for v in point),
                       "curve": None if curve is None else tuple(tuple(float(v) for v in c) for c in curve),
                       "stages": None if stages is None else tuple((float(p), float(w), cls.from_dict(q))
                                                                   for p, w, q in stages)})
@@ -213,7 +213,7 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
         ``{"target": {...}, "model": "3d", "top": 10}``; the target is one of
         ``{"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}``,
         ``{"kind": "expression", "expression": "y = ...", "amplitude": 10}``,
-        ``{"kind": "tip", "goal": "max-x", "point": [x, y]}`` or
+        ``{"kind": "tip", "goal": "max-x", "point": [x, y]}`` (``[x, y, z]``: a point off the plane) or
         ``{"kind": "curve", "points": [[x, y], ...]}`` (a drawn stroke, mm; with
         ``"top_points": [[x, z], ...]``, the same curve drawn seen from above: a space curve).
     length : float
@@ -281,7 +281,11 @@ def _target_fields(kind: str, target: dict[str, Any], length: float) -> tuple[di
         point = target.get("point")
         if goal == "reach":
             try:
-                point = checks.pair(point, "point", unit="mm", error=SettingsError)
+                if isinstance(point, (list, tuple)) and len(point) == 3:  # (x, y, z): off the plane of bending
+                    point = (*checks.pair(point[:2], "point", unit="mm", error=SettingsError),
+                             checks.real(point[2], "point", unit="mm", error=SettingsError))
+                else:
+                    point = checks.pair(point, "point", unit="mm", error=SettingsError)
             except SettingsError as exc:
                 raise QueryError("point", str(exc)) from None
         return {"spec": goal, "point": point if goal == "reach" else None}, "point" if goal == "reach" else "goal"

@@ -36,7 +36,10 @@ function currentBody() {
   else if (kind === "expression") target = { kind, expression: $("expression").value, amplitude: number("expr-amplitude") };
   else if (kind === "tip") {
     target = { kind, goal: $("goal").value };
-    if (target.goal === "reach") target.point = [number("point-x"), number("point-y")];
+    if (target.goal === "reach") {
+      target.point = [number("point-x"), number("point-y")];
+      if ($("point-z").value.trim() !== "") target.point.push(number("point-z"));   // off the plane of bending
+    }
   } else if (kind === "stages") {
     target = { kind, stages: state.stages.map((st) => ({ pressure_kpa: st.pressure_kpa, target: { kind: "curve", points: st.points } })) };
   } else {
@@ -125,10 +128,12 @@ function redraw() {
   // a space curve or a design that leaves the plane: the view from above, the target's z against the
   // actuator's (z = 0 where the chain is planar: it bends in its plane)
   const targetZ = Boolean(a.target && a.target.z);
-  const space = targetZ || state.profiles[k][0].length === 3;
+  const pointZ = Boolean(a.point && a.point.length === 3);
+  const space = targetZ || pointZ || state.profiles[k][0].length === 3;
   $("top-view").hidden = !space;
   if (space) {
     drawProfile($("top-plot"), { target: targetZ ? a.target.x.map((x, i) => [x, a.target.z[i]]) : null,
+      point: pointZ ? [a.point[0], a.point[2]] : null,
       profile: state.profiles[k].map(([x, , z]) => [x, z || 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
   }
 }
@@ -270,7 +275,7 @@ async function main() {
   topArea = new DrawArea($("draw-top-canvas"), state.info.length_mm, (points) => { state.curveTop = points; schedule(); });
   const changed = () => { showKind(); schedule(); };
   for (const id of ["target-kind", "preset", "amplitude", "periods", "expression", "expr-amplitude", "goal", "point-x",
-    "point-y", "model", "unit"]) {
+    "point-y", "point-z", "model", "unit"]) {
     $(id).addEventListener("input", changed);
     if ($(id).tagName === "SELECT") $(id).addEventListener("change", changed);
   }
