@@ -121,3 +121,12 @@ def test_the_cone_of_the_chords_turns_bounds_every_prefix_tighter_than_the_ball(
             tighter += int((cone > ball + 1e-6).sum())
             growth.send((bits, st))
     assert tighter > 0
+
+
+def test_the_verifications_estimate_of_a_model_over_sideways_units_is_the_full_widths() -> None:
+    from pneumorph.design.certified import _solve_estimate
+    from pneumorph.models.factory import make_model
+
+    assert _solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 15 s each)"
+    assert _solve_estimate(make_model(15, {"fidelity": "3d", "library": "spatial"}), 2) == (
+        " (3d full-width, about 60 s each)")

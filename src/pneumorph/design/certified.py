@@ -90,14 +90,16 @@ class CertifiedResult:
 
 
 def _solve_estimate(model: Any, count: int) -> str:
-    """`` (about 15 s each)``: the measured solve time of the model's fidelity, or nothing."""
-    from pneumorph.models.buildplan import duration_text, solve_seconds
+    """`` (about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units: the
+    full width's), or nothing."""
+    from pneumorph.models.buildplan import cost_fidelity, duration_text, solve_seconds
 
-    seconds = solve_seconds(str(getattr(model, "fidelity", "")), int(getattr(model, "n_units", 0) or 0))
+    fidelity = cost_fidelity(model)
+    seconds = solve_seconds(fidelity, int(getattr(model, "n_units", 0) or 0))
     if not seconds:
         return ""
     each = " each" if count > 1 else ""
-    return f" ({getattr(model, 'fidelity', '')}, about {duration_text(seconds)}{each})"
+    return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
 def chain_candidate(chain: ChainModel, objective: Objective, design: str) -> Candidate:

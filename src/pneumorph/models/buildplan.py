@@ -31,7 +31,7 @@ from pneumorph.models.chainfit import (
 )
 
 #: the full 3D model on the full width (designs with a sideways unit, and a chain in space's training designs):
-#: 58-68 s for a 15-unit design on one core (BENCHMARKS.md, benchmarks/full_model.py)
+#: 57.6 s for a 15-unit design on one core on a quiet machine (BENCHMARKS.md, benchmarks/full_model.py)
 FULL_WIDTH = "3d full-width"
 #: held-out designs that validate a table built on first use
 HELDOUT = 20
