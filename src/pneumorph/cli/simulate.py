@@ -137,13 +137,14 @@ def _print_table(resp: Any, out: str | None) -> None:
     """Tip and curl of every level as a table, the solver's effort, and where the files went."""
     from pathlib import Path
 
-    space = resp.axes == 3 and resp.twist is not None  # the full width: the tip's z and the end face's twist too
+    space = resp.axes == 3  # the full width: the tip's z, and the end face's twist where the response has its frame
+    twist = resp.twist
     click.echo(f"{'p [kPa]':>8} {'tip x [mm]':>11} {'tip y [mm]':>11} "
                + (f"{'tip z [mm]':>11} " if space else "") + f"{'curl [deg]':>11}"
-               + (f" {'twist [deg]':>12}" if space else ""))
+               + (f" {'twist [deg]':>12}" if twist is not None else ""))
     for k, p in enumerate(resp.pressures):
         z = f"{resp.tip[k, 2]:11.3f} " if space else ""
-        tw = f" {resp.twist[k]:12.3f}" if space else ""
+        tw = f" {twist[k]:12.3f}" if twist is not None else ""
         click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {z}{resp.curl[k]:11.2f}{tw}")
     m = resp.metadata
     click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
