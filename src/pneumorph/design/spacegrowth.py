@@ -131,11 +131,13 @@ def _support(cos_psi: FloatArray, phi: FloatArray, shortest: FloatArray, longest
     """The most the chords still to place can take the tip along a direction at angle ``psi`` from the frame's x
     axis (``cos_psi``, (m, k)): chord ``i`` within ``phi[i]`` of that axis gives at most ``L cos(max(psi - phi_i,
     0))`` (the shortest chord where that is negative)."""
-    psi = np.arccos(np.clip(cos_psi, -1.0, 1.0))
+    cos_psi = np.clip(cos_psi, -1.0, 1.0)
+    sin_psi = np.sqrt(1.0 - cos_psi * cos_psi)  # psi in [0, pi]
     free = phi >= np.pi  # chords that may point anywhere: each adds its longest length
     total = np.broadcast_to(free.sum(axis=0) * longest, np.shape(cos_psi)).copy()
     for i in np.flatnonzero(~free.all(axis=1)):  # per chord still to place that is held in a cone at some level
-        c = np.cos(np.maximum(psi - phi[i], 0.0))
+        # cos(max(psi - phi, 0)): 1 inside the cone (psi <= phi), else cos psi cos phi + sin psi sin phi
+        c = np.where(cos_psi >= np.cos(phi[i]), 1.0, cos_psi * np.cos(phi[i]) + sin_psi * np.sin(phi[i]))
         total += np.where(free[i], 0.0, np.where(c >= 0.0, longest * c, shortest * c))
     return total
 
