@@ -46,6 +46,7 @@ def unit_frames(mesh: Any, displacement: FloatArray) -> FloatArray:
         out[i] = Rotation.align_vectors(b, a)[0].as_rotvec()  # the rotation that best takes a onto b
     return out
 
+
 def end_frame(mesh: Any, displacement: FloatArray) -> FloatArray:
     """The free end face's rotation (a rotation vector, rad) from the undeformed ``mesh`` by ``displacement``, (3,).
 
