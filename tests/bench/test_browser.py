@@ -266,3 +266,17 @@ def test_a_job_is_cancelled_from_the_page(browser) -> None:  # type: ignore[no-u
     _wait(lambda: "export cancelled" in _el(browser, "jobs").text)
     # (the earlier tests' refused expressions are in the log too)
     assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE" and "/api/jobs" in e["message"]]
+
+
+def test_a_tip_goal_the_spatial_chain_cannot_score_is_refused_beside_the_target(browser) -> None:  # type: ignore[no-untyped-def]
+    """The curl has no chain in space: over the spatial library it is refused at once, the search hint cleared."""
+    Select(_el(browser, "model")).select_by_value("3d")
+    Select(_el(browser, "target-kind")).select_by_value("tip")
+    Select(_el(browser, "goal")).select_by_value("max-curl")
+    _wait(lambda: "curl" in _el(browser, "winner-label").text and _answered(browser), timeout=30)
+    Select(_el(browser, "unit")).select_by_value("spatial")
+    _wait(lambda: "spatial library's chain" in _el(browser, "target-error").text, timeout=30)
+    assert _el(browser, "answer").get_attribute("data-state") == "error"
+    assert "searching" not in _el(browser, "answer-time").text
+    Select(_el(browser, "unit")).select_by_value("builtin")
+    _wait(lambda: _answered(browser) and _el(browser, "target-error").text == "", timeout=30)

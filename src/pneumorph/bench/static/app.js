@@ -73,6 +73,10 @@ async function ask() {
   if ($("target-kind").value === "stages" && !state.stages.length) return;   // no stage added yet
   const seq = ++state.seq;
   $("answer").dataset.state = "loading";
+  // a tip goal over sideways units: a branch-and-bound over 4^15 designs (BENCHMARKS.md: 45-70 s on one core)
+  if ($("target-kind").value === "tip" && $("unit").value === "spatial") {
+    $("answer-time").textContent = "(searching 1,073,741,824 designs for a tip goal: about a minute)";
+  }
   try {
     const answer = await post("/api/design", currentBody());
     if (seq !== state.seq) return;                                  // a newer question is on its way
@@ -83,6 +87,7 @@ async function ask() {
     clearErrors();
     showError(error.field, error.message);
     $("answer").dataset.state = "error";
+    if ($("answer-time").textContent.startsWith("(searching")) $("answer-time").textContent = "";
   }
 }
 
