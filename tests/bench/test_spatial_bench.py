@@ -140,3 +140,19 @@ def test_a_tip_point_off_the_plane_is_reached_in_space(bench: Bench) -> None:
         with pytest.raises(QueryError) as info:
             bench.parse({"target": {"kind": "tip", "goal": "reach", "point": bad}})
         assert info.value.field == "point"
+
+
+def test_the_chain_view_of_an_undeformed_actuator_with_centres_at_several_heights_moves_nothing() -> None:
+    """The built-in library's units have their cavities at different heights, so the undeformed centreline is not
+    straight: the view turns each chord relative to its undeformed direction, so nothing moves (the earlier view
+    turned them by their absolute angles: 0.85 mm here)."""
+    from pneumorph.geometry.assembly import assemble
+    from pneumorph.geometry.library import builtin_library
+    from pneumorph.models.response import Response
+
+    mesh = assemble(builtin_library(), "aeRS", dim=3, half=True)
+    ref = mesh.unit_centres()
+    assert np.ptp(ref[:, 1]) > 1.0  # the centres' heights differ
+    tip = np.array([mesh.points[:, 0].max(), ref[-1, 1]])
+    r = Response("aeRS", np.array([0.01]), ref[None], ref, tip[None], tip, np.zeros(1))
+    np.testing.assert_allclose(chain_placement(mesh, r, 0), mesh.points, atol=1e-9, rtol=0)
