@@ -214,10 +214,11 @@ class Bench:
         if not isinstance(unit, str) or (units is not None and unit not in units) or not self.knows(unit):
             raise QueryError("unit", f"unknown unit {str(unit)[:40]!r}; upload its TOML file to build its chain "
                                      "table first")
-        length = self.length(model, unit)
+        chain = self.chain(model, unit)
+        length = chain.length
         query = parse_query(body, length, self.unit_ids if units is None else units)
         objective = query.objective(length)
-        if self.chain(model, unit).table.axes == 3:  # a chain in space scores fewer kinds of target
+        if chain.table.axes == 3:  # a chain in space scores fewer kinds of target
             try:
                 check_space_objective(objective)
             except SearchConfigError:
@@ -225,7 +226,7 @@ class Bench:
                                            "goals other than the curl, not this target") from None
         if isinstance(objective, StagedTarget):  # each stage at a level of the ramp
             try:
-                objective.levels(self.chain(model, unit).pressures(), how="")
+                objective.levels(chain.pressures(), how="")
             except SearchConfigError as exc:
                 raise QueryError("stages", str(exc)) from None
         return query

@@ -91,12 +91,12 @@ def chain_placement(mesh: ActuatorMesh, response: Response, level: int) -> Float
     pts = polyline(response.centres[level], response.tip[level])
     undeformed, deformed = (transported_frames(space_elements(p)[0]) for p in (ref, pts))
     chords = Rotation.from_matrix(deformed @ np.swapaxes(undeformed, -1, -2))
-    halves = [Slerp([0.0, 1.0], chords[[j, j + 1]])(0.5) for j in range(len(chords) - 1)]
+    halves = chords[:-1] * Rotation.from_rotvec(0.5 * (chords[:-1].inv() * chords[1:]).as_rotvec())  # slerp at 1/2
     end = (Rotation.from_rotvec([0.0, 0.0, np.radians(response.curl[level])])
            if response.centres.shape[-1] == 2 else chords[-1])
     s = ref[:, 0]
     X = np.clip(mesh.points[:, 0], s[0], s[-1])
-    turn = Slerp(s, Rotation.concatenate([Rotation.identity(), *halves, end]))(X)
+    turn = Slerp(s, Rotation.concatenate([Rotation.identity(), halves, end]))(X)
     along = np.column_stack([np.interp(X, s, pts[:, i]) for i in range(3)])
     offset = mesh.points - np.column_stack([np.interp(X, s, ref[:, i]) for i in range(3)])
     return np.asarray(along + turn.apply(offset), dtype=float)

@@ -148,7 +148,7 @@ def _tip_bound(chain: ChainModel, goal: TipGoal, point: FloatArray, remaining: i
     longest chords of the current ``point`` and, with the prefix's ``frame``, where chords that turn at most so far
     from its x axis can take it (module docstring)."""
     table = chain.table
-    radius = remaining * np.linalg.norm(table.space[..., :3], axis=-1).max(axis=0)  # (k,)
+    radius = remaining * _longest(chain)  # (k,)
     x = point[..., 0]
     y = point[..., 1] - table.tip_ref[1]
     u = None if frame is None else frame[..., :, 0]  # (m, k, 3): the prefix's last frame's x axis

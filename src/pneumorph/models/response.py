@@ -185,6 +185,8 @@ class Response:
 
     # -- persistence ------------------------------------------------------------------
     _ARRAYS = ("pressures", "centres", "reference_centres", "tip", "reference_tip", "curl")
+    #: arrays only full-width responses keep (None otherwise)
+    _OPTIONAL = ("frames", "end_frame")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (pressures in MPa, lengths in mm, NaN as null)."""
@@ -198,25 +200,22 @@ class Response:
         out.update({name: clean(getattr(self, name)) for name in self._ARRAYS})
         out.update(converged=self.converged, reached=self.reached, failure=self.failure)
         out["metadata"] = self.metadata
-        if self.frames is not None:
-            out["frames"] = clean(self.frames)
-        if self.end_frame is not None:
-            out["end_frame"] = clean(self.end_frame)
+        out.update({name: clean(getattr(self, name)) for name in self._OPTIONAL if getattr(self, name) is not None})
         return out
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Response:
-        arrays = {
+        arrays: dict[str, Any] = {
             name: np.array(data[name], dtype=float) for name in cls._ARRAYS
         }  # None -> nan via dtype float
+        arrays.update({name: None if data.get(name) is None else np.array(data[name], dtype=float)
+                       for name in cls._OPTIONAL})
         return cls(
             orientation=data["orientation"],
             converged=bool(data["converged"]),
             reached=float(data["reached"]),
             failure=data.get("failure"),
             metadata=dict(data.get("metadata", {})),
-            frames=None if data.get("frames") is None else np.array(data["frames"], dtype=float),
-            end_frame=None if data.get("end_frame") is None else np.array(data["end_frame"], dtype=float),
             **arrays,
         )
 
@@ -225,11 +224,8 @@ class Response:
         base = Path(path)
         base.parent.mkdir(parents=True, exist_ok=True)
         npz, js = base.with_suffix(".npz"), base.with_suffix(".json")
-        arrays = {name: getattr(self, name) for name in self._ARRAYS}
-        if self.frames is not None:
-            arrays["frames"] = self.frames
-        if self.end_frame is not None:
-            arrays["end_frame"] = self.end_frame
+        arrays = {name: getattr(self, name) for name in (*self._ARRAYS, *self._OPTIONAL)
+                  if getattr(self, name) is not None}
         np.savez(npz, **arrays)
         js.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
         return npz, js

@@ -161,12 +161,12 @@ def unfixed_error(designs: Sequence[str], window: int, alphabet: tuple[str, ...]
     windows = written_windows(n_units, width, k, symmetric)
     cols, keys, offset = [], [], 0
     for lo, hi in terms:
-        seen = np.unique(term_codes(rows, width, lo, hi, radix))
+        seen, inverse = np.unique(term_codes(rows, width, lo, hi, radix), return_inverse=True)
         wanted = term_codes(windows, width, lo, hi, radix)
         at = np.searchsorted(seen, wanted)
         if np.any(seen[np.minimum(at, len(seen) - 1)] != wanted):
             return float("inf")
-        cols.append(np.searchsorted(seen, term_codes(rows, width, lo, hi, radix)) + offset)
+        cols.append(inverse.ravel() + offset)
         keys.append(at + offset)
         offset += len(seen)
     a = sparse.csr_matrix((np.ones(len(rows) * len(terms)), (np.repeat(np.arange(len(rows)), len(terms)),
