@@ -46,8 +46,17 @@ def undeformed_of() -> dict[int, tuple[np.ndarray, np.ndarray]]:
     return {n: (5.25 + 10.5 * np.arange(n), np.array([10.5 * n, 6.0, 7.5])) for n in range(1, 16)}
 
 
-def _response(design: str, law: dict[int, np.ndarray], undeformed: dict) -> Response:
-    """The law's response of ``design``: points composed from its elements, each unit's frame, no curl."""
+def end_turn(code: int) -> np.ndarray:
+    """The law's end face's turn (levels, 3) from the last unit's frame, of the last chord's window ``code``: random
+    per window, turned over with it (the turn's signs of ``MIRROR_SIGNS``)."""
+    mirrored = int(mirror_codes(np.array([code]), W, 2)[0])
+    values = np.random.default_rng(min(code, mirrored)).uniform(-0.03, 0.03, (LEVELS, 3))
+    return values if code <= mirrored else values * MIRROR_SIGNS[3:]
+
+
+def _response(design: str, law: dict[int, np.ndarray], undeformed: dict, ends: bool = False) -> Response:
+    """The law's response of ``design``: points composed from its elements, each unit's frame, no curl; with
+    ``ends``, the end face's frame (the last unit's turned by :func:`end_turn`)."""
     codes = design_array(design, alphabet=ALPHABET)
     values = np.stack([law[int(c)] for c in window_codes(codes, W, n_types=2)[0]])  # (n + 1, k, 6)
     values[0, :, 3:] = 0.0  # the base's frame is the actuator's own
@@ -60,8 +69,12 @@ def _response(design: str, law: dict[int, np.ndarray], undeformed: dict) -> Resp
     frames = np.stack([np.linalg.multi_dot([np.eye(3), *turns[lev, : j + 2]]) for lev in range(LEVELS)
                        for j in range(len(design))]).reshape(LEVELS, len(design), 3, 3)
     rotvec = Rotation.from_matrix(frames.reshape(-1, 3, 3)).as_rotvec().reshape(LEVELS, len(design), 3)
+    end = None
+    if ends:
+        last = int(window_codes(codes, W, n_types=2)[0][-1])
+        end = Rotation.from_matrix(frames[:, -1] @ rotation_matrices(end_turn(last))).as_rotvec()
     return Response(design, PRESSURES, points[:, 1:-1], reference, points[:, -1], tip, np.zeros(LEVELS),
-                    frames=rotvec)
+                    frames=rotvec, end_frame=end)
 
 
 def _source() -> dict:

@@ -21,6 +21,7 @@ from pneumorph.models.chainfile import SPACE_FORMAT
 from pneumorph.models.chainfit import fit_table, training_designs
 from pneumorph.models.chaintables import restrict_table
 from pneumorph.models.response import Response
+from pneumorph.models.spacechords import rotation_matrices
 from pneumorph.models.validation import heldout_designs
 from pneumorph.models.windows import covering_designs
 from tests.spacelaw import ALPHABET, LEVELS, LIBRARY, W, _law, _response, _source, undeformed_of
@@ -113,3 +114,49 @@ def test_planar_and_space_responses_are_not_mixed_in_one_table(law, undeformed) 
                       space.tip[:, :2], space.reference_tip[:2], space.curl)
     with pytest.raises(ChainTableError, match="full width"):
         fit_table([space, planar], W, _source(), library=LIBRARY)
+
+
+@pytest.mark.parametrize("far", [False, True])
+def test_a_chain_in_space_predicts_the_end_face_s_frame_and_twist_of_a_local_law(law, undeformed, far: bool,
+                                                                                 tmp_path: Path) -> None:
+    """The end face's turn from the last unit's frame, keyed by the last chord's window, composes the end face's frame
+    exactly at any length; turned over, the frame turns half a turn about the axis, its twist unchanged; it survives
+    the file."""
+    train = [_response(d, law, undeformed, ends=True) for d in training_designs(7, W, far, True, ALPHABET)]
+    table = fit_table(train, W, _source(), library=LIBRARY, far=far)
+    assert table.end_space.shape == (len(table.end_codes), LEVELS, 3) and table.spread < 1e-9
+    assert np.abs(table.end_space).max() > 0.01
+    for n in (7, 10):
+        model = ChainModel(table, n)
+        for design in heldout_designs(n, 6, exclude=[], seed=4, alphabet=ALPHABET):
+            want, got = _response(design, law, undeformed, ends=True), model.evaluate(design)
+            np.testing.assert_allclose(rotation_matrices(got.end_frame), rotation_matrices(want.end_frame),
+                                       atol=1e-12, rtol=0)
+            np.testing.assert_allclose(got.twist, want.twist, atol=1e-9, rtol=0)
+            assert np.abs(want.end_frame).max() > 0.01
+    one, other = model.evaluate("LalAAlLaaL"), model.evaluate("lALaaLlAAl")
+    np.testing.assert_allclose(other.end_frame, one.end_frame * [1, -1, -1], atol=1e-12, rtol=0)
+    np.testing.assert_allclose(other.twist, one.twist, atol=1e-9, rtol=0)  # a half turn about x keeps a twist about x
+    assert np.abs(one.twist).max() > 0.1
+    path = table.save(tmp_path / "space.json")
+    again = ChainTable.load(path)
+    assert again.fingerprint() == table.fingerprint() != fit_table(
+        [_response(d, law, undeformed) for d in training_designs(7, W, far, True, ALPHABET)], W, _source(),
+        library=LIBRARY, far=far).fingerprint()
+    np.testing.assert_array_equal(again.end_space, table.end_space)
+    if not far:  # the windows' file holds the end face's turns beside the elements in space
+        data = json.loads(path.read_text())
+        data["space_end_turn_rad"][0][0][2] += 1e-3
+        path.write_text(json.dumps(data))
+        with pytest.raises(ChainTableError, match="fingerprint"):
+            ChainTable._read(path)
+
+
+def test_a_table_without_the_end_face_s_turns_predicts_no_end_frame(law, undeformed) -> None:
+    table = fit_table([_response(d, law, undeformed) for d in training_designs(7, W, False, True, ALPHABET)], W,
+                      _source(), library=LIBRARY)
+    assert table.end_space.shape[0] == 0 and ChainModel(table, 7).evaluate("LalAAlL").end_frame is None
+    mixed = [_response("alAl", law, undeformed, ends=True), _response("Alal", law, undeformed)]
+    with pytest.raises(ChainTableError, match="end face"):
+        fit_table(mixed, W, _source(), library=LIBRARY)
+

@@ -129,3 +129,5 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
                 click.echo(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} "
                            f"mm, mean at the last level {errs['centre_mean_mm'][-1]:.4f} mm ({errs['centres']} "
                            "centres)")
+        if "end_frame_worst_deg" in v:  # a chain in space with the end face's frame
+            click.echo(f"  end face's frame: worst held-out angle {max(v['end_frame_worst_deg']):.4f} deg")

@@ -222,6 +222,7 @@ class ChainModel:
         c, t, cu = self.predict(bits)
         ref_c, ref_t = self.table.reference(bits)
         ref_t = np.atleast_2d(ref_t)[0]
+        end = self.table.end_frames(bits)  # a chain in space: the end face's frame, and so its twist
         return Response(design, self.pressures(), c[0], ref_c[0], t[0], ref_t, cu[0], converged=True,
-                        reached=float(self.table.pressures[-1]),
+                        reached=float(self.table.pressures[-1]), end_frame=None if end is None else end[0],
                         metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()})

@@ -81,6 +81,8 @@ def entries_of(data: dict[str, Any], fmt: Any, w: int, alphabet: tuple[str, ...]
     if space:
         out["space"] = np.concatenate([np.array(data["space_chord_mm"], dtype=float),
                                        np.array(data["space_turn_rad"], dtype=float)], axis=-1)
+        if "space_end_turn_rad" in data:  # the end face's turns (tables fitted before them have none)
+            out["end_space"] = np.array(data["space_end_turn_rad"], dtype=float)
     return out
 
 

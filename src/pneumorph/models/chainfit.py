@@ -22,14 +22,9 @@ from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
 from pneumorph.models.chain import ChainTable, source_description, source_key, training_model
-from pneumorph.models.chainterms import (
-    check_far_training,
-    chord_spread,
-    chord_values,
-    far_means,
-    fit_text,
-)
-from pneumorph.models.response import FloatArray, Response, response_elements
+from pneumorph.models.chainmeans import check_training, window_means
+from pneumorph.models.chainterms import check_far_training, far_means, fit_text
+from pneumorph.models.response import Response, response_elements
 from pneumorph.models.termdesigns import training_designs
 from pneumorph.models.validation import (
     CLEAR_FRACTION,
@@ -43,8 +38,6 @@ from pneumorph.models.validation import (
 from pneumorph.models.windows import (
     design_array,
     design_strings,
-    mirror_codes,
-    window_codes,
 )
 
 __all__ = ["CLEAR_FRACTION", "DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", "MIN_HELDOUT", "build_table",
@@ -112,7 +105,7 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         No responses, a failed one, mixed lengths or levels; over a library, training
         actuators whose undeformed centres are not where the library's units put them.
     """
-    longest, pressures = _check_training(responses)
+    longest, pressures = check_training(responses)
     n = longest.n_units
     w = int(window)
     alphabet = library.alphabet if library is not None else ()
@@ -121,7 +114,7 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         means = far_means(responses, w, mirror, alphabet, symmetric, len(pressures), n, far)
         w += 1
     else:
-        means = _window_means(responses, w, mirror, alphabet, symmetric, len(pressures))
+        means = window_means(responses, w, mirror, alphabet, symmetric, len(pressures))
     if n < 2:
         raise ChainTableError("a chain table needs training designs of at least 2 units")
     fitted = dict(window=w, pressures=np.asarray(pressures, dtype=float), **means, source=dict(source),
@@ -132,71 +125,6 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
         return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
             **fitted, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0)))
     return ChainTable(**fitted, **_binary_geometry(responses, longest, mirror))
-
-
-def _check_training(responses: Sequence[Response]) -> tuple[Response, FloatArray]:
-    """The longest training response and the pressure levels all share.
-
-    Raises
-    ------
-    ChainTableError
-        No responses, one that did not converge, or responses of different levels.
-    """
-    if not responses:
-        raise ChainTableError("a chain table needs at least one training response")
-    longest = max(responses, key=lambda r: r.n_units)
-    pressures = responses[0].pressures
-    for r in responses:
-        if not r.converged or not np.isfinite(r.centres).all():
-            raise ChainTableError(f"training design {r.orientation} did not converge; the chain table needs "
-                                  "every training design solved to the last level")
-        if not np.allclose(r.pressures, pressures, rtol=0, atol=1e-12):
-            raise ChainTableError("training responses of different pressure levels")
-        if (r.frames is None) != (longest.frames is None):
-            where = "in" if r.frames is None else "out of"
-            raise ChainTableError(f"training design {r.orientation} was solved {where} the plane and others the other "
-                                  "way; a chain in space needs every training design solved on the full width")
-    return longest, pressures
-
-
-def _window_means(responses: Sequence[Response], w: int, mirror: bool, alphabet: tuple[str, ...],
-                  symmetric: tuple[int, ...], levels: int) -> dict[str, Any]:
-    """Every window's mean turn and length, every end window's mean end turn, and the largest deviation.
-
-    The means are over the window's occurrences in ``responses`` (and, with ``mirror``, over
-    the mirrored occurrences with negated turns), per level.
-
-    Returns
-    -------
-    dict
-        :class:`ChainTable`'s ``codes``, ``turn``, ``length``, ``end_codes``, ``end`` and
-        ``spread``.
-    """
-    k = max(1, len(alphabet))
-    all_codes, all_values, e_codes, e_end = [], [], [], []
-    for r in responses:
-        chords, signs, end = chord_values(r)
-        codes = window_codes(design_array(r.orientation, alphabet=alphabet, symmetric=symmetric), w, n_types=k)[0]
-        variants = [(codes, 1.0)] + ([(mirror_codes(codes, w, k, symmetric), -1.0)] if mirror else [])
-        for c, sign in variants:
-            all_codes.append(c)
-            all_values.append(chords if sign > 0 else chords * signs)
-            e_codes.append(c[-1:])
-            e_end.append(sign * end[None])
-    codes = np.concatenate(all_codes)
-    values = np.concatenate(all_values)  # turns, lengths (and the elements in space) per level
-    uniq, inv = np.unique(codes, return_inverse=True)
-    means = np.zeros((len(uniq), values.shape[1]))
-    np.add.at(means, inv, values)
-    means /= np.bincount(inv)[:, None]
-    spread = chord_spread(values - means[inv], levels)
-    euniq, einv = np.unique(np.concatenate(e_codes), return_inverse=True)
-    mean_end = np.zeros((len(euniq), levels))
-    np.add.at(mean_end, einv, np.concatenate(e_end))
-    mean_end /= np.bincount(einv)[:, None]
-    space = {"space": means[:, 2 * levels:].reshape(len(uniq), levels, 6)} if values.shape[1] > 2 * levels else {}
-    return {"codes": uniq, "turn": means[:, :levels], "length": means[:, levels:2 * levels], "end_codes": euniq,
-            "end": mean_end, "spread": spread, **space}
 
 
 def _binary_geometry(responses: Sequence[Response], longest: Response, mirror: bool) -> dict[str, Any]:

@@ -26,7 +26,7 @@ from pneumorph.models.chainfile import (
 )
 from pneumorph.models.chainterms import entries_digest, terms_to_dict
 from pneumorph.models.response import FloatArray
-from pneumorph.models.spacechords import chain_points, rotation_matrices
+from pneumorph.models.spacechords import chain_points, rotation_matrices, rotation_vectors
 from pneumorph.models.windows import (
     design_array,
     design_strings,
@@ -104,6 +104,11 @@ class ChainTable:
         curl). Empty (K = 0) for a planar table.
     centre_z : float
         The undeformed z of the unit centres (the actuator's axis) of a chain in space.
+    end_space : ndarray, shape (E, k, 3)
+        A chain in space's end face's frame in the last unit's frame per end window and level
+        (a rotation vector, :func:`~pneumorph.models.spacechords.end_turns`): the end face's
+        frame, and so its twist, of a prediction (:meth:`end_frames`). Empty (E = 0) for a
+        planar table and for a chain in space fitted without it.
     """
 
     window: int
@@ -130,6 +135,7 @@ class ChainTable:
     terms: dict[str, Any] = field(default_factory=dict, compare=False)
     space: FloatArray = field(default_factory=lambda: np.zeros((0, 0, 6)), compare=False)
     centre_z: float = 0.0
+    end_space: FloatArray = field(default_factory=lambda: np.zeros((0, 0, 3)), compare=False)
 
     @property
     def axes(self) -> int:
@@ -203,8 +209,9 @@ class ChainTable:
         h.update(json.dumps(head, sort_keys=True).encode())
         for a in (self.pressures, self.codes, self.turn, self.length, self.end_codes, self.end):
             h.update(np.ascontiguousarray(a).tobytes())
-        if len(self.space):
-            h.update(np.ascontiguousarray(self.space).tobytes())
+        for extra in (self.space, self.end_space):  # a chain in space (with its end face's turns)
+            if len(extra):
+                h.update(np.ascontiguousarray(extra).tobytes())
         return h.hexdigest()[:16]
 
     # -- lookup and prediction ----------------------------------------------------------
@@ -306,6 +313,23 @@ class ChainTable:
         centres, tip = pts[:, :, :-1], pts[:, :, -1]
         return centres, tip, curl
 
+    def end_frames(self, bits: NDArray[np.integer]) -> FloatArray | None:
+        """The end face's frame (m, k, 3) of designs (m, n), as rotation vectors; ``None`` without :attr:`end_space`.
+
+        The last unit's frame (the frame turns composed from the base) turned by the end
+        window's :attr:`end_space`: the full model's :attr:`~pneumorph.models.response.Response.end_frame`.
+        """
+        if not len(self.end_space):
+            return None
+        bits = np.atleast_2d(np.asarray(bits))
+        codes = window_codes(bits, self.window, n_types=self.n_types)
+        frames = rotation_matrices(self.space[self.lookup(codes)][..., 3:])  # (m, n + 1, k, 3, 3)
+        frame = np.broadcast_to(np.eye(3), (len(bits), self.n_levels, 3, 3))
+        for j in range(frames.shape[1]):
+            frame = frame @ frames[:, j]
+        end = frame @ rotation_matrices(self.end_space[self.lookup(codes[:, -1], end=True)])
+        return rotation_vectors(end)
+
     def _space_points(self, bits: NDArray[np.integer], rows: IntArray) -> tuple[FloatArray, FloatArray]:
         """Centres (m, k, n, 3) and tip (m, k, 3) of a chain in space: its elements composed from the base."""
         m = len(bits)
@@ -346,6 +370,8 @@ class ChainTable:
             extra.update(layout=fmt, centre_z_mm=self.centre_z)
             if fmt != TERMS_FORMAT:
                 entries.update(space_chord_mm=self.space[..., :3].tolist(), space_turn_rad=self.space[..., 3:].tolist())
+                if len(self.end_space):
+                    entries.update(space_end_turn_rad=self.end_space.tolist())
             fmt = SPACE_FORMAT
         return {
             "format": fmt,
@@ -419,9 +445,11 @@ class ChainTable:
             raise ChainTableError(f"{where}: symmetric unit types {list(table.symmetric)} outside the alphabet")
         if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
             raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
-        if len(table.space) and table.space.shape != (K, k, 6):
+        if (len(table.space) and table.space.shape != (K, k, 6)) or (
+                len(table.end_space) and (table.end_space.shape != (E, k, 3) or not len(table.space))):
             raise ChainTableError(f"{where}: damaged chain table (elements in space of another shape)")
-        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures, table.space)):
+        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures, table.space,
+                                                  table.end_space)):
             raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
         if data.get("fingerprint") != table.fingerprint():
             raise ChainTableError(f"{where}: the chain table's contents do not match its fingerprint "

@@ -42,7 +42,8 @@ T = TypeVar("T")
 #: units of the training designs of a table built on first use
 TRAINING_UNITS = 15
 #: validation entries that hold one number per level (restricted with the levels)
-_LEVEL_KEYS = ("centre_mean_mm", "centre_worst_mm", "tip_worst_mm", "curl_worst_deg", "norm_worst_mm")
+_LEVEL_KEYS = ("centre_mean_mm", "centre_worst_mm", "tip_worst_mm", "curl_worst_deg", "norm_worst_mm",
+               "end_frame_worst_deg")
 
 
 def shipped_path(fidelity: str, library: str | None = None) -> Path:
@@ -197,7 +198,7 @@ def restrict_table(table: ChainTable, levels: int) -> ChainTable:
             for symbol, errs in validation["per_type"].items()}
     return replace(table, pressures=table.pressures[:m].copy(), turn=table.turn[:, :m].copy(),
                    length=table.length[:, :m].copy(), end=table.end[:, :m].copy(), space=table.space[:, :m].copy(),
-                   source=source, validation=validation)
+                   end_space=table.end_space[:, :m].copy(), source=source, validation=validation)
 
 
 def level_pressure(table: ChainTable, levels: int) -> float:

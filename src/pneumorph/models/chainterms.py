@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError
 from pneumorph.models.response import Response, response_elements
-from pneumorph.models.spacechords import MIRROR_SIGNS, space_rows
+from pneumorph.models.spacechords import MIRROR_SIGNS, end_turns, space_rows
 from pneumorph.models.windows import (
     canonical_codes,
     covering_designs,
@@ -139,7 +139,7 @@ def fit_text(w: int, far: bool | str) -> str:
     return f"window +-{w} with far-field terms (+-{w + 1})" if layout else f"window +-{w}"
 
 
-def chord_values(response: Response) -> tuple[FloatArray, FloatArray, FloatArray]:
+def chord_values(response: Response) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """What a table averages per chord of ``response``, the levels side by side, and how it turns over.
 
     Returns
@@ -151,14 +151,21 @@ def chord_values(response: Response) -> tuple[FloatArray, FloatArray, FloatArray
         What ``values`` are multiplied by when every unit is turned over: the turns change sign,
         the lengths do not, the elements in space take
         :data:`~pneumorph.models.spacechords.MIRROR_SIGNS`.
-    end : ndarray, shape (k,)
-        The end turn (it changes sign turned over).
+    end : ndarray, shape (k,), or (4 k,) with the end face's frame
+        The end turn, and for a full-width response that keeps the end face's frame, its turn
+        from the last unit's frame per level (:func:`~pneumorph.models.spacechords.end_turns`).
+    end_signs : ndarray, shape like ``end``
+        Turned over, the end turn changes sign and the end face's turn takes the turn's signs
+        of :data:`~pneumorph.models.spacechords.MIRROR_SIGNS`.
     """
     turn, length, end = response_elements(response)
     space = space_rows(response)
     k = len(end)
     signs = np.concatenate([-np.ones(k), np.ones(k), *[np.tile(MIRROR_SIGNS, k) for _ in space]])
-    return np.concatenate([turn.T, length.T, *space], axis=1), signs, end
+    face = end_turns(response) if space else None
+    ends = [end] if face is None else [end, face.ravel()]
+    end_signs = np.concatenate([-np.ones(k), *[np.tile(MIRROR_SIGNS[3:], k) for _ in ends[1:]]])
+    return np.concatenate([turn.T, length.T, *space], axis=1), signs, np.concatenate(ends), end_signs
 
 
 def chord_spread(deviation: FloatArray, levels: int) -> float:
@@ -192,12 +199,12 @@ def _observations(responses: Sequence[Response], width: int, mirror: bool, alpha
     """
     syms, values, esyms, ends = [], [], [], []
     for r in responses:
-        chords, signs, end = chord_values(r)
+        chords, signs, end, end_signs = chord_values(r)
         for s, sign in symbols_of(r.orientation, width, mirror, alphabet, symmetric):
             syms.append(s)
             values.append(chords if sign > 0 else chords * signs)
             esyms.append(s[-1:])
-            ends.append(sign * end[None, :])
+            ends.append((end if sign > 0 else end * end_signs)[None, :])
     return np.concatenate(syms), np.concatenate(values), np.concatenate(esyms), np.concatenate(ends)
 
 
@@ -295,10 +302,12 @@ def fit_terms(responses: Sequence[Response], window: int, mirror: bool, alphabet
     layout = term_layout(layout)
     tables, fit = _backfit([term_codes(syms, width, lo, hi, radix) for lo, hi in far_terms(w, layout)], values)
     etables, efit = _backfit([term_codes(esyms, width, lo, hi, radix) for lo, hi in end_terms(w, layout)], ends)
-    levels = ends.shape[1]
+    levels = responses[0].n_levels
     spread = chord_spread(values - fit, levels)
     if values.shape[1] == 2 * levels:  # a planar chain: its end turns tell it too
         spread = max(spread, float(np.abs(ends - efit).max()))
+    elif ends.shape[1] > levels:  # a chain in space: its end face's turns
+        spread = max(spread, float(np.abs((ends - efit)[:, levels:]).max()))
     return {"window": w, "layout": layout, "chord": tables, "end": etables}, spread
 
 
@@ -337,9 +346,11 @@ def compile_terms(terms: dict[str, Any], n_units: int, n_types: int, symmetric: 
     last = np.all(windows[:, width + 1:] == radix - 1, axis=1) & (windows[:, width] < radix - 2)
     end = _compile(terms["end"], end_terms(w, layout), windows[last], width, radix, "end")
     out = {"codes": codes, "turn": chord[:, :levels], "length": chord[:, levels:2 * levels], "end_codes": codes[last],
-           "end": end}
+           "end": end[:, :levels]}
     if chord.shape[1] > 2 * levels:  # a chain in space: its elements per level after the planar ones
         out["space"] = chord[:, 2 * levels:].reshape(len(codes), levels, 6)
+    if end.shape[1] > levels:  # and the end face's turns
+        out["end_space"] = end[:, levels:].reshape(len(end), levels, 3)
     return out
 
 
@@ -373,8 +384,9 @@ def entries_digest(entries: dict[str, Any]) -> str:
     h = hashlib.sha256()
     for key in ("codes", "turn", "length", "end_codes", "end"):
         h.update(np.ascontiguousarray(entries[key]).tobytes())
-    if len(entries.get("space", ())):  # a chain in space
-        h.update(np.ascontiguousarray(entries["space"]).tobytes())
+    for key in ("space", "end_space"):  # a chain in space, with the end face's turns
+        if len(entries.get(key, ())):
+            h.update(np.ascontiguousarray(entries[key]).tobytes())
     return h.hexdigest()[:16]
 
 

@@ -204,6 +204,28 @@ def space_rows(response: Any) -> list[FloatArray]:
     return [e.transpose(1, 0, 2).reshape(e.shape[1], -1)]
 
 
+def end_turns(response: Any) -> FloatArray | None:
+    """The end face's frame in the last unit's frame per level, as rotation vectors (k, 3); ``None`` without them.
+
+    A full-width response keeps each unit's frame (:attr:`~pneumorph.models.response.Response.frames`)
+    and the end face's (:attr:`~pneumorph.models.response.Response.end_frame`); the chain in space
+    keys this turn by the last chord's window, as the planar chain its end turn, and composes
+    the end face's frame from the last unit's (:meth:`~pneumorph.models.chaintable.ChainTable.end_frames`).
+    Turned over, it takes the signs of :data:`MIRROR_SIGNS`' turn.
+
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> r = SimpleNamespace(frames=np.array([[[0, 0, 0.1], [0, 0, 0.3]]]), end_frame=np.array([[0, 0, 0.4]]))
+    >>> end_turns(r).round(12).tolist()
+    [[0.0, 0.0, 0.1]]
+    """
+    frames, end = getattr(response, "frames", None), getattr(response, "end_frame", None)
+    if frames is None or end is None or not np.shape(frames)[1]:
+        return None
+    last = _rotation(np.asarray(frames, dtype=float)[:, -1, :])
+    return _rotvec(np.einsum("kji,kjl->kil", last, _rotation(np.asarray(end, dtype=float))))
+
+
 def chain_points(chords: FloatArray, turns: FloatArray, start: FloatArray) -> FloatArray:
     """The polyline of the chain's elements in space from ``start``: the inverse of :func:`response_space_elements`.
 
@@ -242,6 +264,11 @@ def rotation_matrices(vectors: FloatArray) -> FloatArray:
     return _rotation(np.asarray(vectors, dtype=float))
 
 
+def rotation_vectors(matrices: FloatArray) -> FloatArray:
+    """Rotation vectors (..., 3) of rotation matrices (..., 3, 3): :func:`rotation_matrices`' inverse."""
+    return _rotvec(np.asarray(matrices, dtype=float))
+
+
 def _rotvec(matrix: FloatArray) -> FloatArray:
     """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3)."""
     return Rotation.from_matrix(matrix.reshape(-1, 3, 3)).as_rotvec().reshape(*matrix.shape[:-2], 3)
@@ -252,5 +279,6 @@ def _rotation(vector: FloatArray) -> FloatArray:
     return Rotation.from_rotvec(vector.reshape(-1, 3)).as_matrix().reshape(*vector.shape[:-1], 3, 3)
 
 
-__all__ = ["MIRROR_SIGNS", "chain_points", "frame_elements", "frame_polyline", "response_space_elements",
-           "rotation_matrices", "space_elements", "space_polyline", "space_rows", "transported_frames"]
+__all__ = ["MIRROR_SIGNS", "chain_points", "end_turns", "frame_elements", "frame_polyline", "response_space_elements",
+           "rotation_matrices", "rotation_vectors", "space_elements", "space_polyline", "space_rows",
+           "transported_frames"]
