@@ -134,6 +134,8 @@ def test_a_chain_in_space_predicts_the_end_face_s_frame_and_twist_of_a_local_law
                                        atol=1e-12, rtol=0)
             np.testing.assert_allclose(got.twist, want.twist, atol=1e-9, rtol=0)
             assert np.abs(want.end_frame).max() > 0.01
+            up = rotation_matrices(want.end_frame)[:, :, 1]  # the curl: the face's line up its height in x-y
+            np.testing.assert_allclose(got.curl, np.degrees(np.arctan2(-up[:, 0], up[:, 1])), atol=1e-9, rtol=0)
     one, other = model.evaluate("LalAAlLaaL"), model.evaluate("lALaaLlAAl")
     np.testing.assert_allclose(other.end_frame, one.end_frame * [1, -1, -1], atol=1e-12, rtol=0)
     np.testing.assert_allclose(other.twist, one.twist, atol=1e-9, rtol=0)  # a half turn about x keeps a twist about x

@@ -86,4 +86,28 @@ def entries_of(data: dict[str, Any], fmt: Any, w: int, alphabet: tuple[str, ...]
     return out
 
 
-__all__ = ["ALPHABET_FORMAT", "SPACE_FORMAT", "TABLE_FORMAT", "TERMS_FORMAT", "entries_of", "types_of"]
+def check_entries(table: Any, where: str) -> None:
+    """Refuse a table read from a file whose arrays do not fit together (shapes, window order, finite values).
+
+    Raises
+    ------
+    ChainTableError
+        Naming ``where`` and what is damaged.
+    """
+    k, K, E = table.n_levels, len(table.codes), len(table.end_codes)
+    shapes_ok = (table.turn.shape == (K, k) and table.length.shape == (K, k) and table.end.shape == (E, k))
+    if not shapes_ok or not (np.all(np.diff(table.codes) > 0) and np.all(np.diff(table.end_codes) > 0)):
+        raise ChainTableError(f"{where}: damaged chain table (array shapes or window order do not match)")
+    if set(table.symmetric) - set(table.alphabet):
+        raise ChainTableError(f"{where}: symmetric unit types {list(table.symmetric)} outside the alphabet")
+    if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
+        raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
+    if (len(table.space) and table.space.shape != (K, k, 6)) or (
+            len(table.end_space) and (table.end_space.shape != (E, k, 3) or not len(table.space))):
+        raise ChainTableError(f"{where}: damaged chain table (elements in space of another shape)")
+    if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures, table.space,
+                                              table.end_space)):
+        raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
+
+
+__all__ = ["ALPHABET_FORMAT", "SPACE_FORMAT", "TABLE_FORMAT", "TERMS_FORMAT", "check_entries", "entries_of", "types_of"]

@@ -21,6 +21,7 @@ from pneumorph.models.chainfile import (
     SPACE_FORMAT,
     TABLE_FORMAT,
     TERMS_FORMAT,
+    check_entries,
     entries_of,
     types_of,
 )
@@ -290,6 +291,10 @@ class ChainTable:
     def predict(self, bits: NDArray[np.integer]) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Centres (m, k, n, 2), tip (m, k, 2) and curl in degrees (m, k) of designs (m, n).
 
+        A chain in space gives points in space (..., 3), and, with :attr:`end_space`, the curl
+        of its end face's frame (the turn of the face's line up its height in the x-y plane, as
+        the full model measures it); without, that of its view in the x-y plane.
+
         Examples
         --------
         See :class:`ChainModel`.
@@ -304,6 +309,9 @@ class ChainTable:
         curl = np.degrees(angle[:, -1, :] + self.end[erows])
         if len(self.space):
             centres, tip = self._space_points(bits, rows)
+            if len(self.end_space):  # the FE's curl: the turn of the end face's line up its height in x-y
+                up = self._end_matrices(rows, erows)[..., :, 1]
+                curl = np.degrees(np.unwrap(np.arctan2(-up[..., 0], up[..., 1]), axis=1))
             return centres, tip, curl
         length = self.length[rows]
         steps = np.stack([length * np.cos(angle), length * np.sin(angle)], axis=-1)  # (m, n + 1, k, 2)
@@ -323,12 +331,15 @@ class ChainTable:
             return None
         bits = np.atleast_2d(np.asarray(bits))
         codes = window_codes(bits, self.window, n_types=self.n_types)
-        frames = rotation_matrices(self.space[self.lookup(codes)][..., 3:])  # (m, n + 1, k, 3, 3)
-        frame = np.broadcast_to(np.eye(3), (len(bits), self.n_levels, 3, 3))
+        return rotation_vectors(self._end_matrices(self.lookup(codes), self.lookup(codes[:, -1], end=True)))
+
+    def _end_matrices(self, rows: IntArray, erows: IntArray) -> FloatArray:
+        """The end face's frames (m, k, 3, 3) of designs of chord ``rows`` (m, n + 1) and end rows (m,)."""
+        frames = rotation_matrices(self.space[rows][..., 3:])  # (m, n + 1, k, 3, 3)
+        frame = np.broadcast_to(np.eye(3), (len(rows), self.n_levels, 3, 3))
         for j in range(frames.shape[1]):
             frame = frame @ frames[:, j]
-        end = frame @ rotation_matrices(self.end_space[self.lookup(codes[:, -1], end=True)])
-        return rotation_vectors(end)
+        return np.asarray(frame @ rotation_matrices(self.end_space[erows]))
 
     def _space_points(self, bits: NDArray[np.integer], rows: IntArray) -> tuple[FloatArray, FloatArray]:
         """Centres (m, k, n, 3) and tip (m, k, 3) of a chain in space: its elements composed from the base."""
@@ -437,20 +448,7 @@ class ChainTable:
             raise ChainTableError(f"{where}: bad alphabet: {exc}") from None
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise ChainTableError(f"{where}: damaged chain table ({type(exc).__name__}: {exc})") from None
-        k, K, E = table.n_levels, len(table.codes), len(table.end_codes)
-        shapes_ok = (table.turn.shape == (K, k) and table.length.shape == (K, k) and table.end.shape == (E, k))
-        if not shapes_ok or not (np.all(np.diff(table.codes) > 0) and np.all(np.diff(table.end_codes) > 0)):
-            raise ChainTableError(f"{where}: damaged chain table (array shapes or window order do not match)")
-        if set(table.symmetric) - set(table.alphabet):
-            raise ChainTableError(f"{where}: symmetric unit types {list(table.symmetric)} outside the alphabet")
-        if table.alphabet and len(table.type_centre_y) != 2 * len(table.alphabet):
-            raise ChainTableError(f"{where}: damaged chain table (a centre height per type and orientation)")
-        if (len(table.space) and table.space.shape != (K, k, 6)) or (
-                len(table.end_space) and (table.end_space.shape != (E, k, 3) or not len(table.space))):
-            raise ChainTableError(f"{where}: damaged chain table (elements in space of another shape)")
-        if not all(np.isfinite(a).all() for a in (table.turn, table.length, table.end, table.pressures, table.space,
-                                                  table.end_space)):
-            raise ChainTableError(f"{where}: damaged chain table (non-finite entries)")
+        check_entries(table, where)
         if data.get("fingerprint") != table.fingerprint():
             raise ChainTableError(f"{where}: the chain table's contents do not match its fingerprint "
                                   "(edited or damaged); rebuild it with `pneumorph chain build`")
