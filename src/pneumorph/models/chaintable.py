@@ -27,7 +27,7 @@ from pneumorph.models.chainfile import (
 )
 from pneumorph.models.chainterms import entries_digest, terms_to_dict
 from pneumorph.models.response import FloatArray
-from pneumorph.models.spacechords import chain_points, rotation_matrices, rotation_vectors
+from pneumorph.models.spacechords import chain_frames, rotation_matrices, rotation_vectors
 from pneumorph.models.windows import (
     design_array,
     design_strings,
@@ -308,9 +308,9 @@ class ChainTable:
         angle = np.cumsum(self.turn[rows], axis=1)  # (m, n + 1, k)
         curl = np.degrees(angle[:, -1, :] + self.end[erows])
         if len(self.space):
-            centres, tip = self._space_points(bits, rows)
+            centres, tip, last = self._space_points(bits, rows)
             if len(self.end_space):  # the FE's curl: the turn of the end face's line up its height in x-y
-                up = self._end_matrices(rows, erows)[..., :, 1]
+                up = (last @ rotation_matrices(self.end_space[erows]))[..., :, 1]
                 curl = np.degrees(np.unwrap(np.arctan2(-up[..., 0], up[..., 1]), axis=1))
             return centres, tip, curl
         length = self.length[rows]
@@ -331,24 +331,19 @@ class ChainTable:
             return None
         bits = np.atleast_2d(np.asarray(bits))
         codes = window_codes(bits, self.window, n_types=self.n_types)
-        return rotation_vectors(self._end_matrices(self.lookup(codes), self.lookup(codes[:, -1], end=True)))
+        last = self._space_points(bits, self.lookup(codes))[2]
+        return rotation_vectors(last @ rotation_matrices(self.end_space[self.lookup(codes[:, -1], end=True)]))
 
-    def _end_matrices(self, rows: IntArray, erows: IntArray) -> FloatArray:
-        """The end face's frames (m, k, 3, 3) of designs of chord ``rows`` (m, n + 1) and end rows (m,)."""
-        frames = rotation_matrices(self.space[rows][..., 3:])  # (m, n + 1, k, 3, 3)
-        frame = np.broadcast_to(np.eye(3), (len(rows), self.n_levels, 3, 3))
-        for j in range(frames.shape[1]):
-            frame = frame @ frames[:, j]
-        return np.asarray(frame @ rotation_matrices(self.end_space[erows]))
-
-    def _space_points(self, bits: NDArray[np.integer], rows: IntArray) -> tuple[FloatArray, FloatArray]:
-        """Centres (m, k, n, 3) and tip (m, k, 3) of a chain in space: its elements composed from the base."""
+    def _space_points(self, bits: NDArray[np.integer], rows: IntArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Centres (m, k, n, 3), tip (m, k, 3) and the last unit's frame (m, k, 3, 3) of a chain in space: its
+        elements composed from the base."""
         m = len(bits)
         chords = self.space[rows][..., :3].transpose(0, 2, 1, 3)  # (m, k, n + 1, 3)
-        turns = rotation_matrices(self.space[rows][..., 3:]).transpose(0, 2, 1, 3, 4)
+        frames = chain_frames(rotation_matrices(self.space[rows][..., 3:]).transpose(0, 2, 1, 3, 4))
         base = np.stack([np.zeros(m), self.heights[bits[:, 0]], np.full(m, self.centre_z)], axis=-1)
-        pts = chain_points(chords, turns, base[:, None, :])[:, :, 1:]  # (m, k, n + 1, 3)
-        return pts[:, :, :-1], pts[:, :, -1]
+        steps = np.einsum("...ij,...j->...i", frames, chords)
+        pts = base[:, None, None, :] + np.cumsum(steps, axis=2)  # (m, k, n + 1, 3)
+        return pts[:, :, :-1], pts[:, :, -1], frames[:, :, -1]
 
     # -- persistence ----------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:

@@ -250,13 +250,25 @@ def chain_points(chords: FloatArray, turns: FloatArray, start: FloatArray) -> Fl
     >>> chain_points(chords, quarter, np.zeros(3)).round(9).tolist()
     [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 0.0, -10.0]]
     """
-    chords, turns = np.asarray(chords, dtype=float), np.asarray(turns, dtype=float)
-    frame = np.broadcast_to(np.eye(3), (*chords.shape[:-2], 3, 3))
-    points = [np.broadcast_to(np.asarray(start, dtype=float), (*chords.shape[:-2], 3))]
-    for j in range(chords.shape[-2]):
-        frame = frame @ turns[..., j, :, :]
-        points.append(points[-1] + np.einsum("...ij,...j->...i", frame, chords[..., j, :]))
-    return np.stack(points, axis=-2)
+    chords = np.asarray(chords, dtype=float)
+    steps = np.einsum("...ij,...j->...i", chain_frames(turns), chords)
+    start = np.broadcast_to(np.asarray(start, dtype=float), (*chords.shape[:-2], 3))
+    return np.concatenate([start[..., None, :], start[..., None, :] + np.cumsum(steps, axis=-2)], axis=-2)
+
+
+def chain_frames(turns: FloatArray) -> FloatArray:
+    """Each point's frame in the actuator's (..., n + 1, 3, 3): the turns (..., n + 1, 3, 3) composed from the base.
+
+    >>> quarter = Rotation.from_rotvec([[0, 0, np.pi / 2]] * 2).as_matrix()
+    >>> chain_frames(quarter)[-1].round(12).tolist()   # two quarter turns about z: a half turn
+    [[-1.0, -0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    turns = np.asarray(turns, dtype=float)
+    frames = np.empty_like(turns)
+    frame = np.broadcast_to(np.eye(3), (*turns.shape[:-3], 3, 3))
+    for j in range(turns.shape[-3]):
+        frame = frames[..., j, :, :] = frame @ turns[..., j, :, :]
+    return frames
 
 
 def rotation_matrices(vectors: FloatArray) -> FloatArray:
@@ -279,6 +291,6 @@ def _rotation(vector: FloatArray) -> FloatArray:
     return Rotation.from_rotvec(vector.reshape(-1, 3)).as_matrix().reshape(*vector.shape[:-1], 3, 3)
 
 
-__all__ = ["MIRROR_SIGNS", "chain_points", "end_turns", "frame_elements", "frame_polyline", "response_space_elements",
-           "rotation_matrices", "rotation_vectors", "space_elements", "space_polyline", "space_rows",
-           "transported_frames"]
+__all__ = ["MIRROR_SIGNS", "chain_frames", "chain_points", "end_turns", "frame_elements", "frame_polyline",
+           "response_space_elements", "rotation_matrices", "rotation_vectors", "space_elements", "space_polyline",
+           "space_rows", "transported_frames"]
