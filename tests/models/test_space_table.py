@@ -7,6 +7,7 @@ The table: `pneumorph chain build --model 3d --library spatial --window 2 --far-
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ from pneumorph.models.chain import ChainModel
 from pneumorph.models.chaintables import find_table, shipped_path
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import Response
+from pneumorph.models.spacechords import rotation_matrices, rotation_vectors
 
 HELDOUT = sorted((Path(__file__).parents[1] / "data" / "space-heldout").glob("*.json"))
 
@@ -46,3 +48,29 @@ def test_the_chain_in_space_composes_held_out_fe_responses_within_its_validation
     assert err.max() <= max(table.validation["centre_worst_mm"]) + 1e-9
     assert np.abs(fe.centres[..., 2] - 7.5).max() > 1.0  # it leaves the plane: the z the chain gets right
     np.testing.assert_allclose(chain.tip, fe.tip, atol=max(table.validation["tip_worst_mm"]) + 1e-9, rtol=0)
+
+
+def test_the_shipped_spatial_table_predicts_the_end_face_s_frame(table) -> None:
+    v = table.validation
+    assert table.end_space.shape == (len(table.end_codes), table.n_levels, 3)
+    assert len(v["end_frame_worst_deg"]) == table.n_levels and np.isfinite(v["end_frame_worst_deg"]).all()
+    assert len(table.validation["designs"]) >= 20  # every held-out design's end face, not a few
+
+
+@pytest.mark.parametrize("path", HELDOUT, ids=lambda p: p.stem)
+def test_the_chain_in_space_gives_the_end_face_s_frame_and_curl_of_held_out_fe_responses(table, path: Path) -> None:
+    """The end face's frame composed from the last unit's, against the full model's; its curl is closer to the FE's
+    than the view of the chain's projection on the x-y plane gives."""
+    fe = Response.load(path)
+    assert fe.end_frame is not None
+    chain = ChainModel(table, 15).evaluate(fe.orientation)
+    assert chain.end_frame is not None
+    turn = np.swapaxes(rotation_matrices(chain.end_frame), -1, -2) @ rotation_matrices(fe.end_frame)
+    angle = np.degrees(np.linalg.norm(rotation_vectors(turn), axis=-1))
+    assert angle.max() <= max(table.validation["end_frame_worst_deg"]) + 1e-9
+    assert np.degrees(np.linalg.norm(fe.end_frame, axis=-1)).max() > 10.0  # the face turns: a real test
+    np.testing.assert_allclose(chain.twist, fe.twist, atol=max(table.validation["end_frame_worst_deg"]) + 1e-9,
+                               rtol=0)
+    planar_view = ChainModel(replace(table, end_space=np.zeros((0, 0, 3))), 15).evaluate(fe.orientation)
+    assert planar_view.end_frame is None
+    assert np.abs(chain.curl - fe.curl).max() < np.abs(planar_view.curl - fe.curl).max()
