@@ -96,7 +96,8 @@ def test_a_chain_in_space_survives_its_file_and_refuses_tampering(law, undeforme
 
 
 def test_a_restricted_chain_in_space_predicts_the_first_levels(law, undeformed) -> None:
-    train = [_response(d, law, undeformed) for d in covering_designs(7, W, n_types=2, alphabet=ALPHABET, short=True)]
+    train = [_response(d, law, undeformed, ends=True)
+             for d in covering_designs(7, W, n_types=2, alphabet=ALPHABET, short=True)]
     source = {**_source(), "description": {"pressure_mpa": 0.03, "steps": {"increments": 3}}}
     from pneumorph.io.provenance import digest
 
@@ -105,7 +106,8 @@ def test_a_restricted_chain_in_space_predicts_the_first_levels(law, undeformed) 
     short = restrict_table(table, 2)
     bits = table.designs(["alLAalA"])
     np.testing.assert_array_equal(short.predict(bits)[0], table.predict(bits)[0][:, :2])
-    assert short.space.shape[1] == 2
+    np.testing.assert_array_equal(short.end_frames(bits), table.end_frames(bits)[:, :2])
+    assert short.space.shape[1] == 2 and short.end_space.shape[1] == 2
 
 
 def test_planar_and_space_responses_are_not_mixed_in_one_table(law, undeformed) -> None:
