@@ -281,6 +281,16 @@ def rotation_vectors(matrices: FloatArray) -> FloatArray:
     return _rotvec(np.asarray(matrices, dtype=float))
 
 
+def angle_between(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The angle (rad) of the rotation from frame ``a`` to frame ``b``, both rotation vectors (..., 3).
+
+    >>> float(angle_between(np.array([0, 0, 0.1]), np.array([0, 0, 0.4])).round(12))
+    0.3
+    """
+    turn = np.swapaxes(_rotation(np.asarray(a, dtype=float)), -1, -2) @ _rotation(np.asarray(b, dtype=float))
+    return np.asarray(np.linalg.norm(_rotvec(turn), axis=-1))
+
+
 def _rotvec(matrix: FloatArray) -> FloatArray:
     """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3)."""
     return Rotation.from_matrix(matrix.reshape(-1, 3, 3)).as_rotvec().reshape(*matrix.shape[:-2], 3)
@@ -291,6 +301,6 @@ def _rotation(vector: FloatArray) -> FloatArray:
     return Rotation.from_rotvec(vector.reshape(-1, 3)).as_matrix().reshape(*vector.shape[:-1], 3, 3)
 
 
-__all__ = ["MIRROR_SIGNS", "chain_frames", "chain_points", "end_turns", "frame_elements", "frame_polyline",
-           "response_space_elements", "rotation_matrices", "rotation_vectors", "space_elements", "space_polyline",
-           "space_rows", "transported_frames"]
+__all__ = ["MIRROR_SIGNS", "angle_between", "chain_frames", "chain_points", "end_turns", "frame_elements",
+           "frame_polyline", "response_space_elements", "rotation_matrices", "rotation_vectors", "space_elements",
+           "space_polyline", "space_rows", "transported_frames"]

@@ -16,7 +16,7 @@ import numpy as np
 
 from pneumorph.models.chaintable import ChainTable
 from pneumorph.models.response import Response
-from pneumorph.models.spacechords import rotation_matrices, rotation_vectors
+from pneumorph.models.spacechords import angle_between
 from pneumorph.models.windows import design_strings, random_designs, unit_codes
 
 #: held-out designs after which the validation may stop early (:func:`validate_in_rounds` with ``early``)
@@ -31,9 +31,10 @@ def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[
     Returns a dict with per-level lists ``centre_mean_mm``, ``centre_worst_mm``,
     ``tip_worst_mm``, ``curl_worst_deg``, ``norm_worst_mm`` (the worst root of the summed
     squared centre errors of one design), and ``designs``; a chain in space that predicts the
-    end face's frame adds ``end_frame_worst_deg`` (the angle between its frame and the FE's). A table over several unit
-    types adds ``per_type``: per symbol the ``centre_worst_mm``, ``centre_mean_mm`` (per
-    level) and ``centres`` (how many) of the centres of the units of that type.
+    end face's frame adds ``end_frame_worst_deg`` (the angle between its frame and the FE's).
+    A table over several unit types adds ``per_type``: per symbol the ``centre_worst_mm``,
+    ``centre_mean_mm`` (per level) and ``centres`` (how many) of the centres of the units of
+    that type.
     """
     k = table.n_levels
     centre_err, tip_err, curl_err, norm_err, end_err = [], [], [], [], []
@@ -44,8 +45,7 @@ def prediction_errors(table: ChainTable, responses: Sequence[Response]) -> dict[
         c, t, cu = table.predict(bits)
         end = table.end_frames(bits)
         if end is not None and r.end_frame is not None:  # the angle between the end faces' frames
-            end_err.append(np.degrees(np.linalg.norm(rotation_vectors(
-                np.swapaxes(rotation_matrices(end[0]), -1, -2) @ rotation_matrices(r.end_frame)), axis=-1)))
+            end_err.append(np.degrees(angle_between(end[0], r.end_frame)))
         e = np.linalg.norm(c[0] - r.centres, axis=-1)  # (k, n); in space for a chain in space
         centre_err.append(e)
         norm_err.append(np.sqrt((e**2).sum(axis=1)))
