@@ -39,8 +39,9 @@ from typing import Any
 import numpy as np
 
 from pneumorph.design.bounds import ChainScores, chain_errors, objective_bounds, score_designs
+from pneumorph.design.branching import MAX_ENUMERATE
 from pneumorph.design.fitness import score
-from pneumorph.design.growth import best_scores, chain_scores, designs_of, grow_designs
+from pneumorph.design.growth import best_scores, chain_scores, designs_of, enumerable, grow_designs
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.spacegrowth import space_scores
@@ -163,7 +164,7 @@ def certified_search(
         # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
         # and the FE verifications alike
         objective = replace(objective, length=chain.length)
-    if designs_of(chain) > 2.0**20:  # a branch-and-bound: a tip goal over sideways units takes about a minute
+    if not enumerable(chain, MAX_ENUMERATE):  # a branch-and-bound: a tip goal over sideways units takes a minute
         say(f"chain: scoring {designs_of(chain):,.0f} designs (branch-and-bound) ...")
     scores = chain_scores(chain, objective, margin)
     order = scores.order()

@@ -69,7 +69,7 @@ def designs_of(chain: ChainModel) -> float:
     return float(choices(chain)) ** chain.n_units
 
 
-def _enumerable(chain: ChainModel, units: int) -> bool:
+def enumerable(chain: ChainModel, units: int) -> bool:
     """At most as many designs as ``2^units`` (every design's geometry fits)."""
     return designs_of(chain) <= 2.0**units
 
@@ -203,7 +203,7 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     errors = chain_errors(chain, margin)
     n = chain.n_units
     if (not isinstance(objective, ProfileTarget) or objective.coordinates != "cartesian"
-            or not _enumerable(chain, KEEP_GEOMETRY_UNITS) or n < 4):
+            or not enumerable(chain, KEEP_GEOMETRY_UNITS) or n < 4):
         return chain_scores(chain, objective, margin)
     g = chain_geometry(chain)
     c = choices(chain)
@@ -259,7 +259,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     """
     if isinstance(objective, StagedTarget):
         return _grow_staged(chain, objective, errors, threshold, max_nodes, beam, spill)
-    if not np.isfinite(threshold) and beam is None and _enumerable(chain, KEEP_GEOMETRY_UNITS):
+    if not np.isfinite(threshold) and beam is None and enumerable(chain, KEEP_GEOMETRY_UNITS):
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
     n, k = chain.n_units, table.n_levels
@@ -339,7 +339,7 @@ def chain_scores(chain: ChainModel, objective: Objective, margin: float = 1.0,
         return space_scores(chain, objective, margin, max_nodes, max_enumerate)
     errors = chain_errors(chain, margin)
     n = chain.n_units
-    if _enumerable(chain, max_enumerate):
+    if enumerable(chain, max_enumerate):
         return grow_designs(chain, objective, errors)
     beamed = grow_designs(chain, objective, errors, beam=BEAM)
     c0 = float(beamed.cost.min())
@@ -390,7 +390,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     tip is placed), so no design of a dropped prefix costs less than ``threshold``.
     """
     if not np.isfinite(threshold) and beam is None:
-        if not _enumerable(chain, MAX_ENUMERATE):
+        if not enumerable(chain, MAX_ENUMERATE):
             raise SearchConfigError(f"scoring every one of {designs_of(chain):.3g} designs of {chain.n_units} units "
                                     "takes too long; give a threshold")
         bits = every_design(chain.n_units, np.asarray(chain.table.unit_codes, dtype=np.uint8))

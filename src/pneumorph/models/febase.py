@@ -35,7 +35,7 @@ from pneumorph.io.provenance import digest
 from pneumorph.materials import get
 from pneumorph.materials.filler import FillerLaw
 from pneumorph.materials.material import Material
-from pneumorph.models.frames import end_frame, unit_frames
+from pneumorph.models.frames import record_frames
 from pneumorph.models.gravity import gravity_vector
 from pneumorph.models.response import FloatArray, Response
 
@@ -415,10 +415,7 @@ class FEModel:
         def record(k: int, t: float) -> None:
             displacements[k] = body.displacement[:, : self.dim]
             response.centres[k] = mesh.unit_centres(displacements[k], axes)
-            if response.frames is not None:  # the full width: each unit's frame, its roll included
-                response.frames[k] = unit_frames(mesh, displacements[k])
-            if response.end_frame is not None:
-                response.end_frame[k] = end_frame(mesh, displacements[k])
+            record_frames(response, k, mesh, displacements[k])  # the full width: each unit's and the end face's
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
             if on_level is not None:

@@ -81,6 +81,15 @@ def end_frame(mesh: Any, displacement: FloatArray) -> FloatArray:
     return np.asarray(Rotation.from_matrix(turned).as_rotvec())
 
 
+def record_frames(response: Any, k: int, mesh: Any, displacement: FloatArray) -> None:
+    """Write level ``k``'s unit frames and end face's frame into a full-width ``response`` (no-op for the arrays it
+    lacks: a planar response keeps neither)."""
+    if response.frames is not None:
+        response.frames[k] = unit_frames(mesh, displacement)
+    if response.end_frame is not None:
+        response.end_frame[k] = end_frame(mesh, displacement)
+
+
 def twist(rotations: FloatArray) -> FloatArray:
     """The twist (deg) of end-face rotations about the face's own normal, the actuator's axis x.
 
@@ -104,4 +113,4 @@ def twist(rotations: FloatArray) -> FloatArray:
     return out.reshape(r.shape[:-1])
 
 
-__all__ = ["end_frame", "twist", "unit_frames"]
+__all__ = ["end_frame", "record_frames", "twist", "unit_frames"]

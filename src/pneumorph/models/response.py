@@ -60,8 +60,9 @@ class Response:
         responses (points in space) keep it (:mod:`pneumorph.models.frames`); None otherwise.
     end_frame : ndarray, shape (k, 3), or None
         The free end face's rotation (a rotation vector, rad) per level, of the full 3D
-        model's responses (:func:`pneumorph.models.frames.end_frame`); its :attr:`twist` about
-        the face's normal. None for planar responses and chains.
+        model's responses (:func:`pneumorph.models.frames.end_frame`) and of a chain in space
+        that predicts it (:meth:`~pneumorph.models.chaintable.ChainTable.end_frames`); its
+        :attr:`twist` about the face's normal. None for planar responses.
 
     Examples
     --------

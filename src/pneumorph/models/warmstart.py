@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.models.febase import FEModel, Solution, _end_face_angle
-from pneumorph.models.frames import end_frame, unit_frames
+from pneumorph.models.frames import record_frames
 
 
 def solve_near(model: FEModel, design: str, start: Solution) -> Solution:
@@ -82,10 +82,7 @@ def _last_level(model: FEModel, design: str, mesh: Any, u: Any, start: Solution,
     displacements = np.full((len(response.pressures), *mesh.points.shape), np.nan)
     displacements[-1] = u
     response.centres[-1] = mesh.unit_centres(u, mesh.axes)
-    if response.frames is not None:
-        response.frames[-1] = unit_frames(mesh, u)
-    if response.end_frame is not None:
-        response.end_frame[-1] = end_frame(mesh, u)
+    record_frames(response, -1, mesh, u)
     response.tip[-1] = response.reference_tip + u[mesh.end_points][:, : mesh.axes].mean(axis=0)
     x_end0 = mesh.points[mesh.end_points][:, :2]
     before = float(start.response.curl[-1])
