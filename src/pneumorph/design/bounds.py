@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.fitness import profile_error_array, tip_value_array
+from pneumorph.design.fitness import path_error_array, profile_error_array, tip_value_array
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.rest import CurveRange
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
@@ -95,6 +96,8 @@ def _uniform_bound(chain: ChainModel, objective: Objective, errors: dict[str, Fl
         return _staged_bound(chain, objective, errors)
     if isinstance(objective, ProfileTarget):
         return errors["centre"] * np.sqrt(chain.n_units * (1.0 + slope**2))
+    if isinstance(objective, PathTarget):  # 1-Lipschitz in the stacked centres (pneumorph.design.paths)
+        return errors["centre"] * np.sqrt(chain.n_units)
     return errors["curl"] if objective.name == "max-curl" else errors["tip"]
 
 
@@ -187,11 +190,13 @@ def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integ
     centres, tip, curl = chain.predict(bits)
     ref_c, _ = chain.table.reference(bits)
 
-    def values_of(o: ProfileTarget | TipGoal) -> FloatArray:
+    def values_of(o: ProfileTarget | PathTarget | TipGoal) -> FloatArray:
         # L: the actuator of the first unit type (over a library the designs' lengths differ), and the
         # tip's undeformed height, which every design shares
         if isinstance(o, ProfileTarget):
             return profile_error_array(centres, ref_c[:, None], o, chain.length)
+        if isinstance(o, PathTarget):
+            return path_error_array(centres, ref_c[:, None], o, chain.length, float(chain.table.tip_ref[1]))
         return tip_value_array(tip, chain.table.tip_reference, curl, o.name, o.point)
 
     if isinstance(objective, StagedTarget):

@@ -19,6 +19,10 @@ Polar targets ``r = f(theta)`` use the same datum: centre ``i`` sits at
 (unwrapped along the actuator so a curl past 180 degrees keeps counting), and the error is
 the root of the summed squared radial differences.
 
+A path (:class:`~pneumorph.design.paths.PathTarget`) is matched by the centres as the model
+reports them, with no datum: each centre's distance to its stretch of the path, summed in
+squares as Eq 4.1 (:mod:`pneumorph.design.paths`).
+
 Tip goals (Table 6.1) use the tip in the same frame: ``X`` = the tip's x, ``Y`` = its
 height above the undeformed tip, the distance to the base ``sqrt(X^2 + Y^2)`` and the curl
 in degrees (counter-clockwise positive).
@@ -35,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.targets import Objective, ProfileTarget, Sense, StagedTarget
 from pneumorph.models.response import Response
 
@@ -94,6 +99,39 @@ def profile_error_array(
     want, got = target.curve(theta, length), np.hypot(x, y)
     with np.errstate(invalid="ignore"):
         return np.sqrt(np.sum((want - got) ** 2, axis=-1))
+
+
+def path_error_array(centres: FloatArray, reference_centres: FloatArray, target: PathTarget, length: float,
+                     height: float) -> FloatArray:
+    """A path's value for stacked centres ``(..., n, 2)`` or ``(..., n, 3)``, shape ``centres.shape[:-2]`` (mm).
+
+    The centres count as they are, but for z, which is measured from the undeformed centres' (the
+    mid-plane); a relative path (a preset) is drawn for an actuator ``length`` mm long whose axis
+    lies ``height`` mm up (:meth:`~pneumorph.design.paths.PathTarget.at`).
+    """
+    c = np.asarray(centres, dtype=float)
+    if c.shape[-1] == 3:
+        c = c.copy()
+        c[..., 2] -= np.asarray(reference_centres, dtype=float)[..., 2]
+    with np.errstate(invalid="ignore"):
+        return target.at(length, height).error(c)
+
+
+def path_errors(response: Response, target: PathTarget) -> FloatArray:
+    """A path's value at every reported level, shape (k,); NaN where a level is missing.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pneumorph.design.paths import path_target
+    >>> ref = np.array([[5.0, 4.5], [15.0, 4.5]])
+    >>> r = Response.empty("00", np.array([0.01]), ref, np.array([20.0, 6.0]))
+    >>> r.centres[0] = [[5.0, 5.5], [15.0, 4.5]]; r.tip[0] = [20.0, 6.0]; r.curl[0] = 0.0
+    >>> path_errors(r, path_target([[0, 4.5], [20, 4.5]])).tolist()  # the first centre 1 mm off the path
+    [1.0]
+    """
+    return path_error_array(response.centres, response.reference_centres[None], target,
+                            float(response.reference_tip[0]), float(response.reference_tip[1]))
 
 
 def profile_errors(response: Response, target: ProfileTarget) -> FloatArray:
@@ -157,6 +195,8 @@ def objective_values(response: Response, objective: Objective) -> FloatArray:
         return objective.at_levels(stage_values(response, objective), response.pressures)
     if isinstance(objective, ProfileTarget):
         return profile_errors(response, objective)
+    if isinstance(objective, PathTarget):
+        return path_errors(response, objective)
     return tip_values(response, objective.name, objective.point)
 
 

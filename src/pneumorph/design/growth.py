@@ -30,7 +30,8 @@ from pneumorph.design.fitness import tip_value_array
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry, depths, seed_prefixes, tip_and_curl
 from pneumorph.design.reach import reach_of
 from pneumorph.design.reachbox import box_bound
-from pneumorph.design.rest import CurveRange, profile_rest, tip_goal_rest
+from pneumorph.design.paths import PathTarget
+from pneumorph.design.rest import CurveRange, path_rest, profile_rest, tip_goal_rest
 from pneumorph.design.spacegrowth import space_scores
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
 from pneumorph.errors import SearchConfigError
@@ -94,6 +95,9 @@ def _prefix_bound(chain: ChainModel, objective: Objective, bits: NDArray[np.uint
     n = chain.n_units
     p = bits.shape[1]
     use = _uses_reach(chain, p)
+    if isinstance(objective, PathTarget):  # the partial sums and the centres still to place (within chords' reach)
+        total = state["sum"] + path_rest(objective, n, state["point"], placed, chain.table.length.max(axis=0))
+        return np.sqrt(total.min(axis=1))
     if isinstance(objective, ProfileTarget):
         total = state["sum"]
         if use and curve is not None and objective.coordinates == "cartesian":
@@ -259,10 +263,14 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     """
     if isinstance(objective, StagedTarget):
         return _grow_staged(chain, objective, errors, threshold, max_nodes, beam, spill)
-    if not np.isfinite(threshold) and beam is None and enumerable(chain, KEEP_GEOMETRY_UNITS):
+    path = isinstance(objective, PathTarget)
+    if not np.isfinite(threshold) and beam is None and enumerable(chain, KEEP_GEOMETRY_UNITS) and not path:
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
     n, k = chain.n_units, table.n_levels
+    if path:  # a preset drawn for the chain's actuator
+        objective = cast(PathTarget, objective).at(chain.length, float(table.tip_ref[1]))
+    route = cast(PathTarget, objective)
     profile = isinstance(objective, ProfileTarget)
     prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
     polar = profile and prof.coordinates == "polar"
@@ -274,15 +282,17 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     curve, refine = None, False
     if profile and not polar and np.isfinite(slope) and (np.isfinite(threshold) or beam is not None):
         curve = _curve_range(chain, prof, errors, slope)
-    if profile:
+    if profile or path:
         st["sum"] = np.zeros((len(bits), k))
     if polar:
         st["bsum"] = np.zeros((len(bits), k))
     with np.errstate(all="ignore"):
         growth = depths(chain, bits, st, polar)
         for p, placed, bits, st, centres in growth:
-            for _, x, y in centres:
-                if profile:
+            for j, x, y in centres:
+                if path:  # centre j + 1 where the model puts it: the state's point
+                    st["sum"] = st["sum"] + route.term(j, n, st["point"])
+                elif profile:
                     if not polar:
                         st["sum"] = st["sum"] + prof.squared_error(x, y, length)
                     else:
@@ -300,7 +310,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                 keep = bound < threshold
             bits, st = kept(bits, st, narrow(keep, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
-        if profile:
+        if profile or path:
             values = np.sqrt(st["sum"])
         else:
             tip, curl = tip_and_curl(chain, bits, st)
@@ -400,6 +410,8 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     weights = objective.weights
     profiles = [(i, st.target, levels[i]) for i, st in enumerate(objective.stages)
                 if isinstance(st.target, ProfileTarget)]
+    paths = [(i, st.target.at(length, float(chain.table.tip_ref[1])), levels[i])
+             for i, st in enumerate(objective.stages) if isinstance(st.target, PathTarget)]
     ranges = {i: _curve_range(chain, target, errors, slope) for i, target, _ in profiles
               if target.coordinates == "cartesian" and np.isfinite(slope := _target_slope(chain, target, errors))}
     refine = False
@@ -409,9 +421,11 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     with np.errstate(all="ignore"):
         growth = depths(chain, bits, state)
         for p, placed, bits, state, centres in growth:
-            for _, x, y in centres:
+            for j, x, y in centres:
                 for i, target, k in profiles:
                     state["ssum"][:, i] += target.squared_error(x[:, k], y[:, k], length)
+                for i, route, k in paths:
+                    state["ssum"][:, i] += route.term(j, n, state["point"][:, k])
             if p == n:
                 continue
             bound = np.sqrt(((weights**2) * state["ssum"]).sum(axis=1))

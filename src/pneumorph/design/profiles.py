@@ -45,6 +45,10 @@ MAX_CURVE_POINTS = 2000
 MIN_CURVE_SPAN = 0.2
 """Least part of the actuator length a drawn curve must span."""
 
+MIN_GRAPH_SPAN = 0.5
+"""Least share of a drawn curve's length its span in x must be: a steeper curve is no graph ``y = f(x)`` to match
+by x (a path is)."""
+
 
 @dataclass(frozen=True)
 class Polyline:
@@ -153,11 +157,32 @@ def _check_span(xs: ArrayLike, length: float) -> None:
             f"at least {MIN_CURVE_SPAN * length:.3g} mm of it ({MIN_CURVE_SPAN:.0%})")
 
 
+def _check_graph(p: NDArray[np.float64]) -> None:
+    """Refuse drawn points that are not a graph ``y = f(x)`` (:func:`curve_target`)."""
+    back = np.flatnonzero(np.diff(p[:, 0]) < 0.0)
+    how = ('give it as a path (objective = "path", path = [[x, y], ...] or --target path:FILE), which keeps its '
+           'order')
+    if back.size:
+        i = int(back[0])
+        raise TargetExpressionError(f"the curve turns back in x at its point {i + 2} (x = {p[i, 0]:.6g} then "
+                                    f"{p[i + 1, 0]:.6g}): a curve is a graph y = f(x) and would be matched as another "
+                                    f"shape; {how}")
+    length = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+    span = float(p[:, 0].max() - p[:, 0].min())
+    if length > 0 and span < MIN_GRAPH_SPAN * length:
+        raise TargetExpressionError(f"the curve spans {span:.3g} mm in x over its {length:.3g} mm: less than "
+                                    f"{MIN_GRAPH_SPAN:.0%} (MIN_GRAPH_SPAN), too steep to be matched as a graph "
+                                    f"y = f(x); {how}")
+
+
 def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarget:
     """A profile target through the points ``(x, y)`` or ``(x, y, z)`` (mm): the polyline joining them.
 
-    Points are sorted by x; repeated x are averaged. The target is level beyond the first
-    and last point. Three columns make a space curve (:attr:`ProfileTarget.depth`: ``z``
+    The curve is a graph ``y = f(x)``: its points come in order of x (a repeated x is averaged,
+    a step). A curve whose x turns back, or whose span in x is less than
+    :data:`MIN_GRAPH_SPAN` of its length, is refused: as a graph it would be another shape; a
+    path (:func:`~pneumorph.design.paths.path_target`) keeps it. The target is level beyond the
+    first and last point. Three columns make a space curve (:attr:`ProfileTarget.depth`: ``z``
     of the polyline too).
 
     Examples
@@ -170,8 +195,15 @@ def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarge
     >>> s = curve_target([[0, 0, 0], [100, 10, -20]])
     >>> s.curve_z([50.0], length=100.0).tolist(), s.spatial
     ([-10.0], True)
+    >>> curve_target([[0, 0], [50, 10], [40, 20]])
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.TargetExpressionError: the curve turns back in x at its point 3 (x = 50 then 40): a curve is
+    a graph y = f(x) and would be matched as another shape; give it as a path (objective = "path", path = [[x,
+    y], ...] or --target path:FILE), which keeps its order
     """
     p = _curve_points(points, (2, 3))
+    _check_graph(p)
     xs, inverse = np.unique(p[:, 0], return_inverse=True)
     if len(xs) < 2:
         raise TargetExpressionError("a curve needs points at two different x at least")

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.reach import AHEAD, EMPTY, Reach
 
 FloatArray = NDArray[np.float64]
@@ -147,4 +148,27 @@ def tip_goal_rest(reach: Reach, name: str, target: tuple[float, ...] | None, tip
     return best
 
 
-__all__ = ["CurveRange", "profile_rest", "tip_goal_rest"]
+
+def path_rest(target: PathTarget, n_units: int, point: FloatArray, placed: int, longest: FloatArray) -> FloatArray:
+    """A lower bound on the summed path terms of the next centres the prefixes have not fixed, (m, k).
+
+    Centre ``i`` (1-based, ``placed < i``, at most :data:`~pneumorph.design.reach.AHEAD` on) lies
+    within ``(i - placed) L_k`` of the prefix's last point ``point`` (m, k, 2 or 3; the base for
+    ``placed = 0``), ``L_k`` the longest chord at level ``k``: its distance to its stretch of the
+    path is at least the point's less that, the term at least the square of what is left.
+
+    Examples
+    --------
+    >>> from pneumorph.design.paths import path_target
+    >>> t = path_target([[0, 0], [20, 0]])  # centre 2 of 2: its stretch is x from 12 to 18
+    >>> path_rest(t, 2, np.array([[[15.0, 20.0]]]), 1, np.array([10.0])).round(6).tolist()  # (20 - 10)^2
+    [[100.0]]
+    """
+    total = np.zeros(point.shape[:2])
+    for i in range(placed + 1, min(n_units, placed + AHEAD) + 1):
+        gap = np.maximum(target.distance_to(i - 1, n_units, point) - (i - placed) * longest, 0.0)
+        total += gap * gap
+    return total
+
+
+__all__ = ["CurveRange", "path_rest", "profile_rest", "tip_goal_rest"]

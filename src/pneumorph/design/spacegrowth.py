@@ -48,8 +48,9 @@ from pneumorph.design.bounds import ChainScores, _costs, _max_slope, _radix, _ta
 from pneumorph.design.branching import BEAM, MAX_ENUMERATE, MAX_NODES, kept, narrow, union
 from pneumorph.design.fitness import tip_value_array
 from pneumorph.design.prefixes import depths
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.reach import AHEAD
-from pneumorph.design.rest import CurveRange
+from pneumorph.design.rest import CurveRange, path_rest
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel, window_codes
@@ -66,13 +67,14 @@ def check_space_objective(objective: Objective) -> None:
     SearchConfigError
         A polar profile, the curl or a staged target.
     """
-    if isinstance(objective, ProfileTarget) and objective.coordinates == "cartesian":
+    if isinstance(objective, ProfileTarget) and objective.coordinates == "cartesian" or isinstance(objective,
+                                                                                                  PathTarget):
         return
     if isinstance(objective, TipGoal) and objective.name != "max-curl":
         return
     what = getattr(objective, "label", None) or getattr(objective, "name", type(objective).__name__)
     raise SearchConfigError(f"the certified search over units that leave the plane scores Cartesian profiles, space "
-                            f"curves and tip goals other than the curl, not {what!r}; use --search ga")
+                            f"curves, paths and tip goals other than the curl, not {what!r}; use --search ga")
 
 
 def _elements(chain: ChainModel) -> tuple[FloatArray, FloatArray]:
@@ -241,6 +243,8 @@ def _beta(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray]
     if isinstance(objective, ProfileTarget):
         slope = _target_slope(chain, objective, errors)
         return errors["centre"] * np.sqrt(chain.n_units * (1.0 + slope**2))
+    if isinstance(objective, PathTarget):  # 1-Lipschitz in the stacked centres (pneumorph.design.paths)
+        return errors["centre"] * np.sqrt(chain.n_units)
     return errors["tip"]
 
 
@@ -261,19 +265,27 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
     n = chain.n_units
     length = chain.length
     profile = isinstance(objective, ProfileTarget)
+    path = isinstance(objective, PathTarget)
     prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
+    route = cast(PathTarget, objective).at(length, float(table.tip_ref[1])) if path else None
+    mid = np.array([0.0, 0.0, table.centre_z])  # a path's z is from the mid-plane
     bits, st = _seed(chain, codes)
     spilled: list[float] | None = [] if spill else None
     place = _placer(chain)
     with np.errstate(all="ignore"):
         growth = depths(chain, bits, st, place=place, codes=codes)
         for p, placed, bits, st, centres in growth:
-            for _, x, y, z in centres:
+            for j, x, y, z in centres:
                 if profile:
                     st["sum"] = st["sum"] + prof.squared_error(x, y, length, z)
+                elif route is not None:
+                    st["sum"] = st["sum"] + route.term(j, n, st["point"] - mid)
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
-            if profile:
+            if route is not None:
+                total = st["sum"] + path_rest(route, n, st["point"] - mid, placed, _longest(chain))
+                bound = np.sqrt(total.min(axis=1))
+            elif profile:
                 total = st["sum"] if curves is None else st["sum"] + space_rest(chain, curves, bits, st["point"],
                                                                                  placed)
                 bound = np.sqrt(total.min(axis=1))
@@ -281,7 +293,7 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
                 bound = _tip_bound(chain, goal, st["point"], n + 1 - placed, st["frame"])
             bits, st = kept(bits, st, narrow(bound < threshold, bound, beam, max_nodes, p, n, spilled))
             growth.send((bits, st))
-        if profile:
+        if profile or path:
             values = np.sqrt(st["sum"])
         else:
             values = tip_value_array(st["point"], table.tip_reference, np.zeros(st["point"].shape[:2]), goal.name,

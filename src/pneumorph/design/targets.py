@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pneumorph.design.expressions import parse_expression
+from pneumorph.design.paths import PATH_PRESETS, PathTarget, path_target, preset_path
 from pneumorph.design.profiles import (
     _CARTESIAN,
     _HINTS_CARTESIAN,
@@ -106,15 +107,15 @@ class Stage:
     ----------
     pressure : float
         The pressure (MPa), a level of the model's ramp.
-    target : ProfileTarget or TipGoal
-        A Cartesian profile (preset, expression or drawn curve; Eq 4.1 in mm) or the tip goal
-        ``reach`` (the tip's distance to a point, mm).
+    target : ProfileTarget or PathTarget or TipGoal
+        A Cartesian profile (preset, expression or drawn curve; Eq 4.1 in mm), a path (mm) or the
+        tip goal ``reach`` (the tip's distance to a point, mm).
     weight : float
         The stage's weight in the root-sum-square (positive).
     """
 
     pressure: float
-    target: ProfileTarget | TipGoal
+    target: ProfileTarget | PathTarget | TipGoal
     weight: float = 1.0
 
     @property
@@ -235,8 +236,9 @@ def staged_target(stages: Any) -> StagedTarget:
             raise SearchConfigError(f"{where}: {target.name!r} is {kind}, not a distance to add up with the other "
                                     "stages; a stage's target is a Cartesian profile, a drawn curve or 'reach' (a "
                                     "tip point)")
-        if not isinstance(target, ProfileTarget | TipGoal):
-            raise SearchConfigError(f"{where}: a stage's target must be a profile or a tip point, not a staged target")
+        if not isinstance(target, ProfileTarget | PathTarget | TipGoal):
+            raise SearchConfigError(f"{where}: a stage's target must be a profile, a path or a tip point, not a "
+                                    "staged target")
         out.append(Stage(float(pressure), target, weight))
     seen: set[float] = set()
     for stage in out:
@@ -247,8 +249,8 @@ def staged_target(stages: Any) -> StagedTarget:
     return StagedTarget(tuple(out))
 
 
-#: What a search optimises: a target profile, a goal for the tip, or targets at several pressures.
-Objective = ProfileTarget | TipGoal | StagedTarget
+#: What a search optimises: a target profile, a path, a goal for the tip, or targets at several pressures.
+Objective = ProfileTarget | PathTarget | TipGoal | StagedTarget
 
 #: The tip goals by name: whether they are minimised or maximised, and their label.
 TIP_GOALS: dict[str, tuple[Sense, str]] = {
@@ -376,12 +378,15 @@ def make_objective(
     anchored: bool = True,
     length: float | None = None,
     curve: ArrayLike | None = None,
+    path: ArrayLike | None = None,
 ) -> Objective:
-    """Any objective from its text: a tip goal, a preset or a profile expression.
+    """Any objective from its text: a tip goal, a preset, a profile expression or a path.
 
     With ``length`` (mm), a profile is also checked to be finite along an actuator that long
     (:meth:`ProfileTarget.check`). ``"curve"`` takes its points from ``curve``
-    (:func:`curve_target`).
+    (:func:`curve_target`), ``"path"`` from ``path`` (:func:`~pneumorph.design.paths.path_target`);
+    the path presets (:data:`~pneumorph.design.paths.PATH_PRESETS`: ``letter-l``, ``hook``, ...)
+    are drawn for the actuator they are matched on.
 
     Examples
     --------
@@ -393,10 +398,21 @@ def make_objective(
     Traceback (most recent call last):
     ...
     pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y,
-    min-y, min-distance, max-curl, reach, sin, cos, helix, helix-left, or a profile 'y = f(x)' / 'r = f(theta)'
-    / 'y = f(x), z = g(x)'
+    min-y, min-distance, max-curl, reach, sin, cos, helix, helix-left, letter-l, letter-s, letter-r, hook,
+    spiral, coil, path, or a profile 'y = f(x)' / 'r = f(theta)' / 'y = f(x), z = g(x)'
     """
     key = _ALIASES.get(_normalise(spec), _normalise(spec))
+    if (key == "path") != (path is not None):
+        raise SearchConfigError("the objective 'path' needs its points: path = [[x, y], ...] in mm (or --target "
+                                "path:FILE)" if key == "path" else f"path points are only used by the objective "
+                                f"'path', not by {spec!r}")
+    if key == "path" or key in PATH_PRESETS:
+        if point is not None or curve is not None:
+            raise SearchConfigError(f"a path takes neither a tip point nor curve points, not {spec!r}")
+        if not anchored:
+            raise SearchConfigError("anchored = false (the path's best rigid placement) is not offered yet: a path "
+                                    "is matched where it is given, base at the origin")
+        return path_target(path) if key == "path" else preset_path(key)  # type: ignore[arg-type]
     if (key == "curve") != (curve is not None):
         raise SearchConfigError("the objective 'curve' needs its points: curve = [[x, y], ...] in mm"
                                 if key == "curve" else f"curve points are only used by the objective 'curve', "
@@ -415,7 +431,7 @@ def make_objective(
     if key not in PRESETS and "=" not in spec:
         words = re.fullmatch(r"[A-Za-z_][\w\- ]*", spec.strip())
         if words and spec.strip() not in (*_CARTESIAN, *_POLAR, "pi", "e"):
-            raise UnknownObjectiveError(spec, [*TIP_GOALS, *PRESETS])
+            raise UnknownObjectiveError(spec, [*TIP_GOALS, *PRESETS, *PATH_PRESETS, "path"])
     target = profile_target(spec, amplitude, periods, anchored=anchored)
     return target if length is None else target.check(length)
 
@@ -429,6 +445,7 @@ __all__ = [
     "PRESETS",
     "TIP_GOALS",
     "Objective",
+    "PathTarget",
     "Polyline",
     "ProfileTarget",
     "Sense",
