@@ -26,15 +26,21 @@ def _kpa(pressure: float | None) -> float:
 
 
 def _default_folder(config: Any) -> str:
-    """``runs/<target>-<units>u-<search>-seed<seed>``."""
+    """``runs/<target>-<units>u-<search>-seed<seed>`` (a path's target: ``path-`` and a digest of its points)."""
     slug = re.sub(r"[^a-z0-9]+", "-", config.objective.lower()).strip("-")[:40] or "target"
+    if config.path is not None:
+        import hashlib
+
+        slug = f"path-{hashlib.sha256(repr(config.path).encode()).hexdigest()[:8]}"
     return f"runs/{slug}-{config.units}u-{config.search}-seed{config.seed}"
 
 
 @click.command("design")
 @click.argument("config_file", required=False, type=P.InputFile())
 @click.option("--target", metavar="TARGET", type=P.Text(),
-              help="Profile to match: 'sin', 'cos', 'y = <expr in x, L, A>' or 'r = <expr in theta>'. "
+              help="Profile to match: 'sin', 'cos', 'y = <expr in x, L, A>' or 'r = <expr in theta>'; a path of any "
+                   "shape: 'path:FILE' (CSV/TXT of x, y[, z] mm, from the base to the free end) or a preset "
+                   "(letter-l, letter-s, letter-r, hook, spiral, coil). "
                    "Default (no config file): sin, amplitude 10 mm, one period.")
 @click.option("--objective", type=click.Choice(_TIP_GOALS), help="A tip goal instead of a profile (Table 6.1).")
 @click.option("--amplitude", type=P.POSITIVE_MM, help="Amplitude A of the sin/cos target, mm (default 10).")
@@ -135,6 +141,17 @@ def design(config_file: str | None, **options: Any) -> None:
         sys.exit(130)
 
 
+def _target_changes(target: str) -> dict[str, Any]:
+    """The config's changes for ``--target``: a path from ``path:FILE`` (its points, read here), else the text."""
+    head, sep, rest = target.partition(":")
+    if sep and head.strip().lower() == "path":
+        from pneumorph.design.paths import read_path
+
+        route = read_path(rest.strip())
+        return {"objective": "path", "path": route.points}
+    return {"objective": target}
+
+
 def _check_inputs(o: Any) -> None:
     """The target, unit file and library checked as the options that gave them (before any setting is merged)."""
     from pneumorph.design import DesignConfig
@@ -147,9 +164,10 @@ def _check_inputs(o: Any) -> None:
         from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):  # along the built-in unit; checked again along the model's
-            make_objective(o.target, o.amplitude if o.amplitude is not None else DesignConfig.amplitude,
+            target = _target_changes(o.target)
+            make_objective(target["objective"], o.amplitude if o.amplitude is not None else DesignConfig.amplitude,
                            o.periods if o.periods is not None else DesignConfig.periods,
-                           length=(o.units or DesignConfig.units) * UnitSpec.pitch)
+                           length=(o.units or DesignConfig.units) * UnitSpec.pitch, path=target.get("path"))
     if o.unit_file is not None:
         P.unit_option(o.unit_file)
     if o.library is not None:
@@ -173,6 +191,16 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
                                "periods or more units")
     design = {key: getattr(o, key) for key in _DESIGN_OPTIONS}
     design["objective"] = o.target or o.objective
+    if o.target is not None:
+        with P.blame("--target"):
+            target = _target_changes(o.target)
+        design.update(target)
+        if config.curve is not None or config.path is not None:  # the config's points belong to its own target
+            data = config.to_dict()
+            for key in ("curve", "path"):
+                data["design"].pop(key, None)
+            data["design"].update(target)
+            config = DesignConfig.from_dict(data)
     design.update(_stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods, o.units))
     identified = None
     if o.model_file is not None:  # the identified model's settings over the config's
@@ -400,7 +428,7 @@ def _stage_option(text: str, amplitude: float | None, periods: float | None) -> 
 
 def _check_shape_options(objective: Any, amplitude: float | None, periods: float | None) -> None:
     """Refuse --amplitude and --periods where the objective would ignore them (one line, exit 2)."""
-    from pneumorph.design.targets import PRESETS, ProfileTarget, StagedTarget
+    from pneumorph.design.targets import PRESETS, PathTarget, ProfileTarget, StagedTarget
 
     if isinstance(objective, StagedTarget):
         profiles = [s.target for s in objective.stages if isinstance(s.target, ProfileTarget)]
@@ -420,19 +448,23 @@ def _check_shape_options(objective: Any, amplitude: float | None, periods: float
         return
     given = [name for name, value in (("--amplitude", amplitude), ("--periods", periods)) if value is not None]
     if given:
-        raise click.UsageError(f"{'/'.join(given)} shape{'s' if len(given) == 1 else ''} a profile target, not the "
-                               f"tip goal {objective.name}; leave {'/'.join(given)} out")
+        what = f"the path {objective.name}" if isinstance(objective, PathTarget) else f"the tip goal {objective.name}"
+        raise click.UsageError(f"{'/'.join(given)} shape{'s' if len(given) == 1 else ''} a profile target, not "
+                               f"{what}; leave {'/'.join(given)} out")
 
 
 def _value_words(result: Any, config: Any) -> str:
     """The winner's value in words with its unit: Eq 4.1 and its RMS per centre for a profile."""
-    from pneumorph.design.targets import ProfileTarget
+    from pneumorph.design.targets import PathTarget, ProfileTarget
 
     best, objective = result.best, result.objective
+    n = config.units
     if isinstance(objective, ProfileTarget):
-        n = config.units
         return (f"error {best.value:.4g} {objective.unit} (Eq 4.1: root of the summed squared offsets of the {n} "
                 f"unit centres from the target; {best.value / n**0.5:.3g} {objective.unit} RMS per centre)")
+    if isinstance(objective, PathTarget):
+        return (f"path error {best.value:.4g} mm (root of the summed squared distances of the {n} unit centres from "
+                f"their stretches of the path; {best.value / n**0.5:.3g} mm RMS per centre)")
     return f"{objective.name} {best.value:.4g} {objective.unit}"
 
 

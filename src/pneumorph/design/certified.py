@@ -42,10 +42,10 @@ from pneumorph.design.bounds import ChainScores, chain_errors, objective_bounds,
 from pneumorph.design.branching import MAX_ENUMERATE
 from pneumorph.design.fitness import score
 from pneumorph.design.growth import best_scores, chain_scores, designs_of, enumerable, grow_designs
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.spacegrowth import space_scores
-from pneumorph.design.paths import PathTarget
 from pneumorph.design.targets import Objective, ProfileTarget
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator

@@ -3,7 +3,8 @@
 A config file::
 
     [design]
-    objective = "sin"        # a tip goal, a preset (sin, cos), "y = ..." / "r = ...", or "stages"
+    objective = "sin"        # a tip goal, a preset (sin, cos, hook, letter-l, ...), "y = ...", "path", or "stages"
+    path = [[0, 6], [90, 6], [120, 40]]   # with objective = "path": ordered points from the base, mm
     amplitude = 10.0         # mm
     periods = 1.0
     units = 15
@@ -96,6 +97,7 @@ class DesignConfig:
     periods: float = 1.0
     point: tuple[float, ...] | None = None
     curve: tuple[tuple[float, ...], ...] | None = None
+    path: tuple[tuple[float, ...], ...] | None = None
     anchored: bool = True
     stage: tuple[dict[str, Any], ...] | None = None
     units: int = 15
@@ -171,6 +173,8 @@ class DesignConfig:
             object.__setattr__(self, "point", _point(self.point, "[design] point"))
         if self.curve is not None:
             object.__setattr__(self, "curve", _curve(self.curve, "[design] curve"))
+        if self.path is not None:
+            object.__setattr__(self, "path", _curve(self.path, "[design] path"))
         object.__setattr__(self, "stage", _stages(self.objective, self.stage))
         self._check_periods()
         unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
@@ -252,10 +256,10 @@ class DesignConfig:
             return staged_target([
                 (s["pressure_kpa"] / 1e3,
                  make_objective(s["objective"], s.get("amplitude", 10.0), s.get("periods", 1.0), s.get("point"),
-                                s.get("anchored", True), length, s.get("curve")),
+                                s.get("anchored", True), length, s.get("curve"), s.get("path")),
                  s.get("weight", 1.0)) for s in self.stage])
         return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
-                              self.curve)
+                              self.curve, self.path)
 
     def with_options(self, design: dict[str, Any], ga: dict[str, Any] | None = None,
                      model: dict[str, Any] | None = None, model_file: dict[str, Any] | None = None) -> DesignConfig:
@@ -297,7 +301,8 @@ class DesignConfig:
         ``refine = 0`` left out)."""
         design = {
             k: getattr(self, k)
-            for k in ("objective", "amplitude", "periods", "point", "curve", "anchored", "stage", "units", "search",
+            for k in ("objective", "amplitude", "periods", "point", "curve", "path", "anchored", "stage", "units",
+                      "search",
                       "seed",
                       "certify", "verify", "margin", "epsilon", "refine", "chain_table", "tolerance", "robust",
                       "robust_samples")
@@ -348,13 +353,13 @@ class DesignConfig:
 
 
 #: the settings of one ``[[design.stage]]`` table, and those it must have
-STAGE_KEYS = ("pressure_kpa", "objective", "amplitude", "periods", "curve", "point", "anchored", "weight")
+STAGE_KEYS = ("pressure_kpa", "objective", "amplitude", "periods", "curve", "path", "point", "anchored", "weight")
 _STAGE_NEEDS = ("pressure_kpa", "objective")
 
 
 def _curve(points: Any, name: str) -> tuple[tuple[float, ...], ...]:
-    """A drawn curve's points as numbers (mm): all ``[x, y]`` or all ``[x, y, z]`` (a space curve), refusing text and
-    true/false."""
+    """A drawn curve's or a path's points as numbers (mm): all ``[x, y]`` or all ``[x, y, z]`` (in space), refusing
+    text and true/false."""
     try:
         if any(isinstance(v, (bool, str, bytes)) for xy in points for v in xy):
             raise TypeError("text or true/false")
@@ -364,7 +369,13 @@ def _curve(points: Any, name: str) -> tuple[tuple[float, ...], ...]:
         return out
     except (TypeError, ValueError, IndexError):
         raise SearchConfigError(f"{name} must be a list of [x, y] (or all [x, y, z]) points in mm, got "
-                                f"{points!r}") from None
+                                f"{_short(points)}") from None
+
+
+def _short(value: Any, limit: int = 80) -> str:
+    """``repr(value)``, cut to ``limit`` characters (a long list of points in an error message)."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + " ..."
 
 
 def _point(value: Any, name: str) -> tuple[float, ...]:
@@ -412,8 +423,9 @@ def _stages(objective: str, stages: Any) -> tuple[dict[str, Any], ...] | None:
             _flag(s["anchored"], f"{where} anchored")
         if "point" in s:
             s["point"] = _point(s["point"], f"{where} point")
-        if "curve" in s:
-            s["curve"] = _curve(s["curve"], f"{where} curve")
+        for key in ("curve", "path"):
+            if key in s:
+                s[key] = _curve(s[key], f"{where} {key}")
         out.append(s)
     return tuple(out)
 

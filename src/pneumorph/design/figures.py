@@ -10,6 +10,8 @@ import matplotlib
 import numpy as np
 
 from pneumorph.design.ga import GenerationStats
+from pneumorph.design.pathfigure import draw_path, placed_path, plot_path
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget
 from pneumorph.plot.figure import new_figure, save_figure
@@ -43,6 +45,8 @@ def plot_profile(candidate: Candidate, objective: Objective, path: str | Path, u
     assert r is not None, "a candidate without a response has no profile"
     if isinstance(objective, StagedTarget):
         return plot_stages(candidate, objective, path)
+    if isinstance(objective, PathTarget):
+        return plot_path(candidate, objective, path, compare)
     pts = profile_points(candidate)
     length = float(r.reference_tip[0])
     curves, what = _target_curves(candidate, objective, pts, length, unit)
@@ -216,6 +220,13 @@ def plot_stages(candidate: Candidate, objective: StagedTarget, path: str | Path)
             ax.plot(xs, np.broadcast_to(target.curve(xs, length), xs.shape), color="C1", lw=2,
                     label=f"target {target.display}")
             what = f"Eq 4.1 error {v:.3g} mm"
+        elif isinstance(target, PathTarget):  # a path is drawn where the model puts the centres, not as heights
+            drawn = draw_path(ax, placed_path(target, r), r, k)[:, :2]
+            lo, hi = np.minimum(lo, drawn.min(axis=0)), np.maximum(hi, drawn.max(axis=0))
+            what = f"path error {v:.3g} mm (centres as the model reports them)"
+            ax.set_title(f"stage at {r.pressures[k] * 1e3:.4g} kPa (weight {stage.weight:g}): {what}", fontsize=9)
+            ax.legend(fontsize=7, loc="best")
+            continue
         else:
             assert target.point is not None
             ax.plot(*target.point, "x", color="C1", ms=10, mew=2, label="point to reach")

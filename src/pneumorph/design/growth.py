@@ -27,10 +27,10 @@ from pneumorph.design.bounds import (
 )
 from pneumorph.design.branching import BEAM, MAX_ENUMERATE, MAX_NODES, kept, narrow, union
 from pneumorph.design.fitness import tip_value_array
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry, depths, seed_prefixes, tip_and_curl
 from pneumorph.design.reach import reach_of
 from pneumorph.design.reachbox import box_bound
-from pneumorph.design.paths import PathTarget
 from pneumorph.design.rest import CurveRange, path_rest, profile_rest, tip_goal_rest
 from pneumorph.design.spacegrowth import space_scores
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal

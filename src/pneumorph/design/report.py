@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from pneumorph.design.certificate import certificate_text
 from pneumorph.design.certified import CertifiedResult
 from pneumorph.design.comparison import comparison_lines
@@ -22,6 +24,7 @@ from pneumorph.design.config import DesignConfig
 from pneumorph.design.figures import plot_convergence, plot_profile
 from pneumorph.design.fitness import stage_values
 from pneumorph.design.ga import GenerationStats
+from pneumorph.design.paths import PathTarget
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget
 from pneumorph.io.files import atomic_path, atomic_write_text, write_json
@@ -124,6 +127,21 @@ def _atomic_figure(path: Path, draw: Callable[[Path], Any]) -> Path:
     with atomic_path(path) as tmp:
         draw(tmp)
     return path
+
+
+def _path_lines(objective: Objective, best: Candidate, units: int) -> list[str]:
+    """A path's value per centre, and its length beside the line through the winner's centres (one line each)."""
+    if not isinstance(objective, PathTarget) or best.response is None or best.level is None \
+            or not math.isfinite(best.value):
+        return []
+    r = best.response
+    route = objective.at(float(r.reference_tip[0]), float(r.reference_tip[1]))
+    centres = r.centres[best.level]
+    line = float(np.linalg.norm(np.diff(centres, axis=0), axis=1).sum())
+    return [f"- RMS distance per centre: {best.value / units**0.5:.3g} mm (the root of the summed squared distances of "
+            f"the {units} unit centres, as the model reports them, from their stretches of the path)",
+            f"- the path: {len(route.points)} points, {route.arc_length():.4g} mm long; the line through the winner's "
+            f"centres {line:.4g} mm (the actuator {float(r.reference_tip[0]):.4g} mm undeformed)"]
 
 
 def _stage_lines(objective: Objective, best: Candidate) -> list[str]:
@@ -268,6 +286,7 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
     best = result.best
     if best is not None:
         what = ("error (Eq 4.1)" if isinstance(o, ProfileTarget) else
+                "path error (Eq 4.1 over the path)" if isinstance(o, PathTarget) else
                 "weighted root-sum-square of the stages" if isinstance(o, StagedTarget) else "value")
         pressure = "-" if best.pressure is None else f"{best.pressure * 1e3:.4g} kPa"
         if best.failure is not None:
@@ -281,6 +300,7 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
                 f" (the root of the summed squared offsets of the {config.units} unit centres from the target: "
                 f"{best.value / config.units**0.5:.3g} {o.unit} RMS per centre)"
                 if isinstance(o, ProfileTarget) and math.isfinite(best.value) else ""),
+            *_path_lines(o, best, config.units),
             *_stage_lines(o, best),
             "",
             "## Hall of fame",

@@ -47,8 +47,8 @@ from numpy.typing import NDArray
 from pneumorph.design.bounds import ChainScores, _costs, _max_slope, _radix, _target_slope, chain_errors
 from pneumorph.design.branching import BEAM, MAX_ENUMERATE, MAX_NODES, kept, narrow, union
 from pneumorph.design.fitness import tip_value_array
-from pneumorph.design.prefixes import depths
 from pneumorph.design.paths import PathTarget
+from pneumorph.design.prefixes import depths
 from pneumorph.design.reach import AHEAD
 from pneumorph.design.rest import CurveRange, path_rest
 from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
@@ -67,7 +67,7 @@ def check_space_objective(objective: Objective) -> None:
     SearchConfigError
         A polar profile, the curl or a staged target.
     """
-    if isinstance(objective, ProfileTarget) and objective.coordinates == "cartesian" or isinstance(objective,
+    if (isinstance(objective, ProfileTarget) and objective.coordinates == "cartesian") or isinstance(objective,
                                                                                                   PathTarget):
         return
     if isinstance(objective, TipGoal) and objective.name != "max-curl":
