@@ -117,6 +117,11 @@ class RunResult:
             "mesh": self.refinement,
             "comparison": self.comparison,
         }
+        if isinstance(self.objective, ProfileTarget | PathTarget) and best is not None and best.response is not None:
+            out["rms_per_centre_mm"] = best.value / best.response.n_units ** 0.5  # Eq 4.1 per centre (SPADA's figure)
+        if isinstance(self.objective, PathTarget) and best is not None and best.response is not None:
+            tip = best.response.reference_tip  # a preset as it was drawn for the actuator
+            out["path"] = [list(p) for p in self.objective.at(float(tip[0]), float(tip[1])).points]
         if self.certified is not None:
             out.update(certificate=self.certified.certificate, top=_top_rows(self), opinion_2d=self.opinion_2d)
         return out
