@@ -47,8 +47,8 @@ def test_a_straight_path_counts_each_centre_s_offset_from_it() -> None:
     x = (np.arange(n) + 0.5) * 160.0 / n
     on = np.column_stack([x, np.full(n, 6.0)])
     assert float(t.error(on)) == pytest.approx(0.0, abs=1e-9)
-    assert float(t.error(on + [0.0, 2.0])) == pytest.approx(2.0 * np.sqrt(n), rel=1e-12)
-    assert float(t.rms(on + [0.0, 2.0])) == pytest.approx(2.0, rel=1e-12)
+    assert float(t.error(on + np.array([0.0, 2.0]))) == pytest.approx(2.0 * np.sqrt(n), rel=1e-12)
+    assert float(t.rms(on + np.array([0.0, 2.0]))) == pytest.approx(2.0, rel=1e-12)
     shifted = on.copy()
     shifted[4, 1] += 3.0  # one centre 3 mm off: only its term counts
     assert float(t.error(shifted)) == pytest.approx(3.0, rel=1e-12)
@@ -73,7 +73,7 @@ def test_the_value_is_1_lipschitz_in_the_stacked_centres() -> None:
     """|V(c) - V(c')| <= ||c - c'|| (the argument of the chain's bound), for random centres near a hook."""
     rng = np.random.default_rng(3)
     t = preset_path("hook").at(157.5, 6.0)
-    base = t.nearest(np.zeros((15, 3)) + [50.0, 20.0, 0.0])  # any points; then random ones around
+    base = t.nearest(np.zeros((15, 3)) + np.array([50.0, 20.0, 0.0]))  # any points; then random ones around
     for _ in range(200):
         c = base + rng.normal(scale=20.0, size=base.shape)
         e = rng.normal(scale=rng.uniform(0.01, 5.0), size=c.shape)
@@ -213,9 +213,9 @@ def test_a_path_file_is_read_with_a_header_and_refused_when_it_is_text(tmp_path:
 
 
 def test_a_curve_that_turns_back_or_stands_too_steep_is_refused_naming_path() -> None:
-    with pytest.raises(TargetExpressionError, match="turns back in x at its point 3.*give it as a path"):
+    with pytest.raises(TargetExpressionError, match=r"turns back in x at its point 3.*give it as a path"):
         make_objective("curve", curve=[[0, 0], [80, 10], [70, 40]])
-    with pytest.raises(TargetExpressionError, match="spans 10 mm in x.*objective = \"path\""):
+    with pytest.raises(TargetExpressionError, match=r"spans 10 mm in x.*objective = \"path\""):
         make_objective("curve", curve=[[0, 0], [5, 50], [10, 100]])
     assert make_objective("curve", curve=[[0, 0], [80, 2], [160, 5]]).label == "curve: y = curve through 3 points"
 

@@ -331,8 +331,11 @@ class _Progress:
 
 def _print_result(result: Any, config: Any, model: Any) -> None:
     """The winner, its certificate, mesh note, robustness and retries, in words."""
+    from pneumorph.design.report import value_words
+
     best = result.best
-    click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {_value_words(result, config)} "
+    words = value_words(result.objective, best.value, config.units)
+    click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {words} "
                f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
     if result.certified is not None:
         from pneumorph.design.certificate import certificate_text
@@ -451,21 +454,6 @@ def _check_shape_options(objective: Any, amplitude: float | None, periods: float
         what = f"the path {objective.name}" if isinstance(objective, PathTarget) else f"the tip goal {objective.name}"
         raise click.UsageError(f"{'/'.join(given)} shape{'s' if len(given) == 1 else ''} a profile target, not "
                                f"{what}; leave {'/'.join(given)} out")
-
-
-def _value_words(result: Any, config: Any) -> str:
-    """The winner's value in words with its unit: Eq 4.1 and its RMS per centre for a profile."""
-    from pneumorph.design.targets import PathTarget, ProfileTarget
-
-    best, objective = result.best, result.objective
-    n = config.units
-    if isinstance(objective, ProfileTarget):
-        return (f"error {best.value:.4g} {objective.unit} (Eq 4.1: root of the summed squared offsets of the {n} "
-                f"unit centres from the target; {best.value / n**0.5:.3g} {objective.unit} RMS per centre)")
-    if isinstance(objective, PathTarget):
-        return (f"path error {best.value:.4g} mm (root of the summed squared distances of the {n} unit centres from "
-                f"their stretches of the path; {best.value / n**0.5:.3g} mm RMS per centre)")
-    return f"{objective.name} {best.value:.4g} {objective.unit}"
 
 
 def _check_options_apply(search: str, owner: str, options: dict) -> None:

@@ -134,6 +134,22 @@ def _atomic_figure(path: Path, draw: Callable[[Path], Any]) -> Path:
     return path
 
 
+def value_words(objective: Objective, value: float, units: int) -> str:
+    """A winner's value in words with its unit: Eq 4.1 and its RMS per centre for a profile or a path.
+
+    >>> from pneumorph.design.targets import make_objective
+    >>> value_words(make_objective("hook"), 6.0, 9).split("; ")[1]
+    '2 mm RMS per centre)'
+    """
+    if isinstance(objective, ProfileTarget):
+        return (f"error {value:.4g} {objective.unit} (Eq 4.1: root of the summed squared offsets of the {units} "
+                f"unit centres from the target; {value / units**0.5:.3g} {objective.unit} RMS per centre)")
+    if isinstance(objective, PathTarget):
+        return (f"path error {value:.4g} mm (root of the summed squared distances of the {units} unit centres from "
+                f"their stretches of the path; {value / units**0.5:.3g} mm RMS per centre)")
+    return f"{objective.name} {value:.4g} {objective.unit}"
+
+
 def _path_lines(objective: Objective, best: Candidate, units: int) -> list[str]:
     """A path's value per centre, and its length beside the line through the winner's centres (one line each)."""
     if not isinstance(objective, PathTarget) or best.response is None or best.level is None \
