@@ -239,6 +239,20 @@ def best_scores(chain: ChainModel, objective: Objective, top: int = 10, margin: 
     return ChainScores(g.bits[alive], values, cost, level, opt, bound, floor=threshold, choices=_radix(chain))
 
 
+def _add_terms(objective: ProfileTarget | PathTarget, st: dict[str, Any], j: int, x: FloatArray, y: FloatArray,
+               sizes: tuple[int, float, FloatArray, float]) -> None:
+    """Add centre ``j + 1``'s term to the prefixes' partial sums ``st["sum"]`` (a polar profile's bound's too):
+    ``sizes`` holds the units, the actuator's length, the chain's centre errors and the target's slope."""
+    n, length, e, slope = sizes
+    if isinstance(objective, PathTarget):  # the centre where the model puts it: the state's point
+        st["sum"] = st["sum"] + objective.term(j, n, st["point"])
+    elif objective.coordinates == "cartesian":
+        st["sum"] = st["sum"] + objective.squared_error(x, y, length)
+    else:
+        st["sum"] = st["sum"] + (objective.curve(st["theta"], length) - st["r"]) ** 2
+        st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
+
+
 def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, FloatArray],
                  threshold: float = float("inf"), max_nodes: int = MAX_NODES, beam: int | None = None,
                  spill: bool = False) -> ChainScores:
@@ -270,7 +284,6 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     n, k = chain.n_units, table.n_levels
     if path:  # a preset drawn for the chain's actuator
         objective = cast(PathTarget, objective).at(chain.length, float(table.tip_ref[1]))
-    route = cast(PathTarget, objective)
     profile = isinstance(objective, ProfileTarget)
     prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
     polar = profile and prof.coordinates == "polar"
@@ -290,14 +303,8 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         growth = depths(chain, bits, st, polar)
         for p, placed, bits, st, centres in growth:
             for j, x, y in centres:
-                if path:  # centre j + 1 where the model puts it: the state's point
-                    st["sum"] = st["sum"] + route.term(j, n, st["point"])
-                elif profile:
-                    if not polar:
-                        st["sum"] = st["sum"] + prof.squared_error(x, y, length)
-                    else:
-                        st["sum"] = st["sum"] + (prof.curve(st["theta"], length) - st["r"]) ** 2
-                        st["bsum"] = st["bsum"] + _polar_term(st["r"], e, slope) ** 2
+                if profile or path:
+                    _add_terms(cast(ProfileTarget | PathTarget, objective), st, j, x, y, (n, length, e, slope))
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
             bound = _prefix_bound(chain, objective, bits, st, placed)
