@@ -4,7 +4,8 @@ The page sends JSON; :func:`parse_query` turns it into a :class:`Query` or raise
 :class:`QueryError` naming the field to show the message beside. Nothing a user types is
 executed: expressions go through the same safe parser as the command line
 (:mod:`pneumorph.design.expressions`), drawn curves are smoothed into a polyline
-(:func:`pneumorph.design.targets.smooth_curve`).
+(:func:`pneumorph.design.targets.smooth_curve`), or into a path where the stroke turns back
+in x (:mod:`pneumorph.bench.strokes`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,9 @@ from typing import Any
 import numpy as np
 
 from pneumorph import checks
+from pneumorph.bench.strokes import AXIS_MM, is_path_stroke, smooth_path
 from pneumorph.design.config import DesignConfig
+from pneumorph.design.paths import PATH_PRESETS, path_points
 from pneumorph.design.targets import (
     MAX_STAGES,
     PRESETS,
@@ -29,9 +32,9 @@ from pneumorph.design.targets import (
 from pneumorph.errors import PneumorphError, SettingsError
 from pneumorph.io.files import nested_deeper
 
-KINDS = ("preset", "expression", "tip", "curve", "stages")
+KINDS = ("preset", "expression", "tip", "curve", "path", "stages")
 #: the kinds of target a stage may hold (a stage's tip goal is ``reach``)
-STAGE_KINDS = ("preset", "expression", "tip", "curve")
+STAGE_KINDS = ("preset", "expression", "tip", "curve", "path")
 MODELS = ("3d", "2d")
 MAX_TOP = 100
 MAX_TEXT = 400
@@ -63,10 +66,10 @@ class Query:
 
     Attributes
     ----------
-    kind : {"preset", "expression", "tip", "curve", "stages"}
+    kind : {"preset", "expression", "tip", "curve", "path", "stages"}
     spec : str
         The objective's text for :func:`~pneumorph.design.targets.make_objective` ("sin",
-        "y = ...", "max-x", "curve").
+        "y = ...", "max-x", "curve", "path" or a path preset such as "hook").
     amplitude, periods : float
     point : (float, float), (float, float, float) or None
         The tip point of the goal "reach" (mm): (x, y), or (x, y, z) off the plane of bending.
@@ -80,6 +83,10 @@ class Query:
     stages : tuple of (float, float, Query), optional
         For ``kind = "stages"``: per stage its pressure (kPa), its weight and its target (a
         query of one of :data:`STAGE_KINDS`).
+    path : tuple of (x, y) or (x, y, z), or None
+        A path's points (mm, in the frame of the unit centres: y from the actuator's bottom
+        face, z from its mid-plane), for ``spec = "path"``: given, or a drawn stroke that
+        turns back in x, smoothed (:func:`~pneumorph.bench.strokes.smooth_path`).
     """
 
     kind: str
@@ -92,12 +99,14 @@ class Query:
     top: int = 10
     unit: str = "builtin"
     stages: tuple[tuple[float, float, Query], ...] | None = None
+    path: tuple[tuple[float, ...], ...] | None = None
 
     def objective(self, length: float) -> Objective:
         """The objective, a profile checked along ``length`` mm (stages: their staged target)."""
         if self.stages is not None:
             return staged_target([(p * 1e-3, q.objective(length), w) for p, w, q in self.stages])
-        return make_objective(self.spec, self.amplitude, self.periods, self.point, length=length, curve=self.curve)
+        return make_objective(self.spec, self.amplitude, self.periods, self.point, length=length, curve=self.curve,
+                              path=self.path)
 
     def key(self) -> str:
         """A canonical text of the query (equal queries, equal keys)."""
@@ -113,9 +122,10 @@ class Query:
         >>> Query.from_dict(json.loads(q.key())) == q
         True
         """
-        point, curve, stages = data.get("point"), data.get("curve"), data.get("stages")
+        point, curve, stages, path = data.get("point"), data.get("curve"), data.get("stages"), data.get("path")
         return cls(**{**data, "point": None if point is None else tuple(float(v) for v in point),
                       "curve": None if curve is None else tuple(tuple(float(v) for v in c) for c in curve),
+                      "path": None if path is None else tuple(tuple(float(v) for v in c) for c in path),
                       "stages": None if stages is None else tuple((float(p), float(w), cls.from_dict(q))
                                                                   for p, w, q in stages)})
 
@@ -129,12 +139,14 @@ class Query:
         if self.stages is not None:
             stage = tuple({"pressure_kpa": p, "weight": w, "objective": q.spec, "amplitude": q.amplitude,
                            "periods": q.periods, **({"point": list(q.point)} if q.point is not None else {}),
-                           **({"curve": [list(c) for c in q.curve]} if q.curve is not None else {})}
+                           **({"curve": [list(c) for c in q.curve]} if q.curve is not None else {}),
+                           **({"path": [list(c) for c in q.path]} if q.path is not None else {})}
                           for p, w, q in self.stages)
             return DesignConfig(objective="stages", stage=stage, units=units, search="certified", model=model,
                                 **settings)
         return DesignConfig(objective=self.spec, amplitude=self.amplitude, periods=self.periods, point=self.point,
-                            curve=self.curve, units=units, search="certified", model=model, **settings)
+                            curve=self.curve, path=self.path, units=units, search="certified", model=model,
+                            **settings)
 
 
 def load_json(raw: bytes | str, field: str = "target") -> Any:
@@ -204,7 +216,7 @@ def _text(data: dict[str, Any], name: str) -> str:
     return value.strip()
 
 
-def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",)) -> Query:
+def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",), axis: float = AXIS_MM) -> Query:
     """Check a query's JSON body against an actuator ``length`` mm long.
 
     Parameters
@@ -213,14 +225,21 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
         ``{"target": {...}, "model": "3d", "top": 10}``; the target is one of
         ``{"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}``,
         ``{"kind": "expression", "expression": "y = ...", "amplitude": 10}``,
-        ``{"kind": "tip", "goal": "max-x", "point": [x, y]}`` (``[x, y, z]``: a point off the plane) or
-        ``{"kind": "curve", "points": [[x, y], ...]}`` (a drawn stroke, mm; with
-        ``"top_points": [[x, z], ...]``, the same curve drawn seen from above: a space curve).
+        ``{"kind": "tip", "goal": "max-x", "point": [x, y]}`` (``[x, y, z]``: a point off the plane),
+        ``{"kind": "curve", "points": [[x, y], ...]}`` (a drawn stroke, mm, y above the undeformed
+        axis; with ``"top_points": [[x, z], ...]``, the same curve drawn seen from above: a space
+        curve; a stroke that turns back in x is a path, :mod:`pneumorph.bench.strokes`) or
+        ``{"kind": "path", "points": [[x, y], ...]}`` (``[x, y, z]``: in space; mm in the frame of
+        the unit centres, y from the bottom face, as ``path = [...]`` of a design config) or
+        ``{"kind": "path", "preset": "hook"}`` (a path preset, drawn for the actuator).
     length : float
         The undeformed actuator length (mm): profiles must be finite on it, strokes are
         smoothed over it.
     units : tuple of str
         The unit ids the query may name in ``"unit"`` (default: the built-in unit only).
+    axis : float
+        The undeformed axis's height above the bottom face (mm; the chain table's
+        ``tip_ref[1]``): a stroke that becomes a path is lifted by it.
 
     Raises
     ------
@@ -254,10 +273,10 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
                                  "first")
     fields: dict[str, Any] = {"kind": kind, "model": model, "top": top, "unit": unit}
     if kind == "stages":
-        fields.update(spec="stages", stages=_stages(target.get("stages"), length, model, unit))
+        fields.update(spec="stages", stages=_stages(target.get("stages"), length, model, unit, axis))
         blame = "stages"
     else:
-        target_fields, blame = _target_fields(kind, target, length)
+        target_fields, blame = _target_fields(kind, target, length, axis)
         fields.update(target_fields)
     query = Query(**fields)
     try:
@@ -267,7 +286,7 @@ def parse_query(body: Any, length: float, units: tuple[str, ...] = ("builtin",))
     return query
 
 
-def _target_fields(kind: str, target: dict[str, Any], length: float) -> tuple[dict[str, Any], str]:
+def _target_fields(kind: str, target: dict[str, Any], length: float, axis: float) -> tuple[dict[str, Any], str]:
     """The :class:`Query` fields of one target (not stages) and the field to blame for a bad one."""
     if kind == "preset":
         name = choice(target.get("name", "sin"), PRESETS, "preset", "the preset")
@@ -289,6 +308,18 @@ def _target_fields(kind: str, target: dict[str, Any], length: float) -> tuple[di
             except SettingsError as exc:
                 raise QueryError("point", str(exc)) from None
         return {"spec": goal, "point": point if goal == "reach" else None}, "point" if goal == "reach" else "goal"
+    if kind == "path":
+        return _path_fields(target)
+    if is_path_stroke(target.get("points", [])):  # no graph y = f(x): a path, in order
+        if target.get("top_points") is not None:
+            raise QueryError("points", "the stroke turns back in x, so it is a path in the plane: the view from "
+                                       "above gives z by x and cannot say which pass of the path a z belongs to; "
+                                       "give a path in space by its points (kind path, [x, y, z])")
+        try:
+            path = smooth_path(target["points"], length, axis)
+        except PneumorphError as exc:
+            raise QueryError("points", str(exc)) from None
+        return {"spec": "path", "path": _rows(np.round(path, 6))}, "points"
     try:
         knots = smooth_curve(target.get("points", []), length)
     except PneumorphError as exc:
@@ -304,7 +335,28 @@ def _target_fields(kind: str, target: dict[str, Any], length: float) -> tuple[di
     return {"spec": "curve", "curve": tuple(tuple(float(v) for v in row) for row in space)}, "points"
 
 
-def _stages(stages: Any, length: float, model: str, unit: str) -> tuple[tuple[float, float, Query], ...]:
+def _rows(points: Any) -> tuple[tuple[float, ...], ...]:
+    return tuple(tuple(float(v) for v in row) for row in points)
+
+
+def _path_fields(target: dict[str, Any]) -> tuple[dict[str, Any], str]:
+    """A path's :class:`Query` fields: a preset's name, or its points as given (2 or 3 columns, repeats dropped)."""
+    if target.get("preset") is not None:
+        if target.get("points") is not None:
+            raise QueryError("points", "a path is given by its points or by a preset, not both")
+        return {"spec": choice(target["preset"], tuple(PATH_PRESETS), "preset", "the path preset")}, "preset"
+    if target.get("points") is None:
+        raise QueryError("points", "a path needs its points, [[x, y], ...] in mm from the base to the free end, or "
+                                   "a preset")
+    try:
+        points = path_points(target["points"], "the path")
+    except PneumorphError as exc:
+        raise QueryError("points", str(exc)) from None
+    columns = len(target["points"][0])  # as given: a path in the plane keeps its two columns
+    return {"spec": "path", "path": _rows(points[:, :columns])}, "points"
+
+
+def _stages(stages: Any, length: float, model: str, unit: str, axis: float) -> tuple[tuple[float, float, Query], ...]:
     """The stages of a ``kind = "stages"`` target: ``[{"pressure_kpa": P, "target": {...}, "weight": w}, ...]``."""
     if not isinstance(stages, list) or not 1 <= len(stages) <= MAX_STAGES:
         raise QueryError("stages", f"stages must be a list of 1 to {MAX_STAGES} stages (a pressure and a target "
@@ -323,7 +375,7 @@ def _stages(stages: Any, length: float, model: str, unit: str) -> tuple[tuple[fl
             raise QueryError("stages", f"stage {i}: the pressure and the weight must be positive")
         kind = choice(stage["target"].get("kind"), STAGE_KINDS, "stages", f"stage {i}'s target kind")
         try:
-            fields, _ = _target_fields(kind, stage["target"], length)
+            fields, _ = _target_fields(kind, stage["target"], length, axis)
         except QueryError as exc:
             raise QueryError("stages", f"stage {i}: {exc.message}") from None
         out.append((pressure, weight, Query(kind=kind, model=model, unit=unit, **fields)))
