@@ -23,11 +23,12 @@ from typing import Any
 import numpy as np
 
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
+from pneumorph.bench.samples import centrelines, path_samples, profiles, stage_samples, target_samples, uses_path
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified import best_scores
 from pneumorph.design.growth import designs_of
 from pneumorph.design.spacegrowth import check_space_objective
-from pneumorph.design.targets import ProfileTarget, StagedTarget, TipGoal
+from pneumorph.design.targets import StagedTarget, TipGoal
 from pneumorph.errors import PneumorphError, SearchConfigError
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import atomic_write_text
@@ -36,7 +37,6 @@ from pneumorph.models.chaintables import find_table
 from pneumorph.models.factory import make_model
 from pneumorph.models.windows import design_numbers
 
-TARGET_SAMPLES = 201
 BUILTIN = "builtin"
 LIBRARIES = {"spatial": "spatial library: a, l (sideways)"}
 """The built-in unit libraries the bench serves, by id (their shipped 3D tables), and their names."""
@@ -216,14 +216,14 @@ class Bench:
                                      "table first")
         chain = self.chain(model, unit)
         length = chain.length
-        query = parse_query(body, length, self.unit_ids if units is None else units)
+        query = parse_query(body, length, self.unit_ids if units is None else units, float(chain.table.tip_ref[1]))
         objective = query.objective(length)
         if chain.table.axes == 3:  # a chain in space scores fewer kinds of target
             try:
                 check_space_objective(objective)
             except SearchConfigError:
-                raise QueryError("target", f"the {unit} library's chain scores profiles, space curves and tip "
-                                           "goals other than the curl, not this target") from None
+                raise QueryError("target", f"the {unit} library's chain scores profiles, space curves, paths and "
+                                           "tip goals other than the curl, not this target") from None
         if isinstance(objective, StagedTarget):  # each stage at a level of the ramp
             try:
                 objective.levels(chain.pressures(), how="")
@@ -256,7 +256,11 @@ class Bench:
         pressure_kpa), ``certificate`` (bound, candidates, designs, scored, complete,
         statement), ``top`` (rank, design, value, pressure_kpa, optimistic), ``target``
         (curve samples or None), ``point``, ``profiles`` (the winner's base, centres and tip
-        at every level, heights above the undeformed axis), ``elapsed_ms`` and ``memo``.
+        at every level, heights above the undeformed axis), ``stages``, ``path`` (a path's
+        polyline placed on the actuator, mm, or None), ``axis_mm`` (the undeformed axis above
+        the bottom face), ``centrelines`` (for a path or stages with one: the winner's base,
+        centres and tip at every level as the model reports them, the path's frame; else
+        None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``.
         """
         hit = self.recall(query)
         if hit is not None:
@@ -275,7 +279,7 @@ class Bench:
 
     def _answer(self, query: Query) -> dict[str, Any]:
         chain = self.chain(query.model, query.unit)
-        length = chain.length
+        length, axis = chain.length, float(chain.table.tip_ref[1])
         objective = query.objective(length)
         scores = best_scores(chain, objective, top=query.top)
         sign = 1.0 if objective.sense == "min" else -1.0
@@ -321,16 +325,21 @@ class Bench:
             "top": [{"rank": i + 1, "design": d, "value": sign * float(scores.cost[j]),
                      "pressure_kpa": float(kpa[int(scores.level[j])]), "optimistic": sign * float(scores.optimistic[j])}
                     for i, (d, j) in enumerate(zip(designs, top, strict=False))],
-            "target": _target_samples(objective, length),
+            "target": target_samples(objective, length),
             "point": list(objective.point) if isinstance(objective, TipGoal) and objective.point is not None else None,
             "profiles": profiles(response),
-            "stages": _stage_samples(objective, chain.pressures(), length),
+            "stages": stage_samples(objective, chain.pressures(), length, axis),
+            "path": path_samples(objective, length, axis),
+            "axis_mm": axis,
+            "centrelines": centrelines(response) if uses_path(objective) else None,
         }
 
-    def chain_profiles(self, design: str, fidelity: str, unit: str = BUILTIN) -> list[list[list[float]]]:
-        """A design's predicted centrelines at every level (see :func:`profiles`)."""
+    def chain_lines(self, design: str, fidelity: str, unit: str = BUILTIN) -> dict[str, Any]:
+        """A design's predicted lines at every level: ``profiles`` (heights above the axis, :func:`profiles`) and
+        ``centrelines`` (as the model reports them, a path's frame, :func:`~pneumorph.bench.samples.centrelines`)."""
         chain = self.chain(fidelity, unit)
-        return profiles(chain.evaluate(_design(chain, design)))
+        response = chain.evaluate(_design(chain, design))
+        return {"profiles": profiles(response), "centrelines": centrelines(response)}
 
     def chain_shape(self, design: str, fidelity: str, level: int, unit: str = BUILTIN) -> dict[str, Any]:
         """The 3D surface of a design at ``level``: its FE solution if one was kept, else laid along its
@@ -409,46 +418,6 @@ def key_id(key: str) -> str:
     import hashlib
 
     return hashlib.sha256(key.encode()).hexdigest()[:16]
-
-
-def profiles(response: Any) -> list[list[list[float]]]:
-    """Base, unit centres and tip at every level, heights above the undeformed axis (mm); a response in space
-    (x, y, z) also gives each point's z off the undeformed axis."""
-    c = response.centres.copy()
-    c[..., 1:] -= response.reference_centres[None, :, 1:]
-    tip = response.tip.copy()
-    tip[:, 1:] -= response.reference_tip[1:]
-    base = np.zeros((len(c), 1, c.shape[-1]))
-    pts = np.concatenate([base, c, tip[:, None]], axis=1)
-    return np.round(pts, 4).tolist()
-
-
-def _stage_samples(objective: Any, pressures: Any, length: float) -> list[dict[str, Any]] | None:
-    """Per stage of a staged target: its pressure (kPa), level, label, target samples and tip point; None otherwise."""
-    if not isinstance(objective, StagedTarget):
-        return None
-    levels = objective.levels(pressures)
-    return [{"pressure_kpa": round(stage.pressure * 1e3, 9), "level": int(k), "label": stage.label,
-             "weight": stage.weight, "target": _target_samples(stage.target, length),
-             "point": list(stage.target.point) if isinstance(stage.target, TipGoal) and stage.target.point is not None
-             else None}
-            for stage, k in zip(objective.stages, levels, strict=True)]
-
-
-def _target_samples(objective: Any, length: float) -> dict[str, list[float]] | None:
-    if not isinstance(objective, ProfileTarget):
-        return None
-    if objective.coordinates == "cartesian":
-        x = np.linspace(0.0, length, TARGET_SAMPLES)
-        y = objective.curve(x, length)
-        if objective.spatial:  # a space curve: its z too, for the view from above
-            z = objective.curve_z(x, length)
-            return {"x": np.round(x, 4).tolist(), "y": np.round(y, 4).tolist(), "z": np.round(z, 4).tolist()}
-    else:
-        th = np.linspace(0.0, np.pi, TARGET_SAMPLES)
-        r = objective.curve(th, length)
-        x, y = r * np.cos(th), r * np.sin(th)
-    return {"x": np.round(x, 4).tolist(), "y": np.round(y, 4).tolist()}
 
 
 __all__ = ["Bench", "profiles"]

@@ -37,6 +37,7 @@ from pneumorph.bench.guard import (
 )
 from pneumorph.bench.jobs import JobBoard, JobLimits
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, load_json
+from pneumorph.design.paths import PATH_PRESETS
 from pneumorph.design.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
 from pneumorph.geometry.limits import MeshLimitError
@@ -284,7 +285,8 @@ def _answers_router(bench: Bench, board: JobBoard, answers: AnswerPool) -> APIRo
         chain = bench.chain("3d")
         return {"version": __version__, "models": list(MODELS), "default_model": "3d", "units": bench.units,
                 "length_mm": length, "pressures_kpa": [float(p) * 1e3 for p in chain.pressures()],
-                "presets": list(PRESETS), "tip_goals": list(TIP_GOALS),
+                "presets": list(PRESETS), "path_presets": list(PATH_PRESETS), "tip_goals": list(TIP_GOALS),
+                "axis_mm": float(chain.table.tip_ref[1]),
                 "defaults": {"kind": "preset", "name": "sin", "amplitude": 10.0, "periods": 1.0}}
 
     @router.post("/api/design")
@@ -305,7 +307,7 @@ def _answers_router(bench: Bench, board: JobBoard, answers: AnswerPool) -> APIRo
     @router.get("/api/profiles")
     async def profiles(design: str, request: Request, model: str = "3d", unit: str = "builtin") -> dict[str, Any]:
         _check_model(bench, board, model, unit, request)
-        return {"design": design, "profiles": await run_in_threadpool(bench.chain_profiles, design, model, unit)}
+        return {"design": design, **await run_in_threadpool(bench.chain_lines, design, model, unit)}
 
     @router.get("/api/shape")
     async def shape(design: str, level: int, request: Request, model: str = "3d",
