@@ -204,6 +204,44 @@ def test_a_curve_drawn_in_two_views(browser) -> None:  # type: ignore[no-untyped
     _shot(browser, "drawn-two-views")
 
 
+def test_a_drawn_hook_is_a_path(browser) -> None:  # type: ignore[no-untyped-def]
+    """A stroke along the axis that curls up and back past vertical: answered as a path, the design's centres (as
+    the model reports them) drawn against it."""
+    import numpy as np
+
+    browser.get_log("browser")  # the earlier tests' entries (a refused expression among them)
+    Select(_el(browser, "target-kind")).select_by_value("curve")
+    _el(browser, "draw-clear").click()  # the earlier test's view from above too
+    canvas = _el(browser, "draw-canvas")
+    w = canvas.size["width"]
+    px = w / 440 * 400 / 157.5  # CSS px per mm (draw.js: 20 px margins on a 440 px wide canvas)
+    theta = np.radians(np.linspace(0.0, 200.0, 40))
+    arc = np.c_[62 + 34 * np.sin(theta), 34 * (1 - np.cos(theta))]
+    mm = np.r_[np.c_[np.linspace(0.0, 62.0, 20), np.zeros(20)], arc]
+    at = np.round(np.c_[mm[:, 0] * px, -mm[:, 1] * px]).astype(int)  # from the base on the axis, y down on screen
+    chain = ActionChains(browser, duration=20)  # ms a move: 60 moves in a second
+    chain = chain.move_to_element_with_offset(canvas, -w // 2 + round(20 * w / 440) + 1, 0).click_and_hold()
+    for step in np.diff(at, axis=0):
+        chain = chain.move_by_offset(int(step[0]), int(step[1]))
+    chain.release().perform()
+    _wait(lambda: _el(browser, "winner-label").text.startswith("path: path through") and _answered(browser),
+          timeout=30)
+    assert len(_el(browser, "winner-design").text) == 15
+    assert _el(browser, "plot-title").text.startswith("Path")
+    assert "matched as a path" in _el(browser, "stroke-kind").text
+    orange = browser.execute_script("const c = document.getElementById('profile-plot');"
+                                    "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+                                    "let n = 0, lo = c.height, hi = 0;"
+                                    "for (let i = 0; i < d.length; i += 4) if (d[i] === 224 && d[i + 1] === 123) {"
+                                    "  n++; const y = Math.floor(i / 4 / c.width);"
+                                    "  lo = Math.min(lo, y); hi = Math.max(hi, y); }"
+                                    "return [n, hi - lo];")
+    assert orange[0] > 100 and orange[1] > 100  # the path (#e07b1a) drawn, climbing most of the plot's height
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    _shot(browser, "path")
+    _el(browser, "draw-clear").click()
+
+
 def _stroke(browser, canvas_id: str, rise: int) -> None:  # type: ignore[no-untyped-def]
     canvas = _el(browser, canvas_id)
     w = canvas.size["width"]

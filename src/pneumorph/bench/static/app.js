@@ -4,8 +4,8 @@ import { Viewer } from "./viewer.js";
 import { DrawArea } from "./draw.js";
 
 const $ = (id) => document.getElementById(id);
-const state = { info: null, answer: null, seq: 0, selected: null, profiles: null, curve: null, job: null,
-  polling: new Set(), shapeSeq: 0, stages: [], stageCurve: null };
+const state = { info: null, answer: null, seq: 0, selected: null, profiles: null, centrelines: null, curve: null,
+  job: null, polling: new Set(), shapeSeq: 0, stages: [], stageCurve: null };
 const ACTIVE = ["queued", "running"];
 const FIELDS = ["target", "preset", "amplitude", "periods", "expression", "goal", "point", "points", "stages", "model", "unit",
   "top"];
@@ -32,7 +32,8 @@ function number(id) {
 function currentBody() {
   const kind = $("target-kind").value;
   let target;
-  if (kind === "preset") target = { kind, name: $("preset").value, amplitude: number("amplitude"), periods: number("periods") };
+  if (kind === "preset" && state.info.path_presets.includes($("preset").value)) target = { kind: "path", preset: $("preset").value };
+  else if (kind === "preset") target = { kind, name: $("preset").value, amplitude: number("amplitude"), periods: number("periods") };
   else if (kind === "expression") target = { kind, expression: $("expression").value, amplitude: number("expr-amplitude") };
   else if (kind === "tip") {
     target = { kind, goal: $("goal").value };
@@ -77,12 +78,20 @@ async function ask() {
   if ($("target-kind").value === "tip" && $("unit").value === "spatial") {
     $("answer-time").textContent = "(searching 1,073,741,824 designs for a tip goal: about a minute)";
   }
+  // a path takes a second or so; over the spatial library a branch-and-bound of minutes (docs/bench.md)
+  const slow = setTimeout(() => {
+    if (seq !== state.seq || $("answer-time").textContent.startsWith("(searching")) return;
+    $("answer-time").textContent = `(searching${$("unit").value === "spatial" ? ": a path over 1,073,741,824 designs " +
+      "takes minutes" : " ..."})`;
+  }, 1500);
   try {
     const answer = await post("/api/design", currentBody());
+    clearTimeout(slow);
     if (seq !== state.seq) return;                                  // a newer question is on its way
     clearErrors();
     show(answer);
   } catch (error) {
+    clearTimeout(slow);
     if (seq !== state.seq) return;
     clearErrors();
     showError(error.field, error.message);
@@ -95,6 +104,7 @@ function show(answer) {
   state.answer = answer;
   state.selected = answer.winner.design;
   state.profiles = answer.profiles;
+  state.centrelines = answer.centrelines;   // a path's frame: the centres as the model reports them
   const w = answer.winner;
   $("answer").dataset.queryId = answer.query_id;
   $("answer").dataset.state = "ok";
@@ -102,8 +112,11 @@ function show(answer) {
   $("design-boxes").innerHTML = [...w.design].map((b, i) => `<span class="b${b}" title="unit ${i + 1}">${b}</span>`).join("");
   $("winner-pressure").textContent = `${w.pressure_kpa.toFixed(1)} kPa (level ${w.level + 1} of ${answer.pressures_kpa.length})`;
   $("winner-error").textContent = `${w.value.toFixed(3)} ${answer.value_unit}` +
-    (answer.sense === "max" ? " (maximised)" : answer.value_unit === "mm" ? " (Eq 4.1)" : "");
+    (answer.sense === "max" ? " (maximised)" : answer.path ? " (the centres' distances to the path, root-sum-square)"
+      : answer.value_unit === "mm" ? " (Eq 4.1)" : "");
   $("winner-label").textContent = answer.label;
+  $("stroke-kind").textContent = answer.path && $("target-kind").value === "curve" ? "The stroke turns back (or " +
+    "climbs too steeply) to be a graph y = f(x): it is matched as a path, the unit centres along it in order." : "";
   $("certificate").textContent = answer.certificate.statement;
   $("answer-time").textContent = answer.memo ? "(remembered)" : `(${answer.elapsed_ms.toFixed(0)} ms)`;
   const body = $("top-table").querySelector("tbody");
@@ -122,24 +135,34 @@ function redraw() {
   if (!a) return;
   const k = Number($("pressure-slider").value);
   $("slider-value").textContent = `${a.pressures_kpa[k].toFixed(1)} kPa`;
-  const target = a.target ? a.target.x.map((x, i) => [x, a.target.y[i]]) : null;
+  // a path (or stages with one) is drawn in its frame: the centres as the model reports them, y from the
+  // bottom face; heights above the axis (profiles, tip points) are lifted onto the axis there
+  const lift = state.centrelines ? a.axis_mm : 0;
+  const lines = state.centrelines || state.profiles;
+  const xy = (s, dy = 0) => s.x.map((x, i) => [x, s.y[i] + dy]);
+  const up = (p) => (p && lift ? [p[0], p[1] + lift, ...p.slice(2)] : p);
+  const target = a.path ? xy(a.path) : a.target ? xy(a.target, lift) : null;
   // stages: every stage's target (the one at this level drawn bold) and the whole ramp behind the profile
   const stages = (a.stages || []).map((st, i) => ({
-    points: st.target ? st.target.x.map((x, j) => [x, st.target.y[j]]) : null, point: st.point,
-    colour: STAGE_COLOURS[i % STAGE_COLOURS.length], current: st.level === k, label: `${st.pressure_kpa} kPa target`,
+    points: st.path ? xy(st.path) : st.target ? xy(st.target, lift) : null, point: up(st.point),
+    colour: STAGE_COLOURS[i % STAGE_COLOURS.length], current: st.level === k,
+    label: `${st.pressure_kpa} kPa ${st.path ? "path" : "target"}`,
   }));
-  drawProfile($("profile-plot"), { target, point: a.point, profile: state.profiles[k], label: `design ${state.selected}`,
-    stages, ramp: a.stages ? state.profiles : null });
+  $("plot-title").textContent = state.centrelines ? "Path: the unit centres as the model reports them" : "Profile";
+  drawProfile($("profile-plot"), { target, point: up(a.point), profile: lines[k], label: `design ${state.selected}`,
+    stages, ramp: a.stages ? lines : null, axis: lift, vertical: lift ? "y (mm) from the bottom face" : "y (mm)",
+    targetLabel: a.path ? `path${a.path.name === "path" ? "" : ` ${a.path.name}`}: the centres along it, in order` : "target" });
   // a space curve or a design that leaves the plane: the view from above, the target's z against the
   // actuator's (z = 0 where the chain is planar: it bends in its plane)
-  const targetZ = Boolean(a.target && a.target.z);
+  const shape = a.path || a.target;
+  const targetZ = Boolean(shape && shape.z);
   const pointZ = Boolean(a.point && a.point.length === 3);
-  const space = targetZ || pointZ || state.profiles[k][0].length === 3;
+  const space = targetZ || pointZ || lines[k][0].length === 3;
   $("top-view").hidden = !space;
   if (space) {
-    drawProfile($("top-plot"), { target: targetZ ? a.target.x.map((x, i) => [x, a.target.z[i]]) : null,
-      point: pointZ ? [a.point[0], a.point[2]] : null,
-      profile: state.profiles[k].map(([x, , z]) => [x, z || 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
+    drawProfile($("top-plot"), { target: targetZ ? shape.x.map((x, i) => [x, shape.z[i]]) : null,
+      point: pointZ ? [a.point[0], a.point[2]] : null, targetLabel: a.path ? "path" : "target",
+      profile: lines[k].map(([x, , z]) => [x, z || 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
   }
 }
 
@@ -154,6 +177,7 @@ async function select(design) {
   document.querySelectorAll("#top-table tbody tr").forEach((tr) => tr.classList.toggle("selected", tr.dataset.design === design));
   const data = await api(`/api/profiles?design=${design}&model=${a.model}&unit=${encodeURIComponent($("unit").value)}`);
   state.profiles = data.profiles;
+  state.centrelines = a.centrelines ? data.centrelines : null;
   redraw();
   loadShape();
 }
@@ -276,6 +300,8 @@ let stageArea = null;
 async function main() {
   state.info = await api("/api/info");
   $("goal").innerHTML = state.info.tip_goals.map((g) => `<option value="${g}">${g}</option>`).join("");
+  $("preset").insertAdjacentHTML("beforeend", `<optgroup label="Paths: the unit centres along a shape, in order">` +
+    state.info.path_presets.map((p) => `<option value="${p}">${p} (a path)</option>`).join("") + "</optgroup>");
   drawArea = new DrawArea($("draw-canvas"), state.info.length_mm, (points) => { state.curve = points; schedule(); });
   topArea = new DrawArea($("draw-top-canvas"), state.info.length_mm, (points) => { state.curveTop = points; schedule(); });
   const changed = () => { showKind(); schedule(); };

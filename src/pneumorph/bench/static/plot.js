@@ -25,8 +25,11 @@ function bounds(sets) {
 // profile: [[x, y]...] (base, centres, tip), label: string,
 // stages: [{points, point, colour, current, label}] (a staged target's stages) and
 // ramp: the profiles of every level (drawn faint behind the profile), both optional;
-// vertical: the vertical axis's label, "y (mm)" unless a view from above}.
-export function drawProfile(canvas, { target, point, profile, label, stages = [], ramp = null, vertical = "y (mm)" }) {
+// vertical: the vertical axis's label, "y (mm)" unless a view from above; axis: the height of the
+// undeformed axis, drawn dashed (0 for heights above it; a path's frame has it 6 mm up);
+// targetLabel: the target's legend ("target", or what the path is)}.
+export function drawProfile(canvas, { target, point, profile, label, stages = [], ramp = null, vertical = "y (mm)",
+  axis = 0, targetLabel = "target" }) {
   const ctx = canvas.getContext("2d");
   const W = canvas.width, H = canvas.height, pad = { l: 48, r: 14, t: 14, b: 34 };
   ctx.clearRect(0, 0, W, H);
@@ -65,7 +68,7 @@ export function drawProfile(canvas, { target, point, profile, label, stages = []
   ctx.save(); ctx.translate(12, pad.t + ph / 2); ctx.rotate(-Math.PI / 2); ctx.fillText(vertical, 0, 0); ctx.restore();
   ctx.strokeStyle = "#b8c0c8";
   ctx.setLineDash([4, 4]);
-  ctx.beginPath(); ctx.moveTo(pad.l, Y(0)); ctx.lineTo(pad.l + pw, Y(0)); ctx.stroke();
+  ctx.beginPath(); ctx.moveTo(pad.l, Y(axis)); ctx.lineTo(pad.l + pw, Y(axis)); ctx.stroke();
   ctx.setLineDash([]);
 
   const line = (pts, colour, width) => {
@@ -98,7 +101,7 @@ export function drawProfile(canvas, { target, point, profile, label, stages = []
     ctx.fillStyle = colour; ctx.fillRect(pad.l + 8, ly - 8, 16, 3);
     ctx.fillStyle = "#1f2328"; ctx.fillText(text, pad.l + 30, ly - 3); ly += 16;
   };
-  if (target || point) legend("#e07b1a", target ? "target" : "tip goal");
+  if (target || point) legend("#e07b1a", target ? targetLabel : "tip goal");
   for (const st of stages) legend(st.colour, st.current ? `${st.label} (this level)` : st.label);
   if (ramp) legend("#d0d7de", "the ramp: every level");
   if (profile) legend("#0b6bcb", label || "unit centres");
