@@ -56,5 +56,5 @@ def test_what_the_chain_in_space_cannot_score_is_refused_before_any_table(tmp_pa
     assert main(["design", "--library", "spatial", "--objective", "max-curl", "--out", str(out),
                  "--cache", str(cache)]) == 2
     err = capsys.readouterr().err.strip()
-    assert "scores Cartesian profiles, space curves and tip goals" in err and len(err.splitlines()) == 1
+    assert "scores Cartesian profiles, space curves, paths and tip goals" in err and len(err.splitlines()) == 1
     assert not out.exists() and not (tmp_path / "chain-tables").exists()

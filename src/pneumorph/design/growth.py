@@ -84,19 +84,22 @@ def _uses_reach(chain: ChainModel, p: int) -> bool:
 
 
 def _prefix_bound(chain: ChainModel, objective: Objective, bits: NDArray[np.uint8], state: dict[str, Any],
-                  placed: int, curve: CurveRange | None = None) -> FloatArray:
+                  placed: int, curve: CurveRange | None = None, limit: float = np.inf) -> FloatArray:
     """A lower bound on the cost of every completion of each prefix, shape (m,).
 
     The partial sums of Eq 4.1 (profiles) or the box of the remaining chords' heading intervals
     (tip goals), and, once the prefix's next window holds no base symbol, the bound on the
     units still to place from the support functions of their displacements
-    (:mod:`pneumorph.design.reach`).
+    (:mod:`pneumorph.design.reach`); a path's partial sums and its next centres within the chords'
+    reach (:func:`~pneumorph.design.rest.path_rest`: levels already at ``limit`` are not looked at
+    again).
     """
     n = chain.n_units
     p = bits.shape[1]
     use = _uses_reach(chain, p)
     if isinstance(objective, PathTarget):  # the partial sums and the centres still to place (within chords' reach)
-        total = state["sum"] + path_rest(objective, n, state["point"], placed, chain.table.length.max(axis=0))
+        total = state["sum"] + path_rest(objective, n, state["point"], placed, chain.table.length.max(axis=0),
+                                         state["sum"], limit**2)
         return np.sqrt(total.min(axis=1))
     if isinstance(objective, ProfileTarget):
         total = state["sum"]
@@ -307,7 +310,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
                     _add_terms(cast(ProfileTarget | PathTarget, objective), st, j, x, y, (n, length, e, slope))
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
-            bound = _prefix_bound(chain, objective, bits, st, placed)
+            bound = _prefix_bound(chain, objective, bits, st, placed, limit=threshold)
             keep = bound < threshold
             if curve is not None and (refine or keep.sum() > REFINE_AT) and _uses_reach(chain, p):
                 # the partial sums leave too many prefixes open: add the bound on the centres still to place

@@ -110,9 +110,9 @@ def path_points(points: ArrayLike, where: str = "a path") -> FloatArray:
 
 
 @functools.lru_cache(maxsize=64)
-def _stretches(points: tuple[tuple[float, ...], ...], window: float, n: int) -> tuple[FloatArray, FloatArray]:
-    """Each of ``n`` centres' stretch of the polyline ``points`` as segments: starts and ends, (n, s, 3) each (the
-    last segment repeated where a stretch has fewer)."""
+def _stretches(points: tuple[tuple[float, ...], ...], window: float,
+               n: int) -> tuple[tuple[FloatArray, ...], tuple[FloatArray, ...]]:
+    """Each of ``n`` centres' stretch of the polyline ``points`` as segments: their starts and ends, (s_i, 3) each."""
     p = np.asarray(points, dtype=float)
     steps = np.linalg.norm(np.diff(p, axis=0), axis=1)
     arc = np.r_[0.0, np.cumsum(steps)]
@@ -132,26 +132,38 @@ def _stretches(points: tuple[tuple[float, ...], ...], window: float, n: int) -> 
         knots = np.vstack([at(lo), p[inner], at(hi)])
         starts.append(knots[:-1])
         ends.append(knots[1:])
-    width = max(len(a) for a in starts)
-    a = np.stack([np.vstack([s, np.repeat(s[-1:], width - len(s), axis=0)]) for s in starts])
-    b = np.stack([np.vstack([e, np.repeat(e[-1:], width - len(e), axis=0)]) for e in ends])
-    a.setflags(write=False)
-    b.setflags(write=False)
-    return a, b
+    for array in (*starts, *ends):
+        array.setflags(write=False)
+    return tuple(starts), tuple(ends)
 
 
 def _segment_distance2(q: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-    """Squared distance of points ``q`` (m, 3) to the nearest of the segments ``a``-``b`` (s, 3), shape (m,)."""
+    """Squared distance of points ``q`` (m, 3) to the nearest of the segments ``a``-``b`` (s, 3), shape (m,).
+
+    Written out per coordinate (no einsum: the segments are few, the points many), and in the plane where the
+    points and the segments all lie at z = 0.
+    """
     out = np.empty(len(q))
     d = b - a
-    dd = np.einsum("sj,sj->s", d, d)
+    dd = (d * d).sum(axis=1)
     inv = np.where(dd > 0.0, 1.0 / np.where(dd > 0.0, dd, 1.0), 0.0)
+    axes = 2 if not (np.any(a[:, 2]) or np.any(b[:, 2]) or np.any(q[:, 2])) else 3
     step = max(1, _CHUNK // max(len(a), 1))
     for lo in range(0, len(q), step):
-        rel = q[lo:lo + step, None, :] - a[None]  # (c, s, 3)
-        t = np.clip(np.einsum("csj,sj->cs", rel, d) * inv, 0.0, 1.0)
-        rel -= t[..., None] * d
-        out[lo:lo + step] = np.einsum("csj,csj->cs", rel, rel).min(axis=1)
+        rel = [q[lo:lo + step, j, None] - a[None, :, j] for j in range(axes)]  # (c, s) each
+        t = rel[0] * d[:, 0]
+        for j in range(1, axes):
+            t += rel[j] * d[:, j]
+        t *= inv
+        np.clip(t, 0.0, 1.0, out=t)
+        total = None
+        for j in range(axes):
+            e = rel[j]
+            e -= t * d[:, j]
+            e *= e
+            total = e if total is None else total + e
+        assert total is not None
+        out[lo:lo + step] = total.min(axis=1)
     return out
 
 
@@ -228,8 +240,8 @@ class PathTarget:
         """True for a path that leaves the plane z = 0."""
         return bool(np.any(np.asarray(self.points, dtype=float)[:, 2] != 0.0))
 
-    def stretches(self, n: int) -> tuple[FloatArray, FloatArray]:
-        """The stretch of each of ``n`` centres as segments: starts and ends, (n, s, 3) each."""
+    def stretches(self, n: int) -> tuple[tuple[FloatArray, ...], tuple[FloatArray, ...]]:
+        """The stretch of each of ``n`` centres as segments: their starts and ends, (s_i, 3) each."""
         self._absolute()
         return _stretches(self.points, float(self.window), int(n))
 

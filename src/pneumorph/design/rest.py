@@ -149,13 +149,18 @@ def tip_goal_rest(reach: Reach, name: str, target: tuple[float, ...] | None, tip
 
 
 
-def path_rest(target: PathTarget, n_units: int, point: FloatArray, placed: int, longest: FloatArray) -> FloatArray:
+def path_rest(target: PathTarget, n_units: int, point: FloatArray, placed: int, longest: FloatArray,
+              partial: FloatArray | None = None, limit: float = np.inf) -> FloatArray:
     """A lower bound on the summed path terms of the next centres the prefixes have not fixed, (m, k).
 
     Centre ``i`` (1-based, ``placed < i``, at most :data:`~pneumorph.design.reach.AHEAD` on) lies
     within ``(i - placed) L_k`` of the prefix's last point ``point`` (m, k, 2 or 3; the base for
     ``placed = 0``), ``L_k`` the longest chord at level ``k``: its distance to its stretch of the
     path is at least the point's less that, the term at least the square of what is left.
+
+    With the prefixes' ``partial`` sums (m, k) and a ``limit`` on the squared cost, a level whose
+    partial sum and bound so far reach it is not looked at again (its bound is infinite: no
+    design of the prefix costs less than the limit there).
 
     Examples
     --------
@@ -165,10 +170,15 @@ def path_rest(target: PathTarget, n_units: int, point: FloatArray, placed: int, 
     [[100.0]]
     """
     total = np.zeros(point.shape[:2])
+    base = np.zeros(point.shape[:2]) if partial is None else partial
     for i in range(placed + 1, min(n_units, placed + AHEAD) + 1):
-        gap = np.maximum(target.distance_to(i - 1, n_units, point) - (i - placed) * longest, 0.0)
-        total += gap * gap
-    return total
+        alive = base + total < limit
+        if not alive.any():
+            break
+        d = target.distance_to(i - 1, n_units, point[alive])
+        gap = np.maximum(d - np.broadcast_to((i - placed) * longest, alive.shape)[alive], 0.0)
+        total[alive] += gap * gap
+    return np.where(base + total < limit, total, np.inf)
 
 
 __all__ = ["CurveRange", "path_rest", "profile_rest", "tip_goal_rest"]

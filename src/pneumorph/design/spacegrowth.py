@@ -283,7 +283,8 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
             if p == n or (not np.isfinite(threshold) and beam is None):
                 continue
             if route is not None:
-                total = st["sum"] + path_rest(route, n, st["point"] - mid, placed, _longest(chain))
+                total = st["sum"] + path_rest(route, n, st["point"] - mid, placed, _longest(chain), st["sum"],
+                                              threshold**2)
                 bound = np.sqrt(total.min(axis=1))
             elif profile:
                 total = st["sum"] if curves is None else st["sum"] + space_rest(chain, curves, bits, st["point"],
