@@ -232,3 +232,10 @@ def test_path_settings_are_checked() -> None:
     with pytest.raises(SearchConfigError, match="anchored = false"):
         DesignConfig(objective="hook", anchored=False)
     assert sorted(PATH_PRESETS) == ["coil", "hook", "letter-l", "letter-r", "letter-s", "spiral"]
+
+
+def test_the_example_finger_path_is_a_valid_path_file() -> None:
+    finger = read_path(Path(__file__).parents[2] / "examples" / "paths" / "finger.csv")
+    p = finger.polyline()
+    assert finger.arc_length() == pytest.approx(60.0 + 35.0 * np.radians(150.0), abs=0.2)  # 15 chords of the arc
+    assert p[0].tolist() == [0.0, 6.0, 0.0] and int(np.sum(np.diff(p[:, 0]) < 0)) > 0  # it curls back past vertical

@@ -39,6 +39,7 @@ SKIPPED = {
      'examples/libraries/chain-3d-bending-bimodal-40kpa-far.json --pressure 40 --stage "16:y = 0.0015*x**2" '
      '--stage "40:y = -0.0015*x**2" --certify'): "a 3D design run with 6 FE verifications: minutes",
     "design --library spatial --target helix --amplitude 25 --certify": "full-width 3D verifications: minutes",
+    "design --target hook": "a 3D design run: about a minute",
     "sensitivity mesh --units 1 --size 1.5 --size 0.75": "3D solves on a fine mesh",
     "sensitivity tolerances --samples 30 --out tol/": "30 3D solves: minutes",
     "sensitivity simplifications --design 001111010001001": "3D solves of a 15-unit design: minutes",
