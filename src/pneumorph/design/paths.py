@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pneumorph.design.profiles import MAX_CURVE_POINTS, MAX_TARGET_MM, Sense
+from pneumorph.design.profiles import MAX_CURVE_POINTS, Sense, target_points
 from pneumorph.errors import TargetExpressionError
 
 FloatArray = NDArray[np.float64]
@@ -60,7 +60,8 @@ def path_points(points: ArrayLike, where: str = "a path") -> FloatArray:
     ------
     TargetExpressionError
         Not a list of [x, y] or [x, y, z] numbers, fewer than 2 or more than :data:`MAX_PATH_POINTS`
-        points, values that are not finite or beyond :data:`~pneumorph.design.profiles.MAX_TARGET_MM`,
+        points, values that are not finite or beyond :data:`~pneumorph.design.profiles.MAX_TARGET_MM`
+        (the checks of a drawn curve's points),
         or a path shorter than :data:`MIN_PATH_MM` (all its points at one place).
 
     Examples
@@ -73,30 +74,7 @@ def path_points(points: ArrayLike, where: str = "a path") -> FloatArray:
     pneumorph.errors.TargetExpressionError: a path's points all lie within 1 mm of each other (its length is 0
     mm); give points along the shape, from the base to the free end
     """
-    if isinstance(points, (str, bytes)):
-        raise TargetExpressionError(f"{where} is a list of [x, y] or [x, y, z] points in mm")
-    if not isinstance(points, np.ndarray):
-        try:
-            rows = list(points)  # type: ignore[arg-type]
-            bad = next((v for row in rows for v in (row if isinstance(row, (list, tuple)) else [row])
-                        if isinstance(v, (bool, str, bytes)) or not isinstance(v, (int, float, np.number))), None)
-        except TypeError:
-            raise TargetExpressionError(f"{where} is a list of [x, y] or [x, y, z] points in mm") from None
-        if bad is not None:
-            raise TargetExpressionError(f"{where}'s points are numbers of mm, got {bad!r}")
-    try:
-        p = np.asarray(points, dtype=float)
-    except (TypeError, ValueError):
-        raise TargetExpressionError(f"{where} is a list of [x, y] or [x, y, z] points in mm (all of one size)") \
-            from None
-    if p.ndim != 2 or p.shape[1] not in (2, 3):
-        raise TargetExpressionError(f"{where} is a list of [x, y] or [x, y, z] points in mm, got an array of shape "
-                                    f"{p.shape}")
-    if not 2 <= len(p) <= MAX_PATH_POINTS:
-        raise TargetExpressionError(f"{where} needs 2 to {MAX_PATH_POINTS} points (MAX_PATH_POINTS), got {len(p)}")
-    if not np.isfinite(p).all() or np.abs(p).max() > MAX_TARGET_MM:
-        raise TargetExpressionError(f"every point of {where} must be a finite number of mm, at most "
-                                    f"{MAX_TARGET_MM:g} in size")
+    p = target_points(points, (2, 3), where)
     if p.shape[1] == 2:
         p = np.column_stack([p, np.zeros(len(p))])
     keep = np.r_[True, np.any(np.diff(p, axis=0) != 0.0, axis=1)]

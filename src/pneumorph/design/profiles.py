@@ -77,30 +77,32 @@ class Polyline:
         return np.interp(np.asarray(values["x"], dtype=float), self.xs, self.ys)
 
 
-def _curve_points(points: ArrayLike, columns: tuple[int, ...] = (2,)) -> NDArray[np.float64]:
+def target_points(points: ArrayLike, columns: tuple[int, ...] = (2,), what: str = "a curve") -> NDArray[np.float64]:
     """Points as a checked (n, 2) (or, where ``columns`` allows, (n, 3)) array of finite mm values (numbers only:
-    not text, not true/false)."""
+    not text, not true/false); ``what`` names them in the messages ("a curve", "a path")."""
+    kinds = " or [x, y, z]" if 3 in columns else ""
+    if isinstance(points, (str, bytes)):
+        raise TargetExpressionError(f"{what} is a list of [x, y]{kinds} points in mm")
     if not isinstance(points, np.ndarray):
         try:
             rows = list(points)  # type: ignore[arg-type]
             bad = next((v for row in rows for v in (row if isinstance(row, (list, tuple)) else [row])
                         if isinstance(v, (bool, str, bytes)) or not isinstance(v, (int, float, np.number))), None)
         except TypeError:
-            raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
+            raise TargetExpressionError(f"{what} is a list of [x, y]{kinds} points in mm") from None
         if bad is not None:
-            raise TargetExpressionError(f"a curve's points are numbers of mm, got {bad!r}")
+            raise TargetExpressionError(f"{what}'s points are numbers of mm, got {bad!r}")
     try:
         p = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
-        raise TargetExpressionError("a curve is a list of [x, y] points in mm") from None
+        raise TargetExpressionError(f"{what} is a list of [x, y]{kinds} points in mm (all of one size)") from None
     if p.ndim != 2 or p.shape[1] not in columns:
-        kinds = " or [x, y, z]" if 3 in columns else ""
-        raise TargetExpressionError(f"a curve is a list of [x, y]{kinds} points in mm, got an array of shape "
+        raise TargetExpressionError(f"{what} is a list of [x, y]{kinds} points in mm, got an array of shape "
                                     f"{p.shape}")
     if not 2 <= len(p) <= MAX_CURVE_POINTS:
-        raise TargetExpressionError(f"a curve needs 2 to {MAX_CURVE_POINTS} points, got {len(p)}")
+        raise TargetExpressionError(f"{what} needs 2 to {MAX_CURVE_POINTS} points, got {len(p)}")
     if not np.isfinite(p).all() or np.abs(p).max() > MAX_TARGET_MM:
-        raise TargetExpressionError("every point of a curve must be a finite number of mm, at most 1e5 in size")
+        raise TargetExpressionError(f"every point of {what} must be a finite number of mm, at most 1e5 in size")
     return p
 
 
@@ -126,7 +128,7 @@ def smooth_curve(points: ArrayLike, length: float, knots: int = 41,
     >>> knots[:, 0].tolist(), np.round(knots[1:-1, 1], 3).tolist()
     ([0.0, 25.0, 50.0, 75.0, 100.0], [12.5, 25.0, 37.5])
     """
-    p = _curve_points(points)
+    p = target_points(points)
     if not (np.isfinite(length) and length > 0):
         raise TargetExpressionError(f"the actuator length must be positive, got {length!r}")
     lo, hi = max(float(p[:, 0].min()), 0.0), min(float(p[:, 0].max()), float(length))
@@ -202,7 +204,7 @@ def curve_target(points: ArrayLike, length: float | None = None) -> ProfileTarge
     a graph y = f(x) and would be matched as another shape; give it as a path (objective = "path", path = [[x,
     y], ...] or --target path:FILE), which keeps its order
     """
-    p = _curve_points(points, (2, 3))
+    p = target_points(points, (2, 3))
     _check_graph(p)
     xs, inverse = np.unique(p[:, 0], return_inverse=True)
     if len(xs) < 2:
