@@ -30,6 +30,7 @@ from pneumorph.design.exhaustive import (
 )
 from pneumorph.design.fitness import Score, score
 from pneumorph.design.ga import GAConfig, GAResult, GenerationStats, run_ga
+from pneumorph.design.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
 from pneumorph.design.problem import Algorithm, Outcome, Problem, Search
 from pneumorph.design.report import RunResult
 from pneumorph.design.run import run_design
@@ -50,6 +51,7 @@ from pneumorph.design.targets import (
 )
 
 __all__ = [
+    "PATH_PRESETS",
     "PRESETS",
     "TIP_GOALS",
     "Algorithm",
@@ -62,6 +64,7 @@ __all__ = [
     "GenerationStats",
     "Objective",
     "Outcome",
+    "PathTarget",
     "Polyline",
     "Problem",
     "ProfileTarget",
@@ -75,9 +78,12 @@ __all__ = [
     "curve_target",
     "make_objective",
     "mirror_response",
+    "path_target",
     "plot_study",
     "population_study",
+    "preset_path",
     "profile_target",
+    "read_path",
     "run_design",
     "run_exhaustive",
     "run_ga",
