@@ -2,10 +2,12 @@
 
 A profile (:mod:`pneumorph.design.profiles`) is a graph ``y = f(x)``; the actuator curls
 past 300 degrees, so the shapes it makes best are not graphs. A :class:`PathTarget` is a
-polyline through points ``(x, y)`` or ``(x, y, z)`` in mm, in the actuator's frame (base at
-the origin, the undeformed axis along +x, y up, z across from the mid-plane), given in order
-from the base to the free end. It is matched by the unit centres as the model reports them
-(:attr:`~pneumorph.models.response.Response.centres`, no shift to their undeformed heights).
+polyline through points ``(x, y)`` or ``(x, y, z)`` in mm, given in order from the base to the
+free end, in the frame of :attr:`~pneumorph.models.response.Response.centres`: x along the
+undeformed axis from the base face, y up from the actuator's bottom face (the built-in unit's
+undeformed centres lie at 4.5 or 7.5 mm, its axis at 6 mm), z across from the mid-plane. It is
+matched by the unit centres as the model reports them, with no shift to their undeformed
+heights.
 
 The correspondence (``docs/shapes.md``): centre ``i`` of ``n`` has its *stretch* of the path,
 the part within ``window * S`` of arc length of its place ``(i - 1/2) S / n`` (``S`` the path's
@@ -271,7 +273,7 @@ class PathTarget:
         return out
 
     def check(self, length: float, height: float = 0.0) -> PathTarget:
-        """Refuse a relative path whose points would be beyond :data:`MAX_TARGET_MM` along an actuator of
+        """Refuse a relative path whose points would be beyond ``MAX_TARGET_MM`` (1e5 mm) along an actuator of
         ``length`` mm (a path in mm was checked when it was made)."""
         if self.relative:
             path_points(self.at(length, height).points, f"the path {self.name!r}")
