@@ -42,11 +42,10 @@ from pneumorph.design.bounds import ChainScores, chain_errors, objective_bounds,
 from pneumorph.design.branching import MAX_ENUMERATE
 from pneumorph.design.fitness import score
 from pneumorph.design.growth import best_scores, chain_scores, designs_of, enumerable, grow_designs
-from pneumorph.design.paths import PathTarget
 from pneumorph.design.prefixes import ChainGeometry, chain_geometry
 from pneumorph.design.scoring import Candidate, ScoreBook
 from pneumorph.design.spacegrowth import space_scores
-from pneumorph.design.targets import Objective, ProfileTarget
+from pneumorph.design.targets import Objective, ProfileTarget, on_actuator
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.chain import ChainModel
@@ -161,8 +160,8 @@ def certified_search(
     start = time.perf_counter()
     say = on_progress or (lambda text: None)
     _check_search(fe_model, chain, verify, margin, epsilon)
-    if isinstance(objective, PathTarget):  # a preset is drawn for the chain's actuator, for the FE alike
-        objective = objective.at(chain.length, float(chain.table.tip_ref[1]))
+    # a preset path is drawn for the chain's actuator, for the FE alike
+    objective = on_actuator(objective, chain.length, float(chain.table.tip_ref[1]))
     if chain.table.alphabet and isinstance(objective, ProfileTarget) and objective.length is None:
         # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
         # and the FE verifications alike

@@ -72,7 +72,7 @@ from pneumorph.design.folder import _check_folder, _created_top, _remove_empty, 
 from pneumorph.design.planning import planned_workers
 from pneumorph.design.problem import Algorithm, Outcome, Problem
 from pneumorph.design.report import RunResult, _write_outputs, _write_report
-from pneumorph.design.targets import StagedTarget
+from pneumorph.design.targets import StagedTarget, on_actuator
 from pneumorph.errors import OutputPathError, SearchConfigError
 from pneumorph.execution.cache import CachedEvaluator, EvaluationCache, chain_table_dir, default_cache_path
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
@@ -119,7 +119,11 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
     if int(model.n_units) != config.units:
         raise SearchConfigError(f"the model has {model.n_units} units but the config asks for {config.units}")
     workers = evaluator_workers(evaluator) if evaluator is not None else planned_workers(config)
-    problem = Problem(config, model, config.make_objective(), workers=workers, table_dir=_table_dir(config, cache),
+    objective = config.make_objective()
+    unit = getattr(model, "unit", None)  # a preset path drawn once for the FE model's actuator (its first unit type)
+    if unit is not None:
+        objective = on_actuator(objective, model.n_units * unit.pitch, unit.height / 2)
+    problem = Problem(config, model, objective, workers=workers, table_dir=_table_dir(config, cache),
                       build=build, say=on_message or (lambda text: None), on_generation=on_generation,
                       on_progress=on_progress, reference=reference)
     algorithm, problem = (algorithm or algorithm_for(config)).plan(problem)

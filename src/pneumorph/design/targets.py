@@ -28,7 +28,7 @@ plain ``A*cos(...)``).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -195,6 +195,22 @@ class StagedTarget:
         out = np.full((*combined.shape, k), np.inf)
         out[..., max(self.levels(pressures))] = combined
         return out
+
+
+def on_actuator(objective: Objective, length: float, height: float) -> Objective:
+    """The objective with its preset paths drawn for an actuator ``length`` mm long whose axis lies ``height`` mm up
+    (:meth:`~pneumorph.design.paths.PathTarget.at`; a staged target's stages alike): drawn once for a run, so
+    that the chain and every FE response are matched against one path whatever their designs' lengths.
+
+    >>> on_actuator(make_objective("hook"), 100.0, 6.0).points[0], on_actuator(tip_goal("max-x"), 100.0, 6.0).name
+    ((0.0, 6.0, 0.0), 'max-x')
+    """
+    if isinstance(objective, PathTarget):
+        return objective.at(length, height)
+    if isinstance(objective, StagedTarget):
+        return StagedTarget(tuple(replace(st, target=st.target.at(length, height)) if isinstance(st.target, PathTarget)
+                                  else st for st in objective.stages))
+    return objective
 
 
 def staged_target(stages: Any) -> StagedTarget:
@@ -454,6 +470,7 @@ __all__ = [
     "TipGoal",
     "curve_target",
     "make_objective",
+    "on_actuator",
     "profile_target",
     "smooth_curve",
     "staged_target",
