@@ -57,6 +57,11 @@ def test_a_preset_path_runs_from_the_cli_and_its_folder_is_its_own(tmp_path: Pat
     text = capsys.readouterr().out
     assert "path error" in text and "RMS per centre" in text
     assert "letter-l" in (out / "report.md").read_text()
+    assert main(["design", "--target", "letter-l", "--model", "2d", "--units", "8", "--tolerance", "0",
+                 "--executor", "serial", "--out", str(out), "--json"]) == 0  # the same run: from its folder
+    path = np.array(json.loads(capsys.readouterr().out)["path"])  # drawn for the 8-unit actuator, on its axis
+    assert path[0].tolist() == [0.0, 6.0, 0.0]
+    assert np.linalg.norm(np.diff(path, axis=0), axis=1).sum() == pytest.approx(1.15 * 8 * 10.5)
 
 
 @pytest.mark.parametrize("content, message", [
