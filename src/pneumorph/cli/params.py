@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -16,7 +17,7 @@ import click
 
 from pneumorph import checks
 from pneumorph.errors import OutputPathError, PneumorphError, SettingsError
-from pneumorph.io.files import check_writable_dir, check_writable_file
+from pneumorph.io.files import MAX_SCAN_BYTES, check_writable_dir, check_writable_file, read_text_file
 
 if TYPE_CHECKING:
     from pneumorph.geometry.library import UnitLibrary
@@ -125,13 +126,16 @@ class InputFile(click.ParamType):
             self.fail(f"{name} {value}: no such file", param, ctx)
         if path.is_dir():
             self.fail(f"{name} {value}: is a folder, not a file", param, ctx)
+        if not stat.S_ISREG(path.stat().st_mode):  # never opened: a named pipe would block, a device never end
+            self.fail(f"{name} {value}: not a regular file (a device, a named pipe or a socket); give a file", param,
+                      ctx)
         if not os.access(path, os.R_OK):
             self.fail(f"{name} {value}: the file is not readable", param, ctx)
         if self.text:
-            try:
-                path.read_bytes().decode("utf-8")
-            except UnicodeDecodeError as exc:
-                self.fail(f"{name} {value}: not a text file (byte {exc.start} is not UTF-8)", param, ctx)
+            try:  # bounded: the command's own reader then applies the limit of its kind of file
+                read_text_file(path, name, limit=MAX_SCAN_BYTES)
+            except PneumorphError as exc:
+                self.fail(str(exc), param, ctx)
         return str(value)
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ScanError, interrupts_kept
-from pneumorph.io.files import read_text_file
+from pneumorph.io.files import MAX_SCAN_BYTES, read_text_file
 
 FloatArray = NDArray[np.float64]
 
@@ -146,7 +146,7 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
 
 
 def _read_csv(path: Path) -> FloatArray:
-    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig")
+    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig", limit=MAX_SCAN_BYTES)
     check_points(path, text.count("\n") - 1)  # the rows below the header, before they are parsed
     rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
     if not rows:

@@ -99,7 +99,7 @@ def read_test_data(sources: Iterable[str | Path], mode: str | None = None, **opt
     names = []
     for s in sources:
         p = Path(s)
-        if p.is_file():
+        if p.exists() and not p.is_dir():  # a file, or a device or pipe its reader refuses by name
             curves.append(read_curve(p, mode, **options))  # type: ignore[arg-type]
             names.append(p.stem)
         elif str(s) in {d.name for d in list_datasets()}:

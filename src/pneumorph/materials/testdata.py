@@ -51,6 +51,7 @@ from types import MappingProxyType
 import numpy as np
 
 from pneumorph.errors import DataFormatError
+from pneumorph.io.files import read_text_file
 from pneumorph.materials.curves import MAX_STRESS_MPA, MAX_STRETCH, TestCurve, TestData
 from pneumorph.materials.hyperelastic import MODES
 
@@ -274,10 +275,7 @@ def _data_lines(path: Path) -> tuple[list[tuple[int, str]], dict[str, str]]:
         An unreadable file, a metadata block without its header, or no data rows.
     """
     src = str(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig", errors="replace")
-    except OSError as exc:
-        raise DataFormatError(f"cannot read the file ({exc.strerror or exc})", path=src) from None
+    text = read_text_file(path, "data file", DataFormatError, encoding="utf-8-sig", errors="replace")
     lines = list(enumerate(text.splitlines(), start=1))
     metadata: dict[str, str] = {}
     body = [(n, s) for n, s in lines if s.strip() and not s.lstrip().startswith("#")]

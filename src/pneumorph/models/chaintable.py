@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError, UnitLibraryError
+from pneumorph.io.files import read_text_file
 from pneumorph.models.chainfile import (
     ALPHABET_FORMAT,
     SPACE_FORMAT,
@@ -482,12 +483,15 @@ class ChainTable:
 
     @classmethod
     def _read(cls, path: Path) -> ChainTable:
+        if not path.exists():
+            raise ChainTableError(f"{path}: no such chain table")
+        text = read_text_file(path, "chain table", ChainTableError)  # a regular file of bounded size
         try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise ChainTableError(f"{path}: no such chain table") from None
-        except (UnicodeDecodeError, json.JSONDecodeError, IsADirectoryError) as exc:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
             raise ChainTableError(f"{path}: not a chain table (unreadable JSON: {type(exc).__name__})") from None
+        except RecursionError:
+            raise ChainTableError(f"{path}: not a chain table (its JSON nests too deep)") from None
         if not isinstance(data, dict):
             raise ChainTableError(f"{path}: not a chain table")
         return cls.from_dict(data, where=str(path))

@@ -1,0 +1,79 @@
+"""Every text input is read bounded: regular files only, at most a size per kind, refused in one line before it
+costs (a device such as /dev/zero, a named pipe, a folder, a file of 1 GB)."""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import pytest
+
+from pneumorph.cli import main
+from pneumorph.errors import SettingsError
+from pneumorph.io.files import MAX_TEXT_BYTES, read_text_file
+
+
+@pytest.fixture
+def fifo(tmp_path: Path) -> Path:
+    path = tmp_path / "pipe.toml"
+    os.mkfifo(path)
+    return path
+
+
+@pytest.fixture
+def huge(tmp_path: Path) -> Path:
+    """A file of 1 GB that takes no disk (sparse)."""
+    path = tmp_path / "huge.toml"
+    with path.open("wb") as fh:
+        fh.truncate(2**30)
+    return path
+
+
+def test_a_device_a_pipe_a_folder_and_a_huge_file_are_refused_by_name(tmp_path: Path, fifo: Path,
+                                                                      huge: Path) -> None:
+    start = time.perf_counter()
+    with pytest.raises(SettingsError, match="not a regular file"):
+        read_text_file("/dev/zero", "design config")
+    with pytest.raises(SettingsError, match="not a regular file"):
+        read_text_file(fifo, "design config")  # refused before it is opened: opening would block
+    with pytest.raises(SettingsError, match="is a folder"):
+        read_text_file(tmp_path, "design config")
+    with pytest.raises(SettingsError, match=r"1024 MB, more than the 64 MB a design config may have"):
+        read_text_file(huge, "design config")
+    assert time.perf_counter() - start < 2.0
+
+
+def test_the_limit_holds_for_a_file_that_reports_no_size(tmp_path: Path) -> None:
+    small = tmp_path / "a.txt"
+    small.write_text("x" * 100)
+    assert read_text_file(small, "path file", limit=100) == "x" * 100
+    with pytest.raises(SettingsError, match=r"100 bytes|more than the 9\.44\d*e-05 MB"):
+        read_text_file(small, "path file", limit=99)
+    status = Path("/proc/self/status")  # a regular file whose size is reported as 0
+    assert status.stat().st_size == 0
+    with pytest.raises(SettingsError, match=r"status: more than the"):
+        read_text_file(status, "path file", limit=10)
+    assert MAX_TEXT_BYTES == 64 * 2**20
+
+
+@pytest.mark.parametrize("args", [
+    ["design", "{bad}"],
+    ["design", "--library", "{bad}"],
+    ["design", "--unit", "{bad}"],
+    ["design", "--chain-table", "{bad}"],
+    ["design", "--target", "path:{bad}"],
+    ["materials", "fit", "{bad}"],
+])
+@pytest.mark.parametrize("kind", ["device", "pipe", "huge"])
+def test_path_inputs_refuse_them_in_one_line_at_once(args: list[str], kind: str, fifo: Path, huge: Path,
+                                                     tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = {"device": "/dev/zero", "pipe": str(fifo), "huge": str(huge)}[kind]
+    out = tmp_path / "run"
+    start = time.perf_counter()
+    code = main([a.replace("{bad}", bad) for a in args] + (["--out", str(out)] if args[0] == "design" else []))
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and time.perf_counter() - start < 2.0
+    assert len(err.splitlines()) == 1 and "Traceback" not in err and "internal error" not in err
+    assert ("regular file" in err) if kind != "huge" else ("MB" in err and "may have" in err)
+    assert not out.exists()
