@@ -43,7 +43,7 @@ def test_mesh_study_of_a_short_section(tmp_path: Path, capsys: pytest.CaptureFix
         (["--design", "01", "--design", "011"], "different lengths"),
         (["--size", "0.2"], "GB for one solve"),
         (["--design", "0" * 15, "--design", "1" * 15, "--size", "1.0", "--size", "0.9", "--executor", "processes",
-          "--workers", "64"], "GB for one solve x 4 at once"),
+          "--workers", "4"], "GB for one solve x 4 at once"),
         (["--target", "max-q"], "unknown objective"),
         (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler only applies"),
     ],

@@ -222,6 +222,8 @@ def test_a_lost_scheduler_is_one_line_and_the_rerun_resumes_from_the_cache(tmp_p
     (["--executor", "serial", "--workers", "2"], "error: --workers does not apply to --executor serial"),
     (["--executor", "dask", "--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"],
      "error: --workers does not apply with --scheduler"),
+    (["--executor", "processes", "--workers", "1024"], "error: --workers 1024: more than 2 worker processes per core"),
+    (["--executor", "dask", "--workers", "64"], "error: --workers 64: more than 2 worker processes per core"),
 ])
 def test_options_that_would_be_ignored_are_refused_before_any_work(
         options: list[str], message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -27,6 +27,7 @@ this module names them all and chooses one by name (:func:`make_evaluator`).
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 from pneumorph.errors import SearchConfigError
@@ -43,6 +44,10 @@ from pneumorph.execution.serial import THREAD_VARIABLES, Evaluator, SerialEvalua
 
 #: The names :func:`make_evaluator` knows: in this process, a process pool, a Dask cluster.
 EXECUTORS = ("serial", "processes", "dask")
+
+#: Most worker processes per core of this machine (a pool or a local Dask cluster): each solves one design at a
+#: time on one core, so more share the cores and multiply the memory.
+MAX_WORKERS_PER_CORE = 2
 
 
 def check_execution(kind: str, workers: int | None = None, scheduler: str | None = None,
@@ -66,6 +71,10 @@ def check_execution(kind: str, workers: int | None = None, scheduler: str | None
     Traceback (most recent call last):
     ...
     pneumorph.errors.SearchConfigError: --scheduler only applies to --executor dask, not to processes
+    >>> check_execution("processes", workers=100_000)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: --workers 100000: more than 2 worker processes per core of this machine ...
     >>> check_execution("serial", workers=2)
     Traceback (most recent call last):
     ...
@@ -83,6 +92,12 @@ def check_execution(kind: str, workers: int | None = None, scheduler: str | None
     if workers is not None and scheduler is not None:
         raise SearchConfigError(f"{n} does not apply with {address}: the cluster's workers are started on their "
                                 f"machines (dask worker ADDR --nworkers 1 --nthreads 1); leave {n} out")
+    cores = os.cpu_count() or 1
+    if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
+        raise SearchConfigError(f"{n} {workers}: more than {MAX_WORKERS_PER_CORE} worker processes per core of this "
+                                f"machine ({cores} cores: at most {MAX_WORKERS_PER_CORE * cores}; "
+                                "MAX_WORKERS_PER_CORE); each solves one design on one core, so more would only "
+                                "share the cores and multiply the memory")
 
 
 def make_evaluator(
