@@ -77,3 +77,26 @@ def test_path_inputs_refuse_them_in_one_line_at_once(args: list[str], kind: str,
     assert len(err.splitlines()) == 1 and "Traceback" not in err and "internal error" not in err
     assert ("regular file" in err) if kind != "huge" else ("MB" in err and "may have" in err)
     assert not out.exists()
+
+
+def test_a_chain_table_nested_too_deep_is_refused_in_one_line(tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    out = tmp_path / "run"
+    assert main(["design", "--chain-table", str(deep), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "nests too deep" in err and len(err.splitlines()) == 1 and "internal error" not in err
+    assert not out.exists()
+
+
+def test_a_scan_listed_twice_in_a_manifest_is_refused(tmp_path: Path) -> None:
+    from pneumorph.identify.scans import read_manifest
+
+    manifest = tmp_path / "scans.toml"
+    entry = '[[scan]]\nfile = "a.xyz"\ndesign = "0110"\npressure_kpa = 30\n'
+    manifest.write_text(entry + '[[scan]]\nfile = "b.xyz"\ndesign = "0110"\npressure_kpa = 30\n' + entry)
+    with pytest.raises(SettingsError, match=r"\[\[scan\]\] 3: the same scan at the same pressure as \[\[scan\]\] 1"):
+        read_manifest(manifest)
+    manifest.write_text(entry + entry.replace("30", "36"))  # one cast scanned at two pressures: two scans
+    assert [s.pressure_kpa for s in read_manifest(manifest)] == [30.0, 36.0]

@@ -143,6 +143,12 @@ def read_manifest(path: str | Path) -> list[ScanSpec]:
                                 table.get("scale")))
         except SettingsError as exc:
             raise SettingsError(f"{where}: {exc}") from None
+        same = next((j for j, spec in enumerate(out[:-1], start=1)
+                     if Path(spec.file).resolve() == Path(out[-1].file).resolve()
+                     and spec.pressure_kpa == out[-1].pressure_kpa), None)
+        if same is not None:  # one scan counted twice would claim more certainty than the data hold
+            raise SettingsError(f"{where}: the same scan at the same pressure as [[scan]] {same}; list each scan "
+                                "once")
     return out
 
 
