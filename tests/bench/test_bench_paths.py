@@ -125,7 +125,7 @@ def test_a_path_stage(client: TestClient) -> None:
 @pytest.mark.parametrize(("target", "field", "words"), [
     ({"kind": "path", "points": [[0, 6]]}, "points", "2 to"),
     ({"kind": "path", "points": [[0, 6], [10, "nan"]]}, "points", "numbers"),
-    ({"kind": "path", "points": [[0, 6], [10, 1e6]]}, "points", "at most 100000"),
+    ({"kind": "path", "points": [[0, 6], [10, 1e6]]}, "points", "at most 1e5 in size"),
     ({"kind": "path", "points": "a hook"}, "points", "list of"),
     ({"kind": "path", "points": [[1, 1], [1, 1], [1.2, 1]]}, "points", "within 1 mm"),
     ({"kind": "path"}, "points", "needs its points"),

@@ -339,7 +339,7 @@ def read_text_file(path: str | Path, what: str, error: type[PneumorphError] = Se
     --------
     >>> import tempfile, pathlib
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "b.toml"
-    >>> _ = p.write_bytes(b"\xff\xfe")
+    >>> _ = p.write_bytes(b"\\xff\\xfe")
     >>> read_text_file(p, "unit file")
     Traceback (most recent call last):
     ...
