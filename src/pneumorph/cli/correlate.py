@@ -18,15 +18,15 @@ from pneumorph.cli import params as P
               help="A unit library: the design's letters name its unit types; instead of --unit. A design with a "
                    "sideways unit ('spatial') is measured on its surface only (a 3D scan).")
 @click.option("--model-file", type=P.InputFile(), help=P.MODEL_FILE_HELP)
-@click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]), default="mm", show_default=True,
-              help="The unit of the scan's coordinates.")
+@click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]),
+              help="The unit of the scan's coordinates (default mm).")
 @click.option("--scale", type=P.Real(0.0, 1e6, low_open=True),
               help="mm per unit of the scan (a photo's mm per pixel), instead of --scan-unit.")
 @click.option("--fit-scale", is_flag=True, help="Fit a scale too (a photo whose scale is not known exactly).")
 @click.option("--photo", type=P.InputFile(text=False), help="The photo the 2D trace was taken on (drawn under it).")
 @click.option("--out", type=P.OutputDir(), help="Folder for correlation.json and correlation.png.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
-def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file: str | None, scan_unit: str,
+def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file: str | None, scan_unit: str | None,
               scale: float | None, fit_scale: bool, photo: str | None, out: str | None, as_json: bool,
               model_file: str | None = None, library: str | None = None) -> None:
     """Align SCAN (STL, PLY, OBJ, OFF, XYZ, or a CSV of x,y traced on a photo) to the model's
@@ -51,7 +51,7 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
         orientation = parse_orientation(design) if parsed is None else parsed.text
     types = parsed.units(units) if parsed is not None and units is not None else ()
     planar = not any(u.layer_side for u in types)
-    data = read_scan(scan, scan_unit, scale)  # a bad scan is refused before the model is solved
+    data = read_scan(scan, P.scan_unit(scan_unit, scale), scale)  # a bad scan is refused before the model is solved
     if not planar and data.dim != 3:
         raise ScanError(SIDEWAYS_TRACE)
     if photo is not None and data.dim != 2:

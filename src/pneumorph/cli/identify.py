@@ -21,8 +21,8 @@ from pneumorph.cli.execution import cluster_report, execution_options, open_eval
 @click.option("--model", "fidelity", type=click.Choice(["3d", "2d"]), default="3d", show_default=True,
               help="The model to identify (a 3D scan needs 3d; a photo trace may use either).")
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file of the nominal unit (default: built-in).")
-@click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]), default="mm", show_default=True,
-              help="The unit of SCAN's coordinates.")
+@click.option("--scan-unit", type=click.Choice(["mm", "cm", "m", "in"]),
+              help="The unit of SCAN's coordinates (default mm).")
 @click.option("--scale", type=P.Real(0.0, 1e6, low_open=True),
               help="mm per unit of SCAN (a photo's mm per pixel), instead of --scan-unit.")
 @click.option("--fit", "fit_names", metavar="NAMES", type=P.Text(200),
@@ -38,7 +38,7 @@ from pneumorph.cli.execution import cluster_report, execution_options, open_eval
 @click.option("--out", type=P.OutputDir(), help="Folder for identified.toml and identify.json.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def identify(scan: str | None, design: str | None, pressure: float | None, manifest: str | None, fidelity: str,
-             unit_file: str | None, scan_unit: str, scale: float | None, fit_names: str | None, tolerance: float,
+             unit_file: str | None, scan_unit: str | None, scale: float | None, fit_names: str | None, tolerance: float,
              seed: int, executor: str, workers: int | None, scheduler: str | None, cache: str | None,
              out: str | None, as_json: bool) -> None:
     """Fit the body silicone's bulk and shear modulus scales and the three mould thicknesses (side walls,
@@ -63,6 +63,7 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
     from pneumorph.identify import identify as fit
     from pneumorph.io import provenance, strict_json, write_json
 
+    scan_unit = P.scan_unit(scan_unit, scale)
     check_options(executor, workers, scheduler)
     specs = _scan_specs(scan, design, pressure, manifest, scan_unit, scale)
     unit = UnitSpec()

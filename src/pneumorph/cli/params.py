@@ -281,3 +281,11 @@ def model_file_option(settings: dict[str, Any], model_file: str | None, options:
     if {"unit_file", "library"} & set(settings):
         table = {k: v for k, v in table.items() if k not in ("unit", "unit_file", "library")}
     return {**settings, **{k: v for k, v in table.items() if k not in typed}}
+
+
+def scan_unit(unit: str | None, scale: float | None) -> str:
+    """The unit of a scan's coordinates from ``--scan-unit`` (mm if not given), refused beside ``--scale``, which says
+    the same another way."""
+    if unit is not None and scale is not None:
+        raise click.UsageError("give --scan-unit or --scale, not both (--scale is the mm per unit of the scan)")
+    return unit or "mm"
