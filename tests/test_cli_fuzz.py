@@ -121,7 +121,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
         "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
-        "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')"], "--scheduler": ["not a url", ""],
+        "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')", "path:", "path:missing.csv",
+        "path:binary.bin", "path:folder", "path:a-file", "path:/dev/zero", "letter-q"], "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""],
         "--chain-table": ["binary.bin", "folder", "missing.json", "", "terms.json"],
@@ -207,19 +208,21 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
              "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""],
              "--model-file": ["binary.bin", "folder", "missing.toml", ""]},
     "correlate": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"], "--unit": ["binary.bin", ""],
-                  "--scale": POSITIVE, "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""],
+                  "--scale": POSITIVE, "--scan-unit": ["cm", "furlongs", ""],
+                  "--photo": ["folder", "missing.png", ""], "--out": ["a-file", "a-file/sub", ""],
                   "--model-file": ["binary.bin", "folder", "missing.toml", ""],
                   "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"]},
     "identify": {"--design": ["", "0120", "abc"], "--pressure": [*POSITIVE, "1e9"],
                  "--manifest": ["binary.bin", "folder", "missing.toml", ""], "--unit": ["binary.bin", "folder", ""],
-                 "--scale": POSITIVE, "--fit": ["", "abc", "wall,abc"], "--tolerance": [*POSITIVE, "5"],
+                 "--scale": POSITIVE, "--scan-unit": ["cm", "furlongs", ""], "--fit": ["", "abc", "wall,abc"],
+                 "--tolerance": [*POSITIVE, "5"],
                  "--seed": COUNT, "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 
 # the one execution option set of every command that solves many designs (pneumorph.cli.execution)
 for _command in ("design", "study", "calibrate", "chain", "optimise", "simplifications", "tolerances", "bulk-modulus",
                  "calibration", "temperature", "mesh", "identify"):
-    OPTIONS[_command].setdefault("--workers", POS_COUNT)
+    OPTIONS[_command]["--workers"] = [*OPTIONS[_command].get("--workers", POS_COUNT), "1024"]  # past the cores
     OPTIONS[_command].setdefault("--scheduler", ["not a url", ""])
 
 CASES = [(cmd, opt, bad) for cmd, options in OPTIONS.items() for opt, values in options.items() for bad in values]
@@ -267,6 +270,7 @@ CONFIG_KEYS: list[tuple[str, str, str]] = [
         ("ga", "budget", ["1", "0", "1.5"]),
         ("design", "margin", ["0", "nan", '"1"']),
         ("design", "point", ["[1]", '"1,2"', "[nan, 0]"]),
+        ("design", "path", ['"abc"', "[1, 2]", "[[0, 0]]", '[[0, "a"], [1, 2]]']),
         ("design", "anchored", ["1"]),
         ("design", "chain_table", ["1", '""']),
         ("ga", "population", ["1", "1.5", "true", '"100"', "100000000"]),
