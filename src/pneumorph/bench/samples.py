@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from pneumorph.design.pathfigure import centrelines as design_centrelines
 from pneumorph.design.paths import PathTarget
 from pneumorph.design.targets import ProfileTarget, StagedTarget, TipGoal
 
@@ -35,20 +36,13 @@ def profiles(response: Any) -> list[list[list[float]]]:
 
 def centrelines(response: Any) -> list[list[list[float]]]:
     """Base (on the undeformed axis), unit centres and tip at every level as the model reports them (mm): the frame
-    a path is matched in, y from the bottom face; a response in space gives z from the mid-plane too.
+    a path is matched in, y from the bottom face; a response in space gives z from the mid-plane too
+    (:func:`pneumorph.design.pathfigure.centrelines`).
 
     The unit centres are those a :class:`~pneumorph.design.paths.PathTarget` scores
     (:func:`pneumorph.design.fitness.path_errors`); the base and the tip join them into a line.
     """
-    c = response.centres.copy()
-    tip = response.tip.copy()
-    if c.shape[-1] == 3:
-        c[..., 2] -= response.reference_centres[None, :, 2]
-        tip[:, 2] -= response.reference_tip[2]
-    base = np.zeros((len(c), 1, c.shape[-1]))
-    base[..., 1] = response.reference_tip[1]
-    pts = np.concatenate([base, c, tip[:, None]], axis=1)
-    return np.round(pts, 4).tolist()
+    return np.round(design_centrelines(response), 4).tolist()
 
 
 def path_samples(objective: Any, length: float, axis: float) -> dict[str, Any] | None:

@@ -153,18 +153,20 @@ def _target_changes(target: str) -> dict[str, Any]:
 
 
 def _check_inputs(o: Any) -> None:
-    """The target, unit file and library checked as the options that gave them (before any setting is merged)."""
+    """The target, unit file and library checked as the options that gave them (before any setting is merged); the
+    config's changes for the target kept as ``o.target_changes``."""
     from pneumorph.design import DesignConfig
     from pneumorph.errors import SearchConfigError
 
     if o.target and o.objective:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
+    o.target_changes = None
     if o.target is not None:
         from pneumorph.design.targets import make_objective
         from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):  # along the built-in unit; checked again along the model's
-            target = _target_changes(o.target)
+            o.target_changes = target = _target_changes(o.target)  # a path file read once, here
             make_objective(target["objective"], o.amplitude if o.amplitude is not None else DesignConfig.amplitude,
                            o.periods if o.periods is not None else DesignConfig.periods,
                            length=(o.units or DesignConfig.units) * UnitSpec.pitch, path=target.get("path"))
@@ -191,9 +193,8 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
                                "periods or more units")
     design = {key: getattr(o, key) for key in _DESIGN_OPTIONS}
     design["objective"] = o.target or o.objective
-    if o.target is not None:
-        with P.blame("--target"):
-            target = _target_changes(o.target)
+    if o.target_changes is not None:
+        target = o.target_changes
         design.update(target)
         if config.curve is not None or config.path is not None:  # the config's points belong to its own target
             data = config.to_dict()

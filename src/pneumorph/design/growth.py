@@ -33,7 +33,7 @@ from pneumorph.design.reach import reach_of
 from pneumorph.design.reachbox import box_bound
 from pneumorph.design.rest import CurveRange, path_rest, profile_rest, tip_goal_rest
 from pneumorph.design.spacegrowth import space_scores
-from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal
+from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget, TipGoal, on_actuator
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel
 from pneumorph.models.windows import every_design
@@ -278,6 +278,7 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
     SearchConfigError
         More than ``max_nodes`` prefixes survive at one depth (the threshold is too loose), without ``spill``.
     """
+    objective = on_actuator(objective, chain.length, float(chain.table.tip_ref[1]))  # preset paths, drawn for it
     if isinstance(objective, StagedTarget):
         return _grow_staged(chain, objective, errors, threshold, max_nodes, beam, spill)
     path = isinstance(objective, PathTarget)
@@ -285,8 +286,6 @@ def grow_designs(chain: ChainModel, objective: Objective, errors: dict[str, Floa
         return _score_all(chain, objective, errors)  # every design: from the kept geometry
     table = chain.table
     n, k = chain.n_units, table.n_levels
-    if path:  # a preset drawn for the chain's actuator
-        objective = cast(PathTarget, objective).at(chain.length, float(table.tip_ref[1]))
     profile = isinstance(objective, ProfileTarget)
     prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
     polar = profile and prof.coordinates == "polar"
@@ -420,8 +419,7 @@ def _grow_staged(chain: ChainModel, objective: StagedTarget, errors: dict[str, F
     weights = objective.weights
     profiles = [(i, st.target, levels[i]) for i, st in enumerate(objective.stages)
                 if isinstance(st.target, ProfileTarget)]
-    paths = [(i, st.target.at(length, float(chain.table.tip_ref[1])), levels[i])
-             for i, st in enumerate(objective.stages) if isinstance(st.target, PathTarget)]
+    paths = [(i, st.target, levels[i]) for i, st in enumerate(objective.stages) if isinstance(st.target, PathTarget)]
     ranges = {i: _curve_range(chain, target, errors, slope) for i, target, _ in profiles
               if target.coordinates == "cartesian" and np.isfinite(slope := _target_slope(chain, target, errors))}
     refine = False

@@ -20,16 +20,24 @@ def placed_path(objective: PathTarget, response: Response) -> PathTarget:
     return objective.at(float(response.reference_tip[0]), float(response.reference_tip[1]))
 
 
+def centrelines(response: Response) -> np.ndarray:
+    """The base (on the actuator's axis), the unit centres and the tip at every level as the model reports them,
+    (k, n + 2, 2) or, for a response in space, (k, n + 2, 3) with z from the mid-plane."""
+    c = response.centres.copy()
+    tip = response.tip.copy()
+    if c.shape[-1] == 3:
+        c[..., 2] -= response.reference_centres[None, :, 2]
+        tip[:, 2] -= response.reference_tip[2]
+    base = np.zeros((len(c), 1, c.shape[-1]))
+    base[..., 1] = response.reference_tip[1]
+    return np.concatenate([base, c, tip[:, None]], axis=1)
+
+
 def centreline(response: Response, level: int) -> np.ndarray:
-    """The base (on the actuator's axis), the unit centres and the tip at ``level`` as the model reports them, (x, y,
-    z) with z from the mid-plane (0 for a planar response)."""
-    out = np.zeros((response.n_units + 2, 3))
-    out[0, 1] = response.reference_tip[1]
-    body = np.vstack([response.centres[level], response.tip[level][None]])
-    out[1:, :body.shape[1]] = body
-    if body.shape[1] == 3:
-        out[1:-1, 2] -= response.reference_centres[:, 2]
-        out[-1, 2] -= response.reference_tip[2]
+    """:func:`centrelines` at ``level`` as (x, y, z) points (z = 0 for a planar response), (n + 2, 3)."""
+    line = centrelines(response)[level]
+    out = np.zeros((len(line), 3))
+    out[:, :line.shape[1]] = line
     return out
 
 
@@ -93,4 +101,4 @@ def plot_path(candidate: Candidate, objective: PathTarget, path: str | Path,
     return save_figure(fig, path)
 
 
-__all__ = ["centreline", "draw_path", "placed_path", "plot_path"]
+__all__ = ["centreline", "centrelines", "draw_path", "placed_path", "plot_path"]

@@ -24,6 +24,7 @@ from pneumorph.design.config import DesignConfig
 from pneumorph.design.figures import plot_convergence, plot_profile
 from pneumorph.design.fitness import stage_values
 from pneumorph.design.ga import GenerationStats
+from pneumorph.design.pathfigure import placed_path
 from pneumorph.design.paths import PathTarget
 from pneumorph.design.scoring import Candidate
 from pneumorph.design.targets import Objective, ProfileTarget, StagedTarget
@@ -120,8 +121,7 @@ class RunResult:
         if isinstance(self.objective, ProfileTarget | PathTarget) and best is not None and best.response is not None:
             out["rms_per_centre_mm"] = best.value / best.response.n_units ** 0.5  # Eq 4.1 per centre (SPADA's figure)
         if isinstance(self.objective, PathTarget) and best is not None and best.response is not None:
-            tip = best.response.reference_tip  # a preset as it was drawn for the actuator
-            out["path"] = [list(p) for p in self.objective.at(float(tip[0]), float(tip[1])).points]
+            out["path"] = [list(p) for p in placed_path(self.objective, best.response).points]  # as drawn for it
         if self.certified is not None:
             out.update(certificate=self.certified.certificate, top=_top_rows(self), opinion_2d=self.opinion_2d)
         return out
@@ -156,7 +156,7 @@ def _path_lines(objective: Objective, best: Candidate, units: int) -> list[str]:
             or not math.isfinite(best.value):
         return []
     r = best.response
-    route = objective.at(float(r.reference_tip[0]), float(r.reference_tip[1]))
+    route = placed_path(objective, r)
     centres = r.centres[best.level]
     line = float(np.linalg.norm(np.diff(centres, axis=0), axis=1).sum())
     return [f"- RMS distance per centre: {best.value / units**0.5:.3g} mm (the root of the summed squared distances of "

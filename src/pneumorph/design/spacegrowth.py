@@ -51,7 +51,7 @@ from pneumorph.design.paths import PathTarget
 from pneumorph.design.prefixes import depths
 from pneumorph.design.reach import AHEAD
 from pneumorph.design.rest import CurveRange, path_rest
-from pneumorph.design.targets import Objective, ProfileTarget, TipGoal
+from pneumorph.design.targets import Objective, ProfileTarget, TipGoal, on_actuator
 from pneumorph.errors import SearchConfigError
 from pneumorph.models.chain import ChainModel, window_codes
 from pneumorph.models.spacechords import rotation_matrices
@@ -261,13 +261,14 @@ def grow_space(chain: ChainModel, objective: Objective, beta: FloatArray, thresh
     """
     codes = np.asarray(chain.table.unit_codes if codes is None else codes, dtype=np.uint8)
     check_space_objective(objective)
+    objective = on_actuator(objective, chain.length, float(chain.table.tip_ref[1]))  # a preset path, drawn for it
     table = chain.table
     n = chain.n_units
     length = chain.length
     profile = isinstance(objective, ProfileTarget)
     path = isinstance(objective, PathTarget)
     prof, goal = cast(ProfileTarget, objective), cast(TipGoal, objective)  # each used on its side only
-    route = cast(PathTarget, objective).at(length, float(table.tip_ref[1])) if path else None
+    route = cast(PathTarget, objective) if path else None
     mid = np.array([0.0, 0.0, table.centre_z])  # a path's z is from the mid-plane
     bits, st = _seed(chain, codes)
     spilled: list[float] | None = [] if spill else None
