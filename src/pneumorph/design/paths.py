@@ -272,13 +272,6 @@ class PathTarget:
             out[i] = foot[np.argmin(np.linalg.norm(foot - q, axis=1))]
         return out
 
-    def check(self, length: float, height: float = 0.0) -> PathTarget:
-        """Refuse a relative path whose points would be beyond ``MAX_TARGET_MM`` (1e5 mm) along an actuator of
-        ``length`` mm (a path in mm was checked when it was made)."""
-        if self.relative:
-            path_points(self.at(length, height).points, f"the path {self.name!r}")
-        return self
-
     @property
     def label(self) -> str:
         what = "a preset drawn for the actuator" if self.relative else f"through {len(self.points)} points"
