@@ -1,4 +1,4 @@
-"""A config's settings are checked as the options that mirror them are (issue 28, item 18)."""
+"""A config's settings are checked as the options that mirror them are."""
 
 from __future__ import annotations
 

@@ -184,8 +184,8 @@ TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119)
 ], ids=["export", "sensitivity", "chain-build", "unit-optimise", "identify", "study", "bimodal", "composite",
         "calibrate"])
 def test_ctrl_c_while_writing_leaves_nothing(tmp_path: Path, slow: str, args: list[str], outputs: list[str]) -> None:
-    """Every command that writes several files writes them all or nothing: stopped midway they left a deck,
-    study.json, half the figures or an empty folder (issue 28, item 19)."""
+    """Every command that writes several files writes them all or nothing: stopped midway it leaves no deck,
+    study.json, part of the figures or empty folder behind."""
     (tmp_path / "unit.toml").write_text(UNIT, encoding="utf-8")
     (tmp_path / "trace.csv").write_text(TRACE, encoding="utf-8")
     (tmp_path / "run.toml").write_text('[design]\nobjective = "sin"\n[model]\nunit = {element_size = 3.0}\n',

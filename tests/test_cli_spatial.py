@@ -1,4 +1,4 @@
-"""`--library spatial` on the command line (issue 25): sideways designs in 3D, refused in 2D and by the chain."""
+"""`--library spatial` on the command line: sideways designs in 3D, refused in 2D and by the chain."""
 
 from __future__ import annotations
 

@@ -1,8 +1,9 @@
-"""The bench against hostile or careless requests (issue 28, items 1-6), through its HTTP API.
+"""The bench against hostile or careless requests, through its HTTP API.
 
-Each test states the behaviour that was wrong before: a unit that costs without bound, jobs
-in the server and without limit or cancel, bodies read whole, cross-site and foreign-host
-requests served, client-chosen sessions, mixed error formats and 500s.
+Each test states a behaviour the bench keeps: a unit's cost bounded before any job, jobs in
+worker processes with limits, cancel, expiry and a quota, bodies counted as they arrive,
+cross-site and foreign-host requests refused, sessions issued by the server only, and one
+error format for every error, a 500 included.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Certified search over a unit library (issue 16): 2k choices per unit, scored exactly, verified by 2D FE."""
+"""Certified search over a unit library : 2k choices per unit, scored exactly, verified by 2D FE."""
 
 from __future__ import annotations
 

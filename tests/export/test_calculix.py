@@ -308,7 +308,7 @@ def _relative_tip_difference(model: Full3D, folder: Path) -> np.ndarray:
 
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed (Debian: calculix-ccx)")
 def test_calculix_tip_agrees_within_the_volumetric_difference(tmp_path: Path) -> None:
-    """1 unit, 20 kPa in 4 levels (ccx 2.20, dev-2c, about 8 s per run).
+    """1 unit, 20 kPa in 4 levels (ccx 2.20, 2 cores, about 8 s per run).
 
     Measured: CalculiX's tip displacement is 4.31 % smaller at 20 kPa (0.89, 1.83, 2.93,
     4.31 % at the four levels; 4.29 % with 10 levels; 4.94 % for "01", in line with the
@@ -329,7 +329,7 @@ def test_calculix_tip_agrees_within_the_volumetric_difference(tmp_path: Path) ->
 def test_calculix_solves_a_sideways_unit_as_pneumorph_does(tmp_path: Path) -> None:
     """The deck of a sideways unit (`l` of the spatial library: full width, no symmetry plane), 20 kPa in 4 levels.
 
-    Measured (ccx 2.20, dev-2c, 29 s): the tip moves the same way in space (cosine above 0.99999 at every level) and
+    Measured (ccx 2.20, 2 cores, 29 s): the tip moves the same way in space (cosine above 0.99999 at every level) and
     4.65 % less at 20 kPa (`al`: 5.39 %), the volumetric term's difference the planar decks show too (4.3 % for one
     planar unit).
     """

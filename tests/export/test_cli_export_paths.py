@@ -12,7 +12,7 @@ from pneumorph.cli import main
 @pytest.mark.parametrize("stl", ["X.inp", "X.inp/parts"])
 def test_export_refuses_a_deck_where_the_stl_folder_goes(tmp_path: Path, stl: str,
                                                          capsys: pytest.CaptureFixture[str]) -> None:
-    """The deck used to be written, then the STL folder refused: now nothing is written."""
+    """An STL folder that collides with the deck is refused before anything is written, the deck included."""
     deck = tmp_path / "X.inp"
     assert main(["export", "0110", "--stl", str(tmp_path / stl), "--inp", str(deck)]) == 2
     assert "collide" in capsys.readouterr().err

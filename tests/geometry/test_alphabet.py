@@ -1,4 +1,4 @@
-"""Designs over a library's alphabet (issue 16): notation, canonical text, and clear errors."""
+"""Designs over a library's alphabet : notation, canonical text, and clear errors."""
 
 from __future__ import annotations
 

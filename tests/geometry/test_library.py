@@ -1,4 +1,4 @@
-"""Unit libraries (issue 16): the built-in file, the file format, and every way a library can be wrong."""
+"""Unit libraries: the built-in file, the file format, and every way a library can be wrong."""
 
 from __future__ import annotations
 

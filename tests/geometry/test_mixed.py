@@ -1,4 +1,4 @@
-"""Meshes of mixed designs (issue 16): today's meshes unchanged, exact volumes, conforming interfaces."""
+"""Meshes of mixed designs: one-type meshes as the reference commit made them, exact volumes, conforming interfaces."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from pneumorph.geometry.features import PHYSICAL_PASSAGE, BaseBlock
 from pneumorph.geometry.library import UnitLibrary, builtin_library
 from pneumorph.geometry.unit import UnitSpec
 
-#: the last commit before unit libraries: its assemble is the reference for today's meshes
+#: the reference commit for one-type meshes (without unit libraries): its assemble is what they must equal
 BEFORE_LIBRARIES = "137ba49"
 REPO = Path(__file__).resolve().parents[2]
 

@@ -1,4 +1,4 @@
-"""Sideways units (issue 25, item 1): the stiff layer on a side face, meshed whole, checked in one line."""
+"""Sideways units: the stiff layer on a side face, meshed whole, checked in one line."""
 
 from __future__ import annotations
 

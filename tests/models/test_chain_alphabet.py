@@ -1,4 +1,4 @@
-"""The chain model over a unit library (issue 16): windows of types and orientations, tables per type."""
+"""The chain model over a unit library: windows of types and orientations, tables per type."""
 
 from __future__ import annotations
 

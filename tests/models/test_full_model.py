@@ -1,4 +1,4 @@
-"""The full 3D model (issue 25, item 2): the half model's answer on planar designs; sideways units leave the plane."""
+"""The full 3D model: the half model's answer on planar designs; sideways units leave the plane."""
 
 from __future__ import annotations
 

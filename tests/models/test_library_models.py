@@ -1,4 +1,4 @@
-"""The FE models over a unit library (issue 16): fingerprints kept, mixed designs solved in 2D."""
+"""The FE models over a unit library: fingerprints kept, mixed designs solved in 2D."""
 
 from __future__ import annotations
 
@@ -83,7 +83,7 @@ def test_mixed_designs_solve_in_2d_and_responses_keep_their_text() -> None:
     # a unit of each type where it belongs: the short unit's centre 7 mm after its start
     r = mixed.evaluate("asa")
     assert np.allclose(np.diff(r.reference_centres[:, 0]), [(10.5 + 7.0) / 2, (7.0 + 10.5) / 2])
-    # a 0/1 design over the library is today's design, solved the same to the last bit
+    # a 0/1 design over the library is the one-type design, solved the same to the last bit
     over = mixed.evaluate("010")
     alone = Reduced2D(3, lib["a"], RAMP).evaluate("010")
     assert over.orientation == "aAa" and alone.orientation == "010"

@@ -6,12 +6,12 @@ Notation (base first, one character per unit; spaces, commas and underscores are
   (orientation 0); in upper case (``A``, ``E``, ...) the unit turned 180 degrees about the
   long axis (orientation 1);
 - the digits ``0`` and ``1`` are a unit of the library's first type (its default) in
-  orientation 0 and 1, so every existing 0/1 design is a design over any library whose first
-  type is the default unit, and means what it always meant.
+  orientation 0 and 1, so every 0/1 design is a design over any library whose first type is
+  the default unit, with the same meaning there.
 
 The canonical text of a design (:attr:`Design.text`, what caches, files and responses keep)
 is the 0/1 string for a one-type library (:meth:`~pneumorph.geometry.library.UnitLibrary.single`),
-so today's designs are written exactly as before, and the letters otherwise.
+so a one-type design is written as its 0/1 string, and the letters otherwise.
 
 Examples
 --------
@@ -137,7 +137,7 @@ def parse_design(design: str | Iterable[int] | Design, library: UnitLibrary, n_u
         return Design(library.default * len(orientation), orientation, _text(library.default * len(orientation),
                                                                               orientation, digits))
     text = "".join(ch for ch in design if ch not in SEPARATORS)
-    if set(text) <= {"0", "1"} or (digits and not any(ch.isalpha() for ch in text)):  # today's checks and messages
+    if set(text) <= {"0", "1"} or (digits and not any(ch.isalpha() for ch in text)):  # the 0/1 checks and messages
         orientation = parse_orientation(design, n_units)
         symbols = library.default * len(orientation)
         return Design(symbols, orientation, _text(symbols, orientation, digits))

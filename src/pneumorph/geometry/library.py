@@ -3,9 +3,9 @@
 A library maps one-character symbols (lower-case letters ``a``-``z``) to unit specs
 (:class:`~pneumorph.geometry.unit.UnitSpec`); a design over it is a string of those symbols
 (:mod:`pneumorph.geometry.alphabet`): lower case for a unit as built, upper case for a unit
-turned 180 degrees about the long axis. The digits 0 and 1 stay what they have always been,
-a unit of the library's first type in orientation 0 or 1, so the designs of the one-unit
-library (:meth:`UnitLibrary.single`) are today's 0/1 strings.
+turned 180 degrees about the long axis. The digits 0 and 1 are a unit of the library's
+first type in orientation 0 or 1, so the designs of the one-unit library
+(:meth:`UnitLibrary.single`) are 0/1 strings.
 
 The library file (TOML; ``docs/unit-library.md``)::
 
@@ -279,7 +279,7 @@ class UnitLibrary:
     # -- construction ----------------------------------------------------------------------
     @classmethod
     def single(cls, spec: UnitSpec | None = None, symbol: str = "a") -> UnitLibrary:
-        """The library of one unit type: the designs of today's actuators (0/1 strings).
+        """The library of one unit type: the designs of one-type actuators (0/1 strings).
 
         >>> UnitLibrary.single().is_single
         True

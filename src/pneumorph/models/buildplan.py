@@ -36,7 +36,7 @@ FULL_WIDTH = "3d full-width"
 #: held-out designs that validate a table built on first use
 HELDOUT = 20
 #: measured wall time of one FE solve of a 15-unit design (:data:`SOLVE_UNITS`) on one core, seconds, per
-#: fidelity (BENCHMARKS.md, dev-2c: a random 3D design 14.2-15.8 s, a 2D one 0.55 s; strongly curled
+#: fidelity (BENCHMARKS.md, 2 cores, 24 GB: a random 3D design 14.2-15.8 s, a 2D one 0.55 s; strongly curled
 #: designs take up to three times as long); the estimates of a build or a search scale it by the units
 #: and divide it among the workers
 SOLVE_SECONDS = {"3d": 15.0, "2d": 0.55, FULL_WIDTH: 60.0}

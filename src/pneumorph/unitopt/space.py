@@ -4,7 +4,7 @@ A :class:`DesignSpace` is a base unit (:class:`~pneumorph.geometry.unit.UnitSpec
 built-in unit by default) and a few of its lengths, each between two bounds (mm), rounded
 to a resolution (0.1 mm by default: what a mould can hold, and the same candidate is then
 the same cache entry). The pitch stays that of the base unit unless it is made a
-variable, so an optimised unit fits the actuators of today's length.
+variable, so an optimised unit fits actuators of the base unit's length.
 
 :meth:`DesignSpace.check` builds the unit at every corner of the box and meshes it, before
 any solve: every constraint of a unit on these lengths (walls that leave a cavity, a slit
