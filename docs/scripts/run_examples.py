@@ -3,8 +3,7 @@
 Each example is searched twice: on the 3D model (the examples' own setting, the shipped 3D
 chain table, winners verified by 3D FE solves) and on the 2D reduced-order model
 (``--model 2d``). Both use ``--certify``: FE verification goes on until no design can beat
-the winner by the chain's validated bound. All runs share one evaluation cache. The GA
-answers of the previous version of this page (2D model) are kept for comparison.
+the winner by the chain's validated bound. All runs share one evaluation cache.
 
     python docs/scripts/run_examples.py [--cache FILE] [--runs DIR] [--only NAME ...]
 """
@@ -70,28 +69,25 @@ def main() -> None:
         "Values: Eq 4.1 (mm) for profiles; the tip coordinate or distance (mm) for tip goals.",
         "",
         "| example | objective | 3D optimum (FE) | pressure | 3D value | 2D model's value of it | 2D optimum (FE) "
-        "| 2D value | GA answer before (2D) | FE solves 3D / 2D | wall 3D / 2D |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| 2D value | FE solves 3D / 2D | wall 3D / 2D |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name in ORDER:
         e = saved.get(name, {})
         if "certified_3d" not in e or "certified_2d" not in e:
             continue
         a, b = e["certified_3d"], e["certified_2d"]
-        ga = e.get("best")
         opinion = a.get("opinion_2d", {}).get(a["best"]["design"])
-        ga_text = "-" if ga is None else f"`{ga['design']}` {ga['fitness']:.2f}"
         lines.append(
             f"| [`{name}`](figures/examples/{name}-3d.png) | {a['objective']} | `{a['best']['design']}`"
             f"{'' if a['certificate']['certified'] else ' (not certified)'} | {a['best']['pressure_kpa']:.1f} kPa | "
             f"{a['best']['fitness']:.2f} | {'-' if opinion is None else f'{opinion:.2f}'} | `{b['best']['design']}`"
             f"{'' if b['certificate']['certified'] else ' (not certified)'} | {b['best']['fitness']:.2f} | "
-            f"{ga_text} | {len(a['certificate']['verified'])} / {len(b['certificate']['verified'])} | "
+            f"{len(a['certificate']['verified'])} / {len(b['certificate']['verified'])} | "
             f"{a['wall_s']:.0f} s / {b['wall_s']:.0f} s |")
     lines += ["",
               "The 2D model's value of the 3D optimum comes from the shipped 2D chain table. FE solves: designs",
-              "verified (a design solved before comes from the shared cache). The GA column is the previous",
-              "version of this page: GA over the 2D model, mostly 24 x 8, the sin-10 run 100 x 15.", ""]
+              "verified (a design already solved comes from the shared cache).", ""]
     for name in ORDER:
         if "certified_3d" in saved.get(name, {}):
             lines += [f"![{name}, 3D](figures/examples/{name}-3d.png)",

@@ -14,7 +14,7 @@ design's own distance.
 
     python docs/scripts/space_support.py --memory 5 --subdivisions 4
 
-Measured (2026-11-26, dev-2c, shared with a table build): memory 5 (1,024 states, 4,096 rows
+Measured (2 cores, 24 GB, shared with a table build): memory 5 (1,024 states, 4,096 rows
 merged from 16,384 windows, widened by 0.016 mm and 0.00107 in rotation), 2,562 directions,
 40 s for one level; ``reach`` (100, 40, 40) mm with ``LAAllalalalaall``, 1.982 mm off at 45
 kPa: the hull bound is -3.47 mm with 6 units placed, 0.32 with 9, 1.34 with 11, 1.96 with 14.
