@@ -229,7 +229,8 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
 
 def _warn_unidentified(path: str) -> None:
     """Say which parameters an identified model's scans left undetermined: its design is only as good as the fit
-    (BENCHMARKS.md: a redesign on a model whose bulk modulus the scans left confounded was worse on the truth)."""
+    (docs/notes/identification.md: a redesign on a model whose bulk modulus the scans left confounded is worse on
+    the truth)."""
     from pneumorph.identify import NAMES
     from pneumorph.io.files import read_toml
 
