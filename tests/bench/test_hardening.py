@@ -148,7 +148,7 @@ def test_a_session_may_have_two_jobs_and_the_bench_three(client: TestClient, app
     board = app.state.board
     client.get("/api/jobs")
     mine = [board.submit(_session(client), "wait", {"seconds": 30}) for _ in range(2)]
-    r = client.post("/api/jobs", json={"kind": "export", "design": "0" * 15})  # issue: 50 queued without limit
+    r = client.post("/api/jobs", json={"kind": "export", "design": "0" * 15})  # without the limit, 50 would queue
     assert r.status_code == 429 and "jobs-per-session" in _error(r)["message"]
     other = TestClient(app, base_url=BASE)
     other.get("/api/jobs")
@@ -387,7 +387,7 @@ def test_a_table_jobs_progress_follows_its_solves() -> None:
     n = plan.covering[0]
     seen = [progress(f"window +-{plan.windows[0]}: {n} covering designs")]
     seen += [progress(f"  covering: {i}/{n} solved (solved d, 3 s)") for i in range(1, n + 1)]
-    # window +-1 has 2 covering designs of 22 solves: the issue saw 0.95 after them (2/2 covering)
+    # window +-1 has 2 covering designs of 22 solves: 0.95 after them (2/2 covering) would overstate it
     assert seen[2] == pytest.approx(0.02 + 0.95 * 2 / plan.solves[0], abs=1e-3) and seen[2] < 0.15
     assert seen[n] == pytest.approx(0.02 + 0.95 * n / plan.solves[0], abs=1e-3)
     held = [progress(f"  held-out: {i}/{plan.heldout} solved") for i in range(1, plan.heldout + 1)]

@@ -25,7 +25,7 @@ def test_a_simulation_past_the_memory_is_refused_with_its_estimate(tmp_path: Pat
 
 def test_a_unit_file_with_a_huge_pitch_is_refused(tmp_path: Path) -> None:
     unit = tmp_path / "big.toml"
-    unit.write_text("[unit]\npitch = 1e9\n")  # the issue: a base block 1e9 mm long went past 6 GB
+    unit.write_text("[unit]\npitch = 1e9\n")  # unbounded, a base block 1e9 mm long goes past 6 GB
     code, out, _ = _run("simulate", "-o", "0" * 15, "--model", "2d", "--unit", str(unit))
     assert code == 2 and "MAX_LENGTH_MM" in out and "Traceback" not in out
 
