@@ -1,0 +1,39 @@
+"""The sparse solvers: PARDISO found without searching the environment, and its answers."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from pneumorph.fem import linear
+
+pytest.importorskip("pypardiso")
+
+
+def test_mkl_runtime_points_at_the_wheels_library_and_restores_the_environment(monkeypatch):
+    monkeypatch.delenv("PYPARDISO_MKL_RT", raising=False)
+    with linear._mkl_runtime():
+        found = os.environ.get("PYPARDISO_MKL_RT")
+    assert "PYPARDISO_MKL_RT" not in os.environ
+    if found is not None:  # the mkl wheel's layout: <prefix>/lib/libmkl_rt.so.N
+        assert Path(found).is_file() and Path(found).parent == Path(sys.prefix) / "lib"
+
+
+def test_mkl_runtime_keeps_a_path_the_user_set(monkeypatch):
+    monkeypatch.setenv("PYPARDISO_MKL_RT", "/somewhere/libmkl_rt.so")
+    with linear._mkl_runtime():
+        assert os.environ["PYPARDISO_MKL_RT"] == "/somewhere/libmkl_rt.so"
+    assert os.environ["PYPARDISO_MKL_RT"] == "/somewhere/libmkl_rt.so"
+
+
+def test_pardiso_solves_a_nonsymmetric_system_to_rounding():
+    rng = np.random.default_rng(3)
+    A = sp.random(40, 40, density=0.2, random_state=rng) + sp.eye(40) * 5.0
+    b = rng.normal(size=40)
+    x = linear.Pardiso()(A.tocsr(), b)
+    assert np.allclose(A @ x, b, rtol=0, atol=1e-12)
