@@ -32,3 +32,29 @@ def shared_dir() -> Path:
 def reference_dir(shared_dir: Path) -> Path:
     """``shared/reference-data``."""
     return shared_dir / "reference-data"
+
+
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
+    """``-n auto``: the cores this run may use, at least one.
+
+    pytest-xdist counts the machine's physical cores; a run pinned to fewer (``taskset``, a
+    container's CPU quota) gets one process per core it has, not one per core of the host.
+    ``PYTEST_XDIST_AUTO_NUM_WORKERS`` still sets the number.
+    """
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS", "").isdigit():
+        return int(os.environ["PYTEST_XDIST_AUTO_NUM_WORKERS"])
+    try:
+        import psutil
+
+        cores = psutil.cpu_count(logical=False) or os.cpu_count() or 1
+    except ImportError:
+        cores = os.cpu_count() or 1
+    if hasattr(os, "sched_getaffinity"):
+        cores = min(cores, len(os.sched_getaffinity(0)))
+    try:  # cgroup v2: "<quota> <period>" or "max <period>"
+        quota, period = Path("/sys/fs/cgroup/cpu.max").read_text().split()
+        if quota != "max":
+            cores = min(cores, max(1, int(quota) // int(period)))
+    except (OSError, ValueError):
+        pass
+    return max(1, cores)

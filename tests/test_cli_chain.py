@@ -12,6 +12,7 @@ from pneumorph.models.chain import ChainTable
 from pneumorph.models.windows import covering_designs
 
 
+@pytest.mark.slow
 def test_chain_build_writes_a_validated_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     unit = tmp_path / "coarse.toml"
     unit.write_text("[unit]\nelement_size = 3.0\n")
@@ -35,6 +36,7 @@ def test_chain_build_writes_a_validated_table(tmp_path: Path, capsys: pytest.Cap
     assert table.metadata["pneumorph"] and table.metadata["created_utc"]
 
 
+@pytest.mark.slow
 def test_chain_build_short_learns_the_ends_from_short_actuators(tmp_path: Path,
                                                                  capsys: pytest.CaptureFixture[str]) -> None:
     unit = tmp_path / "coarse.toml"

@@ -146,6 +146,7 @@ def test_gravity_falls_back_to_the_genetic_algorithm(tmp_path: Path, capsys: pyt
     assert (tmp_path / "run" / "generations.csv").is_file()
 
 
+@pytest.mark.slow
 def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
                                                                  capsys: pytest.CaptureFixture[str]) -> None:
     unit = tmp_path / "coarse.toml"
@@ -181,6 +182,7 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     assert again["solves"] == 0 and again["best"] == first["best"]
 
 
+@pytest.mark.slow
 def test_a_model_the_chain_cannot_represent_falls_back_to_the_ga(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
     from pneumorph.errors import LocalityError
@@ -203,6 +205,7 @@ def test_a_model_the_chain_cannot_represent_falls_back_to_the_ga(tmp_path: Path,
     assert not list((tmp_path / "runs").glob("*certified*"))  # the refused search left no folder
 
 
+@pytest.mark.slow
 def test_a_tampered_cache_entry_is_solved_again_and_reported(tmp_path: Path,
                                                              capsys: pytest.CaptureFixture[str]) -> None:
     import sqlite3
@@ -269,6 +272,7 @@ def test_a_pressure_between_the_tables_levels_is_served_by_the_levels_below_it(
     assert note in (tmp_path / "run6" / "report.md").read_text()
 
 
+@pytest.mark.slow
 def test_no_build_stops_a_run_that_needs_a_table_with_one_line(tmp_path: Path,
                                                                 capsys: pytest.CaptureFixture[str]) -> None:
     args = _short(tmp_path, 8, "--pressure", "3", "--no-build")

@@ -60,6 +60,7 @@ def test_the_subset_covers_every_command_and_the_blind_spots() -> None:
     assert {"out", "unit", "repeat", "valid"} <= kinds, kinds
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", [*SUBSET, *FOUND], ids=lambda c: f"{c.number}-{c.command}-{c.mutation}")
 def test_a_fuzz_case_ends_cleanly(case: object) -> None:
     outcome = FUZZ.run_case(case)  # type: ignore[attr-defined]

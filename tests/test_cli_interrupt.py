@@ -152,4 +152,5 @@ def _alive(pid: int) -> bool:
     return state not in ("Z", "X")
 
 
-pytestmark = pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")]

@@ -34,6 +34,7 @@ from selenium.webdriver.support.ui import Select  # noqa: E402
 from pneumorph.bench import create_app  # noqa: E402
 
 FIGURES = Path(__file__).resolve().parents[2] / "docs" / "figures"
+pytestmark = pytest.mark.browser
 
 
 @pytest.fixture(scope="module")

@@ -129,6 +129,7 @@ def test_cross_site_and_foreign_host_requests_are_refused_by_the_real_server(ser
     assert r.status_code == 400 and r.json()["error"]["field"] == "host"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_ctrl_c_and_sigterm_stop_a_running_job_at_once(tmp_path: Path, sig: signal.Signals) -> None:
     srv = Server(tmp_path)

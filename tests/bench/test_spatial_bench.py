@@ -30,6 +30,7 @@ def bench() -> Bench:
     return Bench()
 
 
+@pytest.mark.slow
 def test_a_helix_gets_the_certified_searchs_sideways_design(bench: Bench) -> None:
     a = bench.answer(bench.parse(HELIX))
     chain = bench.chain("3d", "spatial")
@@ -102,6 +103,7 @@ def test_the_chain_view_of_a_sideways_design_follows_its_space_centreline(bench:
     assert pos[:, 2].max() > response.tip[-1, 2] > 40.0  # it reaches across the width as the chain says
 
 
+@pytest.mark.slow
 def test_the_api_offers_the_spatial_library_and_exports_a_sideways_design(tmp_path) -> None:  # type: ignore[no-untyped-def]
     client = TestClient(create_app(state_dir=tmp_path / "state", cache=tmp_path / "cache.sqlite"),
                         base_url="http://127.0.0.1:8000")

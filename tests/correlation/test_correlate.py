@@ -245,6 +245,7 @@ def test_correlate_with_a_model_file_compares_with_that_model(tmp_path: Path, ca
     assert rms["identified"] < 0.01 < rms["nominal"], rms
 
 
+@pytest.mark.slow
 def test_a_scan_of_a_sideways_design_is_measured_on_its_surface(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
     """A design that leaves the bending plane (`aL` over the spatial library, full model): a moved scan of its own
     surface with 0.05 mm noise comes back to the noise (RMS 0.05 sqrt 3 = 0.087 mm) and the move; the bending

@@ -43,6 +43,7 @@ def test_a_certified_search_of_a_short_actuator_hands_over_to_the_exhaustive_sea
     assert not any(tmp_path.iterdir())
 
 
+@pytest.mark.slow
 def test_the_new_strategy_of_the_docs_finds_the_exhaustive_winner(tmp_path: Path) -> None:
     code = re.search(r"```python\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S)
     assert code is not None

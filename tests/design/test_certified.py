@@ -45,6 +45,7 @@ OBJECTIVES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("spec", "kw"), OBJECTIVES)
 def test_certified_search_equals_fe_exhaustive_search(setup, spec: str, kw: dict) -> None:
     model, chain, evaluator = setup

@@ -77,6 +77,7 @@ def test_a_symmetric_unit_is_written_in_one_letter() -> None:
     assert "E" not in result.best.design
 
 
+@pytest.mark.slow
 def test_ga_over_a_library_finds_the_brute_force_optimum() -> None:
     model = LibraryToy()
     objective = make_objective("sin", 6.0, length=model.n_units * model.unit_length)

@@ -117,8 +117,9 @@ def test_a_path_through_a_3d_designs_fe_centres_curling_past_vertical_gives_it_b
     assert result.winner_chain.value <= result.certificate["bound"]  # the chain's own centres within its error
 
 
-@pytest.mark.parametrize("library, file", [("builtin", "library-heldout/heldout-1.json"),
-                                           ("spatial", "space-heldout/heldout-1.json")])
+@pytest.mark.parametrize("library, file", [
+    pytest.param("builtin", "library-heldout/heldout-1.json", marks=pytest.mark.slow),
+    ("spatial", "space-heldout/heldout-1.json")])
 def test_a_path_through_a_library_designs_fe_centres_gives_it_back_by_branch_and_bound(library: str,
                                                                                        file: str) -> None:
     """Over the four-type library (8^15 designs) and the spatial one (4^15, in space) the branch-and-bound returns

@@ -154,6 +154,7 @@ def test_curve_range_holds_the_curve() -> None:
         assert m2 - 0.08 <= np.sin(x).max() <= m2
 
 
+@pytest.mark.slow
 def test_thirty_units_tip_goals_certify_by_branch_and_bound() -> None:
     """With the bound, max-x and min-distance at 30 units (2^30 designs) list every design within reach of the best."""
     table = find_table(make_model(15, {"fidelity": "3d"}))

@@ -47,6 +47,7 @@ def test_refine_is_left_out_of_default_settings() -> None:
         DesignConfig(search="ga", refine=1.0)
 
 
+@pytest.mark.slow
 def test_design_refine_in_2d(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                              monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("PNEUMORPH_CACHE", str(tmp_path / "cache.sqlite"))

@@ -230,6 +230,7 @@ def test_a_second_run_is_refused_before_it_builds_a_table(tmp_path: Path) -> Non
         assert cache.count() == 0  # not one design solved
 
 
+@pytest.mark.slow
 def test_a_failed_table_build_releases_the_folder_it_claimed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from pneumorph.errors import LocalityError
     from pneumorph.models import chaintables

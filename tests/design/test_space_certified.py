@@ -20,6 +20,7 @@ from pneumorph.models.chain import ChainModel, ChainTable, check_source
 from pneumorph.models.factory import make_model
 
 TABLE = Path(__file__).parents[1] / "data" / "chain-3d-spatial-5u-10kpa.json"
+pytestmark = pytest.mark.slow  # a certified search over the spatial library, verified by full-width 3D solves
 
 
 @pytest.fixture(scope="module")

@@ -88,6 +88,7 @@ def setup(coarse_2d):  # type: ignore[no-untyped-def]
     return coarse_2d
 
 
+@pytest.mark.slow
 def test_the_certified_search_for_a_space_curve_equals_the_fe_exhaustive_search(setup) -> None:
     """A planar actuator against a space curve: the certified search (the chain's centres at z = 0, the bound with
     the slope of y and z) returns the FE exhaustive search's optimum, and the FE value adds the z term in full."""

@@ -111,6 +111,7 @@ def test_a_config_with_stages_round_trips_through_toml() -> None:
         DesignConfig(objective="stages", stage=({"pressure_kpa": 18, "objective": "max-x"},))
 
 
+@pytest.mark.slow
 def test_design_with_stages_on_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     unit = tmp_path / "coarse.toml"
     unit.write_text("[unit]\nelement_size = 3.0\n")

@@ -78,6 +78,7 @@ def test_every_readme_command_is_run_or_skipped_with_a_reason() -> None:
     assert not set(SKIPPED) - set(commands), f"skipped but not in the README: {set(SKIPPED) - set(commands)}"
 
 
+@pytest.mark.docs
 def test_the_quick_readme_commands_run_as_written(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "examples", tmp_path / "examples")
     env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(tmp_path / "xdg")}

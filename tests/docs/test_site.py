@@ -25,6 +25,7 @@ REPO = Path(__file__).resolve().parents[2]
 DOCS = REPO / "docs"
 # the command line has no Python API of its own: docs/cli.rst shows every command's --help
 NOT_IN_REFERENCE = {"pneumorph.cli", "pneumorph.__main__"}
+pytestmark = pytest.mark.docs
 
 
 @pytest.fixture(scope="module")

@@ -91,6 +91,7 @@ def coarse_unit(folder: Path) -> Path:
     return unit
 
 
+@pytest.mark.cluster
 def test_chain_build_on_the_cluster_writes_the_process_pools_table(cluster: Cluster, tmp_path: Path,
                                                                    capsys: pytest.CaptureFixture[str]) -> None:
     common = ["chain", "build", "--model", "2d", "--unit", str(coarse_unit(tmp_path)), "--pressure", "20",
@@ -108,6 +109,7 @@ def test_chain_build_on_the_cluster_writes_the_process_pools_table(cluster: Clus
     assert dask["metadata"]["solves"] == pool["metadata"]["solves"] >= 6
 
 
+@pytest.mark.cluster
 def test_the_workers_are_set_up_for_solving(cluster: Cluster) -> None:
     with DaskEvaluator(cluster.address) as ev:
         assert ev.workers == 2
@@ -121,6 +123,7 @@ def test_the_workers_are_set_up_for_solving(cluster: Cluster) -> None:
             assert set(ev.client.run(tune_allocator).values()) == {True}
 
 
+@pytest.mark.cluster
 def test_workers_of_another_version_are_refused_naming_both(cluster: Cluster, monkeypatch: pytest.MonkeyPatch) -> None:
     import pneumorph
 
@@ -137,6 +140,7 @@ def test_workers_of_another_version_are_refused_naming_both(cluster: Cluster, mo
     assert "(and 1 more)" in text  # both workers named by count
 
 
+@pytest.mark.cluster
 def test_a_lost_worker_has_its_designs_retried_and_counted(cluster: Cluster) -> None:
     model = SlowToy(seconds=1.5, n_units=6, fail={"111000"})
     expected = SerialEvaluator().evaluate_many(SlowToy(seconds=0.0, n_units=6, fail={"111000"}), DESIGNS)
@@ -169,6 +173,7 @@ def test_a_lost_worker_has_its_designs_retried_and_counted(cluster: Cluster) -> 
         client.wait_for_workers(2, timeout=60)
 
 
+@pytest.mark.cluster
 def test_a_lost_scheduler_is_one_line_and_the_rerun_resumes_from_the_cache(tmp_path: Path) -> None:
     cluster = Cluster(tmp_path)
     cache = tmp_path / "c.sqlite"
@@ -240,6 +245,7 @@ def test_options_that_would_be_ignored_are_refused_before_any_work(
     assert not (tmp_path / "c.sqlite").exists()  # refused before the cache was opened
 
 
+@pytest.mark.cluster
 def test_a_scheduler_lost_in_the_middle_of_a_batch_raises_cluster_lost(tmp_path: Path) -> None:
     cluster = Cluster(tmp_path)
     try:
@@ -257,6 +263,7 @@ def test_a_scheduler_lost_in_the_middle_of_a_batch_raises_cluster_lost(tmp_path:
         cluster.stop()
 
 
+@pytest.mark.cluster
 def test_a_batch_without_any_worker_says_so_and_ends_after_the_timeout(tmp_path: Path) -> None:
     cluster = Cluster(tmp_path)  # a scheduler, no worker
     lines: list[str] = []
@@ -270,6 +277,7 @@ def test_a_batch_without_any_worker_says_so_and_ends_after_the_timeout(tmp_path:
     assert len(lines) == 1 and lines[0].startswith(f"no Dask worker at {cluster.address}: waiting up to 1 s")
 
 
+@pytest.mark.cluster
 def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
                                                             capsys: pytest.CaptureFixture[str]) -> None:
     cluster = Cluster(tmp_path)
@@ -292,6 +300,7 @@ def test_a_design_run_builds_its_chain_table_on_the_cluster(tmp_path: Path,
     assert list(kept.values()) == [2]  # the table's model and the verifications' (its levels)
 
 
+@pytest.mark.cluster
 def test_a_worker_killed_during_a_build_costs_nothing_but_the_retries(cluster: Cluster, tmp_path: Path) -> None:
     # a mesh fine enough that a solve takes about 3 s, and the kill only once a worker has held the same design for
     # longer than the evaluator's poll (1 s): it is then still solving it, and the run has seen it there (a design

@@ -113,6 +113,7 @@ def test_bad_executor_settings() -> None:
         ProcessPoolEvaluator(workers=0)
 
 
+@pytest.mark.slow
 def test_a_worker_that_dies_fails_its_design_and_the_others_finish(serial: list,
                                                                      monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.syspath_prepend(str(REPO))

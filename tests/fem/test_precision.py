@@ -74,6 +74,7 @@ def test_a_well_conditioned_solve_stays_in_single_precision() -> None:
     assert _model().evaluate("0").metadata["precision"] == "single"
 
 
+@pytest.mark.slow
 def test_first_step_failure_says_why() -> None:
     """A tolerance below the residual's round-off cannot be met even in double precision: the failure names
     the first load step, the residual reached, the tolerance and the precision."""
@@ -86,6 +87,7 @@ def test_first_step_failure_says_why() -> None:
     assert "double-precision factorisation" in text
 
 
+@pytest.mark.slow
 def test_refined_three_unit_design_converges() -> None:
     """A 3-unit design on the 1.0 mm mesh (4.8 times the default cells) solves the whole ramp and curls
     more than on the default mesh (the coarse mesh is stiffer), by less than 5 %."""

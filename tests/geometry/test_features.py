@@ -67,6 +67,7 @@ def _area_2d(mesh, cells) -> float:
     return float(region.dV.sum())
 
 
+@pytest.mark.slow
 def test_features_solve_and_change_the_shape_as_expected() -> None:
     ramp = RampSpec(pressure=0.02)
     plain = Full3D(2, ramp_spec=ramp).evaluate("00")

@@ -60,6 +60,7 @@ def test_a_scan_of_the_nominal_model_comes_back_at_nominal(coarse: ParameterSet,
     assert np.array_equal(again.values, r.values)
 
 
+@pytest.mark.slow
 def test_a_3d_scan_identifies_all_five(coarse: ParameterSet) -> None:
     """3 units, coarse: every parameter within two of its standard errors of the truth."""
     truth = coarse.nominal + TRUTH

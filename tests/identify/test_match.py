@@ -31,6 +31,7 @@ def cast_2d() -> Observation:
     return synthetic(params, params.nominal + np.array(CAST), DESIGN, "2d", seed=2, points=1500)
 
 
+@pytest.mark.slow
 def test_the_right_design_shows_every_unit(cast_2d: Observation) -> None:
     """Against the chain's shape: no point beyond half a pitch, every unit's share of the scan within 0.2 of
     its share of the model (measured 0.86-1.16 over five casts, docs/identify.md)."""
@@ -61,6 +62,7 @@ def test_a_design_one_unit_off_is_refused_before_any_solve(cast_2d: Observation,
     assert not cache.exists() and not out.exists()
 
 
+@pytest.mark.slow
 def test_a_3d_scan_one_unit_off_is_refused_before_any_solve() -> None:
     """3D surface of a cast 8-unit actuator (the shipped 3D table serves 7 units or more): its own design passes,
     one unit more or less is refused, each by what it lacks."""

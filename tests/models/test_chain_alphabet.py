@@ -42,7 +42,7 @@ def mixed() -> tuple[Reduced2D, ChainTable, CachedEvaluator]:
     return model, build_table(model, evaluator, heldout=6), evaluator
 
 
-@pytest.mark.parametrize("n, w, k", [(5, 1, 2), (6, 1, 3), (6, 2, 2)])
+@pytest.mark.parametrize("n, w, k", [(5, 1, 2), pytest.param(6, 1, 3, marks=pytest.mark.slow), (6, 2, 2)])
 def test_the_covering_set_over_an_alphabet_shows_every_window(n: int, w: int, k: int) -> None:
     alphabet = tuple("aers"[:k])
     designs = covering_designs(n, w, n_types=k, alphabet=alphabet)

@@ -150,6 +150,7 @@ _BUILDER = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 def test_two_processes_that_need_the_same_table_build_it_once(tmp_path: Path) -> None:
     tables = tmp_path / "chain-tables"
     go = tmp_path / "go"

@@ -145,6 +145,7 @@ def test_a_key_no_training_design_shows_is_refused() -> None:
         fit_table(train, 1, {"fidelity": "toy", "key": "additive", "n_units": 9}, far=True)
 
 
+@pytest.mark.slow
 def test_far_terms_on_the_2d_model_match_the_wider_window_from_fewer_unit_solves() -> None:
     """2D FE (coarse mesh, 12 units, 8 held-out designs): window +-1 with far-field terms (a table of window +-2)
     against the table of window +-2, both built from short training designs."""

@@ -44,6 +44,7 @@ def test_the_shipped_table_was_validated_within_0_2_mm_on_20_full_length_designs
     assert set("aers") <= set("".join(v["designs"]).lower())
 
 
+@pytest.mark.slow
 def test_its_training_fixes_every_window_it_writes_out(table) -> None:
     assert len(table.training) > 600 and all(len(d) == 15 for d in table.training)
     assert unfixed_error(table.training, 2, table.alphabet, (1,), 15) < FIXED

@@ -21,6 +21,7 @@ def evaluator() -> CachedEvaluator:
     return CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
 
 
+@pytest.mark.slow
 def test_a_table_clearly_within_the_tolerance_stops_after_the_fewest_held_out_designs(evaluator) -> None:
     full = build_table(MODEL, evaluator, window=2, heldout=12)
     early = build_table(MODEL, evaluator, window=2, heldout=12, early=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
@@ -24,6 +25,7 @@ def test_end_designs_show_every_end_window_of_longer_actuators() -> None:
     assert set(ends.ravel().tolist()) <= seen
 
 
+@pytest.mark.slow
 def test_a_table_from_short_designs_predicts_full_length_designs_as_well() -> None:
     """2D FE, 12 units, window +-2: 68 unit solves instead of 96, the same held-out error on 12-unit designs."""
     model = Reduced2D(12, UnitSpec(element_size=3.0), RampSpec(pressure=0.025))

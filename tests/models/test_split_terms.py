@@ -45,6 +45,7 @@ def test_split_terms_are_exact_on_a_chain_of_such_sums(w: int, short: bool) -> N
     assert worst_error(split, law, w, n) < 1e-9
 
 
+@pytest.mark.slow
 def test_a_cover_of_the_keys_alone_leaves_windows_unfixed() -> None:
     """Two unit types, w = 2: the greedy cover shows every key but not enough chords to tell the four terms apart.
     The check says so without a solve, and a fit to the cover is off at a held-out design by the law's own size;
@@ -80,6 +81,7 @@ def test_a_table_of_split_terms_is_written_as_its_terms(tmp_path) -> None:
         terms_from_dict(data["terms"])
 
 
+@pytest.mark.slow
 def test_split_terms_on_the_2d_model_are_as_close_as_far_field_terms() -> None:
     """2D FE (coarse mesh, 12 units, 8 held-out designs): window +-2 in split terms against far-field terms, both
     a table of +-3 (the split training: 4 designs of 12 units)."""

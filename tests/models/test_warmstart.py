@@ -44,6 +44,7 @@ def test_each_step_of_the_jacobian_is_the_ramps_answer(params: ParameterSet, sta
     assert warm.response.metadata["warm_start"] < cold.response.metadata["newton_iterations"] / 3
 
 
+@pytest.mark.slow
 def test_a_start_that_does_not_fit_falls_back_to_the_ramp(start) -> None:  # type: ignore[no-untyped-def]
     other = make_model(3, {**BASE, "unit": {"element_size": 2.5}})  # another grid: no node is the start's
     warm = solve_near(other, DESIGN, start)

@@ -83,6 +83,7 @@ def test_refined_library_model_refines_every_unit() -> None:
     assert len(fine.mesh("aR").cells) == 8 * len(model.mesh("aR").cells)
 
 
+@pytest.mark.slow
 def test_a_short_actuator_converges_at_its_observed_order() -> None:
     """The 2D section of one unit on four nested meshes (1.5 to 0.1875 mm): the order observed on the three
     coarsest holds on the three finest (the solution is in the asymptotic range), and the Richardson limit

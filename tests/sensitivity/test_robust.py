@@ -134,6 +134,7 @@ def test_the_interpolation_is_exact_for_any_quadratic_with_interactions() -> Non
     assert abs(float(tables._change(values[:7], np.full(3, t))) - (f(np.full(3, t)) - f(np.zeros(3)))) > 1e-6
 
 
+@pytest.mark.slow
 def test_every_design_grown_unit_by_unit_equals_them_scored_one_by_one() -> None:
     from pneumorph.design.targets import make_objective
 

@@ -68,6 +68,7 @@ def test_cases_of_different_models_through_every_evaluator_and_the_cache(tmp_pat
     assert again[0].cached and again[1].cached and again[0].response.curl[-1] == pytest.approx(expected[1])
 
 
+@pytest.mark.slow
 def test_simplifications_study_on_a_small_actuator(tmp_path: Path) -> None:
     model = Full3D(2, ramp_spec=LOW)
     study = simplifications(model)
@@ -88,6 +89,7 @@ def test_simplifications_study_on_a_small_actuator(tmp_path: Path) -> None:
         simplifications(Reduced2D(2))
 
 
+@pytest.mark.slow
 def test_tolerance_study_reports_the_spread_and_the_inputs_of_the_extreme_curls(tmp_path: Path) -> None:
     model = Full3D(2, UnitSpec(element_size=3.0), ramp_spec=LOW)  # coarse: the box's meshes keep its cell counts
     evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(tmp_path / "c.sqlite"))
@@ -109,6 +111,7 @@ def test_tolerance_study_reports_the_spread_and_the_inputs_of_the_extreme_curls(
     assert boxed.summary()["samples_within_corners"] == 3
 
 
+@pytest.mark.slow
 def test_bulk_modulus_and_calibration_variants() -> None:
     ms = get("mold_star_15")
     assert scaled_bulk_modulus(ms, 1.1).bulk_modulus.value == pytest.approx(1.1 * ms.bulk_modulus.value)

@@ -43,6 +43,7 @@ def test_perturbed_units_and_bad_tolerances() -> None:
         Tolerance(0.1, ("side_wall", "colour"))
 
 
+@pytest.mark.slow
 def test_the_corners_bracket_the_curl_of_random_samples() -> None:
     t = Tolerance(PRINTED)
     base = UnitSpec(element_size=3.0)

@@ -49,6 +49,7 @@ def test_bad_input_is_one_line_and_exit_2_before_any_solve(tmp_path: Path, capsy
     assert not out.exists() and not (tmp_path / "c.sqlite").exists()
 
 
+@pytest.mark.slow
 def test_a_tiny_run_prints_the_front_and_writes_its_folder(tmp_path: Path,
                                                          capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
