@@ -147,6 +147,7 @@ UNIT = "[unit]\nelement_size = 3.0\n"
 TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119) ** 2:.4f}\n" for i in range(120))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("slow", "args", "outputs"), [
     # the deck, the parts' STL files and the mould's are written; its drawing is next
     ("call:pneumorph.export:plot_mould",

@@ -220,6 +220,7 @@ def test_verification_runs_the_design_command_and_is_private(client: TestClient,
     assert [j["id"] for j in again.get("/api/jobs").json()["jobs"]] == [job["id"]]
 
 
+@pytest.mark.slow
 def test_a_staged_verification_runs_the_design_command_with_its_stages(client: TestClient) -> None:
     r = client.post("/api/jobs", json={"kind": "verify", "query": STAGES})
     assert r.status_code == 202

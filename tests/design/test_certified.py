@@ -77,6 +77,7 @@ def test_without_certify_one_batch_is_verified_and_the_gap_is_reported(setup) ->
     assert c["gap"] >= 0.0
 
 
+@pytest.mark.slow
 def test_a_certificate_within_epsilon_counts_the_ties_and_solves_less(setup) -> None:
     """Within epsilon: no design can beat the winner by more than epsilon, and the truth (every design by FE)
     agrees; the designs that could beat it by less are counted as ties instead of verified."""

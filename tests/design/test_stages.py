@@ -57,6 +57,7 @@ def test_the_staged_cost_is_the_weighted_root_sum_square_of_each_stage_at_its_le
                                                                                       strict=True))), rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_certified_search_over_stages_equals_the_fe_exhaustive_search(setup) -> None:
     model, chain, evaluator = setup
     staged = _staged(chain.length)
