@@ -8,9 +8,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"
 
 
+@pytest.mark.docs
 def test_the_api_page_example_runs(tmp_path: Path) -> None:
     code = re.search(r"```python\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S)
     assert code is not None

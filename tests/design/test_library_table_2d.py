@@ -13,6 +13,8 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
+import pytest
+
 from pneumorph.design import make_objective
 from pneumorph.design.certified import chain_candidate, chain_errors
 from pneumorph.design.fitness import score
@@ -27,6 +29,7 @@ TABLE = Path(__file__).resolve().parents[2] / "examples" / "libraries" / "chain-
 FE_2D = {"saRASSSAesessaS": 6.798, "saRASSSAesrsass": 6.798}
 
 
+@pytest.mark.slow
 def test_the_four_type_table_is_its_terms_and_scores_designs_within_its_bound() -> None:
     assert json.loads(TABLE.read_text())["format"] == TERMS_FORMAT
     table = ChainTable.load(TABLE)

@@ -78,6 +78,7 @@ def test_design_refine_in_2d(tmp_path: Path, capsys: pytest.CaptureFixture[str],
     assert f"{value / 15**0.5:.3g} mm RMS per centre" in report
 
 
+@pytest.mark.slow
 def test_summary_line_names_the_value(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                       monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("PNEUMORPH_CACHE", str(tmp_path / "cache.sqlite"))
