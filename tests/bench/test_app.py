@@ -13,8 +13,8 @@ from fastapi.testclient import TestClient
 
 from pneumorph.bench import Bench, create_app, parse_query
 from pneumorph.bench.shapes import chain_placement
-from pneumorph.design.certified import chain_scores
-from pneumorph.design.targets import make_objective
+from pneumorph.design.certified.search import chain_scores
+from pneumorph.design.objectives.targets import make_objective
 from pneumorph.geometry.assembly import assemble
 
 SIN = {"target": {"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}}
@@ -249,7 +249,7 @@ def test_the_page_and_its_assets_are_served_from_the_package(client: TestClient)
 
 
 def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient) -> None:
-    from pneumorph.design.config import to_toml
+    from pneumorph.design.runs.config import to_toml
     from pneumorph.geometry.unit import UnitSpec
 
     def upload(content: bytes, model: str = "2d") -> dict:

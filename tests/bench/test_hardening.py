@@ -23,7 +23,7 @@ from fastapi.testclient import TestClient
 from pneumorph.bench import create_app
 from pneumorph.bench.guard import COOKIE
 from pneumorph.bench.jobs import JobLimits
-from pneumorph.design.config import to_toml
+from pneumorph.design.runs.config import to_toml
 from pneumorph.errors import StateQuotaError
 from pneumorph.geometry.limits import MeshLimitError
 from pneumorph.geometry.meshsize import MAX_NODES_3D, check_mesh, estimate_mesh
@@ -379,7 +379,7 @@ def test_a_client_that_goes_away_is_one_log_line_without_traceback(app, caplog: 
 # -- 6. progress that follows the work -----------------------------------------------------------
 def test_a_table_jobs_progress_follows_its_solves() -> None:
     from pneumorph.bench.worker import TableProgress
-    from pneumorph.models.buildplan import build_plan
+    from pneumorph.models.chain.plan import build_plan
     from pneumorph.models.factory import make_model
 
     plan = build_plan(make_model(15, {"fidelity": "2d", "unit": {"layer": 2.5}}))

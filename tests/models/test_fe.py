@@ -190,7 +190,7 @@ def test_3d_fingerprint_holds_the_result_determining_ramp_settings_only() -> Non
 
 
 def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyPatch) -> None:
-    import pneumorph.models.febase as febase
+    import pneumorph.models.fe.base as febase
     from pneumorph.execution.outcome import solve
 
     ramp = RampSpec(pressure=0.01)  # 10 levels

@@ -11,7 +11,7 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.identify import ParameterSet
 from pneumorph.identify.parameters import NAMES, STEPS
 from pneumorph.models.factory import make_model
-from pneumorph.models.warmstart import solve_near
+from pneumorph.models.fe.warmstart import solve_near
 
 BASE = {"fidelity": "3d", "pressure_kpa": 36}
 DESIGN = "010"

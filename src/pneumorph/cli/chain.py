@@ -71,9 +71,9 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pneumorph.errors import ChainTableError
     from pneumorph.io import strict_json
     from pneumorph.io.files import all_or_nothing_file
-    from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
-    from pneumorph.models.chainfit import build_table
-    from pneumorph.models.chaintables import build_options
+    from pneumorph.models.chain.fit import build_table
+    from pneumorph.models.chain.plan import build_plan, cached_counter, evaluator_workers
+    from pneumorph.models.chain.sources import build_options
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
@@ -93,7 +93,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         raise ChainTableError("--split-terms lays out the far-field terms: not with --no-far-terms")
     model = make_model(n_units, settings)
     if getattr(model, "mixed", False):
-        from pneumorph.models.chainfit import check_training_size
+        from pneumorph.models.chain.fit import check_training_size
 
         check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
     evaluator = open_evaluator(executor, workers, scheduler, cache)

@@ -80,7 +80,7 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
     shape = model_shape(solution)
     check_units(data, shape)
     from pneumorph.correlation.scans import align_seconds
-    from pneumorph.models.buildplan import duration_text
+    from pneumorph.models.chain.plan import duration_text
 
     click.echo(f"aligning {len(data.points):,} scan points to the model (about "
                f"{duration_text(align_seconds(len(data.points)))}) ...", err=True)

@@ -145,7 +145,7 @@ def _target_changes(target: str) -> dict[str, Any]:
     """The config's changes for ``--target``: a path from ``path:FILE`` (its points, read here), else the text."""
     head, sep, rest = target.partition(":")
     if sep and head.strip().lower() == "path":
-        from pneumorph.design.paths import read_path
+        from pneumorph.design.objectives.paths import read_path
 
         route = read_path(rest.strip())
         return {"objective": "path", "path": route.points}
@@ -162,7 +162,7 @@ def _check_inputs(o: Any) -> None:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
     o.target_changes = None
     if o.target is not None:
-        from pneumorph.design.targets import make_objective
+        from pneumorph.design.objectives.targets import make_objective
         from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):  # along the built-in unit; checked again along the model's
@@ -262,7 +262,7 @@ def _check_run(config: Any, model: Any, o: Any) -> None:
         raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
                                "turns off; leave one of them out")
     if config.refine and config.search == "certified":  # refused here, naming the option; the run checks again
-        from pneumorph.design.refine import check_refine
+        from pneumorph.design.certified.refine import check_refine
 
         with P.blame("--refine" if o.refine is not None else "[design] refine"):
             check_refine(model, config.refine)
@@ -333,14 +333,14 @@ class _Progress:
 
 def _print_result(result: Any, config: Any, model: Any) -> None:
     """The winner, its certificate, mesh note, robustness and retries, in words."""
-    from pneumorph.design.report import value_words
+    from pneumorph.design.runs.report import value_words
 
     best = result.best
     words = value_words(result.objective, best.value, config.units)
     click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {words} "
                f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
     if result.certified is not None:
-        from pneumorph.design.certificate import certificate_text
+        from pneumorph.design.certified.certificate import certificate_text
 
         for line in certificate_text(result.certified.certificate, result.objective.unit, best.design,
                                      model.fidelity):
@@ -349,7 +349,7 @@ def _print_result(result: Any, config: Any, model: Any) -> None:
         if two_d is not None:
             click.echo(f"  The 2D model's chain value of {best.design}: {two_d:.4g} {result.objective.unit}.")
     _print_mesh(result)
-    from pneumorph.design.comparison import comparison_lines
+    from pneumorph.design.runs.comparison import comparison_lines
 
     for line in comparison_lines(result.comparison):
         click.echo(f"  {line}")
@@ -433,7 +433,7 @@ def _stage_option(text: str, amplitude: float | None, periods: float | None) -> 
 
 def _check_shape_options(objective: Any, amplitude: float | None, periods: float | None) -> None:
     """Refuse --amplitude and --periods where the objective would ignore them (one line, exit 2)."""
-    from pneumorph.design.targets import PRESETS, PathTarget, ProfileTarget, StagedTarget
+    from pneumorph.design.objectives.targets import PRESETS, PathTarget, ProfileTarget, StagedTarget
 
     if isinstance(objective, StagedTarget):
         profiles = [s.target for s in objective.stages if isinstance(s.target, ProfileTarget)]
@@ -483,8 +483,8 @@ def _check_library_run(config: Any, model: Any, tolerance: float | None) -> None
         raise SearchConfigError(f"{'--robust' if config.robust else '--tolerance'}: the mould tolerance report is of "
                                 "one unit type; over a unit library leave it out")
     if config.chain_table is not None:
-        from pneumorph.design.planning import given_table_error
-        from pneumorph.models.chain import ChainTable
+        from pneumorph.design.certified.planning import given_table_error
+        from pneumorph.models.chain.model import ChainTable
 
         try:
             table = ChainTable.load(config.chain_table)

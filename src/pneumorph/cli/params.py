@@ -244,12 +244,12 @@ def blame(option: str) -> Iterator[None]:
 def library_option(library: str, unit_file: str | None) -> UnitLibrary:
     """The :class:`~pneumorph.geometry.library.UnitLibrary` that ``--library`` names (``builtin`` or a
     library file), refused as a usage error beside ``--unit`` or when it is no valid library."""
-    from pneumorph.models.factory import load_library
+    from pneumorph.models.factory import load_unit_library
 
     if unit_file is not None:
         raise click.UsageError("give either --unit or --library, not both")
     with blame("--library"):
-        return load_library(library, "unit library")
+        return load_unit_library(library, "unit library")
 
 
 def unit_option(unit_file: str) -> None:

@@ -273,7 +273,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     import os
     from pathlib import Path
 
-    from pneumorph.design.targets import make_objective
+    from pneumorph.design.objectives.targets import make_objective
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
     from pneumorph.io.files import all_or_nothing, write_json
@@ -343,7 +343,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
 
 def _objective_at_best(objective: Any, response: Any) -> tuple[float, int | None]:
     """The objective at its best level (and the level) of a response."""
-    from pneumorph.design.fitness import score
+    from pneumorph.design.objectives.fitness import score
 
     s = score(response, objective)
     return float(s.value), s.level

@@ -95,7 +95,7 @@ def _check_space(variables: tuple[str, ...], resolution: float, element_size: fl
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from pneumorph.design.planning import planned_workers
+    from pneumorph.design.certified.planning import planned_workers
     from pneumorph.errors import GeometryError
     from pneumorph.geometry.limits import MeshLimitError
     from pneumorph.geometry.unit import UnitSpec

@@ -9,7 +9,7 @@ The method (docs/identify.md):
    again with each free parameter moved by its step (forward differences; a thickness
    moved with the mesh grid kept, as the tolerance study keeps it, so that surface nodes
    correspond): the nodes' sensitivities ``dQ/dtheta``. A moved model starts from the
-   solved state at the top pressure (:func:`~pneumorph.models.warmstart.solve_near`: a few
+   solved state at the top pressure (:func:`~pneumorph.models.fe.warmstart.solve_near`: a few
    Newton iterations to the ramp's own convergence test, not a ramp).
 3. **Gauss-Newton on the linearised shape.** The residual of a scan point is its signed
    distance to the model's surface (3D: the tangent plane at its nearest surface node;
@@ -46,14 +46,14 @@ from pneumorph.identify.extent import chain_shapes
 from pneumorph.identify.linear import (
     MAX_CORRELATION,
     MIN_EIGENVALUE,
-    _correlation,
-    _covariance,
-    _Linear,
-    _nodes,
-    _solve_linearised,
-    _State,
-    _system,
+    LinearisedScan,
+    LinearisedState,
     confounded,
+    correlation_of,
+    linearised_system,
+    scaled_covariance,
+    shape_nodes,
+    solve_linearised,
 )
 from pneumorph.identify.match import check_coverage, check_size
 from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
@@ -297,10 +297,10 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
             solves += len(observations) * (1 + len(trial))
         derivatives = []
         for s in range(len(observations)):
-            nodes, _ = _nodes(base_shapes[s], dim)
+            nodes, _ = shape_nodes(base_shapes[s], dim)
             per = []
             for j, i in enumerate(idx):
-                other, _ = _nodes(moved[j][s], dim)
+                other, _ = shape_nodes(moved[j][s], dim)
                 if other.shape != nodes.shape:
                     raise FitError(f"the mesh of design {observations[s].spec.design} changed with {NAMES[i]} "
                                    f"({other.shape[0]} against {nodes.shape[0]} surface nodes); nothing is "
@@ -312,9 +312,9 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         problem = (dim, base_shapes, derivatives, points, transforms, lower - theta, upper - theta)
         state, r, a, lins, scale = _linearised(problem, idx, columns)
         if residual_before is None:
-            r0, _, _ = _system(lins, points, _State(np.zeros(len(idx)), list(transforms)), scale)
+            r0, _, _ = linearised_system(lins, points, LinearisedState(np.zeros(len(idx)), list(transforms)), scale)
             residual_before = _per_scan_rms(r0, points)
-            cov, sigma = _covariance(r, a, len(idx))
+            cov, sigma = scaled_covariance(r, a, len(idx))
             fixed = confounded(free, cov, np.linalg.norm(_project_out(a, len(idx)), axis=0))
             if fixed:
                 for name, why in fixed.items():
@@ -324,7 +324,7 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
                 state, r, a, lins, scale = _linearised(problem, [idx[c] for c in columns], columns)
                 free = [NAMES[idx[c]] for c in columns]
                 idx = [idx[c] for c in columns]
-        cov, sigma = _covariance(r, a, len(idx))
+        cov, sigma = scaled_covariance(r, a, len(idx))
         se = np.sqrt(np.maximum(np.diag(cov), 0.0)) * scale
         step = state.step
         transforms = state.transforms
@@ -344,9 +344,9 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         after.append(c.surface.rms if dim == 3 else c.outline.rms)
     final_lins = []
     for shape in final_shapes:
-        nodes, normals = _nodes(shape, dim)
-        final_lins.append(_Linear(dim, nodes, np.zeros((0, *nodes.shape)), normals))
-    r_final, _, _ = _system(final_lins, points, _State(np.zeros(0), list(transforms)), np.zeros(0))
+        nodes, normals = shape_nodes(shape, dim)
+        final_lins.append(LinearisedScan(dim, nodes, np.zeros((0, *nodes.shape)), normals))
+    r_final, _, _ = linearised_system(final_lins, points, LinearisedState(np.zeros(0), list(transforms)), np.zeros(0))
     idx = [NAMES.index(n) for n in free]
     errors = np.full(len(NAMES), np.nan)
     errors[idx] = np.sqrt(np.maximum(np.diag(cov), 0.0)) * np.array([SPANS[n] for n in free])
@@ -374,7 +374,7 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     fingerprints = tuple(p.model.fingerprint() for p in build_probes(observations, params, base, theta))
     return Identification(
         values=theta, nominal=params.nominal, standard_errors=errors, fitted=fitted, identified=identified,
-        notes=tuple(notes[n] for n in NAMES), correlation=_correlation(cov) if len(idx) else np.zeros((0, 0)),
+        notes=tuple(notes[n] for n in NAMES), correlation=correlation_of(cov) if len(idx) else np.zeros((0, 0)),
         free=tuple(free), rms_before=rms_before, rms_after=np.array(after),
         residual_before=residual_before if residual_before is not None else np.full(len(points), np.nan),
         residual_after=_per_scan_rms(r_final, points), sigma=sigma, iterations=iterations, solves=solves,
@@ -420,15 +420,15 @@ def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base:
 
 
 def _linearised(problem: tuple[Any, ...], chosen: list[int], columns: list[int]
-                ) -> tuple[_State, FloatArray, FloatArray, list[_Linear], FloatArray]:
+                ) -> tuple[LinearisedState, FloatArray, FloatArray, list[LinearisedScan], FloatArray]:
     """The linearised problem of the ``columns`` of the Jacobian (parameters ``chosen``), solved."""
     dim, shapes, derivatives, points, transforms, lower, upper = problem
     lins = []
     for shape, d in zip(shapes, derivatives, strict=True):
-        nodes, normals = _nodes(shape, dim)
-        lins.append(_Linear(dim, nodes, d[columns], normals))
+        nodes, normals = shape_nodes(shape, dim)
+        lins.append(LinearisedScan(dim, nodes, d[columns], normals))
     scale = np.array([SPANS[NAMES[i]] for i in chosen])
-    state, r, a = _solve_linearised(lins, points, transforms, np.maximum(lower[chosen], -TRUST * scale),
+    state, r, a = solve_linearised(lins, points, transforms, np.maximum(lower[chosen], -TRUST * scale),
                                     np.minimum(upper[chosen], TRUST * scale), scale)
     return state, r, a, lins, scale
 

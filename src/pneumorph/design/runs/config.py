@@ -1,0 +1,484 @@
+"""Settings of a design run and their TOML form (read with :mod:`tomllib`, written here).
+
+A config file::
+
+    [design]
+    objective = "sin"        # a tip goal, a preset (sin, cos, hook, letter-l, ...), "y = ...", "path", or "stages"
+    path = [[0, 6], [90, 6], [120, 40]]   # with objective = "path": ordered points from the base, mm
+    amplitude = 10.0         # mm
+    periods = 1.0
+    units = 15
+    search = "certified"     # or "ga", "exhaustive"
+    seed = 0
+    certify = false          # certified search: verify until no design can beat the winner
+    verify = 2               # designs verified by FE per batch (default: one per worker)
+    tolerance = 0.1          # mould tolerance of the winner's robustness report, +- mm (0: none)
+    robust = "worst"         # certified search: rank designs by their worst (or mean) error under it
+    robust_samples = 30      # seeded samples of the tolerance class (default 30 by the chain, 8 by FE)
+
+    [[design.stage]]         # with objective = "stages": a target at each of several pressures
+    pressure_kpa = 18        # a level of the model's ramp
+    objective = "curve"      # a profile, a drawn curve or "reach"; its own amplitude, periods,
+    curve = [[0, 0], [80, 2], [160, 5]]   # curve, point, anchored, and a weight (default 1)
+
+    [ga]
+    population = 100
+    generations = 15
+
+    [execution]
+    executor = "processes"   # processes (default) | serial | dask
+    cache = "evaluations.sqlite"
+
+    [model]                  # handed to the model factory (DesignConfig.make_model)
+    fidelity = "3d"          # default: 3d for the certified search, 2d for ga and exhaustive
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+from pneumorph import checks
+from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
+from pneumorph.design.search.genetic import GAConfig
+from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
+from pneumorph.errors import (
+    SearchConfigError,
+    TargetExpressionError,
+    UnknownObjectiveError,
+)
+from pneumorph.execution.evaluators import EXECUTORS, check_execution
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.files import read_toml
+
+SEARCHES = ("certified", "ga", "exhaustive")
+#: the ``[model]`` keys that name the unit (one of them replaces the others)
+UNIT_SOURCES = frozenset({"unit", "unit_file", "library"})
+#: what ``robust`` ranks designs by (pneumorph.sensitivity.robust.STATISTICS)
+ROBUST = ("worst", "mean")
+
+# the settings' checks, raising the search's own error
+_integer = partial(checks.integer, error=SearchConfigError)
+_real = partial(checks.real, error=SearchConfigError)
+_flag = partial(checks.flag, error=SearchConfigError)
+_text = partial(checks.text, error=SearchConfigError)
+_pair = partial(checks.pair, error=SearchConfigError)
+_address = partial(checks.address, error=SearchConfigError)
+
+
+@dataclass(frozen=True)
+class DesignConfig:
+    """Everything that defines a design run (the model's own settings go in ``model``).
+
+    The defaults are those of ``pneumorph design``: a 15-unit actuator for the target
+    "sin, amplitude 10 mm, one period", the certified search, the solves in a pool of
+    processes (``executor = "processes"``, one per core; ``"serial"`` solves in this
+    process), and the model of :attr:`fidelity` (3D for the certified search, 2D for the
+    others) built by :meth:`make_model`. A script that uses the process pool (or Dask)
+    needs an ``if __name__ == "__main__":`` guard: the workers import it.
+
+    Examples
+    --------
+    >>> c = DesignConfig(objective="cos", amplitude=20.0, units=8)
+    >>> DesignConfig.from_dict(c.to_dict()) == c
+    True
+    >>> DesignConfig(units=0)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: [design] units must be a whole number >= 1 and <= 100, got 0
+    """
+
+    objective: str = "sin"
+    amplitude: float = 10.0
+    periods: float = 1.0
+    point: tuple[float, ...] | None = None
+    curve: tuple[tuple[float, ...], ...] | None = None
+    path: tuple[tuple[float, ...], ...] | None = None
+    anchored: bool = True
+    stage: tuple[dict[str, Any], ...] | None = None
+    units: int = 15
+    search: str = "certified"
+    seed: int = 0
+    certify: bool = False
+    verify: int | None = None
+    margin: float = 1.0
+    epsilon: float = 0.0
+    refine: float = 0.0
+    chain_table: str | None = None
+    tolerance: float = 0.1
+    robust: str | None = None
+    robust_samples: int | None = None
+    ga: GAConfig = field(default_factory=GAConfig)
+    executor: str = "processes"
+    workers: int | None = None
+    scheduler: str | None = None
+    cache: str | None = None
+    model: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        _integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+        _text(self.objective, "[design] objective")
+        _text(self.search, "[design] search", SEARCHES)
+        if self.search == "exhaustive" and self.units > EXHAUSTIVE_MAX_UNITS:
+            raise SearchConfigError(
+                f"the exhaustive search takes at most {EXHAUSTIVE_MAX_UNITS} units (2^{self.units} = "
+                f"{2 ** self.units:,} designs for {self.units}); use the certified search or the genetic algorithm")
+        _text(self.executor, "[execution] executor", EXECUTORS)
+        _integer(self.seed, "[design] seed", 0, 2**32 - 1)
+        _flag(self.certify, "[design] certify")
+        _flag(self.anchored, "[design] anchored")
+        object.__setattr__(self, "amplitude", _real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
+                                                    unit="mm"))
+        object.__setattr__(self, "periods", _real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
+        object.__setattr__(self, "margin", _real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
+        object.__setattr__(self, "epsilon", _real(self.epsilon, "[design] epsilon", 0.0, 1e3))
+        object.__setattr__(self, "refine", _real(self.refine, "[design] refine", 0.0, 100.0, unit="mm"))
+        object.__setattr__(self, "tolerance", _real(self.tolerance, "[design] tolerance", 0.0, 1.0, unit="mm"))
+        if self.robust_samples is not None:
+            _integer(self.robust_samples, "[design] robust_samples", 1, 10_000)
+        if self.robust is not None:
+            _text(self.robust, "[design] robust", ROBUST)
+            if self.search != "certified" or self.tolerance == 0:
+                raise SearchConfigError("[design] robust ranks every design by the chain model under the mould "
+                                        "tolerance: it needs search = \"certified\" and a tolerance > 0")
+        if self.search != "certified":
+            given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
+                                    ("chain_table", self.chain_table), ("margin", self.margin != 1.0),
+                                    ("epsilon", self.epsilon != 0.0), ("refine", self.refine != 0.0)) if v]
+            if given:
+                raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} "
+                                        "to the "
+                                        "certified search, not to "
+                                        f"search = {self.search!r}; leave them out or set search = \"certified\"")
+        if self.verify is not None:
+            _integer(self.verify, "[design] verify", 1, 1024)
+        if self.workers is not None:
+            _integer(self.workers, "[execution] workers", 1, 1024)
+        if self.scheduler is not None:
+            _address(self.scheduler, "[execution] scheduler")
+        check_execution(self.executor, self.workers, self.scheduler,
+                        ("[execution] executor", "[execution] workers", "[execution] scheduler"))
+        for key in ("chain_table", "cache"):
+            if getattr(self, key) is not None:
+                _text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")
+        if not isinstance(self.model, dict):
+            raise SearchConfigError(f"[model] must be a table, got {self.model!r}")
+        if self.ga.seed != self.seed:
+            object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
+        if self.point is not None:
+            object.__setattr__(self, "point", _point(self.point, "[design] point"))
+        if self.curve is not None:
+            object.__setattr__(self, "curve", _curve(self.curve, "[design] curve"))
+        if self.path is not None:
+            object.__setattr__(self, "path", _curve(self.path, "[design] path"))
+        object.__setattr__(self, "stage", _stages(self.objective, self.stage))
+        self._check_periods()
+        unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
+        pitch = unit.get("pitch", UnitSpec.pitch)  # the inline unit's, else the built-in unit's
+        ok = isinstance(pitch, (int, float)) and not isinstance(pitch, bool) and pitch > 0
+        try:  # fail early on a bad objective: a profile finite along the actuator
+            self.make_objective(length=self.units * (pitch if ok else UnitSpec.pitch))
+        except (TargetExpressionError, UnknownObjectiveError, SearchConfigError) as exc:
+            if self.stage is not None:
+                raise SearchConfigError(f"[[design.stage]]: {exc}") from None
+            if isinstance(exc, SearchConfigError):
+                raise
+            raise SearchConfigError(f"[design] objective: {exc}") from None
+
+    def _check_periods(self) -> None:
+        """Refuse a sin or cos target of more periods than its unit centres can show (Eq 4.1 samples the target at
+        the ``units`` centres: past ``units / 2`` periods it aliases; one period, the presets' default, always)."""
+        presets = [("[design] periods", self.objective, self.periods)] if self.stage is None else [
+            (f"[[design.stage]] {i} periods", s["objective"], s.get("periods", 1.0))
+            for i, s in enumerate(self.stage, 1)]
+        for where, name, periods in presets:
+            if name.strip().lower() in PRESETS and periods > max(1.0, self.units / 2):
+                raise SearchConfigError(f"{where} = {periods:g}: a {name.strip().lower()} target over {self.units} "
+                                        f"unit centres shows at most {max(1.0, self.units / 2):g} periods (Eq 4.1 "
+                                        "samples it at the centres); give fewer periods or more units")
+
+    @property
+    def fidelity(self) -> str:
+        """The model's fidelity: ``[model] fidelity`` if given, else ``"3d"`` for the certified search and
+        ``"2d"`` for the genetic algorithm and the exhaustive search (as ``pneumorph design`` chooses).
+
+        >>> DesignConfig().fidelity, DesignConfig(search="ga").fidelity, DesignConfig(model={"fidelity": "2d"}).fidelity
+        ('3d', '2d', '2d')
+        """
+        given = self.model.get("fidelity")
+        if given is not None:
+            return str(given)
+        return "3d" if self.search == "certified" else "2d"
+
+    def model_settings(self) -> dict[str, Any]:
+        """``model`` with the :attr:`fidelity` written in: the settings :meth:`make_model` builds from."""
+        return {**self.model, "fidelity": self.fidelity}
+
+    def make_model(self) -> Any:
+        """The FE model of these settings, as ``pneumorph design`` builds it (:attr:`fidelity`, ``units``).
+
+        Returns
+        -------
+        pneumorph.models.fe.FEModel
+
+        Raises
+        ------
+        SearchConfigError
+            A model setting that is unknown or out of range (:func:`pneumorph.models.factory.make_model`).
+
+        Examples
+        --------
+        >>> m = DesignConfig(units=4).make_model()
+        >>> m.fidelity, m.n_units
+        ('3d', 4)
+        """
+        from pneumorph.models.factory import make_model
+
+        return make_model(self.units, self.model_settings())
+
+    def samples(self, chain: bool) -> int:
+        """Samples of the tolerance class: ``robust_samples``, else 30 by the chain model, 8 by FE solves."""
+        return self.robust_samples or (30 if chain else 8)
+
+    def make_objective(self, length: float | None = None) -> Objective:
+        """The objective these settings describe (a profile checked along ``length`` mm, if given).
+
+        >>> c = DesignConfig(objective="stages", stage=({"pressure_kpa": 18, "objective": "y = 0.05*x"},
+        ...                                            {"pressure_kpa": 45, "objective": "sin", "weight": 2}))
+        >>> c.make_objective().label
+        'stages: 18 kPa: y = 0.05*x; 45 kPa: sin: y = A*sin(2*pi*1*x/L), A = 10 mm (weight 2)'
+        """
+        if self.stage is not None:
+            return staged_target([
+                (s["pressure_kpa"] / 1e3,
+                 make_objective(s["objective"], s.get("amplitude", 10.0), s.get("periods", 1.0), s.get("point"),
+                                s.get("anchored", True), length, s.get("curve"), s.get("path")),
+                 s.get("weight", 1.0)) for s in self.stage])
+        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
+                              self.curve, self.path)
+
+    def with_options(self, design: dict[str, Any], ga: dict[str, Any] | None = None,
+                     model: dict[str, Any] | None = None, model_file: dict[str, Any] | None = None) -> DesignConfig:
+        """These settings with a front end's over them (a None value: not given), checked as a whole.
+
+        ``design`` holds ``[design]`` and ``[execution]`` keys, ``ga`` those of ``[ga]``;
+        ``model_file`` (an identified model's ``[model]`` table) goes over the config's model
+        settings and ``model`` over both. A unit source in a layer (``unit``, ``unit_file`` or
+        ``library``) replaces the one beneath it.
+
+        >>> c = DesignConfig(model={"unit": {"wall": 1.6}, "pressure_kpa": 40})
+        >>> d = c.with_options({"units": 8, "seed": None}, ga={"population": 20}, model={"library": "builtin"})
+        >>> d.units, d.seed, d.ga.population, d.model
+        (8, 0, 20, {'pressure_kpa': 40, 'library': 'builtin'})
+        """
+        settings = dict(self.model)
+        for layer in (model_file or {}, {k: v for k, v in (model or {}).items() if v is not None}):
+            if UNIT_SOURCES & set(layer):
+                settings = {k: v for k, v in settings.items() if k not in UNIT_SOURCES}
+            settings.update(layer)
+        ga_changes = {k: v for k, v in (ga or {}).items() if v is not None}
+        changed = replace(self, ga=replace(self.ga, **ga_changes), model=settings,
+                          **{k: v for k, v in design.items() if v is not None})
+        return DesignConfig.from_dict(changed.to_dict())
+
+    def as_ga(self) -> DesignConfig:
+        """The same settings searched by the genetic algorithm, the certified search's own settings dropped (the
+        fallback of a run the chain model cannot serve).
+
+        >>> DesignConfig(certify=True, epsilon=0.1).as_ga().search
+        'ga'
+        """
+        return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, refine=0.0,
+                       chain_table=None)
+
+    # -- plain-data form --------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """Nested tables ``design``, ``ga``, ``execution``, ``model`` (None values, ``epsilon = 0`` and
+        ``refine = 0`` left out)."""
+        design = {
+            k: getattr(self, k)
+            for k in ("objective", "amplitude", "periods", "point", "curve", "path", "anchored", "stage", "units",
+                      "search",
+                      "seed",
+                      "certify", "verify", "margin", "epsilon", "refine", "chain_table", "tolerance", "robust",
+                      "robust_samples")
+        }
+        for key in ("epsilon", "refine"):  # absent by default: the settings of earlier run folders stay the same
+            if design[key] == 0.0:
+                design[key] = None
+        ga = {k: v for k, v in asdict(self.ga).items() if k != "seed"}
+        execution = {k: getattr(self, k) for k in ("executor", "workers", "scheduler", "cache")}
+
+        def clean(d: dict[str, Any]) -> dict[str, Any]:
+            def plain(v: Any) -> Any:
+                if isinstance(v, dict):
+                    return {k: plain(x) for k, x in v.items()}
+                return [plain(x) for x in v] if isinstance(v, tuple) else v
+
+            return {k: plain(v) for k, v in d.items() if v is not None}
+
+        return {"design": clean(design), "ga": clean(ga), "execution": clean(execution), "model": dict(self.model)}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> DesignConfig:
+        """Settings from nested tables (unknown keys are an error, naming the key)."""
+        known_design = {f.name for f in fields(cls)} - {"ga", "model", "executor", "workers", "scheduler", "cache"}
+        known_ga = {f.name for f in fields(GAConfig)} - {"seed"}
+        known_exec = {"executor", "workers", "scheduler", "cache"}
+        tables = {"design": known_design, "ga": known_ga, "execution": known_exec}
+        for table in set(data) - {*tables, "model", "provenance"}:
+            raise SearchConfigError(f"unknown table [{table}] in the design config; "
+                                    "known: design, ga, execution, model")
+        for table in ("design", "ga", "execution", "model"):
+            if not isinstance(data.get(table, {}), dict):
+                raise SearchConfigError(f"[{table}] must be a table of settings, got {data[table]!r}")
+        kwargs: dict[str, Any] = {}
+        for table, known in tables.items():
+            for key in set(data.get(table, {})) - known:
+                raise SearchConfigError(f"unknown key {key!r} in [{table}]; known keys: {', '.join(sorted(known))}")
+        kwargs.update(data.get("design", {}))
+        kwargs.update(data.get("execution", {}))
+        ga = GAConfig(**{**data.get("ga", {}), "seed": kwargs.get("seed", 0)})
+        return cls(ga=ga, model=dict(data.get("model", {})), **kwargs)
+
+    @classmethod
+    def read(cls, path: str | Path) -> DesignConfig:
+        """Settings from a TOML file (a run folder's ``config.toml`` works too)."""
+        data = read_toml(path, "design config", SearchConfigError)
+        return cls.from_dict(data)
+
+
+#: the settings of one ``[[design.stage]]`` table, and those it must have
+STAGE_KEYS = ("pressure_kpa", "objective", "amplitude", "periods", "curve", "path", "point", "anchored", "weight")
+_STAGE_NEEDS = ("pressure_kpa", "objective")
+
+
+def _curve(points: Any, name: str) -> tuple[tuple[float, ...], ...]:
+    """A drawn curve's or a path's points as numbers (mm): all ``[x, y]`` or all ``[x, y, z]`` (in space), refusing
+    text and true/false."""
+    try:
+        if any(isinstance(v, (bool, str, bytes)) for xy in points for v in xy):
+            raise TypeError("text or true/false")
+        out = tuple(tuple(float(v) for v in xy) for xy in points)
+        if len({len(xy) for xy in out}) != 1 or len(out[0]) not in (2, 3):
+            raise ValueError("mixed or wrong point sizes")
+        return out
+    except (TypeError, ValueError, IndexError):
+        raise SearchConfigError(f"{name} must be a list of [x, y] (or all [x, y, z]) points in mm, got "
+                                f"{_short(points)}") from None
+
+
+def _short(value: Any, limit: int = 80) -> str:
+    """``repr(value)``, cut to ``limit`` characters (a long list of points in an error message)."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + " ..."
+
+
+def _point(value: Any, name: str) -> tuple[float, ...]:
+    """A tip point: ``[x, y]``, or ``[x, y, z]`` off the plane of bending (mm).
+
+    >>> _point([60, 40, -10], "[design] point")
+    (60.0, 40.0, -10.0)
+    """
+    if isinstance(value, (list, tuple)) and len(value) == 3:
+        return (*_pair(value[:2], name, unit="mm"), checks.real(value[2], name, unit="mm", error=SearchConfigError))
+    return _pair(value, name, unit="mm")
+
+
+def _stages(objective: str, stages: Any) -> tuple[dict[str, Any], ...] | None:
+    """The ``[[design.stage]]`` tables checked (types and ranges; the targets when the objective is made)."""
+    staged = objective.strip().lower() == "stages"
+    if stages is None:
+        if staged:
+            raise SearchConfigError("objective = \"stages\" needs its stages: [[design.stage]] tables with "
+                                    "pressure_kpa and objective (or --stage KPA:TARGET)")
+        return None
+    if not staged:
+        raise SearchConfigError(f"[[design.stage]] only applies to objective = \"stages\", not to {objective!r}")
+    if isinstance(stages, dict) or not isinstance(stages, (list, tuple)):
+        raise SearchConfigError(f"[[design.stage]] must be a list of tables, got {stages!r}")
+    out = []
+    for i, stage in enumerate(stages, 1):
+        where = f"[[design.stage]] {i}"
+        if not isinstance(stage, dict):
+            raise SearchConfigError(f"{where} must be a table of settings, got {stage!r}")
+        for key in set(stage) - set(STAGE_KEYS):
+            raise SearchConfigError(f"unknown key {key!r} in {where}; known keys: {', '.join(STAGE_KEYS)}")
+        for key in _STAGE_NEEDS:
+            if key not in stage:
+                raise SearchConfigError(f"{where} needs {key}")
+        s = dict(stage)
+        s["pressure_kpa"] = _real(s["pressure_kpa"], f"{where} pressure_kpa", 0.0, 1000.0, low_open=True, unit="kPa")
+        _text(s["objective"], f"{where} objective")
+        if s["objective"].strip().lower() == "stages":
+            raise SearchConfigError(f"{where} objective: a stage cannot hold stages")
+        for key, low, high in (("amplitude", 0.0, 1e5), ("periods", 0.0, 1000.0), ("weight", 0.0, 1e6)):
+            if key in s:
+                s[key] = _real(s[key], f"{where} {key}", low, high, low_open=True)
+        if "anchored" in s:
+            _flag(s["anchored"], f"{where} anchored")
+        if "point" in s:
+            s["point"] = _point(s["point"], f"{where} point")
+        for key in ("curve", "path"):
+            if key in s:
+                s[key] = _curve(s[key], f"{where} {key}")
+        out.append(s)
+    return tuple(out)
+
+
+# -- a small TOML writer (tables of scalars, lists and one level of sub-tables) -----------
+def _value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v, ensure_ascii=False)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def to_toml(tables: dict[str, dict[str, Any]]) -> str:
+    """TOML text of ``{table: {key: value or {key: value}}}``.
+
+    >>> print(to_toml({"design": {"units": 8, "point": [1.0, 2.0]}, "provenance": {"deps": {"numpy": "2.0"}}}))
+    [design]
+    units = 8
+    point = [1.0, 2.0]
+    <BLANKLINE>
+    [provenance]
+    <BLANKLINE>
+    [provenance.deps]
+    numpy = "2.0"
+    <BLANKLINE>
+    """
+    lines: list[str] = []
+    for name, table in tables.items():
+        lines.append(f"[{name}]")
+        subtables = {k: v for k, v in table.items() if isinstance(v, dict)}
+        arrays = {k: v for k, v in table.items() if isinstance(v, (list, tuple)) and v
+                  and all(isinstance(x, dict) for x in v)}
+        lines += [f"{k} = {_value(v)}" for k, v in table.items()
+                  if k not in subtables and k not in arrays and v is not None]
+        lines.append("")
+        for sub, content in subtables.items():
+            lines.append(f"[{name}.{sub}]")
+            lines += [f"{k} = {_value(v)}" for k, v in content.items() if v is not None]
+            lines.append("")
+        for sub, entries in arrays.items():  # arrays of tables: [[design.stage]]
+            for content in entries:
+                lines.append(f"[[{name}.{sub}]]")
+                lines += [f"{k} = {_value(v)}" for k, v in content.items() if v is not None]
+                lines.append("")
+    return "\n".join(lines)
