@@ -29,7 +29,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pneumorph.correlation import Scan, Transform, model_shape
-from pneumorph.design.runs.config import to_toml
+from pneumorph.design.config import to_toml
 from pneumorph.execution import CachedEvaluator, EvaluationCache, make_evaluator
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.identify import NAMES, Observation, ParameterSet, ScanSpec, identify, write_identified

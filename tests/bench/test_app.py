@@ -249,7 +249,7 @@ def test_the_page_and_its_assets_are_served_from_the_package(client: TestClient)
 
 
 def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient) -> None:
-    from pneumorph.design.runs.config import to_toml
+    from pneumorph.design.config import to_toml
     from pneumorph.geometry.unit import UnitSpec
 
     def upload(content: bytes, model: str = "2d") -> dict:

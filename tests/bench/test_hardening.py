@@ -23,7 +23,7 @@ from fastapi.testclient import TestClient
 from pneumorph.bench import create_app
 from pneumorph.bench.guard import COOKIE
 from pneumorph.bench.jobs import JobLimits
-from pneumorph.design.runs.config import to_toml
+from pneumorph.design.config import to_toml
 from pneumorph.errors import StateQuotaError
 from pneumorph.geometry.limits import MeshLimitError
 from pneumorph.geometry.meshsize import MAX_NODES_3D, check_mesh, estimate_mesh

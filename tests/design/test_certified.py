@@ -171,7 +171,7 @@ def test_an_fe_model_that_never_converges_is_given_up_early(setup) -> None:
 
 
 def test_epsilon_is_a_setting_of_the_certified_search_only() -> None:
-    from pneumorph.design.runs.config import DesignConfig
+    from pneumorph.design.config import DesignConfig
 
     config = DesignConfig(epsilon=0.05)
     assert DesignConfig.from_dict(config.to_dict()).epsilon == 0.05

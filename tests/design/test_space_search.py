@@ -124,7 +124,7 @@ def test_the_cone_of_the_chords_turns_bounds_every_prefix_tighter_than_the_ball(
 
 
 def test_the_verifications_estimate_of_a_model_over_sideways_units_is_the_full_widths() -> None:
-    from pneumorph.design.certified.search import solve_estimate
+    from pneumorph.models.chain.plan import solve_estimate
     from pneumorph.models.factory import make_model
 
     assert solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 15 s each)"

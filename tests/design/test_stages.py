@@ -11,9 +11,9 @@ import pytest
 from pneumorph.cli import main
 from pneumorph.design import DesignConfig, make_objective, run_exhaustive
 from pneumorph.design.certified.search import certified_search, chain_errors, chain_scores, objective_bounds
+from pneumorph.design.config import to_toml
 from pneumorph.design.objectives.fitness import objective_values, stage_values
 from pneumorph.design.objectives.targets import StagedTarget, staged_target, tip_goal
-from pneumorph.design.runs.config import to_toml
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.models.chain.model import ChainModel, design_strings

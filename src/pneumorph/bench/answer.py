@@ -136,7 +136,7 @@ class Bench:
         with self._lock:
             if unit_id not in self._specs:
                 if self.unit_dir is not None:
-                    from pneumorph.design.runs.config import to_toml
+                    from pneumorph.design.config import to_toml
 
                     self.unit_dir.mkdir(parents=True, exist_ok=True)
                     atomic_write_text(self.unit_dir / f"{unit_id}.toml", to_toml({"unit": spec.to_dict()}))

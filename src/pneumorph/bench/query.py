@@ -18,6 +18,7 @@ import numpy as np
 
 from pneumorph import checks
 from pneumorph.bench.strokes import AXIS_MM, is_path_stroke, smooth_path
+from pneumorph.design.config import DesignConfig
 from pneumorph.design.objectives.paths import PATH_PRESETS, path_points
 from pneumorph.design.objectives.targets import (
     MAX_STAGES,
@@ -28,7 +29,6 @@ from pneumorph.design.objectives.targets import (
     smooth_curve,
     staged_target,
 )
-from pneumorph.design.runs.config import DesignConfig
 from pneumorph.errors import PneumorphError, SettingsError
 from pneumorph.io.files import nested_deeper
 

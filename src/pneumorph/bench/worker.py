@@ -119,7 +119,7 @@ def verify(job: dict[str, Any], bench: Bench, report: Reporter) -> dict[str, Any
     In 3D the chain's best design is solved first, keeping its fields for the 3D view; its
     response goes into the cache, where the design run finds it.
     """
-    from pneumorph.design.runs.driver import run_design
+    from pneumorph.design.driver import run_design
 
     query = Query.from_dict(job["params"]["query"])
     folder = Path(job["folder"])

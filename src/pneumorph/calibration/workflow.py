@@ -264,7 +264,7 @@ class _Plan:
 
 def _write(plan: _Plan, result: Calibration, solve_3d: Solve3D, folder: Path) -> CalibrationRun:
     """Fig 5.3, the calibrated unit, the held-out check with its figures, and ``calibration.json``."""
-    from pneumorph.design.runs.config import to_toml
+    from pneumorph.design.config import to_toml
 
     files = [plot_calibration(result, folder / "calibration.png")]
     summary: dict[str, Any] = {

@@ -20,8 +20,11 @@ Examples
 'sin: y = A*sin(2*pi*1*x/L), A = 15 mm'
 """
 
+from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
 from pneumorph.design.certified.certificate import certificate_text
 from pneumorph.design.certified.search import CertifiedResult, certified_search
+from pneumorph.design.config import DesignConfig
+from pneumorph.design.driver import run_design
 from pneumorph.design.objectives.fitness import Score, score
 from pneumorph.design.objectives.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
 from pneumorph.design.objectives.targets import (
@@ -37,8 +40,6 @@ from pneumorph.design.objectives.targets import (
     smooth_curve,
     tip_goal,
 )
-from pneumorph.design.runs.config import DesignConfig
-from pneumorph.design.runs.driver import run_design
 from pneumorph.design.runs.report import RunResult
 from pneumorph.design.search.exhaustive import (
     ExhaustiveResult,
@@ -47,7 +48,6 @@ from pneumorph.design.search.exhaustive import (
 )
 from pneumorph.design.search.genetic import GAConfig, GAResult, GenerationStats, run_ga
 from pneumorph.design.search.population import PopulationStudy, plot_population_study, population_study
-from pneumorph.design.search.problem import Algorithm, Problem, Search, SearchOutcome
 from pneumorph.design.search.scoring import Candidate
 
 __all__ = [

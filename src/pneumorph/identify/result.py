@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.design.runs.config import to_toml
+from pneumorph.design.config import to_toml
 from pneumorph.identify.fit import Identification
 from pneumorph.identify.parameters import NAMES
 from pneumorph.io.files import atomic_write_text

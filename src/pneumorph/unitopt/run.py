@@ -142,7 +142,7 @@ def unit_file(candidate: UnitCandidate, label: str, result: UnitOptimisation, pr
     then ``[unitopt]`` with its measures and where it comes from (ignored by :meth:`UnitSpec.from_toml`)."""
     from dataclasses import replace
 
-    from pneumorph.design.runs.config import to_toml
+    from pneumorph.design.config import to_toml
     from pneumorph.geometry.unit import UnitSpec
 
     unit = replace(candidate.unit, name=f"unitopt_{label.replace('-', '_')}")

@@ -1,5 +1,5 @@
 """The search strategies of a design run, one module each, with the interface of
-:class:`pneumorph.design.search.problem.Algorithm`.
+:class:`pneumorph.design.algorithms.problem.Algorithm`.
 
 - ``certified`` (:class:`CertifiedSearch`): every design scored by the chain model, the best
   verified by FE, with a bound on what any other design could do.
@@ -12,7 +12,7 @@ A new strategy is a new module here with a class of that interface, named in :da
 
 Examples
 --------
->>> from pneumorph.design.runs.config import DesignConfig
+>>> from pneumorph.design.config import DesignConfig
 >>> [algorithm_for(DesignConfig(search=s)).name for s in ("certified", "ga", "exhaustive")]
 ['certified', 'ga', 'exhaustive']
 >>> type(algorithm_for(DesignConfig(robust="worst"))).__name__

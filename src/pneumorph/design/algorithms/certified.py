@@ -18,12 +18,12 @@ from typing import Any
 import numpy as np
 
 from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
+from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
 from pneumorph.design.certified.planning import SearchPlan, plan_search
 from pneumorph.design.certified.search import CertifiedResult, certified_search, chain_candidate
 from pneumorph.design.objectives.fitness import Score
 from pneumorph.design.runs.comparison import compare_with_reference
 from pneumorph.design.runs.robustness import chain_robustness, winner_robustness
-from pneumorph.design.search.problem import Algorithm, Problem, Search, SearchOutcome
 from pneumorph.errors import LocalityError, MissingTableError, PneumorphError, SearchConfigError
 from pneumorph.models.chain.model import ChainModel
 from pneumorph.models.chain.sources import serve_table, table_for

@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
+from pneumorph.design.algorithms.problem import Problem, Search, SearchOutcome
 from pneumorph.design.runs.robustness import winner_robustness
 from pneumorph.design.search.exhaustive import run_exhaustive
-from pneumorph.design.search.problem import Problem, Search, SearchOutcome
 
 
 class ExhaustiveSearch(Search):

@@ -1,12 +1,12 @@
 """The genetic algorithm as a search strategy: :func:`pneumorph.design.search.genetic.run_ga` on a
-:class:`~pneumorph.design.search.problem.Problem`, its generations logged to ``generations.csv``."""
+:class:`~pneumorph.design.algorithms.problem.Problem`, its generations logged to ``generations.csv``."""
 
 from __future__ import annotations
 
+from pneumorph.design.algorithms.problem import Problem, Search, SearchOutcome
 from pneumorph.design.runs.folder import GenerationLog
 from pneumorph.design.runs.robustness import winner_robustness
 from pneumorph.design.search.genetic import GenerationStats, run_ga
-from pneumorph.design.search.problem import Problem, Search, SearchOutcome
 
 
 class GeneticSearch(Search):

@@ -7,8 +7,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 from pneumorph.design.algorithms.certified import CertifiedSearch
+from pneumorph.design.algorithms.problem import Problem, SearchOutcome
 from pneumorph.design.runs.robustness import chain_robustness, robust_ranking, robust_winner
-from pneumorph.design.search.problem import Problem, SearchOutcome
 
 
 class RobustSearch(CertifiedSearch):

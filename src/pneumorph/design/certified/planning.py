@@ -1,6 +1,6 @@
 """Which search a certified run makes, with which chain table, and what it will build - before anything runs.
 
-A certified run (:func:`pneumorph.design.runs.driver.run_design`) first looks for a chain table
+A certified run (:func:`pneumorph.design.driver.run_design`) first looks for a chain table
 that serves its model (:func:`pneumorph.models.chain.sources.serve_table`: the shipped or a
 kept table of its source, or of a longer ramp of the same step, restricted to the levels
 at or below its pressure). Then :func:`plan_search` decides:
@@ -18,7 +18,7 @@ at or below its pressure). Then :func:`plan_search` decides:
 
 Examples
 --------
->>> from pneumorph.design.runs.config import DesignConfig
+>>> from pneumorph.design.config import DesignConfig
 >>> from pneumorph.models.factory import make_model
 >>> config = DesignConfig(units=6)
 >>> plan = plan_search(config, make_model(6, {"fidelity": "3d"}), None, workers=2)
@@ -79,7 +79,7 @@ class SearchPlan:
 def planned_workers(config: Any) -> int:
     """The workers a run's evaluator will have: 1 for serial, the config's or all cores otherwise.
 
-    >>> from pneumorph.design.runs.config import DesignConfig
+    >>> from pneumorph.design.config import DesignConfig
     >>> planned_workers(DesignConfig(executor="serial")), planned_workers(DesignConfig(executor="processes", workers=3))
     (1, 3)
     """
@@ -212,7 +212,7 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
 def missing_table_message(config: Any, model: Any, table_dir: str | Path | None, workers: int = 1) -> str:
     """The one line of a run that needs a chain table and may not build it: which table, how to build it.
 
-    >>> from pneumorph.design.runs.config import DesignConfig
+    >>> from pneumorph.design.config import DesignConfig
     >>> from pneumorph.models.factory import make_model
     >>> config = DesignConfig(units=10, model={"fidelity": "3d", "pressure_kpa": 3})
     >>> print(missing_table_message(config, make_model(10, config.model), "tables"))

@@ -49,6 +49,7 @@ from pneumorph.design.search.scoring import Candidate, ScoreBook
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.plan import solve_estimate
 from pneumorph.models.response import ActuatorModel
 
 
@@ -88,19 +89,6 @@ class CertifiedResult:
     scores: ChainScores = field(repr=False)
     solves: int = 0
     wall_time: float = 0.0
-
-
-def solve_estimate(model: Any, count: int) -> str:
-    """`` (about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units: the
-    full width's), or nothing."""
-    from pneumorph.models.chain.plan import cost_fidelity, duration_text, solve_seconds
-
-    fidelity = cost_fidelity(model)
-    seconds = solve_seconds(fidelity, int(getattr(model, "n_units", 0) or 0))
-    if not seconds:
-        return ""
-    each = " each" if count > 1 else ""
-    return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
 def chain_candidate(chain: ChainModel, objective: Objective, design: str) -> Candidate:

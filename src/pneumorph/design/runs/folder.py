@@ -1,7 +1,7 @@
 """A design run's folder: which files are a run's, whether a folder holds the same run, the
 generation log a resumed run appends to.
 
-Nothing a run writes is lost or mixed up (:mod:`pneumorph.design.runs.driver` says how the run
+Nothing a run writes is lost or mixed up (:mod:`pneumorph.design.driver` says how the run
 claims its folder): ``overwrite`` removes the files of the old run (:data:`RUN_FILES` and the
 files its report lists), ``config.toml`` last; ``generations.csv`` is appended to, never
 truncated by a resumed run (see :class:`GenerationLog`).
@@ -17,7 +17,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from pneumorph.design.runs.config import DesignConfig
+from pneumorph.design.config import DesignConfig
 from pneumorph.design.search.genetic import GenerationStats
 from pneumorph.errors import RunFolderError
 from pneumorph.io.files import atomic_write_text

@@ -20,7 +20,7 @@ import numpy as np
 from pneumorph.design.certified.certificate import certificate_text
 from pneumorph.design.certified.search import CertifiedResult
 from pneumorph.design.runs.comparison import comparison_lines
-from pneumorph.design.runs.config import DesignConfig
+from pneumorph.design.config import DesignConfig
 from pneumorph.design.runs.figures import plot_convergence, plot_profile
 from pneumorph.design.objectives.fitness import stage_values
 from pneumorph.design.search.genetic import GenerationStats

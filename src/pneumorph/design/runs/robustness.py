@@ -138,7 +138,7 @@ def fe_robustness(config: Any, model: Any, objective: Any, winner: Candidate, ev
 
 def winner_robustness(problem: Any, winner: Candidate | None) -> dict[str, Any] | None:
     """A run's winner under the mould tolerance by FE solves (:func:`fe_robustness`) for a
-    :class:`~pneumorph.design.search.problem.Problem`; None without a tolerance, over a unit library of
+    :class:`~pneumorph.design.algorithms.problem.Problem`; None without a tolerance, over a unit library of
     several types (the tolerances are those of one unit) or for a failed winner."""
     config = problem.config
     if config.tolerance == 0 or getattr(problem.model, "mixed", False) or winner is None or winner.failure is not None:

@@ -380,7 +380,7 @@ def run_ga(
     start = time.perf_counter()
     population = toolbox.population(n=config.population)
     if on_message:  # the FE verification's estimate of a solve (pneumorph.design.certified.search)
-        from pneumorph.design.certified.search import solve_estimate
+        from pneumorph.models.chain.plan import solve_estimate
 
         distinct = len({run.design(ind) for ind in population})
         on_message(f"evaluating generation 0: {distinct} designs{solve_estimate(model, distinct)} ...")

@@ -316,5 +316,16 @@ def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | N
     return count
 
 
+def solve_estimate(model: Any, count: int) -> str:
+    """`` (about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units: the
+    full width's), or nothing."""
+    fidelity = cost_fidelity(model)
+    seconds = solve_seconds(fidelity, int(getattr(model, "n_units", 0) or 0))
+    if not seconds:
+        return ""
+    each = " each" if count > 1 else ""
+    return f" ({fidelity}, about {duration_text(seconds)}{each})"
+
+
 __all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "cost_fidelity",
-           "duration_text", "estimate_text", "evaluator_workers", "solve_seconds", "unit_text"]
+           "duration_text", "estimate_text", "evaluator_workers", "solve_estimate", "solve_seconds", "unit_text"]

@@ -10,7 +10,7 @@ As in pymoo, the problem, the algorithm and the driver are apart:
   :mod:`pneumorph.design.algorithms`.
 - :class:`SearchOutcome` - what an algorithm found: its hall of fame and whatever else it
   measured (generations, a ranking, a certificate, a robustness report).
-- the driver, :func:`pneumorph.design.runs.driver.run_design`, claims the run folder, runs the
+- the driver, :func:`pneumorph.design.driver.run_design`, claims the run folder, runs the
   algorithm and writes its outcome.
 
 An algorithm has four steps, each called once by the driver:
@@ -26,7 +26,7 @@ An algorithm has four steps, each called once by the driver:
 
 Examples
 --------
->>> from pneumorph.design.runs.config import DesignConfig
+>>> from pneumorph.design.config import DesignConfig
 >>> from pneumorph.design.algorithms import algorithm_for
 >>> algorithm_for(DesignConfig(search="ga")).name
 'ga'
@@ -47,7 +47,7 @@ from pneumorph.models.response import ActuatorModel
 
 if TYPE_CHECKING:
     from pneumorph.design.certified.search import CertifiedResult
-    from pneumorph.design.runs.config import DesignConfig
+    from pneumorph.design.config import DesignConfig
 
 
 def _silent(text: str) -> None:

@@ -2,7 +2,7 @@
 
 Folder contents:
 
-- ``config.toml`` - the settings (:class:`~pneumorph.design.runs.config.DesignConfig`) and a
+- ``config.toml`` - the settings (:class:`~pneumorph.design.config.DesignConfig`) and a
   ``[provenance]`` table: pneumorph version, date, seed, model fidelity and fingerprint,
   pressures, Python and dependency versions.
 - ``generations.csv`` - one row per generation, written as the run goes (GA).
@@ -50,7 +50,7 @@ Nothing a run writes is lost or mixed up:
 
 The driver, :func:`run_design`, runs one of the search strategies of
 :mod:`pneumorph.design.algorithms` (the config's ``search``) on a
-:class:`~pneumorph.design.search.problem.Problem`: the algorithm plans before the folder is touched
+:class:`~pneumorph.design.algorithms.problem.Problem`: the algorithm plans before the folder is touched
 (a certified search picks its chain table, or hands a short actuator to the FE exhaustive
 search; :attr:`RunResult.search` and :attr:`RunResult.search_note` say which and why), sets
 up under the folder's lock (builds a table no shipped or kept table serves, or with
@@ -67,12 +67,12 @@ from types import TracebackType
 from typing import Any
 
 from pneumorph.design.algorithms import algorithm_for
-from pneumorph.design.runs.config import DesignConfig, to_toml
-from pneumorph.design.runs.folder import check_folder, created_top, remove_empty, remove_run_files
+from pneumorph.design.algorithms.problem import Algorithm, Problem, SearchOutcome
 from pneumorph.design.certified.planning import planned_workers
-from pneumorph.design.search.problem import Algorithm, SearchOutcome, Problem
-from pneumorph.design.runs.report import RunResult, write_outputs, write_report
+from pneumorph.design.config import DesignConfig, to_toml
 from pneumorph.design.objectives.targets import StagedTarget, on_actuator
+from pneumorph.design.runs.folder import check_folder, created_top, remove_empty, remove_run_files
+from pneumorph.design.runs.report import RunResult, write_outputs, write_report
 from pneumorph.errors import OutputPathError, SearchConfigError
 from pneumorph.execution.cache import CachedEvaluator, EvaluationCache, chain_table_dir, default_cache_path
 from pneumorph.execution.evaluators import Evaluator, make_evaluator
@@ -105,7 +105,7 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
     exhaustive search's (done, total) and a line of text; ``overwrite`` starts afresh in a
     folder of another run; ``figures`` draws them; ``build`` lets a certified run build the
     tables it needs; ``algorithm`` searches instead of the config's ``search`` (any object with the
-    :class:`~pneumorph.design.search.problem.Algorithm` interface; the run's provenance names it);
+    :class:`~pneumorph.design.algorithms.problem.Algorithm` interface; the run's provenance names it);
     ``reference`` is a model whose optimum a certified run judges by ``model`` (the nominal
     model of an identified one, :mod:`pneumorph.design.runs.comparison`).
 

@@ -43,9 +43,9 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
+from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
 from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.search.genetic import GAConfig
-from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
 from pneumorph.errors import (
     SearchConfigError,
     TargetExpressionError,
