@@ -13,7 +13,7 @@ from pneumorph.errors import OrientationError, PressureRangeError, SettingsError
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get_filler
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 
 LOW = RampSpec(pressure=0.01, steps=StepSettings(increments=2, substeps=2))

@@ -13,7 +13,7 @@ import numpy as np
 from pneumorph.cli import params as P
 from pneumorph.errors import DataFormatError
 from pneumorph.io.files import read_text_file, strict_json
-from pneumorph.materials import characterise as ch
+from pneumorph.materials.characterisation import analyses as ch
 
 _STRAIN_SCALE = {"fraction": 1.0, "percent": 0.01}
 

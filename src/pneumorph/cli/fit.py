@@ -8,11 +8,11 @@ from pneumorph import __version__
 from pneumorph.checks import MAX_STARTS
 from pneumorph.cli import params as P
 from pneumorph.io.files import strict_json
-from pneumorph.materials.comparison import compare
-from pneumorph.materials.datasets import list_datasets, read_test_data
-from pneumorph.materials.fitting import MODEL_NAMES, WEIGHTINGS, resolve_model
-from pneumorph.materials.hyperelastic import MODES
-from pneumorph.materials.testdata import COLUMN_ROLES, TRUNCATE
+from pneumorph.materials.characterisation.datasets import list_datasets, read_test_data
+from pneumorph.materials.characterisation.testdata import COLUMN_ROLES, TRUNCATE
+from pneumorph.materials.fitting.comparison import compare
+from pneumorph.materials.fitting.fit import MODEL_NAMES, WEIGHTINGS, resolve_model
+from pneumorph.materials.laws.hyperelastic import MODES
 
 
 @click.command("fit")
@@ -61,7 +61,7 @@ def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, column
     (e.g. treloar1944). Several files are combined, each mode taken from its file name
     (Treloar_ut.dat, .../PS/...) unless --mode is given.
     """
-    from pneumorph.materials.testdata import column_roles, stress_unit_factor
+    from pneumorph.materials.characterisation.testdata import column_roles, stress_unit_factor
 
     models = models or ("ogden-3",)
     with P.blame("--model"):

@@ -9,9 +9,9 @@ import click
 from pneumorph.cli import params as P
 from pneumorph.errors import UnknownMaterialError
 from pneumorph.io.files import strict_json
-from pneumorph.materials import library
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.library import Material, Quantity
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.library import builtin as library
+from pneumorph.materials.library.builtin import Material, Quantity
 
 _LABELS = {
     "density": "density",

@@ -247,7 +247,7 @@ def check_materials(spec: UnitSpec | UnitLibrary, base_block: BaseBlock | None =
     ...
     pneumorph.errors.UnknownMaterialError: unknown material 'nonesuch'; known materials: ...
     """
-    from pneumorph.materials.library import get
+    from pneumorph.materials.library.builtin import get
 
     for unit in _types(spec, design):
         for name in (unit.body_material, *([unit.layer_material] if unit.layer > 0 else [])):

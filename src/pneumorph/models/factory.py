@@ -104,9 +104,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         model's fingerprint then holding the library (unless it has one type only); the
         body silicone's moduli scaled, as an identified model has them
         (``pneumorph identify``, docs/identify.md): ``body_bulk_scale`` (its bulk modulus,
-        :func:`~pneumorph.materials.scaling.scaled_bulk_modulus`) and
+        :func:`~pneumorph.materials.library.scaling.scaled_bulk_modulus`) and
         ``body_shear_scale`` (its Ogden moduli,
-        :func:`~pneumorph.materials.scaling.scaled_shear_modulus`), each in
+        :func:`~pneumorph.materials.library.scaling.scaled_shear_modulus`), each in
         :data:`SCALE_RANGE` (default 1: the library's silicone, the same fingerprint).
 
     Examples
@@ -237,7 +237,7 @@ def _scaled_body(settings: Mapping[str, Any], unit: UnitSpec) -> Any:
     if scales == [1.0, 1.0]:
         return None  # the library's material: every earlier fingerprint stays valid
     from pneumorph.materials import get
-    from pneumorph.materials.scaling import scaled_bulk_modulus, scaled_shear_modulus
+    from pneumorph.materials.library.scaling import scaled_bulk_modulus, scaled_shear_modulus
 
     body = get(unit.body_material)
     if scales[0] != 1.0:

@@ -33,8 +33,8 @@ from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.provenance import digest
 from pneumorph.materials import get
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.material import Material
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.gravity import gravity_vector
 from pneumorph.models.frames import record_frames
 from pneumorph.models.response import FloatArray, Response

@@ -15,7 +15,7 @@ from pneumorph.fem import StepSettings
 from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.materials.material import Material
+from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.base import FEModel, RampSpec
 
 

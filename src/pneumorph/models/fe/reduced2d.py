@@ -19,8 +19,8 @@ from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get_filler
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.material import Material
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.base import FEModel, RampSpec, model_library
 
 

@@ -164,7 +164,7 @@ class FillerLaw:
 
     def umat(self, pressure_mpa: float) -> Any:
         """FElupe linear-elastic material at a fixed pressure (FElupe imported lazily)."""
-        from pneumorph.materials import felupe_models
+        from pneumorph.materials.laws import felupe_models
 
         return felupe_models.build_linear_elastic(self.modulus(float(pressure_mpa)), self.poisson_ratio)
 

@@ -7,15 +7,15 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import MaterialDataError
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.laws.hyperelastic import (
     HyperelasticModel,
     MooneyRivlin,
     NeoHooke,
     Ogden,
     Yeoh,
 )
-from pneumorph.materials.material import (
+from pneumorph.materials.library.material import (
     KINDS,
     POSITIVE_PROPERTIES,
     PROPERTIES,
@@ -25,7 +25,7 @@ from pneumorph.materials.material import (
     Quantity,
     normalise,
 )
-from pneumorph.materials.units import INTERNAL_UNITS, UNITS, to_internal
+from pneumorph.materials.library.units import INTERNAL_UNITS, UNITS, to_internal
 
 _MODEL_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     # type: (required, optional)

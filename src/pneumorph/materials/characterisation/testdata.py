@@ -31,7 +31,7 @@ rows after it record the specimen tearing, not the material law.
 
 Examples
 --------
->>> from pneumorph.materials.datasets import load_dataset
+>>> from pneumorph.materials.characterisation.datasets import load_dataset
 >>> data = load_dataset("treloar1944")
 >>> data.modes
 ('uniaxial', 'equibiaxial', 'planar')
@@ -52,8 +52,8 @@ import numpy as np
 
 from pneumorph.errors import DataFormatError
 from pneumorph.io.files import read_text_file
-from pneumorph.materials.curves import MAX_STRESS_MPA, MAX_STRETCH, TestCurve, TestData
-from pneumorph.materials.hyperelastic import MODES
+from pneumorph.materials.characterisation.curves import MAX_STRESS_MPA, MAX_STRETCH, TestCurve, TestData
+from pneumorph.materials.laws.hyperelastic import MODES
 
 #: Stress units understood by the readers and their factor to MPa.
 STRESS_UNITS: Mapping[str, float] = MappingProxyType(

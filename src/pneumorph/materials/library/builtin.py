@@ -8,7 +8,7 @@ This module turns them into immutable :class:`Material` objects in the internal 
 
 Examples
 --------
->>> from pneumorph.materials import library
+>>> from pneumorph.materials.library import builtin as library
 >>> ms15 = library.get("Mold Star 15")
 >>> ms15.name, round(ms15.shear_modulus, 4), ms15.bulk_modulus.value
 ('mold_star_15', 0.1314, 0.119)
@@ -25,16 +25,16 @@ from importlib import resources
 from pathlib import Path
 
 from pneumorph.errors import MaterialDataError, UnknownMaterialError
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.material import (
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.library.material import (
     BUILTIN_ORIGIN,
     Library,
     Material,
     Quantity,
     normalise,
 )
-from pneumorph.materials.schema import load_library, parse_library
-from pneumorph.materials.units import INTERNAL_UNITS, UNITS, to_internal
+from pneumorph.materials.library.schema import load_library, parse_library
+from pneumorph.materials.library.units import INTERNAL_UNITS, UNITS, to_internal
 
 __all__ = [
     "INTERNAL_UNITS",

@@ -27,7 +27,7 @@ shear modulus is ``mu0 = sum mu_n alpha_n / 2``. FElupe writes
 
 Examples
 --------
->>> from pneumorph.materials.hyperelastic import NeoHooke, Ogden
+>>> from pneumorph.materials.laws.hyperelastic import NeoHooke, Ogden
 >>> NeoHooke(c10=0.5).uniaxial(2.0)  # 2 C10 (l - l^-2)
 array(1.75)
 >>> round(Ogden(mu=(-6.503e-6, 0.2169, 1.372e-3), alpha=(-21.32, 1.180, 4.884)).shear_modulus, 4)

@@ -45,7 +45,7 @@ residuals on top of that.
 
 Examples
 --------
->>> from pneumorph.materials.datasets import load_dataset
+>>> from pneumorph.materials.characterisation.datasets import load_dataset
 >>> r = fit("yeoh", load_dataset("treloar1944"))
 >>> {m: round(v, 3) for m, v in r.r2.items()}
 {'uniaxial': 0.995, 'equibiaxial': 0.945, 'planar': 0.998}
@@ -62,7 +62,9 @@ from typing import Any
 import numpy as np
 
 from pneumorph.errors import FitError, UnknownModelError
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.characterisation.testdata import TestCurve, TestData
+from pneumorph.materials.fitting.ogden import fit_ogden
+from pneumorph.materials.laws.hyperelastic import (
     MODES,
     FloatArray,
     HyperelasticModel,
@@ -73,8 +75,6 @@ from pneumorph.materials.hyperelastic import (
     Yeoh,
     drucker_stability,
 )
-from pneumorph.materials.ogdenfit import fit_ogden
-from pneumorph.materials.testdata import TestCurve, TestData
 
 #: Names accepted by :func:`fit` (``N`` is a number of terms, 1-6).
 MODEL_NAMES = ("neo-hooke", "mooney-rivlin-2", "mooney-rivlin-3", "yeoh", "yeoh-N", "ogden-3", "ogden-N")
@@ -139,7 +139,7 @@ class FitResult:
     model_name : str
         Canonical model name (``"yeoh"`` becomes ``"yeoh-3"``).
     model : HyperelasticModel
-        The fitted model (:mod:`pneumorph.materials.hyperelastic`).
+        The fitted model (:mod:`pneumorph.materials.laws.hyperelastic`).
     parameters : mapping of str to float
         Named parameters, MPa (Ogden exponents dimensionless).
     mu0 : float
@@ -318,7 +318,7 @@ def fit(model_name: str, data: TestData | TestCurve, *, modes: Sequence[str] | N
 
     Examples
     --------
-    >>> from pneumorph.materials.testdata import TestCurve
+    >>> from pneumorph.materials.characterisation.testdata import TestCurve
     >>> lam = [1.1, 1.5, 2.0, 3.0]
     >>> curve = TestCurve("uniaxial", lam, NeoHooke(0.2).uniaxial(lam))
     >>> r = fit("neo-hooke", curve)

@@ -1,6 +1,6 @@
 """Several models fitted to the same data, side by side (:func:`compare`, :class:`FitComparison`):
 R^2 per mode (Eqs A.1-A.3) as a text, Markdown or JSON table; the fits:
-:mod:`pneumorph.materials.fitting`.
+:mod:`pneumorph.materials.fitting.fit`.
 """
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from pneumorph.materials.fitting import FitResult, fit, resolve_model
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.characterisation.testdata import TestCurve, TestData
+from pneumorph.materials.fitting.fit import FitResult, fit, resolve_model
+from pneumorph.materials.laws.hyperelastic import (
     MODES,
 )
-from pneumorph.materials.testdata import TestCurve, TestData
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,7 +80,7 @@ def compare(model_names: Sequence[str], data: TestData | TestCurve, **options: A
 
     Examples
     --------
-    >>> from pneumorph.materials.datasets import load_dataset
+    >>> from pneumorph.materials.characterisation.datasets import load_dataset
     >>> t = compare(["neo-hooke", "mooney-rivlin-2"], load_dataset("treloar1944"))
     >>> print(t.to_markdown().splitlines()[0])
     | model | R^2 uniaxial | R^2 equibiaxial | R^2 planar | R^2 overall | mu0 [MPa] | Drucker-stable |

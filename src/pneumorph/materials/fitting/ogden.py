@@ -1,4 +1,4 @@
-"""The multi-start least-squares fit of an Ogden model (:func:`pneumorph.materials.fitting.fit`).
+"""The multi-start least-squares fit of an Ogden model (:func:`pneumorph.materials.fitting.fit.fit`).
 
 Ogden's model is nonlinear in its exponents: the moduli ``mu_n`` for given exponents are a
 linear least-squares problem (:func:`ogden_columns`), the exponents are found from several
@@ -13,8 +13,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from pneumorph.errors import FitError
-from pneumorph.materials.hyperelastic import FloatArray, mode_stretches
-from pneumorph.materials.testdata import TestCurve
+from pneumorph.materials.characterisation.testdata import TestCurve
+from pneumorph.materials.laws.hyperelastic import FloatArray, mode_stretches
 
 __all__ = ["fit_ogden", "ogden_columns"]
 
@@ -59,7 +59,7 @@ def fit_ogden(curves: Sequence[TestCurve], y: FloatArray, w: FloatArray, n: int,
     works on the exponents directly, each keeping its sign). ``y`` and ``w`` are the
     stresses of ``curves`` and their weights, ``n`` the terms; each of the ``starts`` draws
     its exponents from ``rng`` (the lowest cost wins); ``alpha_bound``, ``gap`` and
-    ``stable`` are :func:`~pneumorph.materials.fitting.fit`'s ``alpha_bound``,
+    ``stable`` are :func:`~pneumorph.materials.fitting.fit.fit`'s ``alpha_bound``,
     ``min_alpha_gap`` and ``stable``. Raises :class:`FitError` if every start ends with
     non-finite parameters.
     """

@@ -9,8 +9,8 @@ from dataclasses import replace
 
 from pneumorph import checks
 from pneumorph.errors import MaterialDataError
-from pneumorph.materials.hyperelastic import Ogden
-from pneumorph.materials.material import Material
+from pneumorph.materials.laws.hyperelastic import Ogden
+from pneumorph.materials.library.material import Material
 
 
 def scaled_bulk_modulus(material: Material, factor: float) -> Material:

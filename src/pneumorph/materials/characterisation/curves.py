@@ -1,6 +1,6 @@
 """Test curves as records: one mode's stretch and nominal stress (:class:`TestCurve`, checked on
 creation) and a material's set of them (:class:`TestData`); reading them from files:
-:mod:`pneumorph.materials.testdata`.
+:mod:`pneumorph.materials.characterisation.testdata`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 
 from pneumorph.errors import DataFormatError
-from pneumorph.materials.hyperelastic import MODES, FloatArray
+from pneumorph.materials.laws.hyperelastic import MODES, FloatArray
 
 #: Bounds of plausible test data: beyond them a number is a unit mistake (or overflows the fit).
 MAX_STRETCH = 100.0
@@ -132,7 +132,7 @@ class TestData:
 
         Examples
         --------
-        >>> from pneumorph.materials.datasets import load_dataset
+        >>> from pneumorph.materials.characterisation.datasets import load_dataset
         >>> len(load_dataset("treloar1944").restrict(max_stretch=3.0).curve("uniaxial"))
         9
         """

@@ -17,7 +17,7 @@ Ogden parameters are in the published (MSC Marc) convention,
 Examples
 --------
 >>> import numpy as np
->>> from pneumorph.materials.hyperelastic import NeoHooke
+>>> from pneumorph.materials.laws.hyperelastic import NeoHooke
 >>> umat = build_umat(NeoHooke(c10=0.5), bulk_modulus=1000.0)
 >>> F = np.diag([1.0, 1.0, 1.0]).reshape(3, 3, 1, 1)
 >>> float(abs(umat.gradient([F, None])[0]).max())  # stress-free reference state
@@ -37,7 +37,7 @@ from tensortrax.math import trace
 from tensortrax.math.linalg import det, eigvalsh
 
 from pneumorph.errors import MaterialDataError, UnknownModelError
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.laws.hyperelastic import (
     HyperelasticModel,
     MooneyRivlin,
     NeoHooke,
@@ -78,7 +78,7 @@ def isochoric_function(
     Parameters
     ----------
     model : NeoHooke, MooneyRivlin, Yeoh or Ogden
-        A closed-form model from :mod:`pneumorph.materials.hyperelastic`.
+        A closed-form model from :mod:`pneumorph.materials.laws.hyperelastic`.
     eigen_perturbation : float
         Ogden only: relative perturbation of ``C`` that separates repeated eigenvalues
         in tensortrax's ``eigvalsh`` (default :data:`OGDEN_EIGEN_PERTURBATION`).
@@ -112,7 +112,7 @@ def isochoric_function(
     Examples
     --------
     >>> import felupe as fem
-    >>> from pneumorph.materials.hyperelastic import Ogden
+    >>> from pneumorph.materials.laws.hyperelastic import Ogden
     >>> umat = fem.Hyperelastic(isochoric_function(Ogden(mu=(1.0,), alpha=(2.0,))))
     >>> import numpy as np
     >>> l1, l2 = 2.0, 0.5**0.5  # uniaxial, stretch 2
@@ -275,7 +275,7 @@ def build_umat(
 
     Examples
     --------
-    >>> from pneumorph.materials.hyperelastic import Yeoh
+    >>> from pneumorph.materials.laws.hyperelastic import Yeoh
     >>> umat = build_umat(Yeoh(c=(0.1, 1e-3)), 0.119, "nearly-incompressible")
     >>> type(umat).__name__, umat.bulk
     ('NearlyIncompressible', 0.119)

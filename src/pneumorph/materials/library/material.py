@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from pneumorph.errors import MaterialDataError, UnknownMaterialError
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.laws.hyperelastic import (
     HyperelasticModel,
     Ogden,
     ogden_marc_to_felupe,
@@ -159,7 +159,7 @@ class Material:
 
     Examples
     --------
-    >>> from pneumorph.materials.library import get
+    >>> from pneumorph.materials.library.builtin import get
     >>> m = get("smooth_sil_950")
     >>> round(m.shear_modulus, 5), [round(x, 5) for x in m.ogden_felupe_mu]
     (0.53338, [0.46833, 0.06505, 0.0])
@@ -271,7 +271,7 @@ class Material:
         Returns
         -------
         felupe constitutive material
-            From :func:`pneumorph.materials.felupe_models.build_umat` (hyperelastic, with
+            From :func:`pneumorph.materials.laws.felupe_models.build_umat` (hyperelastic, with
             the library bulk modulus) or ``build_linear_elastic`` (linear elastic).
 
         Raises
@@ -280,9 +280,7 @@ class Material:
             If a hyperelastic material has no bulk modulus, or the formulation does not
             apply.
         """
-        from pneumorph.materials import (
-            felupe_models,  # lazy: FElupe takes ~0.5 s to import
-        )
+        from pneumorph.materials.laws import felupe_models  # lazy: FElupe takes ~0.5 s to import
 
         if self.kind == "linear-elastic":
             if formulation != "compressible":
@@ -341,7 +339,7 @@ class Library:
 
     Examples
     --------
-    >>> from pneumorph.materials.library import builtin
+    >>> from pneumorph.materials.library.builtin import builtin
     >>> lib = builtin()
     >>> lib.get("Ecoflex 00-30").name, len(lib.names()) >= 7
     ('ecoflex_0030', True)

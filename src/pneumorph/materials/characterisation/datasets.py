@@ -2,7 +2,7 @@
 
 Examples
 --------
->>> from pneumorph.materials.datasets import list_datasets, load_dataset
+>>> from pneumorph.materials.characterisation.datasets import list_datasets, load_dataset
 >>> [d.name for d in list_datasets()]
 ['treloar1944']
 >>> sorted(load_dataset("treloar1944").modes)
@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import DataFormatError, UnknownDatasetError
-from pneumorph.materials.testdata import TestCurve, TestData, read_curve
+from pneumorph.materials.characterisation.testdata import TestCurve, TestData, read_curve
 
 
 @dataclass(frozen=True)
