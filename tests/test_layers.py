@@ -176,6 +176,18 @@ def test_the_circle_finder_finds_circles() -> None:
     assert cycles(edges) == [["a", "b", "c"]]
 
 
+def test_no_private_name_is_imported_from_another_module() -> None:
+    """What another module imports is public: a leading underscore means "this module's own"."""
+    known = modules()
+    wrong = []
+    for name, path in known.items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("pneumorph"):
+                wrong += [f"{name}:{node.lineno} imports {alias.name} from {node.module}" for alias in node.names
+                          if alias.name.startswith("_") and not alias.name.startswith("__")]
+    assert not wrong, "\n".join(wrong)
+
+
 def _module_lines() -> dict[str, int]:
     return {name: len(path.read_text(encoding="utf-8").splitlines()) for name, path in modules().items()}
 

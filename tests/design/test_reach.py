@@ -1,4 +1,5 @@
-"""The bound on the units still to place (design.reach): admissible against enumeration, exact where it can be."""
+"""The bound on the units still to place (design.certified.reach): admissible against enumeration, exact where
+it can be."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A nearby model's solve from a solved state (models.warmstart.solve_near): the ramp's answer at the top
+"""A nearby model's solve from a solved state (models.fe.warmstart.solve_near): the ramp's answer at the top
 pressure in a few Newton iterations, for every parameter the identification moves; a start that does not fit
 falls back to the ramp."""
 

@@ -11,8 +11,8 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, execution_options
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import check_options, execution_options
 
 # the options that are [design] and [execution] settings of the same name
 _DESIGN_OPTIONS = ("amplitude", "periods", "point", "units", "search", "seed", "certify", "verify", "margin",

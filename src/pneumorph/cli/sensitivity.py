@@ -10,8 +10,14 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import (
+    check_options,
+    cluster_line,
+    cluster_report,
+    execution_options,
+    open_evaluator,
+)
 
 
 def _common(command: Callable[..., Any], models: tuple[str, ...] = ("2d", "3d")) -> Callable[..., Any]:

@@ -7,8 +7,14 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_STARTS
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import (
+    check_options,
+    cluster_line,
+    cluster_report,
+    execution_options,
+    open_evaluator,
+)
 
 
 @click.command("study")

@@ -11,7 +11,7 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_INCREMENTS
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 from pneumorph.io.files import all_or_nothing, strict_json, write_json
 
 

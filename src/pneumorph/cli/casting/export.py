@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 
 _MOULD_ONLY = ("clearance", "draft")
 _DECK_ONLY = ("pressure",)

@@ -10,7 +10,7 @@ from typing import Any
 import click
 import numpy as np
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 from pneumorph.errors import DataFormatError
 from pneumorph.io.files import read_text_file, strict_json
 from pneumorph.materials.characterisation import analyses as ch

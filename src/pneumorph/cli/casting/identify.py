@@ -7,8 +7,8 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import cluster_report, execution_options, open_evaluator
 
 
 @click.command("identify")
@@ -48,7 +48,7 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
     (identified.toml: a [model] table for design/simulate --model-file).
     """
 
-    from pneumorph.cli.execution import check_options
+    from pneumorph.cli.options.execution import check_options
     from pneumorph.errors import SettingsError
     from pneumorph.execution.cache import chain_table_dir
     from pneumorph.geometry.unit import UnitSpec

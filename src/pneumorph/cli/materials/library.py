@@ -6,7 +6,7 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 from pneumorph.errors import UnknownMaterialError
 from pneumorph.io.files import strict_json
 from pneumorph.materials.laws.filler import FillerLaw

@@ -20,7 +20,7 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 from pneumorph.execution.evaluators import EXECUTORS
 
 NAMES = ("--executor", "--workers", "--scheduler")

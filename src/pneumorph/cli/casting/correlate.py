@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 
 
 @click.command("correlate")

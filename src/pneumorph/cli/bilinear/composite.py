@@ -12,7 +12,7 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 from pneumorph.errors import CrimpError
 from pneumorph.io.files import all_or_nothing, strict_json, write_json
 

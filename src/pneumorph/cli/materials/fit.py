@@ -6,7 +6,7 @@ import click
 
 from pneumorph import __version__
 from pneumorph.checks import MAX_STARTS
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 from pneumorph.io.files import strict_json
 from pneumorph.materials.characterisation.datasets import list_datasets, read_test_data
 from pneumorph.materials.characterisation.testdata import COLUMN_ROLES, TRUNCATE
