@@ -123,8 +123,7 @@ def design(config_file: str | None, **options: Any) -> None:
     _check_run(config, model, o)
     o.reference = nominal.make_model() if nominal is not None and config.search == "certified" else None
     if fallback:  # said once every setting has been checked
-        click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
-                   "falling back to the genetic algorithm", err=True)
+        click.echo(fallback, err=True)
     if o.model_file is not None:
         _warn_unidentified(o.model_file)
     result, model = _run(config, model, o, fidelity_given)
@@ -176,11 +175,11 @@ def _check_inputs(o: Any) -> None:
         P.library_option(o.library, o.unit_file)
 
 
-def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
+def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any]:
     """The run's settings: the config file's (or the defaults) with the options over them
-    (:meth:`DesignConfig.with_options`), the fidelity of its search written in; whether the certified search fell
-    back to the GA (gravity); whether the fidelity was given; with ``--model-file``, the same settings without it
-    (the nominal model, whose design the report compares)."""
+    (:meth:`DesignConfig.with_options`), the fidelity of its search written in; why the certified search fell
+    back to the GA (:meth:`DesignConfig.searchable`), or None; whether the fidelity was given; with
+    ``--model-file``, the same settings without it (the nominal model, whose design the report compares)."""
     from pneumorph.design import DesignConfig
 
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
@@ -218,9 +217,7 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
     nominal = None if identified is None else config.with_options(design, ga=ga, model=options)
     config = config.with_options(design, ga=ga, model=options, model_file=identified)
     fidelity_given = "fidelity" in config.model
-    fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
-    if fallback:
-        config = config.as_ga()
+    config, fallback = config.searchable()
     if nominal is not None:  # the nominal model at the fidelity and pressure of the run's
         nominal = nominal.with_options({}, model={"fidelity": config.fidelity,
                                                   "pressure_kpa": config.model.get("pressure_kpa")})
@@ -284,9 +281,7 @@ def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, An
         if config.search != "certified":
             raise
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
-    config = config.as_ga()
-    if not fidelity_given:
-        config = config.with_options({}, model={"fidelity": "2d"})
+    config = config.fallback(fidelity_given)
     model = config.make_model()
     progress = _Progress(config, model, o.out or _default_folder(config))  # the new run says its own first line
     result = run_design(config, model, progress.folder, overwrite=o.overwrite, **progress.callbacks())
