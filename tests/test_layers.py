@@ -47,7 +47,6 @@ LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
     "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,
     "pneumorph.fem.stepping:ramp": 130,
-    "pneumorph.identify.fit:identify": 167,
 }
 
 

@@ -286,24 +286,16 @@ class DesignConfig:
         return DesignConfig.from_dict(changed.to_dict())
 
     def as_ga(self) -> DesignConfig:
-        """The same settings searched by the genetic algorithm, the certified search's own settings dropped (the
-        fallback of a run the chain model cannot serve).
-
-        >>> DesignConfig(certify=True, epsilon=0.1).as_ga().search
-        'ga'
-        """
+        """The same settings searched by the GA, the certified search's own dropped (``DesignConfig().as_ga()``)."""
         return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, refine=0.0,
                        chain_table=None)
 
     def searchable(self) -> tuple[DesignConfig, str | None]:
-        """The settings a run can search with, and why they differ from these (None: they do not).
+        """The settings a run can search with, and why they differ from these (None: they do not): the chain
+        model does not hold under gravity, so a certified search under gravity is the genetic algorithm's.
 
-        The certified search needs a free actuator: its chain model does not hold under gravity,
-        so a certified search under gravity is the genetic algorithm's.
-
-        >>> config, why = DesignConfig(model={"gravity": "hanging"}).searchable()
-        >>> config.search, why.split(":")[0]
-        ('ga', 'the certified search needs a free actuator (its chain model does not hold under gravity)')
+        >>> DesignConfig(model={"gravity": "hanging"}).searchable()[0].search
+        'ga'
         """
         if self.search == "certified" and self.model.get("gravity") not in (None, "none"):
             return self.as_ga(), ("the certified search needs a free actuator (its chain model does not hold under "
@@ -311,14 +303,8 @@ class DesignConfig:
         return self, None
 
     def fallback(self, fidelity_given: bool = False) -> DesignConfig:
-        """The genetic algorithm's settings for a certified run whose model the chain cannot represent.
-
-        :func:`~pneumorph.design.driver.run_design` raises
-        :class:`~pneumorph.errors.LocalityError` for it before it writes anything; the GA solves
-        every design it scores, on the 2D model unless the run's fidelity was given.
-
-        >>> DesignConfig(model={"fidelity": "3d"}).fallback().fidelity
-        '2d'
+        """The GA's settings for a certified run whose model the chain cannot represent (``run_design`` raises
+        :class:`~pneumorph.errors.LocalityError` before it writes): on the 2D model unless the fidelity was given.
         """
         ga = self.as_ga()
         return ga if fidelity_given else ga.with_options({}, model={"fidelity": "2d"})
