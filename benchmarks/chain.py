@@ -25,10 +25,10 @@ import time
 import numpy as np
 
 from pneumorph.design import make_objective
-from pneumorph.design.certified import certified_search, chain_errors, chain_scores, grow_designs
+from pneumorph.design.certified.search import certified_search, chain_errors, chain_scores, grow_designs
 from pneumorph.errors import SearchConfigError
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import shipped_path
 
 TARGETS = [("sin", 10.0), ("sin", 20.0), ("cos", 40.0), ("max-x", 10.0), ("max-y", 10.0), ("min-distance", 10.0)]
 
@@ -77,7 +77,7 @@ def search(tables: list[str], units: list[int]) -> None:
 
 def build() -> None:
     from pneumorph.execution import CachedEvaluator, EvaluationCache, ProcessPoolEvaluator
-    from pneumorph.models.chainfit import build_table
+    from pneumorph.models.chain.fit import build_table
     from pneumorph.models.fe import Reduced2D
 
     evaluator = CachedEvaluator(ProcessPoolEvaluator(workers=2), EvaluationCache(":memory:"))
@@ -105,7 +105,7 @@ def search30() -> None:
 
 
 def stages() -> None:
-    from pneumorph.design.targets import staged_target
+    from pneumorph.design.objectives.targets import staged_target
 
     for n in (15, 30):
         for src in ("3d", "2d"):

@@ -3,7 +3,7 @@
     OMP_NUM_THREADS=1 python benchmarks/chain_scores.py
 
 The first query of a chain model grows the prefix tree and keeps its geometry
-(:func:`pneumorph.design.certified.chain_geometry`); later queries only evaluate the
+(:func:`pneumorph.design.certified.search.chain_geometry`); later queries only evaluate the
 objective per prefix. Prints the median of 20 repeated queries for several objectives on
 the shipped 3D and 2D tables.
 """
@@ -16,10 +16,10 @@ import time
 
 import numpy as np
 
-from pneumorph.design.certified import chain_scores
-from pneumorph.design.targets import make_objective
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table
+from pneumorph.design.certified.search import chain_scores
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import find_table
 from pneumorph.models.factory import make_model
 
 

@@ -5,7 +5,7 @@ at the quadrature points of the 15-unit 2D mesh (1,260 quad8 cells x 9 points), 
 Newton iteration of the 2D model does:
 
 - ``pneumorph.fem.OgdenCompressible`` (hand-coded spectral stress and tangent),
-- the automatic-differentiation form ``pneumorph.materials.felupe_models.build_umat``,
+- the automatic-differentiation form ``pneumorph.materials.laws.felupe_models.build_umat``,
 - FElupe's hand-coded neo-Hooke, as the floor of what a hyperelastic kernel costs.
 
 Usage: ``OMP_NUM_THREADS=1 python benchmarks/constitutive_kernels.py [--repeat 5]``.
@@ -23,7 +23,7 @@ import numpy as np
 
 from pneumorph.fem import OgdenCompressible
 from pneumorph.materials import get
-from pneumorph.materials.felupe_models import build_umat
+from pneumorph.materials.laws.felupe_models import build_umat
 
 
 def best_cpu_time(fn, F: np.ndarray, repeat: int) -> float:  # type: ignore[no-untyped-def]

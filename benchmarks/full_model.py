@@ -1,7 +1,7 @@
 """Wall time of one full 3D model solve (no mid-plane symmetry): a 15-unit design with sideways units.
 
 A design over the built-in ``spatial`` library (``a`` bending in the plane, ``l`` sideways)
-is solved by :class:`~pneumorph.models.full3d.Full3D` on the full width (a sideways unit
+is solved by :class:`~pneumorph.models.fe.full3d.Full3D` on the full width (a sideways unit
 breaks the mid-plane symmetry), the default 1.5 mm hex20 mesh, 10 reported levels to 45 kPa,
 the model's own ramp and fast path. Run on one core as a search worker would:
 

@@ -31,7 +31,7 @@ import numpy as np
 from pneumorph.design import GAConfig, make_objective, run_exhaustive, run_ga
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.models import ChainModel, ChainTable, Reduced2D
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.sources import shipped_path
 
 #: the five targets, chosen before any run: two profiles and three tip goals
 TARGETS = {"sin A=10": ("sin", {"amplitude": 10.0}), "cos A=10": ("cos", {"amplitude": 10.0}),

@@ -21,9 +21,9 @@ import os
 import platform
 import time
 
-from pneumorph.design.exhaustive import run_exhaustive
-from pneumorph.design.ga import GAConfig, run_ga
-from pneumorph.design.targets import make_objective
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.design.search.exhaustive import run_exhaustive
+from pneumorph.design.search.genetic import GAConfig, run_ga
 from pneumorph.execution import CachedEvaluator, EvaluationCache
 from pneumorph.execution.evaluators import ProcessPoolEvaluator
 from pneumorph.models.fe import Reduced2D

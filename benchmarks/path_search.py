@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
-from pneumorph.design.growth import chain_scores
-from pneumorph.design.paths import PATH_PRESETS, preset_path
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table
+from pneumorph.design.certified.planegrowth import chain_scores
+from pneumorph.design.objectives.paths import PATH_PRESETS, preset_path
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import find_table
 from pneumorph.models.factory import make_model
 
 LIBRARIES = {"one type (2^15)": None, "builtin (8^15)": "builtin", "spatial (4^15)": "spatial"}

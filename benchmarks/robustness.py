@@ -16,10 +16,10 @@ import time
 
 import numpy as np
 
-from pneumorph.design.robustness import design_robustness
-from pneumorph.design.targets import make_objective
-from pneumorph.models.chain import ChainTable, design_array
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.design.runs.robustness import design_robustness
+from pneumorph.models.chain.model import ChainTable, design_array
+from pneumorph.models.chain.sources import shipped_path
 from pneumorph.sensitivity.robust import shipped_tolerance_tables
 
 

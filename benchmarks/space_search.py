@@ -2,7 +2,7 @@
 
 Scores the designs of ``a`` and ``l`` (4 choices a unit: 4^15 = 1.1e9 designs) for space
 targets with the spatial library's 3D table, no FE solve: the beam, then branch-and-bound
-(:func:`pneumorph.design.spacegrowth.space_scores`), and the same over the planar codes only
+(:func:`pneumorph.design.certified.spacegrowth.space_scores`), and the same over the planar codes only
 (the certificate's best design that stays in the plane). Run on one core:
 
     OMP_NUM_THREADS=1 python benchmarks/space_search.py [--table FILE] [--repeat 3]
@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
-from pneumorph.design.spacegrowth import space_scores
-from pneumorph.design.targets import make_objective, tip_goal
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.design.certified.spacegrowth import space_scores
+from pneumorph.design.objectives.targets import make_objective, tip_goal
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import shipped_path
 
 TARGETS = {
     "helix, A = 25 mm": lambda length: make_objective("helix", 25.0, length=length),

@@ -19,12 +19,12 @@ import time
 
 import numpy as np
 
-from pneumorph.design.certified import certified_search
-from pneumorph.design.fitness import stage_values
-from pneumorph.design.targets import make_objective, staged_target
+from pneumorph.design.certified.search import certified_search
+from pneumorph.design.objectives.fitness import stage_values
+from pneumorph.design.objectives.targets import make_objective, staged_target
 from pneumorph.execution import CachedEvaluator, EvaluationCache, ProcessPoolEvaluator
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import shipped_path
 from pneumorph.models.factory import make_model
 
 

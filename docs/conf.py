@@ -140,7 +140,7 @@ def _candidates(target: str, node: Any) -> list[str]:
 def _resolve_by_object(app: Sphinx, env: Any, node: Any, contnode: Any) -> Any:
     """Resolve a reference to a pneumorph object by what it names, not by how it is spelt.
 
-    Docstrings name objects by the module that defines them (``pneumorph.design.ga.run_ga``),
+    Docstrings name objects by the module that defines them (``pneumorph.design.search.genetic.run_ga``),
     or by their short name in that module; the reference documents them where the
     sub-package exports them (``pneumorph.design.run_ga``). A reference to an object
     documented under another name links there; one to an object that exists but is not in

@@ -10,9 +10,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pneumorph.geometry.library import builtin_library
+from pneumorph.models.chain.space import MIRROR_SIGNS, chain_points, rotation_matrices
+from pneumorph.models.chain.windows import covering_designs, design_array, mirror_codes, window_codes
 from pneumorph.models.response import Response
-from pneumorph.models.spacechords import MIRROR_SIGNS, chain_points, rotation_matrices
-from pneumorph.models.windows import covering_designs, design_array, mirror_codes, window_codes
 
 LIBRARY = builtin_library("spatial")
 ALPHABET = LIBRARY.alphabet

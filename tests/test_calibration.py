@@ -10,7 +10,7 @@ import pytest
 from pneumorph.calibration import CalibrationWarning, calibrate, fit_law
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.models.fe import Reduced2D
 
 TRUE = (0.05, -1.0)  # E(P) = 0.05 - 1.0 P (MPa, P in MPa)

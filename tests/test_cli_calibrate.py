@@ -13,7 +13,7 @@ import pytest
 from pneumorph.calibration import cached_3d_solver, gamma, open_cache, reference_model, unit_centre_displacements
 from pneumorph.cli import main
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response
 

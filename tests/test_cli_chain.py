@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.models.chain import ChainTable
-from pneumorph.models.windows import covering_designs
+from pneumorph.models.chain.model import ChainTable
+from pneumorph.models.chain.windows import covering_designs
 
 
 @pytest.mark.slow

@@ -9,11 +9,11 @@ from pathlib import Path
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.models.buildplan import build_plan
-from pneumorph.models.chainfit import MIN_HELDOUT
-from pneumorph.models.chaintables import build_options
+from pneumorph.models.chain.fit import MIN_HELDOUT
+from pneumorph.models.chain.plan import build_plan
+from pneumorph.models.chain.sources import build_options
+from pneumorph.models.chain.windows import covering_designs
 from pneumorph.models.factory import make_model
-from pneumorph.models.windows import covering_designs
 
 TINY = ["--units", "2", "--search", "ga", "--pop", "4", "--gen", "2", "--pressure", "10", "--executor", "serial"]
 
@@ -115,7 +115,7 @@ def test_certified_design_on_the_shipped_2d_table(tmp_path: Path, capsys: pytest
 
 
 def test_certified_design_refuses_bad_tables_before_writing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from pneumorph.models.chaintables import shipped_path
+    from pneumorph.models.chain.sources import shipped_path
 
     bad = tmp_path / "bad.json"
     bad.write_text('{"kind": "pneumorph chain table", "format": 1, "window": 2')
@@ -171,7 +171,7 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
     assert len(tables) == 1 and [p.name for p in kept if "tolerance" in p.name] == [
         tables[0].name.replace(".json", "-tolerance-0.1.json")]  # the unit's tolerance tables, kept beside it
     assert first["robustness"]["winner"]["worst"] >= first["robustness"]["winner"]["mean"]
-    from pneumorph.models.chain import ChainTable
+    from pneumorph.models.chain.model import ChainTable
 
     table = ChainTable.load(tables[0])
     assert table.source["n_units"] == 15 and max(table.validation["centre_worst_mm"]) <= 0.2
@@ -186,7 +186,7 @@ def test_a_users_unit_gets_its_table_on_first_use_and_keeps_it(tmp_path: Path,
 def test_a_model_the_chain_cannot_represent_falls_back_to_the_ga(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
     from pneumorph.errors import LocalityError
-    from pneumorph.models import chaintables
+    from pneumorph.models.chain import sources as chaintables
 
     def no_locality(*args, **kwargs):  # type: ignore[no-untyped-def]
         raise LocalityError("the chain model does not reproduce this model within 0.2 mm")

@@ -220,7 +220,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
                  "--seed": COUNT, "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
 }
 
-# the one execution option set of every command that solves many designs (pneumorph.cli.execution)
+# the one execution option set of every command that solves many designs (pneumorph.cli.options.execution)
 for _command in ("design", "study", "calibrate", "chain", "optimise", "simplifications", "tolerances", "bulk-modulus",
                  "calibration", "temperature", "mesh", "identify"):
     OPTIONS[_command]["--workers"] = [*OPTIONS[_command].get("--workers", POS_COUNT), "1024"]  # past the cores

@@ -153,11 +153,11 @@ TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119)
     ("call:pneumorph.export:plot_mould",
      ["export", "0110", "--unit", "unit.toml", "--stl", "out", "--inp", "deck/a.inp", "--mould"], ["out", "deck"]),
     # study.json is written; the figure is next
-    ("call:pneumorph.plot.sensitivity:plot_study",
+    ("call:pneumorph.plot.sensitivity:plot_population_study",
      ["sensitivity", "tolerances", "--model", "2d", "--units", "2", "--pressure", "5", "--unit", "unit.toml",
       "--samples", "1", "--executor", "serial", "--out", "out"], ["out"]),
     # the table is built and is being written into a new folder
-    ("call:pneumorph.models.chaintable:ChainTable.save",
+    ("call:pneumorph.models.chain.table:ChainTable.save",
      ["chain", "build", "--model", "2d", "--units", "4", "--pressure", "5", "--unit", "unit.toml", "--window", "1",
       "--heldout", "1", "--executor", "serial", "--out", "new/t.json"], ["new"]),
     # unit optimise, stopped during its search: its folder was made before the search began and stayed, empty
@@ -169,7 +169,7 @@ TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119)
      ["identify", "trace.csv", "--design", "0110", "--model", "2d", "--pressure", "5", "--unit", "unit.toml",
       "--executor", "serial", "--out", "out"], ["out"]),
     # study: study.json is written; the figure is next
-    ("call:pneumorph.design:plot_study",
+    ("call:pneumorph.design:plot_population_study",
      ["study", "run.toml", "--populations", "4", "--seeds", "1", "--gen", "1", "--units", "3", "--pressure", "5",
       "--executor", "serial", "--out", "out"], ["out"]),
     # bimodal: the JSON and the tip-path figure are written; the outline figure is next

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.materials import library
+from pneumorph.materials.library import builtin as library
 
 
 @pytest.fixture(autouse=True)

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.design.certified import certified_search
-from pneumorph.design.paths import path_target
+from pneumorph.design.certified.search import certified_search
+from pneumorph.design.objectives.paths import path_target
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import find_table
 from pneumorph.models.factory import make_model
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.models.chain import ChainTable
+from pneumorph.models.chain.model import ChainTable
 
 #: bending and near-rigid units, meshed coarsely for quick 2D solves
 LIBRARY = """[library]

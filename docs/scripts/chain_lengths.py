@@ -12,9 +12,9 @@ from __future__ import annotations
 import argparse
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, ProcessPoolEvaluator, default_cache_path
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chainfit import heldout_designs, prediction_errors
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.fit import heldout_designs, prediction_errors
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import shipped_path
 from pneumorph.models.factory import make_model
 
 

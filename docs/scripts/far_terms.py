@@ -2,7 +2,7 @@
 
 Reads a table file (its training and held-out designs, its window and unit types) and the
 evaluation cache its build solved them into; fits the table again from the same training
-responses, plainly and with far-field terms (``pneumorph.models.chainterms``), and prints
+responses, plainly and with far-field terms (``pneumorph.models.chain.terms``), and prints
 the worst and mean held-out centre error of both at the last level. No FE solve.
 
     python docs/scripts/far_terms.py --table TABLE.json --cache CACHE.sqlite [--library FILE]
@@ -20,8 +20,8 @@ import sqlite3
 import numpy as np
 
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chainfit import fit_table
+from pneumorph.models.chain.fit import fit_table
+from pneumorph.models.chain.model import ChainModel, ChainTable
 from pneumorph.models.response import Response
 
 

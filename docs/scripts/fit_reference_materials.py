@@ -19,11 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pneumorph.materials.comparison import compare
-from pneumorph.materials.datasets import load_dataset
-from pneumorph.materials.fitting import r_squared
-from pneumorph.materials.hyperelastic import Ogden
-from pneumorph.materials.testdata import TestData, read_curve
+from pneumorph.materials.characterisation.datasets import load_dataset
+from pneumorph.materials.characterisation.testdata import TestData, read_curve
+from pneumorph.materials.fitting.comparison import compare
+from pneumorph.materials.fitting.fit import r_squared
+from pneumorph.materials.laws.hyperelastic import Ogden
 from pneumorph.plot import plot_fits
 
 MODELS = ("neo-hooke", "mooney-rivlin-2", "mooney-rivlin-3", "yeoh", "ogden-3")

@@ -28,8 +28,8 @@ import numpy as np
 from far_terms import errors, responses
 
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainTable
-from pneumorph.models.chainterms import _observations, term_codes
+from pneumorph.models.chain.model import ChainTable
+from pneumorph.models.chain.terms import _observations, term_codes
 from pneumorph.models.response import Response
 
 

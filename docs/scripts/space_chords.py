@@ -3,7 +3,7 @@
 1. Twist: a planar unit bends about its frame's z axis only, wherever the frame points. After
    sideways units have turned the actuator out of the plane, the planar units' chords should
    still turn about z alone (no turn about y) if the frame transported without twist
-   (:mod:`pneumorph.models.spacechords`) is the units' own frame.
+   (:mod:`pneumorph.models.chain.space`) is the units' own frame.
 2. Locality: a chord's twist-free turns and length, in two designs that share the units
    around it (+-2) and differ farther away, differ by what the chain would err.
 
@@ -26,8 +26,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pneumorph.geometry.assembly import unit_starts
+from pneumorph.models.chain.space import space_elements
 from pneumorph.models.factory import make_model
-from pneumorph.models.spacechords import space_elements
 
 OUT = Path(__file__).resolve().parents[1] / "figures" / "space-chords.json"
 PRESSURE = 36.0

@@ -2,7 +2,7 @@
 
 The twist-free elements are not (docs/scripts/space_chords.py: 0.3-0.4 deg about y from
 units beyond +-2). Here each chord is written in the frame of the unit it starts from and
-each unit's frame in the one before (:func:`pneumorph.models.spacechords.frame_elements`,
+each unit's frame in the one before (:func:`pneumorph.models.chain.space.frame_elements`,
 the frames from the full model's responses), for the same pairs of designs that share the
 units +-2 around chord 4 and differ farther away. Writes docs/figures/space-frames.json.
 
@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pneumorph.models.chain.space import frame_elements, space_elements
 from pneumorph.models.factory import make_model
-from pneumorph.models.spacechords import frame_elements, space_elements
 
 OUT = Path(__file__).resolve().parents[1] / "figures" / "space-frames.json"
 PRESSURE = 36.0

@@ -27,10 +27,10 @@ import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
 
-from pneumorph.models.chaintables import find_table
+from pneumorph.models.chain.sources import find_table
+from pneumorph.models.chain.space import rotation_matrices
+from pneumorph.models.chain.windows import ends, window_codes
 from pneumorph.models.factory import make_model
-from pneumorph.models.spacechords import rotation_matrices
-from pneumorph.models.windows import ends, window_codes
 
 EMPTY = -1e30
 

@@ -19,10 +19,10 @@ import time
 
 import numpy as np
 
-from pneumorph.design.fitness import score, stage_values
-from pneumorph.design.targets import make_objective, staged_target
+from pneumorph.design.objectives.fitness import score, stage_values
+from pneumorph.design.objectives.targets import make_objective, staged_target
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator, default_cache_path
-from pneumorph.models.chain import ChainModel, ChainTable
+from pneumorph.models.chain.model import ChainModel, ChainTable
 from pneumorph.models.factory import make_model
 
 

@@ -4,7 +4,7 @@ Every setting a user gives (a CLI option, a config key, a constructor argument) 
 of these functions, which refuse it with a :class:`~pneumorph.errors.SettingsError` that
 names the setting, the value and what is allowed (or the subclass given as ``error``). Types are strict: a bool is not a
 number, a float is not a count, a string is not a number (the CLI parses its text first,
-:mod:`pneumorph.cli.params`).
+:mod:`pneumorph.cli.options.params`).
 
 Limits
 ------

@@ -13,8 +13,8 @@ from fastapi.testclient import TestClient
 
 from pneumorph.bench import Bench, create_app, parse_query
 from pneumorph.bench.shapes import chain_placement
-from pneumorph.design.certified import chain_scores
-from pneumorph.design.targets import make_objective
+from pneumorph.design.certified.search import chain_scores
+from pneumorph.design.objectives.targets import make_objective
 from pneumorph.geometry.assembly import assemble
 
 SIN = {"target": {"kind": "preset", "name": "sin", "amplitude": 10, "periods": 1}}

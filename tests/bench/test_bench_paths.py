@@ -14,9 +14,9 @@ from fastapi.testclient import TestClient
 from pneumorph.bench import Bench, create_app
 from pneumorph.bench.query import Query
 from pneumorph.bench.strokes import is_path_stroke, smooth_path
-from pneumorph.design.certified import chain_scores
-from pneumorph.design.fitness import path_errors
-from pneumorph.design.targets import smooth_curve
+from pneumorph.design.certified.search import chain_scores
+from pneumorph.design.objectives.fitness import path_errors
+from pneumorph.design.objectives.targets import smooth_curve
 
 BASE = "http://127.0.0.1:8000"
 L = 157.5

@@ -379,7 +379,7 @@ def test_a_client_that_goes_away_is_one_log_line_without_traceback(app, caplog: 
 # -- 6. progress that follows the work -----------------------------------------------------------
 def test_a_table_jobs_progress_follows_its_solves() -> None:
     from pneumorph.bench.worker import TableProgress
-    from pneumorph.models.buildplan import build_plan
+    from pneumorph.models.chain.plan import build_plan
     from pneumorph.models.factory import make_model
 
     plan = build_plan(make_model(15, {"fidelity": "2d", "unit": {"layer": 2.5}}))

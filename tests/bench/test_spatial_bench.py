@@ -17,8 +17,8 @@ from pneumorph.bench import Bench, create_app
 from pneumorph.bench import answer as answer_module
 from pneumorph.bench.query import QueryError
 from pneumorph.bench.shapes import chain_placement
-from pneumorph.design.spacegrowth import space_scores
-from pneumorph.design.targets import make_objective
+from pneumorph.design.certified.spacegrowth import space_scores
+from pneumorph.design.objectives.targets import make_objective
 
 HELIX = {"target": {"kind": "preset", "name": "helix", "amplitude": 25, "periods": 1}, "model": "3d",
          "unit": "spatial"}

@@ -7,7 +7,7 @@ import json
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.cli.bimodal import bulk_from_poisson
+from pneumorph.cli.bilinear.bimodal import bulk_from_poisson
 
 
 def test_json_run(tmp_path, capsys) -> None:

@@ -9,8 +9,8 @@ import pytest
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import ChainModel, design_strings
-from pneumorph.models.chainfit import build_table
+from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.model import ChainModel, design_strings
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 #: units of the coarse 2D actuator of :func:`coarse_2d`

@@ -14,8 +14,8 @@ import pytest
 
 from pneumorph.design import DesignConfig
 from pneumorph.design.algorithms import ALGORITHMS, CertifiedSearch, ExhaustiveSearch, GeneticSearch, algorithm_for
-from pneumorph.design.exhaustive import run_exhaustive
-from pneumorph.design.problem import Problem
+from pneumorph.design.algorithms.problem import Problem
+from pneumorph.design.search.exhaustive import run_exhaustive
 from pneumorph.execution.cache import CachedEvaluator, EvaluationCache
 from pneumorph.execution.serial import SerialEvaluator
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from pneumorph.design import make_objective, run_exhaustive
-from pneumorph.design.certified import (
+from pneumorph.design.certified.headingbox import _cos_range, _sin_range
+from pneumorph.design.certified.search import (
     certified_search,
     chain_errors,
     chain_scores,
@@ -14,14 +15,13 @@ from pneumorph.design.certified import (
     objective_bounds,
     score_designs,
 )
-from pneumorph.design.reachbox import _cos_range, _sin_range
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import ChainModel, ChainTable, design_strings
-from pneumorph.models.chainfit import build_table
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.model import ChainModel, ChainTable, design_strings
+from pneumorph.models.chain.sources import shipped_path
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 N = 7

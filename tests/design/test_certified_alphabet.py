@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pneumorph.design import make_objective
-from pneumorph.design.certified import (
+from pneumorph.design.certified.search import (
     best_scores,
     certified_search,
     chain_candidate,
@@ -19,8 +19,8 @@ from pneumorph.design.certified import (
 )
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chainfit import build_table
+from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.model import ChainModel
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 N = 6

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pneumorph.design.certified import chain_errors, chain_geometry, grow_designs
-from pneumorph.design.targets import make_objective
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table
+from pneumorph.design.certified.search import chain_errors, chain_geometry, grow_designs
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import find_table
 from pneumorph.models.factory import make_model
 
 OBJECTIVES = ["sin", "cos", "y = 0.3*x - 0.002*x**2", "r = 60 - 2*theta", "max-x", "min-y", "min-distance",
@@ -52,7 +52,7 @@ def test_the_geometry_is_kept_per_chain_model(chain: ChainModel) -> None:
                                                          ("y = 0.3*x", 1.0, 1.0), ("y = 0.001*x**2", 1.0, 1.0)])
 def test_best_scores_keep_the_top_and_every_design_that_could_beat_the_best(chain: ChainModel, spec: str,
                                                                              amplitude: float, periods: float) -> None:
-    from pneumorph.design.certified import best_scores, chain_scores
+    from pneumorph.design.certified.search import best_scores, chain_scores
 
     objective = make_objective(spec, amplitude, periods, length=chain.length)
     full = chain_scores(chain, objective)

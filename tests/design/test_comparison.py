@@ -10,13 +10,13 @@ from click.testing import CliRunner
 
 from pneumorph.cli import cli
 from pneumorph.design import DesignConfig, Problem
-from pneumorph.design.certified import certified_search
-from pneumorph.design.comparison import compare_with_reference
-from pneumorph.design.fitness import score
+from pneumorph.design.certified.search import certified_search
+from pneumorph.design.objectives.fitness import score
+from pneumorph.design.runs.comparison import compare_with_reference
 from pneumorph.execution.cache import CachedEvaluator, EvaluationCache
 from pneumorph.execution.serial import SerialEvaluator
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import serve_table
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import serve_table
 
 UNITS = 8
 

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from pneumorph.design.fitness import profile_errors, score, tip_values
-from pneumorph.design.targets import make_objective, profile_target, tip_goal
+from pneumorph.design.objectives.fitness import profile_errors, score, tip_values
+from pneumorph.design.objectives.targets import make_objective, profile_target, tip_goal
 from pneumorph.models import Response
 
 P = np.array([0.0225, 0.045])

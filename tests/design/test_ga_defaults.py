@@ -15,7 +15,7 @@ import pytest
 from pneumorph.design import GAConfig, make_objective, run_exhaustive, run_ga
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.models import ChainModel, ChainTable
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.sources import shipped_path
 
 # the benchmark's targets and its notion of a find, loaded from its file (benchmarks/ is no package)
 _spec = importlib.util.spec_from_file_location("ga_defaults", Path(__file__).resolve().parents[2] / "benchmarks"

@@ -12,9 +12,9 @@ import random
 import numpy as np
 import pytest
 
-from pneumorph.design.fitness import score
-from pneumorph.design.ga import GAConfig, _design, mut_other_code, run_ga
-from pneumorph.design.targets import make_objective
+from pneumorph.design.objectives.fitness import score
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.design.search.genetic import GAConfig, _design, mut_other_code, run_ga
 from pneumorph.geometry.alphabet import parse_design
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec

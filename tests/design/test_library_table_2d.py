@@ -16,10 +16,10 @@ from pathlib import Path
 import pytest
 
 from pneumorph.design import make_objective
-from pneumorph.design.certified import chain_candidate, chain_errors
-from pneumorph.design.fitness import score
-from pneumorph.models.chain import ChainModel, ChainTable, check_source
-from pneumorph.models.chainfile import TERMS_FORMAT
+from pneumorph.design.certified.search import chain_candidate, chain_errors
+from pneumorph.design.objectives.fitness import score
+from pneumorph.models.chain.model import ChainModel, ChainTable, check_source
+from pneumorph.models.chain.tablefile import TERMS_FORMAT
 from pneumorph.models.factory import make_model
 
 TABLE = Path(__file__).resolve().parents[2] / "examples" / "libraries" / "chain-2d-builtin-30kpa-far.json"

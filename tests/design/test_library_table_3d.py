@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from pneumorph.design import make_objective
-from pneumorph.design.certified import chain_candidate, chain_errors, chain_scores
-from pneumorph.models.chain import ChainModel, ChainTable, check_source
+from pneumorph.design.certified.search import chain_candidate, chain_errors, chain_scores
+from pneumorph.models.chain.model import ChainModel, ChainTable, check_source
 from pneumorph.models.factory import make_model
 
 LIBRARIES = Path(__file__).resolve().parents[2] / "examples" / "libraries"

@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from pneumorph.design import make_objective
-from pneumorph.design.certified import chain_scores
-from pneumorph.design.targets import staged_target
-from pneumorph.models.chain import ChainModel, ChainTable, check_source
+from pneumorph.design.certified.search import chain_scores
+from pneumorph.design.objectives.targets import staged_target
+from pneumorph.models.chain.model import ChainModel, ChainTable, check_source
 from pneumorph.models.factory import make_model
 
 LIBRARIES = Path(__file__).resolve().parents[2] / "examples" / "libraries"

@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.design.certified import certified_search
-from pneumorph.design.fitness import path_errors, score
-from pneumorph.design.growth import chain_scores
-from pneumorph.design.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
-from pneumorph.design.targets import make_objective, staged_target
+from pneumorph.design.certified.planegrowth import chain_scores
+from pneumorph.design.certified.search import certified_search
+from pneumorph.design.objectives.fitness import path_errors, score
+from pneumorph.design.objectives.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
+from pneumorph.design.objectives.targets import make_objective, staged_target
 from pneumorph.errors import SearchConfigError, TargetExpressionError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, Outcome, SerialEvaluator
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chaintables import find_table, shipped_path
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import find_table, shipped_path
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import Response
 
@@ -148,8 +148,8 @@ def test_branch_and_bound_over_a_path_keeps_every_design_that_matters(keeps_ever
 def test_the_bound_on_the_centres_still_to_place_is_admissible() -> None:
     """On every prefix of 7 units of the 2D table, the prefix bound is at most the best completion's cost, and the
     centres still to place raise it above the partial sums on many prefixes."""
-    from pneumorph.design.growth import _prefix_bound
-    from pneumorph.design.prefixes import depths, seed_prefixes
+    from pneumorph.design.certified.planegrowth import _prefix_bound
+    from pneumorph.design.certified.prefixes import depths, seed_prefixes
 
     chain = ChainModel(find_table(make_model(7, {"fidelity": "2d"})), 7)
     t = path_target([[0, 6], [40, 6], [60, 20], [55, 45]]).at(chain.length, 6.0)

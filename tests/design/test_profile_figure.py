@@ -7,10 +7,10 @@ from typing import Any
 
 import pytest
 
-from pneumorph.design import figures
-from pneumorph.design.fitness import score
-from pneumorph.design.scoring import Candidate
-from pneumorph.design.targets import make_objective
+from pneumorph.design.objectives.fitness import score
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.design.runs import figures
+from pneumorph.design.search.scoring import Candidate
 from tests.design.toy_model import ToyModel
 
 

@@ -1,4 +1,5 @@
-"""The bound on the units still to place (design.reach): admissible against enumeration, exact where it can be."""
+"""The bound on the units still to place (design.certified.reach): admissible against enumeration, exact where
+it can be."""
 
 from __future__ import annotations
 
@@ -7,15 +8,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.design import bounds, growth
-from pneumorph.design import certified as cs
-from pneumorph.design import reach as reach_module
-from pneumorph.design.prefixes import depths, seed_prefixes
-from pneumorph.design.reach import build_reach
-from pneumorph.design.rest import CurveRange
-from pneumorph.design.targets import ProfileTarget, make_objective, tip_goal
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chaintables import find_table
+from pneumorph.design.certified import bounds
+from pneumorph.design.certified import planegrowth as growth
+from pneumorph.design.certified import reach as reach_module
+from pneumorph.design.certified import search as cs
+from pneumorph.design.certified.prefixes import depths, seed_prefixes
+from pneumorph.design.certified.reach import build_reach
+from pneumorph.design.certified.remainder import CurveRange
+from pneumorph.design.objectives.targets import ProfileTarget, make_objective, tip_goal
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import find_table
 from pneumorph.models.factory import make_model
 
 LIBRARY_TABLE = Path(__file__).resolve().parents[2] / "examples" / "libraries" / "chain-3d-bending-rigid.json"
@@ -44,7 +46,7 @@ def _slack(chain: ChainModel, objective) -> list[tuple[int, np.ndarray]]:
     cost[(full.bits.astype(np.int64) * c ** np.arange(n - 1, -1, -1)).sum(axis=1)] = full.cost
     curve = None
     if isinstance(objective, ProfileTarget):
-        curve = bounds._curve_range(chain, objective, errors, bounds._target_slope(chain, objective, errors))
+        curve = bounds.curve_range(chain, objective, errors, bounds.target_slope(chain, objective, errors))
     seeds, state = seed_prefixes(chain)
     state["sum"] = np.zeros((len(seeds), chain.table.n_levels))
     out = []

@@ -9,9 +9,9 @@ import pytest
 
 from pneumorph.cli import main
 from pneumorph.design import DesignConfig
-from pneumorph.design.fitness import score
-from pneumorph.design.refine import MESH_ORDERS, refined_row, verdict
-from pneumorph.design.targets import make_objective
+from pneumorph.design.certified.refine import MESH_ORDERS, refined_row, verdict
+from pneumorph.design.objectives.fitness import score
+from pneumorph.design.objectives.targets import make_objective
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Reduced2D
 from pneumorph.sensitivity.mesh import refined
@@ -112,7 +112,7 @@ def _study(model, objective, values):  # type: ignore[no-untyped-def]
 
 
 def test_mesh_note_from_a_study_of_the_same_model() -> None:
-    from pneumorph.design.refine import mesh_note
+    from pneumorph.design.certified.refine import mesh_note
     from pneumorph.models.fe import Full3D
 
     model, objective = Full3D(15), make_objective("sin", 10.0)
@@ -135,7 +135,7 @@ def test_the_shipped_study_speaks_for_the_default_run() -> None:
     1.5 -> 0.75 mm lowers the close competitors' Eq 4.1 values by 0.15-0.17 mm and raises those of the random and
     aligned designs (at their smallest deformation), so gaps between dissimilar designs move by up to 0.67 mm: the
     default run's runner-up, 0.127 mm behind the winner, is named as one a finer mesh could swap."""
-    from pneumorph.design.refine import load_study, mesh_note
+    from pneumorph.design.certified.refine import load_study, mesh_note
     from pneumorph.models import make_model
 
     study = load_study()

@@ -13,7 +13,7 @@ from pneumorph.design import (
     DesignConfig,
     GAConfig,
     make_objective,
-    plot_study,
+    plot_population_study,
     population_study,
     run_design,
 )
@@ -152,4 +152,4 @@ def test_population_study(tmp_path: Path) -> None:
         assert len(row.best) == 3 and row.lowest <= row.mean <= row.largest
         assert row.lowest == min(row.best) and all(0 <= g <= 5 for g in row.converged_at)
     assert evaluator.solves <= 64  # runs share the cache: no design of the 64 solved twice
-    assert plot_study(study, tmp_path / "study.png").stat().st_size > 0
+    assert plot_population_study(study, tmp_path / "study.png").stat().st_size > 0

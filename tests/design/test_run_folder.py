@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-import pneumorph.design.report as report_module
+import pneumorph.design.runs.report as report_module
 from pneumorph.design import DesignConfig, GAConfig, run_design
-from pneumorph.design.folder import RUN_FILES, _GenerationLog, run_files
+from pneumorph.design.runs.folder import RUN_FILES, GenerationLog, run_files
 from pneumorph.errors import (
     CacheError,
     OutputPathError,
@@ -154,19 +154,19 @@ def test_a_resumed_run_appends_to_generations_csv(tmp_path: Path) -> None:
 
 def test_generation_log_rules(tmp_path: Path) -> None:
     path = tmp_path / "generations.csv"
-    fields = ",".join(_GenerationLog.FIELDS)
+    fields = ",".join(GenerationLog.FIELDS)
     path.write_text(f"{fields}\n0,1,2,3,4,5,6,7,8,9,01,0\nx,1\n0,9,9,9,9,9,9,9,9,9,11,0\n1,1,2,3,4,5,6,7,8,9,10,0\n")
-    log = _GenerationLog(path, resume=True)
+    log = GenerationLog(path, resume=True)
     log.close()
     rows = list(csv.reader(path.read_text().splitlines()))
     assert [r[0] for r in rows[1:]] == ["0", "1"] and rows[1][-2] == "01"  # unreadable and repeated rows dropped
     assert not temporaries(tmp_path)
     # a log written before the repeats column: its rows kept under the new header, the column empty
-    old = ",".join(f for f in _GenerationLog.FIELDS if f != "repeats")
+    old = ",".join(f for f in GenerationLog.FIELDS if f != "repeats")
     path.write_text(f"{old}\n0,1,2,3,4,5,6,7,8,9,01\n")
-    _GenerationLog(path, resume=True).close()
+    GenerationLog(path, resume=True).close()
     assert path.read_text().splitlines() == [fields, "0,1,2,3,4,5,6,7,8,9,01,"]
-    _GenerationLog(path, resume=False).close()  # a new run starts the file afresh
+    GenerationLog(path, resume=False).close()  # a new run starts the file afresh
     assert path.read_text().splitlines() == [fields]
 
 
@@ -233,7 +233,7 @@ def test_a_second_run_is_refused_before_it_builds_a_table(tmp_path: Path) -> Non
 @pytest.mark.slow
 def test_a_failed_table_build_releases_the_folder_it_claimed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from pneumorph.errors import LocalityError
-    from pneumorph.models import chaintables
+    from pneumorph.models.chain import sources as chaintables
 
     def no_locality(*args, **kwargs):  # type: ignore[no-untyped-def]
         assert (folder / LOCK).exists() or (tmp_path / "new" / LOCK).exists()  # built with the folder claimed

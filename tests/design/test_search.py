@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from deap import algorithms, base, creator, tools
 
-from pneumorph.design.exhaustive import mirror_response, run_exhaustive
-from pneumorph.design.fitness import score
-from pneumorph.design.ga import _INDIVIDUAL, GAConfig, run_ga
-from pneumorph.design.targets import make_objective
+from pneumorph.design.objectives.fitness import score
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.design.search.exhaustive import mirror_response, run_exhaustive
+from pneumorph.design.search.genetic import _INDIVIDUAL, GAConfig, run_ga
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror

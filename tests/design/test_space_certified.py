@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.design.certificate import certificate_text
-from pneumorph.design.certified import certified_search, planar_codes
-from pneumorph.design.targets import make_objective
-from pneumorph.models.chain import ChainModel, ChainTable, check_source
+from pneumorph.design.certified.certificate import certificate_text
+from pneumorph.design.certified.search import certified_search, planar_codes
+from pneumorph.design.objectives.targets import make_objective
+from pneumorph.models.chain.model import ChainModel, ChainTable, check_source
 from pneumorph.models.factory import make_model
 
 TABLE = Path(__file__).parents[1] / "data" / "chain-3d-spatial-5u-10kpa.json"

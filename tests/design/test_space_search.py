@@ -8,16 +8,16 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from pneumorph.design import spacegrowth
-from pneumorph.design.bounds import chain_errors, score_designs
-from pneumorph.design.prefixes import depths
-from pneumorph.design.spacegrowth import check_space_objective, space_scores
-from pneumorph.design.targets import make_objective, tip_goal
+from pneumorph.design.certified import spacegrowth
+from pneumorph.design.certified.bounds import chain_errors, score_designs
+from pneumorph.design.certified.prefixes import depths
+from pneumorph.design.certified.spacegrowth import check_space_objective, space_scores
+from pneumorph.design.objectives.targets import make_objective, tip_goal
 from pneumorph.errors import SearchConfigError
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chainfit import fit_table
-from pneumorph.models.chainfit import training_designs as covering
-from pneumorph.models.windows import design_numbers, every_design
+from pneumorph.models.chain.fit import fit_table
+from pneumorph.models.chain.fit import training_designs as covering
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.windows import design_numbers, every_design
 from tests.spacelaw import ALPHABET, LEVELS, LIBRARY, W, _law, _response, _source, undeformed_of
 
 N = 7
@@ -124,9 +124,9 @@ def test_the_cone_of_the_chords_turns_bounds_every_prefix_tighter_than_the_ball(
 
 
 def test_the_verifications_estimate_of_a_model_over_sideways_units_is_the_full_widths() -> None:
-    from pneumorph.design.certified import _solve_estimate
+    from pneumorph.models.chain.plan import solve_estimate
     from pneumorph.models.factory import make_model
 
-    assert _solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 15 s each)"
-    assert _solve_estimate(make_model(15, {"fidelity": "3d", "library": "spatial"}), 2) == (
+    assert solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 15 s each)"
+    assert solve_estimate(make_model(15, {"fidelity": "3d", "library": "spatial"}), 2) == (
         " (3d full-width, about 60 s each)")

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from pneumorph.design import DesignConfig, make_objective, run_exhaustive
-from pneumorph.design.certified import certified_search, chain_scores
-from pneumorph.design.fitness import profile_errors, tip_values
-from pneumorph.design.targets import profile_target, tip_goal
+from pneumorph.design.certified.search import certified_search, chain_scores
+from pneumorph.design.objectives.fitness import profile_errors, tip_values
+from pneumorph.design.objectives.targets import profile_target, tip_goal
 from pneumorph.errors import SearchConfigError, TargetExpressionError
-from pneumorph.models.chain import ChainModel, ChainTable, design_strings
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.model import ChainModel, ChainTable, design_strings
+from pneumorph.models.chain.sources import shipped_path
 from pneumorph.models.response import Response
 
 
@@ -119,7 +119,7 @@ def test_branch_and_bound_in_space_keeps_every_design_that_matters(target, keeps
     grown = chain_scores(chain, target, max_enumerate=10)
     names = keeps_every_design(every, grown)
     # the chain's cost is the objective's own value of the chain's response (the z terms in full)
-    from pneumorph.design.fitness import objective_values
+    from pneumorph.design.objectives.fitness import objective_values
 
     best = design_strings(every.bits[every.order()[:1]])[0]
     values = objective_values(chain.evaluate(best), target)
@@ -131,8 +131,8 @@ def test_branch_and_bound_in_space_keeps_every_design_that_matters(target, keeps
 def test_the_profile_figure_of_a_run_in_space_has_the_view_from_above_and_in_space(target, tmp_path) -> None:
     from matplotlib.image import imread
 
-    from pneumorph.design.figures import plot_profile
-    from pneumorph.design.scoring import Candidate
+    from pneumorph.design.runs.figures import plot_profile
+    from pneumorph.design.search.scoring import Candidate
 
     ref3 = np.array([[5.0, 0.0, 7.5], [15.0, 0.0, 7.5]])
     r = _response(np.array([[5.0, 1.0, 8.5], [15.0, 2.0, 10.5]]), ref3, np.array([20.0, 2.0, 10.5]),

@@ -10,13 +10,13 @@ import pytest
 
 from pneumorph.cli import main
 from pneumorph.design import DesignConfig, make_objective, run_exhaustive
-from pneumorph.design.certified import certified_search, chain_errors, chain_scores, objective_bounds
+from pneumorph.design.certified.search import certified_search, chain_errors, chain_scores, objective_bounds
 from pneumorph.design.config import to_toml
-from pneumorph.design.fitness import objective_values, stage_values
-from pneumorph.design.targets import StagedTarget, staged_target, tip_goal
+from pneumorph.design.objectives.fitness import objective_values, stage_values
+from pneumorph.design.objectives.targets import StagedTarget, staged_target, tip_goal
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
-from pneumorph.models.chain import ChainModel, design_strings
+from pneumorph.models.chain.model import ChainModel, design_strings
 from pneumorph.models.fe import Reduced2D
 
 N = 6  # the units of the coarse_2d fixture (conftest.py)
@@ -144,9 +144,9 @@ def test_branch_and_bound_over_stages_keeps_every_design_that_matters(refine_at:
     """30-unit-style growth on 15 units of the shipped 3D table: forced past enumeration, it keeps every design
     whose enumerated cost is below its threshold, with the same cost, and the same best design; also with the
     profile stages' bound on the centres still to place at every depth (``REFINE_AT = 0``)."""
-    from pneumorph.design import growth
-    from pneumorph.models.chain import ChainTable
-    from pneumorph.models.chaintables import shipped_path
+    from pneumorph.design.certified import planegrowth as growth
+    from pneumorph.models.chain.model import ChainTable
+    from pneumorph.models.chain.sources import shipped_path
 
     if refine_at is not None:
         monkeypatch.setattr(growth, "REFINE_AT", refine_at)
@@ -166,8 +166,8 @@ def test_the_stages_bound_on_the_centres_still_to_place_drops_no_design_below_th
     """Admissible: with each profile stage's bound on its centres still to place at every depth (``REFINE_AT =
     0``), branch-and-bound at thresholds across the enumerated costs (all 4^7 designs of the 3D bending and
     near-rigid table) returns every design below the threshold."""
-    from pneumorph.design import growth
-    from pneumorph.models.chain import ChainTable
+    from pneumorph.design.certified import planegrowth as growth
+    from pneumorph.models.chain.model import ChainTable
 
     monkeypatch.setattr(growth, "REFINE_AT", 0)
     table = ChainTable.load(Path(__file__).resolve().parents[2] / "examples" / "libraries"
@@ -192,8 +192,8 @@ def test_the_stages_bound_on_the_centres_still_to_place_drops_no_design_below_th
 def test_a_target_through_a_designs_own_centres_at_two_pressures_gives_it_back() -> None:
     """Curves drawn through the 2D FE centres of a design at 18 and 45 kPa, as two stages: the certified search over
     all 2^15 designs (shipped 2D table, 2D FE verification) returns that design, at an FE cost of 0."""
-    from pneumorph.models.chain import ChainTable
-    from pneumorph.models.chaintables import shipped_path
+    from pneumorph.models.chain.model import ChainTable
+    from pneumorph.models.chain.sources import shipped_path
 
     model = Reduced2D(15)
     chain = ChainModel(ChainTable.load(shipped_path("2d")), 15)

@@ -9,8 +9,8 @@ import time
 import numpy as np
 import pytest
 
-from pneumorph.design.expressions import parse_expression
-from pneumorph.design.targets import TIP_GOALS, make_objective, profile_target, tip_goal
+from pneumorph.design.objectives.expressions import parse_expression
+from pneumorph.design.objectives.targets import TIP_GOALS, make_objective, profile_target, tip_goal
 from pneumorph.errors import (
     SearchConfigError,
     TargetExpressionError,

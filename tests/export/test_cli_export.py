@@ -9,7 +9,7 @@ import pytest
 import trimesh
 from click.testing import CliRunner
 
-from pneumorph.cli.export import export
+from pneumorph.cli.casting.export import export
 
 DEFAULT = "001111010001001"
 

@@ -29,7 +29,7 @@ from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
 from pneumorph.fem.ogden import OgdenCompressible
 from pneumorph.models.factory import make_model
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
-from pneumorph.models.gravity import STANDARD_GRAVITY, gravity_vector
+from pneumorph.models.fe.gravity import STANDARD_GRAVITY, gravity_vector
 
 L, H = 10.0, 1.0
 MU, LMBDA = 1000.0, 0.0  # nu = 0, E = 2 mu
@@ -155,7 +155,7 @@ def test_bad_gravity_is_refused() -> None:
 def test_gravity_needs_densities(monkeypatch: pytest.MonkeyPatch) -> None:
     from dataclasses import replace
 
-    from pneumorph.models import febase
+    from pneumorph.models.fe import base as febase
 
     real = febase.get  # FEModel's materials
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pneumorph.fem.ogden import OgdenCompressible
-from pneumorph.materials.hyperelastic import Ogden
+from pneumorph.materials.laws.hyperelastic import Ogden
 
 # Table A.4 Mold Star 15 (Marc convention) and Table A.5 bulk modulus 119 kPa
 MU = (-6.503e-6, 0.2169, 1.372e-3)

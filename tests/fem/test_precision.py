@@ -19,7 +19,7 @@ def _model(n: int = 1, tolerance: float = 1e-8, increments: int = 2, **unit: flo
     return Full3D(n, UnitSpec(**unit), RampSpec(pressure=0.045, steps=steps))
 
 
-class _Linear:
+class LinearisedScan:
     """A linear "system" K u = f with a chosen condition number (the fast systems' interface)."""
 
     symmetric, ordering, single_precision, tangent_dtype = True, 0, True, np.float64
@@ -44,8 +44,8 @@ class _Linear:
         return self.K @ u - self.f, 1.0
 
 
-def _solve_linear(cond: float) -> tuple[FastSubstep, str | None, np.ndarray, _Linear]:
-    system = _Linear(cond)
+def _solve_linear(cond: float) -> tuple[FastSubstep, str | None, np.ndarray, LinearisedScan]:
+    system = LinearisedScan(cond)
     step = FastSubstep(system, reuse=Full3D.tangent_reuse, depth=Full3D.anderson_depth)
     fields = [SimpleNamespace(values=np.zeros(len(system.f)))]
     _, cause = step(fields, SimpleNamespace(max_iterations=25, tolerance=1e-5))

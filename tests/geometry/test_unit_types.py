@@ -70,7 +70,7 @@ def test_bad_unit_types_are_refused() -> None:
 def test_the_shipped_chain_tables_describe_the_default_unit_as_it_is_described_now(fidelity: str) -> None:
     import json
 
-    from pneumorph.models.chaintables import shipped_path
+    from pneumorph.models.chain.sources import shipped_path
 
     source = json.loads(shipped_path(fidelity).read_text(encoding="utf-8"))["source"]
     now = UnitSpec().to_dict()

@@ -7,7 +7,7 @@ import pytest
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.identify import NAMES, ParameterSet, identify
-from pneumorph.identify.fit import _Linear
+from pneumorph.identify.linear import LinearisedScan
 from tests.identify.conftest import SIGMA, synthetic
 
 TRUTH = np.array([0.06, 0.0, 0.0, 0.08, 0.0])  # bulk x1.06, wall +0.08 mm
@@ -75,7 +75,7 @@ def test_a_3d_scan_identifies_all_five(coarse: ParameterSet) -> None:
 def test_the_linearised_outline_moves_with_its_end_points() -> None:
     """A 2D residual's derivative is the normal component of its segment's interpolated motion."""
     nodes = np.array([[0.0, 0.0], [10.0, 0.0]])
-    lin = _Linear(2, nodes, np.array([[[0.0, 1.0], [0.0, 3.0]]]), np.empty((0, 2)))
+    lin = LinearisedScan(2, nodes, np.array([[[0.0, 1.0], [0.0, 3.0]]]), np.empty((0, 2)))
     r, d = lin.match(np.array([[2.5, 1.0]]), np.zeros(1))
     assert abs(r[0]) == pytest.approx(1.0) and abs(d[0, 0]) == pytest.approx(1.0 + 0.25 * 2.0)
     r2, _ = lin.match(np.array([[2.5, 1.0]]), np.array([0.1]))

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import felupe as fem
 import numpy as np
 
-from pneumorph.materials.hyperelastic import mode_stretches
+from pneumorph.materials.laws.hyperelastic import mode_stretches
 
 
 @dataclass(frozen=True)

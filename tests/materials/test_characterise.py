@@ -8,8 +8,7 @@ from scipy import stats
 from scipy.optimize import brentq
 
 from pneumorph.errors import DataFormatError, FitError
-from pneumorph.materials import library
-from pneumorph.materials.characterise import (
+from pneumorph.materials.characterisation.analyses import (
     bilinear,
     bulk_modulus,
     characterise_bulk_modulus,
@@ -17,6 +16,7 @@ from pneumorph.materials.characterise import (
     poisson_ratio,
     thermal_expansion,
 )
+from pneumorph.materials.library import builtin as library
 
 # ---------------------------------------------------------------------------------------
 # Poisson's ratio and bulk modulus (Eqs A.4, A.5)

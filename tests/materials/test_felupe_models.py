@@ -11,14 +11,14 @@ import pytest
 from scipy.optimize import brentq
 
 from pneumorph.errors import MaterialDataError, PneumorphError, UnknownModelError
-from pneumorph.materials import felupe_models
-from pneumorph.materials.felupe_models import (
+from pneumorph.materials.laws import felupe_models
+from pneumorph.materials.laws.felupe_models import (
     build_linear_elastic,
     build_umat,
     isochoric_function,
     volumetric_energy,
 )
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.laws.hyperelastic import (
     HyperelasticModel,
     MooneyRivlin,
     NeoHooke,

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from pneumorph.errors import MaterialDataError, PressureRangeError
-from pneumorph.materials import library
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.library import eq_5_2
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.library import builtin as library
+from pneumorph.materials.library.builtin import eq_5_2
 
 
 @pytest.fixture(scope="module")

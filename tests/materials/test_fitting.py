@@ -10,16 +10,16 @@ import pytest
 
 from pneumorph import __version__
 from pneumorph.errors import FitError, UnknownModelError
-from pneumorph.materials.comparison import compare
-from pneumorph.materials.datasets import load_dataset
-from pneumorph.materials.fitting import (
+from pneumorph.materials.characterisation.datasets import load_dataset
+from pneumorph.materials.characterisation.testdata import TestCurve, TestData, read_curve
+from pneumorph.materials.fitting.comparison import compare
+from pneumorph.materials.fitting.fit import (
     MODEL_NAMES,
     fit,
     r_squared,
     resolve_model,
 )
-from pneumorph.materials.hyperelastic import MooneyRivlin, NeoHooke, Ogden, Yeoh
-from pneumorph.materials.testdata import TestCurve, TestData, read_curve
+from pneumorph.materials.laws.hyperelastic import MooneyRivlin, NeoHooke, Ogden, Yeoh
 
 FIVE = ("neo-hooke", "mooney-rivlin-2", "mooney-rivlin-3", "yeoh", "ogden-3")
 SORO = "marechal2021_SoRo-Materials-DB/Tensile-Tests-Data"

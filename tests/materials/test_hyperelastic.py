@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.laws.hyperelastic import (
     MODES,
     MooneyRivlin,
     NeoHooke,

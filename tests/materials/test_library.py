@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from pneumorph.errors import MaterialDataError, UnknownMaterialError
-from pneumorph.materials import library
-from pneumorph.materials.hyperelastic import Ogden, Yeoh
+from pneumorph.materials.laws.hyperelastic import Ogden, Yeoh
+from pneumorph.materials.library import builtin as library
 
 THESIS = "seed/000_2f6eb7f132ab41d4.txt"
 SILICONES = {"Ecoflex 0030": "ecoflex_0030", "Mold Star 15": "mold_star_15", "Smooth-Sil 950": "smooth_sil_950"}
@@ -415,7 +415,7 @@ def test_file_level_errors(tmp_path: Path) -> None:
 def test_materials_built_in_code_obey_the_library_rules() -> None:
     from dataclasses import replace
 
-    from pneumorph.materials.material import Material, Quantity
+    from pneumorph.materials.library.material import Material, Quantity
 
     good = library.get("smooth_sil_950")
     with pytest.raises(MaterialDataError, match="needs a model"):

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from pneumorph.errors import DataFormatError, UnknownDatasetError
-from pneumorph.materials.datasets import list_datasets, load_dataset, read_test_data
-from pneumorph.materials.testdata import TestCurve, TestData, guess_mode, read_curve
+from pneumorph.materials.characterisation.datasets import list_datasets, load_dataset, read_test_data
+from pneumorph.materials.characterisation.testdata import TestCurve, TestData, guess_mode, read_curve
 
 SORO = "marechal2021_SoRo-Materials-DB/Tensile-Tests-Data"
 

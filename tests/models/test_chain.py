@@ -8,12 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.design.exhaustive import mirror_response
+from pneumorph.design.search.exhaustive import mirror_response
 from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.orientation import mirror
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import (
+from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.model import (
     ChainModel,
     ChainTable,
     check_source,
@@ -23,8 +24,7 @@ from pneumorph.models.chain import (
     possible_codes,
     window_codes,
 )
-from pneumorph.models.chainfit import build_table
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.sources import shipped_path
 from pneumorph.models.factory import make_model
 from pneumorph.models.fe import RampSpec, Reduced2D
 

@@ -12,11 +12,10 @@ import pytest
 from pneumorph.errors import ChainTableError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chainfit import build_table, fit_table
-from pneumorph.models.chaintables import shipped_path
-from pneumorph.models.fe import RampSpec, Reduced2D
-from pneumorph.models.windows import (
+from pneumorph.models.chain.fit import build_table, fit_table
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import shipped_path
+from pneumorph.models.chain.windows import (
     covering_designs,
     design_array,
     design_strings,
@@ -24,6 +23,7 @@ from pneumorph.models.windows import (
     possible_codes,
     window_codes,
 )
+from pneumorph.models.fe import RampSpec, Reduced2D
 
 RAMP = RampSpec(pressure=0.02)
 

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from pneumorph.errors import ChainTableError
-from pneumorph.models.buildplan import build_plan
-from pneumorph.models.chain import ChainModel, ChainTable, check_source, source_key
-from pneumorph.models.chaintables import (
+from pneumorph.models.chain.model import ChainModel, ChainTable, check_source, source_key
+from pneumorph.models.chain.plan import build_plan
+from pneumorph.models.chain.sources import (
     build_options,
     ramp_variant,
     restrict_table,
@@ -135,7 +135,7 @@ _BUILDER = textwrap.dedent("""
     import json, sys, time
     from pathlib import Path
     from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
-    from pneumorph.models.chaintables import table_for
+    from pneumorph.models.chain.sources import table_for
     from pneumorph.models.factory import make_model
 
     name, tables, go = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])

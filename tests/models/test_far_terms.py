@@ -12,14 +12,14 @@ import pytest
 from pneumorph.errors import ChainTableError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chainfile import TABLE_FORMAT, TERMS_FORMAT
-from pneumorph.models.chainfit import build_table, fit_table
-from pneumorph.models.chainterms import end_terms, far_designs, far_terms
+from pneumorph.models.chain.fit import build_table, fit_table
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.tablefile import TABLE_FORMAT, TERMS_FORMAT
+from pneumorph.models.chain.terms import end_terms, far_designs, far_terms
+from pneumorph.models.chain.validation import heldout_designs
+from pneumorph.models.chain.windows import design_array, window_symbols
 from pneumorph.models.fe import RampSpec, Reduced2D
 from pneumorph.models.response import Response
-from pneumorph.models.validation import heldout_designs
-from pneumorph.models.windows import design_array, window_symbols
 
 LEVELS = 3
 PITCH = 10.0

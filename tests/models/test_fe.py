@@ -13,7 +13,7 @@ from pneumorph.errors import OrientationError, PressureRangeError, SettingsError
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get_filler
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 
 LOW = RampSpec(pressure=0.01, steps=StepSettings(increments=2, substeps=2))
@@ -190,7 +190,7 @@ def test_3d_fingerprint_holds_the_result_determining_ramp_settings_only() -> Non
 
 
 def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyPatch) -> None:
-    import pneumorph.models.febase as febase
+    import pneumorph.models.fe.base as febase
     from pneumorph.execution.outcome import solve
 
     ramp = RampSpec(pressure=0.01)  # 10 levels

@@ -111,8 +111,8 @@ def test_the_full_width_gets_the_half_models_single_precision_limit_per_half_wid
 
 def test_a_chain_table_over_sideways_units_is_planned_on_the_full_width(spatial: UnitLibrary) -> None:
     """A chain in space: every training design on the full width, estimated at the full model's solve time."""
-    from pneumorph.models.buildplan import FULL_WIDTH, build_plan
-    from pneumorph.models.chain import source_key, training_model
+    from pneumorph.models.chain.model import source_key, training_model
+    from pneumorph.models.chain.plan import FULL_WIDTH, build_plan
 
     model = Full3D(15, library=spatial)
     plan = build_plan(model, window=1, short=True)

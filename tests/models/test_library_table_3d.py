@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import build_options, find_table, shipped_path
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import build_options, find_table, shipped_path
+from pneumorph.models.chain.training import FIXED, unfixed_error
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import Response
-from pneumorph.models.termdesigns import FIXED, unfixed_error
 
 HELDOUT = sorted((Path(__file__).parents[1] / "data" / "library-heldout").glob("*.json"))
 

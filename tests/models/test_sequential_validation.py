@@ -8,10 +8,10 @@ import pytest
 from pneumorph.errors import LocalityError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.buildplan import build_plan
-from pneumorph.models.chainfit import CLEAR_FRACTION, MIN_HELDOUT, build_table, heldout_designs, prediction_errors
+from pneumorph.models.chain.fit import CLEAR_FRACTION, MIN_HELDOUT, build_table, heldout_designs, prediction_errors
+from pneumorph.models.chain.plan import build_plan
+from pneumorph.models.chain.windows import covering_designs
 from pneumorph.models.fe import RampSpec, Reduced2D
-from pneumorph.models.windows import covering_designs
 
 MODEL = Reduced2D(9, UnitSpec(element_size=3.0), RampSpec(pressure=0.02))
 

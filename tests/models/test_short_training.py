@@ -7,9 +7,9 @@ import pytest
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chainfit import build_table, prediction_errors
+from pneumorph.models.chain.fit import build_table, prediction_errors
+from pneumorph.models.chain.windows import covering_designs, end_designs, window_codes
 from pneumorph.models.fe import RampSpec, Reduced2D
-from pneumorph.models.windows import covering_designs, end_designs, window_codes
 
 
 def test_end_designs_show_every_end_window_of_longer_actuators() -> None:

@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 
 from pneumorph.errors import ChainTableError
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chainfile import SPACE_FORMAT
-from pneumorph.models.chainfit import fit_table, training_designs
-from pneumorph.models.chaintables import restrict_table
+from pneumorph.models.chain.fit import fit_table, training_designs
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import restrict_table
+from pneumorph.models.chain.space import rotation_matrices
+from pneumorph.models.chain.tablefile import SPACE_FORMAT
+from pneumorph.models.chain.validation import heldout_designs
+from pneumorph.models.chain.windows import covering_designs
 from pneumorph.models.response import Response
-from pneumorph.models.spacechords import rotation_matrices
-from pneumorph.models.validation import heldout_designs
-from pneumorph.models.windows import covering_designs
 from tests.spacelaw import ALPHABET, LEVELS, LIBRARY, W, _law, _response, _source, undeformed_of
 
 

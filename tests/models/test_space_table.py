@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table, shipped_path
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import find_table, shipped_path
+from pneumorph.models.chain.space import angle_between
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import Response
-from pneumorph.models.spacechords import angle_between
 
 HELDOUT = sorted((Path(__file__).parents[1] / "data" / "space-heldout").glob("*.json"))
 

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import serve_table
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import serve_table
+from pneumorph.models.chain.space import frame_elements, frame_polyline, space_elements, space_polyline
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import response_elements
-from pneumorph.models.spacechords import frame_elements, frame_polyline, space_elements, space_polyline
 
 
 def _curves(seed: int, shape: tuple[int, ...], m: int) -> np.ndarray:

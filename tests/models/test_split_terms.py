@@ -12,12 +12,12 @@ import pytest
 from pneumorph.errors import ChainTableError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.models.chain import ChainTable
-from pneumorph.models.chainfit import build_table, fit_table
-from pneumorph.models.chainterms import end_terms, far_terms, terms_from_dict
+from pneumorph.models.chain.fit import build_table, fit_table
+from pneumorph.models.chain.model import ChainTable
+from pneumorph.models.chain.terms import end_terms, far_terms, terms_from_dict
+from pneumorph.models.chain.training import FIXED, split_designs, unfixed_error
+from pneumorph.models.chain.windows import cover_rows, design_pool
 from pneumorph.models.fe import RampSpec, Reduced2D
-from pneumorph.models.termdesigns import FIXED, split_designs, unfixed_error
-from pneumorph.models.windows import cover_rows, design_pool
 from tests.models.test_far_terms import _law, _response, worst_error
 
 SOURCE = {"fidelity": "toy", "key": "additive"}
@@ -53,7 +53,7 @@ def test_a_cover_of_the_keys_alone_leaves_windows_unfixed() -> None:
     alphabet, n, w = ("a", "r"), 11, 2
     rng = np.random.default_rng(0)
     pool = design_pool(n, 2, (), rng, 4**4)
-    from pneumorph.models.termdesigns import _split_keys
+    from pneumorph.models.chain.training import _split_keys
 
     cover = split_designs(n, w, alphabet)[: len(cover_rows(_split_keys(pool, w, 2, (), False), rng))]
     assert unfixed_error(cover, w, alphabet, (), n) > 0.1

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from pneumorph.design import make_objective
-from pneumorph.design.certified import chain_errors, grow_designs
+from pneumorph.design.certified.search import chain_errors, grow_designs
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.library import UnitLibrary, builtin_library
-from pneumorph.models.chain import ChainModel, covering_designs
-from pneumorph.models.chainfit import build_table
+from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.model import ChainModel, covering_designs
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 N = 6

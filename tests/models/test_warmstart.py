@@ -1,4 +1,4 @@
-"""A nearby model's solve from a solved state (models.warmstart.solve_near): the ramp's answer at the top
+"""A nearby model's solve from a solved state (models.fe.warmstart.solve_near): the ramp's answer at the top
 pressure in a few Newton iterations, for every parameter the identification moves; a start that does not fit
 falls back to the ramp."""
 
@@ -11,7 +11,7 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.identify import ParameterSet
 from pneumorph.identify.parameters import NAMES, STEPS
 from pneumorph.models.factory import make_model
-from pneumorph.models.warmstart import solve_near
+from pneumorph.models.fe.warmstart import solve_near
 
 BASE = {"fidelity": "3d", "pressure_kpa": 36}
 DESIGN = "010"

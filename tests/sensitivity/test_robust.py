@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.design.robustness import design_robustness
+from pneumorph.design.runs.robustness import design_robustness
 from pneumorph.errors import ChainTableError
-from pneumorph.models.chain import ChainModel, ChainTable, design_array
-from pneumorph.models.chaintables import shipped_path
+from pneumorph.models.chain.model import ChainModel, ChainTable, design_array
+from pneumorph.models.chain.sources import shipped_path
+from pneumorph.models.chain.windows import window_codes
 from pneumorph.models.factory import make_model
-from pneumorph.models.windows import window_codes
 from pneumorph.sensitivity import Tolerance, perturbed
 from pneumorph.sensitivity.robust import (
     ToleranceTables,
@@ -68,7 +68,7 @@ def test_perturbed_chain_predicts_the_fe_model_of_a_perturbed_unit() -> None:
 
 
 def test_design_robustness_statistics_and_the_robust_level() -> None:
-    from pneumorph.design.targets import make_objective
+    from pneumorph.design.objectives.targets import make_objective
 
     nominal = ChainTable.load(shipped_path("2d"))
     tables = shipped_tolerance_tables("2d")
@@ -136,7 +136,7 @@ def test_the_interpolation_is_exact_for_any_quadratic_with_interactions() -> Non
 
 @pytest.mark.slow
 def test_every_design_grown_unit_by_unit_equals_them_scored_one_by_one() -> None:
-    from pneumorph.design.targets import make_objective
+    from pneumorph.design.objectives.targets import make_objective
 
     nominal, tables = ChainTable.load(shipped_path("2d")), shipped_tolerance_tables("2d")
     every = ((np.arange(2**15)[:, None] >> np.arange(14, -1, -1)) & 1).astype(np.uint8)

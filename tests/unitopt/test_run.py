@@ -11,7 +11,7 @@ from pneumorph.errors import GeometryError, SettingsError
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.unitopt.measures import UnitMeasures
-from pneumorph.unitopt.problem import Candidate
+from pneumorph.unitopt.problem import UnitCandidate
 from pneumorph.unitopt.run import OptimiseSettings, front_of, optimise, write_outputs
 from pneumorph.unitopt.space import DesignSpace, Variable
 
@@ -86,10 +86,10 @@ def test_the_strain_limit_makes_units_infeasible(run) -> None:
 
 
 def test_a_failed_ramp_is_infeasible_by_the_pressure_it_lacked() -> None:
-    failed = Candidate({"wall": 1.0}, UnitSpec(), None, "limit point", 0.03, False, 1.0, 0)
+    failed = UnitCandidate({"wall": 1.0}, UnitSpec(), None, "limit point", 0.03, False, 1.0, 0)
     assert failed.constraints(4.4, 0.045) == pytest.approx((0.0, 1 / 3))
     assert not failed.feasible(4.4)
-    ok = Candidate({"wall": 1.0}, UnitSpec(), UnitMeasures(20.0, 3.0, 3.0, 1.0, 2.0, 2.2, 0.1, 20.0), None, 0.045,
+    ok = UnitCandidate({"wall": 1.0}, UnitSpec(), UnitMeasures(20.0, 3.0, 3.0, 1.0, 2.0, 2.2, 0.1, 20.0), None, 0.045,
                    False, 1.0, 0)
     assert ok.constraints(4.4, 0.045) == pytest.approx((-0.5, 0.0)) and ok.objectives() == (-20.0, 3.0)
 

@@ -6,7 +6,7 @@ fingerprints) and answers a :class:`~pneumorph.bench.query.Query` with the chain
 best design, its pressure and error, the designs listed by chain value, and what the
 chain's validated error bound proves before any FE solve: the model's optimum is among the
 designs whose optimistic value beats the winner's pessimistic one
-(:mod:`pneumorph.design.certified`). An FE verification (a background job) then certifies
+(:mod:`pneumorph.design.certified.search`). An FE verification (a background job) then certifies
 the winner in the model itself.
 """
 
@@ -25,17 +25,17 @@ import numpy as np
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
 from pneumorph.bench.samples import centrelines, path_samples, profiles, stage_samples, target_samples, uses_path
 from pneumorph.bench.shapes import chain_placement, surface
-from pneumorph.design.certified import best_scores
-from pneumorph.design.growth import designs_of
-from pneumorph.design.spacegrowth import check_space_objective
-from pneumorph.design.targets import StagedTarget, TipGoal
+from pneumorph.design.certified.planegrowth import designs_of
+from pneumorph.design.certified.search import best_scores
+from pneumorph.design.certified.spacegrowth import check_space_objective
+from pneumorph.design.objectives.targets import StagedTarget, TipGoal
 from pneumorph.errors import PneumorphError, SearchConfigError
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import atomic_write_text
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import find_table
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import find_table
+from pneumorph.models.chain.windows import design_numbers
 from pneumorph.models.factory import make_model
-from pneumorph.models.windows import design_numbers
 
 BUILTIN = "builtin"
 LIBRARIES = {"spatial": "spatial library: a, l (sideways)"}

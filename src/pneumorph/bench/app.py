@@ -37,8 +37,8 @@ from pneumorph.bench.guard import (
 )
 from pneumorph.bench.jobs import JobBoard, JobLimits
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, load_json
-from pneumorph.design.paths import PATH_PRESETS
-from pneumorph.design.targets import PRESETS, TIP_GOALS
+from pneumorph.design.objectives.paths import PATH_PRESETS
+from pneumorph.design.objectives.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
 from pneumorph.geometry.limits import MeshLimitError
 from pneumorph.geometry.meshsize import check_mesh

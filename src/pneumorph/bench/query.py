@@ -3,8 +3,8 @@
 The page sends JSON; :func:`parse_query` turns it into a :class:`Query` or raises
 :class:`QueryError` naming the field to show the message beside. Nothing a user types is
 executed: expressions go through the same safe parser as the command line
-(:mod:`pneumorph.design.expressions`), drawn curves are smoothed into a polyline
-(:func:`pneumorph.design.targets.smooth_curve`), or into a path where the stroke turns back
+(:mod:`pneumorph.design.objectives.expressions`), drawn curves are smoothed into a polyline
+(:func:`pneumorph.design.objectives.targets.smooth_curve`), or into a path where the stroke turns back
 in x (:mod:`pneumorph.bench.strokes`).
 """
 
@@ -19,8 +19,8 @@ import numpy as np
 from pneumorph import checks
 from pneumorph.bench.strokes import AXIS_MM, is_path_stroke, smooth_path
 from pneumorph.design.config import DesignConfig
-from pneumorph.design.paths import PATH_PRESETS, path_points
-from pneumorph.design.targets import (
+from pneumorph.design.objectives.paths import PATH_PRESETS, path_points
+from pneumorph.design.objectives.targets import (
     MAX_STAGES,
     PRESETS,
     TIP_GOALS,
@@ -68,7 +68,7 @@ class Query:
     ----------
     kind : {"preset", "expression", "tip", "curve", "path", "stages"}
     spec : str
-        The objective's text for :func:`~pneumorph.design.targets.make_objective` ("sin",
+        The objective's text for :func:`~pneumorph.design.objectives.targets.make_objective` ("sin",
         "y = ...", "max-x", "curve", "path" or a path preset such as "hook").
     amplitude, periods : float
     point : (float, float), (float, float, float) or None

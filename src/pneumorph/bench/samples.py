@@ -6,7 +6,7 @@ Two frames, as the objectives use them:
   each unit centre's height less its undeformed one (Eq 4.1's frame);
 - a *path* (:func:`centrelines`, :func:`path_samples`): the unit centres as the model reports
   them, y from the actuator's bottom face (the undeformed axis at ``tip_ref[1]``, 6 mm for the
-  built-in unit), z from its mid-plane (:mod:`pneumorph.design.paths`).
+  built-in unit), z from its mid-plane (:mod:`pneumorph.design.objectives.paths`).
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.design.pathfigure import centrelines as design_centrelines
-from pneumorph.design.paths import PathTarget
-from pneumorph.design.targets import ProfileTarget, StagedTarget, TipGoal
+from pneumorph.design.objectives.paths import PathTarget
+from pneumorph.design.objectives.targets import ProfileTarget, StagedTarget, TipGoal
+from pneumorph.design.runs.pathfigure import centrelines as design_centrelines
 
 TARGET_SAMPLES = 201
 
@@ -37,10 +37,10 @@ def profiles(response: Any) -> list[list[list[float]]]:
 def centrelines(response: Any) -> list[list[list[float]]]:
     """Base (on the undeformed axis), unit centres and tip at every level as the model reports them (mm): the frame
     a path is matched in, y from the bottom face; a response in space gives z from the mid-plane too
-    (:func:`pneumorph.design.pathfigure.centrelines`).
+    (:func:`pneumorph.design.runs.pathfigure.centrelines`).
 
-    The unit centres are those a :class:`~pneumorph.design.paths.PathTarget` scores
-    (:func:`pneumorph.design.fitness.path_errors`); the base and the tip join them into a line.
+    The unit centres are those a :class:`~pneumorph.design.objectives.paths.PathTarget` scores
+    (:func:`pneumorph.design.objectives.fitness.path_errors`); the base and the tip join them into a line.
     """
     return np.round(design_centrelines(response), 4).tolist()
 

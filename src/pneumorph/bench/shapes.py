@@ -60,7 +60,7 @@ def chain_placement(mesh: ActuatorMesh, response: Response, level: int) -> Float
     The centreline is the polyline base -> unit centres -> tip (a planar response's in the
     plane z = 0). Each chord turns from its undeformed direction by the rotation between the
     two chords' frames transported along the polylines without twist
-    (:func:`~pneumorph.models.spacechords.transported_frames`). A centre turns halfway between
+    (:func:`~pneumorph.models.chain.space.transported_frames`). A centre turns halfway between
     its two chords (spherical linear interpolation), the base not at all, the tip as its
     end face (a planar response's curl) or, in space, as the last chord; a node at arc ``X``
     turns as interpolated between them. It goes to the centreline point at ``X`` plus its
@@ -80,7 +80,7 @@ def chain_placement(mesh: ActuatorMesh, response: Response, level: int) -> Float
     """
     from scipy.spatial.transform import Rotation, Slerp
 
-    from pneumorph.models.spacechords import space_elements, transported_frames
+    from pneumorph.models.chain.space import space_elements, transported_frames
 
     def polyline(centres: FloatArray, tip: FloatArray) -> FloatArray:
         out = np.vstack([response.reference_centres[:1], centres, tip[None]]).astype(float)

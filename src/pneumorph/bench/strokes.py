@@ -2,10 +2,10 @@
 
 The page's drawing canvas gives a stroke in the profile frame: x from the base along the
 undeformed actuator, y above its undeformed axis (mm). A stroke that keeps going one way in x
-is a graph and is smoothed by :func:`pneumorph.design.targets.smooth_curve` as it always was.
+is a graph and is smoothed by :func:`pneumorph.design.objectives.targets.smooth_curve` as it always was.
 A stroke that turns back in x (a hook, a letter, a spiral), or so steep that its span in x
-is less than :data:`~pneumorph.design.profiles.MIN_GRAPH_SPAN` of its length, is no graph:
-:func:`smooth_path` makes it a path (:mod:`pneumorph.design.paths`), in order, in the frame
+is less than :data:`~pneumorph.design.objectives.profiles.MIN_GRAPH_SPAN` of its length, is no graph:
+:func:`smooth_path` makes it a path (:mod:`pneumorph.design.objectives.paths`), in order, in the frame
 of the unit centres (the axis height added to y).
 
 Hand jitter is not a turn: a stroke turns back when its x falls more than
@@ -22,8 +22,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.paths import MAX_PATH_POINTS, path_points
-from pneumorph.design.profiles import MIN_GRAPH_SPAN, smooth_curve
+from pneumorph.design.objectives.paths import MAX_PATH_POINTS, path_points
+from pneumorph.design.objectives.profiles import MIN_GRAPH_SPAN, smooth_curve
 from pneumorph.errors import TargetExpressionError
 
 FloatArray = NDArray[np.float64]
@@ -64,7 +64,7 @@ def is_path_stroke(points: Any) -> bool:
     ``max(TURN_BACK_MM, TURN_BACK_SHARE * span)``, or its span in x is less than ``MIN_GRAPH_SPAN`` of its length.
 
     Anything else (a graph, or points that are not a stroke: text, NaN, too few) is False, for
-    :func:`~pneumorph.design.targets.smooth_curve` to smooth or refuse as before.
+    :func:`~pneumorph.design.objectives.targets.smooth_curve` to smooth or refuse as before.
 
     Examples
     --------
@@ -95,7 +95,7 @@ def smooth_path(points: Any, length: float, axis: float, knots: int = PATH_KNOTS
     """A drawn stroke as a path: ``knots`` points evenly spaced along its arc length, in the centres' frame.
 
     Along the stroke's arc length ``s``, x(s) and y(s) are each smoothed as
-    :func:`~pneumorph.design.targets.smooth_curve` smooths y(x): at every knot a straight line
+    :func:`~pneumorph.design.objectives.targets.smooth_curve` smooths y(x): at every knot a straight line
     fitted with a Gaussian weight in ``s`` (standard deviation ``bandwidth``, default
     ``length / 40``, the graph's), which takes out the hand's jitter and keeps the ends true.
     The first point is the stroke's own (where it was begun). ``axis`` (mm) is added to y: the
@@ -104,7 +104,7 @@ def smooth_path(points: Any, length: float, axis: float, knots: int = PATH_KNOTS
     Raises
     ------
     TargetExpressionError
-        Points :func:`~pneumorph.design.paths.path_points` refuses (text, NaN, fewer than 2,
+        Points :func:`~pneumorph.design.objectives.paths.path_points` refuses (text, NaN, fewer than 2,
         all at one place).
 
     Examples

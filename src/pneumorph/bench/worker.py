@@ -78,7 +78,7 @@ class TableProgress:
 
     Each ``"... N/M solved"`` line is one more design solved (or found in the cache); the
     share is the designs done over the designs of the windows begun so far (covering and
-    held-out, :attr:`pneumorph.models.buildplan.BuildPlan.solves`), so it follows the work
+    held-out, :attr:`pneumorph.models.chain.plan.BuildPlan.solves`), so it follows the work
     whatever the order of the solves.
 
     Parameters
@@ -119,7 +119,7 @@ def verify(job: dict[str, Any], bench: Bench, report: Reporter) -> dict[str, Any
     In 3D the chain's best design is solved first, keeping its fields for the 3D view; its
     response goes into the cache, where the design run finds it.
     """
-    from pneumorph.design.run import run_design
+    from pneumorph.design.driver import run_design
 
     query = Query.from_dict(job["params"]["query"])
     folder = Path(job["folder"])
@@ -174,8 +174,8 @@ def table(job: dict[str, Any], bench: Bench, report: Reporter) -> dict[str, Any]
     """The chain table of an uploaded unit, built through the evaluation cache (or found)."""
     from pneumorph.execution import CachedEvaluator, EvaluationCache, make_evaluator
     from pneumorph.geometry.unit import UnitSpec
-    from pneumorph.models.buildplan import build_plan
-    from pneumorph.models.chaintables import TRAINING_UNITS, build_options, table_for
+    from pneumorph.models.chain.plan import build_plan
+    from pneumorph.models.chain.sources import TRAINING_UNITS, build_options, table_for
 
     params = job["params"]
     spec = UnitSpec.from_dict(params["unit"], "uploaded unit")

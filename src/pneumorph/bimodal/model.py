@@ -41,7 +41,7 @@ from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialErr
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.materials import get
-from pneumorph.materials.hyperelastic import Ogden
+from pneumorph.materials.laws.hyperelastic import Ogden
 from pneumorph.models.fe import Full3D
 
 FloatArray = np.ndarray

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 
 #: R^2 below which a fitted law is reported as a poor fit.
 R2_WARNING = 0.9

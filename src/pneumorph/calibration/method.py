@@ -36,7 +36,7 @@ from pneumorph.calibration.references import Solve3D, reference_model
 from pneumorph.errors import MaterialDataError, SearchConfigError
 from pneumorph.fem import StepSettings
 from pneumorph.geometry.unit import UnitSpec
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.models.fe import RampSpec, Reduced2D
 
 

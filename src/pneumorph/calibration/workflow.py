@@ -45,7 +45,7 @@ from pneumorph.execution.evaluators import Evaluator
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io import atomic_write_text, check_writable_dir, provenance, write_json
 from pneumorph.io.files import all_or_nothing
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.models.fe import Full3D, RampSpec, Reduced2D
 from pneumorph.models.response import Response
 

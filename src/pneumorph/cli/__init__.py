@@ -16,7 +16,7 @@ from typing import Any
 import click
 
 from pneumorph import __version__
-from pneumorph.cli.materials import materials
+from pneumorph.cli.materials.group import materials
 from pneumorph.errors import PneumorphError, note_sigint, sigints
 
 
@@ -28,16 +28,16 @@ def cli() -> None:
 
 cli.add_command(materials)
 
-from pneumorph.cli.composite import composite  # noqa: E402
+from pneumorph.cli.bilinear.composite import composite  # noqa: E402
 
 cli.add_command(composite)
 
 from pneumorph.cli.calibrate import calibrate  # noqa: E402
+from pneumorph.cli.casting.correlate import correlate  # noqa: E402
+from pneumorph.cli.casting.export import export  # noqa: E402
+from pneumorph.cli.casting.identify import identify  # noqa: E402
 from pneumorph.cli.chain import chain  # noqa: E402
-from pneumorph.cli.correlate import correlate  # noqa: E402
 from pneumorph.cli.design import design  # noqa: E402
-from pneumorph.cli.export import export  # noqa: E402
-from pneumorph.cli.identify import identify  # noqa: E402
 from pneumorph.cli.sensitivity import sensitivity  # noqa: E402
 from pneumorph.cli.serve import serve  # noqa: E402
 from pneumorph.cli.simulate import simulate  # noqa: E402
@@ -54,7 +54,7 @@ cli.add_command(serve)
 cli.add_command(simulate)
 cli.add_command(study)
 
-from pneumorph.cli.bimodal import bimodal  # noqa: E402
+from pneumorph.cli.bilinear.bimodal import bimodal  # noqa: E402
 
 cli.add_command(bimodal)
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import check_options, cluster_line, execution_options, open_evaluator
 
 
 @click.command("calibrate")

@@ -7,8 +7,14 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import (
+    check_options,
+    cluster_line,
+    cluster_report,
+    execution_options,
+    open_evaluator,
+)
 
 
 @click.group("chain")
@@ -71,9 +77,9 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pneumorph.errors import ChainTableError
     from pneumorph.io import strict_json
     from pneumorph.io.files import all_or_nothing_file
-    from pneumorph.models.buildplan import build_plan, cached_counter, evaluator_workers
-    from pneumorph.models.chainfit import build_table
-    from pneumorph.models.chaintables import build_options
+    from pneumorph.models.chain.fit import build_table
+    from pneumorph.models.chain.plan import build_plan, cached_counter, evaluator_workers
+    from pneumorph.models.chain.sources import build_options
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
@@ -93,7 +99,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         raise ChainTableError("--split-terms lays out the far-field terms: not with --no-far-terms")
     model = make_model(n_units, settings)
     if getattr(model, "mixed", False):
-        from pneumorph.models.chainfit import check_training_size
+        from pneumorph.models.chain.fit import check_training_size
 
         check_training_size(len(model.library), window or 1, len(model.library.symmetric))  # before any solve
     evaluator = open_evaluator(executor, workers, scheduler, cache)

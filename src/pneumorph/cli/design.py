@@ -11,8 +11,8 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, execution_options
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import check_options, execution_options
 
 # the options that are [design] and [execution] settings of the same name
 _DESIGN_OPTIONS = ("amplitude", "periods", "point", "units", "search", "seed", "certify", "verify", "margin",
@@ -123,8 +123,7 @@ def design(config_file: str | None, **options: Any) -> None:
     _check_run(config, model, o)
     o.reference = nominal.make_model() if nominal is not None and config.search == "certified" else None
     if fallback:  # said once every setting has been checked
-        click.echo("the certified search needs a free actuator (its chain model does not hold under gravity): "
-                   "falling back to the genetic algorithm", err=True)
+        click.echo(fallback, err=True)
     if o.model_file is not None:
         _warn_unidentified(o.model_file)
     result, model = _run(config, model, o, fidelity_given)
@@ -145,7 +144,7 @@ def _target_changes(target: str) -> dict[str, Any]:
     """The config's changes for ``--target``: a path from ``path:FILE`` (its points, read here), else the text."""
     head, sep, rest = target.partition(":")
     if sep and head.strip().lower() == "path":
-        from pneumorph.design.paths import read_path
+        from pneumorph.design.objectives.paths import read_path
 
         route = read_path(rest.strip())
         return {"objective": "path", "path": route.points}
@@ -162,7 +161,7 @@ def _check_inputs(o: Any) -> None:
         raise SearchConfigError("give either --target (a profile) or --objective (a tip goal), not both")
     o.target_changes = None
     if o.target is not None:
-        from pneumorph.design.targets import make_objective
+        from pneumorph.design.objectives.targets import make_objective
         from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):  # along the built-in unit; checked again along the model's
@@ -176,11 +175,11 @@ def _check_inputs(o: Any) -> None:
         P.library_option(o.library, o.unit_file)
 
 
-def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
+def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any]:
     """The run's settings: the config file's (or the defaults) with the options over them
-    (:meth:`DesignConfig.with_options`), the fidelity of its search written in; whether the certified search fell
-    back to the GA (gravity); whether the fidelity was given; with ``--model-file``, the same settings without it
-    (the nominal model, whose design the report compares)."""
+    (:meth:`DesignConfig.with_options`), the fidelity of its search written in; why the certified search fell
+    back to the GA (:meth:`DesignConfig.searchable`), or None; whether the fidelity was given; with
+    ``--model-file``, the same settings without it (the nominal model, whose design the report compares)."""
     from pneumorph.design import DesignConfig
 
     config = DesignConfig.read(config_file) if config_file else DesignConfig()
@@ -218,9 +217,7 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, bool, bool, Any]:
     nominal = None if identified is None else config.with_options(design, ga=ga, model=options)
     config = config.with_options(design, ga=ga, model=options, model_file=identified)
     fidelity_given = "fidelity" in config.model
-    fallback = config.search == "certified" and config.model.get("gravity") not in (None, "none")
-    if fallback:
-        config = config.as_ga()
+    config, fallback = config.searchable()
     if nominal is not None:  # the nominal model at the fidelity and pressure of the run's
         nominal = nominal.with_options({}, model={"fidelity": config.fidelity,
                                                   "pressure_kpa": config.model.get("pressure_kpa")})
@@ -262,7 +259,7 @@ def _check_run(config: Any, model: Any, o: Any) -> None:
         raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
                                "turns off; leave one of them out")
     if config.refine and config.search == "certified":  # refused here, naming the option; the run checks again
-        from pneumorph.design.refine import check_refine
+        from pneumorph.design.certified.refine import check_refine
 
         with P.blame("--refine" if o.refine is not None else "[design] refine"):
             check_refine(model, config.refine)
@@ -284,9 +281,7 @@ def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, An
         if config.search != "certified":
             raise
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
-    config = config.as_ga()
-    if not fidelity_given:
-        config = config.with_options({}, model={"fidelity": "2d"})
+    config = config.fallback(fidelity_given)
     model = config.make_model()
     progress = _Progress(config, model, o.out or _default_folder(config))  # the new run says its own first line
     result = run_design(config, model, progress.folder, overwrite=o.overwrite, **progress.callbacks())
@@ -333,14 +328,14 @@ class _Progress:
 
 def _print_result(result: Any, config: Any, model: Any) -> None:
     """The winner, its certificate, mesh note, robustness and retries, in words."""
-    from pneumorph.design.report import value_words
+    from pneumorph.design.runs.report import value_words
 
     best = result.best
     words = value_words(result.objective, best.value, config.units)
     click.echo(f"best design {best.design} at {_kpa(best.pressure):.4g} kPa: {words} "
                f"({result.solves} solves, {result.cache_hits} cache hits, {result.wall_time:.1f} s)")
     if result.certified is not None:
-        from pneumorph.design.certificate import certificate_text
+        from pneumorph.design.certified.certificate import certificate_text
 
         for line in certificate_text(result.certified.certificate, result.objective.unit, best.design,
                                      model.fidelity):
@@ -349,7 +344,7 @@ def _print_result(result: Any, config: Any, model: Any) -> None:
         if two_d is not None:
             click.echo(f"  The 2D model's chain value of {best.design}: {two_d:.4g} {result.objective.unit}.")
     _print_mesh(result)
-    from pneumorph.design.comparison import comparison_lines
+    from pneumorph.design.runs.comparison import comparison_lines
 
     for line in comparison_lines(result.comparison):
         click.echo(f"  {line}")
@@ -433,7 +428,7 @@ def _stage_option(text: str, amplitude: float | None, periods: float | None) -> 
 
 def _check_shape_options(objective: Any, amplitude: float | None, periods: float | None) -> None:
     """Refuse --amplitude and --periods where the objective would ignore them (one line, exit 2)."""
-    from pneumorph.design.targets import PRESETS, PathTarget, ProfileTarget, StagedTarget
+    from pneumorph.design.objectives.targets import PRESETS, PathTarget, ProfileTarget, StagedTarget
 
     if isinstance(objective, StagedTarget):
         profiles = [s.target for s in objective.stages if isinstance(s.target, ProfileTarget)]
@@ -483,8 +478,8 @@ def _check_library_run(config: Any, model: Any, tolerance: float | None) -> None
         raise SearchConfigError(f"{'--robust' if config.robust else '--tolerance'}: the mould tolerance report is of "
                                 "one unit type; over a unit library leave it out")
     if config.chain_table is not None:
-        from pneumorph.design.planning import given_table_error
-        from pneumorph.models.chain import ChainTable
+        from pneumorph.design.certified.planning import given_table_error
+        from pneumorph.models.chain.model import ChainTable
 
         try:
             table = ChainTable.load(config.chain_table)

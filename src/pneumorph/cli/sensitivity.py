@@ -10,8 +10,14 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import (
+    check_options,
+    cluster_line,
+    cluster_report,
+    execution_options,
+    open_evaluator,
+)
 
 
 def _common(command: Callable[..., Any], models: tuple[str, ...] = ("2d", "3d")) -> Callable[..., Any]:
@@ -273,7 +279,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     import os
     from pathlib import Path
 
-    from pneumorph.design.targets import make_objective
+    from pneumorph.design.objectives.targets import make_objective
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
     from pneumorph.io.files import all_or_nothing, write_json
@@ -343,7 +349,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
 
 def _objective_at_best(objective: Any, response: Any) -> tuple[float, int | None]:
     """The objective at its best level (and the level) of a response."""
-    from pneumorph.design.fitness import score
+    from pneumorph.design.objectives.fitness import score
 
     s = score(response, objective)
     return float(s.value), s.level

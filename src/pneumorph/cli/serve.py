@@ -8,7 +8,7 @@ import socket
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 
 
 def _check_port(host: str, port: int) -> None:

@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from pneumorph.cli import params as P
+from pneumorph.cli.options import params as P
 
 
 @click.command("simulate")

@@ -7,8 +7,14 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_STARTS
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import (
+    check_options,
+    cluster_line,
+    cluster_report,
+    execution_options,
+    open_evaluator,
+)
 
 
 @click.command("study")
@@ -38,14 +44,14 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     """
     from dataclasses import replace
 
-    from pneumorph.design import DesignConfig, plot_study, population_study
+    from pneumorph.design import DesignConfig, plot_population_study, population_study
     from pneumorph.io import provenance, strict_json, write_json
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
     pops = tuple(populations)
     if target is not None:
-        from pneumorph.design.targets import make_objective
+        from pneumorph.design.objectives.targets import make_objective
         from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):
@@ -97,7 +103,7 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
     }
     with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
         write_json(folder / "study.json", summary)
-        plot_study(result, folder / "study.png")
+        plot_population_study(result, folder / "study.png")
     if as_json:
         click.echo(strict_json({k: v for k, v in summary.items() if k != "provenance"}))
     else:

@@ -9,8 +9,14 @@ from typing import Any
 import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION, MAX_UNITS
-from pneumorph.cli import params as P
-from pneumorph.cli.execution import check_options, cluster_line, cluster_report, execution_options, open_evaluator
+from pneumorph.cli.options import params as P
+from pneumorph.cli.options.execution import (
+    check_options,
+    cluster_line,
+    cluster_report,
+    execution_options,
+    open_evaluator,
+)
 
 
 @click.group("unit")
@@ -95,7 +101,7 @@ def _check_space(variables: tuple[str, ...], resolution: float, element_size: fl
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from pneumorph.design.planning import planned_workers
+    from pneumorph.design.certified.planning import planned_workers
     from pneumorph.errors import GeometryError
     from pneumorph.geometry.limits import MeshLimitError
     from pneumorph.geometry.unit import UnitSpec

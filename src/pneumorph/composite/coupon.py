@@ -172,9 +172,9 @@ class CouponResult:
         """Two-line characterisation (section 3.2.6) of force against the chosen strain.
 
         Primary line: points up to 10 % strain; secondary: the last ``secondary_points``
-        levels. Returns :class:`pneumorph.materials.characterise.BilinearResult`.
+        levels. Returns :class:`pneumorph.materials.characterisation.analyses.BilinearResult`.
         """
-        from pneumorph.materials.characterise import bilinear
+        from pneumorph.materials.characterisation.analyses import bilinear
 
         return bilinear(self.strain(kind), self.force, secondary_points=secondary_points)
 
@@ -213,7 +213,7 @@ def _materials(spec: CouponSpec) -> tuple[Any, float, float]:
     """Matrix umat, paper Young's modulus (MPa) and paper thickness (mm)."""
     import pneumorph.materials as pm
     from pneumorph.fem.ogden import OgdenCompressible
-    from pneumorph.materials.hyperelastic import Ogden
+    from pneumorph.materials.laws.hyperelastic import Ogden
 
     matrix = pm.get(spec.matrix)
     if not isinstance(matrix.model, Ogden):

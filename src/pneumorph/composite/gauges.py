@@ -224,7 +224,7 @@ def gauge_study(
     -------
     GaugeStudy
     """
-    from pneumorph.materials.characterise import bilinear
+    from pneumorph.materials.characterisation.analyses import bilinear
 
     gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
     n = sample_size() if count is None else int(count)

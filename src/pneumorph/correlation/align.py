@@ -119,7 +119,7 @@ def starts(source: FloatArray, target: FloatArray) -> list[Transform]:
     return out
 
 
-def _rotation(omega: FloatArray) -> FloatArray:
+def small_rotation(omega: FloatArray) -> FloatArray:
     """The rotation of a small rotation vector (3D, Rodrigues) or angle (2D)."""
     if omega.size == 1:
         c, s = np.cos(omega[0]), np.sin(omega[0])
@@ -148,7 +148,7 @@ def plane_step(moved: FloatArray, targets: FloatArray, normals: FloatArray, scal
     b = ((targets - moved) * normals).sum(axis=1)
     x, *_ = np.linalg.lstsq(A, b, rcond=None)
     k = rot.shape[1]
-    R = _rotation(x[:k])
+    R = small_rotation(x[:k])
     s = 1.0 + (x[-1] if scale else 0.0)
     t = x[k:k + d]
     return Transform(R, centre + t - s * R @ centre, s)

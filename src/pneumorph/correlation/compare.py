@@ -64,12 +64,12 @@ class ModelShape:
     @property
     def samples(self) -> FloatArray:
         """The outline resampled every :data:`SPACING` mm."""
-        return _resample(self.outline)[0]
+        return resample(self.outline)[0]
 
     @property
     def sample_normals(self) -> FloatArray:
         """Unit normals of the outline at :attr:`samples`."""
-        _, segment = _resample(self.outline)
+        _, segment = resample(self.outline)
         d = self.outline[:, 1] - self.outline[:, 0]
         n = np.c_[-d[:, 1], d[:, 0]] / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
         return n[segment]
@@ -99,7 +99,7 @@ def model_shape(solution: Any, level: int = -1) -> ModelShape:
     return ModelShape(surface, side, segments, centres, mesh.spec.pitch, normals)
 
 
-def _resample(segments: FloatArray, spacing: float = SPACING) -> tuple[FloatArray, NDArray[np.int64]]:
+def resample(segments: FloatArray, spacing: float = SPACING) -> tuple[FloatArray, NDArray[np.int64]]:
     """Points every ``spacing`` mm along the segments, and the segment of each."""
     a, b = segments[:, 0], segments[:, 1]
     n = np.maximum(1, np.ceil(np.linalg.norm(b - a, axis=1) / spacing).astype(int))

@@ -9,7 +9,7 @@ The functions a front end calls:
 - :func:`run_ga` / :func:`run_exhaustive` - the searches, through any evaluator.
 - :func:`run_design` - a whole run into a folder (resumable), from a :class:`DesignConfig`:
   the driver of the search strategies (:mod:`pneumorph.design.algorithms`), each an
-  :class:`Algorithm` on a :class:`Problem` giving an :class:`Outcome`; a new strategy
+  :class:`Algorithm` on a :class:`Problem` giving an :class:`SearchOutcome`; a new strategy
   subclasses :class:`Search` (documentation page extending).
 - :func:`population_study` - the population-size study of section 6.1.
 
@@ -20,23 +20,14 @@ Examples
 'sin: y = A*sin(2*pi*1*x/L), A = 15 mm'
 """
 
-from pneumorph.design.certificate import certificate_text
-from pneumorph.design.certified import CertifiedResult, certified_search
+from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
+from pneumorph.design.certified.certificate import certificate_text
+from pneumorph.design.certified.search import CertifiedResult, certified_search
 from pneumorph.design.config import DesignConfig
-from pneumorph.design.exhaustive import (
-    ExhaustiveResult,
-    mirror_response,
-    run_exhaustive,
-)
-from pneumorph.design.fitness import Score, score
-from pneumorph.design.ga import GAConfig, GAResult, GenerationStats, run_ga
-from pneumorph.design.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
-from pneumorph.design.problem import Algorithm, Outcome, Problem, Search
-from pneumorph.design.report import RunResult
-from pneumorph.design.run import run_design
-from pneumorph.design.scoring import Candidate
-from pneumorph.design.study import StudyResult, plot_study, population_study
-from pneumorph.design.targets import (
+from pneumorph.design.driver import run_design
+from pneumorph.design.objectives.fitness import Score, score
+from pneumorph.design.objectives.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
+from pneumorph.design.objectives.targets import (
     PRESETS,
     TIP_GOALS,
     Objective,
@@ -49,6 +40,15 @@ from pneumorph.design.targets import (
     smooth_curve,
     tip_goal,
 )
+from pneumorph.design.runs.report import RunResult
+from pneumorph.design.search.exhaustive import (
+    ExhaustiveResult,
+    mirror_response,
+    run_exhaustive,
+)
+from pneumorph.design.search.genetic import GAConfig, GAResult, GenerationStats, run_ga
+from pneumorph.design.search.population import PopulationStudy, plot_population_study, population_study
+from pneumorph.design.search.scoring import Candidate
 
 __all__ = [
     "PATH_PRESETS",
@@ -63,15 +63,15 @@ __all__ = [
     "GAResult",
     "GenerationStats",
     "Objective",
-    "Outcome",
     "PathTarget",
     "Polyline",
+    "PopulationStudy",
     "Problem",
     "ProfileTarget",
     "RunResult",
     "Score",
     "Search",
-    "StudyResult",
+    "SearchOutcome",
     "TipGoal",
     "certificate_text",
     "certified_search",
@@ -79,7 +79,7 @@ __all__ = [
     "make_objective",
     "mirror_response",
     "path_target",
-    "plot_study",
+    "plot_population_study",
     "population_study",
     "preset_path",
     "profile_target",

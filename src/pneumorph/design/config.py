@@ -43,9 +43,9 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
-from pneumorph.design.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
-from pneumorph.design.ga import GAConfig
-from pneumorph.design.targets import PRESETS, Objective, make_objective, staged_target
+from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
+from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
+from pneumorph.design.search.genetic import GAConfig
 from pneumorph.errors import (
     SearchConfigError,
     TargetExpressionError,
@@ -286,14 +286,28 @@ class DesignConfig:
         return DesignConfig.from_dict(changed.to_dict())
 
     def as_ga(self) -> DesignConfig:
-        """The same settings searched by the genetic algorithm, the certified search's own settings dropped (the
-        fallback of a run the chain model cannot serve).
-
-        >>> DesignConfig(certify=True, epsilon=0.1).as_ga().search
-        'ga'
-        """
+        """The same settings searched by the GA, the certified search's own dropped (``DesignConfig().as_ga()``)."""
         return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, refine=0.0,
                        chain_table=None)
+
+    def searchable(self) -> tuple[DesignConfig, str | None]:
+        """The settings a run can search with, and why they differ from these (None: they do not): the chain
+        model does not hold under gravity, so a certified search under gravity is the genetic algorithm's.
+
+        >>> DesignConfig(model={"gravity": "hanging"}).searchable()[0].search
+        'ga'
+        """
+        if self.search == "certified" and self.model.get("gravity") not in (None, "none"):
+            return self.as_ga(), ("the certified search needs a free actuator (its chain model does not hold under "
+                                  "gravity): falling back to the genetic algorithm")
+        return self, None
+
+    def fallback(self, fidelity_given: bool = False) -> DesignConfig:
+        """The GA's settings for a certified run whose model the chain cannot represent (``run_design`` raises
+        :class:`~pneumorph.errors.LocalityError` before it writes): on the 2D model unless the fidelity was given.
+        """
+        ga = self.as_ga()
+        return ga if fidelity_given else ga.with_options({}, model={"fidelity": "2d"})
 
     # -- plain-data form --------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:

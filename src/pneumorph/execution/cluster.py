@@ -19,7 +19,7 @@ from pneumorph.errors import (
     WorkerVersionError,
 )
 from pneumorph.execution.outcome import Outcome, solve
-from pneumorph.execution.serial import THREAD_VARIABLES, _Base
+from pneumorph.execution.serial import THREAD_VARIABLES, EvaluatorBase
 from pneumorph.models.response import ActuatorModel
 
 #: glibc's mallopt parameters (malloc.h) and the values a Dask worker is given (see :class:`SolverSettings`)
@@ -122,7 +122,7 @@ def _quiet_distributed() -> dict[str, int]:
     return saved
 
 
-class DaskEvaluator(_Base):
+class DaskEvaluator(EvaluatorBase):
     """Solve designs on a Dask ``distributed`` cluster.
 
     Parameters

@@ -31,7 +31,7 @@ from pneumorph.errors import (
     SearchConfigError,
 )
 from pneumorph.execution.outcome import Outcome, solve
-from pneumorph.execution.serial import THREAD_VARIABLES, _Base
+from pneumorph.execution.serial import THREAD_VARIABLES, EvaluatorBase
 from pneumorph.models.response import ActuatorModel
 
 _WORKER_MODEL: Any = None
@@ -143,7 +143,7 @@ def _start_advice() -> str:
     return ('a script that solves in worker processes must start its run under `if __name__ == "__main__":` (each '
             'worker imports the script; documentation page api), or solve in this process with executor "serial"')
 
-class ProcessPoolEvaluator(_Base):
+class ProcessPoolEvaluator(EvaluatorBase):
     """Solve designs in a pool of local processes.
 
     Parameters

@@ -26,7 +26,7 @@ class Evaluator(Protocol):
     def close(self) -> None: ...
 
 
-class _Base:
+class EvaluatorBase:
     def evaluate_many(self, model: ActuatorModel, designs: Iterable[str]) -> list[Outcome]:
         """Outcomes of ``designs``, in their order."""
         designs = list(designs)
@@ -45,7 +45,7 @@ class _Base:
         self.close()
 
 
-class SerialEvaluator(_Base):
+class SerialEvaluator(EvaluatorBase):
     """Solve the designs one after another in this process.
 
     Examples

@@ -105,7 +105,7 @@ from pneumorph.export.c3d20 import (
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.io.files import atomic_write_text, check_writable_file
-from pneumorph.materials.hyperelastic import Ogden
+from pneumorph.materials.laws.hyperelastic import Ogden
 
 __all__ = [
     "C3D20_FACES",

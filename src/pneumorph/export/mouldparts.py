@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 from pneumorph.errors import GeometryError
 from pneumorph.export.mouldlayout import pour_face, unit_castings
-from pneumorph.export.parts import _cavity_boxes
+from pneumorph.export.parts import cavity_boxes
 from pneumorph.geometry.alphabet import library_design
 from pneumorph.geometry.assembly import unit_starts
 from pneumorph.geometry.library import UnitLibrary
@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import trimesh
 
 
-_OUT = 1.0  # how far cutters reach past the faces they open, mm
+CUTTER_OVERRUN = 1.0  # how far cutters reach past the faces they open, mm
 
 
 @dataclass(frozen=True)
@@ -131,7 +131,7 @@ class MouldSpec:
         pneumorph.errors.GeometryError: mould draft 8 degrees narrows each side of the 12 mm deep cores by
         1.69 mm, more than a quarter of the cavity's smaller side (4.5 mm); use at most 5.36 degrees
         """
-        _check_fit(spec, orientation, self)
+        check_fit(spec, orientation, self)
         self.check_design(spec, orientation)
 
     def check_design(self, spec: UnitSpec | UnitLibrary, orientation: str) -> None:
@@ -142,7 +142,7 @@ class MouldSpec:
         ------
         GeometryError
         """
-        _hole_centres(spec, orientation, self)
+        hole_centres(spec, orientation, self)
         unit_castings(spec, orientation)  # the side sheet's pieces all as thick
 
 
@@ -253,7 +253,7 @@ class Mould:
     orientation: str = ""
 
 
-def _hole_centres(spec: UnitSpec | UnitLibrary, design: str,
+def hole_centres(spec: UnitSpec | UnitLibrary, design: str,
                   mould: MouldSpec) -> list[tuple[str, float, float, float]]:
     """The pour and vent holes of the body's pocket: (name, x, y, radius), checked to fit.
 
@@ -293,12 +293,12 @@ def _hole_centres(spec: UnitSpec | UnitLibrary, design: str,
     return out
 
 
-def _check_fit(spec: UnitSpec | UnitLibrary, design: str,
+def check_fit(spec: UnitSpec | UnitLibrary, design: str,
                mould: MouldSpec) -> tuple[list[float], list[float]]:
     """Per cavity: the tenon's inset (a quarter of the cavity's smaller side across z) and the core's tip inset
     (its depth times the draft's tangent), checked against the clearance and the cavity."""
     insets, tips = [], []
-    for x0, x1, y0, y1, z0, z1 in _cavity_boxes(spec, design):
+    for x0, x1, y0, y1, z0, z1 in cavity_boxes(spec, design):
         smaller = min(x1 - x0, y1 - y0)
         inset = smaller / 4
         if mould.clearance >= inset:

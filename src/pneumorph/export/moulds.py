@@ -86,11 +86,11 @@ import numpy as np
 
 from pneumorph.errors import GeometryError
 from pneumorph.export.mouldlayout import UnitCasting, unit_castings
-from pneumorph.export.mouldparts import _OUT, Mould, MouldCheck, MouldSpec, _check_fit, _hole_centres
+from pneumorph.export.mouldparts import CUTTER_OVERRUN, Mould, MouldCheck, MouldSpec, check_fit, hole_centres
 from pneumorph.export.parts import (
-    _cavity_boxes,
     actuator_solids,
     box,
+    cavity_boxes,
     check_buildable,
     outline_solid,
     to_trimesh,
@@ -173,8 +173,8 @@ def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSp
     orientation = parsed.text if not library.is_single else parsed.orientation
     spec = library if not library.is_single else library[library.default]
     check_buildable(spec, orientation)
-    inset, tip = _check_fit(spec, orientation, mould)  # the same checks as MouldSpec.check
-    holes = _hole_centres(spec, orientation, mould)
+    inset, tip = check_fit(spec, orientation, mould)  # the same checks as MouldSpec.check
+    holes = hole_centres(spec, orientation, mould)
     castings = unit_castings(spec, orientation)
     ref = library[library.default]
     n = len(castings)
@@ -209,13 +209,13 @@ def _cores(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSpec, ins
     Parameters
     ----------
     inset, tip : list of float
-        Per cavity: the tenon's setback from its sides and the core tip's inset (:func:`_check_fit`).
+        Per cavity: the tenon's setback from its sides and the core tip's inset (:func:`check_fit`).
     """
     c, td = mould.clearance, mould.tenon_depth
-    cavities = _cavity_boxes(spec, orientation)
+    cavities = cavity_boxes(spec, orientation)
     cores = [_core(cav, tp, i, td) for cav, tp, i in zip(cavities, tip, inset, strict=True)]
     # each core's root is its cavity's open face: the side wall's, or a plinth's top
-    pockets = [box((a + i - c, b - i + c, p + i - c, q - i + c, z - td - c, z + _OUT))
+    pockets = [box((a + i - c, b - i + c, p + i - c, q - i + c, z - td - c, z + CUTTER_OVERRUN))
                for (a, b, p, q, z, _), i in zip(cavities, inset, strict=True)]
     return cores, pockets
 
@@ -237,7 +237,7 @@ def _holes(holes: list[tuple[str, float, float, float]], mould: MouldSpec, dy: f
     hole_cutters, openings = [], []
     for _, x, y, radius in holes:
         for oy in (0.0, dy):
-            hole_cutters.append(_cylinder(x, y + oy, W - _OUT, top + _OUT, radius, mould.segments))
+            hole_cutters.append(_cylinder(x, y + oy, W - CUTTER_OVERRUN, top + CUTTER_OVERRUN, radius, mould.segments))
             openings.append(_cylinder(x, y + oy, W, top, radius, mould.segments))
     return hole_cutters, openings
 
@@ -263,8 +263,9 @@ def _plates(spec: UnitSpec | UnitLibrary, orientation: str, outer: tuple[float, 
     s, W = ref.side_wall, ref.width
     X0, X1, Y0, Y1, _, Z1 = outer
     # the body's pocket over the plinths too (their strips are cast elsewhere); the side sheet's across every unit
-    body_pocket = outline_solid(spec, orientation, s - _OUT, W + _OUT, keep=("left",))
-    sheet_pocket = outline_solid(spec, orientation, W - s, W + _OUT, keep=("left", "right")).translate((0.0, dy, 0.0))
+    body_pocket = outline_solid(spec, orientation, s - CUTTER_OVERRUN, W + CUTTER_OVERRUN, keep=("left",))
+    sheet_pocket = outline_solid(spec, orientation, W - s, W + CUTTER_OVERRUN,
+                                 keep=("left", "right")).translate((0.0, dy, 0.0))
     return {
         "base_plate": m3.Manifold.batch_boolean([plate, *pockets, *pin_holes], m3.OpType.Subtract),
         "side_walls": m3.Manifold.batch_boolean([box((X0, X1, Y0, Y1, s, W)), body_pocket, sheet_pocket,
@@ -287,7 +288,8 @@ def _cast(spec: UnitSpec | UnitLibrary, orientation: str, cores: list[manifold3d
     raised = [c for c in castings if c.bottom > 0]
     in_place, above = sheet, [outline_solid(spec, orientation, s, W), *cores]
     if raised:  # the pieces under turned-over sideways units lie on their strips, not on z = 0
-        spans = [box((c.x0, c.x1, -_OUT, H + _OUT, -_OUT, s + _OUT)) for c in raised]
+        out = CUTTER_OVERRUN
+        spans = [box((c.x0, c.x1, -out, H + out, -out, s + out)) for c in raised]
         moved = [(sheet ^ span).translate((0.0, 0.0, c.bottom)) for span, c in zip(spans, raised, strict=True)]
         flat = m3.Manifold.batch_boolean([sheet, *spans], m3.OpType.Subtract)
         in_place = m3.Manifold.batch_boolean([flat, *moved], m3.OpType.Add)
@@ -340,7 +342,7 @@ def _checked(spec: UnitSpec | UnitLibrary, orientation: str, solids: dict[str, A
     gaps += [(pocket ^ plate) - core for pocket, core in zip(pockets, cores, strict=False)]
     body = actuator_solids(spec, orientation, base_block=None)["body"]
     # the cores above their roots (the side wall's face, or a plinth's top): the cavities as cast
-    roots = [c[4] for c in _cavity_boxes(spec, orientation)]
+    roots = [c[4] for c in cavity_boxes(spec, orientation)]
     core_tops = m3.Manifold.batch_boolean([core ^ box((X0, X1, Y0, Y1, z, W)) for core, z in zip(cores, roots,
                                                                                                    strict=True)],
                                           m3.OpType.Add) if cores else m3.Manifold()

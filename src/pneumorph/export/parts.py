@@ -114,7 +114,7 @@ _BOX_FACES = np.array(
 )
 
 
-def _cavity_boxes(spec: UnitSpec | UnitLibrary, design: str) -> list[Box]:
+def cavity_boxes(spec: UnitSpec | UnitLibrary, design: str) -> list[Box]:
     """Each unit's cavity in the actuator's frame (turned over as the unit is); none for a solid unit
     (``solid = true``: its cavity is filled with the body material)."""
     library, units, orientation = _units(spec, design)
@@ -247,7 +247,7 @@ def check_materials(spec: UnitSpec | UnitLibrary, base_block: BaseBlock | None =
     ...
     pneumorph.errors.UnknownMaterialError: unknown material 'nonesuch'; known materials: ...
     """
-    from pneumorph.materials.library import get
+    from pneumorph.materials.library.builtin import get
 
     for unit in _types(spec, design):
         for name in (unit.body_material, *([unit.layer_material] if unit.layer > 0 else [])):
@@ -297,7 +297,7 @@ def actuator_solids(
     check_buildable(library, design)
     check_materials(library, base_block, design)
     ref = library[library.default]  # the section all units share
-    cavities = [box(b) for b in _cavity_boxes(library, design)]
+    cavities = [box(b) for b in cavity_boxes(library, design)]
     body = m3.Manifold.batch_boolean([outline_solid(library, design, 0.0, ref.width), *cavities],
                                      m3.OpType.Subtract)
     solids = {"body": body}

@@ -10,7 +10,7 @@ form, divided differences exact at equal stretches); :class:`OgdenCompressible` 
 FElupe's ``(3, 3, q, c)`` arrays to it (the FElupe path) and gives the fast assemblers
 the same kernel with the thermal stretch applied (:meth:`OgdenCompressible.kernel`).
 It is about an order of magnitude cheaper than the automatic-differentiation Ogden of
-:mod:`pneumorph.materials.felupe_models` and gives the same stress and tangent to rounding.
+:mod:`pneumorph.materials.laws.felupe_models` and gives the same stress and tangent to rounding.
 """
 
 from __future__ import annotations

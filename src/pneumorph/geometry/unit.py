@@ -80,7 +80,7 @@ from typing import Any
 from pneumorph.checks import MIN_ELEMENT_FRACTION
 from pneumorph.errors import GeometryError
 from pneumorph.geometry.limits import MAX_NAME_CHARS, UNIT_LENGTHS, MeshLimitError, check_lengths
-from pneumorph.materials.filler import FillerLaw
+from pneumorph.materials.laws.filler import FillerLaw
 
 
 def _numbers(values: object, key: str, count: int | None = None) -> tuple[float, ...]:

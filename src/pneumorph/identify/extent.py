@@ -4,7 +4,7 @@ A scan whose design was typed with the wrong unit count is refused by its size
 (:func:`~pneumorph.identify.match.check_size`). The deformed size depends on how far the
 design curls, which only a solve knows, unless a chain table of the model serves the scan's
 pressure: then the table's unit centres (exact to hundredths of a millimetre on the nominal
-model, :mod:`pneumorph.models.chain`) place every unit of the undeformed mesh as a rigid
+model, :mod:`pneumorph.models.chain.model`) place every unit of the undeformed mesh as a rigid
 body, turned by the mean turn of the two chords at its centre. The walls do not balloon in
 this shape, so its size is a little smaller than the solved one's;
 :data:`~pneumorph.identify.match.CHAIN_MARGIN` widens the size check by what that was measured
@@ -23,8 +23,8 @@ from numpy.typing import NDArray
 
 from pneumorph.correlation.compare import ModelShape, model_shape
 from pneumorph.geometry.assembly import ActuatorMesh, unit_starts
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import serve_table
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import serve_table
 from pneumorph.models.factory import make_model
 
 FloatArray = NDArray[np.float64]

@@ -9,7 +9,7 @@ The method (docs/identify.md):
    again with each free parameter moved by its step (forward differences; a thickness
    moved with the mesh grid kept, as the tolerance study keeps it, so that surface nodes
    correspond): the nodes' sensitivities ``dQ/dtheta``. A moved model starts from the
-   solved state at the top pressure (:func:`~pneumorph.models.warmstart.solve_near`: a few
+   solved state at the top pressure (:func:`~pneumorph.models.fe.warmstart.solve_near`: a few
    Newton iterations to the ramp's own convergence test, not a ramp).
 3. **Gauss-Newton on the linearised shape.** The residual of a scan point is its signed
    distance to the model's surface (3D: the tangent plane at its nearest surface node;
@@ -32,31 +32,34 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.correlation.compare import ModelShape, check_units, correlate
+from pneumorph.correlation.compare import ModelShape, check_units
 from pneumorph.correlation.scans import Scan
 from pneumorph.errors import FitError, ScanError
 from pneumorph.identify.extent import chain_shapes
+from pneumorph.identify.gaussnewton import (
+    TRUST,
+    FitState,
+    confirmed,
+    gauss_newton_step,
+    nominal_alignment,
+    shape_derivatives,
+    trial_points,
+    verdicts,
+)
 from pneumorph.identify.linear import (
     MAX_CORRELATION,
     MIN_EIGENVALUE,
-    _correlation,
-    _covariance,
-    _Linear,
-    _nodes,
-    _solve_linearised,
-    _State,
-    _system,
     confounded,
+    correlation_of,
 )
 from pneumorph.identify.match import check_coverage, check_size
-from pneumorph.identify.parameters import NAMES, SPANS, STEPS, ParameterSet, parameter_indices
+from pneumorph.identify.parameters import NAMES, ParameterSet, parameter_indices
 from pneumorph.identify.probe import JacobianProbe, ShapeProbe, shape_of, variant_shapes
 from pneumorph.identify.scans import ScanSpec
 from pneumorph.models.factory import make_model
@@ -65,14 +68,8 @@ FloatArray = NDArray[np.float64]
 
 #: scan points used per scan (a seeded sample of larger scans)
 MAX_POINTS = 4000
-#: a Gauss-Newton step moves each parameter by at most this many plausible changes (its trust region)
-TRUST = 3.0
 #: the Gauss-Newton iterations (FE Jacobians) before the fit is declared not converged
 MAX_ITERATIONS = 6
-#: converged when every free parameter's step is below this fraction of its standard error ...
-STEP_FRACTION = 0.1
-#: ... or below this (scales; mm for thicknesses)
-STEP_FLOOR = 1e-3
 
 
 @dataclass(frozen=True)
@@ -245,151 +242,51 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     """
     base = dict(base or {})
     say = on_progress or (lambda text: None)
-    free = [NAMES[i] for i in parameter_indices(parameters)]
     if not observations:
         raise FitError("no scans to identify from")
     dim = observations[0].scan.dim
-    fidelity_dim = 3 if base.get("fidelity", "2d") == "3d" else 2
-    if dim == 3 and fidelity_dim == 2:
+    if dim == 3 and base.get("fidelity", "2d") != "3d":
         raise ScanError("a 3D scan needs the 3D model (--model 3d); a 2D model has no surface")
     points = [_sample(o.scan, seed + k) for k, o in enumerate(observations)]
-    theta = params.nominal.copy()
     precheck_designs(observations, params, base, table_dir)  # every model refused now, before any solve
-    solves = 0
-
-    lower, upper = params.lower, params.upper
-    first = _trial(theta, [NAMES.index(n) for n in free], upper)
-    say(f"solving the nominal model of {len(observations)} scan(s) and its Jacobian ({len(first)} warm-started "
+    state = FitState(params.nominal.copy(), [NAMES[i] for i in parameter_indices(parameters)],
+                     {name: "" for name in NAMES})
+    trial = trial_points(state.theta, state.idx, params.upper)
+    say(f"solving the nominal model of {len(observations)} scan(s) and its Jacobian ({len(trial)} warm-started "
         "solves each)")
-    nominal_shapes, first_moved = jacobian_at(observations, params, base, evaluator, theta, first)
-    solves += len(observations) * (1 + len(first))
-    transforms, before = [], []
-    for o, shape in zip(observations, nominal_shapes, strict=True):
-        check_units(o.scan, shape)
-        check_size(o.scan, o.spec, [shape])
-        c = correlate(o.scan, shape)
-        check_coverage(o.scan, o.spec, [shape], aligned=[c.aligned])
-        transforms.append(c.alignment.transform)
-        before.append(c.surface.rms if dim == 3 else c.outline.rms)
-    rms_before = np.array(before)
-
-    notes = {name: "" for name in NAMES}
-    residual_before: FloatArray | None = None
-    base_shapes: list[ModelShape] = nominal_shapes
-    iterations = 0
-    cov = np.zeros((0, 0))
-    sigma = float("nan")
-    step = np.zeros(0)
+    shapes, moved = jacobian_at(observations, params, base, evaluator, state.theta, trial)
+    state.solves += len(observations) * (1 + len(trial))
+    state.transforms, rms_before = nominal_alignment(observations, shapes, dim)
     while True:
-        if iterations >= max_iterations:
+        if state.iterations >= max_iterations:
             raise FitError(f"the fit did not converge in {max_iterations} Gauss-Newton iterations (last step "
-                           f"{', '.join(f'{n} {d:+.3g}' for n, d in zip(free, step, strict=True))}); nothing is "
-                           "identified")
-        iterations += 1
-        idx = [NAMES.index(n) for n in free]
-        trial = _trial(theta, idx, upper)
-        if iterations == 1:  # solved with the nominal shapes
-            moved = first_moved
-        else:
-            say(f"iteration {iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} "
-                f"warm-started solves for the Jacobian of {', '.join(free)}")
-            base_shapes, moved = jacobian_at(observations, params, base, evaluator, theta, trial)
-            solves += len(observations) * (1 + len(trial))
-        derivatives = []
-        for s in range(len(observations)):
-            nodes, _ = _nodes(base_shapes[s], dim)
-            per = []
-            for j, i in enumerate(idx):
-                other, _ = _nodes(moved[j][s], dim)
-                if other.shape != nodes.shape:
-                    raise FitError(f"the mesh of design {observations[s].spec.design} changed with {NAMES[i]} "
-                                   f"({other.shape[0]} against {nodes.shape[0]} surface nodes); nothing is "
-                                   "identified")
-                per.append((other - nodes) / (trial[j][i] - theta[i]))
-            derivatives.append(np.array(per).reshape(len(idx), *nodes.shape))
-
-        columns = list(range(len(idx)))
-        problem = (dim, base_shapes, derivatives, points, transforms, lower - theta, upper - theta)
-        state, r, a, lins, scale = _linearised(problem, idx, columns)
-        if residual_before is None:
-            r0, _, _ = _system(lins, points, _State(np.zeros(len(idx)), list(transforms)), scale)
-            residual_before = _per_scan_rms(r0, points)
-            cov, sigma = _covariance(r, a, len(idx))
-            fixed = confounded(free, cov, np.linalg.norm(_project_out(a, len(idx)), axis=0))
-            if fixed:
-                for name, why in fixed.items():
-                    notes[name] = why
-                    say(f"{name}: {why}; fixed at nominal")
-                columns = [c for c in columns if NAMES[idx[c]] not in fixed]
-                state, r, a, lins, scale = _linearised(problem, [idx[c] for c in columns], columns)
-                free = [NAMES[idx[c]] for c in columns]
-                idx = [idx[c] for c in columns]
-        cov, sigma = _covariance(r, a, len(idx))
-        se = np.sqrt(np.maximum(np.diag(cov), 0.0)) * scale
-        step = state.step
-        transforms = state.transforms
-        theta = theta.copy()
-        theta[idx] = np.clip(theta[idx] + step, lower[idx], upper[idx])
-        say(f"  step {', '.join(f'{n} {d:+.4g}' for n, d in zip(free, step, strict=True))}; "
-            f"residual {float(np.sqrt(np.mean(r**2))):.4g} mm")
-        if np.all(np.abs(step) <= np.maximum(STEP_FRACTION * se, STEP_FLOOR)):
+                           f"{', '.join(f'{n} {d:+.3g}' for n, d in zip(state.free, state.step, strict=True))}); "
+                           "nothing is identified")
+        state.iterations += 1
+        if state.iterations > 1:  # the first is solved with the nominal shapes
+            trial = trial_points(state.theta, state.idx, params.upper)
+            say(f"iteration {state.iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} "
+                f"warm-started solves for the Jacobian of {', '.join(state.free)}")
+            shapes, moved = jacobian_at(observations, params, base, evaluator, state.theta, trial)
+            state.solves += len(observations) * (1 + len(trial))
+        derivatives = shape_derivatives(observations, shapes, moved, state.idx, state.theta, trial, dim)
+        if gauss_newton_step(state, dim, shapes, derivatives, points, params.lower, params.upper, say):
             break
-
     say("confirming the fit by FE")
-    final_shapes, _ = jacobian_at(observations, params, base, evaluator, theta, [])
-    solves += len(observations)
-    after = []
-    for o, shape in zip(observations, final_shapes, strict=True):
-        c = correlate(o.scan, shape)
-        after.append(c.surface.rms if dim == 3 else c.outline.rms)
-    final_lins = []
-    for shape in final_shapes:
-        nodes, normals = _nodes(shape, dim)
-        final_lins.append(_Linear(dim, nodes, np.zeros((0, *nodes.shape)), normals))
-    r_final, _, _ = _system(final_lins, points, _State(np.zeros(0), list(transforms)), np.zeros(0))
-    idx = [NAMES.index(n) for n in free]
-    errors = np.full(len(NAMES), np.nan)
-    errors[idx] = np.sqrt(np.maximum(np.diag(cov), 0.0)) * np.array([SPANS[n] for n in free])
-    fitted = np.isin(np.arange(len(NAMES)), idx)
-    identified = fitted.copy()
-    for i in idx:
-        name = NAMES[i]
-        at_bound = min(theta[i] - lower[i], upper[i] - theta[i]) <= 1e-9
-        # fixing a confounded parameter at nominal moves every fitted one by its correlation with it (times
-        # the fixed one's error over its standard error: large when the scans are precise): none stands alone
-        partners = [n for n, why in notes.items() if why.startswith("cannot")]
-        if at_bound:
-            identified[i] = False
-            notes[name] = (f"at the bound of the box ({lower[i]:g} to {upper[i]:g}); the scans ask for more "
-                           "(widen --tolerance)")
-        elif partners:
-            identified[i] = False
-            notes[name] = (f"fitted with {', '.join(partners)} fixed at nominal: its value absorbs their change "
-                           "from nominal")
-        elif errors[i] > SPANS[name]:  # a plausible change moves the scans less than their scatter
-            identified[i] = False
-            notes[name] = (f"loosely determined: standard error {errors[i]:.3g}, more than a plausible change "
-                           f"({SPANS[name]:g})")
-    settings = params.settings(theta, base)
-    fingerprints = tuple(p.model.fingerprint() for p in build_probes(observations, params, base, theta))
+    final_shapes, _ = jacobian_at(observations, params, base, evaluator, state.theta, [])
+    state.solves += len(observations)
+    rms_after, residual_after = confirmed(observations, final_shapes, points, state.transforms, dim)
+    errors, fitted, identified = verdicts(state, params.lower, params.upper)
+    fingerprints = tuple(p.model.fingerprint() for p in build_probes(observations, params, base, state.theta))
     return Identification(
-        values=theta, nominal=params.nominal, standard_errors=errors, fitted=fitted, identified=identified,
-        notes=tuple(notes[n] for n in NAMES), correlation=_correlation(cov) if len(idx) else np.zeros((0, 0)),
-        free=tuple(free), rms_before=rms_before, rms_after=np.array(after),
-        residual_before=residual_before if residual_before is not None else np.full(len(points), np.nan),
-        residual_after=_per_scan_rms(r_final, points), sigma=sigma, iterations=iterations, solves=solves,
-        settings=settings, fingerprints=fingerprints, observations=tuple(observations))
-
-
-def _trial(theta: FloatArray, idx: list[int], upper: FloatArray) -> list[FloatArray]:
-    """The Jacobian's points: each parameter of ``idx`` moved by its step (backwards at the top of the box)."""
-    trial = []
-    for i in idx:
-        h = STEPS[NAMES[i]] if theta[i] + STEPS[NAMES[i]] <= upper[i] + 1e-12 else -STEPS[NAMES[i]]
-        v = theta.copy()
-        v[i] += h
-        trial.append(v)
-    return trial
+        values=state.theta, nominal=params.nominal, standard_errors=errors, fitted=fitted, identified=identified,
+        notes=tuple(state.notes[n] for n in NAMES),
+        correlation=correlation_of(state.cov) if state.free else np.zeros((0, 0)), free=tuple(state.free),
+        rms_before=rms_before, rms_after=rms_after,
+        residual_before=(state.residual_before if state.residual_before is not None
+                         else np.full(len(points), np.nan)),
+        residual_after=residual_after, sigma=state.sigma, iterations=state.iterations, solves=state.solves,
+        settings=params.settings(state.theta, base), fingerprints=fingerprints, observations=tuple(observations))
 
 
 def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any], evaluator: Any,
@@ -417,31 +314,6 @@ def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base:
         for j, shape in enumerate(variant_shapes(outcome.response)):
             moved[j][s] = shape
     return at, moved
-
-
-def _linearised(problem: tuple[Any, ...], chosen: list[int], columns: list[int]
-                ) -> tuple[_State, FloatArray, FloatArray, list[_Linear], FloatArray]:
-    """The linearised problem of the ``columns`` of the Jacobian (parameters ``chosen``), solved."""
-    dim, shapes, derivatives, points, transforms, lower, upper = problem
-    lins = []
-    for shape, d in zip(shapes, derivatives, strict=True):
-        nodes, normals = _nodes(shape, dim)
-        lins.append(_Linear(dim, nodes, d[columns], normals))
-    scale = np.array([SPANS[NAMES[i]] for i in chosen])
-    state, r, a = _solve_linearised(lins, points, transforms, np.maximum(lower[chosen], -TRUST * scale),
-                                    np.minimum(upper[chosen], TRUST * scale), scale)
-    return state, r, a, lins, scale
-
-
-def _project_out(a: FloatArray, k: int) -> FloatArray:
-    """The first ``k`` columns of ``a`` with their parts along the other (alignment) columns removed."""
-    q, _ = np.linalg.qr(a[:, k:])
-    return a[:, :k] - q @ (q.T @ a[:, :k])
-
-
-def _per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
-    bounds = np.cumsum([0, *(len(p) for p in points)])
-    return np.array([float(np.sqrt(np.mean(r[a:b] ** 2))) for a, b in pairwise(bounds)])
 
 
 __all__ = [

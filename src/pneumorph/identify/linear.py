@@ -1,5 +1,5 @@
 """The identification's linearised problem: a model's shape as nodes that move linearly with the
-parameters (:class:`_Linear`), the least-squares system of the correlation distances and its
+parameters (:class:`LinearisedScan`), the least-squares system of the correlation distances and its
 step in a trust region, the covariance and correlations of the parameters, and what cannot be
 told apart (:func:`confounded`); the driver: :mod:`pneumorph.identify.fit`.
 """
@@ -14,8 +14,8 @@ from numpy.typing import NDArray
 from scipy.optimize import lsq_linear
 from scipy.spatial import cKDTree
 
-from pneumorph.correlation.align import Transform, _rotation
-from pneumorph.correlation.compare import ModelShape, _resample
+from pneumorph.correlation.align import Transform, small_rotation
+from pneumorph.correlation.compare import ModelShape, resample
 
 FloatArray = NDArray[np.float64]
 
@@ -28,7 +28,7 @@ MIN_EIGENVALUE = 1e-3
 
 # -- the shape of a model as nodes that move linearly with the parameters ----------------------
 @dataclass(frozen=True)
-class _Linear:
+class LinearisedScan:
     """One scan's model shape at the current parameters and its node sensitivities.
 
     3D: ``nodes`` are the surface nodes (normals kept from the base solve); 2D: the outline's
@@ -53,7 +53,7 @@ class _Linear:
             dq = self.derivatives[:, i, :]  # (free, points, 3)
             return r, -(dq * n[None]).sum(axis=2).T
         segments = nodes.reshape(-1, 2, 2)
-        samples, segment = _resample(segments)
+        samples, segment = resample(segments)
         _, k = cKDTree(samples).query(x)
         s = segment[k]
         a, b = segments[s, 0], segments[s, 1]
@@ -70,7 +70,7 @@ class _Linear:
         return r, -(dq * n[None]).sum(axis=2).T
 
 
-def _nodes(shape: ModelShape, dim: int) -> tuple[FloatArray, FloatArray]:
+def shape_nodes(shape: ModelShape, dim: int) -> tuple[FloatArray, FloatArray]:
     if dim == 3:
         return shape.surface, shape.normals
     return shape.outline.reshape(-1, 2), np.empty((0, 2))
@@ -87,29 +87,29 @@ def _align_columns(x: FloatArray, r_normals: FloatArray) -> tuple[FloatArray, Fl
     return np.hstack([rot, r_normals]), centre
 
 
-def _normals_of(lin: _Linear, x: FloatArray, step: FloatArray) -> FloatArray:
+def _normals_of(lin: LinearisedScan, x: FloatArray, step: FloatArray) -> FloatArray:
     """The unit normals the residuals of ``x`` are measured along (for the alignment columns)."""
     nodes = lin.at(step)
     if lin.dim == 3:
         _, i = cKDTree(nodes).query(x)
         return lin.normals[i]
     segments = nodes.reshape(-1, 2, 2)
-    samples, segment = _resample(segments)
+    samples, segment = resample(segments)
     _, k = cKDTree(samples).query(x)
     d = segments[segment[k], 1] - segments[segment[k], 0]
     return np.c_[-d[:, 1], d[:, 0]] / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
 
 
 @dataclass
-class _State:
+class LinearisedState:
     """The linearised problem's unknowns: the parameter step and each scan's alignment."""
 
     step: FloatArray
     transforms: list[Transform]
 
 
-def _system(lins: Sequence[_Linear], points: Sequence[FloatArray], state: _State, scale: FloatArray
-            ) -> tuple[FloatArray, FloatArray, list[FloatArray]]:
+def linearised_system(lins: Sequence[LinearisedScan], points: Sequence[FloatArray], state: LinearisedState,
+                      scale: FloatArray) -> tuple[FloatArray, FloatArray, list[FloatArray]]:
     """Residuals, the Jacobian (free parameters in units of ``scale``, then each scan's motion), centres."""
     blocks, rows, centres = [], [], []
     motion = [3 + 3 if lin.dim == 3 else 1 + 2 for lin in lins]
@@ -127,13 +127,13 @@ def _system(lins: Sequence[_Linear], points: Sequence[FloatArray], state: _State
     return np.concatenate(rows), np.vstack(blocks), centres
 
 
-def _solve_linearised(lins: Sequence[_Linear], points: Sequence[FloatArray], transforms: list[Transform],
+def solve_linearised(lins: Sequence[LinearisedScan], points: Sequence[FloatArray], transforms: list[Transform],
                       lower: FloatArray, upper: FloatArray, scale: FloatArray, max_steps: int = 60
-                      ) -> tuple[_State, FloatArray, FloatArray]:
+                      ) -> tuple[LinearisedState, FloatArray, FloatArray]:
     """Gauss-Newton on the linearised shapes from a zero step: (state, residuals, Jacobian) at its end."""
-    state = _State(np.zeros(len(scale)), list(transforms))
+    state = LinearisedState(np.zeros(len(scale)), list(transforms))
     for _ in range(max_steps):
-        r, a, centres = _system(lins, points, state, scale)
+        r, a, centres = linearised_system(lins, points, state, scale)
         k = len(scale)
         lo = np.r_[(lower - state.step) / scale, np.full(a.shape[1] - k, -np.inf)]
         hi = np.r_[(upper - state.step) / scale, np.full(a.shape[1] - k, np.inf)]
@@ -144,16 +144,16 @@ def _solve_linearised(lins: Sequence[_Linear], points: Sequence[FloatArray], tra
             n_rot = 3 if lin.dim == 3 else 1
             omega, move = z[offset:offset + n_rot], z[offset + n_rot:offset + n_rot + lin.dim]
             offset += n_rot + lin.dim
-            rotation = _rotation(omega)
+            rotation = small_rotation(omega)
             c = centres[s]
             state.transforms[s] = state.transforms[s].then(Transform(rotation, c + move - rotation @ c))
         if np.max(np.abs(z), initial=0.0) < 1e-9:
             break
-    r, a, _ = _system(lins, points, state, scale)
+    r, a, _ = linearised_system(lins, points, state, scale)
     return state, r, a
 
 
-def _covariance(r: FloatArray, a: FloatArray, k: int) -> tuple[FloatArray, float]:
+def scaled_covariance(r: FloatArray, a: FloatArray, k: int) -> tuple[FloatArray, float]:
     """The covariance of the first ``k`` (scaled) unknowns, ``s^2 (J^T J)^-1``, and ``s``."""
     dof = max(len(r) - a.shape[1], 1)
     sigma = float(np.sqrt(r @ r / dof))
@@ -165,7 +165,7 @@ def _covariance(r: FloatArray, a: FloatArray, k: int) -> tuple[FloatArray, float
     return np.asarray(sigma**2 * inverse[:k, :k], dtype=float), sigma
 
 
-def _correlation(cov: FloatArray) -> FloatArray:
+def correlation_of(cov: FloatArray) -> FloatArray:
     d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
     return np.asarray(cov / np.outer(d, d), dtype=float)
 
@@ -202,7 +202,7 @@ def confounded(names: Sequence[str], cov_scaled: FloatArray, column_norms: Float
         se = np.sqrt(np.maximum(np.diag(sub), 0.0))
         if len(keep) < 2:
             break
-        corr = _correlation(sub)
+        corr = correlation_of(sub)
         off = np.abs(corr - np.eye(len(keep)))
         i, j = (int(v) for v in np.unravel_index(int(np.argmax(off)), off.shape))
         worst = float(off[i, j])

@@ -74,7 +74,7 @@ class JacobianProbe(ShapeProbe):
 
     The point's model solves its ramp; each step's model (``variants``: the same mesh grid, one
     parameter moved) starts from that state at the top pressure
-    (:func:`~pneumorph.models.warmstart.solve_near`), a few Newton iterations instead of a
+    (:func:`~pneumorph.models.fe.warmstart.solve_near`), a few Newton iterations instead of a
     ramp each, converged to the ramp's own test. The response holds the point's shape as a
     :class:`ShapeProbe`'s does, and the steps' shapes under ``"variants"`` (:func:`variant_shapes`);
     the fingerprint digests every model.
@@ -102,7 +102,7 @@ class JacobianProbe(ShapeProbe):
 
     def measure(self, solution: Any) -> dict[str, Any]:
         """The point's shape and, under ``"variants"``, each step's (warm-started from ``solution``)."""
-        from pneumorph.models.warmstart import solve_near
+        from pneumorph.models.fe.warmstart import solve_near
 
         design = solution.response.orientation
         return {**super().measure(solution),

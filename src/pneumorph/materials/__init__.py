@@ -1,12 +1,10 @@
 """Silicone materials: closed-form hyperelastic models, the library, fitting, characterisation.
 
-The most used names are available here; the sub-modules hold the rest:
-:mod:`~pneumorph.materials.hyperelastic` (closed-form models),
-:mod:`~pneumorph.materials.library` (the material library and user TOML files),
-:mod:`~pneumorph.materials.filler` (the 2D model's pressure-dependent filler law),
-:mod:`~pneumorph.materials.testdata` and :mod:`~pneumorph.materials.datasets` (test data),
-:mod:`~pneumorph.materials.fitting`, :mod:`~pneumorph.materials.characterise`, and
-:mod:`~pneumorph.materials.felupe_models` (FElupe constitutive materials; imports FElupe).
+The most used names are available here; the sub-packages hold the rest:
+:mod:`~pneumorph.materials.laws` (closed-form models, FElupe materials, the 2D model's filler
+law), :mod:`~pneumorph.materials.library` (material records, files and the built-in
+library), :mod:`~pneumorph.materials.characterisation` (test data and what is read from it)
+and :mod:`~pneumorph.materials.fitting` (fits of models to test data).
 
 Examples
 --------
@@ -18,12 +16,13 @@ Examples
 0.1991
 """
 
-from pneumorph.materials.characterise import bilinear, characterise_bulk_modulus, thermal_expansion
-from pneumorph.materials.comparison import compare
-from pneumorph.materials.datasets import list_datasets, load_dataset, read_test_data
-from pneumorph.materials.filler import FillerLaw
-from pneumorph.materials.fitting import FitResult, fit
-from pneumorph.materials.hyperelastic import (
+from pneumorph.materials.characterisation.analyses import bilinear, characterise_bulk_modulus, thermal_expansion
+from pneumorph.materials.characterisation.datasets import list_datasets, load_dataset, read_test_data
+from pneumorph.materials.characterisation.testdata import TestCurve, TestData, read_curve
+from pneumorph.materials.fitting.comparison import compare
+from pneumorph.materials.fitting.fit import FitResult, fit
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.laws.hyperelastic import (
     MODES,
     HyperelasticModel,
     MooneyRivlin,
@@ -35,9 +34,8 @@ from pneumorph.materials.hyperelastic import (
     mode_stretches,
     ogden_marc_to_felupe,
 )
-from pneumorph.materials.library import get, get_filler, load_library, names, register_toml
-from pneumorph.materials.material import Material
-from pneumorph.materials.testdata import TestCurve, TestData, read_curve
+from pneumorph.materials.library.builtin import get, get_filler, load_library, names, register_toml
+from pneumorph.materials.library.material import Material
 
 __all__ = [
     "MODES",

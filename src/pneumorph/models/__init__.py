@@ -16,8 +16,8 @@ Examples
 '3d'
 """
 
-from pneumorph.models.chain import ChainModel, ChainTable
-from pneumorph.models.chainfit import build_table
+from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.model import ChainModel, ChainTable
 from pneumorph.models.factory import make_model
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D, Solution
 from pneumorph.models.response import ActuatorModel, Response

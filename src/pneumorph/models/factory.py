@@ -15,7 +15,7 @@ from pneumorph.geometry.library import BUILTIN_LIBRARIES, UnitLibrary, builtin_l
 from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
-from pneumorph.models.gravity import gravity_vector
+from pneumorph.models.fe.gravity import gravity_vector
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
               "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale")
@@ -23,7 +23,7 @@ MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "uni
 SCALE_RANGE = (0.1, 10.0)
 
 
-def load_library(value: Any, where: str = "[model] library",
+def load_unit_library(value: Any, where: str = "[model] library",
                  error: type[SettingsError] = SearchConfigError) -> UnitLibrary:
     """A unit library named by a setting: a built-in one (``"builtin"``, ``"spatial"``, ``"modes"``) or a library file.
 
@@ -35,9 +35,9 @@ def load_library(value: Any, where: str = "[model] library",
 
     Examples
     --------
-    >>> load_library("builtin").symbols, load_library("spatial").symbols
+    >>> load_unit_library("builtin").symbols, load_unit_library("spatial").symbols
     (('a', 'e', 'r', 's'), ('a', 'l'))
-    >>> load_library("no-such-library.toml")  # doctest: +ELLIPSIS
+    >>> load_unit_library("no-such-library.toml")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     pneumorph.errors.SearchConfigError: [model] library: ...no-such-library.toml...
@@ -94,19 +94,19 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         command line, is :attr:`pneumorph.design.DesignConfig.fidelity`, built by
         :meth:`~pneumorph.design.DesignConfig.make_model`), ``pressure_kpa`` (45), ``increments`` (10),
         ``substeps`` (the model class's default: 1), ``gravity`` (none; ``"hanging"``, ``"horizontal"`` or a vector in
-        mm/s^2, :func:`pneumorph.models.gravity.gravity_vector`), and the unit: ``unit`` (a
+        mm/s^2, :func:`pneumorph.models.fe.gravity.gravity_vector`), and the unit: ``unit`` (a
         table of UnitSpec parameters) or ``unit_file`` (a TOML file with a ``[unit]`` table);
         the features of appendix D: ``temperature_change`` (degC, 3D), ``passage`` (the
         diameter of the holes between cavities, mm, 3D) and ``base_block`` (a table of
         :class:`~pneumorph.geometry.features.BaseBlock` parameters: ``length``, ``margin``,
         ``material``); or, instead of the unit, ``library``: ``"builtin"`` or the path of a
-        unit library TOML file (:func:`load_library`): designs over its symbols, the
+        unit library TOML file (:func:`load_unit_library`): designs over its symbols, the
         model's fingerprint then holding the library (unless it has one type only); the
         body silicone's moduli scaled, as an identified model has them
         (``pneumorph identify``, docs/identify.md): ``body_bulk_scale`` (its bulk modulus,
-        :func:`~pneumorph.materials.scaling.scaled_bulk_modulus`) and
+        :func:`~pneumorph.materials.library.scaling.scaled_bulk_modulus`) and
         ``body_shear_scale`` (its Ogden moduli,
-        :func:`~pneumorph.materials.scaling.scaled_shear_modulus`), each in
+        :func:`~pneumorph.materials.library.scaling.scaled_shear_modulus`), each in
         :data:`SCALE_RANGE` (default 1: the library's silicone, the same fingerprint).
 
     Examples
@@ -176,7 +176,7 @@ def unit_or_library(s: Mapping[str, Any]) -> tuple[UnitSpec | None, UnitLibrary 
         if "unit" in s or "unit_file" in s:
             raise SearchConfigError("give either a unit ([model.unit] or unit_file) or a unit library ([model] "
                                     "library), not both: the library names its units")
-        return None, load_library(s["library"])  # the model's unit: the library's first type
+        return None, load_unit_library(s["library"])  # the model's unit: the library's first type
     if "unit_file" in s:
         try:
             return UnitSpec.from_toml(Path(checks.text(s["unit_file"], "[model] unit_file",
@@ -237,7 +237,7 @@ def _scaled_body(settings: Mapping[str, Any], unit: UnitSpec) -> Any:
     if scales == [1.0, 1.0]:
         return None  # the library's material: every earlier fingerprint stays valid
     from pneumorph.materials import get
-    from pneumorph.materials.scaling import scaled_bulk_modulus, scaled_shear_modulus
+    from pneumorph.materials.library.scaling import scaled_bulk_modulus, scaled_shear_modulus
 
     body = get(unit.body_material)
     if scales[0] != 1.0:

@@ -1,6 +1,6 @@
 """Each unit's frame in a deformed actuator: the rotation of its cavity's corners.
 
-A chain in space (:mod:`pneumorph.models.spacechords`, docs/unit-library.md) must know
+A chain in space (:mod:`pneumorph.models.chain.space`, docs/unit-library.md) must know
 how each unit's frame has turned, its roll about the actuator's axis included: where
 sideways and planar units meet, the frames roll by a degree or more, and the chords alone
 cannot show it. A unit's frame is the rotation that best carries the four corners of its

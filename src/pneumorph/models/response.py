@@ -61,7 +61,7 @@ class Response:
     end_frame : ndarray, shape (k, 3), or None
         The free end face's rotation (a rotation vector, rad) per level, of the full 3D
         model's responses (:func:`pneumorph.models.frames.end_frame`) and of a chain in space
-        that predicts it (:meth:`~pneumorph.models.chaintable.ChainTable.end_frames`); its
+        that predicts it (:meth:`~pneumorph.models.chain.table.ChainTable.end_frames`); its
         :attr:`twist` about the face's normal. None for planar responses.
 
     Examples

@@ -2,8 +2,8 @@
 
 Examples
 --------
->>> from pneumorph.materials.datasets import load_dataset
->>> from pneumorph.materials.fitting import fit
+>>> from pneumorph.materials.characterisation.datasets import load_dataset
+>>> from pneumorph.materials.fitting.fit import fit
 >>> data = load_dataset("treloar1944")
 >>> fig = plot_fits(data, [fit("yeoh", data)])
 >>> len(fig.axes)
@@ -22,8 +22,8 @@ from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from pneumorph import __version__
-from pneumorph.materials.fitting import FitResult
-from pneumorph.materials.testdata import TestData
+from pneumorph.materials.characterisation.testdata import TestData
+from pneumorph.materials.fitting.fit import FitResult
 from pneumorph.plot.figure import new_figure, save_figure
 
 _TITLES = {"uniaxial": "Uniaxial", "equibiaxial": "Equibiaxial", "planar": "Planar (pure shear)"}

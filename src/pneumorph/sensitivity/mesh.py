@@ -338,7 +338,7 @@ def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float],
         ``measure(response) -> (value, level)``: the quantity compared besides tip and curl
         and the level it is taken at (a design objective at its best level, e.g.
         ``lambda r: (s := score(r, objective)).value, s.level`` with
-        :func:`pneumorph.design.fitness.score`).
+        :func:`pneumorph.design.objectives.fitness.score`).
     evaluator : Evaluator
         Solves the ``(model, design)`` cases (``iter_cases``).
     on_point : callable, optional

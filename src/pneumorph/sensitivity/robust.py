@@ -1,6 +1,6 @@
 """Robustness of every design to mould tolerances, through the chain model.
 
-A chain table (:mod:`pneumorph.models.chain`) holds the chord turns and lengths of every
+A chain table (:mod:`pneumorph.models.chain.model`) holds the chord turns and lengths of every
 window of units. Under a mould tolerance each of these moves smoothly with the three
 thicknesses of Fig E.4, and the change is local again (a unit's response depends on its
 neighbourhood), so it is tabulated the same way, with a narrower window: a
@@ -12,7 +12,7 @@ class: the full nominal table plus, read at each window's inner three units, a p
 in the offsets that is exact for any quadratic with all products of the thicknesses
 (:meth:`ToleranceTables._change`). Scoring every design under ``S`` seeded samples of the
 class costs ``S`` chain scorings
-(:func:`pneumorph.design.robustness.design_robustness`). The tolerance study's FE
+(:func:`pneumorph.design.runs.robustness.design_robustness`). The tolerance study's FE
 solves of a design check it (``docs/sensitivity.md``).
 """
 
@@ -29,8 +29,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError
-from pneumorph.models.chain import ChainTable, covering_designs, source_description, source_key
-from pneumorph.models.chainfit import fit_table
+from pneumorph.models.chain.fit import fit_table
+from pneumorph.models.chain.model import ChainTable, covering_designs, source_description, source_key
 from pneumorph.sensitivity.tolerances import Tolerance, box_units, corner_label
 
 FloatArray = NDArray[np.float64]
@@ -44,7 +44,7 @@ STATISTICS = ("worst", "mean")
 def inner_codes(codes: NDArray[np.int64], window: int, inner: int = TOLERANCE_WINDOW) -> NDArray[np.int64]:
     """The codes of the inner ``inner``-windows of ``window``-window codes (same centre unit).
 
-    >>> from pneumorph.models.windows import window_codes
+    >>> from pneumorph.models.chain.windows import window_codes
     >>> bits = np.array([[0, 1, 1, 0, 1]])
     >>> bool((inner_codes(window_codes(bits, 3), 3) == window_codes(bits, 1)).all())
     True
@@ -85,7 +85,7 @@ class ToleranceTables:
         Examples
         --------
         >>> tables = shipped_tolerance_tables()
-        >>> from pneumorph.models.chaintables import shipped_path
+        >>> from pneumorph.models.chain.sources import shipped_path
         >>> nominal = ChainTable.load(shipped_path("3d"))
         >>> same = tables.perturbed(nominal, np.zeros(3))
         >>> bool(np.array_equal(same.turn, nominal.turn))
@@ -253,7 +253,7 @@ def tolerance_file(folder: str | Path, model: Any, tolerance: Tolerance) -> Path
 
 def restrict_tolerance_tables(tables: ToleranceTables, levels: int, key: str) -> ToleranceTables:
     """``tables`` restricted to their first ``levels`` levels (each table by
-    :func:`~pneumorph.models.chaintables.restrict_table`), for the model of source key ``key`` (the
+    :func:`~pneumorph.models.chain.sources.restrict_table`), for the model of source key ``key`` (the
     model remade with the ramp of those levels). A pure function.
 
     >>> tables = shipped_tolerance_tables("2d")
@@ -261,7 +261,7 @@ def restrict_tolerance_tables(tables: ToleranceTables, levels: int, key: str) ->
     >>> short.nominal.n_levels, len(short.plus), short.source["key"], short.source["restricted_from"]["levels"]
     (3, 3, 'k', 10)
     """
-    from pneumorph.models.chaintables import restrict_table
+    from pneumorph.models.chain.sources import restrict_table
 
     def cut(group: tuple[ChainTable, ...]) -> tuple[ChainTable, ...]:
         return tuple(restrict_table(t, levels) for t in group)
@@ -275,7 +275,7 @@ def restrict_tolerance_tables(tables: ToleranceTables, levels: int, key: str) ->
 def _serving_levels(tables: ToleranceTables, model: Any) -> int | None:
     """How many of the tables' levels are ``model``'s levels, if the tables are of ``model``'s unit with a longer
     ramp of the same step (``model`` reports exactly their first levels); else None."""
-    from pneumorph.models.chaintables import level_pressure, ramp_variant
+    from pneumorph.models.chain.sources import level_pressure, ramp_variant
 
     nominal = tables.nominal
     k = nominal.n_levels
@@ -293,10 +293,10 @@ def find_tolerance_tables(model: Any, tolerance: Tolerance, folder: str | Path |
     """The shipped or kept tolerance tables of ``model``'s unit and ramp, or None.
 
     Tables of a longer ramp of the same step serve a model whose levels are their first ones
-    (a model remade by :func:`~pneumorph.models.chaintables.ramp_variant` for a restricted
+    (a model remade by :func:`~pneumorph.models.chain.sources.ramp_variant` for a restricted
     chain table): they are restricted to those levels (:func:`restrict_tolerance_tables`).
 
-    >>> from pneumorph.models.chaintables import serve_table
+    >>> from pneumorph.models.chain.sources import serve_table
     >>> from pneumorph.models.factory import make_model
     >>> served = serve_table(make_model(10, {"fidelity": "3d", "pressure_kpa": 25}))
     >>> find_tolerance_tables(served.model, Tolerance(0.1)).nominal.n_levels
@@ -337,7 +337,7 @@ def tolerance_plan_text(model: Any, tolerance: Tolerance, workers: int = 1, n_un
     >>> tolerance_plan_text(make_model(15, {"fidelity": "3d"}), Tolerance(0.1), 2, what=False)  # doctest: +ELLIPSIS
     '15 window-1 tables, 30 FE solves of 15-unit designs; estimated 3.8 min with 2 workers (about 15 s a 3d solve ...'
     """
-    from pneumorph.models.buildplan import estimate_text, unit_text
+    from pneumorph.models.chain.plan import estimate_text, unit_text
 
     m = len(tolerance.fields)
     tables = 1 + 2 * m + (2**m if corners else 0)
@@ -357,11 +357,11 @@ def tolerance_tables_for(model: Any, tolerance: Tolerance, folder: str | Path | 
     step, restricted: :func:`find_tolerance_tables`), or built now (cached) and kept.
 
     A build first says what it will build and its estimated time (:func:`tolerance_plan_text`),
-    and holds a lock on its file (:func:`~pneumorph.models.chaintables.build_once`): another
+    and holds a lock on its file (:func:`~pneumorph.models.chain.sources.build_once`): another
     process that needs the same tables waits for them and reuses them.
     """
-    from pneumorph.models.buildplan import evaluator_workers
-    from pneumorph.models.chaintables import build_once
+    from pneumorph.models.chain.plan import evaluator_workers
+    from pneumorph.models.chain.sources import build_once
 
     found = find_tolerance_tables(model, tolerance, folder)
     if found is not None:

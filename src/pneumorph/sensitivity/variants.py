@@ -3,7 +3,7 @@
 - :func:`scaled_bulk_modulus` - a silicone with its bulk modulus raised (E.1.2: +5 %, +10 %).
 - :func:`scaled_shear_modulus` - a silicone with its Ogden moduli scaled (every ``mu_n``, so its
   shear modulus and its whole stress-stretch curve by the same factor; the exponents kept).
-  Both live in :mod:`pneumorph.materials.scaling`, below the models that apply them (the
+  Both live in :mod:`pneumorph.materials.library.scaling`, below the models that apply them (the
   ``[model]`` table's ``body_bulk_scale`` and ``body_shear_scale``).
 - :func:`tension_only` - a silicone's Ogden model refitted to its uniaxial *tension* curve
   alone (E.1.1), the calibration a lab without compression grips would make.
@@ -13,7 +13,7 @@ A.4 model of each silicone was calibrated on tension and compression tests (appe
 A.2). :func:`tension_only` therefore samples that model's uniaxial curve over the tension
 range of the tests (stretch 1 to 3: the dumbbells were preconditioned to 200 % strain) and
 fits the same Ogden N = 3 form to the tension points only, with pneumorph's fitter
-(:func:`pneumorph.materials.fitting.fit`). The reference is the library's (tension and
+(:func:`pneumorph.materials.fitting.fit.fit`). The reference is the library's (tension and
 compression) model itself; refitting it to tension and compression points together
 recovers it (R^2 = 1 to 6 digits), so the two differ by the calibration data alone.
 """
@@ -24,10 +24,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from pneumorph.materials.fitting import FitResult, fit
-from pneumorph.materials.material import Material, ModelRecord
-from pneumorph.materials.scaling import scaled_bulk_modulus, scaled_shear_modulus
-from pneumorph.materials.testdata import TestCurve
+from pneumorph.materials.characterisation.testdata import TestCurve
+from pneumorph.materials.fitting.fit import FitResult, fit
+from pneumorph.materials.library.material import Material, ModelRecord
+from pneumorph.materials.library.scaling import scaled_bulk_modulus, scaled_shear_modulus
 
 #: the tension range of the calibration data (stretch), appendix A.2: preconditioned to 200 % strain
 TENSION_RANGE = (1.0, 3.0)

@@ -61,7 +61,7 @@ def check_strain_limit(limit: float) -> float:
 
 
 @dataclass(frozen=True)
-class Candidate:
+class UnitCandidate:
     """One solved candidate unit.
 
     Attributes
@@ -135,7 +135,7 @@ class CandidateEvaluator:
     """
 
     def __init__(self, space: DesignSpace, evaluator: Any, n_units: int = DEFAULT_UNITS, pressure: float = 0.045,
-                 on_candidate: Callable[[Candidate], None] | None = None) -> None:
+                 on_candidate: Callable[[UnitCandidate], None] | None = None) -> None:
         self.space = space
         self.evaluator = evaluator
         self.n_units = n_units
@@ -143,12 +143,12 @@ class CandidateEvaluator:
         self.on_candidate = on_candidate
         self.generation = 0
         #: every candidate asked for, by its snapped values
-        self.history: dict[tuple[float, ...], Candidate] = {}
+        self.history: dict[tuple[float, ...], UnitCandidate] = {}
 
     def probe(self, unit: UnitSpec) -> UnitProbe:
         return UnitProbe(unit, self.n_units, self.pressure)
 
-    def evaluate(self, rows: FloatArray) -> list[Candidate]:
+    def evaluate(self, rows: FloatArray) -> list[UnitCandidate]:
         """The candidates of ``rows`` (shape (m, n_var)), in order; each distinct one solved once."""
         keys = [tuple(self.space.snap(x).tolist()) for x in np.atleast_2d(rows)]
         todo = list(dict.fromkeys(k for k in keys if k not in self.history))
@@ -160,10 +160,10 @@ class CandidateEvaluator:
                 self.on_candidate(candidate)
         return [self.history[k] for k in keys]
 
-    def _candidate(self, key: tuple[float, ...], unit: UnitSpec, outcome: Outcome) -> Candidate:
+    def _candidate(self, key: tuple[float, ...], unit: UnitSpec, outcome: Outcome) -> UnitCandidate:
         measures = measures_of(outcome.response) if outcome.ok and outcome.response is not None else None
         reached = self.pressure if outcome.ok else float(outcome.reached or 0.0)
-        return Candidate(dict(zip(self.space.names, key, strict=True)), unit, measures, outcome.failure, reached,
+        return UnitCandidate(dict(zip(self.space.names, key, strict=True)), unit, measures, outcome.failure, reached,
                          outcome.cached, outcome.wall_time, self.generation)
 
 
@@ -202,5 +202,11 @@ class UnitProblem(Problem):
                             dtype=float)
 
 
-__all__ = ["FAILED_OBJECTIVES", "Candidate", "CandidateEvaluator", "SnapRepair", "UnitProblem",
-           "check_strain_limit"]
+__all__ = [
+    "FAILED_OBJECTIVES",
+    "CandidateEvaluator",
+    "SnapRepair",
+    "UnitCandidate",
+    "UnitProblem",
+    "check_strain_limit",
+]

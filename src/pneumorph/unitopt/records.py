@@ -12,7 +12,7 @@ import numpy as np
 from pneumorph import checks
 from pneumorph.unitopt.probe import DEFAULT_UNITS
 from pneumorph.unitopt.problem import (
-    Candidate,
+    UnitCandidate,
     check_strain_limit,
 )
 from pneumorph.unitopt.space import DesignSpace
@@ -82,24 +82,24 @@ class UnitOptimisation:
     Attributes
     ----------
     settings : OptimiseSettings
-    candidates : list of Candidate
+    candidates : list of UnitCandidate
         Every candidate solved, in the order first asked for.
-    front : list of Candidate
+    front : list of UnitCandidate
         The feasible non-dominated candidates, by increasing h_b.
-    base : Candidate
+    base : UnitCandidate
         The base unit (the built-in one), solved with the same probe.
     solves, hits : int
         Candidates solved in this run and answered from the cache.
     """
 
     settings: OptimiseSettings
-    candidates: list[Candidate]
-    front: list[Candidate]
-    base: Candidate
+    candidates: list[UnitCandidate]
+    front: list[UnitCandidate]
+    base: UnitCandidate
     solves: int = 0
     hits: int = 0
 
-    def better(self) -> list[Candidate]:
+    def better(self) -> list[UnitCandidate]:
         """Feasible candidates that turn more than the base unit at the same or a lower h_b, best Omega first."""
         b = self.base.measures
         if b is None:
@@ -109,7 +109,7 @@ class UnitOptimisation:
                and c.measures.omega_deg > b.omega_deg and c.measures.balloon_mm <= b.balloon_mm]
         return [c for _, c in sorted(out, key=lambda pair: -pair[0])]
 
-    def chosen(self) -> dict[str, Candidate]:
+    def chosen(self) -> dict[str, UnitCandidate]:
         """The points written as unit files: ``max-omega``, ``min-balloon``, ``knee`` and ``better``."""
         if not self.front:
             return {}

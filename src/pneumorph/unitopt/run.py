@@ -35,9 +35,9 @@ import numpy as np
 from pneumorph.errors import GeometryError, RunFolderError, SettingsError
 from pneumorph.unitopt.probe import DEFAULT_UNITS
 from pneumorph.unitopt.problem import (
-    Candidate,
     CandidateEvaluator,
     SnapRepair,
+    UnitCandidate,
     UnitProblem,
     check_strain_limit,
 )
@@ -63,7 +63,7 @@ def latin_hypercube(space: DesignSpace, n: int, seed: int) -> FloatArray:
     return np.array([space.snap(row) for row in x])
 
 
-def front_of(candidates: list[Candidate], strain_limit: float) -> list[Candidate]:
+def front_of(candidates: list[UnitCandidate], strain_limit: float) -> list[UnitCandidate]:
     """The feasible candidates no other feasible one dominates (in ``-Omega``, h_b), by increasing h_b."""
     from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
@@ -75,8 +75,8 @@ def front_of(candidates: list[Candidate], strain_limit: float) -> list[Candidate
     return sorted((feasible[i] for i in first), key=lambda c: c.objectives()[1])
 
 
-def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[[Candidate], None] | None = None,
-             on_generation: Callable[[int, list[Candidate]], None] | None = None) -> UnitOptimisation:
+def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[[UnitCandidate], None] | None = None,
+             on_generation: Callable[[int, list[UnitCandidate]], None] | None = None) -> UnitOptimisation:
     """Run NSGA-II on the unit (see the module docstring).
 
     Parameters
@@ -125,8 +125,8 @@ _COLUMNS = ("omega_deg", "balloon_mm", "balloon_bottom_mm", "balloon_end_mm", "b
             "wall_time_s")
 
 
-def table_csv(result: UnitOptimisation, candidates: list[Candidate]) -> str:
-    """CSV text of ``candidates``: the varied dimensions, then the measures (see :class:`Candidate.row`)."""
+def table_csv(result: UnitOptimisation, candidates: list[UnitCandidate]) -> str:
+    """CSV text of ``candidates``: the varied dimensions, then the measures (see :class:`UnitCandidate.row`)."""
     out = io.StringIO()
     writer = csv.DictWriter(out, fieldnames=[*result.settings.space.names, *_COLUMNS], lineterminator="\n")
     writer.writeheader()
@@ -137,7 +137,7 @@ def table_csv(result: UnitOptimisation, candidates: list[Candidate]) -> str:
     return out.getvalue()
 
 
-def unit_file(candidate: Candidate, label: str, result: UnitOptimisation, prov: dict[str, Any]) -> str:
+def unit_file(candidate: UnitCandidate, label: str, result: UnitOptimisation, prov: dict[str, Any]) -> str:
     """TOML text of a chosen unit: its ``[unit]`` table (what differs from the built-in unit, and its name),
     then ``[unitopt]`` with its measures and where it comes from (ignored by :meth:`UnitSpec.from_toml`)."""
     from dataclasses import replace

@@ -1,5 +1,5 @@
 """The search strategies of a design run, one module each, with the interface of
-:class:`pneumorph.design.problem.Algorithm`.
+:class:`pneumorph.design.algorithms.problem.Algorithm`.
 
 - ``certified`` (:class:`CertifiedSearch`): every design scored by the chain model, the best
   verified by FE, with a bound on what any other design could do.

@@ -1,7 +1,7 @@
 """The certified search as a search strategy: every design scored by the chain model, the best
-verified by FE (:func:`pneumorph.design.certified.certified_search`).
+verified by FE (:func:`pneumorph.design.certified.search.certified_search`).
 
-Before the folder is touched it picks its chain table (:func:`pneumorph.design.planning.plan_search`):
+Before the folder is touched it picks its chain table (:func:`pneumorph.design.certified.planning.plan_search`):
 a table of the model's source, or of a longer ramp of the same step restricted to the
 levels at or below the model's pressure (the FE verifications then use the model remade with
 those levels); for an actuator shorter than the table needs it hands over to the FE
@@ -18,15 +18,15 @@ from typing import Any
 import numpy as np
 
 from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
-from pneumorph.design.certified import CertifiedResult, certified_search, chain_candidate
-from pneumorph.design.comparison import compare_with_reference
-from pneumorph.design.fitness import Score
-from pneumorph.design.planning import SearchPlan, plan_search
-from pneumorph.design.problem import Algorithm, Outcome, Problem, Search
-from pneumorph.design.robustness import chain_robustness, winner_robustness
+from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
+from pneumorph.design.certified.planning import SearchPlan, plan_search
+from pneumorph.design.certified.search import CertifiedResult, certified_search, chain_candidate
+from pneumorph.design.objectives.fitness import Score
+from pneumorph.design.runs.comparison import compare_with_reference
+from pneumorph.design.runs.robustness import chain_robustness, winner_robustness
 from pneumorph.errors import LocalityError, MissingTableError, PneumorphError, SearchConfigError
-from pneumorph.models.chain import ChainModel
-from pneumorph.models.chaintables import serve_table, table_for
+from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.sources import serve_table, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for
@@ -63,7 +63,7 @@ class CertifiedSearch(Search):
             if not problem.build and _tolerance_tables_wanted(config, model):
                 _check_tolerance_tables(config, model, problem)
         if config.refine:
-            from pneumorph.design.refine import check_refine
+            from pneumorph.design.certified.refine import check_refine
 
             check_refine(model, config.refine, parallel=max(1, min(problem.workers, config.verify or 1024)))
         return self, replace(problem, model=model)
@@ -87,7 +87,7 @@ class CertifiedSearch(Search):
             entries["chain_table_restricted_from"] = table.source["restricted_from"]
         return entries
 
-    def run(self, problem: Problem) -> Outcome:
+    def run(self, problem: Problem) -> SearchOutcome:
         """The certificate, its winner and runners-up, the chain's best 1,000, the mesh note or refinement,
         the winner's robustness, the 2D model's opinion and, with a reference model, its optimum on this one."""
         config, chain = problem.config, self.chain
@@ -98,13 +98,13 @@ class CertifiedSearch(Search):
                                 margin=config.margin, on_progress=problem.say, epsilon=config.epsilon)
         order = cert.scores.order()[:1000]
         names = chain.table.texts(cert.scores.bits[order])
-        outcome = Outcome(cert.hall_of_fame, certified=cert, refinement=_refinement(problem, cert),
+        outcome = SearchOutcome(cert.hall_of_fame, certified=cert, refinement=_refinement(problem, cert),
                           ranking=[(d, _chain_score(cert, i)) for d, i in zip(names, order, strict=False)])
         outcome = self.robustness(problem, outcome)
         return replace(outcome, opinion_2d=_opinion_2d(problem, cert),
                        comparison=compare_with_reference(problem, outcome.robust_winner or cert.winner))
 
-    def robustness(self, problem: Problem, outcome: Outcome) -> Outcome:
+    def robustness(self, problem: Problem, outcome: SearchOutcome) -> SearchOutcome:
         """The winner's spread under the mould tolerance: by the chain with the unit's tolerance tables, else by
         FE solves."""
         cert, config = outcome.certified, problem.config
@@ -132,7 +132,7 @@ def _check_tolerance_tables(config: Any, model: Any, problem: Problem) -> None:
 def _refinement(problem: Problem, cert: CertifiedResult) -> dict[str, Any] | None:
     """With ``[design] refine`` the verified designs on the finer mesh (:func:`.refine.refine_verified`), else
     what the shipped mesh study says about them (:func:`.refine.mesh_note`)."""
-    from pneumorph.design.refine import mesh_note, refine_verified
+    from pneumorph.design.certified.refine import mesh_note, refine_verified
 
     values = {d: c.value for d, c in cert.verified.items() if c.failure is None}
     if problem.config.refine:

@@ -1,11 +1,11 @@
 """The FE exhaustive search as a search strategy: all 2^n designs of one unit type
-(:func:`pneumorph.design.exhaustive.run_exhaustive`)."""
+(:func:`pneumorph.design.search.exhaustive.run_exhaustive`)."""
 
 from __future__ import annotations
 
-from pneumorph.design.exhaustive import run_exhaustive
-from pneumorph.design.problem import Outcome, Problem, Search
-from pneumorph.design.robustness import winner_robustness
+from pneumorph.design.algorithms.problem import Problem, Search, SearchOutcome
+from pneumorph.design.runs.robustness import winner_robustness
+from pneumorph.design.search.exhaustive import run_exhaustive
 
 
 class ExhaustiveSearch(Search):
@@ -22,10 +22,10 @@ class ExhaustiveSearch(Search):
     def __init__(self, note: str = "") -> None:
         self.note = note
 
-    def run(self, problem: Problem) -> Outcome:
+    def run(self, problem: Problem) -> SearchOutcome:
         """The ranking of all designs and its hall of fame."""
         ex = run_exhaustive(problem.model, problem.objective, problem.evaluator,
                             hall_of_fame=problem.config.ga.hall_of_fame, on_progress=problem.on_progress)
         best = ex.hall_of_fame[0] if ex.hall_of_fame else None
-        return Outcome(ex.hall_of_fame, ranking=[(d, ex.scores[d]) for d in ex.ranking],
+        return SearchOutcome(ex.hall_of_fame, ranking=[(d, ex.scores[d]) for d in ex.ranking],
                        robustness=winner_robustness(problem, best))

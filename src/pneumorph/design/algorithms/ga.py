@@ -1,12 +1,12 @@
-"""The genetic algorithm as a search strategy: :func:`pneumorph.design.ga.run_ga` on a
-:class:`~pneumorph.design.problem.Problem`, its generations logged to ``generations.csv``."""
+"""The genetic algorithm as a search strategy: :func:`pneumorph.design.search.genetic.run_ga` on a
+:class:`~pneumorph.design.algorithms.problem.Problem`, its generations logged to ``generations.csv``."""
 
 from __future__ import annotations
 
-from pneumorph.design.folder import _GenerationLog
-from pneumorph.design.ga import GenerationStats, run_ga
-from pneumorph.design.problem import Outcome, Problem, Search
-from pneumorph.design.robustness import winner_robustness
+from pneumorph.design.algorithms.problem import Problem, Search, SearchOutcome
+from pneumorph.design.runs.folder import GenerationLog
+from pneumorph.design.runs.robustness import winner_robustness
+from pneumorph.design.search.genetic import GenerationStats, run_ga
 
 
 class GeneticSearch(Search):
@@ -19,11 +19,11 @@ class GeneticSearch(Search):
     name = "ga"
 
     def __init__(self) -> None:
-        self._log: _GenerationLog | None = None
+        self._log: GenerationLog | None = None
 
-    def run(self, problem: Problem) -> Outcome:
+    def run(self, problem: Problem) -> SearchOutcome:
         """The GA's hall of fame and generations."""
-        log = None if problem.folder is None else _GenerationLog(problem.folder / "generations.csv",
+        log = None if problem.folder is None else GenerationLog(problem.folder / "generations.csv",
                                                                  resume=problem.resumed)
         self._log = log
 
@@ -40,8 +40,8 @@ class GeneticSearch(Search):
             if log is not None:
                 log.close()
         best = ga.hall_of_fame[0] if ga.hall_of_fame else None
-        return Outcome(ga.hall_of_fame, ga.history, robustness=winner_robustness(problem, best))
+        return SearchOutcome(ga.hall_of_fame, ga.history, robustness=winner_robustness(problem, best))
 
-    def interrupted(self) -> Outcome:
+    def interrupted(self) -> SearchOutcome:
         """The generations logged before the interrupt."""
-        return Outcome(history=tuple(self._log.rows) if self._log is not None else ())
+        return SearchOutcome(history=tuple(self._log.rows) if self._log is not None else ())

@@ -7,8 +7,8 @@ from typing import Any
 from pneumorph.design.algorithms.certified import CertifiedSearch
 from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
 from pneumorph.design.algorithms.ga import GeneticSearch
+from pneumorph.design.algorithms.problem import Algorithm
 from pneumorph.design.algorithms.robust import RobustSearch
-from pneumorph.design.problem import Algorithm
 
 #: the algorithm of each ``[design] search`` (``robust``: the certified search with ``[design] robust``)
 ALGORITHMS: dict[str, type[Any]] = {

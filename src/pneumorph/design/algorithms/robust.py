@@ -7,14 +7,14 @@ from __future__ import annotations
 from dataclasses import replace
 
 from pneumorph.design.algorithms.certified import CertifiedSearch
-from pneumorph.design.problem import Outcome, Problem
-from pneumorph.design.robustness import chain_robustness, robust_ranking, robust_winner
+from pneumorph.design.algorithms.problem import Problem, SearchOutcome
+from pneumorph.design.runs.robustness import chain_robustness, robust_ranking, robust_winner
 
 
 class RobustSearch(CertifiedSearch):
-    """:class:`CertifiedSearch` whose winner is the most robust design (:attr:`Outcome.robust_winner`)."""
+    """:class:`CertifiedSearch` whose winner is the most robust design (:attr:`SearchOutcome.robust_winner`)."""
 
-    def robustness(self, problem: Problem, outcome: Outcome) -> Outcome:
+    def robustness(self, problem: Problem, outcome: SearchOutcome) -> SearchOutcome:
         """The certified winner's spread, the ranking by ``config.robust`` and the most robust design's."""
         config, cert = problem.config, outcome.certified
         if self.tables is None or cert is None or config.robust is None:  # no tolerance tables: as certified

@@ -18,11 +18,11 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 #: cells per chunk of the 3D tangent (keeps the temporaries in the tens of MB)
-_CHUNK = 256
+TANGENT_CHUNK = 256
 
 
 @dataclass
-class _Solid:
+class SolidData:
     """One material on some cells: gradients in the layouts the products need."""
 
     cells: IntArray  # (c, n)
@@ -36,7 +36,7 @@ class _Solid:
 
 
 @dataclass
-class _Walls:
+class WallData:
     """The pressurised faces of one ``SolidBodyPressure``."""
 
     item: Any
@@ -49,7 +49,7 @@ class _Walls:
     edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
-def _deformation(g: FloatArray, cells: IntArray, U: FloatArray) -> FloatArray:
+def deformation_gradient(g: FloatArray, cells: IntArray, U: FloatArray) -> FloatArray:
     """``F = I + grad u`` at every quadrature point, (c, q, d, d)."""
     F = np.matmul(U[cells].transpose(0, 2, 1)[:, None], g)  # (c, q, i, J)
     for i in range(U.shape[1]):
@@ -101,8 +101,8 @@ class FastSystem:
         self.dof1 = np.asarray(dof1, dtype=np.int64)
         self.dof0 = np.asarray(dof0, dtype=np.int64)
         self.points = np.asarray(field[0].region.mesh.points[:, :d], dtype=float)
-        self.solids: list[_Solid] = []
-        self.walls: list[_Walls] = []
+        self.solids: list[SolidData] = []
+        self.walls: list[WallData] = []
         forces = []
         for item in items:
             self._check_field(item.field[0])
@@ -115,9 +115,9 @@ class FastSystem:
             if isinstance(item, fem.SolidBodyPressure):
                 h = np.ascontiguousarray(region.h[:, :, 0].T)  # (n, q) -> (q, n)
                 ndA = np.ascontiguousarray(np.transpose(region.dA[:d], (2, 1, 0)))  # (f, q, d)
-                self.walls.append(_Walls(item, cells, g, h, ndA))
+                self.walls.append(WallData(item, cells, g, h, ndA))
             elif isinstance(item, fem.SolidBody):
-                solid = _Solid(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
+                solid = SolidData(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
                 solid.layouts = self._layouts(g)
                 self.solids.append(solid)
             else:
@@ -138,26 +138,26 @@ class FastSystem:
         """The gradients in the layouts this dimension's products need."""
         raise NotImplementedError  # pragma: no cover
 
-    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+    def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         """Active (row, column) of every element-matrix entry as it is computed, and which
         of them are assembled (``act``: the active index of each cell's dofs, (c, n, d))."""
         raise NotImplementedError  # pragma: no cover
 
-    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+    def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         """The local nodes ``a``, ``b`` that each entry of :meth:`_entries` couples, as index
         arrays that broadcast to its shape without the cell axis."""
         raise NotImplementedError  # pragma: no cover
 
-    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+    def _solid_residual(self, s: SolidData, U: FloatArray) -> tuple[FloatArray, float, Any]:
         """The element vectors ``(c, n, d)`` of a solid, its smallest det F and the state
         :meth:`_solid_tangent` needs."""
         raise NotImplementedError  # pragma: no cover
 
-    def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
+    def _solid_tangent(self, s: SolidData, state: Any) -> FloatArray:
         """The element matrices of a solid, entries in :meth:`_entries` order."""
         raise NotImplementedError  # pragma: no cover
 
-    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
+    def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
         """The follower-pressure stiffness of some walls, entries in :meth:`_entries` order."""
         raise NotImplementedError  # pragma: no cover
 
@@ -183,7 +183,7 @@ class FastSystem:
         active = np.full(self.ndof, -1, dtype=np.int32)  # (int32: half the memory traffic of the gathers)
         active[self.dof1] = np.arange(self.dof1.size)
         n1 = self.dof1.size
-        owners: list[_Solid | _Walls] = [*self.solids, *self.walls]
+        owners: list[SolidData | WallData] = [*self.solids, *self.walls]
         # 1. the node pairs every owner's cells couple, numbered
         pair_keys = []
         for owner in owners:
@@ -267,7 +267,7 @@ class FastSystem:
             self._state.append(state)
         for w in self.walls:
             p = float(w.item.results.pressure)
-            cofN = self._cof_normal(_deformation(w.g, w.cells, U), w.ndA)  # (f, q, d)
+            cofN = self._cof_normal(deformation_gradient(w.g, w.cells, U), w.ndA)  # (f, q, d)
             # r[f, a, i] = p sum_q h[q, a] cof(F)_iJ N_J dA
             r += np.bincount(w.edofs, weights=(p * np.matmul(w.h.T[None], cofN)).ravel(), minlength=self.ndof)
         if self.dead:
@@ -302,7 +302,7 @@ class FastSystem:
         U = u.reshape(-1, self.dim)
         total = 0.0
         for w in self.walls:
-            F = _deformation(w.g, w.cells, U)
+            F = deformation_gradient(w.g, w.cells, U)
             x = np.matmul(w.h[None], (self.points + U)[w.cells])  # (f, q, d)
             total += float(np.sum(x * self._cof_normal(F, w.ndA)))
         return -total / self.dim

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.fem.fast.assembler import _CHUNK, FastSystem, _deformation, _Solid, _Walls
+from pneumorph.fem.fast.assembler import TANGENT_CHUNK, FastSystem, SolidData, WallData, deformation_gradient
 from pneumorph.fem.fast.kernels import neo_hooke_plane_strain, ogden_plane_strain, principal_3d
 
 FloatArray = NDArray[np.float64]
@@ -96,27 +96,27 @@ class PlaneStrainSystem(FastSystem):
             "B": np.ascontiguousarray(np.einsum("cqaJ,ij->caiqjJ", g, np.eye(2)).reshape(c, 2 * n, 4 * q)),
         }
 
-    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+    def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         # the full element matrix, entries (c, a, i, k, b)
         c, n, _ = act.shape
         rows = np.broadcast_to(act[:, :, :, None, None], (c, n, 2, 2, n))
         cols = np.broadcast_to(act.transpose(0, 2, 1)[:, None, None, :, :], (c, n, 2, 2, n))
         return rows, cols, (rows >= 0) & (cols >= 0)
 
-    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+    def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         n = np.arange(owner.cells.shape[1])
         return n[:, None, None, None], n  # entries (a, i, k, b)
 
-    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+    def _solid_residual(self, s: SolidData, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
-        F = _deformation(s.g, s.cells, U)
+        F = deformation_gradient(s.g, s.cells, U)
         P, A, J = s.kernel(np.ascontiguousarray(F.transpose(2, 3, 0, 1)).reshape(2, 2, c * q))
         dV = s.dV.reshape(-1)
         PdV = (P * dV).reshape(2, 2, c, q)
         # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV
         return np.matmul(s.layouts["g_res"], PdV.transpose(2, 3, 1, 0).reshape(c, 2 * q, 2)), float(J.min()), A * dV
 
-    def _solid_tangent(self, s: _Solid, AdV: FloatArray) -> FloatArray:
+    def _solid_tangent(self, s: SolidData, AdV: FloatArray) -> FloatArray:
         c, q, n, _ = s.g.shape
         # D[cq, (i, J, k), b] = sum_L A[i, J, k, L, cq] dV g[cq, b, L]
         At = np.ascontiguousarray(AdV.reshape(16, c * q).T).reshape(c * q, 8, 2)
@@ -124,7 +124,7 @@ class PlaneStrainSystem(FastSystem):
         # K[c, (a, i), (k, b)] = sum_(q, J) g[c, q, a, J] D[c, (q, i, J), (k, b)]
         return np.matmul(s.layouts["B"], D)
 
-    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
+    def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
         # t[f, q, b] = N_1 dN_b/dX_2 - N_2 dN_b/dX_1 (with dA); M[f, a, b] = p sum_q h_a t_b
         t = w.ndA[..., 0:1] * w.g[..., 1] - w.ndA[..., 1:2] * w.g[..., 0]
         M = p * np.matmul(w.h.T[None], t)  # (f, n, n)
@@ -194,9 +194,9 @@ class SolidSystem3D(FastSystem):
             "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
         }
 
-    def _entries(self, owner: _Solid | _Walls, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+    def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         ik = np.array(_UPPER)
-        if isinstance(owner, _Solid):
+        if isinstance(owner, SolidData):
             # entry (c, a, ik, b) at (row of (a, i), column of (b, k)); blocks i < k
             # stand for themselves and their transposes, blocks i == k hold both
             off = (ik[:, 0] != ik[:, 1])[None, None, :, None]
@@ -210,13 +210,13 @@ class SolidSystem3D(FastSystem):
         rows, cols = np.broadcast_arrays(rows, cols)
         return rows, cols, (rows >= 0) & (rows <= cols)
 
-    def _entry_nodes(self, owner: _Solid | _Walls) -> tuple[IntArray, IntArray]:
+    def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         n = np.arange(owner.cells.shape[1])
-        if isinstance(owner, _Solid):
+        if isinstance(owner, SolidData):
             return n[:, None, None], n  # entries (a, ik, b)
         return n[:, None, None, None], n[:, None]  # entries (a, i, b, k)
 
-    def _solid_residual(self, s: _Solid, U: FloatArray) -> tuple[FloatArray, float, Any]:
+    def _solid_residual(self, s: SolidData, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
         # F[c, i, (q, J)] = sum_a u[c, a, i] g[c, q, a, J], then as [i, J, (c, q)]
         F = np.matmul(U[s.cells].transpose(0, 2, 1), s.layouts["G"]).reshape(c, 3, q, 3)
@@ -230,7 +230,7 @@ class SolidSystem3D(FastSystem):
         PdV = (P * s.dV.reshape(-1)).reshape(3, 3, c, q).transpose(2, 3, 1, 0).reshape(c, 3 * q, 3)
         return np.matmul(s.layouts["G"], PdV), float(J.min()), (Fp, principal)
 
-    def _solid_tangent(self, s: _Solid, state: Any) -> FloatArray:
+    def _solid_tangent(self, s: SolidData, state: Any) -> FloatArray:
         Fp, principal = state
         c, q, n, _ = s.g.shape
         _, A, _ = s.kernel(Fp, True, principal)
@@ -245,8 +245,8 @@ class SolidSystem3D(FastSystem):
             s.layouts[f"gt-{np.dtype(dtype).name}"] = s.layouts["gt"].astype(dtype)
         blocks = s.layouts[key]
         G, gt = s.layouts[f"G-{np.dtype(dtype).name}"], s.layouts[f"gt-{np.dtype(dtype).name}"]
-        for start in range(0, c, _CHUNK):
-            sl = slice(start, min(start + _CHUNK, c))
+        for start in range(0, c, TANGENT_CHUNK):
+            sl = slice(start, min(start + TANGENT_CHUNK, c))
             m = sl.stop - sl.start
             # E[c, q, J, ik, b] = sum_L A dV g[c, q, b, L], a batched matrix product (einsum's
             # optimised path returns it transposed, which the reshape below would copy)
@@ -255,8 +255,8 @@ class SolidSystem3D(FastSystem):
             blocks[sl] = np.matmul(G[sl], E.reshape(m, 3 * q, 6 * n)).reshape(m, n, 6, n)
         return blocks
 
-    def _wall_tangent(self, w: _Walls, p: float, U: FloatArray) -> FloatArray:
-        F = _deformation(w.g, w.cells, U)
+    def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
+        F = deformation_gradient(w.g, w.cells, U)
         # v[f, q, b, m] = [F (N dA x dN_b/dX)]_m; M[f, a, b, m] = p sum_q h_a v_bm
         t = _cross(w.ndA[:, :, None, :], w.g)  # (f, q, n, 3)
         v = np.matmul(t, F.transpose(0, 1, 3, 2))  # (f, q, n, m)

@@ -1,0 +1,133 @@
+"""``pneumorph bimodal``: the bimodal Slow Pneu-net actuator of section 3.3 (3D FE).
+
+Pressures in kPa, lengths in mm. FElupe and matplotlib are imported inside the command.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+
+from pneumorph.checks import MAX_INCREMENTS
+from pneumorph.cli.options import params as P
+from pneumorph.io.files import all_or_nothing, strict_json, write_json
+
+
+def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
+    """Small-strain bulk modulus ``K = 2 mu (1 + nu) / (3 (1 - 2 nu))`` (same unit as mu).
+
+    Examples
+    --------
+    >>> round(bulk_from_poisson(1.0, 0.495), 4)
+    99.6667
+    """
+    if not -1.0 < nu < 0.5:
+        raise click.BadParameter(f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
+    return 2.0 * shear_modulus * (1.0 + nu) / (3.0 * (1.0 - 2.0 * nu))
+
+
+@click.command("bimodal")
+@click.option("--crimp-ratio", "-c", type=click.Choice(["0.2", "0.25", "0.3"]), required=True,
+              help="Crimp ratio of the bilinear composite (Table B.1).")
+@click.option("--pmax", type=P.PRESSURE_KPA, default=60.0, show_default=True, help="Top pressure of the ramp in kPa.")
+@click.option("--step", type=P.PRESSURE_KPA, default=5.0, show_default=True, help="Pressure step in kPa.")
+@click.option("--voids", type=P.UNITS, default=15, show_default=True, help="Number of voids (10.5 mm each).")
+@click.option("--element-size", type=P.POSITIVE_MM, default=2.5, show_default=True, help="Target element edge in mm.")
+@click.option("--end-cap", type=P.Real(0.0, 1e4, unit="mm"), default=0.0, show_default=True,
+              help="Extra solid beyond the last void in mm (the free end wall is 1.5 mm + this).")
+@click.option("--bilinear-nu", type=P.Real(-1.0, 0.5, low_open=True, high_open=True), default=None,
+              help="Small-strain Poisson's ratio of the composite, sets its bulk modulus "
+                   "[default: the library's assumed bulk modulus].")
+@click.option("--max-cutbacks", type=P.Count(0, 60), default=None,
+              help="Halvings of a step that does not converge before the ramp ends there "
+                   "[default: the model's own, shown in the --json metadata].")
+@click.option("--max-iterations", type=P.Count(1, 1000), default=None,
+              help="Newton iterations per trial [default: the model's own, shown in --json metadata].")
+@click.option("--out", type=P.OutputDir(), default=None,
+              help="Folder for the response (JSON) and figures (PNG).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
+def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
+            bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
+            as_json: bool, quiet: bool) -> None:
+    """3D FE of the bimodal actuator: tip displacement in pressure steps, switch pressure.
+
+    The ramp ends at --pmax or at the last pressure that converges (where a wall balloons).
+    """
+    from pneumorph.bimodal.geometry import BimodalSpec
+    from pneumorph.bimodal.model import BimodalModel, bilinear_material
+    from pneumorph.materials import get
+
+    n = round(pmax / step)
+    if step > pmax or abs(pmax / step - n) > 1e-6 or n > MAX_INCREMENTS:
+        raise click.BadParameter(f"--step {step:g} kPa must divide --pmax {pmax:g} kPa into at most {MAX_INCREMENTS} "
+                                 f"equal steps, so that the ramp ends at --pmax (e.g. --step "
+                                 f"{pmax / min(max(n, 1), MAX_INCREMENTS):.4g})", param_hint="'--step'")
+    cr = float(crimp_ratio)
+    bulk = None
+    if bilinear_nu is not None:
+        bulk = bulk_from_poisson(get(bilinear_material(cr)).shear_modulus, bilinear_nu)
+    for option, field, value in (("--voids", "voids", voids), ("--element-size", "element_size", element_size),
+                                 ("--end-cap", "end_cap", end_cap)):
+        with P.blame(option):
+            # one field at a time, so that an error names its option
+            BimodalSpec(**{field: value})  # type: ignore[arg-type]
+    spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
+    model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
+                         max_cutbacks=max_cutbacks, max_iterations=max_iterations)  # None: the model's own
+
+    def progress(k: int, p: float, v: float) -> None:
+        if not quiet and not as_json:
+            click.echo(f"  {1e3 * p:6.1f} kPa  tip u_y {v:+8.3f} mm", err=True)
+
+    result = model.solve(on_level=progress)
+    data = result.to_dict()
+    if out is not None:
+        data["files"] = [str(p) for p in write_outputs(result, Path(out))]
+    if as_json:
+        click.echo(strict_json(data, indent=2))
+    else:
+        click.echo(format_result(data))
+    if not result.completed:  # a partial ramp is reported and written, and ends with its cause (exit 2)
+        from pneumorph.errors import SimulationFailed
+
+        reached = float(result.pressures[-1]) / result.pmax if len(result.pressures) else 0.0
+        kept = "the levels before it are printed" + (" and written" if out is not None else "")
+        raise SimulationFailed(reached=reached, cause=f"{result.cause.strip()}; {kept}", pressure=result.pmax)
+
+
+def format_result(d: dict[str, Any]) -> str:
+    """Text summary of a :meth:`BimodalResult.to_dict`."""
+    m = d["metadata"]
+    s = d["switch"]
+    head = (f"bimodal actuator, CR {d['crimp_ratio']:g}: {m['dofs']} dofs, {m['wall_time_s']:.0f} s, "
+            f"bilinear bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa")
+    lines = [head, "pressure (kPa)   tip u_x (mm)   tip u_y (mm)"]
+    for p, ux, uy in zip(d["pressures_kpa"], d["tip_ux_mm"], d["tip_uy_mm"], strict=False):
+        lines.append(f"{p:10.1f}   {ux:12.3f}   {uy:12.3f}")
+    if not d["completed"]:
+        lines.append(f"ramp ended early: {d['cause'].strip()}")
+    turn = "none" if s["turning_kpa"] is None else f"{s['turning_kpa']:g} kPa (u_y {s['peak_mm']:.3f} mm)"
+    lines.append(f"tip turns back at: {turn}")
+    limit = d["pressures_kpa"][-1] if d["pressures_kpa"] else 0.0
+    sw = f"{s['switch_kpa']:.2f} kPa" if s["switch_kpa"] is not None else f"none below {limit:g} kPa"
+    lines.append(f"switch pressure (bending direction reverses): {sw}")
+    return "\n".join(lines)
+
+
+def write_outputs(result: Any, out: Path) -> list[Path]:
+    """Write ``bimodal-CR.json`` and the tip-path and outline figures into ``out``."""
+    from pneumorph.bimodal import figures
+
+    tag = f"cr{result.crimp_ratio:g}".replace(".", "_")
+    js = out / f"bimodal-{tag}.json"
+    tip = out / f"bimodal-{tag}-tip.png"
+    shape = out / f"bimodal-{tag}-shape.png"
+    with all_or_nothing(out):  # stopped while writing (Ctrl-C, a full disk): no partial output
+        write_json(js, result.to_dict(), indent=2)
+        figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)],
+                               title=f"Bimodal actuator, CR {result.crimp_ratio:g}", path=tip)
+        figures.plot_outlines(result, title=f"Mid-plane outline, CR {result.crimp_ratio:g}", path=shape)
+    return [js, tip, shape]

@@ -1,0 +1,428 @@
+"""Fitting and validating a chain table: covering designs solved by FE, windows averaged, held-out designs checked.
+
+A table (:class:`~pneumorph.models.chain.model.ChainTable`) is fitted from FE solves of a *covering
+set* of designs in which every window occurs (:func:`~pneumorph.models.chain.windows.covering_designs`;
+with ``short``, the end windows from actuators of ``2w`` units), each window's entry the mean
+over its occurrences and their mirrors (:func:`fit_table`). It is validated on held-out random
+designs of the full length (:func:`prediction_errors`), and :func:`build_table` grows the
+window half-width until the worst unit-centre error of the held-out designs is within a
+tolerance at every level.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pneumorph.errors import ChainTableError, LocalityError
+from pneumorph.geometry.library import UnitLibrary
+from pneumorph.io.provenance import provenance
+from pneumorph.models.chain.means import check_training, window_means
+from pneumorph.models.chain.model import ChainTable, source_description, source_key, training_model
+from pneumorph.models.chain.terms import check_far_training, far_means, fit_text
+from pneumorph.models.chain.training import training_designs
+from pneumorph.models.chain.validation import (
+    CLEAR_FRACTION,
+    MIN_HELDOUT,
+    evaluator_workers,
+    heldout_designs,
+    prediction_errors,
+    stop_note,
+    validate_in_rounds,
+)
+from pneumorph.models.chain.windows import (
+    design_array,
+    design_strings,
+)
+from pneumorph.models.response import Response, response_elements
+
+__all__ = ["CLEAR_FRACTION", "DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", "MIN_HELDOUT", "build_table",
+           "check_training_size", "evaluator_workers", "first_symbols", "fit_candidates", "fit_table", "fit_text",
+           "heldout_designs", "prediction_errors", "response_elements", "training_designs"]
+
+#: a level's worst held-out centre error above this is refused (mm, default)
+DEFAULT_TOLERANCE = 0.2
+#: widest window tried by :func:`build_table`
+MAX_WINDOW = 3
+#: most covering designs a table over several unit types may ask for (the base windows alone need
+#: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
+MAX_TRAINING = 200
+
+
+def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
+    """Refuse, before any solve, a window whose base windows alone need more than :data:`MAX_TRAINING` designs.
+
+    >>> check_training_size(2, 2)
+    >>> check_training_size(4, 2)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
+    >>> check_training_size(26, 1)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 26 unit types at window +-1 needs at least 1352 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use at most 10 unit types
+    """
+    def need(types: int, w: int) -> int:
+        return (2 * types - min(int(symmetric), types)) ** (w + 1) // 2
+
+    n, w = int(n_types), int(window)
+    if n > 1 and need(n, w) > MAX_TRAINING:
+        most = max((t for t in range(1, n) if need(t, w) <= MAX_TRAINING), default=1)
+        advice = f"at most {most} unit types"
+        if w > 1 and need(n, 1) <= MAX_TRAINING:
+            advice = f"a window of +-1 or {advice}"
+        raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {need(n, w)} FE "
+                            f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use {advice}")
+
+
+# -- fitting --------------------------------------------------------------------------------
+def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
+              library: UnitLibrary | None = None, far: bool | str = False) -> ChainTable:
+    """Fit a table to converged training responses (of one ramp; of any lengths).
+
+    Each window's entry is the mean over its occurrences (and, with ``mirror``, over the
+    mirrored occurrences with negated turns). With ``far``, each chord is the window's term
+    plus the far-field terms of the next unit on each side (:mod:`pneumorph.models.chain.terms`),
+    written out as a table of window +-(``window`` + 1); ``"split"``: their split layout.
+
+    Parameters
+    ----------
+    library : UnitLibrary, optional
+        The unit library of designs over several types (responses keyed by its letters); the
+        table then covers its types (:attr:`ChainTable.alphabet`), and each type's pitch and
+        centre offset are the library's units', checked against the training actuators.
+        None or a one-type library: a 0/1 table.
+
+    Raises
+    ------
+    ChainTableError
+        No responses, a failed one, mixed lengths or levels; over a library, training
+        actuators whose undeformed centres are not where the library's units put them.
+    """
+    longest, pressures = check_training(responses)
+    n = longest.n_units
+    w = int(window)
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
+    if far:
+        means = far_means(responses, w, mirror, alphabet, symmetric, len(pressures), n, far)
+        w += 1
+    else:
+        means = window_means(responses, w, mirror, alphabet, symmetric, len(pressures))
+    if n < 2:
+        raise ChainTableError("a chain table needs training designs of at least 2 units")
+    fitted = dict(window=w, pressures=np.asarray(pressures, dtype=float), **means, source=dict(source),
+                  training=tuple(r.orientation for r in responses),  # a chain in space: its axis, undeformed
+                  **({"centre_z": float(longest.reference_centres[0, 2])} if "space" in means else {}))
+    if alphabet:
+        assert library is not None
+        return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
+            **fitted, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0)))
+    return ChainTable(**fitted, **_binary_geometry(responses, longest, mirror))
+
+
+def _binary_geometry(responses: Sequence[Response], longest: Response, mirror: bool) -> dict[str, Any]:
+    """The undeformed geometry of a 0/1 table: pitch, both orientations' centre heights, first centre, tip.
+
+    Raises
+    ------
+    ChainTableError
+        Training designs without both orientations at fixed heights, or unevenly spaced units.
+    """
+    xs = longest.reference_centres[:, 0]
+    pitch = float(np.mean(np.diff(xs)))
+    tip_y = float(longest.reference_tip[1])
+    heights: dict[int, list[float]] = {0: [], 1: []}
+    for r in responses:
+        for o, y in zip(r.orientation, r.reference_centres[:, 1], strict=False):
+            heights[int(o)].append(float(y))
+            if mirror:
+                heights[1 - int(o)].append(2 * tip_y - float(y))
+    if not heights[0] or not heights[1] or max(np.ptp(heights[0]), np.ptp(heights[1])) > 1e-9:
+        raise ChainTableError("the training designs do not show both unit orientations at fixed heights")
+    if not np.allclose(np.diff(xs), pitch, atol=1e-9):
+        raise ChainTableError("the training actuator's unit centres are not evenly spaced; a chain table "
+                              "needs identical units")
+    return {"pitch": pitch, "centre_y": (heights[0][0], heights[1][0]), "first_offset": float(xs[0]),
+            "tip_ref": (float(longest.reference_tip[0] - xs[-1]), tip_y)}
+
+
+def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], library: UnitLibrary, mirror: bool,
+                  table: ChainTable) -> ChainTable:
+    """The undeformed geometry of a table over several unit types, checked against the training actuators."""
+    k = len(alphabet)
+    pitch = tuple(float(library[a].pitch) for a in alphabet)
+    offset = tuple(float(sum(library[a].cavity[:2]) / 2) for a in alphabet)  # the tracked cavity's middle
+    tip_y = float(responses[0].reference_tip[1])
+    heights: dict[int, list[float]] = {c: [] for c in range(2 * k)}
+    symmetric = set(library.symmetric_types)
+    for r in responses:
+        codes = design_array(r.orientation, alphabet=alphabet)[0]
+        for c, y in zip(codes, r.reference_centres[:, 1], strict=True):
+            heights[int(c)].append(float(y))
+            if mirror:
+                heights[int(c) ^ 1].append(2 * tip_y - float(y))
+            if int(c) // 2 in symmetric:  # turned over, the same body: its centre where it was
+                heights[int(c) ^ 1].append(float(y))
+    missing = [design_strings(np.array([[c]], dtype=np.uint8), alphabet)[0] for c, ys in heights.items() if not ys]
+    if missing:
+        raise ChainTableError(f"the training designs do not show the unit(s) {', '.join(missing)}; every type and "
+                              "orientation must occur")
+    if max(np.ptp(ys) for ys in heights.values()) > 1e-9:
+        raise ChainTableError("the training designs show a unit type's centre at different heights")
+    first = responses[0]
+    cap = float(first.reference_tip[0]) - float(np.sum([library[a].pitch for a in
+                                                         first_symbols(first.orientation, alphabet)]))
+    geometry = {"type_pitch": pitch, "type_offset": offset,
+                "type_centre_y": tuple(heights[c][0] for c in range(2 * k))}
+    fitted = ChainTable(**{**table.__dict__, "alphabet": alphabet, **geometry, "pitch": pitch[0],
+                           "symmetric": library.symmetric,
+                           "centre_y": (heights[0][0], heights[1][0]), "first_offset": offset[0],
+                           "tip_ref": (cap + pitch[0] - offset[0], tip_y)})
+    for r in responses:
+        centres, tip = fitted.reference(fitted.designs(r.orientation))
+        if not (np.allclose(centres[0], r.reference_centres, atol=1e-9, rtol=0)
+                and np.allclose(tip[0], r.reference_tip, atol=1e-9, rtol=0)):
+            raise ChainTableError(f"the undeformed centres of training design {r.orientation} are not where the "
+                                  "library's units put them (pitch, cavity middle); a table of another library?")
+    return fitted
+
+
+def first_symbols(design: str, alphabet: Sequence[str]) -> str:
+    """The type symbol of every unit of a design over ``alphabet`` (lower case; digits: the first type).
+
+    >>> first_symbols("aE1", ("a", "e"))
+    'aea'
+    """
+    return "".join(alphabet[int(c) // 2] for c in design_array(design, alphabet=alphabet)[0])
+
+
+def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
+            say: Callable[[str], None]) -> Callable[..., list[Response]]:
+    """``solve(designs, what, before=0, total=None)``: the responses of ``designs``, those not in ``solved`` solved
+    through ``evaluator`` (and kept in ``solved``), with a progress line per design."""
+    n = int(model.n_units)
+
+    def solve(designs: list[str], what: str, before: int = 0, total: int | None = None) -> list[Response]:
+        """Solve ``designs`` (those not solved yet); progress lines count from ``before`` up to ``total``."""
+        todo = [d for d in designs if d not in solved]
+        t0 = time.perf_counter()
+        done = 0 if total is None else before + len(designs) - len(todo)
+        total = len(todo) if total is None else total
+        # one stream of (model, design) cases, a model per length (short training designs), the longest first: no
+        # pause between the lengths, and the last solves in flight are the short ones
+        todo.sort(key=len, reverse=True)
+        actuators = {length: model if length == n else model.with_units(length) for length in {len(d) for d in todo}}
+        if todo:
+            for _i, outcome in evaluator.iter_cases([(actuators[len(d)], d) for d in todo]):
+                done += 1
+                if not outcome.ok:
+                    raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
+                                          f"({outcome.failure}); the chain table needs every design solved")
+                solved[outcome.design] = outcome.response
+                say(f"  {what}: {done}/{total} solved ({'cached' if outcome.cached else 'solved'} "
+                    f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
+        return [solved[d] for d in designs]
+
+    return solve
+
+
+def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance: float = DEFAULT_TOLERANCE,
+                heldout: int = 20, seed: int = 1, max_window: int = MAX_WINDOW,
+                on_progress: Callable[[str], None] | None = None, short: bool = False, first_window: int = 1,
+                early: bool = False, far: bool | str = False) -> ChainTable:
+    """Fit and validate a chain table to an FE model by solving covering and held-out designs.
+
+    Parameters
+    ----------
+    model : ActuatorModel
+        The FE model of the training actuator (e.g. 15 units); it must be free (no gravity)
+        and mirror-symmetric.
+    evaluator : Evaluator
+        How the designs are solved, a service of the layer above (e.g.
+        :class:`~pneumorph.execution.SerialEvaluator`); a
+        :class:`~pneumorph.execution.CachedEvaluator` makes the build resumable.
+    window : int, optional
+        A fixed half-width; by default ``first_window``, ``first_window + 1``, ... up to
+        ``max_window`` until the worst held-out centre error is within ``tolerance`` at every
+        level.
+    tolerance : float
+        Worst held-out unit-centre error allowed at any level (mm).
+    heldout : int
+        Random held-out designs (seeded by ``seed``) solved to validate the table. They are
+        solved in rounds of the evaluator's width, those already solved first; a window is
+        refused as soon as one of them is off by more than ``tolerance``, without solving the
+        rest (the refusal needs no more evidence).
+    on_progress : callable, optional
+        Called with a line of text after each stage.
+    short : bool
+        Learn the windows that hold the base or the tip from actuators of ``2w`` units
+        (:func:`~pneumorph.models.chain.windows.covering_designs` with ``short``; the model must have
+        ``with_units``), the interior ones from actuators of the model's length. The held-out
+        designs are of the model's length, as always.
+    first_window : int
+        The first half-width tried when ``window`` is not given (e.g. the window the shipped
+        table of the same fidelity needed: :func:`~pneumorph.models.chain.sources.start_window`).
+    early : bool
+        Stop the validation once at least :data:`MIN_HELDOUT` held-out designs are solved and
+        their worst centre error is within :data:`CLEAR_FRACTION` of the tolerance at every
+        level; the validation records how many designs it used (``heldout_solved``) and
+        whether it stopped early. The first :data:`MIN_HELDOUT` held-out designs are then
+        solved in one stream with the covering designs.
+    far : bool
+        Without a fixed ``window``, try first the window one narrower than ``first_window``
+        with far-field terms (:mod:`pneumorph.models.chain.terms`: a table of window
+        ``first_window`` from end windows of the narrower one); with a fixed ``window``, that
+        window with far-field terms (:func:`fit_candidates`); ``"split"``: in their split layout.
+
+    Raises
+    ------
+    LocalityError
+        The model has gravity, or no window up to ``max_window`` meets the tolerance.
+    ChainTableError
+        A training design failed to converge.
+    """
+    _check_buildable(model, tolerance)
+    model = training_model(model)  # over sideways units: every design on the full width, a chain in space
+    n = int(model.n_units)
+    say = on_progress or (lambda text: None)
+    library = getattr(model, "library", None)
+    candidates = fit_candidates(n, window, first_window, max_window, far)
+    solved: dict[str, Response] = {}
+    build = _Build(model, evaluator, tolerance, heldout, seed, short, early, say, solved,
+                   _solver(model, evaluator, solved, say), library, _source(model), time.perf_counter())
+    best: ChainTable | None = None
+    for w, with_far in candidates:
+        best = _window_table(build, w, with_far)
+        if max(best.validation["centre_worst_mm"]) <= tolerance:
+            return best
+    assert best is not None
+    raise LocalityError(
+        f"the chain model does not reproduce this model within {tolerance:g} mm: with window +-{best.window} "
+        f"the worst held-out unit-centre error is {max(best.validation['centre_worst_mm']):.3g} mm; the units "
+        "interact further than the window reaches, so search with the FE model (--search ga or exhaustive)"
+    )
+
+
+def _check_buildable(model: Any, tolerance: float) -> None:
+    """Refuse a model with gravity (the chain needs a free actuator) and a tolerance that is no positive number."""
+    if getattr(model, "gravity", None) is not None:
+        raise LocalityError("the chain model needs a free actuator: with gravity the weight makes moments along "
+                            "the chain, so a unit's response depends on the whole actuator; search with the FE "
+                            "model (--search ga or exhaustive)")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ChainTableError(f"the tolerance must be a positive number of mm, got {tolerance!r}")
+
+
+def _windows(n: int, window: int | None, first_window: int, max_window: int) -> list[int]:
+    """The half-widths to try: ``window``, else ``first_window`` (clipped to fit ``n`` units) up to ``max_window``.
+
+    Raises
+    ------
+    ChainTableError
+        A window wider than ``n`` units allow.
+    """
+    first = min(max(1, int(first_window)), max_window, max(1, (n - 1) // 2))
+    windows = [int(window)] if window is not None else list(range(first, max_window + 1))
+    if windows[0] < 1 or 2 * windows[-1] + 1 > n:
+        raise ChainTableError(f"a window of +-{windows[-1]} units needs training designs of at least "
+                              f"{2 * windows[-1] + 1} units; the model has {n}")
+    return windows
+
+
+def fit_candidates(n: int, window: int | None, first_window: int, max_window: int = MAX_WINDOW,
+                   far: bool | str = False) -> list[tuple[int, bool | str]]:
+    """The tables a build tries in turn: ``(w, far)``, window +-w, with far-field terms if ``far``.
+
+    With ``far`` and no fixed ``window``, window ``first - 1`` with far-field terms (a table
+    of window ``first``) comes first, then the plain windows; with a fixed ``window``, that
+    window with far-field terms.
+
+    >>> fit_candidates(15, None, 3, far=True), fit_candidates(15, 2, 3, far=True)
+    ([(2, True), (3, False)], [(2, True)])
+    """
+    windows = _windows(n, window, first_window, max_window)
+    plain: list[tuple[int, bool | str]] = [(w, False) for w in windows]
+    if far and window is not None:
+        if 2 * int(window) + 3 > n:
+            raise ChainTableError(f"far-field terms of window +-{window} make a table of +-{int(window) + 1}: it "
+                                  f"needs training designs of at least {2 * int(window) + 3} units; the model has {n}")
+        return [(int(window), far)]
+    if far and windows[0] >= 2:
+        return [(windows[0] - 1, far), *plain]
+    return plain
+
+
+@dataclass(frozen=True)
+class _Build:
+    """What every window of a build shares: the model, the settings, the designs solved so far."""
+
+    model: Any
+    evaluator: Any
+    tolerance: float
+    heldout: int
+    seed: int
+    short: bool
+    early: bool
+    say: Callable[[str], None]
+    solved: dict[str, Response]
+    solve: Callable[..., list[Response]]
+    library: UnitLibrary | None
+    source: dict[str, Any]
+    start: float
+
+
+def _source(model: Any) -> dict[str, Any]:
+    """A table's ``source``: the model's fidelity, key, fingerprint, length and description."""
+    return {"fidelity": getattr(model, "fidelity", "?"), "key": source_key(model), "fingerprint": model.fingerprint(),
+            "n_units": int(model.n_units), "description": source_description(model)}
+
+
+def _window_table(build: _Build, w: int, far: bool | str = False) -> ChainTable:
+    """The table of half-width ``w`` (with ``far``: and its far-field terms), fitted to its covering designs and
+    validated on held-out ones.
+
+    Held-out designs solved for a smaller window are validated first; with ``early``, the
+    first :data:`MIN_HELDOUT` go in the covering designs' stream (no pause between the
+    two; they serve the next window too, should this one be refused).
+
+    Raises
+    ------
+    LocalityError
+        Too many covering designs for the library (:func:`check_training_size`).
+    ChainTableError
+        A design failed to converge.
+    """
+    n, library, solved, say = int(build.model.n_units), build.library, build.solved, build.say
+    alphabet = library.alphabet if library is not None else ()
+    symmetric = library.symmetric_types if library is not None else ()
+    check_training_size(max(1, len(alphabet)), w, len(symmetric))
+    train = training_designs(n, w, far, build.short, alphabet, symmetric)
+    if far:  # every far-field key shown, checked before the solves
+        check_far_training(train, w, True, alphabet, symmetric, n, far)
+    name = fit_text(w, far)
+    say(f"{name}: {len(train)} covering designs")
+    tests = heldout_designs(n, build.heldout, exclude=train, seed=build.seed, alphabet=alphabet, symmetric=symmetric)
+    tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
+    ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if build.early else []
+    what = f"covering and {len(ahead)} held-out" if ahead else "covering"
+    table = fit_table(build.solve(train + ahead, what)[: len(train)], w, build.source,
+                      library=library if alphabet else None, far=far)
+    val = validate_in_rounds(table, tests, build.solve, build.tolerance, build.early,
+                             evaluator_workers(build.evaluator))
+    val.update(tolerance_mm=build.tolerance, seed=build.seed)
+    worst = max(val["centre_worst_mm"])
+    say(f"{name}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
+        f"design(s){stop_note(val, build.tolerance)}, mean at the last level {val['centre_mean_mm'][-1]:.4f} mm")
+    for symbol, errs in val.get("per_type", {}).items():
+        if errs["centres"]:
+            say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
+                f"({errs['centres']} centres)")
+    meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - build.start, fit=name)
+    return ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})

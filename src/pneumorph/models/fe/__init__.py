@@ -1,0 +1,26 @@
+"""Finite-element actuator models on FElupe: the 2D reduced-order and the 3D model.
+
+The public import place of the FE models; each concept has a module of its own:
+
+- :mod:`pneumorph.models.fe.base`: the common machinery (:class:`FEModel`), the pressure
+  ramp (:class:`RampSpec`) and the solved fields (:class:`Solution`);
+- :mod:`pneumorph.models.fe.reduced2d`: :class:`Reduced2D`, the plane-strain section whose
+  cavities hold the pressure-dependent filler (chapter 5);
+- :mod:`pneumorph.models.fe.full3d`: :class:`Full3D`, quadratic hexahedra and empty cavities
+  (chapter 4).
+
+Both take a unit, an orientation vector and a pressure ramp and return a
+:class:`~pneumorph.models.response.Response`.
+
+Examples
+--------
+>>> from pneumorph.models.fe import Full3D, RampSpec
+>>> Full3D(2, ramp_spec=RampSpec(pressure=0.01)).fidelity
+'3d'
+"""
+
+from pneumorph.models.fe.base import MODEL_REVISION, FEModel, RampSpec, Solution, model_library
+from pneumorph.models.fe.full3d import Full3D
+from pneumorph.models.fe.reduced2d import Reduced2D
+
+__all__ = ["MODEL_REVISION", "FEModel", "Full3D", "RampSpec", "Reduced2D", "Solution", "model_library"]

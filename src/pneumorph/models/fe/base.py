@@ -1,0 +1,494 @@
+"""The finite-element actuator models' common machinery on FElupe: :class:`FEModel`.
+
+A model takes a unit (or a unit library), an orientation vector and a pressure ramp
+(:class:`RampSpec`) and returns a :class:`~pneumorph.models.response.Response`; a
+:class:`Solution` keeps the displacement fields besides. Silicones use the dissertation's
+compressible Ogden model (Eq 2.12, Tables A.4, A.5) through the hand-coded kernel
+:class:`pneumorph.fem.OgdenCompressible`; the base face is clamped and a follower pressure
+acts on the cavity walls. Optionally gravity acts on the silicones (their densities): it is
+applied in full first, then the pressure is ramped (the hanging test of appendix A.2.2).
+The fidelities are :class:`~pneumorph.models.fe.reduced2d.Reduced2D` (chapter 5) and
+:class:`~pneumorph.models.fe.full3d.Full3D` (chapter 4); :mod:`pneumorph.models.fe` is their
+public import place.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from pneumorph import __version__, checks
+from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
+from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
+from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
+from pneumorph.geometry.alphabet import Design, parse_design
+from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
+from pneumorph.geometry.features import BaseBlock, check_passage
+from pneumorph.geometry.library import UnitLibrary
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.io.provenance import digest
+from pneumorph.materials import get
+from pneumorph.materials.laws.filler import FillerLaw
+from pneumorph.materials.library.material import Material
+from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.frames import record_frames
+from pneumorph.models.response import FloatArray, Response
+
+#: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
+MODEL_REVISION = 1
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A solved design with its full fields, for figures and VTK files.
+
+    Attributes
+    ----------
+    response : Response
+        What the search sees.
+    mesh : ActuatorMesh
+        The meshed actuator.
+    displacements : ndarray, shape (k, p, dim)
+        Nodal displacements at every reported level (NaN after a failure).
+    """
+
+    response: Response
+    mesh: ActuatorMesh
+    displacements: FloatArray
+
+
+@dataclass(frozen=True)
+class RampSpec:
+    """The pressure ramp and how it is solved.
+
+    Parameters
+    ----------
+    pressure : float
+        Final pressure in MPa (0.045 = 45 kPa).
+    steps : StepSettings
+        Reported increments (10 by default: 4.5, 9, ..., 45 kPa), substeps, cut-back.
+    """
+
+    pressure: float = 0.045
+    steps: StepSettings = field(default_factory=lambda: StepSettings(increments=10, substeps=2))
+
+    def __post_init__(self) -> None:
+        checks.real(self.pressure, "pressure", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
+                    limit="MAX_PRESSURE_KPA")
+
+    def pressures(self) -> FloatArray:
+        return self.pressure * self.steps.levels()
+
+
+def end_face_angle(x: FloatArray) -> float:
+    """Angle (rad) of the end face, from its lowest to its highest point, against +y."""
+    d = x[-1] - x[0]
+    return float(np.arctan2(-d[0], d[1]))
+
+
+def model_library(unit: UnitSpec | None, library: UnitLibrary | None) -> UnitLibrary:
+    """The unit library of a model: ``library``, else the one-type library of ``unit`` (default unit).
+
+    Raises
+    ------
+    SettingsError
+        ``library`` is no :class:`UnitLibrary`, or a unit is given too that is not the
+        library's first type.
+
+    Examples
+    --------
+    >>> model_library(None, None).is_single
+    True
+    >>> model_library(UnitSpec(pitch=9.0), None)["a"].pitch
+    9.0
+    """
+    if library is None:
+        if unit is not None and not isinstance(unit, UnitSpec):
+            raise SettingsError(f"unit must be a UnitSpec, got {type(unit).__name__}; a unit library goes to library=")
+        return UnitLibrary.single(unit or UnitSpec())
+    if not isinstance(library, UnitLibrary):
+        raise SettingsError(f"library must be a UnitLibrary, got {type(library).__name__}")
+    if unit is not None and unit != library[library.default]:
+        raise SettingsError("give the model a unit or a unit library, not both (the library's first type is its "
+                            "unit)")
+    return library
+
+
+class FEModel:
+    """Common machinery of the 2D and 3D models (build once per design, solve the ramp)."""
+
+    fidelity = "fe"
+    dim = 2
+    half = False
+    backends: tuple[str, ...] = ("felupe",)
+    #: degree of the predictor's extrapolation through the last converged states
+    predictor_order = 1
+    #: start a level after a cut-back at the substep that converged last (ramp's ``carry``)
+    carry_step = False
+    #: fast backend: keep a factorised tangent while the residual falls by this factor
+    #: per iteration (None: Newton's method), with Anderson acceleration of this depth
+    tangent_reuse: float | None = None
+    anderson_depth = 0
+    #: the ramp when none is given
+    default_steps = StepSettings(increments=10, substeps=2)
+
+    def __init__(
+        self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None,
+        filler: FillerLaw | None = None, backend: str | None = None, gravity: str | Sequence[float] | None = None,
+        temperature_change: float = 0.0, passage: float = 0.0, base_block: BaseBlock | None = None,
+        materials: Mapping[str, Material] | None = None, library: UnitLibrary | None = None,
+    ) -> None:
+        self.backend = check_backend(backend or self.backends[0], self.backends)
+        self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+        self.library = model_library(unit, library)
+        self.unit = self.library[self.library.default]
+        if all(spec.solid for spec in self.library.units):
+            raise SettingsError("every unit type is solid (solid = true: no cavity), so there is nothing to "
+                                "inflate; a solid unit joins units with a cavity in a library (docs/unit-library.md)")
+        self.ramp = ramp_spec or RampSpec(steps=self.default_steps)
+        self.filler = filler
+        self.materials = dict(materials or {})
+        for name, material in self.materials.items():
+            if not isinstance(material, Material) or material.kind != "hyperelastic":
+                raise SettingsError(f"materials[{name!r}] must be a hyperelastic Material, got {material!r}")
+        self.body = self._material(self.unit.body_material)
+        # the units of a library share the body material and the layer's (check_joinable)
+        layered = [u for u in self.library.units if u.layer > 0] or [self.unit]
+        self.layer = self._material(layered[0].layer_material)
+        # the bottom walls of other materials (UnitSpec.bottom_material), one region each
+        self.bottoms = {f"bottom:{name}": self._material(name) for name in bottom_materials(self.library.units)}
+        self.gravity = gravity_vector(gravity, self.dim)
+        self.temperature_change = checks.real(temperature_change, "temperature_change", -100.0, 100.0, unit="degC")
+        if passage and self.dim != 3:
+            raise SettingsError("a passage between cavities is a 3D model option: the 2D section would be cut in two")
+        self.passage = float(passage)
+        for spec in dict.fromkeys(self.library.units):
+            if not spec.solid:  # assemble refuses a passage through a solid unit
+                check_passage(spec, self.passage)
+        if base_block is not None and not isinstance(base_block, BaseBlock):
+            raise SettingsError(f"base_block must be a BaseBlock or None, got {base_block!r}")
+        self.base_block = base_block
+        self.base = self._material(base_block.material) if base_block is not None else None
+        if self.temperature_change != 0.0 and self.backend != "fast":
+            # the thermal strain loads the body before any pressure; FElupe's Newton check on that first
+            # state does not converge (seen on a 1-unit actuator), the fast path's does
+            raise SettingsError("a temperature change needs the fast backend (the 3D model's default)")
+        if self.temperature_change != 0.0:
+            for material in self.silicones.values():
+                if material.thermal_expansion is None:
+                    raise MaterialDataError(f"a temperature change needs the thermal expansion of {material.name!r}, "
+                                            "which has none (Table A.6 gives it for the built-in silicones); add "
+                                            "one to its material entry or leave the temperature unchanged")
+        if self.gravity is not None:
+            for material in self.silicones.values():
+                if material.density is None:
+                    raise MaterialDataError(f"gravity needs the density of {material.name!r}, which has none; "
+                                            "add one to its material entry or run without gravity")
+
+    def _material(self, name: str) -> Material:
+        """``name`` from the model's own materials, else from the library."""
+        return self.materials.get(name) or get(name)
+
+    def options(self) -> dict[str, Any]:
+        """The constructor's arguments that give this model (see :meth:`variant`)."""
+        out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
+                               "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
+                               "base_block": self.base_block, "materials": dict(self.materials)}
+        if not self.library.is_single:
+            out["library"] = self.library
+        return out
+
+    @property
+    def mixed(self) -> bool:
+        """True for a model over a library of several unit types (designs may mix them)."""
+        return not self.library.is_single
+
+    def variant(self, **changes: Any) -> FEModel:
+        """The same model with some constructor arguments changed (a sensitivity study's variant).
+
+        >>> from pneumorph.models.fe.full3d import Full3D
+        >>> Full3D(15).variant(passage=1.5).passage
+        1.5
+        """
+        return type(self)(**{**self.options(), **changes})
+
+    @property
+    def silicones(self) -> dict[str, Any]:
+        """The material of every silicone region of the mesh: body, layer, bottom walls and base block if any."""
+        out = {"body": self.body, "layer": self.layer, **self.bottoms}
+        if self.base is not None:
+            out["base"] = self.base
+        return out
+
+    # -- identity -----------------------------------------------------------------------
+    def describe(self) -> dict[str, Any]:
+        """Everything that determines the results (hashed into the fingerprint)."""
+        out = {
+            "fidelity": self.fidelity,
+            "revision": MODEL_REVISION,
+            "n_units": self.n_units,
+            "unit": self.unit.to_dict(),
+            "materials": {"body": self.body.to_dict(), "layer": self.layer.to_dict(),
+                          **{name: material.to_dict() for name, material in self.bottoms.items()}},
+            "pressure_mpa": self.ramp.pressure,
+            "steps": asdict(self.ramp.steps),
+        }
+        if self.filler is not None:
+            out["filler"] = self.filler.to_dict()
+        if self.gravity is not None:  # absent without gravity: earlier fingerprints stay valid
+            out["gravity_mm_s2"] = list(self.gravity)
+        if self.temperature_change != 0.0:  # likewise
+            out["temperature_change_c"] = self.temperature_change
+        if self.passage:  # likewise
+            out["passage_mm"] = self.passage
+        if self.base_block is not None:  # likewise
+            assert self.base is not None
+            out["base_block"] = {**self.base_block.to_dict(), "material_data": self.base.to_dict()}
+        if self.mixed:  # likewise: a one-type library is described by its unit alone
+            out["library"] = self.library.to_dict()
+        return out
+
+    def with_units(self, n_units: int) -> FEModel:
+        """The same model (unit, materials, ramp, solver) for an actuator of ``n_units`` units.
+
+        >>> from pneumorph.models.fe.reduced2d import Reduced2D
+        >>> Reduced2D(15).with_units(4).n_units
+        4
+        """
+        other = copy.copy(self)
+        other.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+        return other
+
+    def fingerprint(self) -> str:
+        return digest(self.describe())
+
+    def pressures(self) -> FloatArray:
+        return self.ramp.pressures()
+
+    # -- building -------------------------------------------------------------------------
+    def thermal_stretch(self, material: Any) -> float:
+        """``1 + a dT``: the free stretch of ``material`` under the model's temperature change."""
+        if self.temperature_change == 0.0:
+            return 1.0
+        return 1.0 + material.thermal_expansion.value * self.temperature_change
+
+    def _silicone_umat(self, material: Any) -> OgdenCompressible:
+        return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value,
+                                 self.thermal_stretch(material))
+
+    def _extra_regions(self, mesh: ActuatorMesh) -> tuple[list[tuple[str, Any, Any]], Any]:
+        """Further material regions (the 2D filler) and a callback ``set_pressure(p)`` for them."""
+        return [], lambda p: None
+
+    def parse(self, design: str | Design) -> Design:
+        """A design of this model's length over its library (0/1 text or the library's symbols).
+
+        Raises
+        ------
+        OrientationError
+            The wrong length, or a character that is no symbol of the library.
+
+        >>> from pneumorph.geometry.library import builtin_library
+        >>> from pneumorph.models.fe.reduced2d import Reduced2D
+        >>> Reduced2D(3, library=builtin_library()).parse("aEr").text
+        'aEr'
+        """
+        return parse_design(design, self.library, self.n_units)
+
+    def mesh(self, orientation: str | Design) -> ActuatorMesh:
+        """The meshed design (no solver data): what :meth:`build` solves on.
+
+        A design with a sideways unit is meshed whole (:meth:`half_for`).
+
+        >>> from pneumorph.models.fe.full3d import Full3D
+        >>> Full3D(2).mesh("01").cells.shape[1]
+        20
+        """
+        if self.mixed:
+            design = self.parse(orientation)
+            return assemble(self.library, design, self.dim, half=self.half_for(design), passage=self.passage,
+                            base=self.base_block)
+        # today's call, to the last bit
+        return assemble(self.unit, orientation if isinstance(orientation, str) else orientation.orientation,
+                        self.dim, half=self.half and not self.unit.layer_side, passage=self.passage,
+                        base=self.base_block)
+
+    def half_for(self, design: str | Design) -> bool:
+        """Whether ``design`` is solved on the half width: a half model's design without a sideways unit.
+
+        A sideways unit (``layer_side``) bends across the width: no mid-plane symmetry.
+
+        >>> from pneumorph.geometry.library import builtin_library
+        >>> from pneumorph.models.fe.full3d import Full3D
+        >>> model = Full3D(2, library=builtin_library("spatial"))
+        >>> model.half_for("aA"), model.half_for("aL")
+        (True, False)
+        """
+        return self.half and not any(u.layer_side for u in self.parse(design).units(self.library))
+
+    def build(self, orientation: str | Design) -> tuple[ActuatorMesh, PressurisedBody, Any]:
+        """The meshed design, its pressurised body and ``set_pressure(p)`` for a load level.
+
+        ``set_pressure`` sets the cavity pressure and everything that follows it (the 2D
+        filler's modulus). ``orientation`` is a design over the model's library.
+        """
+        mesh = self.mesh(orientation)
+        # a design of extending units has no layer cells: the empty region is left out
+        silicones = {name: material for name, material in self.silicones.items() if len(mesh.regions[name])}
+        regions = [(name, mesh.regions[name], self._silicone_umat(material)) for name, material in silicones.items()]
+        extra, set_extra = self._extra_regions(mesh)
+        densities = None
+        if self.gravity is not None:  # dead loads rho g on the silicones, switched on by the gravity stage
+            densities = {name: material.density.value for name, material in silicones.items()}
+        body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, [*regions, *extra], mesh.cavity_points,
+                                mesh.base_points, mesh.symmetry_points, walls_of=list(silicones),
+                                densities=densities)
+
+        def set_pressure(p: float) -> None:
+            body.pressure.update(p)
+            set_extra(p)
+
+        return mesh, body, set_pressure
+
+    def empty_response(self, mesh: ActuatorMesh, design: str) -> Response:
+        """The response of ``design`` on its ``mesh``: its undeformed centres and tip, every level still unknown."""
+        x_end0 = mesh.points[mesh.end_points][:, : mesh.axes]
+        return Response.empty(design, self.pressures(), mesh.unit_centres(axes=mesh.axes), x_end0.mean(axis=0),
+                              metadata={"fidelity": self.fidelity, "fingerprint": self.fingerprint()})
+
+    # -- solving --------------------------------------------------------------------------
+    def evaluate(self, orientation: str | Design, on_level: Any = None) -> Response:
+        """Solve the pressure ramp of one design and return its :class:`Response`.
+
+        See :meth:`solve` for the parameters and errors.
+        """
+        return self.solve(orientation, on_level).response
+
+    def solve(self, orientation: str | Design, on_level: Any = None) -> Solution:
+        """Solve the pressure ramp of one design, keeping the displacement fields.
+
+        Parameters
+        ----------
+        orientation : str or Design
+            The design, one digit per unit (``"0101..."``), or over the model's library
+            (``"aAer..."``, :mod:`pneumorph.geometry.alphabet`); the response keeps its
+            canonical text (0/1 digits for a one-type library).
+        on_level : callable, optional
+            ``on_level(k, pressure_mpa)`` after each reported level (progress).
+
+        Raises
+        ------
+        SimulationFailed
+            If the ramp cannot be completed; ``reached`` and ``pressure`` name how far it got.
+        OrientationError
+            A design of the wrong length or with symbols the library does not have.
+        """
+        parsed = self.parse(orientation)
+        design = parsed.text
+        t0 = time.perf_counter()
+        mesh, body, set_pressure = self.build(parsed if self.mixed else design)
+        pressures = self.pressures()
+        axes = mesh.axes  # (x, y), or (x, y, z) on the full width
+        x_end0 = mesh.points[mesh.end_points][:, :axes]
+        response = self.empty_response(mesh, design)
+        angle0 = end_face_angle(x_end0[:, :2])
+        turned = {"total": 0.0, "last": angle0}  # end-face rotation, followed substep by substep
+        displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
+
+        def apply(t: float) -> None:
+            set_pressure(t * self.ramp.pressure)
+
+        def follow(t: float) -> None:
+            angle = end_face_angle(x_end0[:, :2] + body.displacement[:, :2][mesh.end_points])
+            step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
+            turned["total"] += step
+            turned["last"] = angle
+
+        def tip_of(v: FloatArray) -> FloatArray:
+            return (x_end0 + v[mesh.end_points][:, :axes]).mean(axis=0)
+
+        def record(k: int, t: float) -> None:
+            displacements[k] = body.displacement[:, : self.dim]
+            response.centres[k] = mesh.unit_centres(displacements[k], axes)
+            record_frames(response, k, mesh, displacements[k])  # the full width: each unit's and the end face's
+            response.tip[k] = tip_of(displacements[k])
+            response.curl[k] = np.degrees(turned["total"])
+            if on_level is not None:
+                on_level(k, pressures[k])
+
+        substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
+        gravity_iterations = 0
+        if self.gravity is not None:
+            gravity_iterations = self._apply_gravity(body, substep, follow, design)
+            response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(body.displacement).tolist())
+        try:
+            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
+                         monitor=monitor, on_substep=follow, substep=substep, predictor_order=self.predictor_order,
+                         carry=self.carry_step)
+        except SimulationFailed as exc:
+            partial = replace(response, converged=False, reached=exc.reached * self.ramp.pressure,
+                              failure=exc.cause)
+            raise SimulationFailed(
+                reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure, partial=partial
+            ) from None
+        final = self._converged(response, stats, substep, gravity_iterations, int(body.displacement.size), t0)
+        return Solution(final, mesh, displacements)
+
+    def _converged(self, response: Response, stats: RampStatistics, substep: Any, gravity_iterations: int, dofs: int,
+                   t0: float) -> Response:
+        """``response`` of a completed ramp, with the solver's statistics in its metadata.
+
+        Parameters
+        ----------
+        response : Response
+            The levels as recorded.
+        stats : RampStatistics
+            The pressure ramp's statistics; ``gravity_iterations`` those of the gravity stage.
+        substep : callable
+            The ramp's Newton solver (its factorisations and precision, if it keeps them).
+        dofs : int
+            The number of unknowns; ``t0`` the solve's start (:func:`time.perf_counter`).
+        """
+        meta = dict(response.metadata)
+        meta.update(
+            newton_iterations=stats.newton_iterations + gravity_iterations,
+            factorisations=getattr(substep, "factorisations", stats.newton_iterations),
+            precision=getattr(substep, "precision", "double"),
+            substeps=stats.substeps,
+            cutbacks=stats.cutbacks,
+            wall_time_s=time.perf_counter() - t0,
+            dofs=dofs,
+            backend=self.backend,
+            pneumorph=__version__,
+        )
+        return replace(response, converged=True, reached=float(response.pressures[-1]), metadata=meta)
+
+    def _apply_gravity(self, body: PressurisedBody, substep: Any, follow: Any, design: str) -> int:
+        """Load the unpressurised actuator with its weight; returns the Newton iterations.
+
+        Gravity rises to its full value in :attr:`gravity_steps`; the pressure ramp then
+        starts from that state with gravity held.
+        """
+        g = np.asarray(self.gravity, dtype=float)
+
+        def apply(t: float) -> None:
+            body.set_gravity(t * g)
+
+        try:
+            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.gravity_steps,
+                         on_substep=follow, substep=substep, predictor_order=self.predictor_order,
+                         carry=self.carry_step)
+        except SimulationFailed as exc:
+            raise SimulationFailed(reached=0.0, cause=f"under its own weight, before any pressure: {exc.cause}",
+                                   design=design, pressure=self.ramp.pressure) from None
+        return stats.newton_iterations
+
+    @property
+    def gravity_steps(self) -> StepSettings:
+        """The gravity stage: two substeps, the pressure ramp's Newton settings."""
+        return replace(self.ramp.steps, increments=1, substeps=2)
