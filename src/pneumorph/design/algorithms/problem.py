@@ -119,7 +119,8 @@ class SearchOutcome:
     opinion_2d : dict
         The 2D model's chain values of the listed designs (a certified 3D run).
     comparison : dict or None
-        The reference model's optimum judged by this model (:func:`.comparison.compare_with_reference`).
+        The reference model's optimum judged by this model
+        (:func:`~pneumorph.design.runs.comparison.compare_with_reference`).
     """
 
     hall_of_fame: tuple[Candidate, ...] = ()

@@ -9,3 +9,5 @@
 
 The names to import are re-exported by :mod:`pneumorph.design`.
 """
+
+__all__: list[str] = []  # the names to import are re-exported by the parent package

@@ -9,3 +9,5 @@ The strategies a run chooses between (and the problem they solve) are in
 :mod:`pneumorph.design.algorithms`; the names to
 import are re-exported by :mod:`pneumorph.design`.
 """
+
+__all__: list[str] = []  # the names to import are re-exported by the parent package

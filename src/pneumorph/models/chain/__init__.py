@@ -21,31 +21,79 @@ Examples
 (3, 10)
 """
 
-from pneumorph.models.chain.fit import build_table
-from pneumorph.models.chain.model import (
-    ALPHABET_FORMAT,
-    BASE,
-    TABLE_FORMAT,
-    TIP,
-    ChainModel,
-    ChainTable,
-    check_source,
-    covering_designs,
-    design_array,
-    design_strings,
-    in_space,
-    mirror_codes,
-    possible_codes,
-    source_description,
-    source_key,
-    training_model,
-    window_codes,
-    window_symbols,
-    window_text,
+from pneumorph.models.chain.fit import (
+    build_table as build_table,
 )
-from pneumorph.models.chain.sources import find_table, serve_table, shipped_path, table_for
+from pneumorph.models.chain.model import (
+    ALPHABET_FORMAT as ALPHABET_FORMAT,
+)
+from pneumorph.models.chain.model import (
+    BASE as BASE,
+)
+from pneumorph.models.chain.model import (
+    TABLE_FORMAT as TABLE_FORMAT,
+)
+from pneumorph.models.chain.model import (
+    TIP as TIP,
+)
+from pneumorph.models.chain.model import (
+    ChainModel as ChainModel,
+)
+from pneumorph.models.chain.model import (
+    ChainTable as ChainTable,
+)
+from pneumorph.models.chain.model import (
+    check_source as check_source,
+)
+from pneumorph.models.chain.model import (
+    covering_designs as covering_designs,
+)
+from pneumorph.models.chain.model import (
+    design_array as design_array,
+)
+from pneumorph.models.chain.model import (
+    design_strings as design_strings,
+)
+from pneumorph.models.chain.model import (
+    in_space as in_space,
+)
+from pneumorph.models.chain.model import (
+    mirror_codes as mirror_codes,
+)
+from pneumorph.models.chain.model import (
+    possible_codes as possible_codes,
+)
+from pneumorph.models.chain.model import (
+    source_description as source_description,
+)
+from pneumorph.models.chain.model import (
+    source_key as source_key,
+)
+from pneumorph.models.chain.model import (
+    training_model as training_model,
+)
+from pneumorph.models.chain.model import (
+    window_codes as window_codes,
+)
+from pneumorph.models.chain.model import (
+    window_symbols as window_symbols,
+)
+from pneumorph.models.chain.model import (
+    window_text as window_text,
+)
+from pneumorph.models.chain.sources import (
+    find_table as find_table,
+)
+from pneumorph.models.chain.sources import (
+    serve_table as serve_table,
+)
+from pneumorph.models.chain.sources import (
+    shipped_path as shipped_path,
+)
+from pneumorph.models.chain.sources import (
+    table_for as table_for,
+)
 
-__all__ = ["ALPHABET_FORMAT", "BASE", "TABLE_FORMAT", "TIP", "ChainModel", "ChainTable", "build_table", "check_source",
-           "covering_designs", "design_array", "design_strings", "find_table", "in_space", "mirror_codes",
-           "possible_codes", "serve_table", "shipped_path", "source_description", "source_key", "table_for",
-           "training_model", "window_codes", "window_symbols", "window_text"]
+# the public place of these names is :mod:`pneumorph.models` (its reference page); here they are
+# importable by their package too
+__all__: list[str] = []

@@ -19,8 +19,28 @@ Examples
 '3d'
 """
 
-from pneumorph.models.fe.base import MODEL_REVISION, FEModel, RampSpec, Solution, model_library
-from pneumorph.models.fe.full3d import Full3D
-from pneumorph.models.fe.reduced2d import Reduced2D
+from pneumorph.models.fe.base import (
+    MODEL_REVISION as MODEL_REVISION,
+)
+from pneumorph.models.fe.base import (
+    FEModel as FEModel,
+)
+from pneumorph.models.fe.base import (
+    RampSpec as RampSpec,
+)
+from pneumorph.models.fe.base import (
+    Solution as Solution,
+)
+from pneumorph.models.fe.base import (
+    model_library as model_library,
+)
+from pneumorph.models.fe.full3d import (
+    Full3D as Full3D,
+)
+from pneumorph.models.fe.reduced2d import (
+    Reduced2D as Reduced2D,
+)
 
-__all__ = ["MODEL_REVISION", "FEModel", "Full3D", "RampSpec", "Reduced2D", "Solution", "model_library"]
+# the public place of these names is :mod:`pneumorph.models` (its reference page); here they are
+# importable by their package too
+__all__: list[str] = []
