@@ -1,4 +1,4 @@
-"""The bench under hostile probes: answers stay fast, memory bounded, cross-site requests refused (issue 28).
+"""The bench under hostile probes: answers stay fast, memory bounded, cross-site requests refused.
 
     python benchmarks/bench_probe.py                    # 4 query clients for 30 s, every probe once
     python benchmarks/bench_probe.py --clients 4 --seconds 30 --think 0.1

@@ -12,7 +12,7 @@
 branch-and-bound and the bounds) for the targets of chapter 6; ``build`` fits and validates
 the 2D table of the built-in unit from a fresh in-memory cache (two worker processes);
 ``search30`` runs a whole certified search of a 30-unit actuator on the 2D model (table of
-15-unit designs, FE verification of the winner, serial). Issue bars: scoring 2^15 designs
+15-unit designs, FE verification of the winner, serial). Targets: scoring 2^15 designs
 <= 0.1 s; certified search for 30 units <= 10 s.
 """
 

@@ -1,4 +1,4 @@
-"""Tables and solves on a real Dask cluster against the process pool (issue 30).
+"""Tables and solves on a real Dask cluster against the process pool.
 
     python benchmarks/cluster.py solve                     # one 3D solve: pool, nanny worker, without and with settings
     python benchmarks/cluster.py solve --units 15 --repeat 2

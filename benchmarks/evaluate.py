@@ -7,7 +7,7 @@ repeats, Newton iterations and cut-backs. Run on one core as a search worker wou
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/evaluate.py --model 2d --repeat 5
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/evaluate.py --model 3d --repeat 1
 
-Issue bars: 2D <= 2 s median (goal 0.25 s); 3D <= 120 s (goal 30 s); the dissertation
+Targets: 2D <= 2 s median (goal 0.25 s); 3D <= 120 s (goal 30 s); the dissertation
 needed 45 s and 590 s. The 3D model's PARDISO factorisation uses ``MKL_NUM_THREADS`` threads
 (a search runs one process per core with 1); for two, keep ``OMP_NUM_THREADS=1``
 (threaded OpenBLAS slows the many small matrix products of the assembly):

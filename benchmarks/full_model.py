@@ -7,7 +7,7 @@ the model's own ramp and fast path. Run on one core as a search worker would:
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/full_model.py --repeat 3
 
-Issue 25's bar: <= 30 s on one core (goal 20 s). ``--design`` takes any design over the
+The target: <= 30 s on one core (goal 20 s). ``--design`` takes any design over the
 library (default: a random one of ``a A l L``, seed 0, with at least one sideways unit);
 ``--planar`` solves a planar design on the full width too (``half=False``) and on the half
 width, to tell the cost of the full width from that of leaving the plane.

@@ -3,7 +3,7 @@
 Solves all 256 designs of an 8-unit actuator with the 2D reduced-order model (mirror
 symmetry: 128 solves plus a symmetry check), takes the global optimum of a sin, a cos and
 a tip objective, then runs the GA with a budget of 85 distinct designs (1/3 of the space)
-for five seeds each and counts how often it finds that optimum (issue bar: 4 of 5). The
+for five seeds each and counts how often it finds that optimum (target: 4 of 5). The
 GA settings are those of the budget test in ``tests/design/test_search.py``, fixed before
 any objective was looked at. A GA run counts as a find when its best value equals the
 optimum within 1e-6 (relative): the solver tolerance, since the exhaustive search scores

@@ -1,4 +1,4 @@
-"""A 3D identification from two synthetic scans of two 15-unit designs (issue 27).
+"""A 3D identification from two synthetic scans of two 15-unit designs.
 
     OMP_NUM_THREADS=1 python benchmarks/identify.py                  # 2 workers, a fresh cache
     OMP_NUM_THREADS=1 python benchmarks/identify.py --workers 2 --cache /tmp/id.sqlite --out /tmp/id

@@ -7,7 +7,7 @@
 Solves the design by 3D FE, draws a curve through its unit centres at 18 and 45 kPa, and runs
 the certified search over the two stages with the shipped 3D table (or a library's, with
 ``--library`` and ``--table``) and FE verification on a fresh in-memory cache, so the
-search's wall time includes its verifications: the issue's bar is the design back, or one
+search's wall time includes its verifications: the answer sought is the design back, or one
 within 0.15 mm of both curves by FE.
 """
 
