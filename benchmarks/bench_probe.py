@@ -5,7 +5,7 @@
 
 Starts ``pneumorph serve`` in a subprocess (a fresh state folder and cache, the default
 options) and, while ``--clients`` clients send design queries (each a different target,
-``--think`` seconds apart on average), sends the probes of the issue:
+``--think`` seconds apart on average), sends these probes:
 
 - hostile uploads: a unit with ``pitch = 1e4`` (which grew a job's worker by 150 MB/s), one
   whose mesh would be 0.8 million nodes, and a 200 MB multipart upload streamed in chunks;
