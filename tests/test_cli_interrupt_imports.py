@@ -153,7 +153,7 @@ TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119)
     ("call:pneumorph.export:plot_mould",
      ["export", "0110", "--unit", "unit.toml", "--stl", "out", "--inp", "deck/a.inp", "--mould"], ["out", "deck"]),
     # study.json is written; the figure is next
-    ("call:pneumorph.plot.sensitivity:plot_population_study",
+    ("call:pneumorph.plot.sensitivity:plot_study",
      ["sensitivity", "tolerances", "--model", "2d", "--units", "2", "--pressure", "5", "--unit", "unit.toml",
       "--samples", "1", "--executor", "serial", "--out", "out"], ["out"]),
     # the table is built and is being written into a new folder
