@@ -275,3 +275,17 @@ def test_a_scan_of_a_sideways_design_is_measured_on_its_surface(tmp_path: Path, 
     assert main(["correlate", str(trace), "--design", "aL", "--library", "spatial", "--pressure", "36"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "needs a 3D scan" in err[0] and "solving" not in err[0]
+
+
+def test_correlate_design_from_the_api_puts_the_models_own_outline_back(tmp_path: Path, shape2d) -> None:  # type: ignore[no-untyped-def]
+    from pneumorph.correlation import correlate_design
+
+    points = shape2d.samples[::7] + np.array([3.0, -2.0])  # moved by (3, -2) mm
+    said: list[str] = []
+    result, summary = correlate_design(Scan(points, None, "trace"), "0110", Reduced2D(4, ramp_spec=RAMP), 20.0,
+                                       out=tmp_path / "c", source="trace.csv", say=said.append)
+    assert result.outline.rms < 0.01 and np.allclose(result.alignment.transform.translation, [-3.0, 2.0], atol=0.01)
+    assert summary["design"] == "0110" and summary["scan"] == "trace.csv" and summary["model"] == "2d"
+    written = json.loads((tmp_path / "c" / "correlation.json").read_text())
+    assert written["outline"] == summary["outline"] and written["provenance"]["fingerprint"]
+    assert said[0].startswith("solving design 0110 at 20 kPa") and said[1].startswith("aligning")

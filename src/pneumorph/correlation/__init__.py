@@ -1,13 +1,15 @@
 """Scan correlation: an inflated actuator's scan or photo against the model (section 6.5, 8.5).
 
 Read a scan (:func:`read_scan`), take the model's deformed shape (:func:`model_shape`),
-align and measure (:func:`correlate`), draw (:func:`plot_correlation`).
+align and measure (:func:`correlate`), draw (:func:`plot_correlation`); all of it for a design,
+from its solve to a written folder (:func:`correlate_design`).
 """
 
 from pneumorph.correlation.align import Alignment, Transform, fit_transform, icp
 from pneumorph.correlation.compare import Correlation, Measure, ModelShape, correlate, model_shape
 from pneumorph.correlation.figures import plot_correlation
 from pneumorph.correlation.scans import SCAN_UNITS, Scan, read_scan
+from pneumorph.correlation.workflow import correlate_design
 
 __all__ = [
     "SCAN_UNITS",
@@ -18,6 +20,7 @@ __all__ = [
     "Scan",
     "Transform",
     "correlate",
+    "correlate_design",
     "fit_transform",
     "icp",
     "model_shape",

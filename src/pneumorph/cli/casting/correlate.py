@@ -35,14 +35,12 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
     """
     from pathlib import Path
 
-    from pneumorph.correlation import correlate as align_and_measure
-    from pneumorph.correlation import model_shape, plot_correlation, read_scan
-    from pneumorph.correlation.compare import SIDEWAYS_TRACE, check_length, check_units
+    from pneumorph.correlation import correlate_design, read_scan
+    from pneumorph.correlation.compare import SIDEWAYS_TRACE
     from pneumorph.errors import ScanError
     from pneumorph.geometry import parse_orientation
     from pneumorph.geometry.alphabet import parse_design
-    from pneumorph.geometry.assembly import unit_starts
-    from pneumorph.io import provenance, strict_json, write_json
+    from pneumorph.io import strict_json
     from pneumorph.models.factory import make_model
 
     units = P.library_option(library, unit_file) if library is not None else None
@@ -74,26 +72,9 @@ def correlate(scan: str, design: str, pressure: float, fidelity: str, unit_file:
                         f"a 3D scan needs the 3D model, but --model-file {model_file} is of the 2D model: "
                         "give --model 3d")
     model = make_model(len(orientation), settings)
-    check_length(data, float(unit_starts(types)[-1]) if types else len(orientation) * model.unit.pitch)
-    click.echo(f"solving design {orientation} at {pressure:g} kPa ({fidelity} model)", err=True)
-    solution = model.solve(orientation)
-    shape = model_shape(solution)
-    check_units(data, shape)
-    from pneumorph.correlation.scans import align_seconds
-    from pneumorph.models.chain.plan import duration_text
-
-    click.echo(f"aligning {len(data.points):,} scan points to the model (about "
-               f"{duration_text(align_seconds(len(data.points)))}) ...", err=True)
-    result = align_and_measure(data, shape, scale=fit_scale, planar=planar)
-    summary = {"scan": str(scan), "design": orientation, "pressure_kpa": pressure, "model": fidelity,
-               "scan_points": len(data.points), **result.to_dict()}
-    if out:
-        from pneumorph.io.files import all_or_nothing
-
-        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a bad photo): no partial output
-            write_json(folder / "correlation.json",
-                       {**summary, "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint())})
-            plot_correlation(result, shape, folder / "correlation.png", photo=photo, photo_scale=scale)
+    result, summary = correlate_design(data, orientation, model, pressure, types=types, planar=planar,
+                                       fit_scale=fit_scale, out=out, photo=photo, photo_scale=scale, source=str(scan),
+                                       say=lambda text: click.echo(text, err=True))
     if as_json:
         click.echo(strict_json(summary))
         return
