@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The full tier, in order: ruff, mypy (the settings of [tool.ruff] and [tool.mypy] in
-# pyproject.toml), the documentation site and the README's commands (the `docs` tests), then
-# every other test, each marker included (`slow`, `browser`, `cluster`). Stops at the first step
-# that fails. Arguments go to the last pytest run (e.g. `bash tests/full.sh -x`).
+# pyproject.toml), the `docs` tests (the documentation site, the README's commands, the API
+# page's example), then every other test, each marker included (`slow`, `browser`, `cluster`).
+# Stops at the first step that fails. Arguments go to the last pytest run (`bash tests/full.sh -x`).
 #
 # The fast tier, while you work: .venv/bin/python -m pytest
 set -euo pipefail
@@ -18,7 +18,7 @@ step "ruff"
 step "mypy"
 "$PYTHON" -m mypy --no-incremental  # the files and settings of [tool.mypy]
 
-step "docs: the site builds, the README's commands run"
+step "docs: the site builds; the README's commands and the API page's example run"
 "$PYTHON" -m pytest -m docs
 
 step "tests: every marker"
