@@ -27,7 +27,7 @@ those of the types and orientations (``a``, ``A``, ``e``, ``E``, ... : codes ``2
 :mod:`pneumorph.models.chain.windows`), and the table keeps the types' symbols (its *alphabet*)
 and each type's pitch, centre offset and centre heights; a design with a type the table
 has not seen is refused ("unit type 'x' has no table"). A table of one unit type is
-today's 0/1 table, file and fingerprint unchanged.
+the 0/1 table of the built-in unit, its file and fingerprint unchanged.
 
 The table is fitted from FE solves and validated on held-out designs by
 :mod:`pneumorph.models.chain.fit`.

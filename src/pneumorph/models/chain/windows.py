@@ -1,6 +1,6 @@
 """Windows of an actuator design and covering sets of designs, for the chain model.
 
-A design is a row of unit codes. For one unit type (today's actuators) the codes are the
+A design is a row of unit codes. For one unit type (the built-in unit's actuators) the codes are the
 0/1 orientations. Over a unit library of ``k`` types (an *alphabet*, the types' symbols in
 the library's order, :mod:`pneumorph.geometry.alphabet`) unit type ``t`` in orientation
 ``o`` is code ``2 t + o``: ``a`` 0, ``A`` 1, ``e`` 2, ``E`` 3, ... (so a one-type design's
@@ -349,7 +349,7 @@ def covering_designs(n_units: int, window: int, mirror: bool = True, seed: int =
         ``k > 1`` types all designs up to 2^16 of them, else ``max(20000, 8 K / n)`` random
         ones for ``K`` windows).
     n_types : int
-        Unit types ``k`` (codes ``0 .. 2k - 1`` per unit); 1: today's 0/1 designs.
+        Unit types ``k`` (codes ``0 .. 2k - 1`` per unit); 1: the 0/1 designs of one type.
     alphabet : sequence of str
         The types' symbols, for the designs' text (letters) when ``n_types > 1``.
     symmetric : sequence of int

@@ -313,7 +313,7 @@ class FEModel:
             design = self.parse(orientation)
             return assemble(self.library, design, self.dim, half=self.half_for(design), passage=self.passage,
                             base=self.base_block)
-        # today's call, to the last bit
+        # one unit type: its meshes to the last bit
         return assemble(self.unit, orientation if isinstance(orientation, str) else orientation.orientation,
                         self.dim, half=self.half and not self.unit.layer_side, passage=self.passage,
                         base=self.base_block)

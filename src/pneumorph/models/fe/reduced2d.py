@@ -120,7 +120,7 @@ class Reduced2D(FEModel):
 
         cells = mesh.regions["filler"]
         groups: dict[FillerLaw, Any] = {}
-        if not self.mixed:  # today's one region
+        if not self.mixed:  # one region
             assert self.filler is not None
             groups[self.filler] = cells
         else:  # the filler of each unit's cavity follows its type's law
