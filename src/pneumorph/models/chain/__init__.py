@@ -1,9 +1,10 @@
 """The chain model: an actuator's response from a table of per-window chord turns and lengths.
 
-The public import place of the chain surrogate; each concept has a module of its own:
+Each concept has a module of its own; the names most used (``ChainModel``, ``ChainTable``,
+``build_table``) are imported from :mod:`pneumorph.models`:
 
-- :mod:`~pneumorph.models.chain.model`: :class:`ChainModel`, the response a table predicts;
-- :mod:`~pneumorph.models.chain.table`: :class:`ChainTable`, the table, its file and
+- :mod:`~pneumorph.models.chain.model`: ``ChainModel``, the response a table predicts;
+- :mod:`~pneumorph.models.chain.table`: ``ChainTable``, the table, its file and
   fingerprint (the layouts in :mod:`~pneumorph.models.chain.tablefile`);
 - :mod:`~pneumorph.models.chain.windows`, :mod:`~pneumorph.models.chain.terms`,
   :mod:`~pneumorph.models.chain.space`: a design's windows, far-field terms, chords in space;
@@ -15,85 +16,11 @@ The public import place of the chain surrogate; each concept has a module of its
 
 Examples
 --------
->>> from pneumorph.models.chain import ChainTable, shipped_path
+>>> from pneumorph.models.chain.sources import shipped_path
+>>> from pneumorph.models.chain.table import ChainTable
 >>> table = ChainTable.load(shipped_path("3d"))
 >>> table.window, table.n_levels
 (3, 10)
 """
 
-from pneumorph.models.chain.fit import (
-    build_table as build_table,
-)
-from pneumorph.models.chain.model import (
-    ALPHABET_FORMAT as ALPHABET_FORMAT,
-)
-from pneumorph.models.chain.model import (
-    BASE as BASE,
-)
-from pneumorph.models.chain.model import (
-    TABLE_FORMAT as TABLE_FORMAT,
-)
-from pneumorph.models.chain.model import (
-    TIP as TIP,
-)
-from pneumorph.models.chain.model import (
-    ChainModel as ChainModel,
-)
-from pneumorph.models.chain.model import (
-    ChainTable as ChainTable,
-)
-from pneumorph.models.chain.model import (
-    check_source as check_source,
-)
-from pneumorph.models.chain.model import (
-    covering_designs as covering_designs,
-)
-from pneumorph.models.chain.model import (
-    design_array as design_array,
-)
-from pneumorph.models.chain.model import (
-    design_strings as design_strings,
-)
-from pneumorph.models.chain.model import (
-    in_space as in_space,
-)
-from pneumorph.models.chain.model import (
-    mirror_codes as mirror_codes,
-)
-from pneumorph.models.chain.model import (
-    possible_codes as possible_codes,
-)
-from pneumorph.models.chain.model import (
-    source_description as source_description,
-)
-from pneumorph.models.chain.model import (
-    source_key as source_key,
-)
-from pneumorph.models.chain.model import (
-    training_model as training_model,
-)
-from pneumorph.models.chain.model import (
-    window_codes as window_codes,
-)
-from pneumorph.models.chain.model import (
-    window_symbols as window_symbols,
-)
-from pneumorph.models.chain.model import (
-    window_text as window_text,
-)
-from pneumorph.models.chain.sources import (
-    find_table as find_table,
-)
-from pneumorph.models.chain.sources import (
-    serve_table as serve_table,
-)
-from pneumorph.models.chain.sources import (
-    shipped_path as shipped_path,
-)
-from pneumorph.models.chain.sources import (
-    table_for as table_for,
-)
-
-# the public place of these names is :mod:`pneumorph.models` (its reference page); here they are
-# importable by their package too
-__all__: list[str] = []
+__all__: list[str] = []  # ChainModel, ChainTable and build_table are re-exported by pneumorph.models
