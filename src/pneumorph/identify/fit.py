@@ -43,7 +43,6 @@ from pneumorph.correlation.scans import Scan
 from pneumorph.errors import FitError, ScanError
 from pneumorph.identify.extent import chain_shapes
 from pneumorph.identify.gaussnewton import (
-    TRUST,
     FitState,
     confirmed,
     gauss_newton_step,
@@ -321,7 +320,6 @@ __all__ = [
     "MAX_ITERATIONS",
     "MAX_POINTS",
     "MIN_EIGENVALUE",
-    "TRUST",
     "Identification",
     "Observation",
     "build_probes",
