@@ -37,11 +37,11 @@ def _mkl_runtime() -> Iterator[None]:
     import os
     import sys
 
-    found = sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")), key=len)
-    if "PYPARDISO_MKL_RT" in os.environ or not found:
+    found = [] if "PYPARDISO_MKL_RT" in os.environ else glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*"))
+    if not found:
         yield
         return
-    os.environ["PYPARDISO_MKL_RT"] = found[0]
+    os.environ["PYPARDISO_MKL_RT"] = min(found, key=len)
     try:
         yield
     finally:
