@@ -63,6 +63,24 @@ def test_mould(tmp_path):
     assert lid.is_watertight and lid.volume == pytest.approx(mould["volumes_mm3"]["lid"], rel=1e-6)
 
 
+def test_the_design_is_read_once(tmp_path, monkeypatch):
+    """The command parses DESIGN once; the parts, the pieces and the mould's checks and solids take the parsed
+    design (a ``Design``) and do not read its text again."""
+    from pneumorph.geometry import alphabet
+
+    texts: list[str] = []
+
+    def counted(design, n_units=None):
+        texts.append(design)
+        return parse_orientation(design, n_units)
+
+    parse_orientation = alphabet.parse_orientation
+    monkeypatch.setattr(alphabet, "parse_orientation", counted)
+    result = run("0110", "--stl", str(tmp_path), "--mould", "--json")
+    assert result.exit_code == 0, result.output
+    assert texts == ["0110"] and json.loads(result.output)["design"] == "0110"
+
+
 def test_mould_text_and_draft(tmp_path):
     result = run("0", "--stl", str(tmp_path), "--mould", "--draft", "1")
     assert result.exit_code == 0, result.output

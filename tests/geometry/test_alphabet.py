@@ -29,6 +29,19 @@ def test_letters_give_type_and_orientation() -> None:
     assert d.mirror().text == "AaEeRrSs" and d.mirror().mirror() == d
 
 
+def test_a_parsed_design_is_checked_against_the_library_not_read_again() -> None:
+    lib = builtin_library()
+    d = parse_design("aAeE", lib)
+    assert parse_design(d, lib) is d  # parsed once: the same object
+    one_type = parse_design("0110", UnitLibrary.single())
+    assert parse_design(one_type, lib).text == "aAAa"  # the library's canonical text
+    assert parse_design(parse_design("aAAa", lib), UnitLibrary.single()).text == "0110"
+    with pytest.raises(OrientationError, match=r"uses 'e', which is no symbol of the unit library 'single'"):
+        parse_design(d, UnitLibrary.single())
+    with pytest.raises(OrientationError, match="has 4 units, expected 5"):
+        parse_design(d, lib, n_units=5)
+
+
 def test_digits_are_the_first_type_and_letters_of_a_one_type_library_read_as_digits() -> None:
     lib = builtin_library()
     assert parse_design("01e", lib) == parse_design("aAe", lib)

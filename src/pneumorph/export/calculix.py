@@ -102,6 +102,7 @@ from pneumorph.export.c3d20 import (
     cavity_faces,
     check_element_order,
 )
+from pneumorph.geometry.alphabet import Design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble
 from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.io.files import atomic_write_text, check_writable_file
@@ -192,7 +193,7 @@ def _nset(name: str, indices: Iterable[int]) -> list[str]:
     return [f"*NSET, NSET={name}", *_rows(ids, 16)]
 
 
-def calculix_mesh(model: Any, design: str) -> ActuatorMesh:
+def calculix_mesh(model: Any, design: str | Design) -> ActuatorMesh:
     """The mesh :meth:`Full3D.build` would solve for ``design`` (without FElupe's objects).
 
     Over a unit library, the model's own mesh (a design with a sideways unit: the full
@@ -202,11 +203,11 @@ def calculix_mesh(model: Any, design: str) -> ActuatorMesh:
     _check_model(model)
     if getattr(model, "mixed", False):
         return model.mesh(design)
-    design = parse_orientation(design, model.n_units)
+    design = parse_orientation(design.orientation if isinstance(design, Design) else design, model.n_units)
     return assemble(model.unit, design, 3, half=model.half)
 
 
-def calculix_deck(model: Any, design: str, *, full_output: bool = True, residual_force: float = 1.0e-4) -> str:
+def calculix_deck(model: Any, design: str | Design, *, full_output: bool = True, residual_force: float = 1.0e-4) -> str:
     """The CalculiX/Abaqus input deck of one design of a 3D model.
 
     Parameters
@@ -214,8 +215,9 @@ def calculix_deck(model: Any, design: str, *, full_output: bool = True, residual
     model : Full3D
         The 3D model: unit, materials, half or full, pressure ramp (its reported levels
         become the step's increments and output times).
-    design : str
-        The orientation vector, one digit per unit (``"0101..."``).
+    design : str or Design
+        The orientation vector, one digit per unit (``"0101..."``; over a unit library its
+        symbols), or the design as parsed (:func:`~pneumorph.geometry.alphabet.parse_design`).
     full_output : bool
         Also write every node's displacement at every level to the ``.frd`` file
         (``*NODE FILE``); the tip nodes always go to the ``.dat`` file (``*NODE PRINT``).
@@ -370,7 +372,7 @@ def _step_lines(model: Any, mesh: ActuatorMesh, loaded: tuple[IntArray, IntArray
     return out
 
 
-def write_calculix_deck(model: Any, design: str, path: str | os.PathLike[str], *, full_output: bool = True,
+def write_calculix_deck(model: Any, design: str | Design, path: str | os.PathLike[str], *, full_output: bool = True,
                         residual_force: float = 1.0e-4) -> Path:
     """Write :func:`calculix_deck` to ``path`` atomically (the old file or the complete new one).
 

@@ -26,6 +26,7 @@ from pneumorph.errors import (
     SimulationFailed,
 )
 from pneumorph.export.calculix import calculix_mesh, write_calculix_deck
+from pneumorph.geometry.alphabet import Design
 from pneumorph.geometry.assembly import ActuatorMesh
 from pneumorph.geometry.orientation import parse_orientation
 
@@ -252,7 +253,7 @@ class CalculixResult:
     log: str
 
 
-def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, executable: str = "ccx",
+def run_calculix(model: Any, design: str | Design, folder: str | os.PathLike[str], *, executable: str = "ccx",
                  threads: int | None = None, timeout: float | None = None, full_output: bool = False,
                  residual_force: float = 1.0e-4) -> CalculixResult:
     """Write the deck of ``design`` into ``folder``, run CalculiX on it and read the tip.
@@ -292,7 +293,8 @@ def run_calculix(model: Any, design: str, folder: str | os.PathLike[str], *, exe
     if getattr(model, "mixed", False):  # a design over a unit library, in its letters
         design = model.parse(design).text
     else:
-        design = parse_orientation(design, getattr(model, "n_units", None))
+        design = parse_orientation(design.orientation if isinstance(design, Design) else design,
+                                   getattr(model, "n_units", None))
     out_dir = Path(folder)
     out_dir.mkdir(parents=True, exist_ok=True)
     deck = write_calculix_deck(model, design, out_dir / f"design_{design}.inp", full_output=full_output,

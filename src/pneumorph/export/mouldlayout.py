@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pneumorph.errors import GeometryError
-from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.assembly import unit_starts
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
@@ -57,7 +57,7 @@ class UnitCasting:
         return self.split - self.bottom
 
 
-def unit_castings(spec: UnitSpec | UnitLibrary, design: str) -> list[UnitCasting]:
+def unit_castings(spec: UnitSpec | UnitLibrary, design: str | Design) -> list[UnitCasting]:
     """How each unit of ``design`` is cast, base first (module docstring).
 
     Raises

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 from pneumorph.errors import GeometryError
 from pneumorph.export.mouldlayout import pour_face, unit_castings
 from pneumorph.export.parts import cavity_boxes
-from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.assembly import unit_starts
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
@@ -112,7 +112,7 @@ class MouldSpec:
         """How deep each core's tenon sits in the base plate: half the plate, mm."""
         return self.plate / 2
 
-    def check(self, spec: UnitSpec | UnitLibrary, orientation: str) -> None:
+    def check(self, spec: UnitSpec | UnitLibrary, orientation: str | Design) -> None:
         """Refuse settings that do not fit this unit and design, before anything is built.
 
         Raises
@@ -134,7 +134,7 @@ class MouldSpec:
         check_fit(spec, orientation, self)
         self.check_design(spec, orientation)
 
-    def check_design(self, spec: UnitSpec | UnitLibrary, orientation: str) -> None:
+    def check_design(self, spec: UnitSpec | UnitLibrary, orientation: str | Design) -> None:
         """Refuse a design no mould of these settings can cast: no unit's face on z = width free of its strip for
         the pour and vent holes (or holes that do not fit on it), or side-sheet pieces of different thicknesses.
 
@@ -253,7 +253,7 @@ class Mould:
     orientation: str = ""
 
 
-def hole_centres(spec: UnitSpec | UnitLibrary, design: str,
+def hole_centres(spec: UnitSpec | UnitLibrary, design: str | Design,
                   mould: MouldSpec) -> list[tuple[str, float, float, float]]:
     """The pour and vent holes of the body's pocket: (name, x, y, radius), checked to fit.
 
@@ -293,7 +293,7 @@ def hole_centres(spec: UnitSpec | UnitLibrary, design: str,
     return out
 
 
-def check_fit(spec: UnitSpec | UnitLibrary, design: str,
+def check_fit(spec: UnitSpec | UnitLibrary, design: str | Design,
                mould: MouldSpec) -> tuple[list[float], list[float]]:
     """Per cavity: the tenon's inset (a quarter of the cavity's smaller side across z) and the core's tip inset
     (its depth times the draft's tangent), checked against the clearance and the cavity."""

@@ -95,7 +95,7 @@ from pneumorph.export.parts import (
     outline_solid,
     to_trimesh,
 )
-from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 
@@ -128,7 +128,7 @@ def _core(cavity: tuple[float, ...], tip_inset: float, tenon_inset: float, tenon
     return body + tenon
 
 
-def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSpec | None = None,
+def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str | Design, mould: MouldSpec | None = None,
                   check: bool = True) -> Mould:
     """Build the casting mould of the body and check that its parts fit.
 
@@ -137,8 +137,9 @@ def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSp
     spec : UnitSpec or UnitLibrary
         The articulating unit, or a library of unit types (a mixed design; a sideways unit
         turned over stands on a plinth: :mod:`pneumorph.export.mouldlayout`).
-    orientation : str
-        The design, base first (0/1, or over the library's symbols).
+    orientation : str or Design
+        The design, base first (0/1, or over the library's symbols), or the design as parsed
+        (:func:`~pneumorph.geometry.alphabet.parse_design`).
     mould : MouldSpec, optional
         Clearance, draft and sizes (default :class:`MouldSpec`'s).
     check : bool
@@ -170,12 +171,11 @@ def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSp
     """
     mould = MouldSpec() if mould is None else mould
     library, parsed = library_design(spec, orientation)
-    orientation = parsed.text if not library.is_single else parsed.orientation
     spec = library if not library.is_single else library[library.default]
-    check_buildable(spec, orientation)
-    inset, tip = check_fit(spec, orientation, mould)  # the same checks as MouldSpec.check
-    holes = hole_centres(spec, orientation, mould)
-    castings = unit_castings(spec, orientation)
+    check_buildable(spec, parsed)
+    inset, tip = check_fit(spec, parsed, mould)  # the same checks as MouldSpec.check
+    holes = hole_centres(spec, parsed, mould)
+    castings = unit_castings(spec, parsed)
     ref = library[library.default]
     n = len(castings)
     s, W, H = ref.side_wall, ref.width, ref.height
@@ -185,24 +185,24 @@ def casting_mould(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSp
     sheet_offset = (0.0, dy, W - s)
     Y = 2 * H + w  # both pockets
     outer = (-w, L + w, -w, Y + w, s - t, W + t)
-    cores, pockets = _cores(spec, orientation, mould, inset, tip)
+    cores, pockets = _cores(spec, parsed, mould, inset, tip)
     pins, pin_holes = _pins(mould, L, Y, s, W)
     hole_cutters, openings = _holes(holes, mould, dy, W, outer[5])
     plate = _plate(outer, s, [box((c.x0, c.x1, 0.0, H, s, c.split)) for c in castings if c.plinth])
-    solids = _plates(spec, orientation, outer, dy, pockets, pin_holes, hole_cutters, plate)
+    solids = _plates(spec, parsed, outer, dy, pockets, pin_holes, hole_cutters, plate)
     digits = len(str(n))
     solids.update({f"core_{k:0{digits}d}": core for k, core in enumerate(cores, start=1)})
     solids.update({f"pin_{k}": pin for k, pin in enumerate(pins, start=1)})
-    cast, opening, in_place = _cast(spec, orientation, cores, sheet_offset, openings, castings)
-    result = (_checked(spec, orientation, solids, cast, opening, [pins, pin_holes, pockets, cores], plate,
+    cast, opening, in_place = _cast(spec, parsed, cores, sheet_offset, openings, castings)
+    result = (_checked(spec, parsed, solids, cast, opening, [pins, pin_holes, pockets, cores], plate,
                        in_place, outer) if check else _unchecked())
     return Mould(parts={name: to_trimesh(solid) for name, solid in solids.items()},
                  cast={name: to_trimesh(solid) for name, solid in cast.items()}, openings=to_trimesh(opening),
                  sheet_offset=sheet_offset, explode=_explode(solids, W + t), outer=outer, check=result, spec=mould,
-                 unit=spec, orientation=orientation)
+                 unit=spec, orientation=parsed.text if not library.is_single else parsed.orientation)
 
 
-def _cores(spec: UnitSpec | UnitLibrary, orientation: str, mould: MouldSpec, inset: list[float],
+def _cores(spec: UnitSpec | UnitLibrary, orientation: str | Design, mould: MouldSpec, inset: list[float],
            tip: list[float]) -> tuple[list[manifold3d.Manifold], list[manifold3d.Manifold]]:
     """The cores (exact cavities on tenons) and the tenons' pockets in the base plate (or its plinths).
 
@@ -252,7 +252,7 @@ def _plate(outer: tuple[float, ...], top: float, plinths: list[manifold3d.Manifo
     return m3.Manifold.batch_boolean([plate, *plinths], m3.OpType.Add) if plinths else plate
 
 
-def _plates(spec: UnitSpec | UnitLibrary, orientation: str, outer: tuple[float, ...], dy: float,
+def _plates(spec: UnitSpec | UnitLibrary, orientation: str | Design, outer: tuple[float, ...], dy: float,
             pockets: list[manifold3d.Manifold], pin_holes: list[manifold3d.Manifold],
             hole_cutters: list[manifold3d.Manifold], plate: manifold3d.Manifold) -> dict[str, manifold3d.Manifold]:
     """The base plate (``plate``, :func:`_plate`, less the tenon pockets), the side walls (the body's and the sheet's
@@ -275,7 +275,7 @@ def _plates(spec: UnitSpec | UnitLibrary, orientation: str, outer: tuple[float, 
     }
 
 
-def _cast(spec: UnitSpec | UnitLibrary, orientation: str, cores: list[manifold3d.Manifold],
+def _cast(spec: UnitSpec | UnitLibrary, orientation: str | Design, cores: list[manifold3d.Manifold],
           sheet_offset: tuple[float, ...], openings: list[manifold3d.Manifold],
           castings: list[UnitCasting]) -> tuple[dict[str, manifold3d.Manifold], manifold3d.Manifold, Any]:
     """What is cast: the open body (around the cores) and the side sheet at its pocket; the holes' openings; the
@@ -319,7 +319,7 @@ def _unchecked() -> MouldCheck:
     return MouldCheck({}, nan, 0, nan, nan, nan, nan, nan, nan, nan, nan)
 
 
-def _checked(spec: UnitSpec | UnitLibrary, orientation: str, solids: dict[str, Any], cast: dict[str, Any],
+def _checked(spec: UnitSpec | UnitLibrary, orientation: str | Design, solids: dict[str, Any], cast: dict[str, Any],
              opening: Any, parts: list[list[manifold3d.Manifold]], plate: Any, in_place: Any,
              outer: tuple[float, ...]) -> MouldCheck:
     """The measured assembly (:func:`_measure`).

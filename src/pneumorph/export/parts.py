@@ -73,7 +73,7 @@ import numpy as np
 
 from pneumorph.errors import GeometryError, interrupts_kept
 from pneumorph.export.strips import LayerPiece, layer_pieces
-from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.assembly import cavity_box, unit_starts
 from pneumorph.geometry.features import BaseBlock, Box
 from pneumorph.geometry.library import UnitLibrary
@@ -114,7 +114,7 @@ _BOX_FACES = np.array(
 )
 
 
-def cavity_boxes(spec: UnitSpec | UnitLibrary, design: str) -> list[Box]:
+def cavity_boxes(spec: UnitSpec | UnitLibrary, design: str | Design) -> list[Box]:
     """Each unit's cavity in the actuator's frame (turned over as the unit is); none for a solid unit
     (``solid = true``: its cavity is filled with the body material)."""
     library, units, orientation = _units(spec, design)
@@ -123,7 +123,7 @@ def cavity_boxes(spec: UnitSpec | UnitLibrary, design: str) -> list[Box]:
             for i, (u, o) in enumerate(zip(units, orientation, strict=True)) if not u.solid]
 
 
-def _units(spec: UnitSpec | UnitLibrary, design: str) -> tuple[UnitLibrary, tuple[UnitSpec, ...], str]:
+def _units(spec: UnitSpec | UnitLibrary, design: str | Design) -> tuple[UnitLibrary, tuple[UnitSpec, ...], str]:
     """The library, every unit's type and the orientation of a design (0/1 for one unit)."""
     library, parsed = library_design(spec, design)
     return library, parsed.units(library), parsed.orientation
@@ -197,7 +197,7 @@ def to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
-def outline_solid(spec: UnitSpec | UnitLibrary, design: str, z0: float, z1: float,
+def outline_solid(spec: UnitSpec | UnitLibrary, design: str | Design, z0: float, z1: float,
                   keep: tuple[str, ...] = ()) -> manifold3d.Manifold:
     """The body without its cavities between two planes z = ``z0`` and z = ``z1``.
 
@@ -229,7 +229,7 @@ def outline_solid(spec: UnitSpec | UnitLibrary, design: str, z0: float, z1: floa
 
 
 def check_materials(spec: UnitSpec | UnitLibrary, base_block: BaseBlock | None = DEFAULT_BLOCK,
-                    design: str | None = None) -> None:
+                    design: str | Design | None = None) -> None:
     """Refuse parts of a material the material library does not know (the body's, the layer's, the block's).
 
     Over a library, of every type (or of those ``design`` uses).
@@ -256,7 +256,7 @@ def check_materials(spec: UnitSpec | UnitLibrary, base_block: BaseBlock | None =
         get(base_block.material)
 
 
-def check_buildable(spec: UnitSpec | UnitLibrary, design: str | None = None) -> None:
+def check_buildable(spec: UnitSpec | UnitLibrary, design: str | Design | None = None) -> None:
     """Refuse a unit whose parts these builders cannot make: one with a bottom wall of another material
     (``bottom_material``). Over a library, every type (or those ``design`` uses).
 
@@ -272,7 +272,7 @@ def check_buildable(spec: UnitSpec | UnitLibrary, design: str | None = None) -> 
                                 "(bottom_material) are not built yet; export a unit of one body material")
 
 
-def _types(spec: UnitSpec | UnitLibrary, design: str | None) -> tuple[UnitSpec, ...]:
+def _types(spec: UnitSpec | UnitLibrary, design: str | Design | None) -> tuple[UnitSpec, ...]:
     """The unit types of ``spec`` (a library's: all, or those ``design`` uses)."""
     if isinstance(spec, UnitSpec):
         return (spec,)
@@ -280,7 +280,7 @@ def _types(spec: UnitSpec | UnitLibrary, design: str | None) -> tuple[UnitSpec, 
 
 
 def actuator_solids(
-    spec: UnitSpec | UnitLibrary, design: str, base_block: BaseBlock | None = DEFAULT_BLOCK
+    spec: UnitSpec | UnitLibrary, design: str | Design, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, manifold3d.Manifold]:
     """The actuator's parts as manifold3d solids (see :func:`actuator_parts`).
 
@@ -311,7 +311,7 @@ def actuator_solids(
 
 
 def actuator_parts(
-    spec: UnitSpec | UnitLibrary, design: str, base_block: BaseBlock | None = DEFAULT_BLOCK
+    spec: UnitSpec | UnitLibrary, design: str | Design, base_block: BaseBlock | None = DEFAULT_BLOCK
 ) -> dict[str, trimesh.Trimesh]:
     """Watertight meshes of the body, the layer pieces and the base block.
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pneumorph.geometry.alphabet import library_design
+from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.assembly import unit_starts
 from pneumorph.geometry.features import Box
 from pneumorph.geometry.library import UnitLibrary
@@ -84,7 +84,7 @@ class LayerPiece:
         return (xa, xb, y0 - out, y1 + out, za, zb)
 
 
-def layer_pieces(spec: UnitSpec | UnitLibrary, design: str) -> list[LayerPiece]:
+def layer_pieces(spec: UnitSpec | UnitLibrary, design: str | Design) -> list[LayerPiece]:
     """The pieces the stiff strip is cut into, base first.
 
     Consecutive units whose layers lie on the same face (of the same thickness and material)

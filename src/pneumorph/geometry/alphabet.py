@@ -130,8 +130,8 @@ def parse_design(design: str | Iterable[int] | Design, library: UnitLibrary, n_u
     the unit as built; upper case or 1: turned 180 degrees about the long axis)
     """
     digits = library.is_single
-    if isinstance(design, Design):
-        design = design.text
+    if isinstance(design, Design):  # parsed once: checked against this library, not read again
+        return _checked(design, library, n_units)
     if not isinstance(design, str):
         orientation = parse_orientation(design, n_units)
         return Design(library.default * len(orientation), orientation, _text(library.default * len(orientation),
@@ -154,6 +154,20 @@ def parse_design(design: str | Iterable[int] | Design, library: UnitLibrary, n_u
     symbols = "".join(library.default if ch in "01" else ch.lower() for ch in text)
     orientation = "".join(ch if ch in "01" else ("1" if ch.isupper() else "0") for ch in text)
     return Design(symbols, orientation, _text(symbols, orientation, digits))
+
+
+def _checked(design: Design, library: UnitLibrary, n_units: int | None) -> Design:
+    """An already parsed design, checked over ``library``: its symbols are the library's and its length is right."""
+    bad = sorted(set(design.symbols) - set(library.symbols))
+    if bad:
+        which = ", ".join(repr(b) for b in bad)
+        raise OrientationError(f"design {design.text!r} uses {which}, which {'is' if len(bad) == 1 else 'are'} no "
+                               f"symbol of the unit library {library.name!r}; allowed: {_allowed(library)}")
+    if n_units is not None and design.n_units != n_units:
+        raise OrientationError(f"design {design.text!r} has {design.n_units} units, expected {n_units}")
+    if design.text.isdigit() != library.is_single:  # the canonical text of this library
+        return Design(design.symbols, design.orientation, _text(design.symbols, design.orientation, library.is_single))
+    return design
 
 
 def library_design(spec: UnitSpec | UnitLibrary, design: str | Iterable[int] | Design) -> tuple[UnitLibrary, Design]:

@@ -47,25 +47,26 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
 
     from pneumorph.export import BaseBlock, check_materials
     from pneumorph.export.parts import check_buildable
-    from pneumorph.geometry import parse_orientation
     from pneumorph.geometry.alphabet import parse_design
+    from pneumorph.geometry.library import UnitLibrary
     from pneumorph.io import strict_json
 
-    # everything is checked before anything is built or written
+    # everything is checked before anything is built or written; the design is parsed once, here
     _check_request(ctx, stl_dir, inp_file, with_mould)
     units = P.library_option(library, unit_file) if library is not None else None
     with P.blame("DESIGN"):
-        orientation = parse_orientation(design) if units is None else parse_design(design, units).text
+        parsed = parse_design(design, units if units is not None else UnitLibrary.single())
+    orientation = parsed.text
     settings = {"fidelity": "3d", "pressure_kpa": pressure, **({"unit_file": unit_file} if unit_file else {}),
                 **({"library": library} if library else {})}
     settings = P.model_file_option(settings, model_file, {"pressure_kpa": "pressure"})
     if units is not None:
         with P.blame("--library"):
-            check_buildable(units, orientation)
-            check_materials(units, BaseBlock(), orientation)
+            check_buildable(units, parsed)
+            check_materials(units, BaseBlock(), parsed)
     unit = units if units is not None else _unit(settings, unit_file, model_file)
     folder = Path(stl_dir) if stl_dir is not None else Path()
-    mould_spec = _mould_spec(unit, orientation, clearance, draft, folder) if with_mould else None
+    mould_spec = _mould_spec(unit, parsed, clearance, draft, folder) if with_mould else None
     model = None
     if inp_file is not None:
         from pneumorph.models.factory import make_model
@@ -73,14 +74,14 @@ def export(ctx: click.Context, design: str, stl_dir: str | None, inp_file: str |
         model = make_model(len(orientation), settings)
     summary: dict = {"design": orientation, "units": len(orientation)}
     block = BaseBlock()
-    parts, paths, mould = _write(orientation, unit, block, model, stl_dir, inp_file, mould_spec, summary)
+    parts, paths, mould = _write(parsed, unit, block, model, stl_dir, inp_file, mould_spec, summary)
     if stl_dir is None:
         if as_json:
             click.echo(strict_json(summary))
         else:
             click.echo(f"wrote the CalculiX deck of design {orientation} at {pressure:g} kPa to {inp_file}")
         return
-    describe = _parts_summary(summary, unit, orientation, block, parts, paths, mould, mould_spec, folder)
+    describe = _parts_summary(summary, unit, parsed, block, parts, paths, mould, mould_spec, folder)
     if as_json:
         click.echo(strict_json(summary))
         return
@@ -138,7 +139,7 @@ def _unit(settings: dict, unit_file: str | None, model_file: str | None) -> Any:
     return unit
 
 
-def _mould_spec(unit: Any, orientation: str, clearance: float, draft: float, folder: Any) -> Any:
+def _mould_spec(unit: Any, orientation: Any, clearance: float, draft: float, folder: Any) -> Any:
     """The mould's settings, each checked naming its option."""
     from pneumorph.export import MouldSpec
     from pneumorph.io import check_writable_dir
@@ -157,7 +158,7 @@ def _mould_spec(unit: Any, orientation: str, clearance: float, draft: float, fol
     return spec
 
 
-def _write(orientation: str, unit: Any, block: Any, model: Any, stl_dir: str | None, inp_file: str | None,
+def _write(orientation: Any, unit: Any, block: Any, model: Any, stl_dir: str | None, inp_file: str | None,
            mould_spec: Any, summary: dict) -> tuple[dict, list, Any]:
     """The deck, the parts and the mould written all or nothing (a failure or Ctrl-C while writing leaves no
     output); the parts, their paths and the mould."""
@@ -191,7 +192,7 @@ def _write(orientation: str, unit: Any, block: Any, model: Any, stl_dir: str | N
     return parts, paths, mould
 
 
-def _parts_summary(summary: dict, unit: Any, orientation: str, block: Any, parts: dict, paths: list, mould: Any,
+def _parts_summary(summary: dict, unit: Any, orientation: Any, block: Any, parts: dict, paths: list, mould: Any,
                    mould_spec: Any, folder: Any) -> dict:
     """The parts (files, volumes, layer pieces) and the mould into ``summary``; each part in words."""
     from pneumorph.export import layer_pieces
