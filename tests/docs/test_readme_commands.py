@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -26,7 +27,7 @@ BIN = Path(sys.executable).parent
 SKIPPED = {
     "simulate -o aRRa --library builtin --model 3d": "a 3D solve",
     "simulate -o bbbbb --library modes --model 3d --pressure 40": "a 3D solve",
-    "unit optimise --out unitopt/": "unit optimisation: minutes",
+    "unit optimise --out runs/unitopt/": "unit optimisation: minutes",
     "design --target cos --amplitude 20 --certify": "a 3D design run: minutes",
     "design --units 8 --search ga --pressure 25": "a 3D GA run: minutes",
     "design --units 10 --pressure 25 --no-build": "a 3D design run with FE verification",
@@ -40,17 +41,16 @@ SKIPPED = {
      '--stage "40:y = -0.0015*x**2" --certify'): "a 3D design run with 6 FE verifications: minutes",
     "design --library spatial --target helix --amplitude 25 --certify": "full-width 3D verifications: minutes",
     "design --target hook": "a 3D design run: about a minute",
-    "sensitivity mesh --units 1 --size 1.5 --size 0.75": "3D solves on a fine mesh",
-    "sensitivity tolerances --samples 30 --out tol/": "30 3D solves: minutes",
+    "sensitivity tolerances --samples 30 --out runs/tol/": "30 3D solves: minutes",
     "sensitivity simplifications --design 001111010001001": "3D solves of a 15-unit design: minutes",
-    "chain build --model 3d --out chain-3d.json": "a chain table build: minutes in 3D",
-    "chain build --model 3d --out chain-3d.json --executor dask --scheduler tcp://ws1:8786": "needs a Dask cluster",
+    "chain build --model 3d --out runs/chain-3d.json": "a chain table build: minutes in 3D",
+    "chain build --model 3d --out runs/chain-3d-cluster.json --executor dask --scheduler tcp://ws1:8786": "needs a Dask cluster",
     "study --units 8 --populations 20,40 --seeds 3": "many GA runs: minutes",
-    "bimodal --crimp-ratio 0.2 --end-cap 1.5 --bilinear-nu 0.495 --voids 5 --pmax 35 --out bim/":
+    "bimodal --crimp-ratio 0.2 --end-cap 1.5 --bilinear-nu 0.495 --voids 5 --pmax 35 --out runs/bim/":
         "a 3D ramp: about 80 s",
-    "calibrate --units 15 --out cal/": "3D references: long",
-    "correlate examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out corr/": "a 3D solve",
-    "identify examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out ident/": "3D solves: minutes",
+    "calibrate --units 15 --out runs/cal/": "3D references: long",
+    "correlate examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out runs/corr/": "a 3D solve",
+    "identify examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out runs/ident/": "3D solves: minutes",
 }
 # The first lines of the README (install, test suite, the bench, the site) are not pneumorph runs.
 NOT_RUNS = ("pip install", "pytest", "serve", "sphinx-build")
@@ -91,7 +91,33 @@ def test_the_quick_readme_commands_run_as_written(tmp_path: Path) -> None:
         assert done.returncode == 0, f"{command}\n{done.stderr}"
         assert "error" not in done.stderr.lower() and "Traceback" not in done.stderr, f"{command}\n{done.stderr}"
         ran.append(_key(command))
-    assert "simulate --orientation 0110 --pressure 20 --out sim/" in ran and len(ran) >= 9, ran
+    assert "simulate --orientation 0110 --pressure 20 --out runs/sim/" in ran and len(ran) >= 9, ran
+    # what the commands wrote is under runs/ (ignored by git), beside the examples and the test's own cache
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["examples", "runs", "xdg"]
 
 
-pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX shell")
+class _Claimed(Exception):
+    """Raised instead of a run, once its folder is chosen."""
+
+
+def test_the_readme_design_runs_never_share_a_folder(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every README design command, in order, writes its own folder: a default folder names every setting that
+    changes the answer, so no command meets another's run (each is refused there, naming the folder)."""
+    import pneumorph.design
+    from pneumorph.cli import main
+
+    claimed: list[str] = []
+
+    def claim(config, model, folder, **kwargs):
+        claimed.append(str(folder))
+        raise _Claimed(folder)
+
+    monkeypatch.setattr(pneumorph.design, "run_design", claim)
+    monkeypatch.chdir(ROOT)
+    commands = [_key(c) for c in readme_commands() if _key(c).startswith("design")]
+    for command in commands:
+        main(shlex.split(command))
+        assert len(claimed) == commands.index(command) + 1, f"{command} chose no folder"
+    folders = dict(zip(commands, claimed, strict=True))
+    assert len(commands) >= 12 and len(set(claimed)) == len(claimed), folders
+    assert all(f.startswith("runs/") for f in claimed), folders

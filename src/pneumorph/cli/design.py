@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import re
 import sys
 from types import SimpleNamespace
 from typing import Any
@@ -23,16 +22,6 @@ _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "r
 
 def _kpa(pressure: float | None) -> float:
     return float("nan") if pressure is None else pressure * 1e3
-
-
-def _default_folder(config: Any) -> str:
-    """``runs/<target>-<units>u-<search>-seed<seed>`` (a path's target: ``path-`` and a digest of its points)."""
-    slug = re.sub(r"[^a-z0-9]+", "-", config.objective.lower()).strip("-")[:40] or "target"
-    if config.path is not None:
-        import hashlib
-
-        slug = f"path-{hashlib.sha256(repr(config.path).encode()).hexdigest()[:8]}"
-    return f"runs/{slug}-{config.units}u-{config.search}-seed{config.seed}"
 
 
 @click.command("design")
@@ -102,7 +91,8 @@ def _default_folder(config: Any) -> str:
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
 @click.option("--out", metavar="DIR", type=P.OutputDir(),
-              help="Run folder (default runs/<target>-<units>u-<search>-seed<seed>).")
+              help="Run folder (default runs/<target>-<units>u-<search>-<model>-<key>, the key a digest of every "
+                   "setting that changes the answer: the same command again resumes its own run).")
 @click.option("--overwrite", is_flag=True, help="Start afresh in a folder that holds another run.")
 @click.option("--no-build", "no_build", is_flag=True,
               help="Certified search: stop with a message instead of building a chain table (or tolerance tables) "
@@ -269,9 +259,10 @@ def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, An
     """The run and its model; a certified run the chain cannot represent (nothing written) falls back to the GA
     (on the 2D model unless the fidelity was given)."""
     from pneumorph.design import run_design
+    from pneumorph.design.runs.folder import default_folder
     from pneumorph.errors import LocalityError
 
-    progress = _Progress(config, model, o.out or _default_folder(config))
+    progress = _Progress(config, model, o.out or default_folder(config))
     try:
         result = run_design(config, model, progress.folder, overwrite=o.overwrite, build=not o.no_build,
                             reference=o.reference, **progress.callbacks())
@@ -283,7 +274,7 @@ def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, An
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
     config = config.fallback(fidelity_given)
     model = config.make_model()
-    progress = _Progress(config, model, o.out or _default_folder(config))  # the new run says its own first line
+    progress = _Progress(config, model, o.out or default_folder(config))  # the new run says its own first line
     result = run_design(config, model, progress.folder, overwrite=o.overwrite, **progress.callbacks())
     progress.announce()
     return result, model

@@ -10,7 +10,9 @@ truncated by a resumed run (see :class:`GenerationLog`).
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
+import json
 import os
 import re
 import tomllib
@@ -44,6 +46,33 @@ RUN_FILES = (
     "winner/vtk/winner_*.vtu",
     "report.md",
 )
+
+
+def default_folder(config: DesignConfig, root: str | Path = "runs") -> Path:
+    """The folder a run of ``config`` writes to when none is given: ``<root>/<target>-<units>u-<search>-<model>-<key>``.
+
+    ``key`` is a digest of every setting that changes the answer (the ``[design]``, ``[ga]`` and
+    ``[model]`` tables :func:`check_folder` compares: the target and its parameters, stages,
+    search, seed, robustness, library, unit, pressure, model), so two runs that could answer
+    differently never share a folder, and the same command again resumes its own run.
+
+    Examples
+    --------
+    >>> a = default_folder(DesignConfig(objective="cos", amplitude=20.0))
+    >>> a.parent.name, a.name.startswith("cos-15u-certified-")
+    ('runs', True)
+    >>> a == default_folder(DesignConfig(objective="cos", amplitude=20.0))
+    True
+    >>> a == default_folder(DesignConfig(objective="cos", amplitude=10.0))
+    False
+    """
+    data = config.to_dict()
+    key = hashlib.sha256(json.dumps({t: data.get(t, {}) for t in _COMPARED}, sort_keys=True,
+                                    default=str).encode()).hexdigest()[:8]
+    target = "path" if config.path is not None else config.objective
+    slug = re.sub(r"[^a-z0-9]+", "-", target.lower()).strip("-")[:40] or "target"
+    model = str(config.model.get("fidelity", "model"))
+    return Path(root) / f"{slug}-{config.units}u-{config.search}-{model}-{key}"
 
 
 def check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrite: bool) -> bool:
