@@ -71,3 +71,12 @@ def test_written_line_has_one_slash(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert main(["simulate", "-o", "01", "--pressure", "10", "--increments", "1", "--out", f"{tmp_path / 'sim'}/"]) == 0
     line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("written to"))
     assert f"written to {tmp_path / 'sim'}/ (" in line and "//" not in line
+
+
+def test_without_out_the_table_says_nothing_was_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "-o", "01", "--pressure", "10", "--increments", "2", "--gravity", "hanging"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[-1] == "nothing written: --out DIR keeps the response, the VTK series and the shape figure"
+    assert not list(tmp_path.iterdir())

@@ -27,6 +27,15 @@ def test_text_run_with_poisson(capsys) -> None:
     assert code == 0
     out = capsys.readouterr().out
     assert "switch pressure" in out and "none below 5 kPa" in out
+    assert out.splitlines()[-1] == "nothing written: --out DIR keeps the response (JSON) and the figures"
+
+
+def test_text_run_says_where_its_files_went(tmp_path, capsys) -> None:
+    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "-q",
+                 "--out", str(tmp_path / "b")])
+    assert code == 0
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        f"written to {tmp_path / 'b'}/ (bimodal-cr0_3.json, bimodal-cr0_3-tip.png, bimodal-cr0_3-shape.png)")
 
 
 def test_bad_crimp_ratio(capsys) -> None:

@@ -44,7 +44,8 @@ SKIPPED = {
     "sensitivity tolerances --samples 30 --out runs/tol/": "30 3D solves: minutes",
     "sensitivity simplifications --design 001111010001001": "3D solves of a 15-unit design: minutes",
     "chain build --model 3d --out runs/chain-3d.json": "a chain table build: minutes in 3D",
-    "chain build --model 3d --out runs/chain-3d-cluster.json --executor dask --scheduler tcp://ws1:8786": "needs a Dask cluster",
+    "chain build --model 3d --out runs/chain-3d-cluster.json --executor dask --scheduler tcp://ws1:8786":
+        "needs a Dask cluster",
     "study --units 8 --populations 20,40 --seeds 3": "many GA runs: minutes",
     "bimodal --crimp-ratio 0.2 --end-cap 1.5 --bilinear-nu 0.495 --voids 5 --pmax 35 --out runs/bim/":
         "a 3D ramp: about 80 s",

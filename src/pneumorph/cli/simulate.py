@@ -151,3 +151,5 @@ def _print_table(resp: Any, out: str | None) -> None:
                f"{m['wall_time_s']:.2f} s")
     if out:
         click.echo(f"written to {Path(out)}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")
+    else:
+        click.echo("nothing written: --out DIR keeps the response, the VTK series and the shape figure")

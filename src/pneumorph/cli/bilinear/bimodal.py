@@ -90,6 +90,8 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
         click.echo(strict_json(data, indent=2))
     else:
         click.echo(format_result(data))
+        click.echo(f"written to {Path(out)}/ ({', '.join(Path(f).name for f in data['files'])})" if out is not None
+                   else "nothing written: --out DIR keeps the response (JSON) and the figures")
     if not result.completed:  # a partial ramp is reported and written, and ends with its cause (exit 2)
         from pneumorph.errors import SimulationFailed
 
