@@ -105,6 +105,7 @@ BASE = {
     **{study: ["sensitivity", study, "--units", "2", "--executor", "serial", "--out", "run"]
        for study in ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature")},
     "mesh": ["sensitivity", "mesh", "--units", "2", "--executor", "serial", "--out", "run"],
+    "synth": ["scan", "synth", "0110", "--model", "2d", "--out", "run/scan.csv"],
 }
 
 REAL = ["nan", "inf", "-inf", "1e999", "abc", ""]  # never a number
@@ -218,6 +219,11 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
                  "--scale": POSITIVE, "--scan-unit": ["cm", "furlongs", ""], "--fit": ["", "abc", "wall,abc"],
                  "--tolerance": [*POSITIVE, "5"],
                  "--seed": COUNT, "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
+    "synth": {"--out": ["folder", "a-file/x.csv", "x.txt", "x.xyz", ""], "--pressure": [*POSITIVE, "1e9"],
+              "--set": ["", "wall", "wall=abc", "walls=1", "wall=-1", "wall=nan", "wall=inf", "body_bulk_scale=100",
+                        "element_size=0.1", "=1"],
+              "--points": ["9", *POS_COUNT, "1000000"], "--noise": ["-1", "11", *REAL], "--seed": COUNT,
+              "--unit": ["binary.bin", "folder", ""], "--model-file": ["binary.bin", "folder", "missing.toml", ""]},
 }
 
 # the one execution option set of every command that solves many designs (pneumorph.cli.options.execution)

@@ -36,6 +36,7 @@ from pneumorph.cli.calibrate import calibrate  # noqa: E402
 from pneumorph.cli.casting.correlate import correlate  # noqa: E402
 from pneumorph.cli.casting.export import export  # noqa: E402
 from pneumorph.cli.casting.identify import identify  # noqa: E402
+from pneumorph.cli.casting.scan import scan  # noqa: E402
 from pneumorph.cli.chain import chain  # noqa: E402
 from pneumorph.cli.design import design  # noqa: E402
 from pneumorph.cli.sensitivity import sensitivity  # noqa: E402
@@ -49,6 +50,7 @@ cli.add_command(correlate)
 cli.add_command(design)
 cli.add_command(export)
 cli.add_command(identify)
+cli.add_command(scan)
 cli.add_command(sensitivity)
 cli.add_command(serve)
 cli.add_command(simulate)

@@ -290,11 +290,13 @@ def run_calculix(model: Any, design: str | Design, folder: str | os.PathLike[str
     exe = shutil.which(executable)
     if exe is None:
         raise SettingsError(f"CalculiX ({executable!r}) is not on the PATH; on Debian: apt-get install calculix-ccx")
+    text: str
     if getattr(model, "mixed", False):  # a design over a unit library, in its letters
-        design = model.parse(design).text
+        text = model.parse(design).text
     else:
-        design = parse_orientation(design.orientation if isinstance(design, Design) else design,
-                                   getattr(model, "n_units", None))
+        text = parse_orientation(design.orientation if isinstance(design, Design) else design,
+                                 getattr(model, "n_units", None))
+    design = text
     out_dir = Path(folder)
     out_dir.mkdir(parents=True, exist_ok=True)
     deck = write_calculix_deck(model, design, out_dir / f"design_{design}.inp", full_output=full_output,
