@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.fem.fast.loads import DeadLoads
+from pneumorph.fem.fast.mixed import cofactor, pressure_space, volumetric
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -33,6 +34,9 @@ class SolidData:
     take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # assembled entries
     scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # their CSR positions
     edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    #: the material and its elements' pressure space when its volumetric term is integrated on a dilatation of its
+    #: own (:mod:`.mixed`)
+    mixed: Any = None
 
 
 @dataclass
@@ -119,6 +123,9 @@ class FastSystem:
             elif isinstance(item, fem.SolidBody):
                 solid = SolidData(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
                 solid.layouts = self._layouts(g)
+                if getattr(item.umat, "mixed", False):  # P1 on quadratic cells, P0 on linear ones
+                    X = np.einsum("aq,cad->cqd", region.h[:, :, 0], self.points[cells])
+                    solid.mixed = (item.umat, pressure_space(X, solid.dV, linear=cells.shape[1] > 2**d))
                 self.solids.append(solid)
             else:
                 raise TypeError(f"no fast assembly for {type(item).__name__}; use the FElupe backend")
@@ -164,6 +171,30 @@ class FastSystem:
     @staticmethod
     def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
         """``cof(F) N dA`` at the boundary points, (f, q, d)."""
+        raise NotImplementedError  # pragma: no cover
+
+    @staticmethod
+    def _mixed_volumetric(s: SolidData, F: FloatArray, P: FloatArray, J: FloatArray) -> tuple[FloatArray, Any]:
+        """The stress with the volumetric term on the elements' own dilatation (:mod:`.mixed`), and what the
+        tangent needs: the pressure at every point, ``cof(F)``, ``det F`` and the element term (c, m, m).
+
+        ``F``, ``P`` (points last, (d, d, c q)) and ``J`` (of the elastic part, (c q,)) as the kernel gives them.
+        """
+        c, q = s.dV.shape
+        umat, space = s.mixed
+        t3 = float(getattr(umat, "thermal_stretch", 1.0)) ** 3
+        first, second = volumetric(space.project(J.reshape(c, q), s.dV), float(umat.bulk))
+        p = space.project(first, s.dV).reshape(-1)
+        cof = cofactor(F)
+        return P + p * cof, (p, cof, J * t3, space.element_term(second, s.dV) / t3)
+
+    def _pressure_vectors(self, s: SolidData, cof: FloatArray) -> FloatArray:
+        """``b_m[c, a, i] = int N_m cof(F)_iJ dN_a/dX_J dV`` of every pressure basis function, (c, m, n, d)."""
+        N = s.mixed[1].N
+        return np.stack([self._element_vectors(s, cof * N[:, :, m].reshape(-1)) for m in range(N.shape[2])], axis=1)
+
+    def _element_vectors(self, s: SolidData, P: FloatArray) -> FloatArray:
+        """``r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV`` of a stress-like field ``P`` (d, d, c q)."""
         raise NotImplementedError  # pragma: no cover
 
     # -- pattern ------------------------------------------------------------------------

@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 
 from pneumorph.fem.fast.assembler import TANGENT_CHUNK, FastSystem, SolidData, WallData, deformation_gradient
 from pneumorph.fem.fast.kernels import neo_hooke_plane_strain, ogden_plane_strain, principal_3d
+from pneumorph.fem.fast.mixed import geometric_blocks
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -81,8 +82,8 @@ class PlaneStrainSystem(FastSystem):
 
         from pneumorph.fem.ogden import OgdenCompressible
 
-        if isinstance(umat, OgdenCompressible):
-            return lambda F: ogden_plane_strain(F, umat.mu, umat.alpha, umat.bulk)
+        if isinstance(umat, OgdenCompressible):  # without its volumetric term when that is on the mean dilatation
+            return lambda F: ogden_plane_strain(F, umat.mu, umat.alpha, 0.0 if umat.mixed else umat.bulk)
         if isinstance(umat, fem.NeoHookeCompressible) and umat.lmbda is not None:
             return lambda F: neo_hooke_plane_strain(F, float(umat.mu), float(umat.lmbda))
         raise TypeError(f"no fast plane-strain kernel for {type(umat).__name__}; use the FElupe backend")
@@ -109,20 +110,36 @@ class PlaneStrainSystem(FastSystem):
 
     def _solid_residual(self, s: SolidData, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
-        F = deformation_gradient(s.g, s.cells, U)
-        P, A, J = s.kernel(np.ascontiguousarray(F.transpose(2, 3, 0, 1)).reshape(2, 2, c * q))
+        F = np.ascontiguousarray(deformation_gradient(s.g, s.cells, U).transpose(2, 3, 0, 1)).reshape(2, 2, c * q)
+        P, A, J = s.kernel(F)
+        rank_one = None
+        if s.mixed is not None:  # the volumetric term on the elements' own dilatation
+            P, (p, cof, detF, term) = self._mixed_volumetric(s, F, P, J)
+            A = A + geometric_blocks(cof, detF, p)
+            rank_one = (self._pressure_vectors(s, cof), term)
         dV = s.dV.reshape(-1)
-        PdV = (P * dV).reshape(2, 2, c, q)
-        # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV
-        return np.matmul(s.layouts["g_res"], PdV.transpose(2, 3, 1, 0).reshape(c, 2 * q, 2)), float(J.min()), A * dV
+        return self._element_vectors(s, P), float(J.min()), (A * dV, rank_one)
 
-    def _solid_tangent(self, s: SolidData, AdV: FloatArray) -> FloatArray:
+    def _element_vectors(self, s: SolidData, P: FloatArray) -> FloatArray:
+        """``r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV`` of a stress-like field ``P`` (2, 2, c q)."""
+        c, q = s.dV.shape
+        PdV = (P * s.dV.reshape(-1)).reshape(2, 2, c, q)
+        return np.matmul(s.layouts["g_res"], PdV.transpose(2, 3, 1, 0).reshape(c, 2 * q, 2))
+
+    def _solid_tangent(self, s: SolidData, state: Any) -> FloatArray:
+        AdV, rank_one = state
         c, q, n, _ = s.g.shape
         # D[cq, (i, J, k), b] = sum_L A[i, J, k, L, cq] dV g[cq, b, L]
         At = np.ascontiguousarray(AdV.reshape(16, c * q).T).reshape(c * q, 8, 2)
         D = np.matmul(At, s.layouts["gT"]).reshape(c, 4 * q, 2 * n)  # [c, (q, i, J), (k, b)]
         # K[c, (a, i), (k, b)] = sum_(q, J) g[c, q, a, J] D[c, (q, i, J), (k, b)]
-        return np.matmul(s.layouts["B"], D)
+        K = np.matmul(s.layouts["B"], D)
+        if rank_one is not None:  # sum_mn [M^-1 H M^-1]_mn b_m (x) b_n
+            b, term = rank_one
+            m = b.shape[1]
+            K += np.matmul(np.matmul(b.reshape(c, m, 2 * n).transpose(0, 2, 1), term),
+                           b.transpose(0, 1, 3, 2).reshape(c, m, 2 * n))
+        return K
 
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
         # t[f, q, b] = N_1 dN_b/dX_2 - N_2 dN_b/dX_1 (with dA); M[f, a, b] = p sum_q h_a t_b
@@ -183,8 +200,9 @@ class SolidSystem3D(FastSystem):
     def _kernel_of(self, umat: Any) -> Any:
         from pneumorph.fem.ogden import OgdenCompressible
 
-        if isinstance(umat, OgdenCompressible):
-            return lambda F, tangent, principal: umat.kernel(F, tangent, principal, _UPPER)
+        if isinstance(umat, OgdenCompressible):  # without its volumetric term when that is on the mean dilatation
+            return lambda F, tangent, principal: umat.kernel(F, tangent, principal, _UPPER,
+                                                             volumetric=not umat.mixed)
         raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
     def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
@@ -226,15 +244,25 @@ class SolidSystem3D(FastSystem):
         Fp[2, 2] += 1.0
         principal = principal_3d(Fp)
         P, _, J = s.kernel(Fp, False, principal)
-        # r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV
+        mixed = None
+        if s.mixed is not None:  # the volumetric term on the elements' own dilatation
+            P, mixed = self._mixed_volumetric(s, Fp, P, J)
+        return self._element_vectors(s, P), float(J.min()), (Fp, principal, mixed)
+
+    def _element_vectors(self, s: SolidData, P: FloatArray) -> FloatArray:
+        """``r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV`` of a stress-like field ``P`` (3, 3, c q)."""
+        c, q = s.dV.shape
         PdV = (P * s.dV.reshape(-1)).reshape(3, 3, c, q).transpose(2, 3, 1, 0).reshape(c, 3 * q, 3)
-        return np.matmul(s.layouts["G"], PdV), float(J.min()), (Fp, principal)
+        return np.matmul(s.layouts["G"], PdV)
 
     def _solid_tangent(self, s: SolidData, state: Any) -> FloatArray:
-        Fp, principal = state
+        Fp, principal, mixed = state
         c, q, n, _ = s.g.shape
         _, A, _ = s.kernel(Fp, True, principal)
         assert A is not None
+        if mixed is not None:
+            p, cof, detF, _ = mixed
+            A += geometric_blocks(cof, detF, p, _UPPER)
         dtype = self.tangent_dtype
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
         Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
@@ -253,6 +281,10 @@ class SolidSystem3D(FastSystem):
             E = np.matmul(Ap[sl].reshape(m * q, 18, 3), gt[sl].reshape(m * q, 3, n))
             # K[c, a, (ik, b)] = sum_(q, J) g[c, q, a, J] E[c, (q, J), (ik, b)]
             blocks[sl] = np.matmul(G[sl], E.reshape(m, 3 * q, 6 * n)).reshape(m, n, 6, n)
+        if mixed is not None:  # sum_mn [M^-1 H M^-1]_mn b_m (x) b_n, blocks (i, k) of the computed pairs
+            b, term = self._pressure_vectors(s, mixed[1]), mixed[3]
+            for m_, (i, k) in enumerate(_UPPER):
+                blocks[:, :, m_, :] += np.matmul(np.matmul(b[..., i].transpose(0, 2, 1), term), b[..., k])
         return blocks
 
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
