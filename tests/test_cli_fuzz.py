@@ -220,7 +220,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
                  "--tolerance": [*POSITIVE, "5"],
                  "--seed": COUNT, "--cache": ["folder", "a-file/x.sqlite", ""], "--out": ["a-file", "a-file/sub", ""]},
     "synth": {"--out": ["folder", "a-file/x.csv", "x.txt", "x.xyz", ""], "--pressure": [*POSITIVE, "1e9"],
-              "--set": ["", "wall", "wall=abc", "walls=1", "wall=-1", "wall=nan", "wall=inf", "body_bulk_scale=100",
+              "--set": ["", "wall", "wall=abc", "walls=1", "wall=-1", "wall=nan", "wall=inf", "body_bulk_scale=10000",
                         "element_size=0.1", "=1"],
               "--points": ["9", *POS_COUNT, "1000000"], "--noise": ["-1", "11", *REAL], "--seed": COUNT,
               "--unit": ["binary.bin", "folder", ""], "--model-file": ["binary.bin", "folder", "missing.toml", ""]},

@@ -22,7 +22,7 @@ from pneumorph.correlation.compare import ModelShape
 from pneumorph.correlation.scans import MAX_SCAN_POINTS, MIN_POINTS, Scan
 from pneumorph.errors import GeometryError, ScanError, SettingsError
 from pneumorph.io.files import all_or_nothing_file
-from pneumorph.models.factory import SCALE_RANGE, unit_or_library
+from pneumorph.models.factory import SCALE_RANGES, unit_or_library
 
 #: the model settings a cast's silicone can differ by (factors on the body's moduli)
 CAST_SCALES = ("body_bulk_scale", "body_shear_scale")
@@ -57,9 +57,9 @@ def cast_settings(settings: Mapping[str, Any], changes: Mapping[str, float]) -> 
     for key in CAST_SCALES:
         if key in changes:
             value = float(changes[key])
-            if not (np.isfinite(value) and SCALE_RANGE[0] <= value <= SCALE_RANGE[1]):
-                raise SettingsError(f"{key} = {value:g}: give a factor between {SCALE_RANGE[0]:g} and "
-                                    f"{SCALE_RANGE[1]:g}")
+            low, high = SCALE_RANGES[key]
+            if not (np.isfinite(value) and low <= value <= high):
+                raise SettingsError(f"{key} = {value:g}: give a factor between {low:g} and {high:g}")
             out[key] = value
     if unit_changes:
         unit, _ = unit_or_library(out)

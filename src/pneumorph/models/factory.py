@@ -15,12 +15,19 @@ from pneumorph.geometry.library import BUILTIN_LIBRARIES, UnitLibrary, builtin_l
 from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
+from pneumorph.models.fe.base import FORMULATIONS
 from pneumorph.models.fe.gravity import gravity_vector
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
-              "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale")
-#: the range of ``body_bulk_scale`` and ``body_shear_scale``: factors on the body silicone's moduli
+              "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale",
+              "formulation")
+#: the range of ``body_shear_scale`` (a factor on the body silicone's Ogden moduli), and of the identified scales
 SCALE_RANGE = (0.1, 10.0)
+#: the range of ``body_bulk_scale``: up to a nearly incompressible body (x1000 gives Mold Star 15 a Poisson's ratio of
+#: 0.4994; the u-p-J form integrates it without locking, :mod:`pneumorph.fem.fast.mixed`)
+BULK_SCALE_RANGE = (0.1, 1000.0)
+#: the range of each body scale
+SCALE_RANGES = {"body_bulk_scale": BULK_SCALE_RANGE, "body_shear_scale": SCALE_RANGE}
 
 
 def load_unit_library(value: Any, where: str = "[model] library",
@@ -106,8 +113,11 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         (``pneumorph identify``, docs/identify.md): ``body_bulk_scale`` (its bulk modulus,
         :func:`~pneumorph.materials.library.scaling.scaled_bulk_modulus`) and
         ``body_shear_scale`` (its Ogden moduli,
-        :func:`~pneumorph.materials.library.scaling.scaled_shear_modulus`), each in
-        :data:`SCALE_RANGE` (default 1: the library's silicone, the same fingerprint).
+        :func:`~pneumorph.materials.library.scaling.scaled_shear_modulus`), each in its
+        :data:`SCALE_RANGES` (default 1: the library's silicone, the same fingerprint);
+        ``formulation``: how the silicones' volumetric term is integrated (``"auto"``, the default:
+        the u-p-J form for a nearly incompressible silicone; ``"displacement"``; ``"u-p-J"``;
+        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`).
 
     Examples
     --------
@@ -145,6 +155,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
                          error=SearchConfigError)
     passage = checks.real(s.get("passage", 0.0), "[model] passage", 0.0, 100.0, unit="mm", error=SearchConfigError)
     extra: dict[str, Any] = {"base_block": block} if block is not None else {}
+    if "formulation" in s:
+        extra["formulation"] = checks.text(s["formulation"], "[model] formulation", FORMULATIONS,
+                                           error=SearchConfigError)
     if library is not None:
         extra["library"] = library
     body = _scaled_body(s, unit if unit is not None else library.units[0] if library is not None else UnitSpec())
@@ -232,7 +245,7 @@ def _base_block(block: Any) -> BaseBlock | None:
 
 def _scaled_body(settings: Mapping[str, Any], unit: UnitSpec) -> Any:
     """The body silicone of ``unit`` with ``body_bulk_scale`` and ``body_shear_scale`` applied, or None (both 1)."""
-    scales = [checks.real(settings.get(key, 1.0), f"[model] {key}", *SCALE_RANGE, error=SearchConfigError)
+    scales = [checks.real(settings.get(key, 1.0), f"[model] {key}", *SCALE_RANGES[key], error=SearchConfigError)
               for key in ("body_bulk_scale", "body_shear_scale")]
     if scales == [1.0, 1.0]:
         return None  # the library's material: every earlier fingerprint stays valid

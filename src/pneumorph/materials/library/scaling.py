@@ -22,7 +22,7 @@ def scaled_bulk_modulus(material: Material, factor: float) -> Material:
     >>> round(scaled_bulk_modulus(get("mold_star_15"), 1.05).bulk_modulus.value * 1e3, 2)   # kPa
     124.95
     """
-    factor = checks.real(factor, "bulk modulus factor", 0.0, 100.0, low_open=True)
+    factor = checks.real(factor, "bulk modulus factor", 0.0, 1000.0, low_open=True)  # to nearly incompressible
     q = material.bulk_modulus
     if q is None:
         raise MaterialDataError(f"{material.name!r} has no bulk modulus to scale")

@@ -26,6 +26,7 @@ from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
+from pneumorph.fem.fast.mixed import MIXED_BULK_RATIO
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -41,6 +42,9 @@ from pneumorph.models.response import FloatArray, Response
 
 #: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
 MODEL_REVISION = 1
+#: how a silicone's volumetric term is integrated: by its bulk modulus ("auto": the u-p-J form from a Poisson's ratio
+#: of 0.45), at every point ("displacement") or on each element's own dilatation ("u-p-J")
+FORMULATIONS = ("auto", "displacement", "u-p-J")
 
 
 @dataclass(frozen=True)
@@ -142,8 +146,10 @@ class FEModel:
         filler: FillerLaw | None = None, backend: str | None = None, gravity: str | Sequence[float] | None = None,
         temperature_change: float = 0.0, passage: float = 0.0, base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None, library: UnitLibrary | None = None,
+        formulation: str = "auto",
     ) -> None:
         self.backend = check_backend(backend or self.backends[0], self.backends)
+        self.formulation = checks.text(formulation, "formulation", FORMULATIONS)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.library = model_library(unit, library)
         self.unit = self.library[self.library.default]
@@ -184,6 +190,9 @@ class FEModel:
                     raise MaterialDataError(f"a temperature change needs the thermal expansion of {material.name!r}, "
                                             "which has none (Table A.6 gives it for the built-in silicones); add "
                                             "one to its material entry or leave the temperature unchanged")
+        if self.backend != "fast" and any(self.element_volume(m) for m in self.silicones.values()):
+            raise SettingsError("the u-p-J form of a nearly incompressible silicone is integrated by the fast "
+                                "backend only (the default)")
         if self.gravity is not None:
             for material in self.silicones.values():
                 if material.density is None:
@@ -198,7 +207,8 @@ class FEModel:
         """The constructor's arguments that give this model (see :meth:`variant`)."""
         out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
                                "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
-                               "base_block": self.base_block, "materials": dict(self.materials)}
+                               "base_block": self.base_block, "materials": dict(self.materials),
+                               "formulation": self.formulation}
         if not self.library.is_single:
             out["library"] = self.library
         return out
@@ -251,6 +261,8 @@ class FEModel:
             out["base_block"] = {**self.base_block.to_dict(), "material_data": self.base.to_dict()}
         if self.mixed:  # likewise: a one-type library is described by its unit alone
             out["library"] = self.library.to_dict()
+        if self.formulation != "auto":  # likewise ("auto" follows from the materials, which are described)
+            out["formulation"] = self.formulation
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -277,9 +289,25 @@ class FEModel:
             return 1.0
         return 1.0 + material.thermal_expansion.value * self.temperature_change
 
+    def element_volume(self, material: Any) -> bool:
+        """Whether ``material``'s volumetric term is integrated on each element's own dilatation (the u-p-J form,
+        :mod:`pneumorph.fem.fast.mixed`): always with ``formulation = "u-p-J"``, never with ``"displacement"``; by
+        default (``"auto"``) for a nearly incompressible silicone, its bulk modulus at least
+        :data:`~pneumorph.fem.fast.mixed.MIXED_BULK_RATIO` times its shear modulus (Poisson's ratio 0.45 or more).
+
+        >>> from pneumorph.materials import get
+        >>> from pneumorph.models.fe.reduced2d import Reduced2D
+        >>> Reduced2D(2).element_volume(get("mold_star_15")), Reduced2D(2, formulation="u-p-J").element_volume(
+        ...     get("mold_star_15"))
+        (False, True)
+        """
+        if self.formulation != "auto":
+            return self.formulation == "u-p-J"
+        return bool(material.bulk_modulus.value >= MIXED_BULK_RATIO * material.shear_modulus)
+
     def _silicone_umat(self, material: Any) -> OgdenCompressible:
         return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value,
-                                 self.thermal_stretch(material))
+                                 self.thermal_stretch(material), mixed=self.element_volume(material))
 
     def _extra_regions(self, mesh: ActuatorMesh) -> tuple[list[tuple[str, Any, Any]], Any]:
         """Further material regions (the 2D filler) and a callback ``set_pressure(p)`` for them."""

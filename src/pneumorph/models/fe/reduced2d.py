@@ -83,6 +83,7 @@ class Reduced2D(FEModel):
         base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None,
         library: UnitLibrary | None = None,
+        formulation: str = "auto",
     ) -> None:
         lib = model_library(unit, library)
         sideways = [s for s, spec in zip(lib.symbols, lib.units, strict=True) if spec.layer_side]
@@ -92,7 +93,7 @@ class Reduced2D(FEModel):
                                 "the 3D model (fidelity \"3d\", --model 3d)")
         first = lib[lib.default]
         super().__init__(n_units, unit, ramp_spec, filler or first.filler_law() or get_filler(), backend, gravity,
-                         base_block=base_block, materials=materials, library=library)
+                         base_block=base_block, materials=materials, library=library, formulation=formulation)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         #: the filler law of every unit type: the given one for all, else each unit's calibrated law, else
