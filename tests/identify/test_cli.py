@@ -95,7 +95,7 @@ def test_identify_writes_a_model_that_simulate_reads(trace: Path, unit: Path, tm
     assert code == 0, err
     result = json.loads(stdout)
     wall = result["parameters"]["wall"]
-    assert set(result["parameters"]) == {"bulk_modulus_scale", "shear_modulus_scale", "side_wall", "wall", "layer"}
+    assert set(result["parameters"]) == {"body_bulk_scale", "body_shear_scale", "side_wall", "wall", "layer"}
     assert wall["value"] == pytest.approx(1.58, abs=0.02) and 0 < wall["standard_error"] < 0.01
     assert result["parameters"]["side_wall"]["identified"] is False
     assert result["residual_rms"]["after"]["all_mm"] < 0.5 * result["residual_rms"]["before"]["all_mm"]

@@ -21,8 +21,8 @@ def test_a_photo_trace_recovers_the_wall_and_says_what_2d_cannot_tell_apart(coar
     # the section has no side walls; plane strain cannot tell the bulk modulus from the shear modulus,
     # nor (one design) the wall from the layer: said, not guessed
     assert p["side_wall"]["note"] == "the scans do not depend on it" and not p["side_wall"]["fitted"]
-    assert not p["bulk_modulus_scale"]["identified"] and not p["shear_modulus_scale"]["identified"]
-    assert "shear_modulus_scale" in p["bulk_modulus_scale"]["note"]
+    assert not p["body_bulk_scale"]["identified"] and not p["body_shear_scale"]["identified"]
+    assert "body_shear_scale" in p["body_bulk_scale"]["note"]
     assert not p["layer"]["identified"] and "wall" in p["layer"]["note"]
     # with parameters fixed for being confounded, the fitted ones absorb their change: none stands alone
     assert not r.identified.any() and "absorbs" in p["wall"]["note"]
@@ -38,9 +38,9 @@ def test_fitting_only_what_a_trace_can_tell_recovers_it(coarse: ParameterSet) ->
     """Shear modulus known (coupons) and layer known: the bulk modulus and the wall from two traces."""
     truth = coarse.nominal + TRUTH
     obs = [synthetic(coarse, truth, d, "2d", seed=k) for k, d in enumerate(("011001", "000000"))]
-    r = identify(obs, coarse, SerialEvaluator(), {"fidelity": "2d"}, ["bulk_modulus_scale", "wall"])
+    r = identify(obs, coarse, SerialEvaluator(), {"fidelity": "2d"}, ["body_bulk_scale", "wall"])
     values, errors = r.values, r.standard_errors
-    assert r.free == ("bulk_modulus_scale", "wall")
+    assert r.free == ("body_bulk_scale", "wall")
     assert abs(values[0] - truth[0]) < max(0.01, 3 * errors[0])
     assert abs(values[3] - truth[3]) < 0.02
     assert np.all(np.isnan(errors[[1, 2, 4]])) and np.all(values[[1, 2, 4]] == coarse.nominal[[1, 2, 4]])

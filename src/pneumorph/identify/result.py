@@ -33,7 +33,7 @@ def identified_toml(result: Identification, **extra: Any) -> str:
     >>> r = Identification(np.array([1.06, 1, 1.5, 1.58, 3]), np.array([1.0, 1, 1.5, 1.5, 3]),
     ...     np.array([0.001, np.nan, np.nan, 0.004, 0.01]), np.array([1, 0, 0, 1, 1], bool),
     ...     np.array([1, 0, 0, 1, 1], bool), ("", "fixed", "fixed", "", ""), np.eye(3),
-    ...     ("bulk_modulus_scale", "wall", "layer"), np.array([2.0]), np.array([0.05]), np.array([2.0]),
+    ...     ("body_bulk_scale", "wall", "layer"), np.array([2.0]), np.array([0.05]), np.array([2.0]),
     ...     np.array([0.05]), 0.05, 2, 12, {"fidelity": "2d", "unit": {"wall": 1.58}, "body_bulk_scale": 1.06}, ("f",))
     >>> data = tomllib.loads(identified_toml(r))
     >>> data["model"]["unit"]["wall"], data["provenance"]["standard_error"]["wall"]

@@ -26,7 +26,7 @@ from pneumorph.cli.options.execution import cluster_report, execution_options, o
 @click.option("--scale", type=P.Real(0.0, 1e6, low_open=True),
               help="mm per unit of SCAN (a photo's mm per pixel), instead of --scan-unit.")
 @click.option("--fit", "fit_names", metavar="NAMES", type=P.Text(200),
-              help="The parameters to fit, comma-separated (default all: bulk_modulus_scale, shear_modulus_scale, "
+              help="The parameters to fit, comma-separated (default all: body_bulk_scale, body_shear_scale, "
                    "side_wall, wall, layer); the others stay at nominal.")
 @click.option("--tolerance", type=P.Real(0.0, 1.0, low_open=True, unit="mm"), default=0.1, show_default=True,
               help="The thicknesses are fitted within +- this of nominal (every mould in the box is meshed alike).")
