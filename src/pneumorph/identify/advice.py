@@ -119,7 +119,7 @@ def rank(found: Directions, normal: FloatArray, further: Sequence[tuple[ScanSpec
     confounded = " and ".join(n for n, ok in zip(found.names, now, strict=True) if not ok)
     weakest = float(directions(normal, found.sigma, found.names, found.spans, found.points).errors().max())
     pressures = ", ".join(f"{p:g}" for p in sorted({s.pressure_kpa for s in scanned}))
-    out = []
+    out: list[dict[str, Any]] = []
     for spec, extra in further:
         after = directions(normal + extra, found.sigma, found.names, found.spans, found.points)
         gained = [n for n, k in zip(found.names, determined(after) & ~now, strict=True) if k]

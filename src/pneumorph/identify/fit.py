@@ -296,7 +296,7 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     found = state.directions
     held = [] if found is None else [
         {"combination": found.combination(j), "scan_change_mm": found.scan_change(j),
-         "standard_error": float(found.errors()[j])} for j in np.flatnonzero(found.held)]
+         "standard_error": float(found.errors()[j])} for j in map(int, np.flatnonzero(found.held))]
     weakest = float("nan") if found is None else float(
         directions(state.normal, found.sigma, found.names, found.spans, found.points).errors().max())
     advice: list[dict[str, Any]] = []

@@ -202,7 +202,7 @@ def gauss_newton_step(state: FitState, dim: int, shapes: Sequence[ModelShape], d
                                    upper[state.idx] - state.theta[state.idx], state.scale)
         found = analyse(state, r, a)
         state.hold = found.vectors[:, found.held]
-        for j in np.flatnonzero(found.held):
+        for j in map(int, np.flatnonzero(found.held)):
             say(f"the scans do not determine {found.combination(j)} (it changes them by "
                 f"{found.scan_change(j):.2g} mm RMS; standard error {found.errors()[j]:.2g} plausible changes): "
                 "held at nominal")
@@ -268,7 +268,7 @@ def verdicts(state: FitState, lower: FloatArray, upper: FloatArray
         name = NAMES[i]
         note = ""
         if shares[c] > MAX_SHARE:
-            combos = "; ".join(found.combination(j) for j in np.flatnonzero(found.held)
+            combos = "; ".join(found.combination(j) for j in map(int, np.flatnonzero(found.held))
                                if abs(found.vectors[c, j]) >= 0.1)
             note = (f"confounded: moves with {combos}, which the scans do not determine "
                     f"({shares[c]:.2g} of a plausible change per plausible change of it)")
