@@ -120,6 +120,18 @@ def test_a_3d_scan_identifies_all_five(coarse: ParameterSet) -> None:
     assert r.residual_after[0] < 1.1 * SIGMA < r.residual_before[0]
 
 
+@pytest.mark.slow
+def test_two_3d_scans_of_a_softer_cast_identify_both_moduli(coarse: ParameterSet) -> None:
+    """What a trace cannot tell apart, a surface can: both scales x0.94 and the wall -0.08 mm, two 3-unit designs
+    at one pressure, every parameter identified within its errors of the truth."""
+    truth = coarse.nominal + np.array([-0.06, -0.06, 0.0, -0.08, 0.0])
+    obs = [synthetic(coarse, truth, d, "3d", seed=k) for k, d in enumerate(("010", "000"))]
+    r = identify(obs, coarse, SerialEvaluator(), {"fidelity": "3d"})
+    assert r.converged and bool(r.identified.all()) and not r.combinations and not r.advice
+    assert all(within(r, truth, name) for name in NAMES)
+    assert abs(r.values[0] - truth[0]) < 0.02 and abs(r.values[1] - truth[1]) < 0.02
+
+
 def test_the_linearised_outline_moves_with_its_end_points() -> None:
     """A 2D residual's derivative is the normal component of its segment's interpolated motion."""
     nodes = np.array([[0.0, 0.0], [10.0, 0.0]])
