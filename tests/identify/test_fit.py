@@ -7,8 +7,10 @@ from typing import Any
 import numpy as np
 import pytest
 
+from pneumorph.correlation import ModelShape, Transform
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
-from pneumorph.identify import NAMES, ParameterSet, identify
+from pneumorph.identify import NAMES, SPANS, ParameterSet, identify
+from pneumorph.identify.gaussnewton import FitState, accept
 from pneumorph.identify.linear import LinearisedScan
 from tests.identify.conftest import SIGMA, synthetic
 
@@ -140,3 +142,21 @@ def test_the_linearised_outline_moves_with_its_end_points() -> None:
     assert abs(r[0]) == pytest.approx(1.0) and abs(d[0, 0]) == pytest.approx(1.0 + 0.25 * 2.0)
     r2, _ = lin.match(np.array([[2.5, 1.0]]), np.array([0.1]))
     assert abs(r2[0]) == pytest.approx(1.0 - 0.15, abs=1e-3)  # the segment tilts by 0.02 rad
+
+
+def test_a_step_that_raises_the_residual_is_taken_back() -> None:
+    """The trust region: a point fitting worse than the one its step came from is refused and the region shrinks to
+    a quarter of that step; a better one is taken and the region grows back."""
+    outline = np.array([[[0.0, 0.0], [10.0, 0.0]]])
+    shape = ModelShape(np.zeros((0, 3)), np.zeros(0, bool), outline, np.zeros((1, 2)), 10.0, np.zeros((0, 3)))
+    # 1 mm either side of the line in turn: a rigid motion removes only their mean offset (1/9 mm; no tilt helps)
+    points = [np.c_[np.linspace(1.0, 9.0, 9), (-1.0) ** np.arange(9)]]
+    best = 9 - 9 * (1 / 9) ** 2
+    state = FitState(np.zeros(len(NAMES)), ["wall"], {}, [Transform(np.eye(2), np.zeros(2))])
+    state.step, state.cost = np.array([0.2]), 4.0
+    assert not accept(state, [shape], points, 2, lambda text: None)
+    assert state.radius == pytest.approx(0.25 * 0.2 / SPANS["wall"]) and state.cost == 4.0
+    state.cost = 20.0
+    assert accept(state, [shape], points, 2, lambda text: None)
+    assert state.cost == pytest.approx(best, rel=1e-9)  # aligned afresh
+    assert state.radius == pytest.approx(0.25 * 0.2 / SPANS["wall"] * 2)
