@@ -69,5 +69,5 @@ def test_design_with_a_model_file_reports_the_nominal_design(tmp_path: Path) -> 
                                               'identified = ["wall", "layer"]\n', encoding="utf-8")
     warned = runner.invoke(cli, args)
     assert warned.exit_code == 0, warned.output
-    assert ("did not identify bulk_modulus_scale, shear_modulus_scale, side_wall (fixed at nominal or confounded)"
+    assert ("did not identify body_bulk_scale, body_shear_scale, side_wall (fixed at nominal or confounded)"
             in warned.stderr)

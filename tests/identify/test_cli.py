@@ -95,7 +95,7 @@ def test_identify_writes_a_model_that_simulate_reads(trace: Path, unit: Path, tm
     assert code == 0, err
     result = json.loads(stdout)
     wall = result["parameters"]["wall"]
-    assert set(result["parameters"]) == {"bulk_modulus_scale", "shear_modulus_scale", "side_wall", "wall", "layer"}
+    assert set(result["parameters"]) == {"body_bulk_scale", "body_shear_scale", "side_wall", "wall", "layer"}
     assert wall["value"] == pytest.approx(1.58, abs=0.02) and 0 < wall["standard_error"] < 0.01
     assert result["parameters"]["side_wall"]["identified"] is False
     assert result["residual_rms"]["after"]["all_mm"] < 0.5 * result["residual_rms"]["before"]["all_mm"]
@@ -113,3 +113,30 @@ def test_identify_writes_a_model_that_simulate_reads(trace: Path, unit: Path, tm
     assert simulated["levels"][-1]["tip_mm"] == pytest.approx(expected.tolist(), abs=1e-9)
     nominal = make_model(6, {"pressure_kpa": 36, "unit": {"element_size": 3.0}}).evaluate("011001").tip[-1]
     assert np.linalg.norm(np.array(simulated["levels"][-1]["tip_mm"]) - nominal) > 0.1
+
+
+def test_the_command_names_what_it_cannot_identify_and_what_to_scan_next(trace: Path, unit: Path, tmp_path: Path,
+                                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """One trace: the walls identified, the moduli's combination named, the further scans weighed; one name per
+    parameter in the printed table, identify.json and identified.toml."""
+    out = tmp_path / "out"
+    code, stdout, err = run(["identify", str(trace), "--design", "011001", "--pressure", "36", "--model", "2d",
+                             "--unit", str(unit), "--executor", "serial", "--cache", str(tmp_path / "c.sqlite"),
+                             "--out", str(out)], capsys)
+    assert code == 0, err
+    lines = stdout.splitlines()
+    assert lines[0].split() == ["parameter", "unit", "nominal", "value", "std", "err", "confounded", "identified"]
+    rows = {line.split()[0]: line.split() for line in lines[1:6]}
+    assert rows["wall"][1] == "mm" and rows["wall"][5] == "0.0054" and rows["wall"][6] == "yes"
+    assert rows["body_bulk_scale"][1] == "-" and rows["body_bulk_scale"][6] == "no"
+    held = next(line for line in lines if line.startswith("not determined by these scans: "))
+    assert held.startswith("not determined by these scans: body_bulk_scale +0.047 with body_shear_scale -0.01"), held
+    advice = next(line for line in lines if line.startswith("scan next: "))
+    assert "cannot tell body_bulk_scale and body_shear_scale apart" in advice
+    assert any("none of the 4 further scans weighed identifies them" in line for line in lines)
+    saved = json.loads((out / "identify.json").read_text())
+    model = tomllib.loads((out / "identified.toml").read_text())
+    assert list(saved["parameters"]) == list(rows) == list(model["provenance"]["value"])
+    assert {"body_bulk_scale", "body_shear_scale"} <= set(model["model"])
+    assert model["provenance"]["identified"] == ["wall", "layer"]
+    assert model["provenance"]["next_scans"] == [advice.removeprefix("scan next: ")]

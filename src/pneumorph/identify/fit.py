@@ -17,15 +17,20 @@ The method (docs/identify.md):
    parameters and every scan's rigid alignment are solved together by bounded linear
    least squares (:func:`scipy.optimize.lsq_linear`), the nearest points matched again
    at every step, until the step vanishes.
-4. **Iterate** 2-3 at the new parameters until the parameter step is below a tenth of its
+4. **Iterate** 2-3 at the new parameters in a trust region (a step that raises the FE model's
+   residual is taken back and shortened) until the parameter step is below a tenth of its
    standard error (or 0.001), then **confirm**: solve at the fitted parameters and measure
    each scan as ``correlate`` does (the residual RMS *after*).
 
 The standard errors are those of linear least squares, ``s^2 (J^T J)^-1`` with the
 alignment parameters in ``J`` (so a parameter that a rigid motion could mimic is not
-credited), ``s^2`` the residual variance. Parameters the scans cannot tell apart
-(|correlation| > :data:`MAX_CORRELATION`, a near-singular ``J^T J``, or a standard error
-larger than a plausible change) are fixed at nominal and reported as not identified.
+credited), ``s^2`` the residual variance. The combinations of parameters the scans do not
+determine (eigenvectors of ``J^T J`` whose standard error exceeds
+:data:`~pneumorph.identify.linear.MAX_DIRECTION_ERROR` plausible changes, or whose eigenvalue
+is below :data:`~pneumorph.identify.linear.MIN_EIGENVALUE` of the largest) are held at
+nominal; every parameter outside them is fitted and identified with its standard error, those
+in them are reported as confounded, with the combination (:func:`~pneumorph.identify.advice.next_scans`
+ranks the further scans that would determine it).
 """
 
 from __future__ import annotations
@@ -40,10 +45,12 @@ from numpy.typing import NDArray
 
 from pneumorph.correlation.compare import ModelShape, check_units
 from pneumorph.correlation.scans import Scan
-from pneumorph.errors import FitError, ScanError
+from pneumorph.errors import FitError, PressureRangeError, ScanError, SearchConfigError
+from pneumorph.identify.advice import candidate_normal, candidates, rank
 from pneumorph.identify.extent import chain_shapes
 from pneumorph.identify.gaussnewton import (
     FitState,
+    accept,
     confirmed,
     gauss_newton_step,
     nominal_alignment,
@@ -51,12 +58,7 @@ from pneumorph.identify.gaussnewton import (
     trial_points,
     verdicts,
 )
-from pneumorph.identify.linear import (
-    MAX_CORRELATION,
-    MIN_EIGENVALUE,
-    confounded,
-    correlation_of,
-)
+from pneumorph.identify.linear import MAX_DIRECTION_ERROR, MAX_SHARE, MIN_EIGENVALUE, correlation_of, directions
 from pneumorph.identify.match import check_coverage, check_size
 from pneumorph.identify.parameters import NAMES, ParameterSet, parameter_indices
 from pneumorph.identify.probe import JacobianProbe, ShapeProbe, shape_of, variant_shapes
@@ -67,8 +69,8 @@ FloatArray = NDArray[np.float64]
 
 #: scan points used per scan (a seeded sample of larger scans)
 MAX_POINTS = 4000
-#: the Gauss-Newton iterations (FE Jacobians) before the fit is declared not converged
-MAX_ITERATIONS = 6
+#: the iterations (FE Jacobians) before the fit stops at its best point, declared not converged
+MAX_ITERATIONS = 8
 
 
 @dataclass(frozen=True)
@@ -87,9 +89,12 @@ class Identification:
     ----------
     values, nominal, standard_errors : ndarray, shape (5,)
         In the order of :data:`~pneumorph.identify.parameters.NAMES` (scales, then mm);
-        the standard error is NaN for a parameter that was not fitted.
+        the standard error is NaN for a parameter that was not fitted. It holds the
+        combinations the scans do not determine where they are (``confounded_errors``: how
+        far they could move it).
     fitted, identified : ndarray of bool, shape (5,)
-        Fitted by the least squares; fitted and not confounded with another parameter.
+        Fitted by the least squares; fitted, determined by the scans (not moving with a
+        combination they do not determine), within the box and converged.
     notes : tuple of str
         Per parameter, why it is not identified (empty when it is).
     correlation : ndarray, shape (k, k)
@@ -110,6 +115,21 @@ class Identification:
         The ``[model]`` settings of the fitted model (unit and scales).
     fingerprints : tuple of str
         The fitted model's fingerprint per scan (its pressure).
+    confounded_errors : ndarray, shape (5,)
+        How far each fitted parameter moves per plausible change of the combinations held (its
+        unit; 0 for a parameter outside them, NaN for one not fitted).
+    combinations : tuple of dict
+        The combinations the scans do not determine: ``combination`` (one plausible change of
+        it, in the parameters' units), ``scan_change_mm`` (the RMS change of the scans along
+        it), ``standard_error`` (in plausible changes).
+    converged : bool
+        The steps became small before :data:`MAX_ITERATIONS` (else the best point is kept,
+        the parameters still moving not identified).
+    advice : tuple of dict
+        The further scans weighed, best first (:func:`~pneumorph.identify.advice.rank`).
+    weakest_error : float
+        The standard error of the combination of the fitted parameters the scans determine
+        least (none held), in plausible changes: what a further scan would lower.
     """
 
     values: FloatArray
@@ -130,15 +150,21 @@ class Identification:
     settings: dict[str, Any]
     fingerprints: tuple[str, ...]
     observations: tuple[Observation, ...] = field(repr=False, default=())
+    confounded_errors: FloatArray = field(default_factory=lambda: np.full(len(NAMES), np.nan))
+    combinations: tuple[dict[str, Any], ...] = ()
+    converged: bool = True
+    advice: tuple[dict[str, Any], ...] = ()
+    weakest_error: float = float("nan")
 
     def parameters(self) -> dict[str, dict[str, Any]]:
-        """Per parameter: value, standard error, identified, fitted, nominal and a note."""
+        """Per parameter: value, standard error, confounded error, identified, fitted, nominal, unit and a note."""
         out = {}
         for i, name in enumerate(NAMES):
-            se = float(self.standard_errors[i])
+            se, ce = float(self.standard_errors[i]), float(self.confounded_errors[i])
             out[name] = {"value": float(self.values[i]), "standard_error": se if np.isfinite(se) else None,
+                         "confounded_error": ce if np.isfinite(ce) else None,
                          "identified": bool(self.identified[i]), "fitted": bool(self.fitted[i]),
-                         "nominal": float(self.nominal[i]), "unit": "mm" if i >= 2 else "scale",
+                         "nominal": float(self.nominal[i]), "unit": "mm" if i >= 2 else "-",
                          "note": self.notes[i]}
         return out
 
@@ -153,6 +179,8 @@ class Identification:
                                  "measure": "surface" if self.observations and self.observations[0].scan.dim == 3
                                  else "outline"},
                 "sigma_mm": self.sigma, "iterations": self.iterations, "solves": self.solves,
+                "converged": self.converged, "undetermined": list(self.combinations), "next_scans": list(self.advice),
+                "weakest_error": self.weakest_error,
                 "scans": [o.spec.to_dict() for o in self.observations], "model": self.settings,
                 "fingerprints": list(self.fingerprints)}
 
@@ -182,7 +210,7 @@ def precheck_designs(observations: Sequence[Observation], params: ParameterSet, 
         A scan's unit or its design's unit count is wrong.
     """
     checked = 0
-    build_probes(observations, params, base, params.nominal)  # every model refused now
+    build_probes([o.spec for o in observations], params, base, params.nominal)  # every model refused now
     for o in observations:
         # the unit as given (the fit meshes it a little coarser or finer to keep its grid): its table's model
         shapes = chain_shapes({**base, "pressure_kpa": o.spec.pressure_kpa, "unit": params.unit.to_dict()},
@@ -195,7 +223,7 @@ def precheck_designs(observations: Sequence[Observation], params: ParameterSet, 
     return checked
 
 
-def build_probes(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any],
+def build_probes(specs: Sequence[ScanSpec], params: ParameterSet, base: dict[str, Any],
                  values: FloatArray) -> list[ShapeProbe]:
     """The probe of every scan's design at ``values`` (its model's ramp ends at the scan's pressure).
 
@@ -204,15 +232,14 @@ def build_probes(observations: Sequence[Observation], params: ParameterSet, base
     SearchConfigError, PressureRangeError
         A setting the model factory refuses, a pressure outside the model's range.
     """
-    return [ShapeProbe(make_model(len(o.spec.design), params.settings(values, {**base,
-                                                                              "pressure_kpa": o.spec.pressure_kpa})))
-            for o in observations]
+    return [ShapeProbe(make_model(len(s.design), params.settings(values, {**base, "pressure_kpa": s.pressure_kpa})))
+            for s in specs]
 
 
 def identify(observations: Sequence[Observation], params: ParameterSet, evaluator: Any,
              base: dict[str, Any] | None = None, parameters: Sequence[str] = NAMES, seed: int = 0,
              max_iterations: int = MAX_ITERATIONS, on_progress: Callable[[str], None] | None = None,
-             table_dir: str | Path | None = None) -> Identification:
+             table_dir: str | Path | None = None, advise: bool = True) -> Identification:
     """Fit ``parameters`` to the scans (see the module docstring; a fit solves the FE model many times, so
     its examples are ``tests/identify/test_fit.py``).
 
@@ -231,11 +258,14 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     seed, table_dir : int, path
         Seed of the sample of a scan's points (over :data:`MAX_POINTS`); kept chain tables, for
         the size check before any solve (:func:`precheck_designs`).
+    advise : bool
+        When a fitted parameter is not identified, solve the candidate further scans
+        (:mod:`pneumorph.identify.advice`) and rank them (``advice``).
 
     Raises
     ------
     FitError
-        A solve failed, or the fit did not converge in ``max_iterations``: nothing is identified.
+        A solve failed: nothing is identified.
     ScanError
         A scan far from its model's size (unit mistake), or a 3D scan against the 2D model.
     """
@@ -248,47 +278,97 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
         raise ScanError("a 3D scan needs the 3D model (--model 3d); a 2D model has no surface")
     points = [_sample(o.scan, seed + k) for k, o in enumerate(observations)]
     precheck_designs(observations, params, base, table_dir)  # every model refused now, before any solve
+    specs = [o.spec for o in observations]
     state = FitState(params.nominal.copy(), [NAMES[i] for i in parameter_indices(parameters)],
                      {name: "" for name in NAMES})
     trial = trial_points(state.theta, state.idx, params.upper)
     say(f"solving the nominal model of {len(observations)} scan(s) and its Jacobian ({len(trial)} warm-started "
         "solves each)")
-    shapes, moved = jacobian_at(observations, params, base, evaluator, state.theta, trial)
+    shapes, moved = jacobian_at(specs, params, base, evaluator, state.theta, trial)
     state.solves += len(observations) * (1 + len(trial))
     state.transforms, rms_before = nominal_alignment(observations, shapes, dim)
-    while True:
-        if state.iterations >= max_iterations:
-            raise FitError(f"the fit did not converge in {max_iterations} Gauss-Newton iterations (last step "
-                           f"{', '.join(f'{n} {d:+.3g}' for n, d in zip(state.free, state.step, strict=True))}); "
-                           "nothing is identified")
-        state.iterations += 1
-        if state.iterations > 1:  # the first is solved with the nominal shapes
-            trial = trial_points(state.theta, state.idx, params.upper)
-            say(f"iteration {state.iterations}: {len(observations)} ramp(s) and {len(trial) * len(observations)} "
-                f"warm-started solves for the Jacobian of {', '.join(state.free)}")
-            shapes, moved = jacobian_at(observations, params, base, evaluator, state.theta, trial)
-            state.solves += len(observations) * (1 + len(trial))
-        derivatives = shape_derivatives(observations, shapes, moved, state.idx, state.theta, trial, dim)
-        if gauss_newton_step(state, dim, shapes, derivatives, points, params.lower, params.upper, say):
-            break
+    _iterate(state, (specs, params, base, evaluator, points, dim), shapes, moved, trial, max_iterations, say)
     say("confirming the fit by FE")
-    final_shapes, _ = jacobian_at(observations, params, base, evaluator, state.theta, [])
+    final_shapes, _ = jacobian_at(specs, params, base, evaluator, state.theta, [])
     state.solves += len(observations)
     rms_after, residual_after = confirmed(observations, final_shapes, points, state.transforms, dim)
-    errors, fitted, identified = verdicts(state, params.lower, params.upper)
-    fingerprints = tuple(p.model.fingerprint() for p in build_probes(observations, params, base, state.theta))
+    errors, confounded_errors, fitted, identified = verdicts(state, params.lower, params.upper)
+    found = state.directions
+    held = [] if found is None else [
+        {"combination": found.combination(j), "scan_change_mm": found.scan_change(j),
+         "standard_error": float(found.errors()[j])} for j in map(int, np.flatnonzero(found.held))]
+    weakest = float("nan") if found is None else float(
+        directions(state.normal, found.sigma, found.names, found.spans, found.points).errors().max())
+    advice: list[dict[str, Any]] = []
+    if advise and not identified[fitted].all() and found is not None:
+        say("weighing further scans that would determine what these do not")
+        advice = _advice(state, (specs, params, base, evaluator, points, dim))
+    fingerprints = tuple(p.model.fingerprint() for p in build_probes(specs, params, base, state.theta))
     return Identification(
         values=state.theta, nominal=params.nominal, standard_errors=errors, fitted=fitted, identified=identified,
         notes=tuple(state.notes[n] for n in NAMES),
-        correlation=correlation_of(state.cov) if state.free else np.zeros((0, 0)), free=tuple(state.free),
-        rms_before=rms_before, rms_after=rms_after,
+        correlation=correlation_of(found.covariance()) if found is not None else np.zeros((0, 0)),
+        free=tuple(state.free), rms_before=rms_before, rms_after=rms_after,
         residual_before=(state.residual_before if state.residual_before is not None
                          else np.full(len(points), np.nan)),
         residual_after=residual_after, sigma=state.sigma, iterations=state.iterations, solves=state.solves,
-        settings=params.settings(state.theta, base), fingerprints=fingerprints, observations=tuple(observations))
+        settings=params.settings(state.theta, base), fingerprints=fingerprints, observations=tuple(observations),
+        confounded_errors=confounded_errors, combinations=tuple(held), converged=state.converged,
+        advice=tuple(advice), weakest_error=weakest)
 
 
-def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base: dict[str, Any], evaluator: Any,
+def _iterate(state: FitState, problem: tuple[Any, ...], shapes: list[ModelShape], moved: list[list[ModelShape]],
+             trial: list[FloatArray], max_iterations: int, say: Callable[[str], None]) -> None:
+    """The iterations from the nominal solve: each solved point accepted (or taken back), a step from the
+    best point, until the steps vanish or ``max_iterations`` FE Jacobians; ``state`` ends at the best point."""
+    specs, params, base, evaluator, points, dim = problem
+    best: tuple[FloatArray, list[ModelShape], list[FloatArray]] | None = None
+    while True:
+        state.iterations += 1
+        if state.iterations > 1:
+            trial = trial_points(state.theta, state.idx, params.upper)
+            say(f"iteration {state.iterations}: {len(specs)} ramp(s) and {len(trial) * len(specs)} "
+                f"warm-started solves for the Jacobian of {', '.join(state.free)}")
+            shapes, moved = jacobian_at(specs, params, base, evaluator, state.theta, trial)
+            state.solves += len(specs) * (1 + len(trial))
+        derivatives = shape_derivatives(specs, shapes, moved, state.idx, state.theta, trial, dim)
+        if accept(state, shapes, points, dim, say) or best is None:
+            best = (state.theta.copy(), shapes, derivatives)
+        else:
+            state.theta, shapes, derivatives = best[0].copy(), best[1], best[2]
+        if gauss_newton_step(state, dim, shapes, derivatives, points, params.lower, params.upper, say):
+            return
+        if state.iterations >= max_iterations:
+            state.theta = best[0].copy()
+            say(f"not converged in {max_iterations} iterations: the best point kept, the parameters still moving "
+                "not identified")
+            return
+
+
+def _advice(state: FitState, problem: tuple[Any, ...]) -> list[dict[str, Any]]:
+    """The candidates of :func:`~pneumorph.identify.advice.candidates` the model accepts, solved at the fit with
+    their Jacobians, ranked (:func:`~pneumorph.identify.advice.rank`)."""
+    specs, params, base, evaluator, points, dim = problem
+    assert state.directions is not None
+    further = []
+    for spec in candidates(specs):
+        try:
+            build_probes([spec], params, base, state.theta)
+        except (PressureRangeError, SearchConfigError):
+            continue  # a pressure the model refuses: not a scan to advise
+        further.append(spec)
+    if not further:
+        return []
+    trial = trial_points(state.theta, state.idx, params.upper)
+    shapes, moved = jacobian_at(further, params, base, evaluator, state.theta, trial)
+    state.solves += len(further) * (1 + len(trial))
+    derivatives = shape_derivatives(further, shapes, moved, state.idx, state.theta, trial, dim)
+    size = int(np.mean([len(p) for p in points]))
+    normals = [candidate_normal(s, d, dim, state.scale, size) for s, d in zip(shapes, derivatives, strict=True)]
+    return rank(state.directions, state.normal, list(zip(further, normals, strict=True)), specs)
+
+
+def jacobian_at(specs: Sequence[ScanSpec], params: ParameterSet, base: dict[str, Any], evaluator: Any,
                 values: FloatArray, trial: list[FloatArray]) -> tuple[list[ModelShape], list[list[ModelShape]]]:
     """Every scan's shape at ``values`` and at each of the ``trial`` points: one case per scan, its ramp at
     ``values`` and the trial points warm-started from it (:class:`~pneumorph.identify.probe.JacobianProbe`).
@@ -298,15 +378,15 @@ def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base:
     FitError
         A solve failed.
     """
-    points_of = [build_probes(observations, params, base, v) for v in trial]
-    cases = [(JacobianProbe(probe.model, [p[s].model for p in points_of]), observations[s].spec.design)
-             for s, probe in enumerate(build_probes(observations, params, base, values))]
-    at: list[Any] = [None] * len(observations)
-    moved: list[list[Any]] = [[None] * len(observations) for _ in trial]
+    points_of = [build_probes(specs, params, base, v) for v in trial]
+    cases = [(JacobianProbe(probe.model, [p[s].model for p in points_of]), specs[s].design)
+             for s, probe in enumerate(build_probes(specs, params, base, values))]
+    at: list[Any] = [None] * len(specs)
+    moved: list[list[Any]] = [[None] * len(specs) for _ in trial]
     for s, outcome in evaluator.iter_cases(cases):
         if not outcome.ok or outcome.response is None:
-            raise FitError(f"the fit's solve of design {observations[s].spec.design} at "
-                           f"{observations[s].spec.pressure_kpa:g} kPa (the Jacobian at "
+            raise FitError(f"the fit's solve of design {specs[s].design} at "
+                           f"{specs[s].pressure_kpa:g} kPa (the Jacobian at "
                            f"{', '.join(f'{n} {x:.6g}' for n, x in zip(NAMES, values, strict=True))}) failed: "
                            f"{outcome.failure}; nothing is identified")
         at[s] = shape_of(outcome.response)
@@ -316,14 +396,15 @@ def jacobian_at(observations: Sequence[Observation], params: ParameterSet, base:
 
 
 __all__ = [
-    "MAX_CORRELATION",
+    "MAX_DIRECTION_ERROR",
     "MAX_ITERATIONS",
     "MAX_POINTS",
+    "MAX_SHARE",
     "MIN_EIGENVALUE",
     "Identification",
     "Observation",
     "build_probes",
-    "confounded",
     "identify",
+    "jacobian_at",
     "precheck_designs",
 ]

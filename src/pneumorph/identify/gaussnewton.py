@@ -1,6 +1,7 @@
 """The steps of an identification: the scans aligned to the nominal model, the shapes' derivatives, one
-Gauss-Newton step (confounded parameters fixed at the first), the fit checked by FE and the verdict on
-each parameter. :func:`pneumorph.identify.fit.identify` runs them in order.
+step of the fit in a trust region (the combinations the scans do not determine held where they were), a
+step checked against the FE model's residual, the fit checked by FE and the verdict on each parameter.
+:func:`pneumorph.identify.fit.identify` runs them in order.
 """
 
 from __future__ import annotations
@@ -16,11 +17,16 @@ from numpy.typing import NDArray
 from pneumorph.correlation.compare import ModelShape, check_units, correlate
 from pneumorph.errors import FitError
 from pneumorph.identify.linear import (
+    MAX_DIRECTION_ERROR,
+    MAX_SHARE,
+    NO_EFFECT,
+    Directions,
     LinearisedScan,
     LinearisedState,
-    confounded,
+    directions,
     linearised_system,
-    scaled_covariance,
+    project_out,
+    residual_sigma,
     shape_nodes,
     solve_linearised,
 )
@@ -29,7 +35,8 @@ from pneumorph.identify.parameters import NAMES, SPANS, STEPS
 
 FloatArray = NDArray[np.float64]
 
-#: a Gauss-Newton step is at most this many plausible changes (``SPANS``) of each parameter
+#: the trust region: a step moves each parameter by at most this many plausible changes (``SPANS``); a
+#: step that raises the FE model's residual is taken back and the region shrunk to a quarter of it
 TRUST = 3.0
 #: the iterations stop when every step is below this fraction of its standard error ...
 STEP_FRACTION = 0.1
@@ -39,11 +46,13 @@ STEP_FLOOR = 1e-3
 
 @dataclass
 class FitState:
-    """What the Gauss-Newton iterations carry from one to the next.
+    """What the iterations carry from one to the next.
 
-    ``free`` are the parameters still fitted (confounded ones leave at the first iteration,
-    their reason in ``notes``); ``transforms`` each scan's alignment; ``cov`` and ``sigma`` the
-    scaled covariance of the last step and the residual's scale.
+    ``free`` are the parameters fitted (those the scans do not depend on leave at the first
+    iteration, their reason in ``notes``); ``hold`` the combinations of them the scans do not
+    determine (found at the first iteration, kept where they were by every step); ``transforms``
+    each scan's alignment; ``directions`` the last step's analysis of ``J^T J``; ``radius`` the
+    trust region in plausible changes; ``cost`` the residual's sum of squares at ``theta``.
     """
 
     theta: FloatArray
@@ -51,9 +60,14 @@ class FitState:
     notes: dict[str, str]
     transforms: list[Any] = field(default_factory=list)
     residual_before: FloatArray | None = None
-    cov: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    hold: FloatArray | None = None
+    directions: Directions | None = None
+    normal: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
     sigma: float = float("nan")
     step: FloatArray = field(default_factory=lambda: np.zeros(0))
+    radius: float = TRUST
+    cost: float = float("inf")
+    converged: bool = False
     solves: int = 0
     iterations: int = 0
 
@@ -61,6 +75,11 @@ class FitState:
     def idx(self) -> list[int]:
         """The free parameters' indices in :data:`~pneumorph.identify.parameters.NAMES`."""
         return [NAMES.index(n) for n in self.free]
+
+    @property
+    def scale(self) -> FloatArray:
+        """The free parameters' plausible changes."""
+        return np.array([SPANS[n] for n in self.free])
 
 
 def trial_points(theta: FloatArray, idx: list[int], upper: FloatArray) -> list[FloatArray]:
@@ -93,37 +112,78 @@ def nominal_alignment(observations: Sequence[Any], shapes: Sequence[ModelShape],
     return transforms, np.array(before)
 
 
-def shape_derivatives(observations: Sequence[Any], shapes: Sequence[ModelShape],
+def shape_derivatives(specs: Sequence[Any], shapes: Sequence[ModelShape],
                       moved: Sequence[Sequence[ModelShape]], idx: list[int], theta: FloatArray,
                       trial: list[FloatArray], dim: int) -> list[FloatArray]:
     """Per scan, the derivatives of its model's nodes by each parameter of ``idx`` (forward differences to the
-    ``trial`` points' shapes ``moved[j][s]``)."""
+    ``trial`` points' shapes ``moved[j][s]``; ``specs``: the scans' designs and pressures)."""
     derivatives = []
-    for s in range(len(observations)):
+    for s in range(len(specs)):
         nodes, _ = shape_nodes(shapes[s], dim)
         per = []
         for j, i in enumerate(idx):
             other, _ = shape_nodes(moved[j][s], dim)
             if other.shape != nodes.shape:
-                raise FitError(f"the mesh of design {observations[s].spec.design} changed with {NAMES[i]} "
+                raise FitError(f"the mesh of design {specs[s].design} changed with {NAMES[i]} "
                                f"({other.shape[0]} against {nodes.shape[0]} surface nodes); nothing is identified")
             per.append((other - nodes) / (trial[j][i] - theta[i]))
         derivatives.append(np.array(per).reshape(len(idx), *nodes.shape))
     return derivatives
 
 
-def linearised(problem: tuple[Any, ...], chosen: list[int], columns: list[int]
-               ) -> tuple[LinearisedState, FloatArray, FloatArray, list[LinearisedScan], FloatArray]:
-    """The linearised problem of the ``columns`` of the Jacobian (parameters ``chosen``), solved."""
-    dim, shapes, derivatives, points, transforms, lower, upper = problem
+def linearise(shapes: Sequence[ModelShape], derivatives: Sequence[FloatArray] | None, dim: int
+              ) -> list[LinearisedScan]:
+    """Each scan's shape with its nodes' derivatives (none: the shape alone)."""
     lins = []
-    for shape, d in zip(shapes, derivatives, strict=True):
+    for s, shape in enumerate(shapes):
         nodes, normals = shape_nodes(shape, dim)
-        lins.append(LinearisedScan(dim, nodes, d[columns], normals))
-    scale = np.array([SPANS[NAMES[i]] for i in chosen])
-    state, r, a = solve_linearised(lins, points, transforms, np.maximum(lower[chosen], -TRUST * scale),
-                                    np.minimum(upper[chosen], TRUST * scale), scale)
-    return state, r, a, lins, scale
+        d = np.zeros((0, *nodes.shape)) if derivatives is None else derivatives[s]
+        lins.append(LinearisedScan(dim, nodes, d, normals))
+    return lins
+
+
+def aligned_cost(state: FitState, shapes: Sequence[ModelShape], points: Sequence[FloatArray], dim: int
+                 ) -> tuple[float, list[Any], FloatArray]:
+    """The residual's sum of squares of ``shapes`` with every scan aligned to its shape afresh, the
+    alignments and the residuals."""
+    solved, r, _ = solve_linearised(linearise(shapes, None, dim), points, state.transforms, np.zeros(0),
+                                    np.zeros(0), np.zeros(0))
+    return float(r @ r), solved.transforms, r
+
+
+def accept(state: FitState, shapes: Sequence[ModelShape], points: Sequence[FloatArray], dim: int,
+           say: Callable[[str], None]) -> bool:
+    """Whether the shapes at ``state.theta`` (the last step's point, solved) fit the scans better than the
+    point the step came from; if so they become the fit's point (its cost and alignments), else the trust
+    region shrinks to a quarter of the step."""
+    cost, transforms, r = aligned_cost(state, shapes, points, dim)
+    if state.residual_before is None:
+        state.residual_before = per_scan_rms(r, points)
+    if cost <= state.cost:
+        state.cost, state.transforms = cost, transforms
+        state.radius = min(TRUST, 2.0 * state.radius)
+        return True
+    state.radius = 0.25 * float(np.max(np.abs(state.step) / state.scale, initial=0.0))
+    say(f"  the step raised the residual to {np.sqrt(cost / len(r)):.4g} mm: taken back, trust region "
+        f"{state.radius:.3g} plausible changes")
+    return False
+
+
+def drop_no_effect(state: FitState, derivatives: list[FloatArray], lins: list[LinearisedScan],
+                   points: Sequence[FloatArray], say: Callable[[str], None]) -> list[LinearisedScan]:
+    """The parameters the scans do not depend on leave the fit (their columns dropped from ``derivatives``,
+    in place); the scans' linearisations without them."""
+    _, a, _ = linearised_system(lins, points, LinearisedState(np.zeros(len(state.free)), state.transforms),
+                                state.scale)
+    norms = np.linalg.norm(project_out(a, len(state.free)), axis=0)
+    keep = [c for c in range(len(state.free)) if norms[c] > NO_EFFECT * float(norms.max(initial=0.0))]
+    for c in range(len(state.free)):
+        if c not in keep:
+            state.notes[state.free[c]] = "the scans do not depend on it"
+            say(f"{state.free[c]}: the scans do not depend on it; fixed at nominal")
+    derivatives[:] = [d[keep] for d in derivatives]
+    state.free = [state.free[c] for c in keep]
+    return [LinearisedScan(lin.dim, lin.nodes, lin.derivatives[keep], lin.normals) for lin in lins]
 
 
 def gauss_newton_step(state: FitState, dim: int, shapes: Sequence[ModelShape], derivatives: list[FloatArray],
@@ -131,36 +191,48 @@ def gauss_newton_step(state: FitState, dim: int, shapes: Sequence[ModelShape], d
                       say: Callable[[str], None]) -> bool:
     """One step of the linearised fit from ``state`` (updated in place); True when it has converged.
 
-    At the first step the residual before the fit is kept, and parameters the scans cannot tell apart
-    (:func:`~pneumorph.identify.linear.confounded`) are fixed at nominal, with their reason in the notes.
+    At the first step the parameters the scans do not depend on leave the fit, and the combinations
+    they do not determine (:func:`~pneumorph.identify.linear.directions`) are held where they are
+    from then on, each said with its size; the step stays in the trust region ``state.radius``.
     """
-    idx = state.idx
-    columns = list(range(len(idx)))
-    problem = (dim, shapes, derivatives, points, state.transforms, lower - state.theta, upper - state.theta)
-    solved, r, a, lins, scale = linearised(problem, idx, columns)
-    if state.residual_before is None:
-        r0, _, _ = linearised_system(lins, points, LinearisedState(np.zeros(len(idx)), list(state.transforms)), scale)
-        state.residual_before = per_scan_rms(r0, points)
-        cov, _ = scaled_covariance(r, a, len(idx))
-        fixed = confounded(state.free, cov, np.linalg.norm(project_out(a, len(idx)), axis=0))
-        if fixed:
-            for name, why in fixed.items():
-                state.notes[name] = why
-                say(f"{name}: {why}; fixed at nominal")
-            columns = [c for c in columns if NAMES[idx[c]] not in fixed]
-            solved, r, a, lins, scale = linearised(problem, [idx[c] for c in columns], columns)
-            state.free = [NAMES[idx[c]] for c in columns]
-            idx = [idx[c] for c in columns]
-    state.cov, state.sigma = scaled_covariance(r, a, len(idx))
-    se = np.sqrt(np.maximum(np.diag(state.cov), 0.0)) * scale
+    lins = linearise(shapes, derivatives, dim)
+    if state.hold is None:
+        lins = drop_no_effect(state, derivatives, lins, points, say)
+        _, r, a = solve_linearised(lins, points, state.transforms, lower[state.idx] - state.theta[state.idx],
+                                   upper[state.idx] - state.theta[state.idx], state.scale)
+        found = analyse(state, r, a)
+        state.hold = found.vectors[:, found.held]
+        for j in map(int, np.flatnonzero(found.held)):
+            say(f"the scans do not determine {found.combination(j)} (it changes them by "
+                f"{found.scan_change(j):.2g} mm RMS; standard error {found.errors()[j]:.2g} plausible changes): "
+                "held at nominal")
+    idx, scale = state.idx, state.scale
+    solved, r, a = solve_linearised(lins, points, state.transforms,
+                                    np.maximum(lower[idx] - state.theta[idx], -state.radius * scale),
+                                    np.minimum(upper[idx] - state.theta[idx], state.radius * scale), scale,
+                                    hold=state.hold)
+    state.directions = analyse(state, r, a)
+    se = state.directions.standard_errors()
     state.step = solved.step
-    state.transforms = solved.transforms
     theta = state.theta.copy()
     theta[idx] = np.clip(theta[idx] + state.step, lower[idx], upper[idx])
     state.theta = theta
     say(f"  step {', '.join(f'{n} {d:+.4g}' for n, d in zip(state.free, state.step, strict=True))}; "
         f"residual {float(np.sqrt(np.mean(r**2))):.4g} mm")
-    return bool(np.all(np.abs(state.step) <= np.maximum(STEP_FRACTION * se, STEP_FLOOR)))
+    state.converged = bool(np.all(np.abs(state.step) <= np.maximum(STEP_FRACTION * se, STEP_FLOOR))
+                           or state.radius < STEP_FLOOR)
+    return state.converged
+
+
+def analyse(state: FitState, r: FloatArray, a: FloatArray) -> Directions:
+    """The combinations of the free parameters in the linearised problem ``(r, a)`` (those in
+    ``state.hold`` held); the residual's sigma kept in ``state``."""
+    k = len(state.free)
+    held = 0 if state.hold is None else state.hold.shape[1]
+    state.sigma = residual_sigma(r, a.shape[1] - held)
+    ap = project_out(a, k)
+    state.normal = ap.T @ ap
+    return directions(state.normal, state.sigma, state.free, state.scale, len(r), state.hold)
 
 
 def confirmed(observations: Sequence[Any], shapes: Sequence[ModelShape], points: Sequence[FloatArray],
@@ -171,52 +243,47 @@ def confirmed(observations: Sequence[Any], shapes: Sequence[ModelShape], points:
     for o, shape in zip(observations, shapes, strict=True):
         c = correlate(o.scan, shape)
         after.append(c.surface.rms if dim == 3 else c.outline.rms)
-    lins = []
-    for shape in shapes:
-        nodes, normals = shape_nodes(shape, dim)
-        lins.append(LinearisedScan(dim, nodes, np.zeros((0, *nodes.shape)), normals))
-    r, _, _ = linearised_system(lins, points, LinearisedState(np.zeros(0), list(transforms)), np.zeros(0))
+    r, _, _ = linearised_system(linearise(shapes, None, dim), points,
+                                LinearisedState(np.zeros(0), list(transforms)), np.zeros(0))
     return np.array(after), per_scan_rms(r, points)
 
 
-def verdicts(state: FitState, lower: FloatArray, upper: FloatArray) -> tuple[FloatArray, NDArray[np.bool_],
-                                                                               NDArray[np.bool_]]:
-    """Standard errors, which parameters were fitted and which are identified; the notes of those that are
-    not (at a bound of the box, fitted beside confounded ones, loosely determined) written into ``state``."""
+def verdicts(state: FitState, lower: FloatArray, upper: FloatArray
+             ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
+    """Standard errors, confounded errors (the change per plausible change of the combinations held),
+    which parameters were fitted and which are identified; the notes of those that are not (moving with
+    a held combination, at a bound of the box, loosely determined, still moving) written into ``state``."""
     idx = state.idx
-    errors = np.full(len(NAMES), np.nan)
-    errors[idx] = np.sqrt(np.maximum(np.diag(state.cov), 0.0)) * np.array([SPANS[n] for n in state.free])
+    errors, confounded = np.full(len(NAMES), np.nan), np.full(len(NAMES), np.nan)
     fitted = np.isin(np.arange(len(NAMES)), idx)
     identified = fitted.copy()
-    theta, notes = state.theta, state.notes
-    # fixing a confounded parameter at nominal moves every fitted one by its correlation with it (times the
-    # fixed one's error over its standard error: large when the scans are precise): none stands alone
-    partners = [n for n, why in notes.items() if why.startswith("cannot")]
-    for i in idx:
+    found = state.directions
+    if found is None:
+        return errors, confounded, fitted, identified
+    errors[idx] = found.standard_errors()
+    shares = found.shares()
+    confounded[idx] = shares * found.spans
+    se = np.maximum(STEP_FRACTION * errors[idx], STEP_FLOOR)
+    for c, i in enumerate(idx):
         name = NAMES[i]
-        if min(theta[i] - lower[i], upper[i] - theta[i]) <= 1e-9:
+        note = ""
+        if shares[c] > MAX_SHARE:
+            combos = "; ".join(found.combination(j) for j in map(int, np.flatnonzero(found.held))
+                               if abs(found.vectors[c, j]) >= 0.1)
+            note = (f"confounded: moves with {combos}, which the scans do not determine "
+                    f"({shares[c]:.2g} of a plausible change per plausible change of it)")
+        elif min(state.theta[i] - lower[i], upper[i] - state.theta[i]) <= 1e-9:
+            note = (f"at the bound of the box ({lower[i]:g} to {upper[i]:g}); the scans ask for more "
+                    "(widen --tolerance)")
+        elif errors[i] > MAX_DIRECTION_ERROR * SPANS[name]:  # a plausible change moves the scans less than noise
+            note = (f"loosely determined: standard error {errors[i]:.3g}, more than a plausible change "
+                    f"({SPANS[name]:g})")
+        elif not state.converged and abs(state.step[c]) > se[c]:
+            note = f"still moving when the iterations stopped (last step {state.step[c]:+.3g})"
+        if note:
             identified[i] = False
-            notes[name] = (f"at the bound of the box ({lower[i]:g} to {upper[i]:g}); the scans ask for more "
-                           "(widen --tolerance)")
-        elif partners:
-            identified[i] = False
-            notes[name] = (f"fitted with {', '.join(partners)} fixed at nominal: its value absorbs their change "
-                           "from nominal")
-        elif errors[i] > SPANS[name]:  # a plausible change moves the scans less than their scatter
-            identified[i] = False
-            notes[name] = (f"loosely determined: standard error {errors[i]:.3g}, more than a plausible change "
-                           f"({SPANS[name]:g})")
-    return errors, fitted, identified
-
-
-def project_out(a: FloatArray, k: int) -> FloatArray:
-    """The first ``k`` columns of ``a`` with their parts along the other (alignment) columns removed.
-
-    >>> project_out(np.array([[1.0, 1.0], [1.0, 0.0]]), 1).ravel().tolist()
-    [0.0, 1.0]
-    """
-    q, _ = np.linalg.qr(a[:, k:])
-    return a[:, :k] - q @ (q.T @ a[:, :k])
+            state.notes[name] = note
+    return errors, confounded, fitted, identified
 
 
 def per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
@@ -229,5 +296,6 @@ def per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
     return np.array([float(np.sqrt(np.mean(r[a:b] ** 2))) for a, b in pairwise(bounds)])
 
 
-__all__ = ["STEP_FLOOR", "STEP_FRACTION", "TRUST", "FitState", "confirmed", "gauss_newton_step", "linearised",
-           "nominal_alignment", "per_scan_rms", "project_out", "shape_derivatives", "trial_points", "verdicts"]
+__all__ = ["STEP_FLOOR", "STEP_FRACTION", "TRUST", "FitState", "accept", "aligned_cost", "analyse", "confirmed",
+           "drop_no_effect", "gauss_newton_step", "linearise", "nominal_alignment", "per_scan_rms",
+           "shape_derivatives", "trial_points", "verdicts"]

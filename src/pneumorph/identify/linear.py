@@ -19,11 +19,17 @@ from pneumorph.correlation.compare import ModelShape, resample
 
 FloatArray = NDArray[np.float64]
 
-#: pairs of parameters correlated beyond this cannot be told apart
-MAX_CORRELATION = 0.95
-
-#: the smallest eigenvalue of the parameters' correlation matrix below which J^T J is near-singular
+#: a combination of the parameters whose standard error exceeds this many plausible changes
+#: (:data:`~pneumorph.identify.parameters.SPANS`) is not determined by the scans
+MAX_DIRECTION_ERROR = 1.0
+#: nor one whose eigenvalue of the scaled ``J^T J`` is below this fraction of the largest: a near-singular
+#: ``J^T J``, where the linearisation's error rather than the noise decides the step (the step oscillates)
 MIN_EIGENVALUE = 1e-3
+#: a parameter whose Jacobian column (alignment taken out) is below this fraction of the largest moves no scan
+NO_EFFECT = 1e-4
+#: a parameter that moves by more than this many of its plausible changes per plausible change of an
+#: undetermined combination is not identified (its value is where that combination was held)
+MAX_SHARE = 0.25
 
 
 # -- the shape of a model as nodes that move linearly with the parameters ----------------------
@@ -128,16 +134,26 @@ def linearised_system(lins: Sequence[LinearisedScan], points: Sequence[FloatArra
 
 
 def solve_linearised(lins: Sequence[LinearisedScan], points: Sequence[FloatArray], transforms: list[Transform],
-                      lower: FloatArray, upper: FloatArray, scale: FloatArray, max_steps: int = 60
-                      ) -> tuple[LinearisedState, FloatArray, FloatArray]:
-    """Gauss-Newton on the linearised shapes from a zero step: (state, residuals, Jacobian) at its end."""
+                      lower: FloatArray, upper: FloatArray, scale: FloatArray, hold: FloatArray | None = None,
+                      max_steps: int = 60) -> tuple[LinearisedState, FloatArray, FloatArray]:
+    """Gauss-Newton on the linearised shapes from a zero step: (state, residuals, Jacobian) at its end.
+
+    ``hold`` (free parameters x combinations, in units of ``scale``, orthonormal columns): combinations the
+    step keeps at zero (stiff rows ``w hold^T z = 0`` beside the scans' rows; residuals and Jacobian are
+    returned without them).
+    """
     state = LinearisedState(np.zeros(len(scale)), list(transforms))
+    k = len(scale)
+    held = np.zeros((k, 0)) if hold is None else hold
     for _ in range(max_steps):
         r, a, centres = linearised_system(lins, points, state, scale)
-        k = len(scale)
         lo = np.r_[(lower - state.step) / scale, np.full(a.shape[1] - k, -np.inf)]
         hi = np.r_[(upper - state.step) / scale, np.full(a.shape[1] - k, np.inf)]
-        z = lsq_linear(a, -r, bounds=(lo, hi), method="bvls" if a.shape[1] < 40 else "trf").x
+        w = 1e3 * max(float(np.linalg.norm(a[:, :k], axis=0).max(initial=0.0)), 1.0)
+        rows = np.zeros((held.shape[1], a.shape[1]))
+        rows[:, :k] = w * held.T
+        z = lsq_linear(np.vstack([a, rows]), -np.r_[r, w * held.T @ (state.step / scale)], bounds=(lo, hi),
+                       method="bvls" if a.shape[1] < 40 else "trf").x
         state.step = np.clip(state.step + z[:k] * scale, lower, upper)
         offset = k
         for s, lin in enumerate(lins):
@@ -153,74 +169,116 @@ def solve_linearised(lins: Sequence[LinearisedScan], points: Sequence[FloatArray
     return state, r, a
 
 
-def scaled_covariance(r: FloatArray, a: FloatArray, k: int) -> tuple[FloatArray, float]:
-    """The covariance of the first ``k`` (scaled) unknowns, ``s^2 (J^T J)^-1``, and ``s``."""
-    dof = max(len(r) - a.shape[1], 1)
-    sigma = float(np.sqrt(r @ r / dof))
-    normal = a.T @ a
-    try:
-        inverse = np.linalg.pinv(normal, rcond=1e-13, hermitian=True)
-    except np.linalg.LinAlgError:  # pragma: no cover - pinv of a symmetric matrix converges
-        inverse = np.full_like(normal, np.nan)
-    return np.asarray(sigma**2 * inverse[:k, :k], dtype=float), sigma
-
-
 def correlation_of(cov: FloatArray) -> FloatArray:
     d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
     return np.asarray(cov / np.outer(d, d), dtype=float)
 
 
-def confounded(names: Sequence[str], cov_scaled: FloatArray, column_norms: FloatArray) -> dict[str, str]:
-    """The parameters to fix, each with why: the scans do not move with it, or cannot tell it from another.
+def project_out(a: FloatArray, k: int) -> FloatArray:
+    """The first ``k`` columns of ``a`` with their parts along the other (alignment) columns removed.
 
-    ``cov_scaled`` is the covariance of the parameters in units of their plausible change
-    (:data:`~pneumorph.identify.parameters.SPANS`), ``column_norms`` the norms of their
-    Jacobian columns. Greedy: a parameter without effect first; then, while a pair is
-    correlated beyond :data:`MAX_CORRELATION` or the correlation matrix is near-singular,
-    the least determined parameter of the worst pair (or of the weakest direction). A
-    parameter that is merely loosely determined (its standard error above its plausible change) stays fitted: fixing it
-    would bias the others.
+    >>> project_out(np.array([[1.0, 1.0], [1.0, 0.0]]), 1).ravel().tolist()
+    [0.0, 1.0]
+    """
+    q, _ = np.linalg.qr(a[:, k:])
+    return a[:, :k] - q @ (q.T @ a[:, :k])
+
+
+@dataclass(frozen=True)
+class Directions:
+    """The combinations of the parameters the scans determine, and those they do not.
+
+    The eigenvectors of ``J^T J`` (``J``: the residuals' derivatives by the parameters in units of their
+    plausible changes ``spans``, the alignment taken out), each a combination of parameters;
+    its standard error is ``sigma / sqrt(eigenvalue)`` plausible changes.
+
+    Attributes
+    ----------
+    names, spans : the parameters and their plausible changes
+    eigenvalues : ndarray, shape (k,)
+        Of ``J^T J`` along each combination.
+    vectors : ndarray, shape (k, k)
+        The combinations as columns (unit length, in plausible changes).
+    held : ndarray of bool, shape (k,)
+        The combinations the scans do not determine (the fit keeps them where they were).
+    sigma : float
+        The residual's standard deviation, mm.
+    points : int
+        The scan points behind ``J``.
 
     Examples
     --------
-    >>> cov = np.array([[1.0, 1.08, 0.0], [1.08, 1.2, 0.0], [0.0, 0.0, 1.0]]) * 1e-4
-    >>> confounded(["a", "b", "c"], cov, np.ones(3))
-    {'b': 'cannot be told apart from a (correlation 0.986)'}
-    >>> confounded(["a", "b", "c"], np.diag([1e-4, 4.0, 1e-4]), np.array([1.0, 1.0, 0.0]))
-    {'c': 'the scans do not depend on it'}
-    """
-    out: dict[str, str] = {}
-    names = list(names)
-    keep = list(range(len(names)))
-    top = float(np.max(column_norms, initial=0.0))
-    for i in list(keep):
-        if column_norms[i] <= 1e-9 * max(top, 1e-300):
-            out[names[i]] = "the scans do not depend on it"
-            keep.remove(i)
-    while keep:
-        sub = cov_scaled[np.ix_(keep, keep)]
-        se = np.sqrt(np.maximum(np.diag(sub), 0.0))
-        if len(keep) < 2:
-            break
-        corr = correlation_of(sub)
-        off = np.abs(corr - np.eye(len(keep)))
-        i, j = (int(v) for v in np.unravel_index(int(np.argmax(off)), off.shape))
-        worst = float(off[i, j])
-        eigenvalues, vectors = np.linalg.eigh(corr)
-        if worst > MAX_CORRELATION:
-            drop = i if se[i] >= se[j] else j
-            other = j if drop == i else i
-            out[names[keep[drop]]] = (f"cannot be told apart from {names[keep[other]]} (correlation "
-                                      f"{corr[i, j]:.3g})")
-        elif eigenvalues[0] < MIN_EIGENVALUE:
-            weights = np.abs(vectors[:, 0])
-            drop = int(np.argmax(weights * se))
-            partners = [names[keep[m]] for m in np.argsort(-weights) if m != drop and weights[m] > 0.2]
-            out[names[keep[drop]]] = (f"cannot be told apart from a combination of {', '.join(partners)} (J^T J "
-                                      f"near-singular: smallest correlation eigenvalue {eigenvalues[0]:.2g})")
-        else:
-            break
-        del keep[drop]
-    return out
+    Two parameters that move the scans alike, and a third on its own:
 
-#: pairs of parameters correlated beyond this cannot be told apart
+    >>> j = np.array([[1.0, 1.0, 0.0], [1.0, 1.0001, 0.0], [0.0, 0.0, 2.0]]) * 100
+    >>> d = directions(j.T @ j, 0.05, ("a", "b", "c"), np.array([0.05, 0.05, 0.1]), 3)
+    >>> d.held.tolist(), d.combination(0)
+    ([True, False, False], 'a +0.035 with b -0.035')
+    >>> (d.shares().round(2).tolist(), d.standard_errors().round(6).tolist())
+    ([0.71, 0.71, 0.0], [9e-06, 9e-06, 2.5e-05])
+    """
+
+    names: tuple[str, ...]
+    spans: FloatArray
+    eigenvalues: FloatArray
+    vectors: FloatArray
+    held: NDArray[np.bool_]
+    sigma: float
+    points: int
+
+    def errors(self) -> FloatArray:
+        """Each combination's standard error, in plausible changes."""
+        return np.asarray(self.sigma / np.sqrt(np.maximum(self.eigenvalues, 1e-300)), dtype=float)
+
+    def covariance(self) -> FloatArray:
+        """The parameters' covariance in plausible changes, the held combinations fixed."""
+        v = self.vectors[:, ~self.held]
+        return np.asarray(self.sigma**2 * (v / np.maximum(self.eigenvalues[~self.held], 1e-300)) @ v.T, dtype=float)
+
+    def standard_errors(self) -> FloatArray:
+        """Each parameter's standard error in its own unit, the held combinations fixed."""
+        return np.sqrt(np.maximum(np.diag(self.covariance()), 0.0)) * self.spans
+
+    def shares(self) -> FloatArray:
+        """How far each parameter moves per plausible change of the held combinations, in its plausible changes."""
+        return np.asarray(np.sqrt((self.vectors[:, self.held] ** 2).sum(axis=1)), dtype=float)
+
+    def combination(self, j: int) -> str:
+        """Combination ``j`` in the parameters' units, one plausible change long (terms under 0.1 left out)."""
+        v = self.vectors[:, j] * np.sign(self.vectors[np.argmax(np.abs(self.vectors[:, j])), j])
+        return " with ".join(f"{n} {x * s:+.2g}" for n, x, s in zip(self.names, v, self.spans, strict=True)
+                             if abs(x) >= 0.1)
+
+    def scan_change(self, j: int) -> float:
+        """The RMS change of the scans' residuals, mm, along one plausible change of combination ``j``."""
+        return float(np.sqrt(max(self.eigenvalues[j], 0.0) / max(self.points, 1)))
+
+
+def directions(normal: FloatArray, sigma: float, names: Sequence[str], spans: FloatArray, points: int,
+               hold: FloatArray | None = None) -> Directions:
+    """The combinations of ``normal`` (``J^T J`` in plausible changes, alignment taken out): those whose
+    standard error exceeds :data:`MAX_DIRECTION_ERROR` plausible changes, or whose eigenvalue is below
+    :data:`MIN_EIGENVALUE` times the largest, are held; or ``hold`` (orthonormal columns) are.
+    """
+    if hold is None:
+        eigenvalues, vectors = np.linalg.eigh(normal)
+        top = float(max(eigenvalues.max(initial=0.0), 1e-300))
+        held = (sigma / np.sqrt(np.maximum(eigenvalues, 1e-300)) > MAX_DIRECTION_ERROR) | (
+            eigenvalues < MIN_EIGENVALUE * top)
+        return Directions(tuple(names), np.asarray(spans, float), eigenvalues, vectors, held, sigma, points)
+    p = np.eye(len(normal)) - hold @ hold.T
+    eigenvalues, vectors = np.linalg.eigh(p @ normal @ p)
+    kept = vectors[:, hold.shape[1]:]  # the null space of p is the held combinations
+    held_values = np.einsum("ij,ik,kj->j", hold, normal, hold)
+    return Directions(tuple(names), np.asarray(spans, float), np.r_[held_values, eigenvalues[hold.shape[1]:]],
+                      np.hstack([hold, kept]), np.r_[np.ones(hold.shape[1], bool), np.zeros(kept.shape[1], bool)],
+                      sigma, points)
+
+
+def residual_sigma(r: FloatArray, unknowns: int) -> float:
+    """The residual's standard deviation with ``unknowns`` fitted.
+
+    >>> residual_sigma(np.array([1.0, -1.0, 1.0, -1.0]), 2)
+    1.4142135623730951
+    """
+    return float(np.sqrt(r @ r / max(len(r) - unknowns, 1)))

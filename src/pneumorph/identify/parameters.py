@@ -1,8 +1,8 @@
 """The model inputs a scan can identify: two material scales and the three mould thicknesses of Fig E.4.
 
 ========================  ==========================================================
-``bulk_modulus_scale``    factor on the body silicone's bulk modulus (appendix E.1.2)
-``shear_modulus_scale``   factor on the body silicone's Ogden moduli (its shear modulus)
+``body_bulk_scale``       factor on the body silicone's bulk modulus (appendix E.1.2)
+``body_shear_scale``      factor on the body silicone's Ogden moduli (its shear modulus)
 ``side_wall``             the side walls, mm (Fig E.4; the 2D section has none)
 ``wall``                  the Mold Star wall on both sides of the cavity, mm
 ``layer``                 the Smooth-Sil layer, mm
@@ -32,16 +32,16 @@ from pneumorph.sensitivity.tolerances import FIELDS, PRINTED, Tolerance, box_uni
 
 FloatArray = NDArray[np.float64]
 
-#: the identified parameters, in the order of every array here
-NAMES = ("bulk_modulus_scale", "shear_modulus_scale", *FIELDS)
+#: the identified parameters, in the order of every array here; the scales are named as the model
+#: factory's settings (the ``[model]`` table ``--model-file`` reads), so one name serves the command's
+#: output, identify.json and identified.toml
+NAMES = ("body_bulk_scale", "body_shear_scale", *FIELDS)
 #: the material scales (dimensionless) and the thicknesses (mm)
 SCALES = NAMES[:2]
 #: forward-difference steps of the Jacobian: 2 % on a modulus, 0.05 mm on a thickness
-STEPS = {"bulk_modulus_scale": 0.02, "shear_modulus_scale": 0.02, "side_wall": 0.05, "wall": 0.05, "layer": 0.05}
+STEPS = {"body_bulk_scale": 0.02, "body_shear_scale": 0.02, "side_wall": 0.05, "wall": 0.05, "layer": 0.05}
 #: a plausible change of each parameter (5 %, 0.1 mm): the columns' scale, and the yardstick of "not constrained"
-SPANS = {"bulk_modulus_scale": 0.05, "shear_modulus_scale": 0.05, "side_wall": 0.1, "wall": 0.1, "layer": 0.1}
-#: the model factory's settings of the two scales
-SCALE_SETTINGS = {"bulk_modulus_scale": "body_bulk_scale", "shear_modulus_scale": "body_shear_scale"}
+SPANS = {"body_bulk_scale": 0.05, "body_shear_scale": 0.05, "side_wall": 0.1, "wall": 0.1, "layer": 0.1}
 
 
 @dataclass(frozen=True)
@@ -123,20 +123,20 @@ class ParameterSet:
         """The model factory's settings at ``values`` (``base``: the other settings, e.g. fidelity).
 
         The unit goes in as a table (``[model.unit]``), with the matched element size; the
-        scales as ``body_bulk_scale`` and ``body_shear_scale``.
+        scales under their own names (``body_bulk_scale``, ``body_shear_scale``).
         """
         v = self.check(values)
         out = {k: val for k, val in dict(base or {}).items() if k not in ("unit", "unit_file", "library")}
         out["unit"] = self.unit_at(v).to_dict()
         for name, x in zip(SCALES, v[:2], strict=True):
-            out[SCALE_SETTINGS[name]] = round(float(x), 12)
+            out[name] = round(float(x), 12)
         return out
 
 
 def parameter_indices(names: Any) -> list[int]:
     """Indices into :data:`NAMES` of ``names`` (refusing unknown ones).
 
-    >>> parameter_indices(["wall", "bulk_modulus_scale"])
+    >>> parameter_indices(["wall", "body_bulk_scale"])
     [0, 3]
     """
     unknown = [n for n in names if n not in NAMES]
@@ -145,4 +145,4 @@ def parameter_indices(names: Any) -> list[int]:
     return sorted(NAMES.index(n) for n in names)
 
 
-__all__ = ["NAMES", "SCALES", "SCALE_SETTINGS", "SPANS", "STEPS", "ParameterSet", "parameter_indices"]
+__all__ = ["NAMES", "SCALES", "SPANS", "STEPS", "ParameterSet", "parameter_indices"]

@@ -26,7 +26,7 @@ from pneumorph.cli.options.execution import cluster_report, execution_options, o
 @click.option("--scale", type=P.Real(0.0, 1e6, low_open=True),
               help="mm per unit of SCAN (a photo's mm per pixel), instead of --scan-unit.")
 @click.option("--fit", "fit_names", metavar="NAMES", type=P.Text(200),
-              help="The parameters to fit, comma-separated (default all: bulk_modulus_scale, shear_modulus_scale, "
+              help="The parameters to fit, comma-separated (default all: body_bulk_scale, body_shear_scale, "
                    "side_wall, wall, layer); the others stay at nominal.")
 @click.option("--tolerance", type=P.Real(0.0, 1.0, low_open=True, unit="mm"), default=0.1, show_default=True,
               help="The thicknesses are fitted within +- this of nominal (every mould in the box is meshed alike).")
@@ -44,7 +44,8 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
     """Fit the body silicone's bulk and shear modulus scales and the three mould thicknesses (side walls,
     Mold Star wall, Smooth-Sil layer) to scans of cast actuators, by least squares on the distances
     `correlate` measures; report each with its standard error, the correlations, the residuals before and
-    after, and which parameters the scans cannot tell apart. With --out, write the identified model
+    after, the combinations of parameters the scans do not determine (held at nominal, the others still
+    identified) and which further scan would determine them. With --out, write the identified model
     (identified.toml: a [model] table for design/simulate --model-file).
     """
 
@@ -132,23 +133,41 @@ def _scan_specs(scan: str | None, design: str | None, pressure: float | None, ma
 
 
 def _print_identification(result: Any, observations: list[Any], dim: int, out: str | None) -> None:
-    """The parameters, their correlations and the residuals, in words."""
+    """The parameters (each column with its unit), the combinations the scans do not determine, what to scan
+    next, the correlations and the residuals, in words."""
     from pathlib import Path
 
-    click.echo(f"{'parameter':<20} {'nominal':>9} {'value':>10} {'std err':>9}  identified")
+    click.echo(f"{'parameter':<17} {'unit':>4} {'nominal':>8} {'value':>9} {'std err':>9} {'confounded':>10}  "
+               "identified")
     for name, p in result.parameters().items():
-        se = "-" if p["standard_error"] is None else f"{p['standard_error']:.3g}"
+        se = "-" if p["standard_error"] is None else f"{p['standard_error']:.2g}"
+        ce = "-" if p["confounded_error"] is None else f"{p['confounded_error']:.2g}"
         note = f"  ({p['note']})" if p["note"] else ""
-        click.echo(f"{name:<20} {p['nominal']:9.4g} {p['value']:10.5g} {se:>9}  "
+        click.echo(f"{name:<17} {p['unit']:>4} {p['nominal']:8.4g} {p['value']:9.5g} {se:>9} {ce:>10}  "
                    f"{'yes' if p['identified'] else 'no'}{note}")
+    click.echo("(std err: the least-squares standard error; confounded: how far the parameter moves per plausible "
+               "change of a combination the scans do not determine; both in the parameter's unit)")
+    for c in result.combinations:
+        click.echo(f"not determined by these scans: {c['combination']} (it changes them by {c['scan_change_mm']:.2g} "
+                   f"mm RMS, against a residual sigma of {result.sigma:.2g} mm); held at nominal")
+    if result.advice:
+        click.echo(f"scan next: {result.advice[0]['why']}")
+        if not result.advice[0]["determines"]:
+            click.echo(f"  none of the {len(result.advice)} further scans weighed identifies them: take them from "
+                       "coupon tests and fit the others (--fit)")
+    if not result.converged:
+        click.echo("the iterations stopped before the steps became small: the best point is kept, the parameters "
+                   "still moving are not identified")
     if len(result.free) > 1:
-        click.echo("correlations of the fitted parameters:")
+        click.echo("correlations of the fitted parameters (the combinations not determined held):")
         for name, row in zip(result.free, result.correlation, strict=True):
-            click.echo(f"  {name:<20} " + " ".join(f"{v:+6.3f}" for v in row))
+            click.echo(f"  {name:<17} " + " ".join(f"{v:+6.3f}" for v in row))
     what = "surface" if dim == 3 else "outline"
-    for o, before, after in zip(observations, result.rms_before, result.rms_after, strict=True):
-        click.echo(f"  {Path(o.spec.file).name}: {what} RMS {before:.4g} mm at nominal, {after:.4g} mm identified")
-    click.echo(f"{result.iterations} Gauss-Newton iteration(s), {result.solves} solves (cache hits included), "
+    for o, before, after, fit_before, fit_after in zip(observations, result.rms_before, result.rms_after,
+                                                        result.residual_before, result.residual_after, strict=True):
+        click.echo(f"  {Path(o.spec.file).name}: fit residual (to the surface) {fit_before:.4g} mm at nominal, "
+                   f"{fit_after:.4g} mm identified; {what} RMS (as correlate) {before:.4g} mm, {after:.4g} mm")
+    click.echo(f"{result.iterations} iteration(s), {result.solves} solves (cache hits included), "
                f"residual sigma {result.sigma:.3g} mm")
     if out:
         click.echo(f"written to {Path(out)}/ (identified.toml, identify.json)")
