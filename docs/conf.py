@@ -246,8 +246,56 @@ class CommandHelp(SphinxDirective):
         return self.parse_text_to_nodes("\n".join(lines), allow_section_headings=True)
 
 
+class BenchApi(SphinxDirective):
+    """``.. bench-api::``: every route of the bench with its parameters, request and answer fields, as tables.
+
+    The tables are read from the app's own OpenAPI description (``create_app(...).openapi()``,
+    whose bodies and answers ``pneumorph.bench.schema`` describes), so the page follows the API.
+    """
+
+    def run(self) -> list[Node]:
+        import tempfile
+        from pathlib import Path
+
+        from pneumorph.bench import create_app
+        from pneumorph.bench.schema import field_rows
+
+        with tempfile.TemporaryDirectory() as root:
+            spec = create_app(Path(root) / "state", Path(root) / "cache.sqlite", answer_workers=0).openapi()
+        lines: list[str] = []
+        for path, operations in spec["paths"].items():
+            for method, op in operations.items():
+                title = f"``{method.upper()} {path}``"
+                lines += [title, "-" * len(title), "", op["summary"] + ".", ""]
+                params = [(p["name"], f"{p['in']}, {p['schema']['type']}", p["required"], p["description"])
+                          for p in op.get("parameters", [])]
+                lines += _field_table("Parameters", params)
+                for media, body in op.get("requestBody", {}).get("content", {}).items():
+                    lines += _field_table(f"Request body ({media}): {body['schema']['description']}",
+                                          field_rows(body["schema"]))
+                for status, answer in op["responses"].items():
+                    if status != "default":
+                        schema = answer.get("content", {}).get("application/json", {}).get("schema")
+                        rows = field_rows(schema) if schema else []
+                        lines += _field_table(f"Answer ({status}): {answer['description']}", rows) if rows else [
+                            f"Answer ({status}): {answer['description']}.", ""]
+        return self.parse_text_to_nodes("\n".join(lines), allow_section_headings=True)
+
+
+def _field_table(title: str, rows: list[tuple[str, str, bool, str]]) -> list[str]:
+    """An RST list-table of fields: name, type, whether required, what it is."""
+    if not rows:
+        return []
+    lines = [f".. list-table:: {title}", "   :header-rows: 1", "   :widths: 25 12 8 55", "",
+             "   * - field", "     - type", "     - required", "     - what"]
+    for name, kind, required, text in rows:
+        lines += [f"   * - ``{name}``", f"     - {kind}", f"     - {'yes' if required else ''}", f"     - {text}"]
+    return [*lines, ""]
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("exported-data", ExportedData)
+    app.add_directive("bench-api", BenchApi)
     app.add_directive("command-help", CommandHelp)
     app.connect("missing-reference", _resolve_by_object)
     app.connect("autodoc-skip-member", _skip_undocumented_class_members)
