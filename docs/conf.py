@@ -247,10 +247,11 @@ class CommandHelp(SphinxDirective):
 
 
 class BenchApi(SphinxDirective):
-    """``.. bench-api::``: every route of the bench with its parameters, request and answer fields, as tables.
+    """``{bench-api}`` in a Markdown page: every route of the bench with its parameters, request and answer fields.
 
     The tables are read from the app's own OpenAPI description (``create_app(...).openapi()``,
     whose bodies and answers ``pneumorph.bench.schema`` describes), so the page follows the API.
+    The text is Markdown, parsed by the page's parser (MyST).
     """
 
     def run(self) -> list[Node]:
@@ -265,8 +266,7 @@ class BenchApi(SphinxDirective):
         lines: list[str] = []
         for path, operations in spec["paths"].items():
             for method, op in operations.items():
-                title = f"``{method.upper()} {path}``"
-                lines += [title, "-" * len(title), "", op["summary"] + ".", ""]
+                lines += [f"### `{method.upper()} {path}`", "", op["summary"] + ".", ""]
                 params = [(p["name"], f"{p['in']}, {p['schema']['type']}", p["required"], p["description"])
                           for p in op.get("parameters", [])]
                 lines += _field_table("Parameters", params)
@@ -274,22 +274,21 @@ class BenchApi(SphinxDirective):
                     lines += _field_table(f"Request body ({media}): {body['schema']['description']}",
                                           field_rows(body["schema"]))
                 for status, answer in op["responses"].items():
+                    schema = answer.get("content", {}).get("application/json", {}).get("schema")
                     if status != "default":
-                        schema = answer.get("content", {}).get("application/json", {}).get("schema")
-                        rows = field_rows(schema) if schema else []
-                        lines += _field_table(f"Answer ({status}): {answer['description']}", rows) if rows else [
+                        lines += _field_table(f"Answer ({status}): {answer['description']}",
+                                              field_rows(schema) if schema else []) or [
                             f"Answer ({status}): {answer['description']}.", ""]
         return self.parse_text_to_nodes("\n".join(lines), allow_section_headings=True)
 
 
 def _field_table(title: str, rows: list[tuple[str, str, bool, str]]) -> list[str]:
-    """An RST list-table of fields: name, type, whether required, what it is."""
+    """A Markdown table of fields (name, type, whether required, what it is) under its title; none without rows."""
     if not rows:
         return []
-    lines = [f".. list-table:: {title}", "   :header-rows: 1", "   :widths: 25 12 8 55", "",
-             "   * - field", "     - type", "     - required", "     - what"]
-    for name, kind, required, text in rows:
-        lines += [f"   * - ``{name}``", f"     - {kind}", f"     - {'yes' if required else ''}", f"     - {text}"]
+    lines = [f"**{title}**", "", "| field | type | required | what |", "|---|---|---|---|"]
+    lines += [f"| `{name}` | {kind} | {'yes' if required else ''} | {text.replace('|', '/')} |"
+              for name, kind, required, text in rows]
     return [*lines, ""]
 
 
