@@ -246,8 +246,55 @@ class CommandHelp(SphinxDirective):
         return self.parse_text_to_nodes("\n".join(lines), allow_section_headings=True)
 
 
+class BenchApi(SphinxDirective):
+    """``{bench-api}`` in a Markdown page: every route of the bench with its parameters, request and answer fields.
+
+    The tables are read from the app's own OpenAPI description (``create_app(...).openapi()``,
+    whose bodies and answers ``pneumorph.bench.schema`` describes), so the page follows the API.
+    The text is Markdown, parsed by the page's parser (MyST).
+    """
+
+    def run(self) -> list[Node]:
+        import tempfile
+        from pathlib import Path
+
+        from pneumorph.bench import create_app
+        from pneumorph.bench.schema import field_rows
+
+        with tempfile.TemporaryDirectory() as root:
+            spec = create_app(Path(root) / "state", Path(root) / "cache.sqlite", answer_workers=0).openapi()
+        lines: list[str] = []
+        for path, operations in spec["paths"].items():
+            for method, op in operations.items():
+                lines += [f"### `{method.upper()} {path}`", "", op["summary"] + ".", ""]
+                params = [(p["name"], f"{p['in']}, {p['schema']['type']}", p["required"], p["description"])
+                          for p in op.get("parameters", [])]
+                lines += _field_table("Parameters", params)
+                for media, body in op.get("requestBody", {}).get("content", {}).items():
+                    lines += _field_table(f"Request body ({media}): {body['schema']['description']}",
+                                          field_rows(body["schema"]))
+                for status, answer in op["responses"].items():
+                    schema = answer.get("content", {}).get("application/json", {}).get("schema")
+                    if status != "default":
+                        lines += _field_table(f"Answer ({status}): {answer['description']}",
+                                              field_rows(schema) if schema else []) or [
+                            f"Answer ({status}): {answer['description']}.", ""]
+        return self.parse_text_to_nodes("\n".join(lines), allow_section_headings=True)
+
+
+def _field_table(title: str, rows: list[tuple[str, str, bool, str]]) -> list[str]:
+    """A Markdown table of fields (name, type, whether required, what it is) under its title; none without rows."""
+    if not rows:
+        return []
+    lines = [f"**{title}**", "", "| field | type | required | what |", "|---|---|---|---|"]
+    lines += [f"| `{name}` | {kind} | {'yes' if required else ''} | {text.replace('|', '/')} |"
+              for name, kind, required, text in rows]
+    return [*lines, ""]
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("exported-data", ExportedData)
+    app.add_directive("bench-api", BenchApi)
     app.add_directive("command-help", CommandHelp)
     app.connect("missing-reference", _resolve_by_object)
     app.connect("autodoc-skip-member", _skip_undocumented_class_members)

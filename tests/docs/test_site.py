@@ -73,8 +73,8 @@ def public_names() -> list[str]:
 
 def test_the_site_builds_without_warnings(site: Path) -> None:
     assert (site / "index.html").is_file() and (site / "reference" / "pneumorph.design.html").is_file()
-    for page in [*DOCS.glob("*.md"), *DOCS.glob("*.rst")]:
-        assert (site / f"{page.stem}.html").is_file(), page.name
+    for page in [*DOCS.glob("*.md"), *DOCS.glob("*.rst"), *DOCS.glob("tutorials/*.md"), *DOCS.glob("notes/*.md")]:
+        assert (site / page.relative_to(DOCS).with_suffix(".html")).is_file(), page.name
 
 
 def test_the_command_line_page_has_every_command(site: Path) -> None:
@@ -105,3 +105,16 @@ def test_the_example_pages_show_every_example_and_its_figures(site: Path) -> Non
     for path in sorted((DOCS / "figures" / "examples").glob("*.png")):
         assert path.name in results, f"{path.name} is not on the examples page"
         assert (site / "_images" / path.name).is_file(), path.name
+
+
+def test_the_bench_api_page_lists_every_route_and_field(site: Path) -> None:
+    pytest.importorskip("fastapi")
+    from pneumorph.bench.schema import ROUTES, field_rows
+
+    text = html.unescape(re.sub(r"<[^>]+>", "", (site / "bench-api.html").read_text(encoding="utf-8")))
+    text = text.replace("\u2019", "'").replace("\u2026", "...")  # Sphinx's smart quotes and ellipses
+    for (path, method), (summary, body, _status, answer) in ROUTES.items():
+        assert f"{method.upper()} {path}" in text and summary in text, (method, path)
+        for schema in [body[1] if body else None, answer]:
+            for name, _kind, _required, description in field_rows(schema or {}):
+                assert name in text and description.split(" (")[0].replace("`", "") in text, (path, name)

@@ -37,6 +37,7 @@ from pneumorph.bench.guard import (
 )
 from pneumorph.bench.jobs import JobBoard, JobLimits
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, load_json
+from pneumorph.bench.schema import describe
 from pneumorph.design.objectives.paths import PATH_PRESETS
 from pneumorph.design.objectives.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
@@ -225,6 +226,7 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     app.include_router(_answers_router(bench, board, answers))
     app.include_router(_units_router(bench, board))
     app.include_router(_jobs_router(bench, board))
+    describe(app)  # the bodies and answers in app.openapi(): docs/bench-api.md renders it
     return app
 
 
