@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.errors import PneumorphError
+from pneumorph.io.progress import duration_text
 from pneumorph.models.chain.fit import (
     DEFAULT_TOLERANCE,
     MAX_WINDOW,
@@ -59,21 +60,6 @@ def cost_fidelity(model: Any) -> str:
     model over sideways units (its training designs are solved on the full width)."""
     fidelity = str(getattr(model, "fidelity", "?"))
     return FULL_WIDTH if fidelity == "3d" and in_space(model) else fidelity
-
-
-def duration_text(seconds: float) -> str:
-    """A duration for people: ``45 s``, ``3.5 min``, ``1.2 h``.
-
-    >>> duration_text(0.37), duration_text(44.6), duration_text(210), duration_text(9000)
-    ('0.4 s', '45 s', '3.5 min', '2.5 h')
-    """
-    if seconds < 9.95:
-        return f"{seconds:.1f} s"
-    if seconds < 90:
-        return f"{seconds:.0f} s"
-    if seconds < 5400:
-        return f"{seconds / 60:.2g} min"
-    return f"{seconds / 3600:.2g} h"
 
 
 def estimate_text(solves: int, fidelity: str, n_units: int, workers: int) -> str:
@@ -328,4 +314,4 @@ def solve_estimate(model: Any, count: int) -> str:
 
 
 __all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "cost_fidelity",
-           "duration_text", "estimate_text", "evaluator_workers", "solve_estimate", "solve_seconds", "unit_text"]
+           "estimate_text", "evaluator_workers", "solve_estimate", "solve_seconds", "unit_text"]
