@@ -17,6 +17,20 @@ def reporter() -> Progress:
     return Progress(lambda text: click.echo(text, err=True))
 
 
+def plan_solves(lines: Progress, what: str, total: int, model: Any, executor: str, workers: int | None,
+                where: str | None = None, title: str | None = None) -> None:
+    """Say the plan of ``total`` FE solves of ``model`` (estimated by its fidelity's measured solve time, among
+    the workers the execution options make) and start counting them (:meth:`Progress.plan`)."""
+    from types import SimpleNamespace
+
+    from pneumorph.design.certified.planning import planned_workers
+    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
+
+    each = solve_seconds(cost_fidelity(model), int(getattr(model, "n_units", 0) or 0))
+    lines.plan(what, total, each=each, workers=planned_workers(SimpleNamespace(executor=executor, workers=workers)),
+               where=where, title=title)
+
+
 class RunLines:
     """A design run's lines on stderr, through the command's reporter (:func:`reporter`): its
     first line once it has started (an error before it stays one line), then the GA's generations with the time
@@ -72,4 +86,4 @@ class RunLines:
         return {"on_generation": self.on_generation, "on_progress": self.on_progress, "on_message": self.on_message}
 
 
-__all__ = ["RunLines", "reporter"]
+__all__ = ["RunLines", "plan_solves", "reporter"]

@@ -138,10 +138,12 @@ class Progress:
             self.said = str(text).strip()
 
     def plan(self, what: str, total: int, each: float | None = None, workers: int = 1, where: str | None = None,
-             noun: str = "solves", load: float | None = None, cores: int | None = None, done: int = 0) -> None:
+             noun: str = "solves", load: float | None = None, cores: int | None = None, done: int = 0,
+             title: str | None = None) -> None:
         """Start counting ``total`` items of ``what`` and say the plan: how many, the estimated wall time
         (from ``each`` seconds an item on one core of a quiet machine, :func:`estimate_seconds`) and where the
-        results go. ``done`` items are finished already (the rate counts the others)."""
+        results go. ``done`` items are finished already (the rate counts the others); ``title`` names the work
+        in the plan's line instead of ``what`` (which names it in the counted lines)."""
         with self.lock:
             self.what, self.noun, self.total, self.done, self.first = what, noun, int(total), int(done), int(done)
             self.started, self.detail = self.clock(), ""
@@ -152,16 +154,16 @@ class Progress:
                 f", estimated {duration_text(self.estimate)} ({duration_text(float(each or 0.0))} each, "
                 f"{workers} worker{'s' if workers > 1 else ''})")
             noun = noun[:-1] if int(total) == 1 and noun.endswith("s") else noun
-            self.say(f"{what}: {total} {noun}{cost}" + (f" -> {where}" if where else ""))
+            self.say(f"{title or what}: {total} {noun}{cost}" + (f" -> {where}" if where else ""))
 
-    def count(self, done: int, detail: str = "") -> None:
+    def count(self, done: int, detail: str = "", always: bool = False) -> None:
         """``done`` items of the plan are finished: a line if :data:`THROTTLE` seconds passed since the last
-        one, or at the last item."""
+        one, at the last item, or ``always`` (a failure)."""
         with self.lock:
             if not self.what:
                 return  # no count running (or it was said to its end)
             self.done = int(done)
-            if self.done >= self.total or self.clock() - self.last >= self.throttle:
+            if always or self.done >= self.total or self.clock() - self.last >= self.throttle:
                 self.say(f"  {self.status()}" + (f"; {detail}" if detail else ""))
             if self.done >= self.total:
                 self.what, self.detail = "", ""  # counted to the end: the heartbeat names the last line
