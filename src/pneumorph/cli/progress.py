@@ -4,17 +4,33 @@ output (its JSON modes clean)."""
 
 from __future__ import annotations
 
+import math
+import os
 import time
 from typing import Any
 
 import click
 
-from pneumorph.io.progress import Progress, duration_text
+from pneumorph.io.progress import HEARTBEAT, Progress, duration_text
 
 
 def reporter() -> Progress:
-    """A reporter writing each line to standard error (``with reporter() as say:`` runs its heartbeat)."""
-    return Progress(lambda text: click.echo(text, err=True))
+    """A reporter writing each line to standard error (``with reporter() as say:`` runs its heartbeat).
+
+    The heartbeat speaks after :data:`~pneumorph.io.progress.HEARTBEAT` seconds of silence, or after the seconds
+    in the environment variable ``PNEUMORPH_HEARTBEAT`` (a log file may want fewer lines; the contract's test
+    a shorter beat)."""
+    text = os.environ.get("PNEUMORPH_HEARTBEAT", "").strip()
+    heartbeat = HEARTBEAT
+    if text:
+        try:
+            heartbeat = float(text)
+        except ValueError:
+            heartbeat = float("nan")
+        if not (math.isfinite(heartbeat) and heartbeat > 0):
+            raise click.UsageError(f"PNEUMORPH_HEARTBEAT={text!r}: give the seconds of silence after which a long "
+                                   "command says it is still running, a number > 0 (default 7)")
+    return Progress(lambda line: click.echo(line, err=True), heartbeat=heartbeat)
 
 
 def plan_solves(lines: Progress, what: str, total: int, model: Any, executor: str, workers: int | None,

@@ -158,12 +158,12 @@ class Progress:
 
     def count(self, done: int, detail: str = "", always: bool = False) -> None:
         """``done`` items of the plan are finished: a line if :data:`THROTTLE` seconds passed since the last
-        one, at the last item, or ``always`` (a failure)."""
+        line (the heartbeat's aside), at the last item, or ``always`` (a failure)."""
         with self.lock:
             if not self.what:
                 return  # no count running (or it was said to its end)
             self.done = int(done)
-            if always or self.done >= self.total or self.clock() - self.last >= self.throttle:
+            if always or self.done >= self.total or self.clock() - self.said_at >= self.throttle:
                 self.say(f"  {self.status()}" + (f"; {detail}" if detail else ""))
             if self.done >= self.total:
                 self.what, self.detail = "", ""  # counted to the end: the heartbeat names the last line

@@ -10,6 +10,7 @@ no long build starts silently.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -17,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.errors import PneumorphError
-from pneumorph.io.progress import duration_text
+from pneumorph.io.progress import duration_text, load_factor
 from pneumorph.models.chain.fit import (
     DEFAULT_TOLERANCE,
     MAX_WINDOW,
@@ -302,14 +303,16 @@ def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | N
     return count
 
 
-def solve_estimate(model: Any, count: int) -> str:
-    """`` (about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units: the
-    full width's), or nothing."""
+def solve_estimate(model: Any, count: int, scale: float = 1.0) -> str:
+    """`` (3d, about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units:
+    the full width's; times ``scale``, e.g. a finer mesh's cells over the measured mesh's), slowed by what else
+    runs on this machine now (:func:`pneumorph.io.progress.load_factor`), or nothing."""
     fidelity = cost_fidelity(model)
     seconds = solve_seconds(fidelity, int(getattr(model, "n_units", 0) or 0))
     if not seconds:
         return ""
     each = " each" if count > 1 else ""
+    seconds *= scale * load_factor(min(max(1, count), os.cpu_count() or 1))
     return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
