@@ -12,11 +12,13 @@ from pneumorph.io.files import (
     write_json,
 )
 from pneumorph.io.lock import FileLock, RunLock
-from pneumorph.io.progress import Progress, duration_text, estimate_seconds
+from pneumorph.io.progress import HEARTBEAT, THROTTLE, Progress, duration_text, estimate_seconds, load_factor
 from pneumorph.io.provenance import digest, provenance
 from pneumorph.io.vtk import write_vtk_series
 
 __all__ = [
+    "HEARTBEAT",
+    "THROTTLE",
     "FileLock",
     "Progress",
     "RunLock",
@@ -28,6 +30,7 @@ __all__ = [
     "duration_text",
     "estimate_seconds",
     "json_safe",
+    "load_factor",
     "provenance",
     "strict_json",
     "write_json",

@@ -191,7 +191,7 @@ class Progress:
             return text
 
     def beat(self) -> None:
-        """The heartbeat's line, if :attr:`heartbeat` seconds passed without one."""
+        """The heartbeat's line, if ``heartbeat`` seconds passed without one."""
         with self.lock:
             now = self.clock()
             if now - self.last < self.heartbeat:
