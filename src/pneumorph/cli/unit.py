@@ -77,7 +77,7 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
                   f"{generations} generations, seed {seed}")
         # the base unit and each generation's candidates, at most (duplicates and cached ones are not solved)
         plan_solves(lines, "unit optimisation", 1 + pop_size * (generations + 1), _probe(settings), executor, workers,
-                    out, title="unit optimisation: at most")
+                    out, title="unit optimisation, at most")
         try:
             result = optimise(settings, evaluator, _on_candidate(lines),
                               lambda g, front: lines.say(f"  generation {g}: front of {len(front)}"))
