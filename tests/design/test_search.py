@@ -84,7 +84,9 @@ def test_symmetry_halves_the_solves(model: ToyModel) -> None:
         model, obj, CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:")), batch_size=32,
         on_progress=lambda done, total: progress.append((done, total)),
     )
-    assert progress[-1] == (256, 256) and len(progress) == 4  # 128 designs solved in batches of 32
+    assert progress[0] == (0, 256)  # said before the first solve
+    assert progress[-1] == (256, 256) and progress == sorted(progress)
+    assert len(progress) == 1 + 127 + 4  # as each of the other 127 solves finishes (with its mirror), and per batch
     full = run_exhaustive(model, obj, CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:")), symmetry=False)
     assert (half.solves, full.solves) == (129, 256)  # 128 + one mirror solved to verify the symmetry
     assert half.ranking == full.ranking

@@ -123,10 +123,15 @@ def test_the_cone_of_the_chords_turns_bounds_every_prefix_tighter_than_the_ball(
     assert tighter > 0
 
 
-def test_the_verifications_estimate_of_a_model_over_sideways_units_is_the_full_widths() -> None:
+def test_the_verifications_estimate_of_a_model_over_sideways_units_is_the_full_widths(
+        monkeypatch: pytest.MonkeyPatch) -> None:
     from pneumorph.models.chain.plan import solve_estimate
     from pneumorph.models.factory import make_model
 
+    monkeypatch.setattr("os.cpu_count", lambda: 2)
+    monkeypatch.setattr("os.getloadavg", lambda: (0.0, 0.0, 0.0))  # a quiet machine of 2 cores
     assert solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 15 s each)"
     assert solve_estimate(make_model(15, {"fidelity": "3d", "library": "spatial"}), 2) == (
         " (3d full-width, about 60 s each)")
+    monkeypatch.setattr("os.getloadavg", lambda: (2.0, 2.0, 2.0))  # two other processes busy: half a core each
+    assert solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 30 s each)"

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+from typing import Any
+
 import click
 
 from pneumorph.checks import MAX_STARTS, MAX_UNITS
 from pneumorph.cli.options import params as P
 from pneumorph.cli.options.execution import check_options, cluster_line, execution_options, open_evaluator
+from pneumorph.cli.progress import plan_solves, reporter
 
 
 @click.command("calibrate")
@@ -53,22 +57,35 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
                                  param_hint="'--pressures'")
     unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
 
-    def on_point(p) -> None:
-        click.echo(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
-                   f"(Eq 5.1 = {p.gamma:.4g} mm^2, {p.evaluations} 2D solves)", err=True)
+    from pneumorph.calibration.references import reference_jobs
 
+    jobs = len(reference_jobs(unit, n_units, levels, runs, seed, n_validate))
     evaluator = open_evaluator(executor, workers, scheduler, cache)  # the 3D references: solved first, into the cache
-    try:
-        if references_only:
-            solve_references(unit, n_units, levels, runs, seed, n_validate, evaluator.cache,
-                             on_reference=_echo_reference, evaluator=evaluator.inner)
-            done = None
-        else:
-            done = run_calibration(unit, n_units, levels, out, runs, seed, n_validate, weighting, evaluator.cache,
-                                   on_point, evaluator=evaluator.inner, on_reference=_echo_reference)
-    finally:
-        evaluator.close()
-        evaluator.cache.close()
+    with reporter() as lines:
+        plan_solves(lines, "3D references", jobs, SimpleNamespace(fidelity="3d", n_units=n_units), executor, workers,
+                    None if references_only else out, title=f"3D references ({runs} calibration, {n_validate} "
+                    f"validation)")
+
+        def on_point(p: Any) -> None:
+            lines.say(f"  run {p.run + 1}, {p.pressure * 1e3:5.1f} kPa, design {p.design}: E = {p.modulus:.5g} MPa "
+                      f"(Eq 5.1 = {p.gamma:.4g} mm^2, {p.evaluations} 2D solves)")
+
+        def on_reference(r: Any) -> None:
+            msg = f"curl {r.curl:.1f} deg" if r.failure is None else f"FAILED: {r.failure}"
+            lines.count(r.index, f"3D reference {r.index}/{r.total} ({r.kind}) {r.design}: {msg}, {r.seconds:.0f} s",
+                        always=True)
+
+        try:
+            if references_only:
+                solve_references(unit, n_units, levels, runs, seed, n_validate, evaluator.cache,
+                                 on_reference=on_reference, evaluator=evaluator.inner)
+                done = None
+            else:
+                done = run_calibration(unit, n_units, levels, out, runs, seed, n_validate, weighting, evaluator.cache,
+                                       on_point, evaluator=evaluator.inner, on_reference=on_reference)
+        finally:
+            evaluator.close()
+            evaluator.cache.close()
     if (line := cluster_line(evaluator)) is not None:
         click.echo(line, err=True)
     if done is None:
@@ -90,9 +107,3 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
             click.echo(f"  {p:5.1f} kPa: 2D-3D unit-centre distance mean {m:.3f} mm, max {x:.3f} mm")
     written = "calibration.json, calibration.png" + (", unit.toml" if done.unit is not None else "")
     click.echo(f"written to {done.folder}/ ({written})")
-
-
-def _echo_reference(r) -> None:
-    """One line per 3D reference, with its wall time."""
-    msg = f"curl {r.curl:.1f} deg" if r.failure is None else f"FAILED: {r.failure}"
-    click.echo(f"  3D reference {r.index}/{r.total} ({r.kind}) {r.design}: {msg}, {r.seconds:.0f} s", err=True)

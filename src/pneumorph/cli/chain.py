@@ -15,6 +15,7 @@ from pneumorph.cli.options.execution import (
     execution_options,
     open_evaluator,
 )
+from pneumorph.cli.progress import reporter
 
 
 @click.group("chain")
@@ -110,8 +111,9 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
                    "far": "split" if split else defaults["far"] if far is None else far}
         plan = build_plan(model, workers=evaluator_workers(evaluator), cached=cached_counter(evaluator, model),
                           **options)
-        click.echo(plan.text(), err=True)  # what will be built and its estimate, before the first solve
-        table = build_table(model, evaluator, on_progress=lambda text: click.echo(text, err=True), **options)
+        with reporter() as lines:  # its heartbeat speaks while a window's solves or fits run
+            lines.say(plan.text())  # what will be built and its estimate, before the first solve
+            table = build_table(model, evaluator, on_progress=lines, **options)
     finally:
         evaluator.close()
     cluster = cluster_report(evaluator)

@@ -12,6 +12,7 @@ import click
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli.options import params as P
 from pneumorph.cli.options.execution import check_options, execution_options
+from pneumorph.cli.progress import RunLines, reporter
 
 # the options that are [design] and [execution] settings of the same name
 _DESIGN_OPTIONS = ("amplitude", "periods", "point", "units", "search", "seed", "certify", "verify", "margin",
@@ -257,12 +258,18 @@ def _check_run(config: Any, model: Any, o: Any) -> None:
 
 def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, Any]:
     """The run and its model; a certified run the chain cannot represent (nothing written) falls back to the GA
-    (on the 2D model unless the fidelity was given)."""
+    (on the 2D model unless the fidelity was given). Its lines go through one reporter, whose heartbeat speaks in
+    any silence (a long FE verification, a table build, the figures)."""
+    with reporter() as lines:
+        return _run_with(config, model, o, fidelity_given, lines)
+
+
+def _run_with(config: Any, model: Any, o: Any, fidelity_given: bool, lines: Any) -> tuple[Any, Any]:
     from pneumorph.design import run_design
     from pneumorph.design.runs.folder import default_folder
     from pneumorph.errors import LocalityError
 
-    progress = _Progress(config, model, o.out or default_folder(config))
+    progress = RunLines(config, model, o.out or default_folder(config), lines)
     try:
         result = run_design(config, model, progress.folder, overwrite=o.overwrite, build=not o.no_build,
                             reference=o.reference, **progress.callbacks())
@@ -274,47 +281,10 @@ def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, An
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
     config = config.fallback(fidelity_given)
     model = config.make_model()
-    progress = _Progress(config, model, o.out or default_folder(config))  # the new run says its own first line
+    progress = RunLines(config, model, o.out or default_folder(config), lines)  # the new run's own first line
     result = run_design(config, model, progress.folder, overwrite=o.overwrite, **progress.callbacks())
     progress.announce()
     return result, model
-
-
-class _Progress:
-    """A run's lines on stderr: its first line once it has started (an error before it stays one line), then
-    the GA's generations, the exhaustive search's designs and the certified search's messages."""
-
-    def __init__(self, config: Any, model: Any, folder: str) -> None:
-        self.config, self.model, self.folder = config, model, folder
-        objective = config.make_objective()
-        self.label, self.unit = objective.label, objective.unit
-        self.said = False
-
-    def announce(self) -> None:
-        if not self.said:
-            self.said = True
-            c = self.config
-            units = f"{c.units} unit{'s' if c.units != 1 else ''}"
-            click.echo(f"designing {units} for {self.label} ({self.model.fidelity} model, {c.search}, "
-                       f"executor {c.executor}) -> {self.folder}", err=True)
-
-    def on_generation(self, stats: Any) -> None:
-        self.announce()
-        total, done = self.config.ga.generations, stats.generation
-        bar = "#" * int(20 * done / max(total, 1))
-        click.echo(f"  [{bar:<20}] generation {done:2d}/{total}: {stats.describe(self.unit)}", err=True)
-
-    def on_progress(self, done: int, total: int) -> None:
-        self.announce()
-        bar = "#" * int(20 * done / max(total, 1))
-        click.echo(f"  [{bar:<20}] {done}/{total} designs", err=True)
-
-    def on_message(self, text: str) -> None:
-        self.announce()
-        click.echo(f"  {text}", err=True)
-
-    def callbacks(self) -> dict[str, Any]:
-        return {"on_generation": self.on_generation, "on_progress": self.on_progress, "on_message": self.on_message}
 
 
 def _print_result(result: Any, config: Any, model: Any) -> None:

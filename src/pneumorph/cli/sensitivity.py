@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import sys
-import time
 from collections.abc import Callable
 from functools import partial
 from typing import Any
@@ -18,6 +17,7 @@ from pneumorph.cli.options.execution import (
     execution_options,
     open_evaluator,
 )
+from pneumorph.cli.progress import plan_solves, reporter
 
 
 def _common(command: Callable[..., Any], models: tuple[str, ...] = ("2d", "3d")) -> Callable[..., Any]:
@@ -75,20 +75,21 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
         _check_base_block(model, options["base"], common)
     study = BUILDERS[name](model, design, **options)  # every variant is built (and checked) before any solve
     total = len(study.cases) + 1
-    click.echo(f"{name} study of design {study.design} ({common['fidelity']} model, {model.n_units} units, "
-               f"{common['pressure']:g} kPa): {total} solves", err=True)
     evaluator = open_evaluator(common["executor"], common["workers"], common["scheduler"], common["cache"])
-    t0 = time.perf_counter()
 
     def progress(done: int, total: int, r: Any) -> None:
         state = "cached" if r.outcome.cached else ("solved" if r.outcome.ok else f"failed: {r.outcome.failure}")
         curl = f", curl {r.outcome.response.curl[-1]:.2f} deg" if r.outcome.ok else ""
-        click.echo(f"  [{done}/{total}] {r.case.label}: {state}{curl}  [{time.perf_counter() - t0:.0f} s]", err=True)
+        lines.count(done, f"{r.case.label}: {state}{curl}", always=not r.outcome.ok)
 
-    try:
-        result = run_study(study, evaluator, on_case=progress)
-    finally:
-        evaluator.close()
+    with reporter() as lines:
+        plan_solves(lines, f"{name} study", total, model, common["executor"], common["workers"], common["out"],
+                    title=f"{name} study of design {study.design} ({common['fidelity']} model, {model.n_units} "
+                    f"units, {common['pressure']:g} kPa)")
+        try:
+            result = run_study(study, evaluator, on_case=progress)
+        finally:
+            evaluator.close()
     if (line := cluster_line(evaluator)) is not None:
         click.echo(line, err=True)
     data = result.to_dict()
@@ -309,24 +310,25 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     parallel = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
     with P.blame("--size"):
         check_refinement(model, sizes, parallel=min(parallel, len(designs) * len(sizes)))
-    click.echo(f"mesh study ({fidelity} model, {n} units, {pressure:g} kPa): {len(designs)} design(s) x "
-               f"{len(sizes)} element size(s) = {len(designs) * len(sizes)} solves", err=True)
     evaluator = open_evaluator(executor, workers, scheduler, cache)
-    t0 = time.perf_counter()
     done = [0]
 
     def progress(point: Any) -> None:
         done[0] += 1
         state = (f"curl {point.curl:.4f} deg, value {point.value:.4g} {objective.unit}" if point.ok
                  else f"failed: {point.failure}")
-        click.echo(f"  [{done[0]}/{len(designs) * len(sizes)}] {point.design} at {point.element_size:g} mm "
-                   f"({point.cells:,} cells): {state}  [{time.perf_counter() - t0:.0f} s]", err=True)
+        lines.count(done[0], f"{point.design} at {point.element_size:g} mm ({point.cells:,} cells): {state}",
+                    always=True)  # each point a line: their element sizes differ in cost
 
-    try:
-        points = mesh_points(model, designs, sizes, partial(_objective_at_best, objective), evaluator,
-                             on_point=progress)
-    finally:
-        evaluator.close()
+    with reporter() as lines:
+        plan_solves(lines, "mesh study", len(designs) * len(sizes), model, executor, workers, out,
+                    title=f"mesh study ({fidelity} model, {n} units, {pressure:g} kPa; {len(designs)} design(s) x "
+                    f"{len(sizes)} element size(s))")
+        try:
+            points = mesh_points(model, designs, sizes, partial(_objective_at_best, objective), evaluator,
+                                 on_point=progress)
+        finally:
+            evaluator.close()
     study = MeshStudy(tuple(points), objective.label, order)
     data = study.to_dict()
     data["objective_unit"] = objective.unit

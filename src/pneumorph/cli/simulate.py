@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import sys
-import time
 from typing import Any
 
 import click
 
 from pneumorph.cli.options import params as P
+from pneumorph.cli.progress import reporter
 
 
 @click.command("simulate")
@@ -47,6 +47,7 @@ def simulate(
     """Inflate one actuator design and report its shape at every pressure level."""
     from pneumorph.io import provenance
     from pneumorph.models import make_model
+    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
 
     design = _check_design(orientation, library, unit_file)
     # the factory, as `design` and the API use it: the model class's tuned ramp, the same fingerprint
@@ -59,16 +60,14 @@ def simulate(
                                                           "increments": "increments", "gravity": "gravity"})
     fidelity = str(settings["fidelity"])
     model = make_model(len(design), settings)
-    t0 = time.perf_counter()
-
-    def progress(k: int, p: float) -> None:
-        click.echo(f"  level {k + 1:2d}/{increments}: {p * 1e3:7.3f} kPa converged  "
-                   f"[{time.perf_counter() - t0:6.1f} s]", err=True)
-
     weight = "" if gravity == "none" else f", {gravity} under gravity"
-    click.echo(f"simulating design {design} ({fidelity} model, {len(design)} units, {pressure:g} kPa{weight})",
-               err=True)
-    solution = model.solve(design, on_level=progress)
+    each, levels = solve_seconds(cost_fidelity(model), len(design)), len(model.pressures())  # one solve's levels
+    with reporter() as lines:
+        lines.plan(f"design {design}", levels, each=None if each is None else each / levels, noun="levels",
+                   title=f"simulating design {design} ({fidelity} model, {len(design)} units, "
+                   f"{pressure:g} kPa{weight})")
+        solution = model.solve(design, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
+                                                                           always=True))
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
         _write(out, solution, meta)

@@ -17,6 +17,7 @@ from pneumorph.cli.options.execution import (
     execution_options,
     open_evaluator,
 )
+from pneumorph.cli.progress import plan_solves, reporter
 
 
 @click.group("unit")
@@ -67,22 +68,23 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
     settings = OptimiseSettings(space=space, strain_limit=strain_limit, pressure=pressure / 1e3, n_units=n_units,
                                 pop_size=pop_size, generations=generations, seed=seed)
     check_folder(out, settings, overwrite)
-    click.echo(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
-               f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
-               f"{generations} generations, seed {seed}", err=True)
     evaluator = open_evaluator(executor, workers, scheduler, cache)
     t0 = time.perf_counter()
-
-    def on_generation(g: int, front: list[Any]) -> None:
-        click.echo(f"generation {g}: front of {len(front)}", err=True)
-
-    with all_or_nothing(out) as folder, RunLock(folder):  # stopped before its files are whole: nothing left
+    # stopped before its files are whole: nothing left
+    with reporter() as lines, all_or_nothing(out) as folder, RunLock(folder):
+        lines.say(f"unit optimisation: {', '.join(f'{v.name} {v.low:g}-{v.high:g}' for v in space.variables)} mm; "
+                  f"strain limit {strain_limit:g}; {pressure:g} kPa; {n_units}-unit 3D probe; NSGA-II {pop_size} x "
+                  f"{generations} generations, seed {seed}")
+        # the base unit and each generation's candidates, at most (duplicates and cached ones are not solved)
+        plan_solves(lines, "unit optimisation", 1 + pop_size * (generations + 1), _probe(settings), executor, workers,
+                    out, title="unit optimisation, at most")
         try:
-            result = optimise(settings, evaluator, _on_candidate(t0), on_generation)
+            result = optimise(settings, evaluator, _on_candidate(lines),
+                              lambda g, front: lines.say(f"  generation {g}: front of {len(front)}"))
         finally:
             evaluator.close()
         if (line := cluster_line(evaluator)) is not None:
-            click.echo(line, err=True)
+            lines.say(line)
         write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
     if as_json:
         _print_json(result, strain_limit, evaluator)
@@ -127,8 +129,15 @@ def _check_space(variables: tuple[str, ...], resolution: float, element_size: fl
     return space
 
 
-def _on_candidate(t0: float) -> Any:
-    """The progress line of each candidate (counted, timed from ``t0``), on standard error."""
+def _probe(settings: Any) -> Any:
+    """What the solve time of a candidate is estimated by: a 3D model of the probe's units."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(fidelity="3d", n_units=settings.n_units)
+
+
+def _on_candidate(lines: Any) -> Any:
+    """Each candidate counted (with the time left at the measured rate), its measures said, on standard error."""
     count = {"n": 0}
 
     def on_candidate(c: Any) -> None:
@@ -140,7 +149,7 @@ def _on_candidate(t0: float) -> Any:
             m = c.measures
             state = (f"Omega {m.omega_deg:.2f} deg, h_b {m.balloon_mm:.2f} mm, strain {m.strain:.2f}"
                      + (" (cached)" if c.cached else ""))
-        click.echo(f"  [{count['n']}] ({dims}): {state}  [{time.perf_counter() - t0:.0f} s]", err=True)
+        lines.count(count["n"], f"({dims}): {state}", always=True)  # each a 3D solve: every one said
 
     return on_candidate
 

@@ -60,7 +60,7 @@ def check_points(path: str | Path, points: int) -> None:
         leaves 500,000)
     """
     if points > MAX_SCAN_POINTS:
-        from pneumorph.models.chain.plan import duration_text
+        from pneumorph.io.progress import duration_text
 
         every = -(-int(points) // MAX_SCAN_POINTS)
         raise ScanError(f"scan {path}: {points:,} points, more than MAX_SCAN_POINTS = {MAX_SCAN_POINTS:,} "

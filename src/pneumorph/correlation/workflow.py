@@ -51,7 +51,7 @@ def correlate_design(scan: Scan, design: str, model: Any, pressure_kpa: float, *
         The scan's length or units do not match the actuator's, before the solve or right after it.
     """
     from pneumorph.geometry.assembly import unit_starts
-    from pneumorph.models.chain.plan import duration_text
+    from pneumorph.io.progress import duration_text
 
     check_length(scan, float(unit_starts(list(types))[-1]) if types else len(design) * model.unit.pitch)
     say(f"solving design {design} at {pressure_kpa:g} kPa ({model.fidelity} model)")

@@ -231,6 +231,7 @@ def _finish(claim: _Claim, algorithm: Algorithm, problem: Problem, status: str, 
                        retried=int(getattr(claim.inner, "retried", 0)), refinement=outcome.refinement,
                        comparison=outcome.comparison)
     files: list[Path] = []
+    problem.say(f"writing the report{' and figures' if figures else ''} to {claim.folder}")
     try:
         write_outputs(result, problem.config, problem.model, outcome.ranking, figures, files)
     except KeyboardInterrupt:

@@ -103,7 +103,7 @@ def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[
     problem = UnitProblem(candidates, settings.strain_limit)
     base = candidates.evaluate(settings.space.base_point()[None])[0]  # in or outside the box: the reference
 
-    class Progress(Callback):
+    class Generations(Callback):  # the front said after each generation
         def notify(self, algorithm: Any) -> None:
             candidates.generation = algorithm.n_gen  # the offspring asked for next belong to this generation
             if on_generation is not None:
@@ -113,7 +113,7 @@ def optimise(settings: OptimiseSettings, evaluator: Any, on_candidate: Callable[
     algorithm = NSGA2(pop_size=settings.pop_size, sampling=latin_hypercube(settings.space, settings.pop_size,
                                                                            settings.seed),
                       repair=SnapRepair(settings.space), eliminate_duplicates=True)
-    minimize(problem, algorithm, ("n_gen", settings.generations + 1), seed=settings.seed, callback=Progress(),
+    minimize(problem, algorithm, ("n_gen", settings.generations + 1), seed=settings.seed, callback=Generations(),
              verbose=False, save_history=False)
     everything = list(candidates.history.values())
     return UnitOptimisation(settings, everything, front_of(everything, settings.strain_limit), base,

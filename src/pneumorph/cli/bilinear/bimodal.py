@@ -12,6 +12,7 @@ import click
 
 from pneumorph.checks import MAX_INCREMENTS
 from pneumorph.cli.options import params as P
+from pneumorph.cli.progress import reporter
 from pneumorph.io.files import all_or_nothing, strict_json, write_json
 
 
@@ -78,11 +79,14 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations)  # None: the model's own
 
-    def progress(k: int, p: float, v: float) -> None:
-        if not quiet and not as_json:
-            click.echo(f"  {1e3 * p:6.1f} kPa  tip u_y {v:+8.3f} mm", err=True)
+    from pneumorph.io.progress import Progress
 
-    result = model.solve(on_level=progress)
+    lines = Progress(lambda text: None, heartbeat=0) if quiet or as_json else reporter()
+    with lines:
+        lines.plan("bimodal ramp", max(1, round(pmax / step)), noun="levels",
+                   title=f"bimodal ramp to {pmax:g} kPa in steps of {step:g} kPa")
+        result = model.solve(on_level=lambda k, p, v: lines.count(k + 1, f"{1e3 * p:6.1f} kPa  tip u_y {v:+8.3f} mm",
+                                                                  always=True))
     data = result.to_dict()
     if out is not None:
         data["files"] = [str(p) for p in write_outputs(result, Path(out))]

@@ -194,14 +194,16 @@ def refine_verified(model: Any, objective: Any, designs: Sequence[str], values: 
         the refined solve failed) and the :func:`verdict`.
     """
     from pneumorph.design.objectives.fitness import score
+    from pneumorph.models.chain.plan import solve_estimate
 
     if order is None:
         order = MESH_ORDERS.get(str(getattr(model, "fidelity", "3d")), MESH_ORDER)
     fine = refined(model, element_size)
     h0 = representative_size(model.mesh(winner))
     h1 = representative_size(fine.mesh(winner))
+    cells = len(fine.mesh(winner).cells), len(model.mesh(winner).cells)
     say(f"refining: {len(designs)} verified design(s) at {element_size:g} mm elements "
-        f"({len(fine.mesh(winner).cells):,} cells against {len(model.mesh(winner).cells):,})")
+        f"({cells[0]:,} cells against {cells[1]:,}){solve_estimate(model, len(designs), cells[0] / cells[1])}")
     found: dict[int, dict[str, Any]] = {}
     for i, outcome in evaluator.iter_evaluate(fine, list(designs)):
         design = designs[i]

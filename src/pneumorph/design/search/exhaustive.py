@@ -136,7 +136,7 @@ def all_designs(n: int, first: str | None = None) -> list[str]:
     return [first + format(i, f"0{n - 1}b") if n > 1 else first for i in range(2 ** (n - 1))]
 
 
-def _mirror_holds(model: ActuatorModel) -> bool:
+def mirror_holds(model: ActuatorModel) -> bool:
     """Whether a design and its mirror give mirrored responses: no gravity across the actuator (y)."""
     gravity = getattr(model, "gravity", None)
     return gravity is None or len(gravity) < 2 or gravity[1] == 0.0
@@ -170,7 +170,8 @@ def run_exhaustive(
     hall_of_fame : int
         Number of best designs kept with their responses.
     on_progress : callable, optional
-        Called with (designs scored, designs in total) after each batch.
+        Called with (designs scored, designs in total): once before the first solve, as each
+        solve finishes (a design and its mirror) and after each batch.
     max_units : int
         Refuse longer actuators (``2^n`` grows fast).
 
@@ -191,26 +192,15 @@ def run_exhaustive(
     if batch_size < 1:
         raise SearchConfigError(f"the batch size must be at least 1, got {batch_size}")
     if symmetry is None:
-        symmetry = _mirror_holds(model)
+        symmetry = mirror_holds(model)
     total = 2**n
     todo = all_designs(n, first="0") if symmetry else all_designs(n)
+    say = on_progress or (lambda done, total: None)
+    say(0, total)  # before the first solve: the run has started, nothing is scored yet
     if symmetry and verify_symmetry and n > 1:
         _verify(book, todo[1])
-    done = 0
     for lo in range(0, len(todo), batch_size):
-        batch = todo[lo : lo + batch_size]
-        new = [d for d in batch if d not in book.outcomes]
-        for outcome in book.evaluator.evaluate_many(model, new) if new else []:
-            book.solves += not outcome.cached
-            book.add(outcome)
-        if symmetry:
-            for d in batch:
-                twin = mirror(d)
-                if twin not in book.scores:
-                    book.add(mirror_outcome(book.outcomes[d]))
-        done = len(book.scores)
-        if on_progress:
-            on_progress(done, total)
+        _score_batch(book, todo[lo : lo + batch_size], symmetry, lambda: say(len(book.scores), total))
     ranking = book.ranking()
     return ExhaustiveResult(
         objective.sense,
@@ -222,6 +212,23 @@ def run_exhaustive(
         dict(book.scores),
         tuple(ranking),
     )
+
+
+def _score_batch(book: ScoreBook, batch: list[str], symmetry: bool, said: Callable[[], None]) -> None:
+    """Score ``batch`` (and with ``symmetry`` the mirrors), calling ``said`` as each solve finishes (a batch is
+    solved in parallel; its outcomes come as they end) and once more at the end."""
+    new = [d for d in batch if d not in book.outcomes]
+    for _, outcome in book.evaluator.iter_evaluate(book.model, new) if new else ():
+        book.solves += not outcome.cached
+        book.add(outcome)
+        if symmetry and mirror(outcome.design) not in book.scores:
+            book.add(mirror_outcome(outcome))
+        said()
+    if symmetry:
+        for d in batch:
+            if mirror(d) not in book.scores:
+                book.add(mirror_outcome(book.outcomes[d]))
+    said()
 
 
 def _verify(book: ScoreBook, design: str) -> None:

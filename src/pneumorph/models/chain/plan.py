@@ -10,6 +10,7 @@ no long build starts silently.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -17,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.errors import PneumorphError
+from pneumorph.io.progress import duration_text, load_factor
 from pneumorph.models.chain.fit import (
     DEFAULT_TOLERANCE,
     MAX_WINDOW,
@@ -59,21 +61,6 @@ def cost_fidelity(model: Any) -> str:
     model over sideways units (its training designs are solved on the full width)."""
     fidelity = str(getattr(model, "fidelity", "?"))
     return FULL_WIDTH if fidelity == "3d" and in_space(model) else fidelity
-
-
-def duration_text(seconds: float) -> str:
-    """A duration for people: ``45 s``, ``3.5 min``, ``1.2 h``.
-
-    >>> duration_text(0.37), duration_text(44.6), duration_text(210), duration_text(9000)
-    ('0.4 s', '45 s', '3.5 min', '2.5 h')
-    """
-    if seconds < 9.95:
-        return f"{seconds:.1f} s"
-    if seconds < 90:
-        return f"{seconds:.0f} s"
-    if seconds < 5400:
-        return f"{seconds / 60:.2g} min"
-    return f"{seconds / 3600:.2g} h"
 
 
 def estimate_text(solves: int, fidelity: str, n_units: int, workers: int) -> str:
@@ -316,16 +303,18 @@ def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | N
     return count
 
 
-def solve_estimate(model: Any, count: int) -> str:
-    """`` (about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units: the
-    full width's), or nothing."""
+def solve_estimate(model: Any, count: int, scale: float = 1.0) -> str:
+    """`` (3d, about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units:
+    the full width's; times ``scale``, e.g. a finer mesh's cells over the measured mesh's), slowed by what else
+    runs on this machine now (:func:`pneumorph.io.progress.load_factor`), or nothing."""
     fidelity = cost_fidelity(model)
     seconds = solve_seconds(fidelity, int(getattr(model, "n_units", 0) or 0))
     if not seconds:
         return ""
     each = " each" if count > 1 else ""
+    seconds *= scale * load_factor(min(max(1, count), os.cpu_count() or 1))
     return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
 __all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "cost_fidelity",
-           "duration_text", "estimate_text", "evaluator_workers", "solve_estimate", "solve_seconds", "unit_text"]
+           "estimate_text", "evaluator_workers", "solve_estimate", "solve_seconds", "unit_text"]
