@@ -76,7 +76,9 @@ def test_scan_synth_writes_a_scan_of_the_changed_cast_and_its_truth(tmp_path: Pa
     assert main(args) == 0
     captured = capsys.readouterr()
     assert captured.out.strip() == f"wrote 800 points (0.05 mm noise, seed 5) to {out}; the truth to {out}.json"
-    assert "one solve of 10 levels" in captured.err and "level 10/10" in captured.err
+    assert ("synthetic scan of design 0110's cast at 30 kPa (2d model, wall = 1.3, body_shear_scale = 0.8)"
+            in captured.err)
+    assert "10/10" in captured.err
     truth = json.loads(Path(f"{out}.json").read_text())
     assert truth["changes"] == {"wall": 1.3, "body_shear_scale": 0.8} and truth["settings"]["unit"]["wall"] == 1.3
     assert truth["provenance"]["pneumorph"]

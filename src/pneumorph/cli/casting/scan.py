@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import sys
-import time
 from typing import Any
 
 import click
@@ -54,11 +53,13 @@ def synth(design: str, out: str, pressure: float, fidelity: str, changes: tuple[
     sampled, moved into a scanner's frame and given noise; the truth (changes, motion, settings) goes beside it."""
     from pathlib import Path
 
+    from pneumorph.cli.progress import reporter
     from pneumorph.correlation import model_shape
     from pneumorph.correlation.synthetic import ScanNoise, cast_settings, synthetic_scan, write_scan
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
     from pneumorph.io.files import all_or_nothing_file, write_json
+    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
     from pneumorph.models.factory import make_model
 
     with P.blame("DESIGN"):
@@ -77,13 +78,14 @@ def synth(design: str, out: str, pressure: float, fidelity: str, changes: tuple[
         settings = cast_settings(settings, cast)
     noisy = ScanNoise(points=points, noise=noise, seed=seed)
     model = make_model(len(orientation), settings)
-    increments = model.ramp.steps.increments
-    click.echo(f"synthetic scan of design {orientation}'s cast at {pressure:g} kPa ({fidelity} model"
-               f"{', ' + ', '.join(f'{k} = {v:g}' for k, v in cast.items()) if cast else ', as modelled'}): one solve "
-               f"of {increments} levels, then {out}", err=True)
-    t0 = time.perf_counter()
-    solution = model.solve(orientation, on_level=lambda k, p: click.echo(
-        f"  level {k + 1:2d}/{increments}: {p * 1e3:7.3f} kPa  [{time.perf_counter() - t0:6.1f} s]", err=True))
+    changed = ", ".join(f"{k} = {v:g}" for k, v in cast.items()) if cast else "as modelled"
+    each, levels = solve_seconds(cost_fidelity(model), len(orientation)), len(model.pressures())
+    with reporter() as lines:
+        lines.plan(f"design {orientation}'s cast", levels, each=None if each is None else each / levels,
+                   noun="levels", where=out, title=f"synthetic scan of design {orientation}'s cast at {pressure:g} "
+                   f"kPa ({fidelity} model, {changed})")
+        solution = model.solve(orientation, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
+                                                                              always=True))
     scanned, motion = synthetic_scan(model_shape(solution), noisy)
     truth = {"design": orientation, "pressure_kpa": pressure, "model": fidelity, "changes": cast,
              "points": len(scanned.points), "noise_mm": noise, "seed": seed,
