@@ -74,6 +74,10 @@ class Pardiso:
         A = A.tocsr()
         A.sort_indices()
         b = np.asarray(b, dtype=float)
+        if not (np.isfinite(A.data).all() and np.isfinite(b).all()):
+            # a state outside the material's domain (an element turned inside out at a Newton iterate): the
+            # solution is NaN, and PARDISO never sees the values, whose scaling its kept analysis would reuse
+            return np.full(b.shape, np.nan)
         s = self._solver
         s._check_A(A)
         b2 = s._check_b(A, b)
@@ -89,6 +93,8 @@ class Pardiso:
             self._pattern = (A.indptr.copy(), A.indices.copy())
             self.analyses += 1
         x = s._call_pardiso(A, b2)
+        if not np.isfinite(x).all():
+            self._pattern = None  # analyse afresh next time rather than reuse what gave this
         return x.reshape(b.shape)
 
 
