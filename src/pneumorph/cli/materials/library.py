@@ -70,14 +70,15 @@ def list_materials(as_json: bool, library_files: tuple[str, ...]) -> None:
         }
         click.echo(strict_json(out, indent=2))
         return
-    click.echo(f"{'name':<20} {'kind':<15} {'mu0 [kPa]':>10} {'K [kPa]':>9}  display name")
+    width = max(20, *(len(m.name) for m in materials), *(len(f.name) for f in fillers))
+    click.echo(f"{'name':<{width}} {'kind':<15} {'mu0 [kPa]':>10} {'K [kPa]':>9}  display name")
     for m in materials:
-        k = f"{m.bulk_modulus.value * 1e3:9.4g}" if m.bulk_modulus else f"{'-':>9}"
+        k = f"{m.bulk_modulus.value * 1e3:9.5g}" if m.bulk_modulus else f"{'-':>9}"
         star = "*" if m.assumed else " "
-        click.echo(f"{m.name:<20} {m.kind:<15} {m.shear_modulus * 1e3:10.4g} {k}{star} {m.display_name}")
+        click.echo(f"{m.name:<{width}} {m.kind:<15} {m.shear_modulus * 1e3:10.4g} {k}{star} {m.display_name}")
     for f in fillers:
         lo, hi = (x * 1e3 for x in f.pressure_range)
-        click.echo(f"{f.name:<20} {'filler E(P)':<15} {'':>10} {'':>9}  {f.display_name} ({lo:g}-{hi:g} kPa)")
+        click.echo(f"{f.name:<{width}} {'filler E(P)':<15} {'':>10} {'':>9}  {f.display_name} ({lo:g}-{hi:g} kPa)")
     if any(m.assumed for m in materials):
         click.echo("* includes assumed values (not given by the source); see `pneumorph materials show NAME`")
 
