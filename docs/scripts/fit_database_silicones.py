@@ -18,6 +18,8 @@ import argparse
 import re
 from pathlib import Path
 
+import numpy as np
+
 from pneumorph.materials.characterisation.testdata import read_curve
 from pneumorph.materials.fitting.database import TENSILE_FIT, fit_tensile_curve
 from pneumorph.materials.fitting.fit import r_squared
@@ -109,7 +111,9 @@ def fitted(shared: Path, stem: str) -> dict:  # type: ignore[type-arg]
                                "rounded to 4 significant figures"))
     mu0 = model.shear_modulus
     k = sig(2.0 * mu0 * (1.0 + NU) / (3.0 * (1.0 - 2.0 * NU)) * 1e3, 3)
-    return {"model": model, "r2": r2, "mu0": mu0, "k_kpa": k, "record": record,
+    error = {x: float(np.interp(x, curve.stretch, model.uniaxial(curve.stretch) / curve.stress - 1.0))
+             for x in (1.5, 2.0)}
+    return {"model": model, "r2": r2, "mu0": mu0, "k_kpa": k, "record": record, "error": error,
             "stable": record.stability(model), "supplier": meta.get("Material supplier", "")}
 
 
@@ -184,16 +188,17 @@ def main() -> None:
     args = ap.parse_args()
 
     entries = []
-    print("| material | key | mu [MPa] | alpha | mu0 [kPa] | R^2 | stretch fitted | points | "
-          "K assumed [kPa] | Drucker-stable |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| material | key | mu [MPa] | alpha | mu0 [kPa] | R^2 | stress error at stretch 1.5, 2 | "
+          "stretch fitted | points | K assumed [kPa] | Drucker-stable |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for stem, key, name, aliases in MATERIALS:
         f = fitted(args.shared, stem)
         m, rec = f["model"], f["record"]
         lo, hi = rec.stability_range
         stable = "yes" if f["stable"].is_stable else "no"
         print(f"| {name} | `{key}` | {', '.join(f'{x:g}' for x in m.mu)} | {', '.join(f'{x:g}' for x in m.alpha)} "
-              f"| {f['mu0'] * 1e3:.4g} | {f['r2']:.5f} | {rec.stretch_range[0]:g}-{rec.stretch_range[1]:g} "
+              f"| {f['mu0'] * 1e3:.4g} | {f['r2']:.5f} | {f['error'][1.5]:+.1%}, {f['error'][2.0]:+.1%} "
+              f"| {rec.stretch_range[0]:g}-{rec.stretch_range[1]:g} "
               f"| {rec.points} | {f['k_kpa']:g} | {stable} ({lo:g}-{hi:g}) |")
         entries.append(entry(stem, key, name, aliases, f))
     if args.write:

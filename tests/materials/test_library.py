@@ -186,7 +186,8 @@ def test_names_are_case_and_format_tolerant(spelling: str) -> None:
 
 
 def test_aliases() -> None:
-    assert library.get("Ecoflex 00-30").name == "ecoflex_0030"
+    assert library.get("Ecoflex 0030").name == "ecoflex_0030"
+    assert library.get("Ecoflex 00-30").name == "ecoflex_00_30"  # the database's, not the dissertation's
     assert library.get("bilinear cr 0.25").name == "bilinear_0_25"
     assert library.get("paper").name == "paper_purco_80gsm"
 

@@ -98,6 +98,30 @@ def _quantity_line(q: Quantity) -> list[str]:
     return lines
 
 
+def _fit_lines(m: Material) -> list[str]:
+    """How the model was fitted: data, attribution, range, method, stability, caveats."""
+    f = m.fitting
+    assert f is not None and m.model is not None
+    lo, hi = f.stretch_range
+    report = f.stability(m.model)
+    check_lo, check_hi = f.stability_range
+    lines = [
+        "fitted to test data:",
+        f"  data: {f.data}",
+        f"  {f.attribution}",
+        f"  fitted: {f.mode} tension, stretch {lo:g}-{hi:g} ({f.points} points); "
+        "outside that range the model extrapolates",
+        f"  method: {f.method}",
+        f"  Drucker stability (uniaxial, equibiaxial, planar; stretch {check_lo:g}-{check_hi:g}): "
+        + ("stable in every mode" if report.is_stable else "NOT stable everywhere"),
+    ]
+    if not report.is_stable:
+        lines += ["    " + line for line in report.summary().splitlines()]
+    lines.append("  caveats:")
+    lines += [f"  - {c}" for c in f.caveats]
+    return lines
+
+
 def _material_text(m: Material) -> str:
     lines = [f"{m.display_name} ({m.name})", f"  kind: {m.kind}; source: {m.source}"]
     if m.description:
@@ -139,6 +163,8 @@ def _material_text(m: Material) -> str:
     if m.r_squared:
         values = ", ".join(f"{k} {v:.4f}" for k, v in m.r_squared)
         lines.append(f"R^2 of the source's fits: {values} ({m.r_squared_source})")
+    if m.fitting is not None:
+        lines.extend(_fit_lines(m))
     lines.append(f"assumed values: {', '.join(m.assumed) if m.assumed else 'none'}")
     return "\n".join(lines)
 

@@ -428,8 +428,8 @@ class Library:
     --------
     >>> from pneumorph.materials.library.builtin import builtin
     >>> lib = builtin()
-    >>> lib.get("Ecoflex 00-30").name, len(lib.names()) >= 7
-    ('ecoflex_0030', True)
+    >>> lib.get("Ecoflex 0030").name, lib.get("Ecoflex 00-30").name, len(lib.names()) >= 26
+    ('ecoflex_0030', 'ecoflex_00_30', True)
     """
 
     path: str
