@@ -149,7 +149,10 @@ def test_assumed_values_are_flagged_with_reasons() -> None:
         "bilinear_0_3": ("density", "bulk_modulus"),
         "paper_purco_80gsm": ("density", "youngs_modulus", "poisson_ratio", "thickness"),
     }
-    assert library.names() == tuple(expected)
+    # then the silicones fitted to the Soft Robotics Materials Database (tests/materials/test_database_silicones.py)
+    database = library.names()[len(expected):]
+    assert library.names()[: len(expected)] == tuple(expected) and len(database) == 19
+    expected |= dict.fromkeys(database, ("bulk_modulus",))
     for name, assumed in expected.items():
         m = library.get(name)
         assert m.assumed == assumed
