@@ -37,7 +37,7 @@ BEGIN = "# >>> silicones fitted to the Soft Robotics Materials Database (docs/sc
 END = "# <<< silicones fitted to the Soft Robotics Materials Database"
 
 #: (file stem, library key, display name, aliases)
-MATERIALS = (
+MATERIALS: tuple[tuple[str, str, str, list[str]], ...] = (
     ("Ecoflex 00-10", "ecoflex_00_10", "Ecoflex 00-10", []),
     ("Ecoflex 00-30", "ecoflex_00_30", "Ecoflex 00-30", []),
     ("Ecoflex 00-35 FAST", "ecoflex_00_35_fast", "Ecoflex 00-35 FAST", ["ecoflex 00-35"]),

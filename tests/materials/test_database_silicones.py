@@ -156,8 +156,8 @@ def _simulate(tmp_path: Path, name: str, unit: str | None) -> dict:  # type: ign
         (tmp_path / f"{name}.toml").write_text(f"[unit]\n{unit}\n")
         args += ["--unit", str(tmp_path / f"{name}.toml")]
     assert main(args) == 0
-    return json.loads((tmp_path / name / "provenance.json").read_text()) | {
-        "response": json.loads((tmp_path / name / "response.json").read_text())}
+    provenance: dict = json.loads((tmp_path / name / "provenance.json").read_text())  # type: ignore[type-arg]
+    return provenance | {"response": json.loads((tmp_path / name / "response.json").read_text())}
 
 
 def test_unit_cast_in_ecoflex_00_30_with_a_dragon_skin_30_layer_simulates_in_2d(tmp_path: Path) -> None:

@@ -36,7 +36,9 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +49,7 @@ from pneumorph.materials.laws.hyperelastic import Ogden
 __all__ = ["TENSILE_FIT", "fit_tensile_curve"]
 
 #: Settings of :func:`fit_tensile_curve` (keyword arguments of :func:`~pneumorph.materials.fitting.fit.fit`).
-TENSILE_FIT = MappingProxyType({"model_name": "ogden-2", "stable": True, "weighting": "relative",
+TENSILE_FIT: Mapping[str, Any] = MappingProxyType({"model_name": "ogden-2", "stable": True, "weighting": "relative",
                                 "starts": 8, "seed": 0})
 
 #: A term whose share of the initial shear modulus is below this is dropped.
