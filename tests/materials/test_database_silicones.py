@@ -173,3 +173,17 @@ def test_unit_cast_in_ecoflex_00_30_with_a_dragon_skin_30_layer_simulates_in_2d(
     # four units of 10.5 mm: at rest the tip is at x = 42 mm; both extend, the softer body
     # (mu0 15 kPa against 131 kPa) more
     assert np.all(np.diff(tip[:, 0]) > 0) and tip[-1, 0] > ref_tip[-1, 0] > 42.0
+
+
+def test_a_database_silicone_makes_the_bottom_wall(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    def tip_x(unit: str) -> float:
+        (tmp_path / "unit.toml").write_text(f"[unit]\n{unit}\n")
+        code, out, _ = run(capsys, "simulate", "-o", "0110", "--model", "2d", "--pressure", "15", "--increments",
+                           "3", "--unit", str(tmp_path / "unit.toml"), "--json")
+        data = json.loads(out)
+        assert code == 0 and data["converged"]
+        return float(data["levels"][-1]["tip_mm"][0])
+
+    cast = 'body_material = "ecoflex_00_30"\nlayer_material = "dragon_skin_30"'
+    # a stiffer bottom wall (Ecoflex 00-50, mu0 21 kPa, against the body's 15 kPa) extends less
+    assert 42.0 < tip_x(cast + '\nbottom_material = "ecoflex_00_50"') < tip_x(cast)
