@@ -70,14 +70,15 @@ def list_materials(as_json: bool, library_files: tuple[str, ...]) -> None:
         }
         click.echo(strict_json(out, indent=2))
         return
-    click.echo(f"{'name':<20} {'kind':<15} {'mu0 [kPa]':>10} {'K [kPa]':>9}  display name")
+    width = max(20, *(len(m.name) for m in materials), *(len(f.name) for f in fillers))
+    click.echo(f"{'name':<{width}} {'kind':<15} {'mu0 [kPa]':>10} {'K [kPa]':>9}  display name")
     for m in materials:
-        k = f"{m.bulk_modulus.value * 1e3:9.4g}" if m.bulk_modulus else f"{'-':>9}"
+        k = f"{m.bulk_modulus.value * 1e3:9.5g}" if m.bulk_modulus else f"{'-':>9}"
         star = "*" if m.assumed else " "
-        click.echo(f"{m.name:<20} {m.kind:<15} {m.shear_modulus * 1e3:10.4g} {k}{star} {m.display_name}")
+        click.echo(f"{m.name:<{width}} {m.kind:<15} {m.shear_modulus * 1e3:10.4g} {k}{star} {m.display_name}")
     for f in fillers:
         lo, hi = (x * 1e3 for x in f.pressure_range)
-        click.echo(f"{f.name:<20} {'filler E(P)':<15} {'':>10} {'':>9}  {f.display_name} ({lo:g}-{hi:g} kPa)")
+        click.echo(f"{f.name:<{width}} {'filler E(P)':<15} {'':>10} {'':>9}  {f.display_name} ({lo:g}-{hi:g} kPa)")
     if any(m.assumed for m in materials):
         click.echo("* includes assumed values (not given by the source); see `pneumorph materials show NAME`")
 
@@ -94,6 +95,30 @@ def _quantity_line(q: Quantity) -> list[str]:
     ]
     if q.reason:
         lines.append(f"  {'':<18} reason: {q.reason}")
+    return lines
+
+
+def _fit_lines(m: Material) -> list[str]:
+    """How the model was fitted: data, attribution, range, method, stability, caveats."""
+    f = m.fitting
+    assert f is not None and m.model is not None
+    lo, hi = f.stretch_range
+    report = f.stability(m.model)
+    check_lo, check_hi = f.stability_range
+    lines = [
+        "fitted to test data:",
+        f"  data: {f.data}",
+        f"  {f.attribution}",
+        f"  fitted: {f.mode} tension, stretch {lo:g}-{hi:g} ({f.points} points); "
+        "outside that range the model extrapolates",
+        f"  method: {f.method}",
+        f"  Drucker stability (uniaxial, equibiaxial, planar; stretch {check_lo:g}-{check_hi:g}): "
+        + ("stable in every mode" if report.is_stable else "NOT stable everywhere"),
+    ]
+    if not report.is_stable:
+        lines += ["    " + line for line in report.summary().splitlines()]
+    lines.append("  caveats:")
+    lines += [f"  - {c}" for c in f.caveats]
     return lines
 
 
@@ -138,6 +163,8 @@ def _material_text(m: Material) -> str:
     if m.r_squared:
         values = ", ".join(f"{k} {v:.4f}" for k, v in m.r_squared)
         lines.append(f"R^2 of the source's fits: {values} ({m.r_squared_source})")
+    if m.fitting is not None:
+        lines.extend(_fit_lines(m))
     lines.append(f"assumed values: {', '.join(m.assumed) if m.assumed else 'none'}")
     return "\n".join(lines)
 

@@ -10,8 +10,11 @@ from typing import Any, Literal
 from pneumorph.errors import MaterialDataError, UnknownMaterialError
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.laws.hyperelastic import (
+    MODES,
     HyperelasticModel,
     Ogden,
+    StabilityReport,
+    drucker_stability,
     ogden_marc_to_felupe,
 )
 
@@ -128,6 +131,83 @@ class ModelRecord:
 
 
 @dataclass(frozen=True)
+class FitRecord:
+    """How a library model was fitted to test data: the data, their licence and caveats, the range.
+
+    Attributes
+    ----------
+    data : str
+        The test data fitted (database, file, test).
+    attribution : str
+        The attribution line the data's licence asks for.
+    mode : str
+        The loading mode fitted (one of :data:`~pneumorph.materials.laws.hyperelastic.MODES`).
+    stretch_range : (float, float)
+        Smallest and largest stretch of the points fitted.
+    points : int
+        Number of points fitted.
+    method : str
+        Model, settings and the function that made the fit.
+    caveats : tuple of str
+        What the test does not tell (how the strain was measured, modes not tested, ...).
+
+    Examples
+    --------
+    >>> r = FitRecord("a curve", "Data: someone", "uniaxial", (1.05, 4.0), 30, "ogden-2")
+    >>> r.stability_range
+    (0.5, 4.0)
+    """
+
+    data: str
+    attribution: str
+    mode: str
+    stretch_range: tuple[float, float]
+    points: int
+    method: str
+    caveats: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise MaterialDataError(f"fit mode must be one of {', '.join(MODES)}, got {self.mode!r}")
+        lo, hi = self.stretch_range
+        if not 0.0 < lo < hi:
+            raise MaterialDataError(f"fit stretch_range must rise from a positive stretch, got [{lo}, {hi}]")
+        if isinstance(self.points, bool) or not isinstance(self.points, int) or self.points < 1:
+            raise MaterialDataError(f"fit points must be a positive whole number, got {self.points!r}")
+
+    @property
+    def stability_range(self) -> tuple[float, float]:
+        """Stretches of the Drucker check: the fitted range widened to 0.5-1.5 at least."""
+        lo, hi = self.stretch_range
+        return min(0.5, lo), max(1.5, hi)
+
+    def stability(self, model: HyperelasticModel) -> StabilityReport:
+        """Drucker stability of ``model`` in the three modes over :attr:`stability_range`."""
+        return drucker_stability(model, stretch_range=self.stability_range)
+
+    def to_dict(self, model: HyperelasticModel | None = None) -> dict[str, Any]:
+        """Plain-data form (JSON-serialisable); with ``model``, its Drucker stability too."""
+        out: dict[str, Any] = {
+            "data": self.data,
+            "attribution": self.attribution,
+            "mode": self.mode,
+            "stretch_range": list(self.stretch_range),
+            "points": self.points,
+            "method": self.method,
+            "caveats": list(self.caveats),
+        }
+        if model is not None:
+            report = self.stability(model)
+            out["drucker_stability"] = {
+                "checked": list(self.stability_range),
+                "modes": list(MODES),
+                "stable": report.is_stable,
+                "stable_limits": {k: list(v) for k, v in report.limits().items()},
+            }
+        return out
+
+
+@dataclass(frozen=True)
 class Material:
     """One library material in internal units (MPa, tonne/mm^3, 1/K, mm).
 
@@ -151,6 +231,8 @@ class Material:
         Further properties where known.
     r_squared : tuple of (str, float)
         Goodness of fit printed by the source, per model; ``r_squared_source`` names it.
+    fitting : FitRecord or None
+        For a model fitted to public test data: the data, attribution, caveats and range.
     aliases : tuple of str
         Other accepted names.
     description : str
@@ -179,6 +261,7 @@ class Material:
     thickness: Quantity | None = None
     r_squared: tuple[tuple[str, float], ...] = ()
     r_squared_source: str | None = None
+    fitting: FitRecord | None = None
     aliases: tuple[str, ...] = ()
     description: str = ""
     origin: str = BUILTIN_ORIGIN
@@ -206,6 +289,8 @@ class Material:
             q = getattr(self, name)
             if q is not None and (not isinstance(q, Quantity) or q.name != name):
                 raise MaterialDataError(f"{where}: {name} must be a Quantity named {name!r}, got {q!r}")
+        if self.fitting is not None and (not isinstance(self.fitting, FitRecord) or self.model is None):
+            raise MaterialDataError(f"{where}: a fit record (FitRecord) belongs to a hyperelastic material's model")
         for model_name, r in self.r_squared:
             if isinstance(r, bool) or not isinstance(r, (int, float)) or not r <= 1.0:
                 raise MaterialDataError(f"{where}: R^2 of {model_name} must be a number <= 1, got {r!r}")
@@ -329,6 +414,8 @@ class Material:
         out["properties"] = {q.name: q.to_dict() for q in self.quantities}
         if self.r_squared:
             out["r_squared"] = {"source": self.r_squared_source, **dict(self.r_squared)}
+        if self.fitting is not None:
+            out["fit"] = self.fitting.to_dict(self.model)
         out["assumed"] = list(self.assumed)
         return out
 
@@ -341,8 +428,8 @@ class Library:
     --------
     >>> from pneumorph.materials.library.builtin import builtin
     >>> lib = builtin()
-    >>> lib.get("Ecoflex 00-30").name, len(lib.names()) >= 7
-    ('ecoflex_0030', True)
+    >>> lib.get("Ecoflex 0030").name, lib.get("Ecoflex 00-30").name, len(lib.names()) >= 26
+    ('ecoflex_0030', 'ecoflex_00_30', True)
     """
 
     path: str

@@ -19,6 +19,7 @@ from pneumorph.materials.library.material import (
     KINDS,
     POSITIVE_PROPERTIES,
     PROPERTIES,
+    FitRecord,
     Library,
     Material,
     ModelRecord,
@@ -34,7 +35,8 @@ _MODEL_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "mooney-rivlin": (("c10", "c01"), ("c11",)),
     "yeoh": (("c",), ()),
 }
-_ENTRY_KEYS = {"display_name", "kind", "source", "aliases", "description", "model", "r_squared"}
+_ENTRY_KEYS = {"display_name", "kind", "source", "aliases", "description", "model", "r_squared", "fit"}
+_FIT_KEYS = {"data", "attribution", "mode", "stretch_range", "points", "method", "caveats"}
 _ENTRY_KEYS |= set(PROPERTIES)
 
 
@@ -168,6 +170,25 @@ def _model(where: _Where, data: dict[str, Any]) -> tuple[HyperelasticModel, Mode
     return model, ModelRecord(kind, convention, unit, tuple(printed.items()), source)
 
 
+def _fit_record(where: _Where, data: dict[str, Any]) -> FitRecord:
+    """The ``[materials.<key>.fit]`` table: the test data a model was fitted to, and how."""
+    w = _Where(where.path, f"{where.entry}.fit")
+    w.no_extra(data, _FIT_KEYS)
+    texts = {k: w.text(data, k) for k in ("data", "attribution", "mode", "method")}
+    rng = w.numbers(data, "stretch_range")
+    if len(rng) != 2:
+        raise w.error(f"'stretch_range' must be [lower, upper], got {list(rng)}")
+    points = data.get("points")
+    caveats = data.get("caveats", [])
+    if not isinstance(caveats, list) or not all(isinstance(c, str) and c.strip() for c in caveats):
+        raise w.error(f"'caveats' must be a list of texts, got {caveats!r}")
+    try:
+        return FitRecord(stretch_range=(rng[0], rng[1]), points=points, caveats=tuple(caveats),  # type: ignore[arg-type]
+                         **texts)  # type: ignore[arg-type]
+    except MaterialDataError as exc:
+        raise w.error(str(exc)) from None
+
+
 def _material(path: str, key: str, data: Any) -> Material:
     where = _Where(path, f"materials.{key}")
     if not isinstance(data, dict):
@@ -189,7 +210,7 @@ def _material(path: str, key: str, data: Any) -> Material:
         table = where.table(data, name, required=False)
         if table is not None:
             props[name] = _quantity(where, name, table)
-    model = record = None
+    model = record = fitting = None
     if kind == "hyperelastic":
         for name in ("youngs_modulus", "poisson_ratio"):
             if name in props:
@@ -197,9 +218,11 @@ def _material(path: str, key: str, data: Any) -> Material:
         table = where.table(data, "model")
         assert table is not None
         model, record = _model(where, table)
+        fit_table = where.table(data, "fit", required=False)
+        fitting = _fit_record(where, fit_table) if fit_table is not None else None
     else:
-        if "model" in data:
-            raise where.error("a linear-elastic material takes youngs_modulus and poisson_ratio, not 'model'")
+        if "model" in data or "fit" in data:
+            raise where.error("a linear-elastic material takes youngs_modulus and poisson_ratio, not 'model' or 'fit'")
         for name in ("youngs_modulus", "poisson_ratio"):
             if name not in props:
                 raise where.error(f"missing table '{name}' (required for a linear-elastic material)")
@@ -228,6 +251,7 @@ def _material(path: str, key: str, data: Any) -> Material:
         model_record=record,
         r_squared=r2,
         r_squared_source=r2_source,
+        fitting=fitting,
         aliases=tuple(aliases),
         description=description,
         origin=path,
