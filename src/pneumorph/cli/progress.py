@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from pathlib import Path
 from typing import Any
 
 import click
@@ -53,7 +54,7 @@ class RunLines:
     left at the measured rate, the exhaustive search's plan (designs, estimate) and count, and the certified
     search's messages."""
 
-    def __init__(self, config: Any, model: Any, folder: str, lines: Any) -> None:
+    def __init__(self, config: Any, model: Any, folder: str | Path, lines: Any) -> None:
         self.config, self.model, self.folder, self.lines = config, model, folder, lines
         objective = config.make_objective()
         self.label, self.unit = objective.label, objective.unit
