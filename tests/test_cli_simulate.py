@@ -80,3 +80,17 @@ def test_without_out_the_table_says_nothing_was_written(tmp_path: Path, monkeypa
     out = capsys.readouterr().out.splitlines()
     assert out[-1] == "nothing written: --out DIR keeps the response, the VTK series and the shape figure"
     assert not list(tmp_path.iterdir())
+
+
+def test_a_unit_with_a_bottom_wall_of_another_material_writes_its_region(tmp_path: Path) -> None:
+    import meshio
+
+    unit = tmp_path / "unit.toml"
+    unit.write_text('[unit]\nbottom_material = "smooth_sil_950"\n')
+    out = tmp_path / "sim"
+    assert main(["simulate", "-o", "01", "--unit", str(unit), "--pressure", "10", "--increments", "2",
+                 "--out", str(out)]) == 0
+    pvd = (out / "vtk" / "actuator.pvd").read_text()
+    assert '"regions": {"body": 0, "layer": 1, "filler": 2, "bottom:smooth_sil_950": 3}' in pvd
+    region = meshio.read(out / "vtk" / "actuator_01.vtu").cell_data["region"][0]
+    assert sorted(set(region.tolist())) == [0, 1, 2, 3]

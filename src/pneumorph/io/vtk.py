@@ -12,13 +12,26 @@ import numpy as np
 _REGION_IDS = {"body": 0, "layer": 1, "filler": 2}
 
 
+def region_ids(names: Any) -> dict[str, int]:
+    """The ``region`` cell value of every region: 0 body, 1 stiff layer, 2 filler, then the others (bottom walls of
+    other materials, a base block) from 3 in name order.
+
+    >>> region_ids(["layer", "body", "bottom:ecoflex_00_50", "base"])
+    {'body': 0, 'layer': 1, 'base': 3, 'bottom:ecoflex_00_50': 4}
+    """
+    known = {n: _REGION_IDS[n] for n in sorted(names, key=lambda n: _REGION_IDS.get(n, 99)) if n in _REGION_IDS}
+    others = sorted(n for n in names if n not in _REGION_IDS)
+    return {**known, **{n: 3 + k for k, n in enumerate(others)}}
+
+
 def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
                      meta: dict[str, Any] | None = None) -> Path:
     """Write ``<stem>_<k>.vtu`` for every converged level and ``<stem>.pvd`` to open them all.
 
     Each VTU holds the undeformed points with the point data ``displacement`` (use
-    ParaView's *Warp By Vector*) and the cell data ``region`` (0 body, 1 stiff layer,
-    2 filler). The PVD's time value is the pressure in kPa.
+    ParaView's *Warp By Vector*) and the cell data ``region`` (:func:`region_ids`: 0 body,
+    1 stiff layer, 2 filler, then the others; the PVD's comment names them). The PVD's time
+    value is the pressure in kPa.
 
     Parameters
     ----------
@@ -44,8 +57,9 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
     points = np.zeros((len(mesh.points), 3))
     points[:, : mesh.dim] = mesh.points
     region = np.empty(len(mesh.cells), dtype=np.int32)
+    ids = region_ids(list(mesh.regions))
     for name, idx in mesh.regions.items():
-        region[idx] = _REGION_IDS[name]
+        region[idx] = ids[name]
     pressures = solution.response.pressures
     entries = []
     for k, u in enumerate(solution.displacements):
@@ -60,7 +74,7 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
                         cell_data={"region": [region]}),
         )
         entries.append(f'    <DataSet timestep="{pressures[k] * 1e3:.6g}" file={quoteattr(name)}/>')
-    comment = json.dumps(meta or {}, default=str).replace("--", "- -")
+    comment = json.dumps({"regions": ids, **(meta or {})}, default=str).replace("--", "- -")
     pvd = out / f"{stem}.pvd"
     pvd.write_text(
         '<?xml version="1.0"?>\n'
