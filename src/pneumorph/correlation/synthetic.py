@@ -66,7 +66,7 @@ def cast_settings(settings: Mapping[str, Any], changes: Mapping[str, float]) -> 
         if unit is None:
             raise SettingsError(f"{', '.join(unit_changes)}: a unit library's types are changed in its file, not "
                                 "one field for all")
-        data = unit.to_dict()
+        data = unit.with_own_filler().to_dict()  # the cast keeps the nominal unit's 2D filler law
         for key, value in unit_changes.items():
             if not isinstance(data.get(key), float) or key == "element_size":
                 names = ", ".join([*CAST_SCALES, *sorted(k for k, v in data.items()

@@ -73,7 +73,7 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -362,6 +362,22 @@ class UnitSpec:
         ignored = {"name", "element_size", "element_order"}
         mine, builtin = asdict(self), asdict(UnitSpec())
         return all(mine[k] == builtin[k] for k in mine if k not in ignored and not k.startswith("filler_"))
+
+    def with_own_filler(self) -> UnitSpec:
+        """This unit with the filler law it gets written into its own fields, so that a cast of it with other
+        thicknesses keeps the law (the built-in unit's :data:`BUILTIN_FILLER` belongs to the physical unit: a
+        wall 0.08 mm thinner would otherwise switch the 2D model to Eq 5.2).
+
+        >>> from dataclasses import replace
+        >>> replace(UnitSpec(), wall=1.42).filler_law() is None
+        True
+        >>> replace(UnitSpec().with_own_filler(), wall=1.42).filler_law() == UnitSpec().filler_law()
+        True
+        """
+        if self.filler_coefficients or not self.is_builtin_shape():
+            return self
+        return replace(self, filler_coefficients=tuple(BUILTIN_FILLER["coefficients"]),
+                       filler_range_kpa=tuple(BUILTIN_FILLER["range_kpa"]), filler_source=BUILTIN_FILLER["source"])
 
     def filler_law(self) -> FillerLaw | None:
         """The unit's calibrated filler law, or None (then the 2D model uses Eq 5.2).

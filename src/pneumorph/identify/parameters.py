@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import SettingsError
-from pneumorph.geometry.unit import BUILTIN_FILLER, UnitSpec
+from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.factory import SCALE_RANGE
 from pneumorph.sensitivity.tolerances import FIELDS, PRINTED, Tolerance, box_units
 
@@ -77,13 +77,8 @@ class ParameterSet:
         box = Tolerance(self.tolerance)
         box.check(self.unit)
         nominal, _ = box_units(self.unit, box, [])
-        if not nominal.filler_coefficients and nominal.is_builtin_shape():
-            # the 2D model's filler law belongs to the physical unit: a cast with other thicknesses keeps it
-            # (else any thickness off the built-in unit's would switch the 2D model to Eq 5.2)
-            nominal = replace(nominal, filler_coefficients=tuple(BUILTIN_FILLER["coefficients"]),
-                              filler_range_kpa=tuple(BUILTIN_FILLER["range_kpa"]),
-                              filler_source=BUILTIN_FILLER["source"])
-        object.__setattr__(self, "meshed_unit", nominal)
+        # the 2D model's filler law belongs to the physical unit: a cast with other thicknesses keeps it
+        object.__setattr__(self, "meshed_unit", nominal.with_own_filler())
 
     @property
     def element_size(self) -> float:

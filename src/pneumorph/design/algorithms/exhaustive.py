@@ -4,12 +4,14 @@
 from __future__ import annotations
 
 from pneumorph.design.algorithms.problem import Problem, Search, SearchOutcome
+from pneumorph.design.runs.comparison import compare_with_reference
 from pneumorph.design.runs.robustness import winner_robustness
 from pneumorph.design.search.exhaustive import run_exhaustive
 
 
 class ExhaustiveSearch(Search):
-    """Every design solved by the problem's evaluator, ranked; the winner's FE robustness after it.
+    """Every design solved by the problem's evaluator, ranked; the winner's FE robustness after it, and with a
+    reference model (the nominal one of an identified model) how the reference's optimum does here.
 
     Parameters
     ----------
@@ -28,4 +30,5 @@ class ExhaustiveSearch(Search):
                             hall_of_fame=problem.config.ga.hall_of_fame, on_progress=problem.on_progress)
         best = ex.hall_of_fame[0] if ex.hall_of_fame else None
         return SearchOutcome(ex.hall_of_fame, ranking=[(d, ex.scores[d]) for d in ex.ranking],
-                       robustness=winner_robustness(problem, best))
+                             robustness=winner_robustness(problem, best),
+                             comparison=None if best is None else compare_with_reference(problem, best))
