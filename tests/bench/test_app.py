@@ -347,7 +347,7 @@ def test_serve_refuses_a_bad_model_file_before_it_starts(tmp_path: Path) -> None
     from pneumorph.cli import cli
 
     bad = tmp_path / "identified.toml"
-    bad.write_text("[model]\nbody_bulk_scale = 50\n")
+    bad.write_text("[model]\nbody_bulk_scale = 5000\n")
     done = CliRunner().invoke(cli, ["serve", "--model-file", str(bad), "--state", str(tmp_path / "s")])
     assert done.exit_code == 2 and "body_bulk_scale" in done.output and "Traceback" not in done.output
     assert not (tmp_path / "s").exists()

@@ -22,7 +22,7 @@ def test_scales_reach_the_body_and_only_the_body() -> None:
     assert make_model(3, {"body_bulk_scale": 1.0, "body_shear_scale": 1}).fingerprint() == nominal.fingerprint()
 
 
-@pytest.mark.parametrize("value", [0, -1.0, float("nan"), "1.1", True, 11.0])
+@pytest.mark.parametrize("value", [0, -1.0, float("nan"), "1.1", True, 1001.0])
 def test_bad_scales_are_refused(value: object) -> None:
     with pytest.raises(SearchConfigError, match="body_bulk_scale"):
         make_model(3, {"body_bulk_scale": value})

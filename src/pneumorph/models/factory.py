@@ -15,8 +15,8 @@ from pneumorph.geometry.library import BUILTIN_LIBRARIES, UnitLibrary, builtin_l
 from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
-from pneumorph.models.fe.base import FORMULATIONS
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.volumetric import FORMULATIONS
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
               "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale",
@@ -154,15 +154,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     change = checks.real(s.get("temperature_change", 0.0), "[model] temperature_change", -100.0, 100.0, unit="degC",
                          error=SearchConfigError)
     passage = checks.real(s.get("passage", 0.0), "[model] passage", 0.0, 100.0, unit="mm", error=SearchConfigError)
-    extra: dict[str, Any] = {"base_block": block} if block is not None else {}
-    if "formulation" in s:
-        extra["formulation"] = checks.text(s["formulation"], "[model] formulation", FORMULATIONS,
-                                           error=SearchConfigError)
-    if library is not None:
-        extra["library"] = library
-    body = _scaled_body(s, unit if unit is not None else library.units[0] if library is not None else UnitSpec())
-    if body is not None:
-        extra["materials"] = {body.name: body}
+    extra = _model_options(s, unit, library, block)
     if change != 0.0 or passage != 0.0:
         if Model is not Full3D:
             what = "temperature_change" if change != 0.0 else "passage"
@@ -172,6 +164,22 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         except GeometryError as exc:
             raise SearchConfigError(f"[model] passage: {exc}") from None
     return Model(units, unit, ramp, gravity=gravity, **extra)
+
+
+def _model_options(s: Mapping[str, Any], unit: UnitSpec | None, library: UnitLibrary | None,
+                   block: BaseBlock | None) -> dict[str, Any]:
+    """The model class's keyword arguments the settings give beyond the ramp and the loads: the base block, the
+    volumetric formulation, the unit library and the scaled body silicone."""
+    extra: dict[str, Any] = {"base_block": block} if block is not None else {}
+    if "formulation" in s:
+        extra["formulation"] = checks.text(s["formulation"], "[model] formulation", FORMULATIONS,
+                                           error=SearchConfigError)
+    if library is not None:
+        extra["library"] = library
+    body = _scaled_body(s, unit if unit is not None else library.units[0] if library is not None else UnitSpec())
+    if body is not None:
+        extra["materials"] = {body.name: body}
+    return extra
 
 
 def unit_or_library(s: Mapping[str, Any]) -> tuple[UnitSpec | None, UnitLibrary | None]:

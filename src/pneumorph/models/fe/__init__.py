@@ -2,8 +2,10 @@
 
 The public import place of the FE models; each concept has a module of its own:
 
-- :mod:`pneumorph.models.fe.base`: the common machinery (:class:`FEModel`), the pressure
-  ramp (:class:`RampSpec`) and the solved fields (:class:`Solution`);
+- :mod:`pneumorph.models.fe.base`: the common machinery (:class:`FEModel`) and the solved
+  fields (:class:`Solution`); :mod:`pneumorph.models.fe.ramp`: the pressure ramp
+  (:class:`RampSpec`); :mod:`pneumorph.models.fe.volumetric`: how the silicones' volumetric
+  term is integrated (the u-p-J form for a nearly incompressible one);
 - :mod:`pneumorph.models.fe.reduced2d`: :class:`Reduced2D`, the plane-strain section whose
   cavities hold the pressure-dependent filler (chapter 5);
 - :mod:`pneumorph.models.fe.full3d`: :class:`Full3D`, quadratic hexahedra and empty cavities
@@ -26,9 +28,6 @@ from pneumorph.models.fe.base import (
     FEModel as FEModel,
 )
 from pneumorph.models.fe.base import (
-    RampSpec as RampSpec,
-)
-from pneumorph.models.fe.base import (
     Solution as Solution,
 )
 from pneumorph.models.fe.base import (
@@ -36,6 +35,9 @@ from pneumorph.models.fe.base import (
 )
 from pneumorph.models.fe.full3d import (
     Full3D as Full3D,
+)
+from pneumorph.models.fe.ramp import (
+    RampSpec as RampSpec,
 )
 from pneumorph.models.fe.reduced2d import (
     Reduced2D as Reduced2D,

@@ -17,7 +17,7 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -26,7 +26,6 @@ from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
-from pneumorph.fem.fast.mixed import MIXED_BULK_RATIO
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -37,14 +36,13 @@ from pneumorph.materials import get
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.ramp import RampSpec
+from pneumorph.models.fe.volumetric import FORMULATIONS, element_volume
 from pneumorph.models.frames import record_frames
 from pneumorph.models.response import FloatArray, Response
 
 #: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
 MODEL_REVISION = 1
-#: how a silicone's volumetric term is integrated: by its bulk modulus ("auto": the u-p-J form from a Poisson's ratio
-#: of 0.45), at every point ("displacement") or on each element's own dilatation ("u-p-J")
-FORMULATIONS = ("auto", "displacement", "u-p-J")
 
 
 @dataclass(frozen=True)
@@ -64,29 +62,6 @@ class Solution:
     response: Response
     mesh: ActuatorMesh
     displacements: FloatArray
-
-
-@dataclass(frozen=True)
-class RampSpec:
-    """The pressure ramp and how it is solved.
-
-    Parameters
-    ----------
-    pressure : float
-        Final pressure in MPa (0.045 = 45 kPa).
-    steps : StepSettings
-        Reported increments (10 by default: 4.5, 9, ..., 45 kPa), substeps, cut-back.
-    """
-
-    pressure: float = 0.045
-    steps: StepSettings = field(default_factory=lambda: StepSettings(increments=10, substeps=2))
-
-    def __post_init__(self) -> None:
-        checks.real(self.pressure, "pressure", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
-                    limit="MAX_PRESSURE_KPA")
-
-    def pressures(self) -> FloatArray:
-        return self.pressure * self.steps.levels()
 
 
 def end_face_angle(x: FloatArray) -> float:
@@ -290,20 +265,9 @@ class FEModel:
         return 1.0 + material.thermal_expansion.value * self.temperature_change
 
     def element_volume(self, material: Any) -> bool:
-        """Whether ``material``'s volumetric term is integrated on each element's own dilatation (the u-p-J form,
-        :mod:`pneumorph.fem.fast.mixed`): always with ``formulation = "u-p-J"``, never with ``"displacement"``; by
-        default (``"auto"``) for a nearly incompressible silicone, its bulk modulus at least
-        :data:`~pneumorph.fem.fast.mixed.MIXED_BULK_RATIO` times its shear modulus (Poisson's ratio 0.45 or more).
-
-        >>> from pneumorph.materials import get
-        >>> from pneumorph.models.fe.reduced2d import Reduced2D
-        >>> Reduced2D(2).element_volume(get("mold_star_15")), Reduced2D(2, formulation="u-p-J").element_volume(
-        ...     get("mold_star_15"))
-        (False, True)
-        """
-        if self.formulation != "auto":
-            return self.formulation == "u-p-J"
-        return bool(material.bulk_modulus.value >= MIXED_BULK_RATIO * material.shear_modulus)
+        """Whether ``material``'s volumetric term is on each element's own dilatation in this model
+        (:func:`~pneumorph.models.fe.volumetric.element_volume` with its ``formulation``)."""
+        return element_volume(material, self.formulation)
 
     def _silicone_umat(self, material: Any) -> OgdenCompressible:
         return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value,

@@ -16,7 +16,8 @@ from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials.library.material import Material
-from pneumorph.models.fe.base import FEModel, RampSpec
+from pneumorph.models.fe.base import FEModel
+from pneumorph.models.fe.ramp import RampSpec
 
 
 class Full3D(FEModel):

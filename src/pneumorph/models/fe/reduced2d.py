@@ -21,7 +21,8 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.materials import get_filler
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.library.material import Material
-from pneumorph.models.fe.base import FEModel, RampSpec, model_library
+from pneumorph.models.fe.base import FEModel, model_library
+from pneumorph.models.fe.ramp import RampSpec
 
 
 class Reduced2D(FEModel):
