@@ -135,6 +135,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     },
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
+        "--volume-change": [*POSITIVE, "1e3"],
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
         "--model-file": ["binary.bin", "folder", "missing.toml", ""],

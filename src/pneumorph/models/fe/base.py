@@ -27,6 +27,7 @@ from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.fem.fast.mixed import MIXED_BULK_RATIO
+from pneumorph.fem.fast.volume import volume_control
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -76,14 +77,22 @@ class RampSpec:
         Final pressure in MPa (0.045 = 45 kPa).
     steps : StepSettings
         Reported increments (10 by default: 4.5, 9, ..., 45 kPa), substeps, cut-back.
+    volume : float, optional
+        Volume control: the cavities' relative volume change ``V / V0 - 1`` at the ramp's
+        end, reported in equal volume increments, the pressure an output that may pass a
+        maximum (:class:`~pneumorph.fem.fast.volume.VolumeControl`, fast backend); ``pressure``
+        then only scales the load factor. None: the pressure is ramped.
     """
 
     pressure: float = 0.045
     steps: StepSettings = field(default_factory=lambda: StepSettings(increments=10, substeps=2))
+    volume: float | None = None
 
     def __post_init__(self) -> None:
         checks.real(self.pressure, "pressure", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                     limit="MAX_PRESSURE_KPA")
+        if self.volume is not None:
+            checks.real(self.volume, "volume change", 0.0, 100.0, low_open=True)
 
     def pressures(self) -> FloatArray:
         return self.pressure * self.steps.levels()
@@ -248,6 +257,8 @@ class FEModel:
             "pressure_mpa": self.ramp.pressure,
             "steps": asdict(self.ramp.steps),
         }
+        if self.ramp.volume is not None:  # absent under pressure control: earlier fingerprints stay valid
+            out["volume_change"] = self.ramp.volume
         if self.filler is not None:
             out["filler"] = self.filler.to_dict()
         if self.gravity is not None:  # absent without gravity: earlier fingerprints stay valid
@@ -446,6 +457,8 @@ class FEModel:
             record_frames(response, k, mesh, displacements[k])  # the full width: each unit's and the end face's
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
+            if control is not None:
+                pressures[k] = response.pressures[k] = control.factor * self.ramp.pressure
             if on_level is not None:
                 on_level(k, pressures[k])
 
@@ -454,12 +467,17 @@ class FEModel:
         if self.gravity is not None:
             gravity_iterations = self._apply_gravity(body, substep, follow, design)
             response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(body.displacement).tolist())
+        control = volume_control(self.ramp.volume, substep, apply, body.displacement)
+        if control is not None:  # the volume drives, the pressure of every level is an output
+            apply, substep, monitor = control.apply, control, None
+            response.metadata["volume0"] = control.volume0
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
                          monitor=monitor, on_substep=follow, substep=substep, predictor_order=self.predictor_order,
                          carry=self.carry_step)
         except SimulationFailed as exc:
-            partial = replace(response, converged=False, reached=exc.reached * self.ramp.pressure,
+            reached = exc.reached if control is None else control.factor
+            partial = replace(response, converged=False, reached=reached * self.ramp.pressure,
                               failure=exc.cause)
             raise SimulationFailed(
                 reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure, partial=partial
