@@ -308,7 +308,7 @@ class BimodalModel:
         substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
         control = volume_control(self.volume, substep, apply, body.displacement)
         if control is not None:  # the voids' volume drives, the pressure is an output
-            apply, substep, monitor = control.apply, control, None
+            apply, substep = control.apply, control
 
         def record(k: int, t: float) -> None:
             u = body.displacement
@@ -322,7 +322,8 @@ class BimodalModel:
         cause, stats = "", None
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, settings, on_level=record,
-                         monitor=monitor, substep=substep, predictor_order=self.predictor_order)
+                         monitor=monitor if control is None else None, substep=substep,
+                         predictor_order=self.predictor_order)
         except SimulationFailed as exc:
             cause = f"stopped after {1e3 * (pressures[-1] if pressures else 0.0):g} kPa: {exc.cause}"
         p = np.asarray(pressures, dtype=float)

@@ -337,10 +337,11 @@ class FastSystem:
         (:class:`~pneumorph.fem.fast.volume.VolumeControl`).
         """
         U = u.reshape(-1, self.dim)
-        loads = []
+        loads: list[FloatArray] = []
         for w in self.walls:
             cofN = self._cof_normal(deformation_gradient(w.g, w.cells, U), w.ndA)
-            loads.append(np.bincount(w.edofs, weights=np.matmul(w.h.T[None], cofN).ravel(), minlength=self.ndof))
+            load = np.bincount(w.edofs, weights=np.matmul(w.h.T[None], cofN).ravel(), minlength=self.ndof)
+            loads.append(load.astype(np.float64, copy=False))
         return loads
 
     def cavity_volume(self, u: FloatArray) -> float:

@@ -469,11 +469,12 @@ class FEModel:
             response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(body.displacement).tolist())
         control = volume_control(self.ramp.volume, substep, apply, body.displacement)
         if control is not None:  # the volume drives, the pressure of every level is an output
-            apply, substep, monitor = control.apply, control, None
+            apply, substep = control.apply, control
             response.metadata["volume0"] = control.volume0
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
-                         monitor=monitor, on_substep=follow, substep=substep, predictor_order=self.predictor_order,
+                         monitor=monitor if control is None else None, on_substep=follow, substep=substep,
+                         predictor_order=self.predictor_order,
                          carry=self.carry_step)
         except SimulationFailed as exc:
             reached = exc.reached if control is None else control.factor
