@@ -48,7 +48,7 @@ class VolumeControl:
     Pass :meth:`apply` as the ramp's ``apply`` and the object itself as its ``substep``
     (and no monitor: the volume only rises). The ramp's factor ``t`` sets the target volume
     ``V0 (1 + t change)``; the load factor that holds it is found with the displacements
-    and read from :attr:`factor` after each converged substep.
+    and read from ``factor`` after each converged substep.
 
     Parameters
     ----------
