@@ -135,6 +135,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     },
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
+        "--volume-change": [*POSITIVE, "1e3"],
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
         "--model-file": ["binary.bin", "folder", "missing.toml", ""],
@@ -158,6 +159,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     "bimodal": {
         "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE,
         "--element-size": [*POSITIVE, "1e-4"], "--end-cap": NONNEG, "--bilinear-nu": ["0.5", "-1.5", *REAL],
+        "--control": ["", "arc-length"], "--volume-change": [*POSITIVE, "1e3"],
         "--max-cutbacks": COUNT + HUGE, "--max-iterations": POS_COUNT + HUGE, "--out": ["a-file", "a-file/sub", ""],
     },
     "coupon": {

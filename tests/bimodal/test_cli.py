@@ -11,7 +11,8 @@ from pneumorph.cli.bilinear.bimodal import bulk_from_poisson
 
 
 def test_json_run(tmp_path, capsys) -> None:
-    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--json",
+    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
+                 "--json",
                  "--out", str(tmp_path)])
     assert code == 0
     d = json.loads(capsys.readouterr().out)
@@ -22,8 +23,8 @@ def test_json_run(tmp_path, capsys) -> None:
 
 
 def test_text_run_with_poisson(capsys) -> None:
-    code = main(["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "-q",
-                 "--bilinear-nu", "0.45"])
+    code = main(["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
+                 "-q", "--bilinear-nu", "0.45"])
     assert code == 0
     out = capsys.readouterr().out
     assert "switch pressure" in out and "none below 5 kPa" in out
@@ -31,8 +32,8 @@ def test_text_run_with_poisson(capsys) -> None:
 
 
 def test_text_run_says_where_its_files_went(tmp_path, capsys) -> None:
-    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "-q",
-                 "--out", str(tmp_path / "b")])
+    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
+                 "-q", "--out", str(tmp_path / "b")])
     assert code == 0
     assert capsys.readouterr().out.splitlines()[-1] == (
         f"written to {tmp_path / 'b'}/ (bimodal-cr0_3.json, bimodal-cr0_3-tip.png, bimodal-cr0_3-shape.png)")
@@ -51,7 +52,7 @@ def test_bulk_from_poisson() -> None:
 def test_a_ramp_that_ends_early_is_not_a_success(tmp_path, capsys) -> None:
     """One Newton iteration and no cut-back cannot reach the first level: the table is printed, the outputs
     written, and the command ends with one line naming the cause and exit 2 (not 0)."""
-    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5",
+    code = main(["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
                  "--max-iterations", "1", "--max-cutbacks", "0", "-q", "--out", str(tmp_path)])
     captured = capsys.readouterr()
     assert code == 2

@@ -109,7 +109,7 @@ def test_precision_attribute_follows_the_solver() -> None:
     system = Pattern()
     step = FastSubstep(system, reuse=0.7)
     assert step.precision == "single" and system.tangent_dtype == np.float32
-    step._to_double()
+    step.to_double()
     assert step.precision == "double" and system.tangent_dtype == np.float64
 
 

@@ -40,6 +40,8 @@ from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
+from pneumorph.fem.fast.mixed import MIXED_BULK_RATIO
+from pneumorph.fem.fast.volume import volume_control
 from pneumorph.materials import get
 from pneumorph.materials.laws.hyperelastic import Ogden
 from pneumorph.models.fe import Full3D
@@ -159,6 +161,11 @@ class BimodalModel:
         ``"fast"`` (default): the fast 3D system and its Newton method keeping factorised
         tangents, as :class:`pneumorph.models.fe.Full3D`; ``"felupe"``: FElupe's assembly
         and ``newtonraphson`` (the reference path). Both stop at the same criterion.
+    volume : float, optional
+        Volume control (fast backend): the voids' relative volume change ``V / V0 - 1`` at the
+        ramp's end, reached in ``pmax / step`` equal volume steps; the pressure of every step
+        is an output, so the ramp follows a wall that balloons past the pressure's maximum
+        (:class:`~pneumorph.fem.fast.volume.VolumeControl`). None: the pressure is ramped.
 
     Examples
     --------
@@ -196,6 +203,7 @@ class BimodalModel:
         max_iterations: int | None = None,
         half: bool = True,
         backend: str = "fast",
+        volume: float | None = None,
     ) -> None:
         pmax = checks.real(pmax, "pmax", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                            limit="MAX_PRESSURE_KPA")
@@ -234,6 +242,7 @@ class BimodalModel:
         self.max_iterations = int(max_iterations)
         self.half = bool(half)
         self.backend = check_backend(backend)
+        self.volume = None if volume is None else checks.real(volume, "volume", 0.0, 100.0, low_open=True)
 
     def bulk(self, layer: str) -> float:
         """Bulk modulus (MPa) used for a layer."""
@@ -256,6 +265,7 @@ class BimodalModel:
             "max_iterations": self.max_iterations,
             "half_model": self.half,
             "element": "hexahedron20",
+            "control": "pressure" if self.volume is None else f"volume (V/V0 - 1 = {self.volume:g} at the end)",
         }
 
     def build(self) -> tuple[BimodalMesh, PressurisedBody]:
@@ -266,7 +276,9 @@ class BimodalModel:
             name = LABELS[code]
             m = self.materials[name].model
             assert isinstance(m, Ogden), f"{name}: the bimodal model takes Ogden silicones"
-            regions.append((name, mesh.label == code, OgdenCompressible(m.mu, m.alpha, self.bulk(name))))
+            # a nearly incompressible layer (the composite at nu = 0.495) on the u-p-J form, as the models choose it
+            mixed = self.bulk(name) >= MIXED_BULK_RATIO * self.materials[name].shear_modulus
+            regions.append((name, mesh.label == code, OgdenCompressible(m.mu, m.alpha, self.bulk(name), mixed=mixed)))
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
                                 mesh.symmetry_points)
         return mesh, body
@@ -293,20 +305,25 @@ class BimodalModel:
         def apply(t: float) -> None:
             body.pressure.update(t * self.pmax)
 
+        substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
+        control = volume_control(self.volume, substep, apply, body.displacement)
+        if control is not None:  # the voids' volume drives, the pressure is an output
+            apply, substep = control.apply, control
+
         def record(k: int, t: float) -> None:
             u = body.displacement
-            pressures.append(t * self.pmax)
+            pressures.append((t if control is None else control.factor) * self.pmax)
             tips.append(u[mesh.tip, :2].mean(axis=0))
             stations.append(u[mesh.station, :2].mean(axis=0))
             outlines.append(x0 + u[outline_ids, :2])
             if on_level is not None:
                 on_level(k, pressures[-1], float(tips[-1][1]))
 
-        substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
         cause, stats = "", None
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, settings, on_level=record,
-                         monitor=monitor, substep=substep, predictor_order=self.predictor_order)
+                         monitor=monitor if control is None else None, substep=substep,
+                         predictor_order=self.predictor_order)
         except SimulationFailed as exc:
             cause = f"stopped after {1e3 * (pressures[-1] if pressures else 0.0):g} kPa: {exc.cause}"
         p = np.asarray(pressures, dtype=float)
@@ -320,6 +337,10 @@ class BimodalModel:
             "backend": self.backend,
             "pneumorph": __version__,
         }
+        if control is not None:
+            meta.update(volume0_mm3=control.volume0, volumes_mm3=(control.volume0 * (
+                1.0 + self.volume * settings.levels()[: len(pressures)])).tolist(),  # type: ignore[operator]
+                pressure_max_kpa=1e3 * float(p.max(initial=0.0)))
         if stats is not None:
             meta.update(newton_iterations=stats.newton_iterations, substeps=stats.substeps, cutbacks=stats.cutbacks,
                         factorisations=getattr(substep, "factorisations", stats.newton_iterations))

@@ -17,6 +17,10 @@ from pneumorph.cli.progress import reporter
                    "over a --library, one letter per unit, upper case = turned (e.g. aRRa).")
 @click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure in kPa.")
 @click.option("--increments", type=P.INCREMENTS, default=10, show_default=True, help="Reported pressure levels.")
+@click.option("--volume-change", type=P.Real(0.0, 100.0, low_open=True), default=None,
+              help="Drive the cavities' volume instead of the pressure, to this relative change V/V0 - 1 in "
+                   "--increments equal steps: the pressure is an output and may pass a maximum (a wall that "
+                   "balloons); --pressure then only scales the solver's load factor.")
 @click.option("--model", "fidelity", type=click.Choice(["2d", "3d"]), default="2d", show_default=True,
               help="2D reduced-order (plane strain with filler) or 3D model.")
 @click.option("--unit", "unit_file", type=P.InputFile(),
@@ -43,6 +47,7 @@ def simulate(
     out: str | None,
     as_json: bool,
     model_file: str | None = None,
+    volume_change: float | None = None,
 ) -> None:
     """Inflate one actuator design and report its shape at every pressure level."""
     from pneumorph.io import provenance
@@ -56,6 +61,8 @@ def simulate(
         settings["unit_file"] = unit_file
     if library is not None:
         settings["library"] = library
+    if volume_change is not None:
+        settings["volume_change"] = volume_change
     settings = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure",
                                                           "increments": "increments", "gravity": "gravity"})
     fidelity = str(settings["fidelity"])

@@ -20,7 +20,7 @@ from pneumorph.models.fe.volumetric import FORMULATIONS
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
               "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale",
-              "formulation")
+              "formulation", "volume_change")
 #: the range of ``body_shear_scale`` (a factor on the body silicone's Ogden moduli), and of the identified scales
 SCALE_RANGE = (0.1, 10.0)
 #: the range of ``body_bulk_scale``: up to a nearly incompressible body (x1000 gives Mold Star 15 a Poisson's ratio of
@@ -117,7 +117,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         :data:`SCALE_RANGES` (default 1: the library's silicone, the same fingerprint);
         ``formulation``: how the silicones' volumetric term is integrated (``"auto"``, the default:
         the u-p-J form for a nearly incompressible silicone; ``"displacement"``; ``"u-p-J"``;
-        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`).
+        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`); ``volume_change`` (RampSpec's ``volume``).
 
     Examples
     --------
@@ -226,7 +226,11 @@ def _ramp(s: Mapping[str, Any], defaults: StepSettings) -> RampSpec:
                                 checks.MAX_INCREMENTS, limit="MAX_INCREMENTS", error=SearchConfigError)
     substeps = checks.integer(s.get("substeps", defaults.substeps), "[model] substeps", 1, checks.MAX_SUBSTEPS,
                               limit="MAX_SUBSTEPS", error=SearchConfigError)
-    return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps))
+    volume = s.get("volume_change")
+    if volume is not None:
+        volume = checks.real(volume, "[model] volume_change", 0.0, 100.0, low_open=True, error=SearchConfigError)
+    return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps),
+                    volume=volume)
 
 
 def _base_block(block: Any) -> BaseBlock | None:

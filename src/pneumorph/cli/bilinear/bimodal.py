@@ -15,6 +15,10 @@ from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import reporter
 from pneumorph.io.files import all_or_nothing, strict_json, write_json
 
+#: the voids' relative volume change V/V0 - 1 at the end of the default volume-controlled ramp: the full-size
+#: actuator (CR 0.2, library bulk modulus) passes the pressure ramp's end (about 35 kPa) and its pressure maximum
+DEFAULT_VOLUME_CHANGE = 8.0
+
 
 def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
     """Small-strain bulk modulus ``K = 2 mu (1 + nu) / (3 (1 - 2 nu))`` (same unit as mu).
@@ -46,16 +50,24 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
                    "[default: the model's own, shown in the --json metadata].")
 @click.option("--max-iterations", type=P.Count(1, 1000), default=None,
               help="Newton iterations per trial [default: the model's own, shown in --json metadata].")
+@click.option("--control", type=click.Choice(["volume", "pressure"]), default="volume", show_default=True,
+              help="What the ramp drives: the voids' volume (the pressure an output, followed past its maximum "
+                   "where a wall balloons) or the pressure (the ramp ends where a wall balloons).")
+@click.option("--volume-change", type=P.Real(0.0, 100.0, low_open=True), default=DEFAULT_VOLUME_CHANGE,
+              show_default=True, help="With --control volume: the voids' relative volume change V/V0 - 1 at the "
+                                      "ramp's end, in --pmax/--step equal steps (--pmax then scales the solver).")
 @click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
 def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
             bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
-            as_json: bool, quiet: bool) -> None:
-    """3D FE of the bimodal actuator: tip displacement in pressure steps, switch pressure.
+            as_json: bool, quiet: bool, control: str = "volume", volume_change: float = DEFAULT_VOLUME_CHANGE) -> None:
+    """3D FE of the bimodal actuator: tip displacement in volume or pressure steps, switch pressure.
 
-    The ramp ends at --pmax or at the last pressure that converges (where a wall balloons).
+    Volume control (default) follows the pressure past its maximum where a wall balloons and
+    reports the pressure of every step; pressure control ends at --pmax or at the last
+    pressure that converges.
     """
     from pneumorph.bimodal.geometry import BimodalSpec
     from pneumorph.bimodal.model import BimodalModel, bilinear_material
@@ -77,14 +89,16 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
             BimodalSpec(**{field: value})  # type: ignore[arg-type]
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
-                         max_cutbacks=max_cutbacks, max_iterations=max_iterations)  # None: the model's own
+                         max_cutbacks=max_cutbacks, max_iterations=max_iterations,  # None: the model's own
+                         volume=volume_change if control == "volume" else None)
 
     from pneumorph.io.progress import Progress
 
     lines = Progress(lambda text: None, heartbeat=0) if quiet or as_json else reporter()
     with lines:
         lines.plan("bimodal ramp", max(1, round(pmax / step)), noun="levels",
-                   title=f"bimodal ramp to {pmax:g} kPa in steps of {step:g} kPa")
+                   title=f"bimodal ramp to {pmax:g} kPa in steps of {step:g} kPa" if control == "pressure" else
+                   f"bimodal ramp of the voids' volume to {1 + volume_change:g} V0 in {n} steps")
         result = model.solve(on_level=lambda k, p, v: lines.count(k + 1, f"{1e3 * p:6.1f} kPa  tip u_y {v:+8.3f} mm",
                                                                   always=True))
     data = result.to_dict()
@@ -115,6 +129,11 @@ def format_result(d: dict[str, Any]) -> str:
         lines.append(f"{p:10.1f}   {ux:12.3f}   {uy:12.3f}")
     if not d["completed"]:
         lines.append(f"ramp ended early: {d['cause'].strip()}")
+    if "pressure_max_kpa" in m and d["pressures_kpa"]:
+        top = int(max(range(len(d["pressures_kpa"])), key=lambda k: d["pressures_kpa"][k]))
+        after = "" if top == len(d["pressures_kpa"]) - 1 else f", then {d['pressures_kpa'][-1]:.1f} kPa at the end"
+        lines.append(f"volume control: pressure maximum {m['pressure_max_kpa']:.2f} kPa at step {top + 1} "
+                     f"(V = {m['volumes_mm3'][top] / m['volume0_mm3']:.3g} V0){after}")
     turn = "none" if s["turning_kpa"] is None else f"{s['turning_kpa']:g} kPa (u_y {s['peak_mm']:.3f} mm)"
     lines.append(f"tip turns back at: {turn}")
     limit = d["pressures_kpa"][-1] if d["pressures_kpa"] else 0.0

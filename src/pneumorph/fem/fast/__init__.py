@@ -10,11 +10,15 @@ same criterion, an order of magnitude faster:
 - :mod:`~pneumorph.fem.fast.loads` - dead loads as one nodal vector;
 - :mod:`~pneumorph.fem.fast.newton` - :class:`FastSubstep`, Newton's method on a system
   (kept factorised tangents, Anderson acceleration), a substep strategy of
-  :func:`pneumorph.fem.ramp`.
+  :func:`pneumorph.fem.ramp`;
+- :mod:`~pneumorph.fem.fast.volume` - :class:`VolumeControl`, the volume-controlled substeps
+  (the cavities' volume drives, the pressure is an unknown and passes its maximum).
 """
 
 from pneumorph.fem.fast.loads import DeadLoads
 from pneumorph.fem.fast.newton import FastSubstep, pattern_solver
 from pneumorph.fem.fast.system import FastSystem, PlaneStrainSystem, SolidSystem3D
+from pneumorph.fem.fast.volume import VolumeControl, volume_control
 
-__all__ = ["DeadLoads", "FastSubstep", "FastSystem", "PlaneStrainSystem", "SolidSystem3D", "pattern_solver"]
+__all__ = ["DeadLoads", "FastSubstep", "FastSystem", "PlaneStrainSystem", "SolidSystem3D", "VolumeControl",
+           "pattern_solver", "volume_control"]

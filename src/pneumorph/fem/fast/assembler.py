@@ -328,6 +328,22 @@ class FastSystem:
             matrix = (matrix + sp.triu(matrix, k=1).T).tocsr()
         return matrix
 
+    def wall_loads(self, u: FloatArray) -> list[FloatArray]:
+        """Every wall's residual at unit pressure, ``int h cof(F) N dA`` over all dofs, at ``u``.
+
+        The residual's derivative with respect to a wall's pressure; over closed cavities
+        their sum is minus the derivative of the enclosed volume (:meth:`cavity_volume`)
+        with respect to ``u``, the border of a volume-controlled solve
+        (:class:`~pneumorph.fem.fast.volume.VolumeControl`).
+        """
+        U = u.reshape(-1, self.dim)
+        loads: list[FloatArray] = []
+        for w in self.walls:
+            cofN = self._cof_normal(deformation_gradient(w.g, w.cells, U), w.ndA)
+            load = np.bincount(w.edofs, weights=np.matmul(w.h.T[None], cofN).ravel(), minlength=self.ndof)
+            loads.append(load.astype(np.float64, copy=False))
+        return loads
+
     def cavity_volume(self, u: FloatArray) -> float:
         """Volume (area in 2D) enclosed by the pressurised walls, as :func:`pneumorph.fem.cavity_volume`."""
         U = u.reshape(-1, self.dim)

@@ -188,7 +188,7 @@ class FastSubstep:
     def precision(self) -> str:
         return "single" if getattr(self.solver, "dtype", None) == np.float32 else "double"
 
-    def _to_double(self) -> None:
+    def to_double(self) -> None:
         """Factorise in double precision from now on (tangents assembled in double too)."""
         system = self.system
         self.solver = pattern_solver(system.indptr, system.indices, getattr(system, "symmetric", False),
@@ -201,7 +201,8 @@ class FastSubstep:
         return (f"the residual norm reached {self.best:.3g} in {settings.max_iterations} iterations, not the "
                 f"tolerance {settings.tolerance:.3g} ({self.precision}-precision factorisation)")
 
-    def _factorize(self) -> None:
+    def factorize(self) -> None:
+        """Assemble the tangent at the state of the system's last residual and factorise it."""
         data = self.system.tangent_data()
         if hasattr(self.solver, "factorize"):
             self.solver.factorize(data)
@@ -210,7 +211,8 @@ class FastSubstep:
         self._factorised = True
         self.factorisations += 1
 
-    def _solve(self, b: FloatArray) -> FloatArray:
+    def solve(self, b: FloatArray) -> FloatArray:
+        """``K^-1 b`` with the last factorised tangent (``b`` over the active dofs)."""
         if hasattr(self.solver, "factorize"):
             return np.asarray(self.solver.solve(b))
         return np.asarray(self.solver(self._data, b))
@@ -238,8 +240,8 @@ class FastSubstep:
                 return 0, cause
             for iteration in range(1, settings.max_iterations + 1):
                 try:
-                    self._factorize()
-                    dx = self._solve(-r[dof1])
+                    self.factorize()
+                    dx = self.solve(-r[dof1])
                 except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
                     return iteration, f"{type(exc).__name__}: {exc}"
                 if not np.all(np.isfinite(dx)):
@@ -280,10 +282,10 @@ class FastSubstep:
             for iteration in range(1, settings.max_iterations + 1):
                 try:
                     if not self._factorised:
-                        self._factorize()  # at the state of the last residual, u
+                        self.factorize()  # at the state of the last residual, u
                         fresh, f, dU, dF = True, None, [], []
                     if f is None:
-                        f = -self._solve(r[dof1])
+                        f = -self.solve(r[dof1])
                 except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
                     return iteration, f"{type(exc).__name__}: {exc}"
                 step = f
@@ -311,14 +313,14 @@ class FastSubstep:
                 if done:
                     return iteration, cause
                 if poor >= STALLED_FRESH and self.precision == "single":
-                    self._to_double()  # refresh at u_new, in double precision from now on
+                    self.to_double()  # refresh at u_new, in double precision from now on
                     f, poor = None, 0
                 elif fnorm_new > reuse * fnorm:
                     self._factorised = False  # refresh at u_new
                     f = None
                 else:
                     try:
-                        f_new = -self._solve(r_new[dof1])
+                        f_new = -self.solve(r_new[dof1])
                     except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
                         return iteration, f"{type(exc).__name__}: {exc}"
                     if self.depth > 0:

@@ -26,6 +26,7 @@ from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
+from pneumorph.fem.fast.volume import volume_control
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -223,6 +224,8 @@ class FEModel:
             "pressure_mpa": self.ramp.pressure,
             "steps": asdict(self.ramp.steps),
         }
+        if self.ramp.volume is not None:  # absent under pressure control: earlier fingerprints stay valid
+            out["volume_change"] = self.ramp.volume
         if self.filler is not None:
             out["filler"] = self.filler.to_dict()
         if self.gravity is not None:  # absent without gravity: earlier fingerprints stay valid
@@ -410,6 +413,8 @@ class FEModel:
             record_frames(response, k, mesh, displacements[k])  # the full width: each unit's and the end face's
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
+            if control is not None:
+                pressures[k] = response.pressures[k] = control.factor * self.ramp.pressure
             if on_level is not None:
                 on_level(k, pressures[k])
 
@@ -418,12 +423,18 @@ class FEModel:
         if self.gravity is not None:
             gravity_iterations = self._apply_gravity(body, substep, follow, design)
             response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(body.displacement).tolist())
+        control = volume_control(self.ramp.volume, substep, apply, body.displacement)
+        if control is not None:  # the volume drives, the pressure of every level is an output
+            apply, substep = control.apply, control
+            response.metadata["volume0"] = control.volume0
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
-                         monitor=monitor, on_substep=follow, substep=substep, predictor_order=self.predictor_order,
+                         monitor=monitor if control is None else None, on_substep=follow, substep=substep,
+                         predictor_order=self.predictor_order,
                          carry=self.carry_step)
         except SimulationFailed as exc:
-            partial = replace(response, converged=False, reached=exc.reached * self.ramp.pressure,
+            reached = exc.reached if control is None else control.factor
+            partial = replace(response, converged=False, reached=reached * self.ramp.pressure,
                               failure=exc.cause)
             raise SimulationFailed(
                 reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure, partial=partial
