@@ -29,6 +29,6 @@ class ExhaustiveSearch(Search):
         ex = run_exhaustive(problem.model, problem.objective, problem.evaluator,
                             hall_of_fame=problem.config.ga.hall_of_fame, on_progress=problem.on_progress)
         best = ex.hall_of_fame[0] if ex.hall_of_fame else None
+        comparison = None if best is None else compare_with_reference(problem, best, exhaustive=True)
         return SearchOutcome(ex.hall_of_fame, ranking=[(d, ex.scores[d]) for d in ex.ranking],
-                             robustness=winner_robustness(problem, best),
-                             comparison=None if best is None else compare_with_reference(problem, best))
+                             robustness=winner_robustness(problem, best), comparison=comparison)
