@@ -60,6 +60,8 @@ def test_design_with_a_model_file_reports_the_nominal_design(tmp_path: Path) -> 
     assert comparison["reference_on_model"] == comparison["winner_value"] == out["best"]["fitness"]
     report = (tmp_path / "run" / "report.md").read_text(encoding="utf-8")
     assert f"the nominal model chose the same design {out['best']['design']}" in report
+    # a certified run's hall of fame holds the chain's values, the winner's is by FE: each labelled
+    assert "| rank | design | chain (mm) | pressure (kPa) |" in report and "The chain model's values" in report
     assert "warning" not in done.stderr  # not a file of pneumorph identify: nothing to say of its fit
     plain = runner.invoke(cli, args)  # again, from the cache: the comparison in words
     assert plain.exit_code == 0, plain.output

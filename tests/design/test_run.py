@@ -70,6 +70,7 @@ def test_run_folder_contents(tmp_path: Path) -> None:
             assert "kPa" not in (folder / name).read_text(), name
     report = (folder / "report.md").read_text()
     assert f"`{best.design}`" in report and f"{best.pressure * 1e3:.4g} kPa" in report and "error (Eq 4.1)" in report
+    assert "| rank | design | FE (mm) | pressure (kPa) |" in report  # a GA's hall of fame: the model's own values
 
 
 def test_a_killed_run_resumes_without_solving_any_cached_design(tmp_path: Path) -> None:

@@ -326,7 +326,9 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
             "",
             "## Hall of fame",
             "",
-            f"| rank | design | {o.unit} | pressure (kPa) |",
+            *(["The chain model's values (the winner's above and the verified designs' below are by FE).", ""]
+              if result.certified is not None else []),
+            f"| rank | design | {'chain' if result.certified is not None else 'FE'} ({o.unit}) | pressure (kPa) |",
             "|---:|---|---:|---:|",
         ]
         for i, c in enumerate(result.hall_of_fame, 1):
