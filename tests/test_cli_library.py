@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pneumorph.cli import main
 from pneumorph.materials.library import builtin as library
+from tests.cli import run
 
 
 @pytest.fixture(autouse=True)
@@ -17,12 +17,6 @@ def _clean_registry():
     library.clear_registered()
     yield
     library.clear_registered()
-
-
-def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_list(capsys: pytest.CaptureFixture[str]) -> None:

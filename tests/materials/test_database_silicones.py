@@ -20,6 +20,7 @@ from pneumorph.materials.fitting.database import fit_tensile_curve
 from pneumorph.materials.fitting.fit import r_squared
 from pneumorph.materials.laws.hyperelastic import Ogden
 from pneumorph.materials.library import builtin as library
+from tests.cli import run
 
 SORO = "marechal2021_SoRo-Materials-DB/Tensile-Tests-Data"
 ATTRIBUTION = "Data: Soft Robotics Materials Database, Marechal et al. 2021, doi:10.1089/soro.2019.0115, ODbL 1.0"
@@ -39,12 +40,6 @@ def _clean_registry():  # type: ignore[no-untyped-def]
     library.clear_registered()
     yield
     library.clear_registered()
-
-
-def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_every_file_of_the_database_is_in_the_library(reference_dir: Path) -> None:
