@@ -17,10 +17,11 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.fe.base import FORMULATIONS
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.obstacles import check_obstacles
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
               "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale",
-              "formulation")
+              "formulation", "obstacle")
 #: the range of ``body_shear_scale`` (a factor on the body silicone's Ogden moduli), and of the identified scales
 SCALE_RANGE = (0.1, 10.0)
 #: the range of ``body_bulk_scale``: up to a nearly incompressible body (x1000 gives Mold Star 15 a Poisson's ratio of
@@ -117,7 +118,8 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         :data:`SCALE_RANGES` (default 1: the library's silicone, the same fingerprint);
         ``formulation``: how the silicones' volumetric term is integrated (``"auto"``, the default:
         the u-p-J form for a nearly incompressible silicone; ``"displacement"``; ``"u-p-J"``;
-        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`).
+        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`); ``obstacle``: a list of rigid obstacles
+        (``[[model.obstacle]]`` tables, :func:`pneumorph.models.fe.obstacles.check_obstacles`).
 
     Examples
     --------
@@ -160,6 +162,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
                                            error=SearchConfigError)
     if library is not None:
         extra["library"] = library
+    extra.update(_obstacles(s.get("obstacle"), Model.dim))
     body = _scaled_body(s, unit if unit is not None else library.units[0] if library is not None else UnitSpec())
     if body is not None:
         extra["materials"] = {body.name: body}
@@ -219,6 +222,22 @@ def _ramp(s: Mapping[str, Any], defaults: StepSettings) -> RampSpec:
     substeps = checks.integer(s.get("substeps", defaults.substeps), "[model] substeps", 1, checks.MAX_SUBSTEPS,
                               limit="MAX_SUBSTEPS", error=SearchConfigError)
     return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps))
+
+
+def _obstacles(tables: Any, dim: int) -> dict[str, Any]:
+    """``{"obstacles": ...}`` of the ``[[model.obstacle]]`` tables, or nothing (none given).
+
+    Raises
+    ------
+    SearchConfigError
+        A table that is no valid obstacle.
+    """
+    if tables is None:
+        return {}
+    try:
+        return {"obstacles": check_obstacles(tables, dim)}
+    except SettingsError as exc:
+        raise SearchConfigError(str(exc)) from None
 
 
 def _base_block(block: Any) -> BaseBlock | None:

@@ -37,6 +37,7 @@ from pneumorph.materials import get
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.obstacles import ContactRecord, check_obstacles, contact_items
 from pneumorph.models.frames import record_frames
 from pneumorph.models.response import FloatArray, Response
 
@@ -146,9 +147,12 @@ class FEModel:
         filler: FillerLaw | None = None, backend: str | None = None, gravity: str | Sequence[float] | None = None,
         temperature_change: float = 0.0, passage: float = 0.0, base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None, library: UnitLibrary | None = None,
-        formulation: str = "auto",
+        formulation: str = "auto", obstacles: Sequence[Any] | None = None,
     ) -> None:
         self.backend = check_backend(backend or self.backends[0], self.backends)
+        self.obstacles = check_obstacles(obstacles, self.dim)  # rigid, against the outer surface (fast backend)
+        if self.obstacles and self.backend != "fast":
+            raise SettingsError("contact with obstacles is solved by the fast backend only (the default)")
         self.formulation = checks.text(formulation, "formulation", FORMULATIONS)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.library = model_library(unit, library)
@@ -208,7 +212,7 @@ class FEModel:
         out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
                                "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
                                "base_block": self.base_block, "materials": dict(self.materials),
-                               "formulation": self.formulation}
+                               "formulation": self.formulation, "obstacles": self.obstacles}
         if not self.library.is_single:
             out["library"] = self.library
         return out
@@ -263,6 +267,8 @@ class FEModel:
             out["library"] = self.library.to_dict()
         if self.formulation != "auto":  # likewise ("auto" follows from the materials, which are described)
             out["formulation"] = self.formulation
+        if self.obstacles:  # likewise
+            out["obstacles"] = [o.to_dict() for o in self.obstacles]
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -376,6 +382,7 @@ class FEModel:
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, [*regions, *extra], mesh.cavity_points,
                                 mesh.base_points, mesh.symmetry_points, walls_of=list(silicones),
                                 densities=densities)
+        body.contacts = contact_items(self.obstacles, mesh, self.body.shear_modulus)
 
         def set_pressure(p: float) -> None:
             body.pressure.update(p)
@@ -446,10 +453,15 @@ class FEModel:
             record_frames(response, k, mesh, displacements[k])  # the full width: each unit's and the end face's
             response.tip[k] = tip_of(displacements[k])
             response.curl[k] = np.degrees(turned["total"])
+            if contact is not None:  # the obstacles' forces, the base reaction
+                contact.record(k, pressures[k], substep.system, displacements[k])
+                response.metadata["contact"] = contact.metadata()
             if on_level is not None:
                 on_level(k, pressures[k])
 
         substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
+        contact = ContactRecord(self.obstacles, mesh, body.contacts, mesh.symmetry_points is not None) \
+            if self.obstacles else None
         gravity_iterations = 0
         if self.gravity is not None:
             gravity_iterations = self._apply_gravity(body, substep, follow, design)
