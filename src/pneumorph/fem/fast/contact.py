@@ -368,15 +368,19 @@ def surface_points(cells: IntArray, cell_type: str, excluded: NDArray[np.bool_] 
     return faces, np.unique(faces)
 
 
-def start_inside(contacts: Sequence[RigidContact], x: FloatArray) -> str | None:
-    """Why an obstacle cannot start where it is (a surface node inside it at the start), or None."""
-    for i, contact in enumerate(contacts):
-        gap = contact.obstacle.kinematics(x[contact.points])[0]
-        if np.any(gap < -1e-9):  # (a wall through a surface point touches it)
-            worst = int(np.argmin(gap))
-            where = ", ".join(f"{v:g}" for v in x[contact.points[worst]])
-            return (f"obstacle {i + 1} ({contact.obstacle.kind}) starts inside the actuator: the surface point "
-                    f"({where}) mm lies {-gap[worst]:.3g} mm inside it")
+def start_inside(obstacles: Sequence[Obstacle], x: FloatArray) -> str | None:
+    """Why an obstacle cannot start where it is (a point ``x`` (p, d) of the body inside it), or None.
+
+    >>> start_inside([Sphere((0.0, 0.0), 1.0)], np.array([[3.0, 0.0], [0.5, 0.0]]))
+    'obstacle 1 (sphere) starts inside the actuator: its point (0.5, 0) mm lies 0.5 mm inside it'
+    """
+    for i, obstacle in enumerate(obstacles):
+        gap = obstacle.kinematics(x)[0]
+        worst = int(np.argmin(gap))
+        if gap[worst] < -1e-9:  # (a wall through a surface point touches it)
+            where = ", ".join(f"{v:g}" for v in x[worst])
+            return (f"obstacle {i + 1} ({obstacle.kind}) starts inside the actuator: its point ({where}) mm lies "
+                    f"{-gap[worst]:.3g} mm inside it")
     return None
 
 

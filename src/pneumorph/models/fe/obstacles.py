@@ -136,7 +136,7 @@ def contact_items(obstacles: Sequence[ModelObstacle], mesh: ActuatorMesh, shear_
     smoothing = SMOOTHING * mesh.spec.element_size
     items = [RigidContact(o.obstacle, np.unique(end_faces) if o.on == "end" else nodes, k,
                           end_faces if o.on == "end" else faces, smoothing) for o in obstacles]
-    problem = start_inside(items, mesh.points)
+    problem = start_inside([o.obstacle for o in obstacles], mesh.points)  # any point: an obstacle in a cavity too
     if problem is not None:
         raise SettingsError(problem)
     return items
