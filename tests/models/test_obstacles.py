@@ -126,3 +126,13 @@ def test_3d_an_obstacle_out_of_reach_changes_nothing_and_the_clamp_balances_a_wa
         assert np.allclose(level["base_reaction_n"], force, rtol=0.0, atol=1e-2 * np.linalg.norm(force))
     assert levels[-1]["obstacles"][0]["force_magnitude_n"] > levels[0]["obstacles"][0]["force_magnitude_n"] > 0.0
     assert levels[-1]["obstacles"][0]["contact_area_mm2"] > 0.0
+
+
+def test_a_certified_search_over_obstacles_falls_back_to_the_ga() -> None:
+    """The chain model knows no contact: the certified search is not claimed over obstacles."""
+    from pneumorph.design.config import DesignConfig
+
+    wall = {"kind": "plane", "point": [0, 100, 0], "normal": [0, -1, 0]}
+    config, why = DesignConfig(model={"obstacle": [wall]}).searchable()
+    assert config.search == "ga" and "no contact" in (why or "")
+    assert DesignConfig().searchable() == (DesignConfig(), None)

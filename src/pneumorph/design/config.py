@@ -300,6 +300,9 @@ class DesignConfig:
         if self.search == "certified" and self.model.get("gravity") not in (None, "none"):
             return self.as_ga(), ("the certified search needs a free actuator (its chain model does not hold under "
                                   "gravity): falling back to the genetic algorithm")
+        if self.search == "certified" and self.model.get("obstacle"):
+            return self.as_ga(), ("the certified search needs a free actuator (its chain model knows no contact with "
+                                  "[[model.obstacle]]): falling back to the genetic algorithm on FE with contact")
         return self, None
 
     def fallback(self, fidelity_given: bool = False) -> DesignConfig:
