@@ -87,7 +87,7 @@ def test_blocked_force_rises_along_the_ramp() -> None:
 def test_model_settings_carry_obstacles() -> None:
     table = parse_obstacle("cylinder:centre=38,22;radius=4")
     model = make_model(3, {"obstacle": [table]})
-    assert model.describe()["obstacles"] == [{"kind": "cylinder", "centre": [38.0, 22.0], "radius": 4.0, "axis": []}]
+    assert model.describe()["obstacles"] == [{"kind": "cylinder", "centre": [38.0, 22.0], "radius": 4.0}]
     assert model.variant().obstacles == model.obstacles
     with pytest.raises(SearchConfigError, match="radius"):
         make_model(3, {"obstacle": [{"kind": "cylinder", "centre": [38, 22], "radius": 0}]})

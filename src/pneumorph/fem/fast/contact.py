@@ -90,7 +90,8 @@ class Obstacle:
         """The obstacle as a TOML/JSON table (``[[model.obstacle]]``)."""
         out: dict[str, Any] = {"kind": self.kind}
         for key, value in vars(self).items():
-            out[key] = [float(v) for v in value] if isinstance(value, tuple) else float(value)
+            if value != ():  # (a circle has no axis)
+                out[key] = [float(v) for v in value] if isinstance(value, tuple) else float(value)
         return out
 
 
