@@ -80,6 +80,29 @@ def test_tangent_is_the_residuals_derivative_3d() -> None:
     assert _fd_check(system, u) < 1e-5
 
 
+@pytest.mark.parametrize("obstacle", [Plane((3.75, 0.0), (-0.8, -0.6)), Cylinder((4.6, 1.0), 0.9)],
+                         ids=["plane", "circle"])
+def test_friction_tangent_is_the_residuals_derivative(obstacle: object) -> None:
+    """Anchors a little off: some nodes in contact stick, the others slide."""
+    points, cells = _beam(4.0)
+    body = _body(points, cells, "quad8")
+    faces, nodes = surface_points(cells, "quad8")
+    contact = RigidContact(obstacle, nodes, 3.0, faces, 0.2, friction=0.5)
+    body.contacts.append(contact)
+    system = PlaneStrainSystem(body.items, body.field, body.dof1, body.dof0)
+    u = np.zeros(system.ndof)
+    u[0::2] = 0.05 * points[:, 0]
+    x = points + u.reshape(-1, 2)
+    contact.anchors = x[nodes] + np.random.default_rng(1).normal(0.0, 0.05, (len(nodes), 2))
+    force, active = contact.forces(x)
+    n = obstacle.kinematics(x[nodes])[1]
+    normal = np.einsum("ai,ai->a", force, n)
+    along = np.linalg.norm(force - normal[:, None] * n, axis=1)
+    sliding = active & np.isclose(along, 0.5 * np.abs(normal), rtol=1e-9)
+    assert np.any(sliding) and np.any(active & ~sliding)
+    assert _fd_check(system, u) < 1e-5
+
+
 def test_penalty_blend_is_continuous_and_its_slope_too() -> None:
     s = 0.1
     gap = np.array([-s - 1e-9, -s + 1e-9, s - 1e-9, s + 1e-9])
@@ -117,6 +140,30 @@ def test_a_sagging_cantilever_lands_on_a_floor_mid_ramp() -> None:
     for force, reaction, weight in zip(forces, reactions, weights, strict=True):
         assert np.allclose(reaction, force - weight, rtol=0.0, atol=1e-6 * np.abs(weight).max())
     assert body.displacement[:, 1].min() > -1.5 - 0.05  # penetration within a small part of an element
+
+
+def test_friction_holds_the_landing_tip_within_its_cone() -> None:
+    """With friction the floor also pushes along itself, never beyond the cone; clamp + floor = weight still."""
+    points, cells = _beam()
+    body = _body(points, cells, "quad8", density=1.1e-9)
+    faces, nodes = surface_points(cells, "quad8")
+    contact = RigidContact(Plane((0.0, -1.5), (0.0, 1.0)), nodes, 3.0, faces, 0.02, friction=0.5)
+    contact.commit(points)
+    body.contacts.append(contact)
+    substep, _ = body.stepper("fast")
+    g = np.array([0.0, -9810.0])
+
+    def committed(t: float) -> None:
+        contact.commit(points + body.displacement)
+
+    ramp(body.items, body.field, lambda t: body.set_gravity(t * g), body.dof1, body.dof0,
+         StepSettings(increments=5, substeps=2), substep=substep, on_substep=committed)
+    force, active = contact.forces(points + body.displacement)
+    assert np.abs(force[active, 0]).max() > 1e-3 * np.abs(force[active, 1]).max()  # friction acts
+    assert np.all(np.abs(force[:, 0]) <= 0.5 * np.abs(force[:, 1]) * (1 + 1e-9) + 1e-15)  # within the cone
+    r = substep.system.residual(body.displacement.ravel())[0].reshape(-1, 2)
+    weight = substep.system.dead.vector().reshape(-1, 2).sum(axis=0)
+    assert np.allclose(r[points[:, 0] == 0.0].sum(axis=0), force.sum(axis=0) - weight, atol=1e-6 * abs(weight[1]))
 
 
 def test_the_same_penalty_as_felupes_rigid_plane() -> None:
@@ -157,8 +204,9 @@ def test_bad_obstacles_are_refused() -> None:
         obstacle_from_dict({"kind": "plane", "point": [0, 0], "normal": [0, 0]}, 2)
     with pytest.raises(SettingsError, match="finite"):
         obstacle_from_dict({"kind": "plane", "point": [float("nan"), 0], "normal": [1, 0]}, 2)
-    with pytest.raises(SettingsError, match="friction"):
-        obstacle_from_dict({"kind": "plane", "point": [0, 0], "normal": [1, 0], "friction": -0.1}, 2)
+    for friction in (-0.1, float("nan"), "0.5"):
+        with pytest.raises(SettingsError, match="friction"):
+            obstacle_from_dict({"kind": "plane", "point": [0, 0], "normal": [1, 0], "friction": friction}, 2)
     with pytest.raises(SettingsError, match="axis"):
         obstacle_from_dict({"kind": "cylinder", "centre": [0, 0, 0], "radius": 1.0}, 3)
     points, _ = _beam(4.0, "quad")

@@ -136,3 +136,18 @@ def test_a_certified_search_over_obstacles_falls_back_to_the_ga() -> None:
     config, why = DesignConfig(model={"obstacle": [wall]}).searchable()
     assert config.search == "ga" and "no contact" in (why or "")
     assert DesignConfig().searchable() == (DesignConfig(), None)
+
+
+def test_a_finger_with_friction_on_a_cylinder() -> None:
+    """Friction 0 and 0.5 both run to the full pressure and balance the clamp; friction changes the grip."""
+    cylinder = {"kind": "cylinder", "centre": [35.0, 25.0], "radius": 5.0}
+    forces = {}
+    for friction in (0.0, 0.5):
+        model = Reduced2D(4, obstacles=[{**cylinder, "friction": friction}])
+        assert ("friction" in model.describe()["obstacles"][0]) == (friction > 0)
+        solution = model.solve("0000")
+        assert solution.response.converged
+        last = _levels(solution)[-1]
+        forces[friction] = force = np.asarray(last["obstacles"][0]["force_n"])
+        assert np.allclose(last["base_reaction_n"], force, rtol=0.0, atol=1e-6 * np.linalg.norm(force))
+    assert np.linalg.norm(forces[0.5] - forces[0.0]) > 1e-2 * np.linalg.norm(forces[0.0])

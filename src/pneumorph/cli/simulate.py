@@ -31,10 +31,11 @@ from pneumorph.cli.progress import reporter
               help="Weight of the silicones, applied before the pressure: hanging from the clamped base "
                    "(appendix A.2.2) or lying horizontal with gravity across the height.")
 @click.option("--obstacle", "obstacles", multiple=True, metavar="KIND:KEY=V;...", type=P.Text(max_length=1000),
-              help="A rigid, frictionless obstacle against the outer surface, mm (repeatable): "
+              help="A rigid obstacle against the outer surface, mm (repeatable): "
                    "plane:point=X,Y;normal=NX,NY (the actuator on the normal's side), cylinder:centre=X,Y;radius=R "
                    "(a circle in 2D; 3D: ;axis=AX,AY,AZ), sphere:centre=...;radius=R; on=end touches the free end "
-                   "face only. Each level's force on it and the base reaction go to the JSON and the response.")
+                   "face only, friction=MU adds Coulomb friction. Each level's force on it and the base reaction "
+                   "go to the JSON and the response.")
 @click.option("--blocked", is_flag=True,
               help="Add a wall against the free end, normal to the free tip's motion at the first level (one more "
                    "solve of that level) at its start position: the blocked force over the ramp.")

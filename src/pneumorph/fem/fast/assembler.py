@@ -325,7 +325,10 @@ class FastSystem:
             values[start : start + w.take.size] = K.ravel()[w.take]
             start += w.take.size
         for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike
-            values[start : start + c.take.size] = c.tangent(self.points + self._U).ravel()[c.take]
+            K = c.tangent(self.points + self._U)
+            if self.symmetric:  # (sliding friction's blocks are not)
+                K = 0.5 * (K + K.transpose(0, 2, 1))
+            values[start : start + c.take.size] = K.ravel()[c.take]
             start += c.take.size
         return np.asarray(np.bincount(self._scatter, weights=values, minlength=self.nnz), dtype=np.float64)
 

@@ -19,7 +19,8 @@ The penalty ``k`` (:func:`penalty_stiffness`) is :data:`PENALTY` times the body'
 times the element size to the power ``d - 2``: a node carrying a contact pressure ``p_c`` over its
 share ``h^(d-1)`` of the surface penetrates ``g = p_c h^(d-1) / k = h p_c / (PENALTY mu)``, a
 fraction ``p_c / (PENALTY mu)`` of the element size (1 % for a contact pressure equal to the shear
-modulus). Coulomb friction is not modelled: the obstacles are frictionless.
+modulus). Coulomb friction (``friction`` > 0) adds a tangential penalty of the same stiffness with
+return-mapped sliding (:mod:`~pneumorph.fem.fast.friction`).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from numpy.typing import NDArray
 
 from pneumorph import checks
 from pneumorph.errors import SettingsError
+from pneumorph.fem.fast.friction import coulomb, slip
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -171,7 +173,8 @@ def obstacle_from_dict(table: Mapping[str, Any], dim: int, where: str = "obstacl
     ------
     SettingsError
         An unknown kind or key, a point of the wrong size or not finite, a zero normal or
-        axis, a radius <= 0, a friction < 0 (or > 0: not modelled).
+        axis, a radius <= 0, a friction < 0 (the table's ``friction`` is checked here and kept by the
+        caller: the geometry does not hold it).
 
     Examples
     --------
@@ -196,9 +199,6 @@ def obstacle_from_dict(table: Mapping[str, Any], dim: int, where: str = "obstacl
     if not (isinstance(friction, (int, float)) and not isinstance(friction, bool) and math.isfinite(friction)
             and friction >= 0.0):
         raise SettingsError(f"{where} friction must be a finite number >= 0, got {friction!r}")
-    if friction > 0.0:
-        raise SettingsError(f"{where} friction {friction!r}: Coulomb friction is not modelled yet; the obstacles "
-                            "are frictionless (friction = 0)")
     missing = [k for k in keys[kind] if k not in table and not (k == "axis" and dim == 2)]
     if missing:
         raise SettingsError(f"{where}: a {kind} needs {', '.join(missing)}")
@@ -290,6 +290,9 @@ class RigidContact:
         The surface faces, for the contact length (2D) or area (3D) in :meth:`report`.
     smoothing : float
         The gap (mm) over which the penalty sets in (:func:`penalty_gap`; 0: at once).
+    friction : float
+        Coulomb's coefficient (:mod:`.friction`; 0: frictionless), with the penalty as the
+        tangential stiffness too; its anchors are kept by :meth:`commit` after each converged state.
 
     Examples
     --------
@@ -307,6 +310,9 @@ class RigidContact:
     stiffness: float
     faces: IntArray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     smoothing: float = 0.0
+    friction: float = 0.0
+    #: the friction anchors of the last converged state (None: every node where it is)
+    anchors: FloatArray | None = None
     # the assembler's owner data: one "cell" per node
     cells: IntArray = field(init=False)
     take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
@@ -317,26 +323,47 @@ class RigidContact:
         self.points = np.asarray(self.points, dtype=np.int64)
         self.cells = self.points[:, None]
 
+    def evaluate(self, x: FloatArray) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], FloatArray]:
+        """At the positions ``x`` of all the body's points (p, d): the force on the obstacle at every node
+        ``k phi(g) n`` (:func:`penalty_gap`) plus its friction (:mod:`.friction`), (m, d); their blocks
+        ``k (phi'(g) n (x) n + phi(g) H)`` plus friction's, (m, d, d); which nodes the obstacle pushes
+        (``phi < 0``); and the anchors a commit at ``x`` keeps (m, d)."""
+        xs = x[self.points]
+        gap, n, H = self.obstacle.kinematics(xs)
+        phi, slope = penalty_gap(gap, self.smoothing)
+        force = self.stiffness * phi[:, None] * n
+        K = self.stiffness * slope[:, None, None] * n[:, :, None] * n[:, None, :]
+        if H is not None:
+            K += self.stiffness * phi[:, None, None] * H
+        active = phi < 0.0
+        anchors = xs.copy()  # out of contact: where a node is
+        if self.friction > 0.0 and np.any(active):
+            a = np.flatnonzero(active)
+            reference = xs[a] if self.anchors is None else self.anchors[a]
+            e, E = slip(xs[a] - reference, n[a], None if H is None else H[a])
+            ft, Kt, kept = coulomb(e, E, -self.stiffness * phi[a], self.stiffness * slope[a], n[a], self.friction,
+                                   self.stiffness)
+            force[a] += ft
+            K[a] += Kt
+            anchors[a] = xs[a] - kept
+        return force, K, active, anchors
+
     def forces(self, x: FloatArray) -> tuple[FloatArray, NDArray[np.bool_]]:
-        """The force on the obstacle at every node ``k phi(g) n`` (:func:`penalty_gap`), (m, d), and which the
-        obstacle pushes (``phi < 0``). ``x``: current positions of all the body's points (p, d).
-        """
-        gap, n, _ = self.obstacle.kinematics(x[self.points])
-        phi, _ = penalty_gap(gap, self.smoothing)
-        return self.stiffness * phi[:, None] * n, phi < 0.0
+        """The force on the obstacle at every node (m, d) and which nodes it pushes (:meth:`evaluate`)."""
+        force, _, active, _ = self.evaluate(x)
+        return force, active
 
     def residual(self, x: FloatArray) -> FloatArray:
         """The nodes' contributions to the residual, (m, d) (the force on the obstacle)."""
-        return self.forces(x)[0]
+        return self.evaluate(x)[0]
 
     def tangent(self, x: FloatArray) -> FloatArray:
-        """The nodes' d x d blocks ``k (phi'(g) n (x) n + phi(g) H)`` (zero out of contact), (m, d, d)."""
-        gap, n, H = self.obstacle.kinematics(x[self.points])
-        phi, slope = penalty_gap(gap, self.smoothing)
-        K = slope[:, None, None] * n[:, :, None] * n[:, None, :]
-        if H is not None:
-            K = K + phi[:, None, None] * H
-        return np.asarray(self.stiffness * K)
+        """The nodes' d x d blocks (zero out of contact), (m, d, d)."""
+        return self.evaluate(x)[1]
+
+    def commit(self, x: FloatArray) -> None:
+        """Keep the friction anchors of the converged state ``x`` (positions of all the body's points)."""
+        self.anchors = self.evaluate(x)[3]
 
     def report(self, x: FloatArray) -> dict[str, Any]:
         """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and the contact

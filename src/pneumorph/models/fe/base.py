@@ -443,6 +443,8 @@ class FEModel:
             step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
             turned["total"] += step
             turned["last"] = angle
+            for item in body.contacts:  # friction's anchors: the converged state's
+                item.commit(mesh.points + body.displacement)
 
         def tip_of(v: FloatArray) -> FloatArray:
             return (x_end0 + v[mesh.end_points][:, :axes]).mean(axis=0)

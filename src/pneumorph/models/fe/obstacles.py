@@ -1,9 +1,9 @@
 """Rigid obstacles in the FE models: ``[[model.obstacle]]`` tables, the contact items of a mesh, the forces out.
 
 An obstacle (:mod:`pneumorph.fem.fast.contact`: a plane, a cylinder - a circle in 2D - or a sphere,
-frictionless) touches the actuator's outer surface nodes, or with ``on = "end"`` the nodes of its
-free end face only (a load cell against the tip: :func:`blocked_wall`). Every reported level
-records, per obstacle, the force the actuator exerts on it (N), the nodes in contact and the
+frictionless or with Coulomb ``friction``) touches the actuator's outer surface nodes, or with
+``on = "end"`` the nodes of its free end face only (a load cell against the tip: :func:`blocked_wall`).
+Every reported level records, per obstacle, the force the actuator exerts on it (N), the nodes in contact and the
 contact length (2D, mm) or area (3D, mm^2), and the reaction of the clamped base on the actuator
 (N): with no gravity it equals the sum of the obstacles' forces, since the cavity pressure is
 internal. The 2D section's forces per mm of depth are multiplied by the unit's width; a 3D half
@@ -46,15 +46,19 @@ TOUCHES = ("surface", "end")
 
 @dataclass(frozen=True)
 class ModelObstacle:
-    """An obstacle of a model and the nodes it may touch (``on``: ``"surface"`` or ``"end"``)."""
+    """An obstacle of a model, the nodes it may touch (``on``: ``"surface"`` or ``"end"``) and Coulomb's
+    friction coefficient on it."""
 
     obstacle: Obstacle
     on: str = "surface"
+    friction: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         out = self.obstacle.to_dict()
         if self.on != "surface":  # absent by default
             out["on"] = self.on
+        if self.friction > 0.0:  # likewise
+            out["friction"] = self.friction
         return out
 
 
@@ -90,7 +94,8 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
             on = entry.get("on", "surface")
             if on not in TOUCHES:
                 raise SettingsError(f"{name} on must be one of {', '.join(TOUCHES)}, got {on!r}")
-            item = ModelObstacle(obstacle_from_dict({k: v for k, v in entry.items() if k != "on"}, dim, name), on)
+            obstacle = obstacle_from_dict({k: v for k, v in entry.items() if k != "on"}, dim, name)
+            item = ModelObstacle(obstacle, on, float(entry.get("friction", 0.0)))
         else:
             raise SettingsError(f"{name} must be a table (kind, and its geometry), got {entry!r}")
         out.append(item)
@@ -135,7 +140,9 @@ def contact_items(obstacles: Sequence[ModelObstacle], mesh: ActuatorMesh, shear_
     k = penalty_stiffness(shear_modulus, mesh.spec.element_size, mesh.dim)
     smoothing = SMOOTHING * mesh.spec.element_size
     items = [RigidContact(o.obstacle, np.unique(end_faces) if o.on == "end" else nodes, k,
-                          end_faces if o.on == "end" else faces, smoothing) for o in obstacles]
+                          end_faces if o.on == "end" else faces, smoothing, o.friction) for o in obstacles]
+    for item in items:
+        item.commit(mesh.points)  # friction's anchors: where the nodes start
     problem = start_inside([o.obstacle for o in obstacles], mesh.points)  # any point: an obstacle in a cavity too
     if problem is not None:
         raise SettingsError(problem)

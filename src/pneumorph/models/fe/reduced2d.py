@@ -52,9 +52,9 @@ class Reduced2D(FEModel):
         Responses then include the sag under gravity (displacements from the unloaded
         mesh); the filler has no mass.
     obstacles : sequence of mapping, optional
-        Rigid, frictionless obstacles against the outer surface, as ``[[model.obstacle]]`` tables
-        (:mod:`pneumorph.models.fe.obstacles`): each level's forces on them and the base reaction go
-        to the response's ``metadata["contact"]``. Default none.
+        Rigid obstacles (frictionless, or with Coulomb ``friction``) against the outer surface, as
+        ``[[model.obstacle]]`` tables (:mod:`pneumorph.models.fe.obstacles`): each level's forces on
+        them and the base reaction go to the response's ``metadata["contact"]``. Default none.
 
     A library or unit with a sideways unit (``layer_side``) is refused: it bends out of the
     section's plane (:class:`~pneumorph.models.fe.full3d.Full3D` solves it).
