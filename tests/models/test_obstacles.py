@@ -34,6 +34,14 @@ def test_an_obstacle_out_of_reach_changes_nothing(free: object) -> None:
     assert np.abs(solution.displacements - free.displacements).max() < 1e-6
     for level in _levels(solution):
         assert all(o["force_magnitude_n"] == 0.0 and not o["nodes_in_contact"] for o in level["obstacles"])
+    # the shape figure draws them (a plane as a line, the cylinder as a circle) with their forces
+    from matplotlib.patches import Circle
+
+    from pneumorph.plot.shape import plot_shape
+
+    ax = plot_shape(solution).axes[0]
+    assert [type(p) for p in ax.patches if isinstance(p, Circle)] == [Circle]
+    assert any(line.get_label() == "obstacle 1: 0 N" for line in ax.lines)
     # the free model's fingerprint is that of a model without the option; obstacles change it
     assert "obstacles" not in Reduced2D(3).describe()
     assert model.fingerprint() != Reduced2D(3).fingerprint()
