@@ -66,7 +66,7 @@ def test_a_wall_at_the_free_tip_takes_force_only_above_its_pressure(free: object
     assert np.all(np.diff(forces[k:]) > 0.0)
 
 
-def test_the_clamp_balances_the_obstacles() -> None:
+def test_the_clamp_balances_the_obstacles(tmp_path: object) -> None:
     """The pressure is internal: the clamp's reaction on the actuator is the sum of the obstacles' forces."""
     obstacles = [{"kind": "cylinder", "centre": [38.0, 22.0], "radius": 4.0},
                  {"kind": "plane", "point": [36.0, 0.0], "normal": [-1.0, 0.0]}]
@@ -80,6 +80,14 @@ def test_the_clamp_balances_the_obstacles() -> None:
         total = np.sum([o["force_n"] for o in level["obstacles"]], axis=0)
         assert np.allclose(level["base_reaction_n"], total, rtol=0.0, atol=1e-2 * max(np.linalg.norm(total), 1e-9))
     assert solution.response.converged
+    # the VTK series holds each node's share: the obstacles' forces summed
+    import meshio
+
+    from pneumorph.io import write_vtk_series
+
+    write_vtk_series(solution, tmp_path)
+    field = meshio.read(tmp_path / f"actuator_{len(levels) - 1:02d}.vtu").point_data["contact_force"]
+    assert np.allclose(field.sum(axis=0)[:2], np.sum([o["force_n"] for o in last["obstacles"]], axis=0), atol=1e-12)
 
 
 def test_blocked_force_rises_along_the_ramp() -> None:

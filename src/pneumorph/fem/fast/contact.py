@@ -366,7 +366,7 @@ class RigidContact:
         self.anchors = self.evaluate(x)[3]
 
     def report(self, x: FloatArray) -> dict[str, Any]:
-        """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and the contact
+        """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and theirs, and the contact
         length (2D) or area (3D): the nodes' shares of their faces (:data:`SHARES`), summed over those in contact."""
         force, active = self.forces(x)
         touching = np.zeros(x.shape[0], dtype=bool)
@@ -375,7 +375,8 @@ class RigidContact:
         if len(self.faces):
             share = SHARES[self.faces.shape[1]]
             measure = float(np.sum(face_measures(self.faces, x) * (touching[self.faces] @ share)))
-        return {"force": force.sum(axis=0), "nodes": self.points[active], "measure": measure}
+        return {"force": force.sum(axis=0), "nodes": self.points[active], "node_forces": force[active],
+                "measure": measure}
 
 
 def surface_points(cells: IntArray, cell_type: str, excluded: NDArray[np.bool_] | None = None) -> tuple[IntArray,
