@@ -19,8 +19,8 @@ The penalty ``k`` (:func:`penalty_stiffness`) is :data:`PENALTY` times the body'
 times the element size to the power ``d - 2``: a node carrying a contact pressure ``p_c`` over its
 share ``h^(d-1)`` of the surface penetrates ``g = p_c h^(d-1) / k = h p_c / (PENALTY mu)``, a
 fraction ``p_c / (PENALTY mu)`` of the element size (1 % for a contact pressure equal to the shear
-modulus). Coulomb friction (``friction`` > 0) adds a tangential penalty of the same stiffness with
-return-mapped sliding (:mod:`~pneumorph.fem.fast.friction`).
+modulus). Coulomb friction (``friction`` > 0) adds a tangential penalty (:data:`TANGENTIAL` times
+``k``) with return-mapped sliding (:mod:`~pneumorph.fem.fast.friction`).
 """
 
 from __future__ import annotations
@@ -42,6 +42,11 @@ IntArray = NDArray[np.int64]
 
 #: the penalty over the shear modulus (2D) or over shear modulus x element size (3D)
 PENALTY = 100.0
+
+#: the tangential penalty of friction over the normal one (FElupe's default): a sticking node creeps by
+#: ``mu f_n / k_t``, ten times its penetration at ``mu = 1``; a stiffer one (1) failed a 3D ramp whose
+#: symmetrised sliding tangents then stalled Newton (:mod:`.friction`)
+TANGENTIAL = 0.1
 
 #: every cell type's faces, as local nodes: the corners first (in order around the face), then the
 #: edges' middle nodes of a quadratic cell (VTK numbering, as FElupe's meshes)
@@ -291,8 +296,8 @@ class RigidContact:
     smoothing : float
         The gap (mm) over which the penalty sets in (:func:`penalty_gap`; 0: at once).
     friction : float
-        Coulomb's coefficient (:mod:`.friction`; 0: frictionless), with the penalty as the
-        tangential stiffness too; its anchors are kept by :meth:`commit` after each converged state.
+        Coulomb's coefficient (:mod:`.friction`; 0: frictionless), with :data:`TANGENTIAL` times the
+        penalty as the tangential stiffness; its anchors are kept by :meth:`commit` after each converged state.
 
     Examples
     --------
@@ -342,7 +347,7 @@ class RigidContact:
             reference = xs[a] if self.anchors is None else self.anchors[a]
             e, E = slip(xs[a] - reference, n[a], None if H is None else H[a])
             ft, Kt, kept = coulomb(e, E, -self.stiffness * phi[a], self.stiffness * slope[a], n[a], self.friction,
-                                   self.stiffness)
+                                   TANGENTIAL * self.stiffness)
             force[a] += ft
             K[a] += Kt
             anchors[a] = xs[a] - kept
@@ -413,6 +418,6 @@ def start_inside(obstacles: Sequence[Obstacle], x: FloatArray) -> str | None:
     return None
 
 
-__all__ = ["FACES", "KINDS", "PENALTY", "SHARES", "Cylinder", "Obstacle", "Plane", "RigidContact", "Sphere",
-           "face_measures", "obstacle_from_dict", "penalty_gap", "penalty_stiffness", "start_inside", "surface_faces",
-           "surface_points"]
+__all__ = ["FACES", "KINDS", "PENALTY", "SHARES", "TANGENTIAL", "Cylinder", "Obstacle", "Plane", "RigidContact",
+           "Sphere", "face_measures", "obstacle_from_dict", "penalty_gap", "penalty_stiffness", "start_inside",
+           "surface_faces", "surface_points"]
