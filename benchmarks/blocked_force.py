@@ -2,11 +2,13 @@
 
 For each design: the free ramp, then the blocked-force ramp (``simulate --blocked``: a wall
 normal to the free tip's motion at the first level, through the end face's farthest point,
-touching the end face), or with ``--cylinder X,Y[,Z];R`` a cylinder against the whole surface.
+touching the end face), or with ``--cylinder X,Y[,Z];R`` a cylinder against the whole surface
+(``--cylinder "tip;R"``: centred where the free tip ends).
 Prints a Markdown table row per design: the wall times, Newton iterations and cut-backs of both
 ramps, and the force on the obstacle at the middle and last levels.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --model 3d --designs 00000,01010,00011
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --designs 111000000111111 --cylinder "tip;4"
 """
 
 from __future__ import annotations
@@ -24,7 +26,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="3d", choices=["2d", "3d"])
     parser.add_argument("--designs", default="00000,01010,00011")
-    parser.add_argument("--cylinder", default=None, help="X,Y[,Z];R: a cylinder (along z in 3D) instead of the wall")
+    parser.add_argument("--cylinder", default=None, help="X,Y[,Z];R or tip;R: a cylinder (along z in 3D) instead of "
+                        "the wall, centred there or where the free tip ends")
     args = parser.parse_args()
     print("| design | free: wall, iterations, cut-backs | with contact: wall, iterations, cut-backs | "
           "force at mid / last level (N) | base reaction at last level (N) |")
@@ -39,7 +42,10 @@ def main() -> None:
             obstacle = blocked_obstacle(model, design)
         else:
             centre, radius = args.cylinder.split(";")
-            obstacle = {"kind": "cylinder", "centre": [float(v) for v in centre.split(",")], "radius": float(radius)}
+            where = [float(v) for v in free.tip[-1]] if centre == "tip" else [float(v) for v in centre.split(",")]
+            if args.model == "3d" and len(where) == 2:  # across the width, on the half model's mid-plane
+                where.append(model.unit.width / 2)
+            obstacle = {"kind": "cylinder", "centre": where, "radius": float(radius)}
             if args.model == "3d":
                 obstacle["axis"] = [0.0, 0.0, 1.0]
         contact = model.variant(obstacles=[obstacle]).solve(design).response

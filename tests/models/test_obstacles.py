@@ -142,6 +142,12 @@ def test_3d_an_obstacle_out_of_reach_changes_nothing_and_the_clamp_balances_a_wa
         assert np.allclose(level["base_reaction_n"], force, rtol=0.0, atol=1e-2 * np.linalg.norm(force))
     assert levels[-1]["obstacles"][0]["force_magnitude_n"] > levels[0]["obstacles"][0]["force_magnitude_n"] > 0.0
     assert levels[-1]["obstacles"][0]["contact_area_mm2"] > 0.0
+    # with friction on the wall: the end sticks to it, the clamp still balances it
+    rough = model.variant(obstacles=[{**wall, "friction": 0.5}]).solve("00")
+    last = _levels(rough)[-1]
+    force = np.asarray(last["obstacles"][0]["force_n"])
+    assert rough.response.converged and np.allclose(last["base_reaction_n"], force, atol=1e-2 * np.linalg.norm(force))
+    assert np.linalg.norm(force - levels[-1]["obstacles"][0]["force_n"]) > 1e-3 * np.linalg.norm(force)
 
 
 def test_a_certified_search_over_obstacles_falls_back_to_the_ga() -> None:
