@@ -156,7 +156,7 @@ def test_a_certified_search_over_obstacles_falls_back_to_the_ga() -> None:
 
     wall = {"kind": "plane", "point": [0, 100, 0], "normal": [0, -1, 0]}
     config, why = DesignConfig(model={"obstacle": [wall]}).searchable()
-    assert config.search == "ga" and "no contact" in (why or "")
+    assert config.search == "ga" and "contact with [[model.obstacle]]" in (why or "")
     assert DesignConfig().searchable() == (DesignConfig(), None)
 
 
