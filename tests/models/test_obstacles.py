@@ -127,6 +127,14 @@ def test_a_half_model_needs_symmetric_obstacles() -> None:
         model.build("0")
 
 
+def test_a_calculix_deck_of_a_model_with_obstacles_is_refused() -> None:
+    from pneumorph.export.calculix import calculix_deck
+
+    model = Full3D(1, obstacles=[{"kind": "plane", "point": [0, 80, 0], "normal": [0, -1, 0]}])
+    with pytest.raises(SettingsError, match="obstacles"):
+        calculix_deck(model, "0")
+
+
 @pytest.mark.slow
 def test_3d_an_obstacle_out_of_reach_changes_nothing_and_the_clamp_balances_a_wall() -> None:
     ramp = RampSpec(pressure=0.03, steps=replace(Full3D.default_steps, increments=3))
