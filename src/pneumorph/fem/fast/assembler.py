@@ -325,7 +325,7 @@ class FastSystem:
             values[start : start + w.take.size] = K.ravel()[w.take]
             start += w.take.size
         for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike
-            K = c.tangent(self.points + self._U)
+            K = c.tangent(self.points + self._U, self.symmetric)
             if self.symmetric:  # (sliding friction's blocks are not)
                 K = 0.5 * (K + K.transpose(0, 2, 1))
             values[start : start + c.take.size] = K.ravel()[c.take]

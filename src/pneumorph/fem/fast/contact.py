@@ -328,10 +328,12 @@ class RigidContact:
         self.points = np.asarray(self.points, dtype=np.int64)
         self.cells = self.points[:, None]
 
-    def evaluate(self, x: FloatArray) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], FloatArray]:
+    def evaluate(self, x: FloatArray, symmetric: bool = False) -> tuple[FloatArray, FloatArray, NDArray[np.bool_],
+                                                                        FloatArray]:
         """At the positions ``x`` of all the body's points (p, d): the force on the obstacle at every node
         ``k phi(g) n`` (:func:`penalty_gap`) plus its friction (:mod:`.friction`), (m, d); their blocks
-        ``k (phi'(g) n (x) n + phi(g) H)`` plus friction's, (m, d, d); which nodes the obstacle pushes
+        ``k (phi'(g) n (x) n + phi(g) H)`` plus friction's, (m, d, d; ``symmetric``: for a symmetric tangent,
+        :func:`~pneumorph.fem.fast.friction.coulomb`'s ``coupled`` off); which nodes the obstacle pushes
         (``phi < 0``); and the anchors a commit at ``x`` keeps (m, d)."""
         xs = x[self.points]
         gap, n, H = self.obstacle.kinematics(xs)
@@ -347,7 +349,7 @@ class RigidContact:
             reference = xs[a] if self.anchors is None else self.anchors[a]
             e, E = slip(xs[a] - reference, n[a], None if H is None else H[a])
             ft, Kt, kept = coulomb(e, E, -self.stiffness * phi[a], self.stiffness * slope[a], n[a], self.friction,
-                                   TANGENTIAL * self.stiffness)
+                                   TANGENTIAL * self.stiffness, coupled=not symmetric)
             force[a] += ft
             K[a] += Kt
             anchors[a] = xs[a] - kept
@@ -362,9 +364,9 @@ class RigidContact:
         """The nodes' contributions to the residual, (m, d) (the force on the obstacle)."""
         return self.evaluate(x)[0]
 
-    def tangent(self, x: FloatArray) -> FloatArray:
-        """The nodes' d x d blocks (zero out of contact), (m, d, d)."""
-        return self.evaluate(x)[1]
+    def tangent(self, x: FloatArray, symmetric: bool = False) -> FloatArray:
+        """The nodes' d x d blocks (zero out of contact), (m, d, d) (:meth:`evaluate`)."""
+        return self.evaluate(x, symmetric)[1]
 
     def commit(self, x: FloatArray) -> None:
         """Keep the friction anchors of the converged state ``x`` (positions of all the body's points)."""
