@@ -139,6 +139,12 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
         "--model-file": ["binary.bin", "folder", "missing.toml", ""],
+        "--obstacle": ["", "plane", "cube:centre=1,2", "plane:point=1,2", "plane:point=0,0;normal=0,0",
+                       "cylinder:centre=60,20;radius=0", "sphere:centre=60,20;radius=-1",
+                       "sphere:centre=nan,20;radius=2", "sphere:centre=60,20;radius=2;friction=-1",
+                       "sphere:centre=60,20;radius=inf",
+                       "plane:point=10,5;normal=0,1", "sphere:centre=10,6;radius=2", "plane:point=a,b;normal=1,0",
+                       "sphere:centre=60,20;radius=2;on=side", "cylinder:centre=60,20;radius=2;axis=0,0,1"],
     },
     "study": {
         "--populations": ["", "0", "1", "20,,40", "abc", "1.5", "-20"], "--seeds": POS_COUNT + HUGE,

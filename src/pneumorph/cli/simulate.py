@@ -34,6 +34,15 @@ from pneumorph.cli.progress import reporter
 @click.option("--gravity", type=click.Choice(["none", "hanging", "horizontal"]), default="none", show_default=True,
               help="Weight of the silicones, applied before the pressure: hanging from the clamped base "
                    "(appendix A.2.2) or lying horizontal with gravity across the height.")
+@click.option("--obstacle", "obstacles", multiple=True, metavar="KIND:KEY=V;...", type=P.Text(max_length=1000),
+              help="A rigid obstacle against the outer surface, mm (repeatable): "
+                   "plane:point=X,Y;normal=NX,NY (the actuator on the normal's side), cylinder:centre=X,Y;radius=R "
+                   "(a circle in 2D; 3D: ;axis=AX,AY,AZ), sphere:centre=...;radius=R; on=end touches the free end "
+                   "face only, friction=MU adds Coulomb friction. Each level's force on it and the base reaction "
+                   "go to the JSON and the response.")
+@click.option("--blocked", is_flag=True,
+              help="Add a wall against the free end, normal to the free tip's motion at the first level (one more "
+                   "solve of that level) at its start position: the blocked force over the ramp.")
 @click.option("--out", type=P.OutputDir(), help="Folder for response (NPZ+JSON), VTK and PNG files.")
 @click.option("--json", "as_json", is_flag=True, help="Print tip, curl and unit centres of every level as JSON.")
 def simulate(
@@ -48,6 +57,8 @@ def simulate(
     as_json: bool,
     model_file: str | None = None,
     volume_change: float | None = None,
+    obstacles: tuple[str, ...] = (),
+    blocked: bool = False,
 ) -> None:
     """Inflate one actuator design and report its shape at every pressure level."""
     from pneumorph.io import provenance
@@ -63,10 +74,14 @@ def simulate(
         settings["library"] = library
     if volume_change is not None:
         settings["volume_change"] = volume_change
+    if obstacles:
+        settings["obstacle"] = _obstacles(obstacles, fidelity)
     settings = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure",
-                                                          "increments": "increments", "gravity": "gravity"})
+                                                          "increments": "increments", "gravity": "gravity",
+                                                          "obstacle": "obstacles"})
     fidelity = str(settings["fidelity"])
     model = make_model(len(design), settings)
+    model = _with_obstacles(model, design, bool(obstacles), blocked)
     weight = "" if gravity == "none" else f", {gravity} under gravity"
     each, levels = solve_seconds(cost_fidelity(model), len(design)), len(model.pressures())  # one solve's levels
     with reporter() as lines:
@@ -82,6 +97,37 @@ def simulate(
         _print_json(design, fidelity, solution.response)
     else:
         _print_table(solution.response, out)
+
+
+def _obstacles(texts: tuple[str, ...], fidelity: str) -> list[dict[str, Any]]:
+    """The ``--obstacle`` tables, checked (a usage error naming the option)."""
+    from pneumorph.models.fe.obstacles import check_obstacles, parse_obstacle
+
+    with P.blame("--obstacle"):
+        tables = [parse_obstacle(text) for text in texts]
+        check_obstacles(tables, 3 if fidelity == "3d" else 2, where="obstacle")
+    return tables
+
+
+def _with_obstacles(model: Any, design: str, typed: bool, blocked: bool) -> Any:
+    """``model`` with the ``--blocked`` wall added; an obstacle that starts inside the actuator refused before any
+    solve (naming ``--obstacle`` when typed)."""
+    from contextlib import nullcontext
+
+    from pneumorph.models.fe.obstacles import blocked_obstacle, check_reach
+
+    with P.blame("--obstacle") if typed else nullcontext():
+        check_reach(model, design)
+    if not blocked:
+        return model
+    wall = blocked_obstacle(model, design)
+    click.echo(f"blocking wall: plane through {_numbers(wall['point'])} mm, normal {_numbers(wall['normal'])}, "
+               "against the free end", err=True)
+    return model.variant(obstacles=[*model.obstacles, wall])
+
+
+def _numbers(values: Any) -> str:
+    return "(" + ", ".join(f"{v:.4g}" for v in values) + ")"
 
 
 def _check_design(orientation: str, library: str | None, unit_file: str | None) -> str:
@@ -153,9 +199,26 @@ def _print_table(resp: Any, out: str | None) -> None:
         tw = f" {twist[k]:12.3f}" if twist is not None else ""
         click.echo(f"{p * 1e3:8.3f} {resp.tip[k, 0]:11.3f} {resp.tip[k, 1]:11.3f} {z}{resp.curl[k]:11.2f}{tw}")
     m = resp.metadata
+    if "contact" in m:
+        _print_contact(m["contact"])
     click.echo(f"{m['newton_iterations']} Newton iterations, {m['cutbacks']} cut-backs, {m['dofs']} dofs, "
                f"{m['wall_time_s']:.2f} s")
     if out:
         click.echo(f"written to {Path(out)}/ (response.npz/.json, vtk/actuator.pvd, shape.png, provenance.json)")
     else:
         click.echo("nothing written: --out DIR keeps the response, the VTK series and the shape figure")
+
+
+def _print_contact(contact: dict) -> None:
+    """Each level's force on every obstacle, its contact and the base reaction."""
+    import numpy as np
+
+    n = len(contact["obstacles"])
+    key = next((k for k in ("contact_length_mm", "contact_area_mm2")
+                if contact["levels"] and k in contact["levels"][0]["obstacles"][0]), "contact_length_mm")
+    unit = "mm" if key.endswith("_mm") else "mm^2"
+    click.echo(f"{'p [kPa]':>8} " + " ".join(f"{f'F{i + 1} [N]':>10} {f'c{i + 1} [{unit}]':>11}" for i in range(n))
+               + f" {'base reaction [N]':>18}")
+    for level in contact["levels"]:
+        cells = " ".join(f"{o['force_magnitude_n']:10.4f} {o[key]:11.3f}" for o in level["obstacles"])
+        click.echo(f"{level['pressure_kpa']:8.3f} {cells} {np.linalg.norm(level['base_reaction_n']):18.4f}")

@@ -297,9 +297,11 @@ class DesignConfig:
         >>> DesignConfig(model={"gravity": "hanging"}).searchable()[0].search
         'ga'
         """
-        if self.search == "certified" and self.model.get("gravity") not in (None, "none"):
-            return self.as_ga(), ("the certified search needs a free actuator (its chain model does not hold under "
-                                  "gravity): falling back to the genetic algorithm")
+        held = "gravity" if self.model.get("gravity") not in (None, "none") else \
+            "contact with [[model.obstacle]]" if self.model.get("obstacle") else None
+        if self.search == "certified" and held:
+            return self.as_ga(), (f"the certified search needs a free actuator (its chain model does not hold under "
+                                  f"{held}): falling back to the genetic algorithm")
         return self, None
 
     def fallback(self, fidelity_given: bool = False) -> DesignConfig:

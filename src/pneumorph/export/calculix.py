@@ -136,6 +136,9 @@ def _check_model(model: Any) -> None:
         raise SettingsError(f"a CalculiX deck is written for the 3D model (Full3D), got {type(model).__name__}")
     if model.gravity is not None:
         raise SettingsError("the CalculiX deck does not include gravity; export the model without gravity")
+    if model.obstacles:
+        raise SettingsError("the CalculiX deck does not include obstacles (no rigid contact pair yet); export the "
+                            "model without them")
 
 
 def _set_name(region: str) -> str:

@@ -13,6 +13,7 @@ its ramp the same way.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -90,6 +91,9 @@ class PressurisedBody:
         Prescribed (clamped base, symmetry plane) and active degrees of freedom.
     half : bool
         Held on a plane of symmetry (a 3D half model); False: the full width.
+    contacts : list of RigidContact
+        Rigid obstacles against the outer surface
+        (:class:`~pneumorph.fem.fast.contact.RigidContact`; the fast backend only).
     """
 
     points: FloatArray
@@ -104,11 +108,12 @@ class PressurisedBody:
     dof0: IntArray
     dof1: IntArray
     half: bool = False
+    contacts: list[Any] = dataclasses.field(default_factory=list)
 
     @property
     def items(self) -> list[Any]:
         """Every FElupe item whose sum is the residual."""
-        return [*self.solids.values(), self.pressure, *self.forces.values()]
+        return [*self.solids.values(), self.pressure, *self.forces.values(), *self.contacts]
 
     @property
     def displacement(self) -> FloatArray:
@@ -152,6 +157,8 @@ class PressurisedBody:
         from pneumorph.fem.stepping import FElupeSubstep
 
         if check_backend(backend) == "felupe":
+            if self.contacts:
+                raise SettingsError("contact with obstacles is solved by the fast backend only (the default)")
             return FElupeSubstep(self.items, self.dof1, self.dof0), lambda: cavity_volume(self.walls)
         from pneumorph.fem.fast.newton import SINGLE_PRECISION_MAX_DOFS, FastSubstep
         from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D

@@ -24,6 +24,18 @@ def region_ids(names: Any) -> dict[str, int]:
     return {**known, **{n: 3 + k for k, n in enumerate(others)}}
 
 
+def _contact_forces(contact: Any, k: int, npoints: int) -> dict[str, Any]:
+    """``{"contact_force": (p, 3)}`` of level ``k`` of a response's contact record, or nothing (no obstacles)."""
+    if not contact or k >= len(contact["levels"]):
+        return {}
+    field = np.zeros((npoints, 3))
+    for entry in contact["levels"][k]["obstacles"]:
+        if entry["nodes_in_contact"]:
+            forces = np.asarray(entry["node_forces_n"], dtype=float)
+            field[entry["nodes_in_contact"], : forces.shape[1]] += forces
+    return {"contact_force": field}
+
+
 def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
                      meta: dict[str, Any] | None = None) -> Path:
     """Write ``<stem>_<k>.vtu`` for every converged level and ``<stem>.pvd`` to open them all.
@@ -31,7 +43,8 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
     Each VTU holds the undeformed points with the point data ``displacement`` (use
     ParaView's *Warp By Vector*) and the cell data ``region`` (:func:`region_ids`: 0 body,
     1 stiff layer, 2 filler, then the others; the PVD's comment names them). The PVD's time
-    value is the pressure in kPa.
+    value is the pressure in kPa. A solve with obstacles (:mod:`pneumorph.models.fe.obstacles`) adds the point data
+    ``contact_force``: the force each surface node exerts on the obstacles (N, as the response reports it).
 
     Parameters
     ----------
@@ -68,10 +81,10 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
         disp = np.zeros_like(points)
         disp[:, : mesh.dim] = u
         name = f"{stem}_{k:02d}.vtu"
+        data = {"displacement": disp, **_contact_forces(solution.response.metadata.get("contact"), k, len(points))}
         meshio.write(
             out / name,
-            meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data={"displacement": disp},
-                        cell_data={"region": [region]}),
+            meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data=data, cell_data={"region": [region]}),
         )
         entries.append(f'    <DataSet timestep="{pressures[k] * 1e3:.6g}" file={quoteattr(name)}/>')
     comment = json.dumps({"regions": ids, **(meta or {})}, default=str).replace("--", "- -")

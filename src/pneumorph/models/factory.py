@@ -16,11 +16,12 @@ from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.obstacles import check_obstacles
 from pneumorph.models.fe.volumetric import FORMULATIONS
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
               "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale",
-              "formulation", "volume_change")
+              "formulation", "volume_change", "obstacle")
 #: the range of ``body_shear_scale`` (a factor on the body silicone's Ogden moduli), and of the identified scales
 SCALE_RANGE = (0.1, 10.0)
 #: the range of ``body_bulk_scale``: up to a nearly incompressible body (x1000 gives Mold Star 15 a Poisson's ratio of
@@ -117,7 +118,9 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         :data:`SCALE_RANGES` (default 1: the library's silicone, the same fingerprint);
         ``formulation``: how the silicones' volumetric term is integrated (``"auto"``, the default:
         the u-p-J form for a nearly incompressible silicone; ``"displacement"``; ``"u-p-J"``;
-        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`); ``volume_change`` (RampSpec's ``volume``).
+        :meth:`~pneumorph.models.fe.base.FEModel.element_volume`); ``volume_change`` (RampSpec's ``volume``);
+        ``obstacle``: a list of rigid obstacles (``[[model.obstacle]]`` tables,
+        :func:`pneumorph.models.fe.obstacles.check_obstacles`).
 
     Examples
     --------
@@ -154,7 +157,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     change = checks.real(s.get("temperature_change", 0.0), "[model] temperature_change", -100.0, 100.0, unit="degC",
                          error=SearchConfigError)
     passage = checks.real(s.get("passage", 0.0), "[model] passage", 0.0, 100.0, unit="mm", error=SearchConfigError)
-    extra = _model_options(s, unit, library, block)
+    extra = {**_model_options(s, unit, library, block), **_obstacles(s.get("obstacle"), Model.dim)}
     if change != 0.0 or passage != 0.0:
         if Model is not Full3D:
             what = "temperature_change" if change != 0.0 else "passage"
@@ -231,6 +234,22 @@ def _ramp(s: Mapping[str, Any], defaults: StepSettings) -> RampSpec:
         volume = checks.real(volume, "[model] volume_change", 0.0, 100.0, low_open=True, error=SearchConfigError)
     return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps),
                     volume=volume)
+
+
+def _obstacles(tables: Any, dim: int) -> dict[str, Any]:
+    """``{"obstacles": ...}`` of the ``[[model.obstacle]]`` tables, or nothing (none given).
+
+    Raises
+    ------
+    SearchConfigError
+        A table that is no valid obstacle.
+    """
+    if tables is None:
+        return {}
+    try:
+        return {"obstacles": check_obstacles(tables, dim)}
+    except SettingsError as exc:
+        raise SearchConfigError(str(exc)) from None
 
 
 def _base_block(block: Any) -> BaseBlock | None:

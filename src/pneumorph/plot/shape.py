@@ -105,6 +105,7 @@ def plot_shape(
             _section(ax, solution, k, outline=True)
             ax.set_aspect("equal")
             ax.autoscale_view()
+            _obstacles(ax, resp.metadata.get("contact"), k)
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("y [mm]")
             ax.grid(alpha=0.3)
@@ -122,3 +123,28 @@ def plot_shape(
     if path is not None:
         save_figure(fig, path, f"design {resp.orientation}")
     return fig
+
+
+def _obstacles(ax: Any, contact: Any, k: int) -> None:
+    """The rigid obstacles of a 2D solve (:mod:`pneumorph.models.fe.obstacles`) on the section, each with its force
+    at level ``k`` (N); a plane as its trace across the drawn extent."""
+    if not contact:
+        return
+    from matplotlib.patches import Circle
+
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    level = contact["levels"][k] if k < len(contact["levels"]) else None
+    for i, obstacle in enumerate(contact["obstacles"]):
+        force = level["obstacles"][i]["force_magnitude_n"] if level else float("nan")
+        label = f"obstacle {i + 1}: {force:.3g} N"
+        if obstacle["kind"] == "plane":
+            p, n = np.asarray(obstacle["point"][:2]), np.asarray(obstacle["normal"][:2])
+            t = np.array([-n[1], n[0]]) * 2 * max(x1 - x0, y1 - y0)
+            ax.plot(*np.transpose([p - t, p + t]), color="0.2", lw=2, label=label)
+        else:
+            (cx, cy), r = obstacle["centre"][:2], obstacle["radius"]
+            ax.add_patch(Circle((cx, cy), r, color="0.5", alpha=0.6, label=label))
+            x0, x1, y0, y1 = min(x0, cx - r), max(x1, cx + r), min(y0, cy - r), max(y1, cy + r)  # drawn whole
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)

@@ -54,6 +54,9 @@ class CertifiedSearch(Search):
         if getattr(model, "gravity", None) is not None:
             raise LocalityError("the certified search needs a free actuator (its chain model does not hold under "
                                 "gravity); search with --search ga or exhaustive")
+        if getattr(model, "obstacles", ()):
+            raise LocalityError("the certified search needs a free actuator (its chain model knows no contact with "
+                                "obstacles); search with --search ga or exhaustive")
         plan = plan_search(config, model, problem.table_dir, build=problem.build, workers=problem.workers)
         self.plan_, self.note = plan, plan.note
         if plan.search == "exhaustive":

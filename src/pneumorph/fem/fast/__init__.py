@@ -8,6 +8,9 @@ same criterion, an order of magnitude faster:
   plane-strain and 3D hooks (:class:`PlaneStrainSystem`, :class:`SolidSystem3D`);
 - :mod:`~pneumorph.fem.fast.kernels` - constitutive kernels with the quadrature points last;
 - :mod:`~pneumorph.fem.fast.loads` - dead loads as one nodal vector;
+- :mod:`~pneumorph.fem.fast.contact` - rigid obstacles (:class:`Plane`, :class:`Cylinder`,
+  :class:`Sphere`) against a body's surface nodes, a penalty owner of the assembler
+  (:class:`RigidContact`);
 - :mod:`~pneumorph.fem.fast.newton` - :class:`FastSubstep`, Newton's method on a system
   (kept factorised tangents, Anderson acceleration), a substep strategy of
   :func:`pneumorph.fem.ramp`;
@@ -15,10 +18,11 @@ same criterion, an order of magnitude faster:
   (the cavities' volume drives, the pressure is an unknown and passes its maximum).
 """
 
+from pneumorph.fem.fast.contact import Cylinder, Plane, RigidContact, Sphere
 from pneumorph.fem.fast.loads import DeadLoads
 from pneumorph.fem.fast.newton import FastSubstep, pattern_solver
 from pneumorph.fem.fast.system import FastSystem, PlaneStrainSystem, SolidSystem3D
 from pneumorph.fem.fast.volume import VolumeControl, volume_control
 
-__all__ = ["DeadLoads", "FastSubstep", "FastSystem", "PlaneStrainSystem", "SolidSystem3D", "VolumeControl",
-           "pattern_solver", "volume_control"]
+__all__ = ["Cylinder", "DeadLoads", "FastSubstep", "FastSystem", "Plane", "PlaneStrainSystem", "RigidContact",
+           "SolidSystem3D", "Sphere", "VolumeControl", "pattern_solver", "volume_control"]

@@ -12,6 +12,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.fem.fast.contact import RigidContact
 from pneumorph.fem.fast.loads import DeadLoads
 from pneumorph.fem.fast.mixed import cofactor, pressure_space, volumetric
 
@@ -73,7 +74,8 @@ class FastSystem:
     items : sequence
         ``felupe.SolidBody`` items with materials the dimension has a kernel for,
         ``felupe.SolidBodyPressure`` items on boundary regions of closed cavities and
-        ``felupe.SolidBodyForce`` dead loads (all linked to one global field).
+        ``felupe.SolidBodyForce`` dead loads (all linked to one global field) and
+        :class:`~pneumorph.fem.fast.contact.RigidContact` obstacles (owners of their nodes' own blocks).
     field : felupe.FieldContainer
         The global field; only its size and mesh points are read here.
     dof1, dof0 : ndarray
@@ -107,8 +109,12 @@ class FastSystem:
         self.points = np.asarray(field[0].region.mesh.points[:, :d], dtype=float)
         self.solids: list[SolidData] = []
         self.walls: list[WallData] = []
+        self.contacts: list[RigidContact] = []
         forces = []
         for item in items:
+            if isinstance(item, RigidContact):  # rigid obstacles: a block per surface node
+                self.contacts.append(item)
+                continue
             self._check_field(item.field[0])
             if isinstance(item, fem.SolidBodyForce):
                 forces.append(item)
@@ -214,7 +220,7 @@ class FastSystem:
         active = np.full(self.ndof, -1, dtype=np.int32)  # (int32: half the memory traffic of the gathers)
         active[self.dof1] = np.arange(self.dof1.size)
         n1 = self.dof1.size
-        owners: list[SolidData | WallData] = [*self.solids, *self.walls]
+        owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
         # 1. the node pairs every owner's cells couple, numbered
         pair_keys = []
         for owner in owners:
@@ -301,6 +307,8 @@ class FastSystem:
             cofN = self._cof_normal(deformation_gradient(w.g, w.cells, U), w.ndA)  # (f, q, d)
             # r[f, a, i] = p sum_q h[q, a] cof(F)_iJ N_J dA
             r += np.bincount(w.edofs, weights=(p * np.matmul(w.h.T[None], cofN)).ravel(), minlength=self.ndof)
+        for c in self.contacts:  # k g n at the nodes inside an obstacle
+            r += np.bincount(c.edofs, weights=c.residual(self.points + U).ravel(), minlength=self.ndof)
         if self.dead:
             r -= self.dead.vector()
         return r, jmin
@@ -316,6 +324,12 @@ class FastSystem:
             K = self._wall_tangent(w, float(w.item.results.pressure), self._U)
             values[start : start + w.take.size] = K.ravel()[w.take]
             start += w.take.size
+        for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike
+            K = c.tangent(self.points + self._U, self.symmetric)
+            if self.symmetric:  # (sliding friction's blocks are not)
+                K = 0.5 * (K + K.transpose(0, 2, 1))
+            values[start : start + c.take.size] = K.ravel()[c.take]
+            start += c.take.size
         return np.asarray(np.bincount(self._scatter, weights=values, minlength=self.nnz), dtype=np.float64)
 
     def tangent(self) -> Any:

@@ -9,7 +9,9 @@ The public import place of the FE models; each concept has a module of its own:
 - :mod:`pneumorph.models.fe.reduced2d`: :class:`Reduced2D`, the plane-strain section whose
   cavities hold the pressure-dependent filler (chapter 5);
 - :mod:`pneumorph.models.fe.full3d`: :class:`Full3D`, quadratic hexahedra and empty cavities
-  (chapter 4).
+  (chapter 4);
+- :mod:`pneumorph.models.fe.obstacles`: rigid obstacles against the outer surface
+  (``[[model.obstacle]]``), the forces on them and the blocked-force wall.
 
 Both take a unit, an orientation vector and a pressure ramp and return a
 :class:`~pneumorph.models.response.Response`.

@@ -26,7 +26,6 @@ from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
-from pneumorph.fem.fast.volume import volume_control
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -37,7 +36,9 @@ from pneumorph.materials import get
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.obstacles import ContactRecord, check_obstacles, contact_items
 from pneumorph.models.fe.ramp import RampSpec
+from pneumorph.models.fe.stages import before_the_ramp
 from pneumorph.models.fe.volumetric import FORMULATIONS, element_volume
 from pneumorph.models.frames import record_frames
 from pneumorph.models.response import FloatArray, Response
@@ -122,9 +123,12 @@ class FEModel:
         filler: FillerLaw | None = None, backend: str | None = None, gravity: str | Sequence[float] | None = None,
         temperature_change: float = 0.0, passage: float = 0.0, base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None, library: UnitLibrary | None = None,
-        formulation: str = "auto",
+        formulation: str = "auto", obstacles: Sequence[Any] | None = None,
     ) -> None:
         self.backend = check_backend(backend or self.backends[0], self.backends)
+        self.obstacles = check_obstacles(obstacles, self.dim)  # rigid, against the outer surface (fast backend)
+        if self.obstacles and self.backend != "fast":
+            raise SettingsError("contact with obstacles is solved by the fast backend only (the default)")
         self.formulation = checks.text(formulation, "formulation", FORMULATIONS)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.library = model_library(unit, library)
@@ -184,7 +188,7 @@ class FEModel:
         out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
                                "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
                                "base_block": self.base_block, "materials": dict(self.materials),
-                               "formulation": self.formulation}
+                               "formulation": self.formulation, "obstacles": self.obstacles}
         if not self.library.is_single:
             out["library"] = self.library
         return out
@@ -241,6 +245,8 @@ class FEModel:
             out["library"] = self.library.to_dict()
         if self.formulation != "auto":  # likewise ("auto" follows from the materials, which are described)
             out["formulation"] = self.formulation
+        if self.obstacles:  # likewise
+            out["obstacles"] = [o.to_dict() for o in self.obstacles]
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -343,6 +349,7 @@ class FEModel:
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, [*regions, *extra], mesh.cavity_points,
                                 mesh.base_points, mesh.symmetry_points, walls_of=list(silicones),
                                 densities=densities)
+        body.contacts = contact_items(self.obstacles, mesh, self.body.shear_modulus)
 
         def set_pressure(p: float) -> None:
             body.pressure.update(p)
@@ -403,6 +410,8 @@ class FEModel:
             step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
             turned["total"] += step
             turned["last"] = angle
+            for item in body.contacts:  # friction's anchors: the converged state's
+                item.commit(mesh.points + body.displacement)
 
         def tip_of(v: FloatArray) -> FloatArray:
             return (x_end0 + v[mesh.end_points][:, :axes]).mean(axis=0)
@@ -415,18 +424,17 @@ class FEModel:
             response.curl[k] = np.degrees(turned["total"])
             if control is not None:
                 pressures[k] = response.pressures[k] = control.factor * self.ramp.pressure
+            if contact is not None:  # the obstacles' forces, the base reaction
+                contact.record(k, pressures[k], substep.system, displacements[k])
+                response.metadata["contact"] = contact.metadata()
             if on_level is not None:
                 on_level(k, pressures[k])
 
         substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
-        gravity_iterations = 0
-        if self.gravity is not None:
-            gravity_iterations = self._apply_gravity(body, substep, follow, design)
-            response.metadata.update(gravity_mm_s2=list(self.gravity), gravity_tip=tip_of(body.displacement).tolist())
-        control = volume_control(self.ramp.volume, substep, apply, body.displacement)
-        if control is not None:  # the volume drives, the pressure of every level is an output
-            apply, substep = control.apply, control
-            response.metadata["volume0"] = control.volume0
+        contact = ContactRecord(self.obstacles, mesh, body.contacts, mesh.symmetry_points is not None) \
+            if self.obstacles else None
+        apply, substep, control, gravity_iterations = before_the_ramp(self, body, substep, follow, design,
+                                                                      response.metadata, tip_of, apply)
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
                          monitor=monitor if control is None else None, on_substep=follow, substep=substep,
@@ -470,28 +478,3 @@ class FEModel:
             pneumorph=__version__,
         )
         return replace(response, converged=True, reached=float(response.pressures[-1]), metadata=meta)
-
-    def _apply_gravity(self, body: PressurisedBody, substep: Any, follow: Any, design: str) -> int:
-        """Load the unpressurised actuator with its weight; returns the Newton iterations.
-
-        Gravity rises to its full value in :attr:`gravity_steps`; the pressure ramp then
-        starts from that state with gravity held.
-        """
-        g = np.asarray(self.gravity, dtype=float)
-
-        def apply(t: float) -> None:
-            body.set_gravity(t * g)
-
-        try:
-            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.gravity_steps,
-                         on_substep=follow, substep=substep, predictor_order=self.predictor_order,
-                         carry=self.carry_step)
-        except SimulationFailed as exc:
-            raise SimulationFailed(reached=0.0, cause=f"under its own weight, before any pressure: {exc.cause}",
-                                   design=design, pressure=self.ramp.pressure) from None
-        return stats.newton_iterations
-
-    @property
-    def gravity_steps(self) -> StepSettings:
-        """The gravity stage: two substeps, the pressure ramp's Newton settings."""
-        return replace(self.ramp.steps, increments=1, substeps=2)

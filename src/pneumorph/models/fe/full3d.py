@@ -88,10 +88,10 @@ class Full3D(FEModel):
         self, n_units: int, unit: UnitSpec | None = None, ramp_spec: RampSpec | None = None, half: bool = True,
         backend: str | None = None, gravity: str | Sequence[float] | None = None, temperature_change: float = 0.0,
         passage: float = 0.0, base_block: BaseBlock | None = None, materials: Mapping[str, Material] | None = None,
-        library: UnitLibrary | None = None, formulation: str = "auto",
+        library: UnitLibrary | None = None, formulation: str = "auto", obstacles: Sequence[Any] | None = None,
     ) -> None:
         super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block,
-                         materials, library, formulation)
+                         materials, library, formulation, obstacles)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "

@@ -52,6 +52,10 @@ class Reduced2D(FEModel):
         vector in mm/s^2 (:func:`pneumorph.models.fe.gravity.gravity_vector`). Default none.
         Responses then include the sag under gravity (displacements from the unloaded
         mesh); the filler has no mass.
+    obstacles : sequence of mapping, optional
+        Rigid obstacles (frictionless, or with Coulomb ``friction``) against the outer surface, as
+        ``[[model.obstacle]]`` tables (:mod:`pneumorph.models.fe.obstacles`): each level's forces on
+        them and the base reaction go to the response's ``metadata["contact"]``. Default none.
 
     A library or unit with a sideways unit (``layer_side``) is refused: it bends out of the
     section's plane (:class:`~pneumorph.models.fe.full3d.Full3D` solves it).
@@ -85,6 +89,7 @@ class Reduced2D(FEModel):
         materials: Mapping[str, Material] | None = None,
         library: UnitLibrary | None = None,
         formulation: str = "auto",
+        obstacles: Sequence[Any] | None = None,
     ) -> None:
         lib = model_library(unit, library)
         sideways = [s for s, spec in zip(lib.symbols, lib.units, strict=True) if spec.layer_side]
@@ -94,7 +99,8 @@ class Reduced2D(FEModel):
                                 "the 3D model (fidelity \"3d\", --model 3d)")
         first = lib[lib.default]
         super().__init__(n_units, unit, ramp_spec, filler or first.filler_law() or get_filler(), backend, gravity,
-                         base_block=base_block, materials=materials, library=library, formulation=formulation)
+                         base_block=base_block, materials=materials, library=library, formulation=formulation,
+                         obstacles=obstacles)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         #: the filler law of every unit type: the given one for all, else each unit's calibrated law, else

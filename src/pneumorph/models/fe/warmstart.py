@@ -60,8 +60,8 @@ def solve_near(model: FEModel, design: str, start: Solution) -> Solution:
     """
     t0 = time.perf_counter()
     u0 = start.displacements[-1]
-    if model.gravity is not None or not np.all(np.isfinite(u0)):
-        return model.solve(design)
+    if model.gravity is not None or model.obstacles or not np.all(np.isfinite(u0)):
+        return model.solve(design)  # (contact: its forces are recorded level by level, friction follows the path)
     parsed = model.parse(design)
     mesh, body, set_pressure = model.build(parsed if model.mixed else parsed.text)
     if mesh.points.shape != u0.shape:

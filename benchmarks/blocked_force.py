@@ -1,0 +1,63 @@
+"""Blocked force of some designs, and what contact costs against the free solve.
+
+For each design: the free ramp, then the blocked-force ramp (``simulate --blocked``: a wall
+normal to the free tip's motion at the first level, through the end face's farthest point,
+touching the end face), or with ``--cylinder X,Y[,Z];R`` a cylinder against the whole surface
+(``--cylinder "tip;R"``: centred where the free tip ends).
+Prints a Markdown table row per design: the wall times, Newton iterations and cut-backs of both
+ramps, and the force on the obstacle at the middle and last levels.
+
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --model 3d --designs 00000,01010,00011
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --designs 111000000111111 --cylinder "tip;4"
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from pneumorph.models import make_model
+from pneumorph.models.fe.obstacles import blocked_obstacle
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", default="3d", choices=["2d", "3d"])
+    parser.add_argument("--designs", default="00000,01010,00011")
+    parser.add_argument("--cylinder", default=None, help="X,Y[,Z];R or tip;R: a cylinder (along z in 3D) instead of "
+                        "the wall, centred there or where the free tip ends")
+    args = parser.parse_args()
+    print("| design | free: wall, iterations, cut-backs | with contact: wall, iterations, cut-backs | "
+          "force at mid / last level (N) | base reaction at last level (N) |")
+    print("|---|---|---|---|---|")
+    for design in args.designs.split(","):
+        model = make_model(len(design), {"fidelity": args.model})
+        t0 = time.perf_counter()
+        free = model.solve(design).response
+        t_free = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        if args.cylinder is None:
+            obstacle = blocked_obstacle(model, design)
+        else:
+            centre, radius = args.cylinder.split(";")
+            where = [float(v) for v in free.tip[-1]] if centre == "tip" else [float(v) for v in centre.split(",")]
+            if args.model == "3d" and len(where) == 2:  # across the width, on the half model's mid-plane
+                where.append(model.unit.width / 2)
+            obstacle = {"kind": "cylinder", "centre": where, "radius": float(radius)}
+            if args.model == "3d":
+                obstacle["axis"] = [0.0, 0.0, 1.0]
+        contact = model.variant(obstacles=[obstacle]).solve(design).response
+        t_contact = time.perf_counter() - t0
+        levels = contact.metadata["contact"]["levels"]
+        mid, last = levels[len(levels) // 2 - 1], levels[-1]
+        m, f = contact.metadata, free.metadata
+        print(f"| `{design}` | {t_free:.1f} s, {f['newton_iterations']}, {f['cutbacks']} | {t_contact:.1f} s, "
+              f"{m['newton_iterations']}, {m['cutbacks']} | {mid['obstacles'][0]['force_magnitude_n']:.3f} at "
+              f"{mid['pressure_kpa']:.1f} kPa / {last['obstacles'][0]['force_magnitude_n']:.3f} | "
+              f"{np.linalg.norm(last['base_reaction_n']):.3f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
