@@ -40,7 +40,7 @@ from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
-from pneumorph.fem.fast.mixed import MIXED_BULK_RATIO
+from pneumorph.fem.fast.mixed import nearly_incompressible
 from pneumorph.fem.fast.volume import volume_control
 from pneumorph.materials import get
 from pneumorph.materials.laws.hyperelastic import Ogden
@@ -276,8 +276,8 @@ class BimodalModel:
             name = LABELS[code]
             m = self.materials[name].model
             assert isinstance(m, Ogden), f"{name}: the bimodal model takes Ogden silicones"
-            # a nearly incompressible layer (the composite at nu = 0.495) on the u-p-J form, as the models choose it
-            mixed = self.bulk(name) >= MIXED_BULK_RATIO * self.materials[name].shear_modulus
+            # a nearly incompressible layer (the composite at nu = 0.495) on the u-p-J form, by the models' rule
+            mixed = nearly_incompressible(self.bulk(name), self.materials[name].shear_modulus)
             regions.append((name, mesh.label == code, OgdenCompressible(m.mu, m.alpha, self.bulk(name), mixed=mixed)))
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
                                 mesh.symmetry_points)

@@ -40,6 +40,16 @@ FloatArray = NDArray[np.float64]
 MIXED_BULK_RATIO = 2.0 * 1.45 / (3.0 * 0.1)
 
 
+def nearly_incompressible(bulk: float, shear: float) -> bool:
+    """Whether a material of this bulk and (initial) shear modulus is integrated in the u-p-J form by default:
+    ``K >= MIXED_BULK_RATIO * mu``, a Poisson's ratio of 0.45 or more.
+
+    >>> nearly_incompressible(0.119, 0.131), nearly_incompressible(65.5, 0.131)   # Mold Star 15, and x550
+    (False, True)
+    """
+    return bool(bulk >= MIXED_BULK_RATIO * shear)
+
+
 def cofactor(F: FloatArray) -> FloatArray:
     """``cof(F) = det(F) F^-T`` of deformation gradients stored points last, (d, d, n), d = 2 or 3.
 
@@ -147,4 +157,5 @@ def geometric_blocks(cof: FloatArray, detF: FloatArray, p: FloatArray,
     return out
 
 
-__all__ = ["MIXED_BULK_RATIO", "PressureSpace", "cofactor", "geometric_blocks", "pressure_space", "volumetric"]
+__all__ = ["MIXED_BULK_RATIO", "PressureSpace", "cofactor", "geometric_blocks", "nearly_incompressible",
+           "pressure_space", "volumetric"]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from pneumorph.fem.fast.mixed import MIXED_BULK_RATIO
+from pneumorph.fem.fast.mixed import nearly_incompressible
 
 #: a model's choices: by the bulk modulus ("auto": the u-p-J form from a Poisson's ratio of 0.45), at every point
 #: ("displacement") or on each element's own dilatation ("u-p-J")
@@ -21,7 +21,7 @@ def element_volume(material: Any, formulation: str = "auto") -> bool:
     """Whether ``material``'s volumetric term is integrated on each element's own dilatation (the u-p-J form):
     always with ``"u-p-J"``, never with ``"displacement"``; with ``"auto"`` for a nearly incompressible silicone,
     its bulk modulus at least :data:`~pneumorph.fem.fast.mixed.MIXED_BULK_RATIO` times its shear modulus
-    (Poisson's ratio 0.45 or more).
+    (Poisson's ratio 0.45 or more: :func:`~pneumorph.fem.fast.mixed.nearly_incompressible`).
 
     >>> from pneumorph.materials import get
     >>> element_volume(get("mold_star_15")), element_volume(get("mold_star_15"), "u-p-J")
@@ -29,7 +29,7 @@ def element_volume(material: Any, formulation: str = "auto") -> bool:
     """
     if formulation != "auto":
         return formulation == "u-p-J"
-    return bool(material.bulk_modulus.value >= MIXED_BULK_RATIO * material.shear_modulus)
+    return nearly_incompressible(material.bulk_modulus.value, material.shear_modulus)
 
 
 __all__ = ["FORMULATIONS", "element_volume"]
