@@ -112,13 +112,10 @@ class PlaneStrainSystem(FastSystem):
         c, q = s.dV.shape
         F = np.ascontiguousarray(deformation_gradient(s.g, s.cells, U).transpose(2, 3, 0, 1)).reshape(2, 2, c * q)
         P, A, J = s.kernel(F)
-        rank_one = None
-        if s.mixed is not None:  # the volumetric term on the elements' own dilatation
-            P, (p, cof, detF, term) = self._mixed_volumetric(s, F, P, J)
-            A = A + geometric_blocks(cof, detF, p)
-            rank_one = (self._pressure_vectors(s, cof), term)
-        dV = s.dV.reshape(-1)
-        return self._element_vectors(s, P), float(J.min()), (A * dV, rank_one)
+        mixed = None
+        if s.mixed is not None:  # the volumetric term on the elements' own dilatation (its tangent's terms later)
+            P, mixed = self._mixed_volumetric(s, F, P, J)
+        return self._element_vectors(s, P), float(J.min()), (A, mixed)
 
     def _element_vectors(self, s: SolidData, P: FloatArray) -> FloatArray:
         """``r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV`` of a stress-like field ``P`` (2, 2, c q)."""
@@ -127,15 +124,19 @@ class PlaneStrainSystem(FastSystem):
         return np.matmul(s.layouts["g_res"], PdV.transpose(2, 3, 1, 0).reshape(c, 2 * q, 2))
 
     def _solid_tangent(self, s: SolidData, state: Any) -> FloatArray:
-        AdV, rank_one = state
+        A, mixed = state
         c, q, n, _ = s.g.shape
+        if mixed is not None:  # the pressure's geometric term at every point
+            p, cof, detF, term = mixed
+            A = A + geometric_blocks(cof, detF, p)
+        AdV = A * s.dV.reshape(-1)
         # D[cq, (i, J, k), b] = sum_L A[i, J, k, L, cq] dV g[cq, b, L]
         At = np.ascontiguousarray(AdV.reshape(16, c * q).T).reshape(c * q, 8, 2)
         D = np.matmul(At, s.layouts["gT"]).reshape(c, 4 * q, 2 * n)  # [c, (q, i, J), (k, b)]
         # K[c, (a, i), (k, b)] = sum_(q, J) g[c, q, a, J] D[c, (q, i, J), (k, b)]
         K = np.matmul(s.layouts["B"], D)
-        if rank_one is not None:  # sum_mn [M^-1 H M^-1]_mn b_m (x) b_n
-            b, term = rank_one
+        if mixed is not None:  # sum_mn [M^-1 H M^-1]_mn b_m (x) b_n
+            b = self._pressure_vectors(s, cof)
             m = b.shape[1]
             K += np.matmul(np.matmul(b.reshape(c, m, 2 * n).transpose(0, 2, 1), term),
                            b.transpose(0, 1, 3, 2).reshape(c, m, 2 * n))
