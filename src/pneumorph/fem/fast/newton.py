@@ -73,7 +73,7 @@ def pattern_solver(
         return SuperLUPattern(indptr, indices, symmetric=symmetric)
 
 
-def _inadmissible(r: FloatArray, jmin: float) -> str | None:
+def inadmissible(r: FloatArray, jmin: float) -> str | None:
     """Why a substep's starting state cannot be iterated from, or None.
 
     An over-reaching predictor inverts elements; the ramp then cuts the substep back at no
@@ -84,13 +84,15 @@ def _inadmissible(r: FloatArray, jmin: float) -> str | None:
     return f"the predicted start is not admissible (det F = {jmin:.3g})"
 
 
-def _verdict(fnorm: float, jmin: float, u: FloatArray, values: FloatArray, tolerance: float) -> tuple[bool, str | None]:
-    """``(done, cause)`` after an iteration; on convergence ``u`` is written into ``values``."""
+def verdict(fnorm: float, jmin: float, u: FloatArray, values: FloatArray, tolerance: float,
+            constraint: float = 0.0) -> tuple[bool, str | None]:
+    """``(done, cause)`` after an iteration; on convergence (the relative residual ``fnorm`` and a constraint's
+    relative error, e.g. a volume control's, both below ``tolerance``) ``u`` is written into ``values``."""
     if not np.isfinite(fnorm):
         return True, "the residual is not finite"
     if fnorm > DIVERGED:
         return True, f"diverging (residual norm {fnorm:.3g})"
-    if fnorm < tolerance:
+    if fnorm < tolerance and constraint < tolerance:
         values[:] = u.reshape(values.shape)
         if not jmin > 0.0:
             return True, f"an element inverted (det F = {jmin:.3g})"
@@ -236,7 +238,7 @@ class FastSubstep:
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
             r, jmin = system.residual(u)
-            if (cause := _inadmissible(r, jmin)) is not None:
+            if (cause := inadmissible(r, jmin)) is not None:
                 return 0, cause
             for iteration in range(1, settings.max_iterations + 1):
                 try:
@@ -252,7 +254,7 @@ class FastSubstep:
                 self.best = min(self.best, fnorm)
                 if self.trace is not None:
                     self.trace.append((fnorm, True))
-                done, cause = _verdict(fnorm, jmin, u, values, settings.tolerance)
+                done, cause = verdict(fnorm, jmin, u, values, settings.tolerance)
                 if done:
                     return iteration, cause
         values[:] = u.reshape(values.shape)
@@ -268,7 +270,7 @@ class FastSubstep:
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
             r, jmin = system.residual(u)
-            if (cause := _inadmissible(r, jmin)) is not None:
+            if (cause := inadmissible(r, jmin)) is not None:
                 return 0, cause
             fnorm = relative_residual(r, dof1, dof0)
             self.best = fnorm
@@ -309,7 +311,7 @@ class FastSubstep:
                     system.residual(u)  # the state the tangent is assembled at
                     self._factorised = False
                     continue
-                done, cause = _verdict(fnorm_new, jmin, u_new, values, settings.tolerance)
+                done, cause = verdict(fnorm_new, jmin, u_new, values, settings.tolerance)
                 if done:
                     return iteration, cause
                 if poor >= STALLED_FRESH and self.precision == "single":

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import SettingsError
-from pneumorph.fem.fast.newton import DIVERGED, STALLED_FRESH, FastSubstep
+from pneumorph.fem.fast.newton import STALLED_FRESH, FastSubstep, inadmissible, verdict
 from pneumorph.fem.stepping import relative_residual
 
 FloatArray = NDArray[np.float64]
@@ -166,8 +166,8 @@ class VolumeControl:
         u = values.ravel().copy()
         factor = self.factor
         r, jmin, fnorm, dv = self._state(u)
-        if not (jmin > 0.0 and np.all(np.isfinite(r))):
-            return 0, f"the predicted start is not admissible (det F = {jmin:.3g})"
+        if (cause := inadmissible(r, jmin)) is not None:
+            return 0, cause
         reuse = substep.reuse
         factorised, fresh, poor = False, False, 0
         for iteration in range(1, settings.max_iterations + 1):
@@ -189,15 +189,9 @@ class VolumeControl:
                 r, jmin, fnorm, dv = self._state(u)
                 factorised = False
                 continue
-            if not np.isfinite(fnorm_new):
-                return iteration, "the residual is not finite"
-            if fnorm_new > DIVERGED:
-                return iteration, f"diverging (residual norm {fnorm_new:.3g})"
-            if fnorm_new < tol and dv_new < tol:
-                if not jmin > 0.0:
-                    return iteration, f"an element inverted (det F = {jmin:.3g})"
-                values[:] = u_new.reshape(values.shape)
-                return iteration, None
+            done, cause = verdict(fnorm_new, jmin, u_new, values, tol, constraint=dv_new)
+            if done:
+                return iteration, cause
             if fresh and reuse is not None:
                 poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
                 if poor >= STALLED_FRESH and substep.precision == "single":
