@@ -48,6 +48,19 @@ def plan_solves(lines: Progress, what: str, total: int, model: Any, executor: st
                where=where, title=title)
 
 
+def solve_levels(model: Any, design: str, what: str, title: str, where: str | None = None) -> Any:
+    """Solve ``design`` on ``model``, saying the plan (its levels, estimated by its fidelity's measured solve time)
+    and counting each level as it converges; the :class:`~pneumorph.models.fe.base.Solution`."""
+    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
+
+    each, levels = solve_seconds(cost_fidelity(model), len(design)), len(model.pressures())
+    with reporter() as lines:
+        lines.plan(what, levels, each=None if each is None else each / levels, noun="levels", where=where,
+                   title=title)
+        return model.solve(design, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
+                                                                      always=True))
+
+
 class RunLines:
     """A design run's lines on stderr, through the command's reporter (:func:`reporter`): its
     first line once it has started (an error before it stays one line), then the GA's generations with the time

@@ -8,7 +8,7 @@ from typing import Any
 import click
 
 from pneumorph.cli.options import params as P
-from pneumorph.cli.progress import reporter
+from pneumorph.cli.progress import solve_levels
 
 
 @click.command("simulate")
@@ -63,7 +63,6 @@ def simulate(
     """Inflate one actuator design and report its shape at every pressure level."""
     from pneumorph.io import provenance
     from pneumorph.models import make_model
-    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
 
     design = _check_design(orientation, library, unit_file)
     # the factory, as `design` and the API use it: the model class's tuned ramp, the same fingerprint
@@ -83,13 +82,8 @@ def simulate(
     model = make_model(len(design), settings)
     model = _with_obstacles(model, design, bool(obstacles), blocked)
     weight = "" if gravity == "none" else f", {gravity} under gravity"
-    each, levels = solve_seconds(cost_fidelity(model), len(design)), len(model.pressures())  # one solve's levels
-    with reporter() as lines:
-        lines.plan(f"design {design}", levels, each=None if each is None else each / levels, noun="levels",
-                   title=f"simulating design {design} ({fidelity} model, {len(design)} units, "
-                   f"{pressure:g} kPa{weight})")
-        solution = model.solve(design, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
-                                                                           always=True))
+    solution = solve_levels(model, design, f"design {design}", f"simulating design {design} ({fidelity} model, "
+                            f"{len(design)} units, {pressure:g} kPa{weight})")
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
         _write(out, solution, meta)

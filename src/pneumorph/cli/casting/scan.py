@@ -53,13 +53,12 @@ def synth(design: str, out: str, pressure: float, fidelity: str, changes: tuple[
     sampled, moved into a scanner's frame and given noise; the truth (changes, motion, settings) goes beside it."""
     from pathlib import Path
 
-    from pneumorph.cli.progress import reporter
+    from pneumorph.cli.progress import solve_levels
     from pneumorph.correlation import model_shape
     from pneumorph.correlation.synthetic import ScanNoise, cast_settings, synthetic_scan, write_scan
     from pneumorph.geometry import parse_orientation
     from pneumorph.io import provenance, strict_json
     from pneumorph.io.files import all_or_nothing_file, write_json
-    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
     from pneumorph.models.factory import make_model
 
     with P.blame("DESIGN"):
@@ -79,13 +78,8 @@ def synth(design: str, out: str, pressure: float, fidelity: str, changes: tuple[
     noisy = ScanNoise(points=points, noise=noise, seed=seed)
     model = make_model(len(orientation), settings)
     changed = ", ".join(f"{k} = {v:g}" for k, v in cast.items()) if cast else "as modelled"
-    each, levels = solve_seconds(cost_fidelity(model), len(orientation)), len(model.pressures())
-    with reporter() as lines:
-        lines.plan(f"design {orientation}'s cast", levels, each=None if each is None else each / levels,
-                   noun="levels", where=out, title=f"synthetic scan of design {orientation}'s cast at {pressure:g} "
-                   f"kPa ({fidelity} model, {changed})")
-        solution = model.solve(orientation, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
-                                                                              always=True))
+    solution = solve_levels(model, orientation, f"design {orientation}'s cast", f"synthetic scan of design "
+                            f"{orientation}'s cast at {pressure:g} kPa ({fidelity} model, {changed})", where=out)
     scanned, motion = synthetic_scan(model_shape(solution), noisy)
     truth = {"design": orientation, "pressure_kpa": pressure, "model": fidelity, "changes": cast,
              "points": len(scanned.points), "noise_mm": noise, "seed": seed,
