@@ -50,7 +50,7 @@ def test_cast_settings_change_the_unit_and_the_scales_and_refuse_the_rest() -> N
     assert cast_settings(SETTINGS, {}) == SETTINGS
     with pytest.raises(SettingsError, match="unknown cast change 'walls'; known: body_bulk_scale"):
         cast_settings(SETTINGS, {"walls": 1.3})
-    with pytest.raises(SettingsError, match=r"body_shear_scale = 20: give a factor between 0\.1 and 10"):
+    with pytest.raises(SettingsError, match=r"body_shear_scale must be a finite number >= 0\.1 and <= 10, got 20\.0"):
         cast_settings(SETTINGS, {"body_shear_scale": 20.0})
     with pytest.raises(SettingsError, match="a unit library's types"):
         cast_settings({**SETTINGS, "library": "builtin"}, {"wall": 1.3})

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from pneumorph import checks
 from pneumorph.correlation.align import Transform
 from pneumorph.correlation.compare import ModelShape
 from pneumorph.correlation.scans import MAX_SCAN_POINTS, MIN_POINTS, Scan
@@ -55,12 +56,8 @@ def cast_settings(settings: Mapping[str, Any], changes: Mapping[str, float]) -> 
     out = dict(settings)
     unit_changes = {k: float(v) for k, v in changes.items() if k not in CAST_SCALES}
     for key in CAST_SCALES:
-        if key in changes:
-            value = float(changes[key])
-            low, high = SCALE_RANGES[key]
-            if not (np.isfinite(value) and low <= value <= high):
-                raise SettingsError(f"{key} = {value:g}: give a factor between {low:g} and {high:g}")
-            out[key] = value
+        if key in changes:  # the range the model factory refuses outside of, checked here as the change's
+            out[key] = checks.real(changes[key], key, *SCALE_RANGES[key])
     if unit_changes:
         unit, _ = unit_or_library(out)
         if unit is None:
