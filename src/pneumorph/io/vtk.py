@@ -19,9 +19,8 @@ def region_ids(names: Any) -> dict[str, int]:
     >>> region_ids(["layer", "body", "bottom:ecoflex_00_50", "base"])
     {'body': 0, 'layer': 1, 'base': 3, 'bottom:ecoflex_00_50': 4}
     """
-    known = {n: _REGION_IDS[n] for n in sorted(names, key=lambda n: _REGION_IDS.get(n, 99)) if n in _REGION_IDS}
     others = sorted(n for n in names if n not in _REGION_IDS)
-    return {**known, **{n: 3 + k for k, n in enumerate(others)}}
+    return {**{n: i for n, i in _REGION_IDS.items() if n in names}, **{n: 3 + k for k, n in enumerate(others)}}
 
 
 def _contact_forces(contact: Any, k: int, npoints: int) -> dict[str, Any]:
