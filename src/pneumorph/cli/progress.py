@@ -116,4 +116,4 @@ class RunLines:
         return {"on_generation": self.on_generation, "on_progress": self.on_progress, "on_message": self.on_message}
 
 
-__all__ = ["RunLines", "plan_solves", "reporter"]
+__all__ = ["RunLines", "plan_solves", "reporter", "solve_levels"]
