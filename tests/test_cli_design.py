@@ -289,6 +289,23 @@ def test_no_build_stops_a_run_that_needs_a_table_with_one_line(tmp_path: Path,
     assert not (tmp_path / "run8").exists() and not tables.exists()
 
 
+def test_no_build_does_not_fall_back_to_the_ga(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # 26 types: a table at window +-1 needs (2*26)^2/2 = 1352 covering solves, more than MAX_TRAINING, so the
+    # chain cannot serve and the certified run would fall back to the GA on the FE model
+    units = "".join(f'[[units]]\nsymbol = "{chr(97 + i)}"\nunit = {{}}\n' for i in range(26))
+    library = tmp_path / "many.toml"
+    library.write_text(f'[library]\nname = "many"\n{units}')
+    out = tmp_path / "run"
+    args = ["design", "--library", str(library), "--model", "2d", "--no-build", "--cache", str(tmp_path / "c.sqlite"),
+            "--out", str(out)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert "1352 FE solves" in err and "--no-build" in err and "falling back" not in err
+    assert "the fall-back to the genetic algorithm on the FE model is not started" in err
+    assert not out.exists() and not (tmp_path / "c.sqlite").exists()
+
+
 def test_no_build_stops_a_run_whose_tolerance_tables_are_missing(tmp_path: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
     args = _short(tmp_path, 6, "--no-build")

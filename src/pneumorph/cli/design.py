@@ -97,7 +97,8 @@ def _kpa(pressure: float | None) -> float:
 @click.option("--overwrite", is_flag=True, help="Start afresh in a folder that holds another run.")
 @click.option("--no-build", "no_build", is_flag=True,
               help="Certified search: stop with a message instead of building a chain table (or tolerance tables) "
-                   "that no shipped or kept table serves.")
+                   "that no shipped or kept table serves, or instead of falling back to the genetic algorithm on "
+                   "the FE model when the chain cannot represent it.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def design(config_file: str | None, **options: Any) -> None:
     """Design the actuator whose inflated shape best matches a target or tip goal.
@@ -278,6 +279,11 @@ def _run_with(config: Any, model: Any, o: Any, fidelity_given: bool, lines: Any)
     except LocalityError as exc:
         if config.search != "certified":
             raise
+        if o.no_build:  # the fall-back is the GA on the FE model: hundreds of solves, more than any table build
+            from pneumorph.errors import MissingTableError
+
+            raise MissingTableError(f"--no-build: {exc}; the fall-back to the genetic algorithm on the FE model "
+                                    "is not started (run without --no-build to start it)") from None
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
     config = config.fallback(fidelity_given)
     model = config.make_model()
