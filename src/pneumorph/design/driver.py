@@ -137,7 +137,9 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
                           resumed=resumed)
         if algorithm.note:
             problem.say(algorithm.note)
-        entries = algorithm.setup(problem)
+        problem, entries = algorithm.setup(problem)
+        if isinstance(problem.objective, StagedTarget):  # the levels of a table built to fewer: checked again
+            problem.objective.levels(problem.model.pressures())
         searched = {"search": algorithm.name} if algorithm.name != config.search else {}
         claim.start(overwrite, {**provenance(config, problem.model), "resumed": resumed, **searched, **entries})
         status, outcome = _search(algorithm, problem, claim)

@@ -26,7 +26,7 @@ from pneumorph.design.runs.comparison import compare_with_reference
 from pneumorph.design.runs.robustness import chain_robustness, winner_robustness
 from pneumorph.errors import LocalityError, MissingTableError, PneumorphError, SearchConfigError
 from pneumorph.models.chain.model import ChainModel
-from pneumorph.models.chain.sources import serve_table, table_for
+from pneumorph.models.chain.sources import serve_table, served_as_built, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for
@@ -71,24 +71,31 @@ class CertifiedSearch(Search):
             check_refine(model, config.refine, parallel=max(1, min(problem.workers, config.verify or 1024)))
         return self, replace(problem, model=model)
 
-    def setup(self, problem: Problem) -> dict[str, Any]:
+    def setup(self, problem: Problem) -> tuple[Problem, dict[str, Any]]:
         """The chain table (built now, if its plan said so, under the table's lock) and the unit's tolerance
-        tables; the table's fingerprint for the provenance."""
+        tables; the table's fingerprint for the provenance. A table built to the levels every design reached
+        (a design did not converge to the top pressure) remakes the model with those levels, saying so."""
         assert self.plan_ is not None
         if self.plan_.served is not None:
             table = self.plan_.served.table
         else:  # a model the chain cannot represent raises LocalityError and leaves nothing behind
             table = table_for(problem.model, _training(problem.model), folder=problem.table_dir,
                               evaluator=problem.evaluator, on_progress=problem.say)
+            served = served_as_built(table, problem.model)
+            if served.restricted:
+                problem.say(f"the design goes on at the levels the table serves: {served.origin_text()}, "
+                            f"{served.levels_text()}")
+                problem = replace(problem, model=served.model)
         self.chain = ChainModel(table, problem.config.units)
         if _tolerance_tables_wanted(problem.config, problem.model):  # of one unit type
             self.tables = tolerance_tables_for(problem.model, Tolerance(problem.config.tolerance),
                                                folder=problem.table_dir, evaluator=problem.evaluator,
                                                on_progress=problem.say)
         entries = {"chain_table": table.fingerprint()}
-        if "restricted_from" in table.source:
-            entries["chain_table_restricted_from"] = table.source["restricted_from"]
-        return entries
+        for key in ("restricted_from", "cut_from"):
+            if key in table.source:
+                entries[f"chain_table_{key}"] = table.source[key]
+        return problem, entries
 
     def run(self, problem: Problem) -> SearchOutcome:
         """The certificate, its winner and runners-up, the chain's best 1,000, the mesh note or refinement,

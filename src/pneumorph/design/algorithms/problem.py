@@ -20,7 +20,9 @@ An algorithm has four steps, each called once by the driver:
    an actuator too short for its chain table hands over to the FE exhaustive search) and
    the problem it will run on (a chain table's levels may remake the model).
 2. ``setup(problem)``: under the run folder's lock, what the search needs built (a chain
-   table, tolerance tables); returns the entries it adds to the run's provenance.
+   table, tolerance tables); returns the problem it runs on (a table built to the levels every
+   design reached remakes the model with those levels) and the entries it adds to the run's
+   provenance.
 3. ``run(problem)``: the search; returns an :class:`SearchOutcome`.
 4. ``interrupted()``: what survives a Ctrl-C during ``run`` (the GA's generations).
 
@@ -152,8 +154,9 @@ class Algorithm(Protocol):
         """The algorithm that runs and its problem; refuses (a specific error) before any solve."""
         ...
 
-    def setup(self, problem: Problem) -> dict[str, Any]:
-        """Build what the search needs (under the folder's lock); the provenance entries it adds."""
+    def setup(self, problem: Problem) -> tuple[Problem, dict[str, Any]]:
+        """Build what the search needs (under the folder's lock); the problem it runs on and the provenance entries
+        it adds."""
         ...
 
     def run(self, problem: Problem) -> SearchOutcome:
@@ -175,9 +178,9 @@ class Search:
         """Itself, on the same problem."""
         return self, problem
 
-    def setup(self, problem: Problem) -> dict[str, Any]:
-        """Nothing to build."""
-        return {}
+    def setup(self, problem: Problem) -> tuple[Problem, dict[str, Any]]:
+        """Nothing to build: the same problem, no entries."""
+        return problem, {}
 
     def run(self, problem: Problem) -> SearchOutcome:  # pragma: no cover - every algorithm has its own
         """Search."""

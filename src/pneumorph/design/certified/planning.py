@@ -189,7 +189,7 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
         t = served.table
         note = f"certified search with the chain table of window +-{t.window}"
         if served.restricted:
-            note += f" fitted to {t.source['restricted_from']['levels']} levels, {served.levels_text()}"
+            note += f" {served.origin_text()}, {served.levels_text()}"
         return SearchPlan("certified", served, note=note)
     if served is not None:
         w = served.table.window

@@ -21,6 +21,7 @@ import numpy as np
 from pneumorph.errors import ChainTableError, LocalityError
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.io.provenance import provenance
+from pneumorph.models.chain.levels import first_levels, levels_reached, ramp_source
 from pneumorph.models.chain.means import check_training, window_means
 from pneumorph.models.chain.model import ChainTable, source_description, source_key, training_model
 from pneumorph.models.chain.terms import check_far_training, far_means, fit_text
@@ -53,8 +54,13 @@ MAX_WINDOW = 3
 MAX_TRAINING = 200
 
 
-def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
-    """Refuse, before any solve, a window whose base windows alone need more than :data:`MAX_TRAINING` designs.
+def check_training_size(n_types: int, window: int, symmetric: int = 0, n_units: int | None = None) -> None:
+    """Refuse, before any solve, a window whose covering designs must be more than :data:`MAX_TRAINING`.
+
+    Two lower bounds count them: the base windows alone need ``(2k)^(w+1) / 2`` designs (one
+    each), and with ``n_units`` given, the interior windows ``(2k)^(2w+1) / 2`` patterns of
+    ``2w + 1`` units, ``n_units - 2w`` of them in each design (``2k - s`` for ``k`` types,
+    ``s`` of them symmetric; mirrored designs count once).
 
     >>> check_training_size(2, 2)
     >>> check_training_size(4, 2)
@@ -67,9 +73,22 @@ def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
     ...
     pneumorph.errors.LocalityError: a chain table over 26 unit types at window +-1 needs at least 1352 FE solves for
     its base windows alone (at most 200, MAX_TRAINING); use at most 10 unit types
+    >>> check_training_size(4, 2, 1, n_units=15)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 764 FE solves of
+    15-unit designs for its interior windows (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
     """
-    def need(types: int, w: int) -> int:
+    def base(types: int, w: int) -> int:
         return (2 * types - min(int(symmetric), types)) ** (w + 1) // 2
+
+    def interior(types: int, w: int) -> int:
+        if n_units is None or int(n_units) <= 2 * w:
+            return 0
+        return -(-((2 * types - min(int(symmetric), types)) ** (2 * w + 1) // 2) // (int(n_units) - 2 * w))
+
+    def need(types: int, w: int) -> int:
+        return max(base(types, w), interior(types, w))
 
     n, w = int(n_types), int(window)
     if n > 1 and need(n, w) > MAX_TRAINING:
@@ -77,8 +96,10 @@ def check_training_size(n_types: int, window: int, symmetric: int = 0) -> None:
         advice = f"at most {most} unit types"
         if w > 1 and need(n, 1) <= MAX_TRAINING:
             advice = f"a window of +-1 or {advice}"
-        raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {need(n, w)} FE "
-                            f"solves for its base windows alone (at most {MAX_TRAINING}, MAX_TRAINING); use {advice}")
+        what = (f"{base(n, w)} FE solves for its base windows alone" if base(n, w) > MAX_TRAINING else
+                f"{interior(n, w)} FE solves of {n_units}-unit designs for its interior windows")
+        raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {what} (at most "
+                            f"{MAX_TRAINING}, MAX_TRAINING); use {advice}")
 
 
 # -- fitting --------------------------------------------------------------------------------
@@ -203,10 +224,14 @@ def first_symbols(design: str, alphabet: Sequence[str]) -> str:
     return "".join(alphabet[int(c) // 2] for c in design_array(design, alphabet=alphabet)[0])
 
 
-def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
+def _solver(model: Any, evaluator: Any, solved: dict[str, Response], reached: dict[str, int],
             say: Callable[[str], None]) -> Callable[..., list[Response]]:
     """``solve(designs, what, before=0, total=None)``: the responses of ``designs``, those not in ``solved`` solved
-    through ``evaluator`` (and kept in ``solved``), with a progress line per design."""
+    through ``evaluator`` (and kept in ``solved``), with a progress line per design.
+
+    A design that fails after its first level is kept with the levels it reached (``reached``
+    names it and how many): the table is then fitted to the levels every design reached.
+    """
     n = int(model.n_units)
 
     def solve(designs: list[str], what: str, before: int = 0, total: int | None = None) -> list[Response]:
@@ -222,12 +247,19 @@ def _solver(model: Any, evaluator: Any, solved: dict[str, Response],
         if todo:
             for _i, outcome in evaluator.iter_cases([(actuators[len(d)], d) for d in todo]):
                 done += 1
+                got = "cached" if outcome.cached else "solved"
                 if not outcome.ok:
-                    raise ChainTableError(f"{what} design {outcome.design} failed in the FE model "
-                                          f"({outcome.failure}); the chain table needs every design solved")
+                    levels = levels_reached(outcome.response)
+                    if levels == 0 or outcome.response is None:
+                        raise ChainTableError(f"{what} design {outcome.design} failed in the FE model before its "
+                                              f"first level ({outcome.failure}); the chain table needs every "
+                                              "design solved at its first level at least")
+                    reached[outcome.design] = levels
+                    got = (f"{got} {outcome.design} to level {levels} of {outcome.response.n_levels} only: "
+                           f"{outcome.failure}; the table keeps the levels every design reached")
                 solved[outcome.design] = outcome.response
-                say(f"  {what}: {done}/{total} solved ({'cached' if outcome.cached else 'solved'} "
-                    f"{outcome.design}, {time.perf_counter() - t0:.0f} s)")
+                say(f"  {what}: {done}/{total} solved ({got if not outcome.ok else f'{got} {outcome.design}'}, "
+                    f"{time.perf_counter() - t0:.0f} s)")
         return [solved[d] for d in designs]
 
     return solve
@@ -295,14 +327,26 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
     library = getattr(model, "library", None)
     candidates = fit_candidates(n, window, first_window, max_window, far)
     solved: dict[str, Response] = {}
+    reached: dict[str, int] = {}
     build = _Build(model, evaluator, tolerance, heldout, seed, short, early, say, solved,
-                   _solver(model, evaluator, solved, say), library, _source(model), time.perf_counter())
+                   _solver(model, evaluator, solved, reached, say), library, _source(model), time.perf_counter(),
+                   reached)
     best: ChainTable | None = None
     for w, with_far in candidates:
-        best = _window_table(build, w, with_far)
-        if max(best.validation["centre_worst_mm"]) <= tolerance:
-            return best
+        try:
+            table = _window_table(build, w, with_far)
+        except LocalityError as exc:  # a wider window than a build may ask covering solves for
+            if best is None:
+                raise
+            say(f"{fit_text(w, with_far)}: not tried: {exc}")
+            break
+        if max(table.validation["centre_worst_mm"]) <= tolerance:
+            return table
+        best, tried = table, (w, with_far)
     assert best is not None
+    within = _within_tolerance(build, best, *tried)
+    if within is not None:
+        return within
     raise LocalityError(
         f"the chain model does not reproduce this model within {tolerance:g} mm: with window +-{best.window} "
         f"the worst held-out unit-centre error is {max(best.validation['centre_worst_mm']):.3g} mm; the units "
@@ -376,6 +420,26 @@ class _Build:
     library: UnitLibrary | None
     source: dict[str, Any]
     start: float
+    reached: dict[str, int]  # the designs that failed after their first level: how many levels they reached
+
+    def levels(self) -> int:
+        """The levels every design solved so far reached (all the ramp's if none failed)."""
+        return min(self.reached.values(), default=len(self.model.pressures()))
+
+    def table_source(self, levels: int, why: str = "") -> dict[str, Any]:
+        """The table's source: the model's, or with fewer levels than the ramp's, that of the ramp of ``levels``
+        levels, its ``cut_from`` naming the model's ramp, why those levels (``why``: "those <why>"), and the designs
+        that failed (and the levels they reached)."""
+        pressures = self.model.pressures()
+        if levels == len(pressures):
+            return self.source
+        return ramp_source(self.source, pressures, levels, cut_from={
+            "key": self.source["key"], "levels": len(pressures), "pressure_mpa": float(pressures[-1]), "why": why,
+            "failed": dict(sorted(self.reached.items()))})
+
+
+class _FewerLevels(Exception):
+    """A held-out design reached fewer levels than the table being validated has: fit it again to fewer."""
 
 
 def _source(model: Any) -> dict[str, Any]:
@@ -384,7 +448,20 @@ def _source(model: Any) -> dict[str, Any]:
             "n_units": int(model.n_units), "description": source_description(model)}
 
 
-def _window_table(build: _Build, w: int, far: bool | str = False) -> ChainTable:
+def _within_tolerance(build: _Build, table: ChainTable, w: int, far: bool | str) -> ChainTable | None:
+    """The table of window ``w`` (``far``) at its first levels where its held-out error is within the tolerance,
+    validated again at those levels (fewer if the further held-out designs show it beyond); None if no level is."""
+    while True:
+        errors = np.asarray(table.validation["centre_worst_mm"], dtype=float)
+        within = int(np.argmin(errors <= build.tolerance)) if not (errors <= build.tolerance).all() else len(errors)
+        if within == len(errors) or within == 0:
+            return table if within else None
+        build.say(f"{fit_text(w, far)}: within {build.tolerance:g} mm at its first {within} level(s) only (up to "
+                  f"{table.pressures[within - 1] * 1e3:.4g} kPa): validated again at those levels")
+        table = _window_table(build, w, far, within)
+
+
+def _window_table(build: _Build, w: int, far: bool | str = False, levels: int | None = None) -> ChainTable:
     """The table of half-width ``w`` (with ``far``: and its far-field terms), fitted to its covering designs and
     validated on held-out ones.
 
@@ -392,17 +469,20 @@ def _window_table(build: _Build, w: int, far: bool | str = False) -> ChainTable:
     first :data:`MIN_HELDOUT` go in the covering designs' stream (no pause between the
     two; they serve the next window too, should this one be refused).
 
+    With ``levels``, the table of at most its first ``levels`` levels (those where a wider
+    table was within the tolerance).
+
     Raises
     ------
     LocalityError
         Too many covering designs for the library (:func:`check_training_size`).
     ChainTableError
-        A design failed to converge.
+        A design failed before its first level.
     """
     n, library, solved, say = int(build.model.n_units), build.library, build.solved, build.say
     alphabet = library.alphabet if library is not None else ()
     symmetric = library.symmetric_types if library is not None else ()
-    check_training_size(max(1, len(alphabet)), w, len(symmetric))
+    check_training_size(max(1, len(alphabet)), w, len(symmetric), n)
     train = training_designs(n, w, far, build.short, alphabet, symmetric)
     if far:  # every far-field key shown, checked before the solves
         check_far_training(train, w, True, alphabet, symmetric, n, far)
@@ -412,10 +492,17 @@ def _window_table(build: _Build, w: int, far: bool | str = False) -> ChainTable:
     tests = sorted(tests, key=lambda d: d not in solved)  # those solved for a smaller window first
     ahead = [d for d in tests[:MIN_HELDOUT] if d not in solved] if build.early else []
     what = f"covering and {len(ahead)} held-out" if ahead else "covering"
-    table = fit_table(build.solve(train + ahead, what)[: len(train)], w, build.source,
-                      library=library if alphabet else None, far=far)
-    val = validate_in_rounds(table, tests, build.solve, build.tolerance, build.early,
-                             evaluator_workers(build.evaluator))
+    responses = build.solve(train + ahead, what)[: len(train)]
+    while True:  # fitted to the levels every design reached; again to fewer if a held-out design reaches fewer
+        m = build.levels() if levels is None else min(build.levels(), levels)
+        table = fit_table([first_levels(r, m) for r in responses], w, build.source,
+                          library=library if alphabet else None, far=far)
+        try:
+            val = validate_in_rounds(table, tests, _held_out(build, m), build.tolerance, build.early,
+                                     evaluator_workers(build.evaluator))
+            break
+        except _FewerLevels:
+            continue
     val.update(tolerance_mm=build.tolerance, seed=build.seed)
     worst = max(val["centre_worst_mm"])
     say(f"{name}: worst held-out centre error {worst:.4f} mm over {val['heldout_solved']} held-out "
@@ -425,4 +512,26 @@ def _window_table(build: _Build, w: int, far: bool | str = False) -> ChainTable:
             say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
                 f"({errs['centres']} centres)")
     meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - build.start, fit=name)
-    return ChainTable(**{**table.__dict__, "validation": val, "metadata": meta})
+    why = ""
+    if m < build.levels():
+        why = f"at which it is within {build.tolerance:g} mm"
+    elif build.reached:
+        why = f"every design reached ({len(build.reached)} did not converge beyond)"
+    if m < len(build.model.pressures()):
+        say(f"{name}: fitted to the first {m} level(s), {table.pressures[0] * 1e3:.4g}-{table.pressures[-1] * 1e3:.4g}"
+            f" kPa of the ramp's {len(build.model.pressures())} (up to {build.model.pressures()[-1] * 1e3:.4g} kPa), "
+            f"those {why}")
+    source = build.table_source(m, why)
+    return ChainTable(**{**table.__dict__, "validation": val, "metadata": meta, "source": source})
+
+
+def _held_out(build: _Build, levels: int) -> Callable[..., list[Response]]:
+    """``build.solve`` for a table of ``levels`` levels: the responses' first ``levels``; :class:`_FewerLevels` if a
+    design reached fewer."""
+    def solve(designs: list[str], what: str, before: int = 0, total: int | None = None) -> list[Response]:
+        out = build.solve(designs, what, before, total)
+        if build.levels() < levels:
+            raise _FewerLevels
+        return [first_levels(r, levels) for r in out]
+
+    return solve

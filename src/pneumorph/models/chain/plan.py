@@ -248,7 +248,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
     rows: list[tuple[int, int, int, float, bool | str]] = []  # window, covering designs, solves, work, far-field terms
     for w, with_far in fit_candidates(n_units, window, first, widest, far):
         try:
-            check_training_size(types, w, len(symmetric))
+            check_training_size(types, w, len(symmetric), n_units)
         except PneumorphError:
             break
         train = training_designs(n_units, w, with_far, short, alphabet, symmetric)
@@ -260,7 +260,7 @@ def build_plan(model: Any, heldout: int = HELDOUT, workers: int = 1, cached: Cal
         seen.update(tests)
         rows.append((w, len(train), len(seen), _work(seen, n_units), with_far))
     if not rows:  # not even the first window fits: the check's own refusal, with its advice
-        check_training_size(types, first if window is None else int(window), len(symmetric))
+        check_training_size(types, first if window is None else int(window), len(symmetric), n_units)
     held, held_work = _cached(cached, seen, n_units)
     windows, covering, solves, work, fars = (tuple(column) for column in zip(*rows, strict=True))
     return BuildPlan(cost_fidelity(model), unit_text(model),

@@ -12,12 +12,17 @@ built on first use through the evaluation cache (resumable) and kept in a table 
   (:func:`restrict_table`) and the FE model remade with the ramp of exactly those levels
   (:func:`ramp_variant`: top pressure the ``m``-th level, ``m`` increments), so that the FE
   verifications report the chain's levels.
+- **Builds that survive a failed solve.** A build whose training or held-out design does not
+  converge to the top pressure fits the table to the levels every design reached
+  (:func:`~pneumorph.models.chain.fit.build_table`); such a table (:func:`cut_from`) serves
+  the model it was built for at those levels, the model remade with their ramp
+  (:func:`served_as_built`), and says so.
 - **No silent builds.** Before a table is built, :func:`table_for` prints what will be built
   and its estimated time (:func:`~pneumorph.models.chain.plan.build_plan`) before the first
   solve.
 - **One build of a table at a time.** A build holds a lock on its table file
-  (:func:`build_once`, :class:`~pneumorph.io.lock.FileLock`); a second process that needs
-  the same table waits for it, says for whom, and then reuses it.
+  (:func:`~pneumorph.models.chain.building.build_once`, :class:`~pneumorph.io.lock.FileLock`); a
+  second process that needs the same table waits for it, says for whom, and then reuses it.
 """
 
 from __future__ import annotations
@@ -26,18 +31,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 
 from pneumorph.errors import ChainTableError, PneumorphError
-from pneumorph.io.lock import FileLock
-from pneumorph.io.provenance import digest
+from pneumorph.models.chain.building import build_once
 from pneumorph.models.chain.fit import build_table
+from pneumorph.models.chain.levels import ramp_source
 from pneumorph.models.chain.model import ChainTable, check_source, source_key
 from pneumorph.models.chain.plan import HELDOUT, build_plan, cached_counter, evaluator_workers
-
-T = TypeVar("T")
 
 #: units of the training designs of a table built on first use
 TRAINING_UNITS = 15
@@ -119,7 +122,8 @@ def table_file(folder: str | Path, model: Any) -> Path:
 def find_table(model: Any, folder: str | Path | None = None) -> ChainTable | None:
     """The shipped or kept table fitted to ``model``'s source (its very ramp), or None.
 
-    :func:`serve_table` also finds a table of a longer ramp that serves the model's pressure.
+    :func:`serve_table` also finds a table of a longer ramp that serves the model's pressure. A
+    table built for the model's ramp and fitted to fewer levels (:func:`cut_from`) is found too.
     """
     candidates = [shipped_for(model)]
     if folder is not None:
@@ -127,9 +131,21 @@ def find_table(model: Any, folder: str | Path | None = None) -> ChainTable | Non
     for path in candidates:
         if path.is_file():
             table = ChainTable.load(path)
-            if table.source.get("key") == source_key(model):
+            if table.source.get("key") == source_key(model) or cut_from(table, model):
                 return table
     return None
+
+
+def cut_from(table: ChainTable, model: Any) -> bool:
+    """Whether ``table`` was built for ``model``'s ramp and fitted to fewer levels, those every design reached
+    (its ``source["cut_from"]`` names the model's source; :func:`~pneumorph.models.chain.fit.build_table`).
+
+    >>> from pneumorph.models.factory import make_model
+    >>> cut_from(ChainTable.load(shipped_path("2d")), make_model(6))
+    False
+    """
+    cut = table.source.get("cut_from")
+    return isinstance(cut, dict) and cut.get("key") == source_key(model)
 
 
 # -- pressures served by a table's levels ---------------------------------------------------------
@@ -173,20 +189,8 @@ def restrict_table(table: ChainTable, levels: int) -> ChainTable:
     m = int(levels)
     if m == k:
         return table
-    desc = table.source.get("description")
-    if not (isinstance(desc, dict) and "pressure_mpa" in desc and isinstance(desc.get("steps"), dict)
-            and digest(desc) == table.source.get("key")):
-        raise ChainTableError("the chain table does not hold its model's description (source.description), so "
-                              "the model of a restriction to fewer levels cannot be named; rebuild it with "
-                              "`pneumorph chain build`")
-    description = {**desc, "pressure_mpa": level_pressure(table, m), "steps": {**desc["steps"], "increments": m}}
-    source: dict[str, Any] = {
-        **table.source, "key": digest(description), "description": description,
-        "restricted_from": {"key": table.source.get("key"), "levels": k,
-                            "pressure_mpa": float(table.pressures[-1])},
-    }
-    if "n_units" in table.source:  # the training model's fingerprint: its description with its units
-        source["fingerprint"] = digest({**description, "n_units": table.source["n_units"]})
+    source = ramp_source(table.source, table.pressures, m, restricted_from={
+        "key": table.source.get("key"), "levels": k, "pressure_mpa": float(table.pressures[-1])})
     validation = dict(table.validation)
     for key in _LEVEL_KEYS:
         if isinstance(validation.get(key), list) and len(validation[key]) == k:
@@ -288,6 +292,15 @@ class ServedTable:
     requested: float
     restricted: bool = False
 
+    def origin_text(self) -> str:
+        """Which levels the table was fitted to, e.g. ``fitted to 10 levels`` or, built for the model's ramp, ``fitted
+        to the first 8 of 10 levels, those every design reached (1 did not converge beyond)``."""
+        cut = self.table.source.get("cut_from")
+        if isinstance(cut, dict):
+            return f"fitted to the first {self.table.n_levels} of {cut.get('levels')} levels, those {cut.get('why')}"
+        levels = self.table.source.get("restricted_from", {}).get("levels", self.table.n_levels)
+        return f"fitted to {levels} levels"
+
     def levels_text(self) -> str:
         """What the chain scores, e.g. ``scored at the table's levels 4.5-22.5 kPa (5 levels) at or below 25 kPa``."""
         p = self.table.pressures * 1e3
@@ -331,15 +344,15 @@ def serve_table(model: Any, folder: str | Path | None = None, path: str | Path |
     requested = float(ramp.pressure) if ramp is not None else float(np.max(model.pressures()))
     if path is not None:
         table = ChainTable.load(path)
-        if table.source.get("key") == source_key(model):
-            return ServedTable(table, model, requested)
+        if table.source.get("key") == source_key(model) or cut_from(table, model):
+            return served_as_built(table, model, requested)
         served = _restricted(table, model, requested)
         if served is None:
             check_source(table, model)  # the usual error, naming both models
         return served
     found = find_table(model, folder)
     if found is not None:
-        return ServedTable(found, model, requested)
+        return served_as_built(found, model, requested)
     for candidate in _kept_tables(folder, model):
         try:
             table = ChainTable.load(candidate)
@@ -349,6 +362,27 @@ def serve_table(model: Any, folder: str | Path | None = None, path: str | Path |
         if served is not None:
             return served
     return None
+
+
+def served_as_built(table: ChainTable, model: Any, requested: float | None = None) -> ServedTable:
+    """``table``, of ``model``'s source or cut from its ramp (:func:`cut_from`), and the model it serves: ``model``,
+    or remade with the ramp of the table's levels (:func:`ramp_variant`) for a cut table.
+
+    Raises
+    ------
+    ChainTableError
+        A cut table whose levels the model cannot be remade with.
+    """
+    top = float(model.ramp.pressure) if getattr(model, "ramp", None) is not None else float(model.pressures()[-1])
+    requested = top if requested is None else requested
+    if not cut_from(table, model):
+        return ServedTable(table, model, requested)
+    remade = ramp_variant(model, level_pressure(table, table.n_levels), table.n_levels)
+    if remade is None:
+        raise ChainTableError("the chain table was fitted to fewer levels than the model's ramp, and the model "
+                              "cannot be remade with those levels")
+    check_source(table, remade)
+    return ServedTable(table, remade, requested, restricted=True)
 
 
 def _restricted(table: ChainTable, model: Any, requested: float) -> ServedTable | None:
@@ -364,62 +398,6 @@ def _restricted(table: ChainTable, model: Any, requested: float) -> ServedTable 
     return ServedTable(restricted, remade, requested, restricted=True)
 
 
-# -- one build at a time --------------------------------------------------------------------------
-def build_once(target: Path, find: Callable[[], T | None], build: Callable[[], T],
-               on_progress: Callable[[str], None] | None = None, what: str | None = None) -> T:
-    """``find()``, else ``build()``, under a lock on ``target`` (``<target>.lock``): built once for all processes.
-
-    A process that finds the lock held waits for it (saying once that it waits, and for
-    whom), then looks again: the table the holder built is reused (saying so) and nothing is
-    built twice. ``build`` is expected to write ``target``; the lock is given back however
-    it ends (a killed holder's lock is released by the operating system).
-
-    Parameters
-    ----------
-    target : Path
-        The file built; its folder is created.
-    find : callable
-        Returns what is there already (or None); called again under the lock.
-    build : callable
-        Builds (and writes) it.
-    what : str, optional
-        What is built, for the messages (default: the file's name).
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> target = Path(tempfile.mkdtemp()) / "t.json"
-    >>> def make():
-    ...     target.write_text("1")
-    ...     return 1
-    >>> build_once(target, lambda: None, make), build_once(target, lambda: 2 if target.exists() else None, make)
-    (1, 2)
-    """
-    say = on_progress or (lambda text: None)
-    name = what or target.name
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ChainTableError(f"{name}: cannot create its folder {target.parent} ({exc.strerror or exc})") from None
-    lock = FileLock(target.with_name(target.name + ".lock"), name)
-    waited: list[str] = []
-
-    def on_wait(holder: str) -> None:
-        waited.append(holder)
-        say(f"waiting for {name}: another process builds it ({holder})")
-
-    lock.acquire(wait=True, on_wait=on_wait)
-    try:
-        found = find()
-        if found is not None:
-            if waited:
-                say(f"{name} was built meanwhile by {waited[0].split(',')[0]}: reusing it")
-            return found
-        return build()
-    finally:
-        lock.release()
-
-
 def table_for(
     model: Any,
     make_training: Callable[[int], Any],
@@ -433,7 +411,9 @@ def table_for(
     A new build first says what it will build and its estimated time
     (:func:`~pneumorph.models.chain.plan.build_plan`),
     through ``on_progress``, and holds a lock on its table file while it builds
-    (:func:`build_once`): another process that needs the same table waits and reuses it.
+    (:func:`~pneumorph.models.chain.building.build_once`): another process that needs the same table waits
+    and reuses it. A table fitted to fewer levels than the model's ramp (a design did not converge to its top,
+    :func:`cut_from`) is returned as built: :func:`served_as_built` names the model it serves.
 
     Parameters
     ----------
@@ -461,7 +441,8 @@ def table_for(
     """
     if path is not None:
         table = ChainTable.load(path)
-        check_source(table, model)
+        if not cut_from(table, model):
+            check_source(table, model)
         return table
     found = find_table(model, folder)
     if found is not None:
