@@ -342,11 +342,11 @@ def test_shape_options_that_would_be_ignored_are_refused(args: list[str], messag
 
 def test_a_tolerance_as_large_as_a_wall_names_the_option(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     unit = tmp_path / "thin.toml"
-    unit.write_text("[unit]\nside_wall = 0.5\n")
-    for argv in (["design", "--tolerance", "0.9", "--unit", str(unit), "--out", str(tmp_path / "never")],
-                 ["sensitivity", "tolerances", "--tolerance", "0.9", "--unit", str(unit), "--units", "2",
+    unit.write_text("[unit]\nside_wall = 1.0\n")  # the thinnest wall a mould casts (MIN_WALL_MM)
+    for argv in (["design", "--tolerance", "1.0", "--unit", str(unit), "--out", str(tmp_path / "never")],
+                 ["sensitivity", "tolerances", "--tolerance", "1.0", "--unit", str(unit), "--units", "2",
                   "--executor", "serial"]):
         assert main(argv) == 2
         err = capsys.readouterr().err
-        assert "not smaller than the unit's side_wall (0.5 mm)" in err and "--tolerance" in err
+        assert "not smaller than the unit's side_wall (1 mm)" in err and "--tolerance" in err
     assert not (tmp_path / "never").exists()

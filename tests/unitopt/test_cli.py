@@ -30,6 +30,9 @@ TINY = ["unit", "optimise", "--var", "cavity_height=4.5:7.5", "--var", "end_wall
     (["--var", "wall=1.01:1.09"], "the range of wall 1.01-1.09 mm holds no value at the resolution 0.1 mm"),
     (["--var", "wall=1:900"], "narrow the bounds (this is the unit at wall=900 mm)"),
     (["--var", "wall=1:1e9"], "unit wall 1e+09 mm is above the limit MAX_LENGTH_MM"),
+    (["--var", "wall=0.000001:2"], "at wall=1e-06 mm: unit wall 1e-06 mm is thinner than the thinnest wall a mould "
+                                   "casts, MIN_WALL_MM = 1 mm"),
+    (["--var", "cavity_height=0.5:6"], "MIN_FEATURE_MM = 1 mm"),
 ])
 def test_bad_input_is_one_line_and_exit_2_before_any_solve(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                           monkeypatch: pytest.MonkeyPatch, args: list[str],
@@ -128,3 +131,27 @@ def test_another_runs_folder_is_refused_without_overwrite(tmp_path: Path, capsys
     assert f"{out} holds another run's files (config.toml); give another folder with --out, or write into it " \
            "with --overwrite" in line
     assert sorted(p.name for p in out.iterdir()) == before
+
+
+def test_an_optimisation_without_a_feasible_candidate_exits_2_and_says_why(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every candidate failed: "front of 0" and exit 0 before; now one line naming the counts, and exit 2."""
+    from dataclasses import replace
+
+    import pneumorph.unitopt.run as run
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.unitopt.problem import UnitCandidate
+    from pneumorph.unitopt.records import UnitOptimisation
+
+    def all_fail(settings, evaluator, on_candidate=None, on_generation=None):  # type: ignore[no-untyped-def]
+        failed = [UnitCandidate({"cavity_height": h}, replace(UnitSpec(), cavity_height=h), None,
+                                "no convergence at load factor 0.4", 0.004, False, 1.0, 0) for h in (4.5, 6.0, 7.5)]
+        return UnitOptimisation(settings, failed, [], failed[1])
+
+    monkeypatch.setattr(run, "optimise", all_fail)
+    out = tmp_path / "run"
+    code = main([*TINY, "--cache", str(tmp_path / "c.sqlite"), "--out", str(out)])
+    err = [line for line in capsys.readouterr().err.splitlines() if line.startswith("error: ")]
+    assert code == 2 and len(err) == 1, err
+    assert "no feasible unit: of 3 candidates 3 failed to converge and 0 strained past --strain-limit" in err[0]
+    assert "--var" in err[0] and (out / "candidates.csv").is_file()  # the failures are kept, to be read

@@ -86,6 +86,7 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
         if (line := cluster_line(evaluator)) is not None:
             lines.say(line)
         write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
+    _check_front(result, strain_limit, out)
     if as_json:
         _print_json(result, strain_limit, evaluator)
     else:
@@ -127,6 +128,20 @@ def _check_space(variables: tuple[str, ...], resolution: float, element_size: fl
             raise
         raise click.BadParameter(" ".join(str(exc).split()), param_hint="'--var'") from None
     return space
+
+
+def _check_front(result: Any, strain_limit: float, out: str) -> None:
+    """Refuse (exit 2) an optimisation without a feasible candidate: every one failed to converge or strained past
+    the limit; its candidates stay in the folder, and the line says what to change."""
+    from pneumorph.errors import SettingsError
+
+    if result.front:
+        return
+    failed = sum(1 for c in result.candidates if c.measures is None)
+    strained = len(result.candidates) - failed
+    raise SettingsError(f"no feasible unit: of {len(result.candidates)} candidates {failed} failed to converge and "
+                        f"{strained} strained past --strain-limit {strain_limit:g} ({out}/candidates.csv lists them); "
+                        "change the bounds (--var), raise --strain-limit or lower --pressure")
 
 
 def _probe(settings: Any) -> Any:

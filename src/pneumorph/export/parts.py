@@ -77,6 +77,7 @@ from pneumorph.geometry.alphabet import Design, library_design
 from pneumorph.geometry.assembly import cavity_box, unit_starts
 from pneumorph.geometry.features import BaseBlock, Box
 from pneumorph.geometry.library import UnitLibrary
+from pneumorph.geometry.limits import check_manufacturable
 from pneumorph.geometry.unit import UnitSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -257,8 +258,10 @@ def check_materials(spec: UnitSpec | UnitLibrary, base_block: BaseBlock | None =
 
 
 def check_buildable(spec: UnitSpec | UnitLibrary, design: str | Design | None = None) -> None:
-    """Refuse a unit whose parts these builders cannot make: one with a bottom wall of another material
-    (``bottom_material``). Over a library, every type (or those ``design`` uses).
+    """Refuse a unit whose parts these builders cannot make: one a mould cannot cast
+    (:func:`~pneumorph.geometry.limits.check_manufacturable`: a wall, layer, cavity or slit too thin, a unit
+    too large), or one with a bottom wall of another material (``bottom_material``). Over a library, every
+    type (or those ``design`` uses).
 
     >>> check_buildable(UnitSpec(bottom_material="smooth_sil_950"))
     Traceback (most recent call last):
@@ -267,6 +270,7 @@ def check_buildable(spec: UnitSpec | UnitLibrary, design: str | Design | None = 
     (bottom_material) are not built yet; export a unit of one body material
     """
     for unit in _types(spec, design):
+        check_manufacturable(unit, f"unit {unit.name!r}:" if unit.name != "unit" else "unit")
         if unit.bottom_material:
             raise GeometryError(f"the parts and moulds of a unit with a bottom wall of {unit.bottom_material} "
                                 "(bottom_material) are not built yet; export a unit of one body material")

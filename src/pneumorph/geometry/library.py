@@ -49,6 +49,7 @@ import numpy as np
 
 from pneumorph.errors import GeometryError, UnitLibraryError
 from pneumorph.geometry.grid import cross_section_lines
+from pneumorph.geometry.limits import check_manufacturable
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.provenance import digest
 
@@ -385,7 +386,9 @@ def _entry_unit(value: Any, where: str, base: Path | None) -> UnitSpec:
                 path = base / path
             return UnitSpec.from_toml(path)
         if isinstance(value, Mapping):
-            return UnitSpec.from_dict(dict(value), source=where)
+            spec = UnitSpec.from_dict(dict(value), source=where)
+            check_manufacturable(spec, f"{where}: unit")
+            return spec
     except UnitLibraryError:
         raise
     except GeometryError as exc:

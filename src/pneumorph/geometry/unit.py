@@ -79,7 +79,13 @@ from typing import Any
 
 from pneumorph.checks import MIN_ELEMENT_FRACTION
 from pneumorph.errors import GeometryError
-from pneumorph.geometry.limits import MAX_NAME_CHARS, UNIT_LENGTHS, MeshLimitError, check_lengths
+from pneumorph.geometry.limits import (
+    MAX_NAME_CHARS,
+    UNIT_LENGTHS,
+    MeshLimitError,
+    check_lengths,
+    check_manufacturable,
+)
 from pneumorph.materials.laws.filler import FillerLaw
 
 
@@ -454,7 +460,8 @@ class UnitSpec:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> UnitSpec:
-        """Read a unit from a TOML file with a ``[unit]`` table (lengths in mm).
+        """Read a unit from a TOML file with a ``[unit]`` table (lengths in mm): a unit a mould can cast
+        (:func:`~pneumorph.geometry.limits.check_manufacturable`).
 
         Examples
         --------
@@ -470,7 +477,9 @@ class UnitSpec:
         data = read_toml(p, "unit file", GeometryError)
         if "unit" not in data or not isinstance(data["unit"], dict):
             raise GeometryError(f"{p}: expected a [unit] table with the unit's dimensions in mm")
-        return cls.from_dict(data["unit"], source=str(p))
+        spec = cls.from_dict(data["unit"], source=str(p))
+        check_manufacturable(spec, f"{p}: unit")
+        return spec
 
 
 #: Fields added after the first release, with their defaults: :meth:`UnitSpec.to_dict` leaves

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError, SettingsError
+from pneumorph.geometry.limits import check_manufacturable
 from pneumorph.geometry.unit import UnitSpec
 
 FloatArray = NDArray[np.float64]
@@ -200,12 +201,14 @@ class DesignSpace:
         return np.array([float(getattr(self.base, n)) for n in self.names])
 
     def check(self) -> None:
-        """Build and mesh (3D, one unit) the unit at every corner of the box; nothing is solved.
+        """Build and mesh (3D, one unit) the unit at every corner of the box; nothing is solved. Every corner must
+        be a unit a mould casts (:func:`~pneumorph.geometry.limits.check_manufacturable`): the box's units then
+        are too (walls, layer and cavity grow or shrink along each variable).
 
         Raises
         ------
         GeometryError
-            A corner that makes no unit or does not mesh, naming the corner.
+            A corner that makes no unit, is not manufacturable or does not mesh, naming the corner.
 
         Examples
         --------
@@ -222,6 +225,7 @@ class DesignSpace:
             try:
                 corner_values: dict[str, Any] = dict(zip(self.names, corner, strict=True))
                 spec = replace(self.base, **corner_values)
+                check_manufacturable(spec)
                 assemble(spec, "0", dim=3, half=True)
             except GeometryError as exc:
                 raise GeometryError(f"the bounds do not always make a unit: at {where} mm: {exc}") from None
