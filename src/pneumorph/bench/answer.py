@@ -27,7 +27,7 @@ from pneumorph.bench.samples import centrelines, path_samples, profiles, stage_s
 from pneumorph.bench.shapes import chain_placement, surface
 from pneumorph.design.certified.planegrowth import designs_of
 from pneumorph.design.certified.search import best_scores
-from pneumorph.design.certified.spacegrowth import check_space_objective
+from pneumorph.design.certified.spacegrowth import check_space_objective, space_scores
 from pneumorph.design.objectives.targets import StagedTarget, TipGoal
 from pneumorph.errors import PneumorphError, SearchConfigError
 from pneumorph.geometry.unit import UnitSpec
@@ -37,6 +37,16 @@ from pneumorph.models.chain.sources import find_table
 from pneumorph.models.chain.windows import design_numbers
 from pneumorph.models.factory import make_model
 
+#: memory a query's branch-and-bound in space may hold (bytes): within the 1.5 GB a bench worker may use, with
+#: the worker's own ~0.2 GB (Python, the models and tables) and room to spare
+QUERY_MEMORY = 750 * 10**6
+#: memory one open prefix of the branch-and-bound in space costs (bytes): 12.9 kB measured (the spatial
+#: library's 15 units, 10 levels: peak resident memory 809 MB over 50,000 open prefixes, 309 MB over 10,000,
+#: BENCHMARKS.md), rounded up
+PREFIX_BYTES = 16_000
+#: the open prefixes a query of a chain in space keeps (46,875): more stay open, the best are kept and the
+#: certificate says how much better an unlisted design could be; the default (500,000) held 6 GB
+QUERY_NODES = QUERY_MEMORY // PREFIX_BYTES
 BUILTIN = "builtin"
 LIBRARIES = {"spatial": "spatial library: a, l (sideways)"}
 """The built-in unit libraries the bench serves, by id (their shipped 3D tables), and their names."""
@@ -231,6 +241,17 @@ class Bench:
                 raise QueryError("stages", str(exc)) from None
         return query
 
+    def slow(self, query: Query) -> bool:
+        """Whether ``query`` is answered by the branch-and-bound of a chain in space (seconds to a minute, within
+        :data:`QUERY_MEMORY`): the bench answers such queries on a worker of their own.
+
+        >>> from pneumorph.bench.query import Query
+        >>> bench = Bench()
+        >>> bench.slow(Query("preset", "sin")), bench.slow(Query("tip", "max-x", unit="spatial"))
+        (False, True)
+        """
+        return self.chain(query.model, query.unit).table.axes == 3
+
     def recall(self, query: Query) -> dict[str, Any] | None:
         """A remembered answer to ``query`` (marked ``memo``), or None."""
         key = query.key()
@@ -281,7 +302,10 @@ class Bench:
         chain = self.chain(query.model, query.unit)
         length, axis = chain.length, float(chain.table.tip_ref[1])
         objective = query.objective(length)
-        scores = best_scores(chain, objective, top=query.top)
+        if self.slow(query):  # within the query's memory budget (QUERY_NODES)
+            scores = space_scores(chain, objective, max_nodes=QUERY_NODES)
+        else:
+            scores = best_scores(chain, objective, top=query.top)
         sign = 1.0 if objective.sense == "min" else -1.0
         k = min(query.top, len(scores.cost))
         top = np.argpartition(scores.cost, k - 1)[:k]

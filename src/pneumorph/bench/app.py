@@ -41,14 +41,15 @@ from pneumorph.bench.schema import describe
 from pneumorph.design.objectives.paths import PATH_PRESETS
 from pneumorph.design.objectives.targets import PRESETS, TIP_GOALS
 from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
-from pneumorph.geometry.limits import MeshLimitError
+from pneumorph.geometry.limits import MeshLimitError, check_manufacturable
 from pneumorph.geometry.meshsize import check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import json_safe
 
 
 def read_unit(raw: bytes) -> UnitSpec:
-    """An uploaded unit TOML file, checked: size, UTF-8 text, TOML, a valid ``[unit]`` table.
+    """An uploaded unit TOML file, checked: size, UTF-8 text, TOML, a valid ``[unit]`` table, a unit a mould can
+    cast (:func:`~pneumorph.geometry.limits.check_manufacturable`).
 
     Raises
     ------
@@ -71,7 +72,9 @@ def read_unit(raw: bytes) -> UnitSpec:
     if not isinstance(table, dict):
         raise QueryError("unit", "the unit file needs a [unit] table (lengths in mm)")
     try:
-        return UnitSpec.from_dict(table, "uploaded unit")
+        spec = UnitSpec.from_dict(table, "uploaded unit")
+        check_manufacturable(spec, "uploaded unit:")
+        return spec
     except PneumorphError as exc:
         raise QueryError("unit", str(exc)) from None
 
@@ -100,21 +103,36 @@ def _warm_worker(fidelity: str) -> int:
     return os.getpid()
 
 
+#: slow queries (:meth:`~pneumorph.bench.answer.Bench.slow`) the bench holds at once: one answered, one waiting
+#: for it; more are refused (429) with the reason, to be asked again
+SLOW_QUEUE = 2
+
+
+class SlowQueriesBusy(JobLimitError):
+    """A slow query refused: :data:`SLOW_QUEUE` of them are being answered or waiting."""
+
+
 class AnswerPool:
     """Answers computed in worker processes, so that concurrent queries use every core.
 
     Each worker holds its own :class:`Bench` (models and chain tables loaded once); a query
-    travels as a :class:`Query` and its answer comes back as plain data. With no workers,
-    answers are computed on the server's threads.
+    travels as a :class:`Query` and its answer comes back as plain data. Slow queries (the
+    branch-and-bound of a chain in space, seconds to a minute within the query's memory
+    budget, :data:`~pneumorph.bench.answer.QUERY_MEMORY`) go to a worker of their own, at
+    most :data:`SLOW_QUEUE` at a time, so that they never hold up the plain ones: ``workers``
+    is the plain queries' workers plus that one (at least one each). With no workers, answers
+    are computed on the server's threads (slow ones counted the same).
     """
 
     def __init__(self, bench: Bench, workers: int | None = None) -> None:
         self.bench = bench
         self.workers = min(os.cpu_count() or 1, 4) if workers is None else int(workers)
         self._pool: ProcessPoolExecutor | None = None
+        self._slow_pool: ProcessPoolExecutor | None = None
+        self._slow = 0  # slow queries answered or waiting
 
-    def _make(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
+    def _make(self, workers: int) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
                                    initializer=_start_answer_worker,
                                    initargs=(self.bench.table_dir, self.bench.unit_dir, self.bench.settings))
 
@@ -122,27 +140,53 @@ class AnswerPool:
         """Start the workers and load their tables (before the first query is taken)."""
         if self.workers < 1:
             return
-        self._pool = self._make()
+        plain = max(1, self.workers - 1)
+        self._pool, self._slow_pool = self._make(plain), self._make(1)
         loop = asyncio.get_running_loop()
         for fidelity in ("3d", "2d"):
-            await asyncio.gather(*(loop.run_in_executor(self._pool, _warm_worker, fidelity)
-                                   for _ in range(self.workers)))
+            await asyncio.gather(*(loop.run_in_executor(self._pool, _warm_worker, fidelity) for _ in range(plain)),
+                                 loop.run_in_executor(self._slow_pool, _warm_worker, fidelity))
 
     async def compute(self, query: Query) -> dict[str, Any]:
-        if self._pool is None:
+        """The answer to ``query``: on the plain queries' workers, or a slow one's (refused when too many wait).
+
+        Raises
+        ------
+        SlowQueriesBusy
+            :data:`SLOW_QUEUE` slow queries are being answered or waiting.
+        """
+        if not self.bench.slow(query):
+            return await self._run(query, slow=False)
+        if self._slow >= SLOW_QUEUE:
+            raise SlowQueriesBusy(f"{self._slow} slow queries (a chain in space searched by branch-and-bound, up to a "
+                                  "minute each) are being answered or waiting; ask again when they are done")
+        self._slow += 1
+        try:
+            return await self._run(query, slow=True)
+        finally:
+            self._slow -= 1
+
+    async def _run(self, query: Query, slow: bool) -> dict[str, Any]:
+        pool = self._slow_pool if slow else self._pool
+        if pool is None:
             return await run_in_threadpool(self.bench.compute, query)
         loop = asyncio.get_running_loop()
         try:
-            return await loop.run_in_executor(self._pool, _answer_in_worker, query)
+            return await loop.run_in_executor(pool, _answer_in_worker, query)
         except BrokenProcessPool:  # a worker died (killed, out of memory): start afresh once
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = self._make()
-            return await loop.run_in_executor(self._pool, _answer_in_worker, query)
+            pool.shutdown(wait=False, cancel_futures=True)
+            pool = self._make(1 if slow else max(1, self.workers - 1))
+            if slow:
+                self._slow_pool = pool
+            else:
+                self._pool = pool
+            return await loop.run_in_executor(pool, _answer_in_worker, query)
 
     def close(self) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
+        for pool in (self._pool, self._slow_pool):
+            if pool is not None:
+                pool.shutdown(wait=False, cancel_futures=True)
+        self._pool = self._slow_pool = None
 
 
 def static_dir() -> Path:
@@ -171,7 +215,8 @@ def create_app(state_dir: str | Path | None = None, cache: str | Path | None = N
     workers : int
         FE worker processes of a background job.
     answer_workers : int, optional
-        Processes that compute answers (default: one per core, at most 4); 0: on the server's threads.
+        Processes that compute answers (default: one per core, at most 4): one of them answers the slow
+        queries (a chain in space), the others the plain ones (at least one); 0: on the server's threads.
     allowed_hosts : sequence of str
         The host names (``Host`` header) served; any other is refused (DNS rebinding).
         Default: this machine's loopback names.
@@ -253,7 +298,8 @@ def _add_error_handlers(app: FastAPI) -> None:
 
     @app.exception_handler(JobLimitError)
     async def _job_limit(request: Request, exc: JobLimitError) -> JSONResponse:
-        return error(507 if isinstance(exc, StateQuotaError) else 429, "job", str(exc))
+        field = "query" if isinstance(exc, SlowQueriesBusy) else "job"
+        return error(507 if isinstance(exc, StateQuotaError) else 429, field, str(exc))
 
     @app.exception_handler(BodyTooLargeError)
     async def _too_large(request: Request, exc: BodyTooLargeError) -> JSONResponse:

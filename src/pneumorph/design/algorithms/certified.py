@@ -26,7 +26,7 @@ from pneumorph.design.runs.comparison import compare_with_reference
 from pneumorph.design.runs.robustness import chain_robustness, winner_robustness
 from pneumorph.errors import LocalityError, MissingTableError, PneumorphError, SearchConfigError
 from pneumorph.models.chain.model import ChainModel
-from pneumorph.models.chain.sources import serve_table, served_as_built, table_for
+from pneumorph.models.chain.sources import limits_text, serve_table, served_as_built, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for
@@ -81,6 +81,8 @@ class CertifiedSearch(Search):
         else:  # a model the chain cannot represent raises LocalityError and leaves nothing behind
             table = table_for(problem.model, _training(problem.model), folder=problem.table_dir,
                               evaluator=problem.evaluator, on_progress=problem.say)
+            if limits_text(table):
+                problem.say(f"the chain table: {limits_text(table)}")
             served = served_as_built(table, problem.model)
             if served.restricted:
                 problem.say(f"the design goes on at the levels the table serves: {served.origin_text()}, "
@@ -92,9 +94,10 @@ class CertifiedSearch(Search):
                                                folder=problem.table_dir, evaluator=problem.evaluator,
                                                on_progress=problem.say)
         entries = {"chain_table": table.fingerprint()}
-        for key in ("restricted_from", "cut_from"):
-            if key in table.source:
-                entries[f"chain_table_{key}"] = table.source[key]
+        if "restricted_from" in table.source:
+            entries["chain_table_restricted_from"] = table.source["restricted_from"]
+        if isinstance(cut := table.source.get("cut_from"), dict):  # the designs that failed, by name
+            entries["chain_table_cut_from"] = {**cut, "failed": sorted(cut.get("failed", {}))}
         return problem, entries
 
     def run(self, problem: Problem) -> SearchOutcome:
