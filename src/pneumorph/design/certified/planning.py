@@ -43,6 +43,7 @@ from pneumorph.models.chain.sources import (
     TRAINING_UNITS,
     ServedTable,
     build_options,
+    limits_text,
     same_source,
     serve_table,
     shipped_for,
@@ -190,6 +191,8 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
         note = f"certified search with the chain table of window +-{t.window}"
         if served.restricted:
             note += f" {served.origin_text()}, {served.levels_text()}"
+        if limits_text(t):
+            note += f"; {limits_text(t)}"
         return SearchPlan("certified", served, note=note)
     if served is not None:
         w = served.table.window

@@ -25,7 +25,7 @@ from pneumorph.models.chain.levels import first_levels, levels_reached, ramp_sou
 from pneumorph.models.chain.means import check_training, window_means
 from pneumorph.models.chain.model import ChainTable, source_description, source_key, training_model
 from pneumorph.models.chain.terms import check_far_training, far_means, fit_text
-from pneumorph.models.chain.training import training_designs
+from pneumorph.models.chain.training import MAX_TRAINING, check_training_size, training_designs
 from pneumorph.models.chain.validation import (
     CLEAR_FRACTION,
     MIN_HELDOUT,
@@ -49,59 +49,6 @@ __all__ = ["CLEAR_FRACTION", "DEFAULT_TOLERANCE", "MAX_TRAINING", "MAX_WINDOW", 
 DEFAULT_TOLERANCE = 0.2
 #: widest window tried by :func:`build_table`
 MAX_WINDOW = 3
-#: most covering designs a table over several unit types may ask for (the base windows alone need
-#: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
-MAX_TRAINING = 200
-
-
-def check_training_size(n_types: int, window: int, symmetric: int = 0, n_units: int | None = None) -> None:
-    """Refuse, before any solve, a window whose covering designs must be more than :data:`MAX_TRAINING`.
-
-    Two lower bounds count them: the base windows alone need ``(2k)^(w+1) / 2`` designs (one
-    each), and with ``n_units`` given, the interior windows ``(2k)^(2w+1) / 2`` patterns of
-    ``2w + 1`` units, ``n_units - 2w`` of them in each design (``2k - s`` for ``k`` types,
-    ``s`` of them symmetric; mirrored designs count once).
-
-    >>> check_training_size(2, 2)
-    >>> check_training_size(4, 2)
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
-    its base windows alone (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
-    >>> check_training_size(26, 1)
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.LocalityError: a chain table over 26 unit types at window +-1 needs at least 1352 FE solves for
-    its base windows alone (at most 200, MAX_TRAINING); use at most 10 unit types
-    >>> check_training_size(4, 2, 1, n_units=15)
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 764 FE solves of
-    15-unit designs for its interior windows (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
-    """
-    def base(types: int, w: int) -> int:
-        return (2 * types - min(int(symmetric), types)) ** (w + 1) // 2
-
-    def interior(types: int, w: int) -> int:
-        if n_units is None or int(n_units) <= 2 * w:
-            return 0
-        return -(-((2 * types - min(int(symmetric), types)) ** (2 * w + 1) // 2) // (int(n_units) - 2 * w))
-
-    def need(types: int, w: int) -> int:
-        return max(base(types, w), interior(types, w))
-
-    n, w = int(n_types), int(window)
-    if n > 1 and need(n, w) > MAX_TRAINING:
-        most = max((t for t in range(1, n) if need(t, w) <= MAX_TRAINING), default=1)
-        advice = f"at most {most} unit types"
-        if w > 1 and need(n, 1) <= MAX_TRAINING:
-            advice = f"a window of +-1 or {advice}"
-        what = (f"{base(n, w)} FE solves for its base windows alone" if base(n, w) > MAX_TRAINING else
-                f"{interior(n, w)} FE solves of {n_units}-unit designs for its interior windows")
-        raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {what} (at most "
-                            f"{MAX_TRAINING}, MAX_TRAINING); use {advice}")
-
-
 # -- fitting --------------------------------------------------------------------------------
 def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any], mirror: bool = True,
               library: UnitLibrary | None = None, far: bool | str = False) -> ChainTable:
@@ -313,12 +260,19 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
         ``first_window`` from end windows of the narrower one); with a fixed ``window``, that
         window with far-field terms (:func:`fit_candidates`); ``"split"``: in their split layout.
 
+    A design that does not converge to the top pressure is kept with the levels it reached,
+    and the table is fitted to the levels every design reached (its ``source["cut_from"]``
+    names the model's ramp and the designs). When the next wider window would need more
+    covering solves than a build may ask for (:func:`check_training_size`), the widest
+    affordable table is validated on every held-out design and returned with its errors
+    stated (``validation["beyond_tolerance"]``): the certified search carries them in its bound.
+
     Raises
     ------
     LocalityError
         The model has gravity, or no window up to ``max_window`` meets the tolerance.
     ChainTableError
-        A training design failed to converge.
+        A design failed before its first level.
     """
     _check_buildable(model, tolerance)
     model = training_model(model)  # over sideways units: every design on the full width, a chain in space
@@ -331,24 +285,37 @@ def build_table(model: Any, evaluator: Any, window: int | None = None, tolerance
     build = _Build(model, evaluator, tolerance, heldout, seed, short, early, say, solved,
                    _solver(model, evaluator, solved, reached, say), library, _source(model), time.perf_counter(),
                    reached)
+    return _first_within(build, candidates)
+
+
+def _first_within(build: _Build, candidates: list[tuple[int, bool | str]]) -> ChainTable:
+    """The first candidate table within the tolerance; else, when the next is unaffordable, the last one with its
+    errors stated (:func:`_stated`).
+
+    Raises
+    ------
+    LocalityError
+        Every affordable candidate is beyond the tolerance, and there is none wider to try.
+    """
     best: ChainTable | None = None
+    unaffordable = ""
     for w, with_far in candidates:
         try:
             table = _window_table(build, w, with_far)
         except LocalityError as exc:  # a wider window than a build may ask covering solves for
             if best is None:
                 raise
-            say(f"{fit_text(w, with_far)}: not tried: {exc}")
+            build.say(f"{fit_text(w, with_far)}: not tried: {exc}")
+            unaffordable = str(exc).split(" (at most")[0].replace("a chain table over", "a table over")
             break
-        if max(table.validation["centre_worst_mm"]) <= tolerance:
+        if max(table.validation["centre_worst_mm"]) <= build.tolerance:
             return table
         best, tried = table, (w, with_far)
     assert best is not None
-    within = _within_tolerance(build, best, *tried)
-    if within is not None:
-        return within
+    if unaffordable:
+        return _stated(build, best, *tried, unaffordable)
     raise LocalityError(
-        f"the chain model does not reproduce this model within {tolerance:g} mm: with window +-{best.window} "
+        f"the chain model does not reproduce this model within {build.tolerance:g} mm: with window +-{best.window} "
         f"the worst held-out unit-centre error is {max(best.validation['centre_worst_mm']):.3g} mm; the units "
         "interact further than the window reaches, so search with the FE model (--search ga or exhaustive)"
     )
@@ -448,20 +415,20 @@ def _source(model: Any) -> dict[str, Any]:
             "n_units": int(model.n_units), "description": source_description(model)}
 
 
-def _within_tolerance(build: _Build, table: ChainTable, w: int, far: bool | str) -> ChainTable | None:
-    """The table of window ``w`` (``far``) at its first levels where its held-out error is within the tolerance,
-    validated again at those levels (fewer if the further held-out designs show it beyond); None if no level is."""
-    while True:
-        errors = np.asarray(table.validation["centre_worst_mm"], dtype=float)
-        within = int(np.argmin(errors <= build.tolerance)) if not (errors <= build.tolerance).all() else len(errors)
-        if within == len(errors) or within == 0:
-            return table if within else None
-        build.say(f"{fit_text(w, far)}: within {build.tolerance:g} mm at its first {within} level(s) only (up to "
-                  f"{table.pressures[within - 1] * 1e3:.4g} kPa): validated again at those levels")
-        table = _window_table(build, w, far, within)
+def _stated(build: _Build, table: ChainTable, w: int, far: bool | str, wider: str) -> ChainTable:
+    """The table of window ``w`` (``far``) when no wider window is affordable: validated on every held-out design
+    (no stop once above the tolerance), its errors stated and marked ``beyond_tolerance`` in its validation;
+    the certified search carries them into its bound."""
+    worst = max(table.validation["centre_worst_mm"])
+    build.say(f"{fit_text(w, far)}: the widest window a build may afford ({wider}); its worst held-out centre error "
+              f"{worst:.3g} mm is above {build.tolerance:g} mm: validated on every held-out design and served with "
+              "its errors stated")
+    table = _window_table(build, w, far, every=True)
+    val = {**table.validation, "beyond_tolerance": True, "wider": wider}
+    return ChainTable(**{**table.__dict__, "validation": val})
 
 
-def _window_table(build: _Build, w: int, far: bool | str = False, levels: int | None = None) -> ChainTable:
+def _window_table(build: _Build, w: int, far: bool | str = False, every: bool = False) -> ChainTable:
     """The table of half-width ``w`` (with ``far``: and its far-field terms), fitted to its covering designs and
     validated on held-out ones.
 
@@ -469,8 +436,7 @@ def _window_table(build: _Build, w: int, far: bool | str = False, levels: int | 
     first :data:`MIN_HELDOUT` go in the covering designs' stream (no pause between the
     two; they serve the next window too, should this one be refused).
 
-    With ``levels``, the table of at most its first ``levels`` levels (those where a wider
-    table was within the tolerance).
+    With ``every``, validated on every held-out design (its errors stated, not tested).
 
     Raises
     ------
@@ -494,12 +460,12 @@ def _window_table(build: _Build, w: int, far: bool | str = False, levels: int | 
     what = f"covering and {len(ahead)} held-out" if ahead else "covering"
     responses = build.solve(train + ahead, what)[: len(train)]
     while True:  # fitted to the levels every design reached; again to fewer if a held-out design reaches fewer
-        m = build.levels() if levels is None else min(build.levels(), levels)
+        m = build.levels()
         table = fit_table([first_levels(r, m) for r in responses], w, build.source,
                           library=library if alphabet else None, far=far)
         try:
-            val = validate_in_rounds(table, tests, _held_out(build, m), build.tolerance, build.early,
-                                     evaluator_workers(build.evaluator))
+            val = validate_in_rounds(table, tests, _held_out(build, m), np.inf if every else build.tolerance,
+                                     build.early and not every, evaluator_workers(build.evaluator))
             break
         except _FewerLevels:
             continue
@@ -512,11 +478,7 @@ def _window_table(build: _Build, w: int, far: bool | str = False, levels: int | 
             say(f"  unit type {symbol}: worst held-out centre error {max(errs['centre_worst_mm']):.4f} mm "
                 f"({errs['centres']} centres)")
     meta = provenance(solves=len(solved), build_wall_s=time.perf_counter() - build.start, fit=name)
-    why = ""
-    if m < build.levels():
-        why = f"at which it is within {build.tolerance:g} mm"
-    elif build.reached:
-        why = f"every design reached ({len(build.reached)} did not converge beyond)"
+    why = f"every design reached ({len(build.reached)} did not converge beyond)" if build.reached else ""
     if m < len(build.model.pressures()):
         say(f"{name}: fitted to the first {m} level(s), {table.pressures[0] * 1e3:.4g}-{table.pressures[-1] * 1e3:.4g}"
             f" kPa of the ramp's {len(build.model.pressures())} (up to {build.model.pressures()[-1] * 1e3:.4g} kPa), "

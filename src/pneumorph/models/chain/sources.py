@@ -309,6 +309,21 @@ class ServedTable:
                 f"{self.requested * 1e3:.4g} kPa")
 
 
+def limits_text(table: ChainTable) -> str:
+    """What a table served beyond its build's tolerance says of itself ('' for a table within it), e.g. ``its worst
+    held-out centre error 2.4 mm is above the tolerance 0.2 mm (...): the certificate's bound carries it``.
+
+    >>> limits_text(ChainTable.load(shipped_path("2d")))
+    ''
+    """
+    val = table.validation
+    if not val.get("beyond_tolerance"):
+        return ""
+    return (f"its worst held-out centre error {max(val['centre_worst_mm']):.3g} mm is above the tolerance "
+            f"{float(val.get('tolerance_mm', float('nan'))):g} mm ({val.get('wider', 'no wider window affordable')}): "
+            "the certificate's bound carries it")
+
+
 def _kept_tables(folder: str | Path | None, model: Any) -> list[Path]:
     """The shipped table of a model and the chain tables of its fidelity kept in ``folder`` (no tolerance tables)."""
     fidelity = str(getattr(model, "fidelity", ""))

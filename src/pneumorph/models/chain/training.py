@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from scipy import sparse
 from scipy.sparse.linalg import lsqr
 
+from pneumorph.errors import LocalityError
 from pneumorph.models.chain.terms import (
     end_terms,
     end_units,
@@ -177,4 +178,58 @@ def unfixed_error(designs: Sequence[str], window: int, alphabet: tuple[str, ...]
     return float(np.abs(fit[at].sum(axis=1) - truth[at].sum(axis=1)).max())
 
 
-__all__ = ["BATCH_FRACTION", "FIXED", "MAX_ADDED", "split_designs", "training_designs", "unfixed_error"]
+#: most covering designs a table over several unit types may ask for (the base windows alone need
+#: ``(2k)^(w+1) / 2``: 256 for 4 types at window +-2)
+MAX_TRAINING = 200
+
+
+def check_training_size(n_types: int, window: int, symmetric: int = 0, n_units: int | None = None) -> None:
+    """Refuse, before any solve, a window whose covering designs must be more than :data:`MAX_TRAINING`.
+
+    Two lower bounds count them: the base windows alone need ``(2k)^(w+1) / 2`` designs (one
+    each), and with ``n_units`` given, the interior windows ``(2k)^(2w+1) / 2`` patterns of
+    ``2w + 1`` units, ``n_units - 2w`` of them in each design (``2k - s`` for ``k`` types,
+    ``s`` of them symmetric; mirrored designs count once).
+
+    >>> check_training_size(2, 2)
+    >>> check_training_size(4, 2)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 256 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
+    >>> check_training_size(26, 1)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 26 unit types at window +-1 needs at least 1352 FE solves for
+    its base windows alone (at most 200, MAX_TRAINING); use at most 10 unit types
+    >>> check_training_size(4, 2, 1, n_units=15)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.LocalityError: a chain table over 4 unit types at window +-2 needs at least 764 FE solves of
+    15-unit designs for its interior windows (at most 200, MAX_TRAINING); use a window of +-1 or at most 3 unit types
+    """
+    def base(types: int, w: int) -> int:
+        return (2 * types - min(int(symmetric), types)) ** (w + 1) // 2
+
+    def interior(types: int, w: int) -> int:
+        if n_units is None or int(n_units) <= 2 * w:
+            return 0
+        return -(-((2 * types - min(int(symmetric), types)) ** (2 * w + 1) // 2) // (int(n_units) - 2 * w))
+
+    def need(types: int, w: int) -> int:
+        return max(base(types, w), interior(types, w))
+
+    n, w = int(n_types), int(window)
+    if n > 1 and need(n, w) > MAX_TRAINING:
+        most = max((t for t in range(1, n) if need(t, w) <= MAX_TRAINING), default=1)
+        advice = f"at most {most} unit types"
+        if w > 1 and need(n, 1) <= MAX_TRAINING:
+            advice = f"a window of +-1 or {advice}"
+        what = (f"{base(n, w)} FE solves for its base windows alone" if base(n, w) > MAX_TRAINING else
+                f"{interior(n, w)} FE solves of {n_units}-unit designs for its interior windows")
+        raise LocalityError(f"a chain table over {n} unit types at window +-{w} needs at least {what} (at most "
+                            f"{MAX_TRAINING}, MAX_TRAINING); use {advice}")
+
+
+__all__ = ["BATCH_FRACTION", "FIXED", "MAX_ADDED", "MAX_TRAINING", "check_training_size", "split_designs",
+           "training_designs", "unfixed_error"]
