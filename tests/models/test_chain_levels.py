@@ -100,3 +100,26 @@ def test_first_levels_refuses_levels_not_reached() -> None:
     assert levels_reached(r) == 1
     with pytest.raises(ChainTableError, match="reached 1 level"):
         first_levels(r, 2)
+
+
+@pytest.mark.slow
+def test_the_widest_affordable_table_is_served_with_its_errors_stated() -> None:
+    """The built-in library on 7 units: window +-2 needs at least 2801 covering solves, so +-1 is validated on
+    every held-out design (no stop above the tolerance) and returned with its errors, not refused."""
+    from pneumorph.models.chain.sources import limits_text
+    from pneumorph.models.chain.validation import prediction_errors
+    from pneumorph.models.factory import make_model
+
+    model = make_model(7, {"fidelity": "2d", "library": "builtin", "pressure_kpa": 10})
+    evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(":memory:"))
+    lines: list[str] = []
+    table = build_table(model, evaluator, tolerance=1e-6, heldout=6, on_progress=lines.append)
+    val = table.validation
+    assert table.window == 1 and val["beyond_tolerance"] is True and val["heldout_solved"] == 6
+    assert val["stopped_early"] == "" and "2801 FE solves of 7-unit designs" in val["wider"]
+    # the stated errors are the table's own against the six held-out FE responses
+    responses = [o.response for o in evaluator.evaluate_many(model, val["designs"])]  # from the cache
+    assert prediction_errors(table, responses)["centre_worst_mm"] == pytest.approx(val["centre_worst_mm"], abs=1e-12)
+    assert limits_text(table).startswith(f"its worst held-out centre error {max(val['centre_worst_mm']):.3g} mm is "
+                                         "above the tolerance 1e-06 mm")
+    assert any("window +-2: not tried" in line for line in lines)
