@@ -357,11 +357,11 @@ def tolerance_tables_for(model: Any, tolerance: Tolerance, folder: str | Path | 
     step, restricted: :func:`find_tolerance_tables`), or built now (cached) and kept.
 
     A build first says what it will build and its estimated time (:func:`tolerance_plan_text`),
-    and holds a lock on its file (:func:`~pneumorph.models.chain.sources.build_once`): another
+    and holds a lock on its file (:func:`~pneumorph.models.chain.building.build_once`): another
     process that needs the same tables waits for them and reuses them.
     """
     from pneumorph.models.chain.plan import evaluator_workers
-    from pneumorph.models.chain.sources import build_once
+    from pneumorph.models.chain.building import build_once
 
     found = find_tolerance_tables(model, tolerance, folder)
     if found is not None:

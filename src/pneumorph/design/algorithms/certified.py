@@ -93,7 +93,7 @@ class CertifiedSearch(Search):
             self.tables = tolerance_tables_for(problem.model, Tolerance(problem.config.tolerance),
                                                folder=problem.table_dir, evaluator=problem.evaluator,
                                                on_progress=problem.say)
-        entries = {"chain_table": table.fingerprint()}
+        entries: dict[str, Any] = {"chain_table": table.fingerprint()}
         if "restricted_from" in table.source:
             entries["chain_table_restricted_from"] = table.source["restricted_from"]
         if isinstance(cut := table.source.get("cut_from"), dict):  # the designs that failed, by name

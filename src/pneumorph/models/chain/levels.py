@@ -62,8 +62,8 @@ def first_levels(response: Response, levels: int) -> Response:
         raise ChainTableError(f"design {response.orientation} reached {have} level(s); {levels!r} asked for")
     if m == response.n_levels and response.converged:
         return response
-    cut = {name: None if getattr(response, name) is None else getattr(response, name)[:m].copy()
-           for name in ("pressures", "centres", "tip", "curl", "frames", "end_frame")}
+    cut: dict[str, Any] = {name: None if getattr(response, name) is None else getattr(response, name)[:m].copy()
+                           for name in ("pressures", "centres", "tip", "curl", "frames", "end_frame")}
     return replace(response, **cut, converged=True, reached=float(response.pressures[m - 1]), failure=None)
 
 
