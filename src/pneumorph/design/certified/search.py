@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.design.certified.bounds import ChainScores, chain_errors, objective_bounds, score_designs
-from pneumorph.design.certified.branching import MAX_ENUMERATE
+from pneumorph.design.certified.branching import MAX_ENUMERATE, MAX_NODES
 from pneumorph.design.certified.planegrowth import best_scores, chain_scores, designs_of, enumerable, grow_designs
 from pneumorph.design.certified.prefixes import ChainGeometry, chain_geometry
 from pneumorph.design.certified.spacegrowth import space_scores
@@ -111,6 +111,7 @@ def certified_search(
     on_progress: Callable[[str], None] | None = None,
     max_failures: int = 4,
     epsilon: float = 0.0,
+    max_nodes: int = MAX_NODES,
 ) -> CertifiedResult:
     """Score every design with the chain, verify the best with FE, and bound the rest.
 
@@ -139,6 +140,9 @@ def certified_search(
         Certify within ``epsilon`` (the objective's units): designs that could beat the winner
         by at most ``epsilon`` are *tied* - counted in the certificate, not verified - and
         the winner is certified when no other design can beat it by more.
+    max_nodes : int
+        Open prefixes the branch-and-bound keeps at most (the best, when more stay open; the
+        certificate's floor then bounds the rest): fewer for a table whose errors prune little.
 
     Raises
     ------
@@ -156,7 +160,7 @@ def certified_search(
         objective = replace(objective, length=chain.length)
     if not enumerable(chain, MAX_ENUMERATE):  # a branch-and-bound: a tip goal over sideways units takes a minute
         say(f"chain: scoring {designs_of(chain):,.0f} designs (branch-and-bound) ...")
-    scores = chain_scores(chain, objective, margin)
+    scores = chain_scores(chain, objective, margin, max_nodes=max_nodes)
     order = scores.order()
     designs = chain.table.texts(scores.bits[order])
     say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "
