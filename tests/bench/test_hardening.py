@@ -76,7 +76,7 @@ def test_a_unit_beyond_the_limits_is_refused_with_its_estimate_before_any_job(cl
     r = _upload(client, "[unit]\npitch = 1e4\n")  # passed every check before, then grew 150 MB/s
     assert r.status_code == 422
     assert _error(r)["field"] == "unit" and "MAX_LENGTH_MM" in _error(r)["message"]
-    r = _upload(client, "[unit]\npitch = 400.0\n")  # within the lengths, but its mesh is not
+    r = _upload(client, "[unit]\npitch = 240.0\n")  # within the lengths and castable, but its mesh is not
     err = _error(r)
     assert r.status_code == 422 and err["field"] == "unit"
     assert "nodes" in err["message"] and "GB" in err["message"] and "MAX_NODES_3D" in err["message"]

@@ -69,14 +69,14 @@ def test_an_answer_whose_floor_is_below_the_winners_worst_case_is_not_called_cer
         bench: Bench, monkeypatch: pytest.MonkeyPatch) -> None:
     """A branch-and-bound that had to drop open prefixes bounds them by its floor; below the winner's worst case
     an unlisted design could still beat it, and the certificate says so."""
-    real = answer_module.best_scores
+    real = answer_module.space_scores  # a chain in space: within the query's budget of open prefixes
 
-    def dropped(chain, objective, top=10):  # type: ignore[no-untyped-def]
-        s = real(chain, objective, top=top)
+    def dropped(chain, objective, **options):  # type: ignore[no-untyped-def]
+        s = real(chain, objective, **options)
         best = int(s.order()[0])
         return replace(s, floor=float(s.cost[best] + s.bound[best]) - 0.25)
 
-    monkeypatch.setattr(answer_module, "best_scores", dropped)
+    monkeypatch.setattr(answer_module, "space_scores", dropped)
     a = bench.compute(bench.parse(HELIX))
     assert not a["certificate"]["certified"]
     statement = a["certificate"]["statement"]
