@@ -108,3 +108,33 @@ def test_a_spatial_tip_query_stays_within_a_workers_memory() -> None:
     assert out["winner"]["design"] == "lLlLlLlLlLlLlLl" and out["winner"]["value"] == pytest.approx(196.3135, abs=1e-3)
     assert out["winner"]["pressure_kpa"] == pytest.approx(45.0)
     assert out["certificate"]["certified"] is False and "Not certified" in out["certificate"]["statement"]
+
+
+def test_a_table_fitted_to_fewer_levels_remakes_the_benchs_model(tmp_path: Path) -> None:
+    """A table built to the levels every design reached serves its unit's model at those levels, the FE model
+    (of the verifications) remade with them."""
+    from dataclasses import replace
+
+    from pneumorph.bench.answer import Bench
+    from pneumorph.geometry.unit import UnitSpec
+    from pneumorph.models.chain.levels import ramp_source
+    from pneumorph.models.chain.model import ChainTable, source_description, source_key
+    from pneumorph.models.chain.sources import restrict_table, shipped_path, table_file
+    from pneumorph.models.factory import make_model
+
+    spec = UnitSpec(layer=2.5)
+    full = make_model(15, {"fidelity": "2d", "unit": spec.to_dict()})
+    shipped = ChainTable.load(shipped_path("2d"))
+    description = source_description(full)
+    own = replace(shipped, source={**shipped.source, "key": source_key(full), "description": description})
+    cut = restrict_table(own, 6)  # its entries: the first 6 levels, its source the ramp of those levels
+    source = ramp_source(own.source, own.pressures, 6, cut_from={
+        "key": source_key(full), "levels": 10, "pressure_mpa": 0.045, "why": "every design reached (1 did not "
+        "converge beyond)", "failed": {"0" * 15: 6}})
+    replace(cut, source={k: v for k, v in source.items() if k != "restricted_from"}).save(
+        table_file(tmp_path, full))
+    bench = Bench(table_dir=tmp_path)
+    unit = bench.add_unit(spec)
+    model = bench.model("2d", unit)
+    assert model.ramp.steps.increments == 6 and model.ramp.pressure == pytest.approx(0.027)
+    assert bench.chain("2d", unit).table.n_levels == 6

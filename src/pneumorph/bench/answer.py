@@ -32,8 +32,8 @@ from pneumorph.design.objectives.targets import StagedTarget, TipGoal
 from pneumorph.errors import PneumorphError, SearchConfigError
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import atomic_write_text
-from pneumorph.models.chain.model import ChainModel
-from pneumorph.models.chain.sources import find_table
+from pneumorph.models.chain.model import ChainModel, ChainTable
+from pneumorph.models.chain.sources import cut_from, find_table, served_as_built
 from pneumorph.models.chain.windows import design_numbers
 from pneumorph.models.factory import make_model
 
@@ -87,6 +87,7 @@ class Bench:
         self.unit_dir = None if unit_dir is None else Path(unit_dir)
         self._specs: dict[str, UnitSpec] = {BUILTIN: UnitSpec()}
         self._models: dict[tuple[str, str], Any] = {}
+        self._cut: dict[tuple[str, str], ChainTable] = {}  # tables fitted to fewer levels than the ramp, by model
         self._chains: dict[tuple[str, str], ChainModel] = {}
         self._memo: OrderedDict[str, dict[str, Any]] = OrderedDict()
         self._memo_size = int(memo)
@@ -171,10 +172,17 @@ class Bench:
         return settings
 
     def model(self, fidelity: str, unit: str = BUILTIN) -> Any:
-        """The FE model of a fidelity and unit, as ``pneumorph design --model <fidelity>`` builds it."""
+        """The FE model of a fidelity and unit, as ``pneumorph design --model <fidelity>`` builds it; remade with the
+        levels of its chain table when the table was fitted to those every design reached
+        (:func:`~pneumorph.models.chain.sources.served_as_built`), so that verifications report the chain's levels."""
         with self._lock:
             if (fidelity, unit) not in self._models:
-                self._models[fidelity, unit] = make_model(self.units, self.model_settings(fidelity, unit))
+                made = make_model(self.units, self.model_settings(fidelity, unit))
+                table = find_table(made, self.table_dir)
+                if table is not None and cut_from(table, made):
+                    made = served_as_built(table, made).model
+                    self._cut[fidelity, unit] = table
+                self._models[fidelity, unit] = made
             return self._models[fidelity, unit]
 
     def chain(self, fidelity: str, unit: str = BUILTIN) -> ChainModel:
@@ -190,7 +198,9 @@ class Bench:
         model = self.model(fidelity, unit)
         with self._lock:
             if (fidelity, unit) not in self._chains:
-                table = find_table(model, self.table_dir)
+                table = self._cut.get((fidelity, unit)) or find_table(model, self.table_dir)
+                if table is not None and cut_from(table, model):  # built since the model was made
+                    self._models[fidelity, unit] = served_as_built(table, model).model
                 if table is None and unit == BUILTIN and self.settings:
                     raise QueryError("model", f"no chain table for the {fidelity} model of the served model file "
                                               f"yet; build it once with `pneumorph design --model-file FILE --model "
