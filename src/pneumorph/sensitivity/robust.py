@@ -360,8 +360,8 @@ def tolerance_tables_for(model: Any, tolerance: Tolerance, folder: str | Path | 
     and holds a lock on its file (:func:`~pneumorph.models.chain.building.build_once`): another
     process that needs the same tables waits for them and reuses them.
     """
-    from pneumorph.models.chain.plan import evaluator_workers
     from pneumorph.models.chain.building import build_once
+    from pneumorph.models.chain.plan import evaluator_workers
 
     found = find_tolerance_tables(model, tolerance, folder)
     if found is not None:

@@ -110,8 +110,7 @@ def certified_search(
     max_verify: int = 200,
     on_progress: Callable[[str], None] | None = None,
     max_failures: int = 4,
-    epsilon: float = 0.0,
-    max_nodes: int = MAX_NODES,
+    epsilon: float = 0.0, max_nodes: int = MAX_NODES,
 ) -> CertifiedResult:
     """Score every design with the chain, verify the best with FE, and bound the rest.
 
@@ -141,8 +140,7 @@ def certified_search(
         by at most ``epsilon`` are *tied* - counted in the certificate, not verified - and
         the winner is certified when no other design can beat it by more.
     max_nodes : int
-        Open prefixes the branch-and-bound keeps at most (the best, when more stay open; the
-        certificate's floor then bounds the rest): fewer for a table whose errors prune little.
+        Open prefixes a branch-and-bound keeps at most (the floor bounds the rest).
 
     Raises
     ------
