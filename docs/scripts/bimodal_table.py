@@ -23,7 +23,7 @@ from pneumorph.bimodal.figures import plot_outlines, plot_tip_paths
 from pneumorph.bimodal.geometry import BimodalSpec
 from pneumorph.bimodal.model import BimodalModel, BimodalResult, bilinear_material
 from pneumorph.bimodal.switch import find_switch
-from pneumorph.cli.bilinear.bimodal import bulk_from_poisson
+from pneumorph.bimodal.model import bulk_from_poisson
 from pneumorph.materials import get
 
 DOCS = Path(__file__).resolve().parents[1]
