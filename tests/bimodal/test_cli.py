@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from pneumorph.cli import main
 from pneumorph.bimodal.model import bulk_from_poisson
+from pneumorph.cli import main
 
 
 def test_json_run(tmp_path, capsys) -> None:

@@ -195,9 +195,10 @@ class BimodalModel:
         is an output, so the ramp follows a wall that balloons past the pressure's maximum
         (:class:`~pneumorph.fem.fast.volume.VolumeControl`). None: the pressure is ramped.
     composite : {"fibre", "homogenised"}
-        ``"fibre"`` (default): the Ecoflex 0030 matrix with the crimped paper along the actuator
-        (:func:`~pneumorph.bimodal.paper.paper_composite`); ``"homogenised"``: the Table B.1
-        Ogden material of the crimp ratio, isotropic (the dissertation's model).
+        ``"fibre"`` (default): the Ecoflex 0030 matrix (or ``materials["bilinear"]``) with the
+        crimped paper along the actuator (:func:`~pneumorph.bimodal.paper.paper_composite`);
+        ``"homogenised"``: the Table B.1 Ogden material of the crimp ratio, isotropic (the
+        dissertation's model). Without a crimp ratio the layer is ``materials["bilinear"]`` alone.
 
     Examples
     --------
@@ -260,15 +261,14 @@ class BimodalModel:
             checks.integer(value, name, low, 1000)
         if composite not in COMPOSITES:
             raise SettingsError(f"composite must be one of {', '.join(COMPOSITES)}, got {composite!r}")
-        if composite == "fibre" and crimp_ratio is None:
-            raise SettingsError("the fibre composite needs a crimp ratio")
-        self.composite = composite
+        # without a crimp ratio there is no paper: the layer is the named material alone
+        self.composite = composite if crimp_ratio is not None else "homogenised"
         self.spec = spec or BimodalSpec()
         self.crimp_ratio = crimp_ratio
         names = {"bilinear": None, "seal": "mold_star_15", "body": "mold_star_15", "strip": "smooth_sil_950"}
         if crimp_ratio is not None:  # Table B.1 knows the crimp ratio, also for the fibre law's matrix
             names["bilinear"] = bilinear_material(crimp_ratio)
-            if composite == "fibre":
+            if self.composite == "fibre":
                 names["bilinear"] = MATRIX
         unknown = set(materials or {}) - set(names)
         if unknown:
