@@ -328,7 +328,7 @@ class BimodalModel:
             umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name), mixed=mixed)
             if code == BILINEAR and self.composite == "fibre":  # the paper along the actuator, the layer's thickness
                 umat = paper_composite(float(self.crimp_ratio or 0.0), thickness=self.spec.bilinear,
-                                       matrix=self.names[name], paper=PAPER, bulk=self.bulk(name), mixed=mixed)
+                                       matrix=str(self.names[name]), paper=PAPER, bulk=self.bulk(name), mixed=mixed)
             regions.append((name, mesh.label == code, umat))
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
                                 mesh.symmetry_points)
