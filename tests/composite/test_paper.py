@@ -66,3 +66,15 @@ def test_bad_layers() -> None:
         paper_composite(-0.2)
     with pytest.raises(CrimpError):
         paper_composite(0.2, paper="mold_star_15")
+    with pytest.raises(CrimpError):
+        paper_composite(0.2, transition=0.01)  # inside the blend
+
+
+def test_a_measured_transition_strain() -> None:
+    """Table 3.2's measured 15.2 % for CR 0.2 in place of the analytic 28.1 %: the paper straightens there and its
+    slope is the straight paper's over that length, E t / (H 1.152)."""
+    law = paper_composite(0.2, transition=0.152)
+    assert law.straight == pytest.approx(1.152, rel=1e-12)
+    assert law.slope == pytest.approx(6500.0 * 0.107 / (5.0 * 1.152), rel=1e-3)
+    stress = uniaxial_stress(law, [1.12, 1.25]) - uniaxial_stress(paper_composite(0.3), [1.12, 1.25])
+    np.testing.assert_allclose(stress, [0.0, law.slope * (1.25 - 1.152)], rtol=1e-9, atol=1e-12)

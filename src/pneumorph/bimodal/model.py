@@ -199,6 +199,9 @@ class BimodalModel:
         crimped paper along the actuator (:func:`~pneumorph.bimodal.paper.paper_composite`);
         ``"homogenised"``: the Table B.1 Ogden material of the crimp ratio, isotropic (the
         dissertation's model). Without a crimp ratio the layer is ``materials["bilinear"]`` alone.
+    transition : float, optional
+        With ``composite="fibre"``: the paper's straightening strain instead of the crimp's
+        analytic one (e.g. Table 3.2's measured transition strain).
 
     Examples
     --------
@@ -243,6 +246,7 @@ class BimodalModel:
         backend: str = "fast",
         volume: float | None = None,
         composite: str = "fibre",
+        transition: float | None = None,
     ) -> None:
         pmax = checks.real(pmax, "pmax", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                            limit="MAX_PRESSURE_KPA")
@@ -263,6 +267,8 @@ class BimodalModel:
             raise SettingsError(f"composite must be one of {', '.join(COMPOSITES)}, got {composite!r}")
         # without a crimp ratio there is no paper: the layer is the named material alone
         self.composite = composite if crimp_ratio is not None else "homogenised"
+        self.transition = None if transition is None else checks.real(transition, "transition", 0.0, 10.0,
+                                                                      low_open=True)
         self.spec = spec or BimodalSpec()
         self.crimp_ratio = crimp_ratio
         names = {"bilinear": None, "seal": "mold_star_15", "body": "mold_star_15", "strip": "smooth_sil_950"}
@@ -312,6 +318,7 @@ class BimodalModel:
             "element": "hexahedron20",
             "composite": self.composite if self.composite == "homogenised" else
             f"fibre: {self.names['bilinear']} with {PAPER} along x",
+            "paper_transition": self.transition,
             "control": "pressure" if self.volume is None else f"volume (V/V0 - 1 = {self.volume:g} at the end)",
         }
 
@@ -328,7 +335,8 @@ class BimodalModel:
             umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name), mixed=mixed)
             if code == BILINEAR and self.composite == "fibre":  # the paper along the actuator, the layer's thickness
                 umat = paper_composite(float(self.crimp_ratio or 0.0), thickness=self.spec.bilinear,
-                                       matrix=str(self.names[name]), paper=PAPER, bulk=self.bulk(name), mixed=mixed)
+                                       matrix=str(self.names[name]), paper=PAPER, bulk=self.bulk(name), mixed=mixed,
+                                       transition=self.transition)
             regions.append((name, mesh.label == code, umat))
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
                                 mesh.symmetry_points)

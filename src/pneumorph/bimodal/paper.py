@@ -42,7 +42,7 @@ BLEND = 0.02
 def paper_composite(crimp_ratio: float, thickness: float = THICKNESS, amplitude: float = AMPLITUDE,
                     matrix: str = "ecoflex_0030", paper: str = "paper_purco_80gsm", bulk: float | None = None,
                     direction: ArrayLike = (1.0, 0.0, 0.0), blend: float = BLEND,
-                    mixed: bool = False) -> CrimpedFibreOgden:
+                    mixed: bool = False, transition: float | None = None) -> CrimpedFibreOgden:
     """The 3D law of a composite layer of crimp ratio ``CR``: Ogden matrix and crimped paper along ``direction``.
 
     Parameters
@@ -62,6 +62,9 @@ def paper_composite(crimp_ratio: float, thickness: float = THICKNESS, amplitude:
         Half-width of the slack-to-taut blend in stretch.
     mixed : bool
         Integrate the matrix's volumetric term on the elements' dilatation (nearly incompressible).
+    transition : float, optional
+        The paper's straightening strain instead of the crimp's analytic ``2 s / lambda - 1``
+        (e.g. a measured transition strain, Table 3.2).
 
     Raises
     ------
@@ -80,7 +83,9 @@ def paper_composite(crimp_ratio: float, thickness: float = THICKNESS, amplitude:
     if not (np.isfinite(thickness) and thickness > 2.0 * amplitude):
         raise CrimpError(f"the layer ({thickness!r} mm) must be thicker than the crimp height "
                          f"2A = {2 * amplitude:g} mm")
-    straight = straight_stretch(_positive_ratio(crimp_ratio))
+    straight = straight_stretch(_positive_ratio(crimp_ratio)) if transition is None else 1.0 + float(transition)
+    if not (np.isfinite(straight) and straight > 1.0 + blend):
+        raise CrimpError(f"the transition strain must exceed the blend {blend:g}, got {transition!r}")
     m = pm.get(matrix)
     if not isinstance(m.model, Ogden):
         raise CrimpError(f"the matrix {matrix!r} must have an Ogden model, it has {type(m.model).__name__}")
