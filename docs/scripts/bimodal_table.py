@@ -1,12 +1,16 @@
 """Regenerate the bimodal-actuator table and figures of docs/bimodal.md.
 
-Runs the 3D model for the three crimp ratios, each with the library's assumed bulk modulus
-of the composite and with a nearly incompressible composite (nu = 0.495), one process, one
-run after the other; every run's result is kept as JSON in ``--out`` and reused when the
-script is started again (delete the file to re-run it). Figures go to docs/figures/.
+Runs the 3D model for the three crimp ratios, each with the composite's variants: the Ecoflex
+matrix with the crimped paper as fibres (``fibre``, the default model), and the Table B.1
+homogeneous material with a nearly incompressible composite (``homogenised``, nu = 0.495) or
+the library's assumed bulk modulus (``library``); one process, one run after the other;
+every run's result is kept as JSON in ``--out`` and reused when the script is started again
+(delete the file to re-run it). Figures go to docs/figures/. The ramp drives the voids'
+volume (``--control volume``, the default) or the pressure.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/bimodal_table.py [--voids 15]
         [--element-size 2.5] [--pmax 60] [--end-cap 0] [--max-cutbacks N] [--max-iterations N]
+        [--control volume] [--volume-change 8] [--variants fibre homogenised]
         [--out /tmp/bimodal-runs] [--only 0.2] [--tag=-v5]
 """
 
@@ -21,13 +25,15 @@ import numpy as np
 
 from pneumorph.bimodal.figures import plot_outlines, plot_tip_paths
 from pneumorph.bimodal.geometry import BimodalSpec
-from pneumorph.bimodal.model import BimodalModel, BimodalResult, bilinear_material
+from pneumorph.bimodal.model import BimodalModel, BimodalResult, bilinear_material, bulk_from_poisson
 from pneumorph.bimodal.switch import find_switch
-from pneumorph.cli.bilinear.bimodal import bulk_from_poisson
 from pneumorph.materials import get
 
 DOCS = Path(__file__).resolve().parents[1]
-VARIANTS = {"nu0495": 0.495, "library": None}
+#: variant: (composite model, the composite's Poisson's ratio or None for the library's bulk modulus, label)
+VARIANTS = {"fibre": ("fibre", None, "paper as fibres"),
+            "homogenised": ("homogenised", 0.495, "homogenised, nu = 0.495"),
+            "library": ("homogenised", None, "homogenised, library K")}
 
 
 def station_from_outline(outline: np.ndarray, spec: dict) -> np.ndarray:
@@ -50,15 +56,17 @@ def load(path: Path) -> BimodalResult:
                          station_switch=find_switch(p, station[:, 1]))
 
 
-def run(cr: float, nu: float | None, args: argparse.Namespace, path: Path) -> BimodalResult:
+def run(cr: float, variant: str, args: argparse.Namespace, path: Path) -> BimodalResult:
     if path.exists():
         return load(path)
+    composite, nu, _ = VARIANTS[variant]
     bulk = None if nu is None else bulk_from_poisson(get(bilinear_material(cr)).shear_modulus, nu)
     spec = BimodalSpec(voids=args.voids, element_size=args.element_size, end_cap=args.end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=args.pmax / 1e3, bilinear_bulk=bulk,
-                         max_cutbacks=args.max_cutbacks, max_iterations=args.max_iterations)
+                         max_cutbacks=args.max_cutbacks, max_iterations=args.max_iterations, composite=composite,
+                         volume=args.volume_change if args.control == "volume" else None)
     t0 = time.perf_counter()
-    print(f"CR {cr} nu {nu}: ", end="", flush=True)
+    print(f"CR {cr} {variant}: ", end="", flush=True)
     r = model.solve(on_level=lambda k, p, v: print(f"{1e3 * p:g}:{v:+.2f} ", end="", flush=True))
     print(f"({time.perf_counter() - t0:.0f} s)", flush=True)
     d = r.to_dict()
@@ -75,24 +83,26 @@ def main() -> None:
     ap.add_argument("--end-cap", type=float, default=0.0)
     ap.add_argument("--max-cutbacks", type=int, default=BimodalModel.default_max_cutbacks)
     ap.add_argument("--max-iterations", type=int, default=BimodalModel.default_max_iterations)
+    ap.add_argument("--control", choices=["volume", "pressure"], default="volume")
+    ap.add_argument("--volume-change", type=float, default=8.0)
     ap.add_argument("--out", type=Path, default=Path("/tmp/bimodal-runs"))
     ap.add_argument("--only", type=float, nargs="*", default=None, help="crimp ratios to run")
     ap.add_argument("--variants", nargs="*", default=list(VARIANTS), choices=list(VARIANTS),
-                    help="composite bulk moduli to run")
+                    help="composite models to run")
     ap.add_argument("--tag", default="", help="suffix of the figure names (e.g. for reduced models)")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     ratios = args.only or [0.2, 0.25, 0.3]
     stem = (f"v{args.voids}-h{args.element_size:g}-p{args.pmax:g}-cap{args.end_cap:g}"
-            f"-c{args.max_cutbacks}-i{args.max_iterations}")
+            f"-c{args.max_cutbacks}-i{args.max_iterations}-{args.control}"
+            + (f"{args.volume_change:g}" if args.control == "volume" else ""))
     rows = []
     for cr in ratios:
         runs = []
-        for key, nu in VARIANTS.items():
+        for key, (_, _, label) in VARIANTS.items():
             if key not in args.variants:
                 continue
-            r = run(cr, nu, args, args.out / f"{stem}-cr{cr:g}-{key}.json")
-            label = "nu = 0.495" if nu is not None else "library K"
+            r = run(cr, key, args, args.out / f"{stem}-cr{cr:g}-{key}.json")
             runs.append((label, r))
             s, ss = r.switch, r.station_switch
             m = r.metadata
@@ -103,7 +113,8 @@ def main() -> None:
                 f"{'none' if s.switch is None else f'{1e3 * s.switch:.1f}'} | "
                 f"{'-' if ss.turning is None else f'{1e3 * ss.turning:g} ({ss.peak:+.2f} mm)'} | "
                 f"{'none' if ss.switch is None else f'{1e3 * ss.switch:.1f}'} | "
-                f"{r.tip[:, 1].max():+.2f} / {r.tip[:, 1].min():+.2f} | {m['dofs']:,} | {m['wall_time_s']:.0f} |"
+                f"{r.tip[:, 1].max():+.2f} / {r.tip[:, 1].min():+.2f} | {1e3 * r.pressures.max():.1f} | "
+                f"{m['dofs']:,} | {m['wall_time_s']:.0f} |"
             )
         tag = f"cr{cr:g}".replace(".", "_") + args.tag
         plot_tip_paths(runs, title=f"Bimodal actuator, CR {cr:g} ({args.voids} voids)",
@@ -111,9 +122,10 @@ def main() -> None:
         best = max(runs, key=lambda lr: len(lr[1].pressures))[1]
         plot_outlines(best, title=f"Mid-plane outline, CR {cr:g} ({args.voids} voids)",
                       path=DOCS / "figures" / f"bimodal-{tag}-shape.png")
-    print("| CR | composite bulk modulus | last converged (kPa) | tip turns back at (kPa) | tip switch (kPa) "
-          "| station turns back at (kPa) | station switch (kPa) | tip max / min u_y (mm) | dofs | time (s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| CR | composite (its bulk modulus) | last converged (kPa) | tip turns back at (kPa) | tip switch (kPa) "
+          "| station turns back at (kPa) | station switch (kPa) | tip max / min u_y (mm) | pressure max (kPa) "
+          "| dofs | time (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     print("\n".join(rows))
 
 

@@ -6,8 +6,8 @@ import json
 
 import pytest
 
+from pneumorph.bimodal.model import bulk_from_poisson
 from pneumorph.cli import main
-from pneumorph.cli.bilinear.bimodal import bulk_from_poisson
 
 
 def test_json_run(tmp_path, capsys) -> None:
@@ -17,7 +17,9 @@ def test_json_run(tmp_path, capsys) -> None:
     assert code == 0
     d = json.loads(capsys.readouterr().out)
     assert d["pressures_kpa"] == [5.0] and d["completed"]
-    assert d["metadata"]["model"]["materials"]["bilinear"] == "bilinear_0_3"
+    # the default composite: the Ecoflex matrix with the paper along the actuator
+    assert d["metadata"]["model"]["materials"]["bilinear"] == "ecoflex_0030"
+    assert d["metadata"]["model"]["composite"].startswith("fibre")
     assert {p.split("/")[-1] for p in d["files"]} == {"bimodal-cr0_3.json", "bimodal-cr0_3-tip.png",
                                                       "bimodal-cr0_3-shape.png"}
 
@@ -37,6 +39,20 @@ def test_text_run_says_where_its_files_went(tmp_path, capsys) -> None:
     assert code == 0
     assert capsys.readouterr().out.splitlines()[-1] == (
         f"written to {tmp_path / 'b'}/ (bimodal-cr0_3.json, bimodal-cr0_3-tip.png, bimodal-cr0_3-shape.png)")
+
+
+def test_homogenised_composite_and_its_poisson_ratio(capsys) -> None:
+    """``--composite homogenised`` is the Table B.1 material; ``--bilinear-nu`` sets the bulk modulus of the
+    composite's own material: K = 2 mu0 (1 + nu) / (3 (1 - 2 nu)) of Table B.1's or of the Ecoflex matrix's mu0."""
+    from pneumorph.materials import get
+
+    base = ["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
+            "--json", "--bilinear-nu", "0.45"]
+    for composite, material in (("homogenised", "bilinear_0_2"), ("fibre", "ecoflex_0030")):
+        assert main([*base, "--composite", composite]) == 0
+        m = json.loads(capsys.readouterr().out)["metadata"]["model"]
+        assert m["materials"]["bilinear"] == material
+        assert m["bulk_moduli_kpa"]["bilinear"] == pytest.approx(1e3 * get(material).shear_modulus * 2 * 1.45 / 0.3)
 
 
 def test_bad_crimp_ratio(capsys) -> None:

@@ -7,7 +7,7 @@ import pytest
 
 from pneumorph.bimodal.geometry import BimodalSpec
 from pneumorph.bimodal.model import BimodalModel, bilinear_material
-from pneumorph.errors import UnknownMaterialError
+from pneumorph.errors import SettingsError, UnknownMaterialError
 from pneumorph.materials import drucker_stability, get
 
 TINY = BimodalSpec(voids=3, element_size=5.0)
@@ -48,7 +48,27 @@ def test_bulk_modulus_override() -> None:
     m = BimodalModel(TINY, crimp_ratio=0.2, bilinear_bulk=5.0)
     assert m.bulk("bilinear") == 5.0
     assert m.bulk("body") == get("mold_star_15").bulk_modulus.value
-    assert BimodalModel(TINY, crimp_ratio=0.2).bulk("bilinear") == get("bilinear_0_2").bulk_modulus.value
+    # the fibre composite's matrix is Ecoflex 0030; the homogenised composite is Table B.1's material
+    assert BimodalModel(TINY, crimp_ratio=0.2).bulk("bilinear") == get("ecoflex_0030").bulk_modulus.value
+    assert BimodalModel(TINY, crimp_ratio=0.2, composite="homogenised").bulk("bilinear") == get(
+        "bilinear_0_2").bulk_modulus.value
+
+
+def test_slack_paper_leaves_the_ecoflex_alone() -> None:
+    """Below the crimp's straightening (28 % for CR 0.2) the paper carries nothing: the fibre composite's actuator
+    is the one with a plain Ecoflex 0030 layer, and both differ from the homogenised Table B.1 layer."""
+    spec = BimodalSpec(voids=1, element_size=5.0)
+    fibre = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005).solve()
+    plain = BimodalModel(spec, crimp_ratio=None, pmax=0.005, materials={"bilinear": "ecoflex_0030"}).solve()
+    homogenised = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005, composite="homogenised").solve()
+    np.testing.assert_allclose(fibre.tip, plain.tip, rtol=1e-9, atol=1e-12)
+    assert abs(fibre.tip[0, 1] - homogenised.tip[0, 1]) > 0.05 * abs(homogenised.tip[0, 1])
+    assert fibre.metadata["model"]["composite"].startswith("fibre")
+
+
+def test_unknown_composite() -> None:
+    with pytest.raises(SettingsError, match="rebar"):
+        BimodalModel(TINY, composite="rebar")
 
 
 def test_only_table_b1_crimp_ratios() -> None:

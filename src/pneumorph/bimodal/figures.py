@@ -55,14 +55,14 @@ def plot_tip_paths(
         s = r.switch
         extra = []
         if s.turning is not None:
-            extra.append(f"turns at {1e3 * s.turning:g} kPa")
+            extra.append(f"turns at {1e3 * s.turning:.3g} kPa")
         extra.append(f"switch {1e3 * s.switch:.1f} kPa" if s.switch is not None else "no switch")
         if not r.completed:
             extra.append(f"ramp ends at {p[-1]:g} kPa")
         full = f"{label}: " + ", ".join(extra)
         ax.plot(v, u, "o-", color=c, ms=3.5, lw=1.2, label=full)
         for vi, ui, pi in zip(v[1:], u[1:], p[1:], strict=False):
-            ax.annotate(f"{pi:g}", (vi, ui), textcoords="offset points", xytext=(4, 2), fontsize=6, color=c)
+            ax.annotate(f"{pi:.3g}", (vi, ui), textcoords="offset points", xytext=(4, 2), fontsize=6, color=c)
         ax2.plot(p, v, "o-", color=c, ms=3.5, lw=1.2, label=label)
         if s.switch is not None:
             ax2.axvline(1e3 * s.switch, color=c, ls=":", lw=1, label=f"{label}: switch at {1e3 * s.switch:.1f} kPa")

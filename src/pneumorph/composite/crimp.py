@@ -121,8 +121,10 @@ def limit_transition_strain(amplitude: float, wavelength: float) -> float:
     >>> round(100 * limit_transition_strain(1.5, 7.5), 2)
     28.06
     """
-    lam = _check_positive("wavelength lambda", wavelength)
-    return 2.0 * flute_length(amplitude, lam) / lam - 1.0
+    from pneumorph.fem.fibre import straight_stretch  # the crimp ratio's straightening stretch, 2 s / lambda
+
+    a = _check_positive("amplitude A", amplitude)
+    return straight_stretch(a / _check_positive("wavelength lambda", wavelength)) - 1.0
 
 
 @dataclass(frozen=True)

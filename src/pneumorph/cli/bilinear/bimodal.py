@@ -20,19 +20,6 @@ from pneumorph.io.files import all_or_nothing, strict_json, write_json
 DEFAULT_VOLUME_CHANGE = 8.0
 
 
-def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
-    """Small-strain bulk modulus ``K = 2 mu (1 + nu) / (3 (1 - 2 nu))`` (same unit as mu).
-
-    Examples
-    --------
-    >>> round(bulk_from_poisson(1.0, 0.495), 4)
-    99.6667
-    """
-    if not -1.0 < nu < 0.5:
-        raise click.BadParameter(f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
-    return 2.0 * shear_modulus * (1.0 + nu) / (3.0 * (1.0 - 2.0 * nu))
-
-
 @click.command("bimodal")
 @click.option("--crimp-ratio", "-c", type=click.Choice(["0.2", "0.25", "0.3"]), required=True,
               help="Crimp ratio of the bilinear composite (Table B.1).")
@@ -42,9 +29,12 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
 @click.option("--element-size", type=P.POSITIVE_MM, default=2.5, show_default=True, help="Target element edge in mm.")
 @click.option("--end-cap", type=P.Real(0.0, 1e4, unit="mm"), default=0.0, show_default=True,
               help="Extra solid beyond the last void in mm (the free end wall is 1.5 mm + this).")
+@click.option("--composite", type=click.Choice(["fibre", "homogenised"]), default="fibre", show_default=True,
+              help="The composite: the Ecoflex matrix with the crimped paper along the actuator, or the "
+                   "Table B.1 homogeneous Ogden material (isotropic, the dissertation's model).")
 @click.option("--bilinear-nu", type=P.Real(-1.0, 0.5, low_open=True, high_open=True), default=None,
-              help="Small-strain Poisson's ratio of the composite, sets its bulk modulus "
-                   "[default: the library's assumed bulk modulus].")
+              help="Small-strain Poisson's ratio of the composite (with --composite fibre: of its matrix), sets "
+                   "its bulk modulus [default: the library's assumed bulk modulus].")
 @click.option("--max-cutbacks", type=P.Count(0, 60), default=None,
               help="Halvings of a step that does not converge before the ramp ends there "
                    "[default: the model's own, shown in the --json metadata].")
@@ -62,7 +52,8 @@ def bulk_from_poisson(shear_modulus: float, nu: float) -> float:
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
 def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
             bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
-            as_json: bool, quiet: bool, control: str = "volume", volume_change: float = DEFAULT_VOLUME_CHANGE) -> None:
+            as_json: bool, quiet: bool, control: str = "volume", volume_change: float = DEFAULT_VOLUME_CHANGE,
+            composite: str = "fibre") -> None:
     """3D FE of the bimodal actuator: tip displacement in volume or pressure steps, switch pressure.
 
     Volume control (default) follows the pressure past its maximum where a wall balloons and
@@ -70,7 +61,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     pressure that converges.
     """
     from pneumorph.bimodal.geometry import BimodalSpec
-    from pneumorph.bimodal.model import BimodalModel, bilinear_material
+    from pneumorph.bimodal.model import MATRIX, BimodalModel, bilinear_material, bulk_from_poisson
     from pneumorph.materials import get
 
     n = round(pmax / step)
@@ -81,7 +72,8 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     cr = float(crimp_ratio)
     bulk = None
     if bilinear_nu is not None:
-        bulk = bulk_from_poisson(get(bilinear_material(cr)).shear_modulus, bilinear_nu)
+        matrix = MATRIX if composite == "fibre" else bilinear_material(cr)
+        bulk = bulk_from_poisson(get(matrix).shear_modulus, bilinear_nu)
     for option, field, value in (("--voids", "voids", voids), ("--element-size", "element_size", element_size),
                                  ("--end-cap", "end_cap", end_cap)):
         with P.blame(option):
@@ -90,7 +82,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations,  # None: the model's own
-                         volume=volume_change if control == "volume" else None)
+                         volume=volume_change if control == "volume" else None, composite=composite)
 
     from pneumorph.io.progress import Progress
 
@@ -123,7 +115,8 @@ def format_result(d: dict[str, Any]) -> str:
     m = d["metadata"]
     s = d["switch"]
     head = (f"bimodal actuator, CR {d['crimp_ratio']:g}: {m['dofs']} dofs, {m['wall_time_s']:.0f} s, "
-            f"bilinear bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa")
+            f"composite {m['model'].get('composite', 'homogenised')}, "
+            f"its bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa")
     lines = [head, "pressure (kPa)   tip u_x (mm)   tip u_y (mm)"]
     for p, ux, uy in zip(d["pressures_kpa"], d["tip_ux_mm"], d["tip_uy_mm"], strict=False):
         lines.append(f"{p:10.1f}   {ux:12.3f}   {uy:12.3f}")

@@ -15,6 +15,9 @@ axis, so that NumPy's elementwise loops run over long rows rather than 2x2 block
 * :func:`ogden_3d` - the one 3D Ogden kernel: the fast 3D assembly calls it directly and
   :class:`~pneumorph.fem.ogden.OgdenCompressible` adapts it to FElupe; with
   :func:`principal_3d`, the closed-form eigen-decomposition of ``C``.
+* :func:`crimped_fibre_3d` - crimped fibres along a direction per point: slack until their
+  crimp has straightened, then linear (the paper of the bilinear composite); added to a
+  matrix kernel by :class:`pneumorph.fem.fibre.CrimpedFibreOgden`.
 """
 
 from __future__ import annotations
@@ -360,3 +363,94 @@ def ogden_3d(
                 row += L[i, j] * R
             row[i] += S_mat[j]
     return P, A, J
+
+
+def crimp_blend(stretch: FloatArray, straight: float, blend: float) -> tuple[FloatArray, FloatArray]:
+    """The slack-then-taut fibre stretch function ``g(x)``, ``x = stretch - straight``, and ``g'(x)``.
+
+    ``g = 0`` for ``x <= -blend``, ``g = x`` for ``x >= blend`` and the quadratic
+    ``(x + blend)^2 / (4 blend)`` between, which joins both with a continuous slope (so the
+    tangent has no jump for Newton's method to trip on). ``g`` is exactly zero before the
+    blend: a fibre whose crimp has not straightened carries nothing, also in compression.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> g, dg = crimp_blend(np.array([1.0, 1.3, 1.5]), straight=1.3, blend=0.02)
+    >>> np.round(g, 6).tolist(), dg.tolist()
+    ([0.0, 0.005, 0.2], [0.0, 0.5, 1.0])
+    """
+    x = stretch - straight
+    inside = (x + blend) / (2.0 * blend)
+    g = np.where(x <= -blend, 0.0, np.where(x >= blend, x, 0.5 * (x + blend) * inside))
+    dg = np.where(x <= -blend, 0.0, np.where(x >= blend, 1.0, inside))
+    return g, dg
+
+
+def crimped_fibre_3d(
+    F: FloatArray,
+    direction: FloatArray,
+    straight: float,
+    slope: float,
+    blend: float,
+    tangent: bool = True,
+    pairs: Sequence[tuple[int, int]] | None = None,
+) -> tuple[FloatArray, FloatArray | None]:
+    """Stress and tangent of crimped fibres along unit vectors ``a`` (points last).
+
+    The fibres' nominal stress (force per reference area across them) is
+    ``s(l) = slope g(l - straight)`` with ``l = |F a|`` their stretch and ``g``
+    :func:`crimp_blend`: nothing until the crimp has straightened at the stretch
+    ``straight``, then ``slope`` per unit stretch. With ``f = F a``,
+
+        P = s / l  f (x) a,
+        A_iJkL = s / l  d_ik a_J a_L + (s' - s / l) / l^2  f_i a_J f_k a_L.
+
+    Parameters
+    ----------
+    F : ndarray, shape (3, 3, n)
+    direction : ndarray, shape (3, n)
+        The fibres' unit vector in the reference configuration at every point.
+    straight : float
+        Stretch at which the crimp is straight (> 1 + blend).
+    slope : float
+        Nominal stress per unit stretch of the straight fibres (MPa).
+    blend : float
+        Half-width of the quadratic blend in stretch (> 0).
+    tangent : bool
+        Compute the tangent (else it is None).
+    pairs : sequence of (int, int), optional
+        Return only the blocks ``A[i, :, k, :]`` of these component pairs, as
+        ``(len(pairs), 3, 3, n)`` (the layout of :func:`ogden_3d`'s).
+
+    Returns
+    -------
+    P : ndarray, shape (3, 3, n)
+    A : ndarray, shape (3, 3, 3, 3, n), the pairs' blocks, or None
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a = np.array([[1.0], [0.0], [0.0]])
+    >>> P, A = crimped_fibre_3d(np.diag([1.5, 1.0, 1.0])[..., None], a, 1.3, 100.0, 0.02)
+    >>> round(float(P[0, 0, 0]), 9), round(float(A[0, 0, 0, 0, 0]), 9), float(abs(P[1:]).max())
+    (20.0, 100.0, 0.0)
+    """
+    f = np.einsum("iJp,Jp->ip", F, direction)
+    lam = np.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+    g, dg = crimp_blend(lam, straight, blend)
+    over = slope * g / lam  # s / l
+    P = (over * f)[:, None] * direction[None, :]
+    if not tangent:
+        return P, None
+    aa = direction[:, None] * direction[None, :]  # a_J a_L
+    second = (slope * dg - over) / (lam * lam)
+    if pairs is not None:
+        Ab = np.empty((len(pairs), 3, 3, F.shape[-1]))
+        for q, (i, k) in enumerate(pairs):
+            Ab[q] = (second * f[i] * f[k] + over * (i == k)) * aa
+        return P, Ab
+    A = (second * f)[:, None, None, None] * direction[None, :, None, None] * f[None, None, :, None] * direction
+    for i in range(3):
+        A[i, :, i, :] += over * aa
+    return P, A

@@ -80,8 +80,11 @@ class PlaneStrainSystem(FastSystem):
         """The plane-strain kernel of a material, reading its parameters at every call."""
         import felupe as fem
 
+        from pneumorph.fem.fibre import CrimpedFibreOgden
         from pneumorph.fem.ogden import OgdenCompressible
 
+        if isinstance(umat, CrimpedFibreOgden):  # its kernel is 3D; the 2D coupon carries its paper as trusses
+            raise TypeError("no fast plane-strain kernel for the crimped-fibre law; model the paper in 3D")
         if isinstance(umat, OgdenCompressible):  # without its volumetric term when that is on the mean dilatation
             return lambda F: ogden_plane_strain(F, umat.mu, umat.alpha, 0.0 if umat.mixed else umat.bulk)
         if isinstance(umat, fem.NeoHookeCompressible) and umat.lmbda is not None:
