@@ -298,6 +298,9 @@ class RigidContact:
     friction : float
         Coulomb's coefficient (:mod:`.friction`; 0: frictionless), with :data:`TANGENTIAL` times the
         penalty as the tangential stiffness; its anchors are kept by :meth:`commit` after each converged state.
+    reach : float
+        The deepest (mm) a Newton step may carry a node into the obstacle from outside the penalty's full
+        stiffness (:meth:`step_fraction`; 0: no limit).
 
     Examples
     --------
@@ -316,6 +319,7 @@ class RigidContact:
     faces: IntArray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     smoothing: float = 0.0
     friction: float = 0.0
+    reach: float = 0.0
     #: the friction anchors of the last converged state (None: every node where it is)
     anchors: FloatArray | None = None
     # the assembler's owner data: one "cell" per node
@@ -367,6 +371,32 @@ class RigidContact:
     def tangent(self, x: FloatArray, symmetric: bool = False) -> FloatArray:
         """The nodes' d x d blocks (zero out of contact), (m, d, d) (:meth:`evaluate`)."""
         return self.evaluate(x, symmetric)[1]
+
+    def step_fraction(self, x: FloatArray, dx: FloatArray) -> float:
+        """The fraction of a step ``dx`` from ``x`` (all the body's points, (p, d)) that carries no node from
+        outside the penalty's full stiffness (a gap above ``-smoothing``) deeper than ``reach`` into the obstacle.
+
+        A Newton step is computed with no contact stiffness at the nodes still outside: it can carry one a whole
+        substep's motion (mm) into the obstacle, whose penalty then throws it back far enough to invert the
+        elements next to it. Scaled to land such a node ``reach`` inside (a straight path's gap, linear
+        between its ends), the next step sees the node in contact with its full stiffness.
+
+        >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, reach=0.1)
+        >>> x = np.array([[0.0, 0.0], [0.5, 0.0]])
+        >>> round(contact.step_fraction(x, np.array([[0.0, 0.0], [1.1, 0.0]])), 6)  # 0.6 of its 1.1 mm reach 0.1 mm in
+        0.545455
+        >>> contact.step_fraction(x, np.array([[0.0, 0.0], [0.55, 0.0]]))  # 0.05 mm in: all of it
+        1.0
+        """
+        if self.reach <= 0.0:
+            return 1.0
+        xs = x[self.points]
+        g0 = self.obstacle.kinematics(xs)[0]
+        g1 = self.obstacle.kinematics(xs + dx[self.points])[0]
+        deep = (g0 > -max(self.smoothing, 0.5 * self.reach)) & (g1 < -self.reach)
+        if not np.any(deep):
+            return 1.0
+        return float(np.min((g0[deep] + self.reach) / (g0[deep] - g1[deep])))
 
     def commit(self, x: FloatArray) -> None:
         """Keep the friction anchors of the converged state ``x`` (positions of all the body's points)."""

@@ -32,6 +32,11 @@ FloatArray = NDArray[np.float64]
 #: ones pass 1e4 on their way to inverted elements.
 DIVERGED = 1e3
 
+#: Halvings of a fresh tangent's step on a body with obstacles whose iterate is not admissible
+#: (:meth:`FastSubstep._trial`): a contact that closes within the step (a node the tangent saw free)
+#: threw the 15-unit actuator against a cylinder into inverted elements and cut-backs.
+BACKTRACKS = 5
+
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
 #: before a single-precision factorisation is judged too inaccurate and replaced by a
 #: double-precision one. A fresh Newton step near the solution converges quadratically;
@@ -82,6 +87,20 @@ def inadmissible(r: FloatArray, jmin: float) -> str | None:
     if jmin > 0.0 and np.all(np.isfinite(r)):
         return None
     return f"the predicted start is not admissible (det F = {jmin:.3g})"
+
+
+def contact_fraction(system: Any, u: FloatArray, step: FloatArray) -> float:
+    """The fraction of a Newton ``step`` (over the active dofs) from ``u`` that carries no surface node deep into
+    an obstacle it was not pressing on (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1
+    without obstacles)."""
+    contacts = getattr(system, "contacts", ())
+    if not contacts:
+        return 1.0
+    du = np.zeros_like(u)
+    du[system.dof1] = step
+    d = system.points.shape[1]
+    x, dx = system.points + u.reshape(-1, d), du.reshape(-1, d)
+    return min(c.step_fraction(x, dx) for c in contacts)
 
 
 def verdict(fnorm: float, jmin: float, u: FloatArray, values: FloatArray, tolerance: float,
@@ -229,9 +248,35 @@ class FastSubstep:
             self._factorised = False
         return iterations, cause
 
-    def _newton(self, fields: Any, settings: Any) -> tuple[int, str | None]:
+    def _trial(self, u: FloatArray, step: FloatArray, fresh: bool) -> tuple[FloatArray, FloatArray, FloatArray,
+                                                                            float, float]:
+        """The iterate of ``step`` from ``u``: ``(step taken, u_new, its residual, smallest det F, relative
+        residual)``.
+
+        On a body with obstacles, the step is first shortened to carry no node deep into an obstacle it was not
+        pressing on (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
+        (a non-finite residual, an inverted element, or a residual norm above :data:`DIVERGED`) is halved,
+        up to :data:`BACKTRACKS` times: a contact that closes or opens within the step changes the tangent
+        the step was computed with.
+        """
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
+        backtracks = BACKTRACKS if fresh and getattr(system, "contacts", ()) else 0
+        step = contact_fraction(system, u, step) * step
+        for trial in range(backtracks + 1):
+            if trial:
+                step = 0.5 * step
+            u_new = u.copy()
+            u_new[dof1] += step
+            r_new, jmin = system.residual(u_new)
+            fnorm = relative_residual(r_new, dof1, dof0)
+            if jmin > 0.0 and fnorm <= DIVERGED:  # (a NaN residual norm fails this too)
+                break
+        return step, u_new, r_new, jmin, fnorm
+
+    def _newton(self, fields: Any, settings: Any) -> tuple[int, str | None]:
+        system = self.system
+        dof1 = system.dof1
         values = fields[0].values
         u = values.ravel().copy()
         self.best = float("inf")
@@ -248,9 +293,7 @@ class FastSubstep:
                     return iteration, f"{type(exc).__name__}: {exc}"
                 if not np.all(np.isfinite(dx)):
                     return iteration, "the linear solve gave a non-finite increment"
-                u[dof1] += dx
-                r, jmin = system.residual(u)
-                fnorm = relative_residual(r, dof1, dof0)
+                _, u, r, jmin, fnorm = self._trial(u, dx, True)
                 self.best = min(self.best, fnorm)
                 if self.trace is not None:
                     self.trace.append((fnorm, True))
@@ -297,10 +340,7 @@ class FastSubstep:
                     step = f - (np.column_stack(dU) + Fm) @ gamma
                 if not np.all(np.isfinite(step)):
                     return iteration, "the linear solve gave a non-finite increment"
-                u_new = u.copy()
-                u_new[dof1] += step
-                r_new, jmin = system.residual(u_new)
-                fnorm_new = relative_residual(r_new, dof1, dof0)
+                step, u_new, r_new, jmin, fnorm_new = self._trial(u, step, fresh)
                 self.best = min(self.best, fnorm_new)
                 if self.trace is not None:
                     self.trace.append((fnorm_new, fresh))

@@ -40,6 +40,9 @@ from pneumorph.models.response import FloatArray
 #: the gap over which the penalty sets in, over the element size
 #: (:func:`~pneumorph.fem.fast.contact.penalty_gap`)
 SMOOTHING = 0.02
+#: the deepest a Newton step may carry a node into an obstacle from outside, over the element size
+#: (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`)
+REACH = 0.1
 #: where an obstacle may touch: the whole outer surface, or the free end face only
 TOUCHES = ("surface", "end")
 
@@ -140,7 +143,8 @@ def contact_items(obstacles: Sequence[ModelObstacle], mesh: ActuatorMesh, shear_
     k = penalty_stiffness(shear_modulus, mesh.spec.element_size, mesh.dim)
     smoothing = SMOOTHING * mesh.spec.element_size
     items = [RigidContact(o.obstacle, np.unique(end_faces) if o.on == "end" else nodes, k,
-                          end_faces if o.on == "end" else faces, smoothing, o.friction) for o in obstacles]
+                          end_faces if o.on == "end" else faces, smoothing, o.friction,
+                          REACH * mesh.spec.element_size) for o in obstacles]
     for item in items:
         item.commit(mesh.points)  # friction's anchors: where the nodes start
     problem = start_inside([o.obstacle for o in obstacles], mesh.points)  # any point: an obstacle in a cavity too
@@ -282,5 +286,5 @@ def blocked_wall(tip0: FloatArray, tip1: FloatArray, end_points: FloatArray) -> 
     return {"kind": "plane", "point": farthest.tolist(), "normal": (-d).tolist(), "on": "end"}
 
 
-__all__ = ["SMOOTHING", "TOUCHES", "ContactRecord", "ModelObstacle", "blocked_obstacle", "blocked_wall",
+__all__ = ["REACH", "SMOOTHING", "TOUCHES", "ContactRecord", "ModelObstacle", "blocked_obstacle", "blocked_wall",
            "check_obstacles", "check_reach", "contact_items", "parse_obstacle"]
