@@ -302,6 +302,13 @@ class RigidContact:
         The deepest (mm) a Newton step may carry a node into the obstacle from outside the penalty's full
         stiffness (:meth:`step_fraction`; 0: no limit).
 
+    Once a state is committed (:meth:`commit`), the curvature's term of the tangent ``k phi H`` takes the
+    smaller of the node's penalised gap and the converged one, as FElupe's ``curvature="converged"``: outside
+    a round obstacle the term is a negative stiffness across the normal, and a trial state deep inside (a
+    predictor or Newton step that overshoots) made the tangent of a soft finger touching a cylinder
+    indefinite, with steps of 10-150 mm. Converged states are unchanged; Newton converges linearly in that
+    term while the contact presses harder.
+
     Examples
     --------
     A node 0.25 mm inside a wall is pushed back with ``k g`` along its normal:
@@ -322,6 +329,8 @@ class RigidContact:
     reach: float = 0.0
     #: the friction anchors of the last converged state (None: every node where it is)
     anchors: FloatArray | None = None
+    #: the penalised gaps of the last converged state (None: no bound on the curvature's term)
+    converged: FloatArray | None = None
     # the assembler's owner data: one "cell" per node
     cells: IntArray = field(init=False)
     take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
@@ -344,8 +353,9 @@ class RigidContact:
         phi, slope = penalty_gap(gap, self.smoothing)
         force = self.stiffness * phi[:, None] * n
         K = self.stiffness * slope[:, None, None] * n[:, :, None] * n[:, None, :]
-        if H is not None:
-            K += self.stiffness * phi[:, None, None] * H
+        if H is not None:  # the curvature's term, at most the last converged state's (see the class notes)
+            bound = phi if self.converged is None else np.maximum(phi, self.converged)
+            K += self.stiffness * bound[:, None, None] * H
         active = phi < 0.0
         anchors = xs.copy()  # out of contact: where a node is
         if self.friction > 0.0 and np.any(active):
@@ -399,8 +409,10 @@ class RigidContact:
         return float(np.min((g0[deep] + self.reach) / (g0[deep] - g1[deep])))
 
     def commit(self, x: FloatArray) -> None:
-        """Keep the friction anchors of the converged state ``x`` (positions of all the body's points)."""
+        """Keep the friction anchors and the penalised gaps of the converged state ``x`` (positions of all the
+        body's points)."""
         self.anchors = self.evaluate(x)[3]
+        self.converged = penalty_gap(self.obstacle.kinematics(x[self.points])[0], self.smoothing)[0]
 
     def report(self, x: FloatArray) -> dict[str, Any]:
         """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and theirs, and the contact
