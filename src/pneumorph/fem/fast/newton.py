@@ -37,6 +37,13 @@ DIVERGED = 1e3
 #: threw the 15-unit actuator against a cylinder into inverted elements and cut-backs.
 BACKTRACKS = 5
 
+#: The growth of the relative residual norm beyond which a fresh tangent's iterate on a body with obstacles is
+#: halved too: a node thrown into an obstacle by a step (a contact the tangent did not hold) multiplies the
+#: residual. On a 15-unit 2D finger grazing a cylinder this line search took the ramp from 210 Newton
+#: iterations and 6 cut-backs to 81 and 1 (100: 83 and 1; on the 2D cases of tests/models/test_obstacles.py
+#: 10 gave 1, 0 and 1 cut-backs, 100 gave 1, 1 and 1).
+GROWTH = 10.0
+
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
 #: before a single-precision factorisation is judged too inaccurate and replaced by a
 #: double-precision one. A fresh Newton step near the solution converges quadratically;
@@ -270,16 +277,16 @@ class FastSubstep:
             u[dof1] = last[dof1] + fraction * step
             values[:] = u.reshape(values.shape)
 
-    def _trial(self, u: FloatArray, step: FloatArray, fresh: bool) -> tuple[FloatArray, FloatArray, FloatArray,
-                                                                            float, float]:
+    def _trial(self, u: FloatArray, step: FloatArray, fresh: bool, previous: float = np.inf
+               ) -> tuple[FloatArray, FloatArray, FloatArray, float, float]:
         """The iterate of ``step`` from ``u``: ``(step taken, u_new, its residual, smallest det F, relative
         residual)``.
 
         On a body with obstacles, the step is first shortened to carry no node deep into an obstacle it was not
         pressing on (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
-        (a non-finite residual, an inverted element, or a residual norm above :data:`DIVERGED`) is halved,
-        up to :data:`BACKTRACKS` times: a contact that closes or opens within the step changes the tangent
-        the step was computed with.
+        (a non-finite residual, an inverted element, or a residual norm above :data:`DIVERGED` or :data:`GROWTH`
+        times the ``previous`` one) is halved, up to :data:`BACKTRACKS` times: a contact that closes or opens
+        within the step changes the tangent the step was computed with.
         """
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
@@ -292,7 +299,7 @@ class FastSubstep:
             u_new[dof1] += step
             r_new, jmin = system.residual(u_new)
             fnorm = relative_residual(r_new, dof1, dof0)
-            if jmin > 0.0 and fnorm <= DIVERGED:  # (a NaN residual norm fails this too)
+            if jmin > 0.0 and fnorm <= min(DIVERGED, GROWTH * previous):  # (a NaN residual norm fails this too)
                 break
         return step, u_new, r_new, jmin, fnorm
 
@@ -307,6 +314,7 @@ class FastSubstep:
             r, jmin = system.residual(u)
             if (cause := inadmissible(r, jmin)) is not None:
                 return 0, cause
+            fnorm = relative_residual(r, dof1, system.dof0)
             for iteration in range(1, settings.max_iterations + 1):
                 try:
                     self.factorize()
@@ -315,7 +323,7 @@ class FastSubstep:
                     return iteration, f"{type(exc).__name__}: {exc}"
                 if not np.all(np.isfinite(dx)):
                     return iteration, "the linear solve gave a non-finite increment"
-                _, u, r, jmin, fnorm = self._trial(u, dx, True)
+                _, u, r, jmin, fnorm = self._trial(u, dx, True, fnorm)
                 self.best = min(self.best, fnorm)
                 if self.trace is not None:
                     self.trace.append((fnorm, True))
@@ -362,7 +370,7 @@ class FastSubstep:
                     step = f - (np.column_stack(dU) + Fm) @ gamma
                 if not np.all(np.isfinite(step)):
                     return iteration, "the linear solve gave a non-finite increment"
-                step, u_new, r_new, jmin, fnorm_new = self._trial(u, step, fresh)
+                step, u_new, r_new, jmin, fnorm_new = self._trial(u, step, fresh, fnorm)
                 self.best = min(self.best, fnorm_new)
                 if self.trace is not None:
                     self.trace.append((fnorm_new, fresh))
