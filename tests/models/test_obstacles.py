@@ -86,8 +86,14 @@ def test_the_clamp_balances_the_obstacles(tmp_path: object) -> None:
     from pneumorph.io import write_vtk_series
 
     write_vtk_series(solution, tmp_path)
-    field = meshio.read(tmp_path / f"actuator_{len(levels) - 1:02d}.vtu").point_data["contact_force"]
+    data = meshio.read(tmp_path / f"actuator_{len(levels) - 1:02d}.vtu").point_data
+    field = data["contact_force"]
     assert np.allclose(field.sum(axis=0)[:2], np.sum([o["force_n"] for o in last["obstacles"]], axis=0), atol=1e-12)
+    # and its contact pressure (kPa), where it touches only
+    touching = np.zeros(len(field), dtype=bool)
+    for o in last["obstacles"]:
+        touching[o["nodes_in_contact"]] = True
+    assert np.all(data["contact_pressure"][touching] > 0.0) and np.all(data["contact_pressure"][~touching] == 0.0)
 
 
 def test_blocked_force_rises_along_the_ramp() -> None:

@@ -408,6 +408,16 @@ class RigidContact:
             return 1.0
         return float(np.min((g0[deep] + self.reach) / (g0[deep] - g1[deep])))
 
+    def _tributary(self, measures: FloatArray, share: FloatArray, touching: NDArray[np.bool_]) -> FloatArray:
+        """Every point's share of the faces in contact (those whose corners all touch), or of all its faces
+        where none of its faces is: the area (length in 2D) its contact force acts on."""
+        corners = 2 if self.faces.shape[1] <= 3 else 4
+        full = np.all(touching[self.faces[:, :corners]], axis=1)
+        out, anywhere = np.zeros(len(touching)), np.zeros(len(touching))
+        np.add.at(out, self.faces[full], measures[full, None] * share[None, :])
+        np.add.at(anywhere, self.faces, measures[:, None] * share[None, :])
+        return np.where(out > 0.0, out, anywhere)
+
     def commit(self, x: FloatArray) -> None:
         """Keep the friction anchors and the penalised gaps of the converged state ``x`` (positions of all the
         body's points)."""
@@ -415,17 +425,22 @@ class RigidContact:
         self.converged = penalty_gap(self.obstacle.kinematics(x[self.points])[0], self.smoothing)[0]
 
     def report(self, x: FloatArray) -> dict[str, Any]:
-        """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and theirs, and the contact
-        length (2D) or area (3D): the nodes' shares of their faces (:data:`SHARES`), summed over those in contact."""
+        """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and theirs, the contact
+        length (2D) or area (3D): the nodes' shares of their faces (:data:`SHARES`), summed over those in contact,
+        and each node's contact pressure: its force over its share of the faces in contact (MPa)."""
         force, active = self.forces(x)
         touching = np.zeros(x.shape[0], dtype=bool)
         touching[self.points[active]] = True
         measure = 0.0
+        pressures = np.zeros(int(active.sum()))
         if len(self.faces):
             share = SHARES[self.faces.shape[1]]
-            measure = float(np.sum(face_measures(self.faces, x) * (touching[self.faces] @ share)))
+            faces = face_measures(self.faces, x)
+            measure = float(np.sum(faces * (touching[self.faces] @ share)))
+            pressures = np.linalg.norm(force[active], axis=1) / self._tributary(faces, share, touching)[
+                self.points[active]]
         return {"force": force.sum(axis=0), "nodes": self.points[active], "node_forces": force[active],
-                "measure": measure}
+                "measure": measure, "node_pressures": pressures}
 
 
 def surface_points(cells: IntArray, cell_type: str, excluded: NDArray[np.bool_] | None = None) -> tuple[IntArray,

@@ -190,6 +190,7 @@ class ContactRecord:
                             "force_magnitude_n": float(np.linalg.norm(report["force"] * self.scale)),
                             "nodes_in_contact": report["nodes"].tolist(),
                             "node_forces_n": (report["node_forces"] * self.scale).tolist(),
+                            "node_pressures_kpa": (report["node_pressures"] * 1e3).tolist(),
                             "contact_length_mm" if self.mesh.dim == 2 else "contact_area_mm2":
                                 report["measure"] * (2.0 if self.mesh.dim == 3 and self.scale[2] == 0.0 else 1.0)})
         self.levels[k:] = [{"pressure_kpa": pressure * 1e3, "base_reaction_n": reaction.tolist(),
