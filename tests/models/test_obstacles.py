@@ -190,3 +190,17 @@ def test_a_finger_with_friction_on_a_cylinder() -> None:
         forces[friction] = force = np.asarray(last["obstacles"][0]["force_n"])
         assert np.allclose(last["base_reaction_n"], force, rtol=0.0, atol=1e-6 * np.linalg.norm(force))
     assert np.linalg.norm(forces[0.5] - forces[0.0]) > 1e-2 * np.linalg.norm(forces[0.0])
+
+
+@pytest.mark.slow
+def test_a_long_finger_grazing_a_cylinder_solves_through_the_ramp() -> None:
+    """A 15-unit finger whose free tip ends (152.2, -5.55) mm at 45 kPa, against a cylinder of 4 mm radius
+    centred there: the tip slides round it. Newton steps blind to the cylinder failed this ramp at 40 kPa."""
+    cylinder = {"kind": "cylinder", "centre": [152.2, -5.55], "radius": 4.0}
+    solution = Reduced2D(15, obstacles=[cylinder]).solve("111000000111111")
+    response = solution.response
+    assert response.converged and response.metadata["cutbacks"] <= 1
+    last = _levels(solution)[-1]
+    force = np.asarray(last["obstacles"][0]["force_n"])
+    assert 1e-4 < np.linalg.norm(force) < 1e-2  # N: it grazes the cylinder
+    assert np.allclose(last["base_reaction_n"], force, rtol=0.0, atol=1e-2 * np.linalg.norm(force))
