@@ -290,7 +290,7 @@ class FastSubstep:
         """
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
-        backtracks = BACKTRACKS if fresh and getattr(system, "contacts", ()) else 0
+        backtracks = BACKTRACKS if fresh and len(getattr(system, "contacts", ())) else 0
         step = contact_fraction(system, u, step) * step
         for trial in range(backtracks + 1):
             if trial:
