@@ -156,6 +156,11 @@ def test_3d_an_obstacle_out_of_reach_changes_nothing_and_the_clamp_balances_a_wa
         assert np.allclose(level["base_reaction_n"], force, rtol=0.0, atol=1e-2 * np.linalg.norm(force))
     assert levels[-1]["obstacles"][0]["force_magnitude_n"] > levels[0]["obstacles"][0]["force_magnitude_n"] > 0.0
     assert levels[-1]["obstacles"][0]["contact_area_mm2"] > 0.0
+    # the 3D shape figure draws the wall beside the actuator's surface, with its force
+    from pneumorph.plot.shape import plot_shape
+
+    labels = [c.get_label() for c in plot_shape(solution).axes[0].collections]
+    assert labels[1:] == [f"obstacle 1: {levels[-1]['obstacles'][0]['force_magnitude_n']:.3g} N"]
     # with friction on the wall: the end sticks to it, the clamp still balances it
     rough = model.variant(obstacles=[{**wall, "friction": 0.5}]).solve("00")
     last = _levels(rough)[-1]
