@@ -3,12 +3,13 @@
 For each design: the free ramp, then the blocked-force ramp (``simulate --blocked``: a wall
 normal to the free tip's motion at the first level, through the end face's farthest point,
 touching the end face), or with ``--cylinder X,Y[,Z];R`` a cylinder against the whole surface
-(``--cylinder "tip;R"``: centred where the free tip ends).
+(``--cylinder "tip;R"``: centred where the free tip ends), with Coulomb ``--friction``.
 Prints a Markdown table row per design: the wall times, Newton iterations and cut-backs of both
 ramps, and the force on the obstacle at the middle and last levels.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --model 3d --designs 00000,01010,00011
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --designs 111000000111111 --cylinder "tip;4"
+    OMP_NUM_THREADS=1 python benchmarks/blocked_force.py --designs 000 --cylinder "34,24;4" --friction 0.5
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ def main() -> None:
     parser.add_argument("--designs", default="00000,01010,00011")
     parser.add_argument("--cylinder", default=None, help="X,Y[,Z];R or tip;R: a cylinder (along z in 3D) instead of "
                         "the wall, centred there or where the free tip ends")
+    parser.add_argument("--friction", type=float, default=0.0, help="Coulomb's coefficient on the obstacle")
     args = parser.parse_args()
     print("| design | free: wall, iterations, cut-backs | with contact: wall, iterations, cut-backs | "
           "force at mid / last level (N) | base reaction at last level (N) |")
@@ -48,6 +50,8 @@ def main() -> None:
             obstacle = {"kind": "cylinder", "centre": where, "radius": float(radius)}
             if args.model == "3d":
                 obstacle["axis"] = [0.0, 0.0, 1.0]
+        if args.friction > 0.0:
+            obstacle["friction"] = args.friction
         contact = model.variant(obstacles=[obstacle]).solve(design).response
         t_contact = time.perf_counter() - t0
         levels = contact.metadata["contact"]["levels"]

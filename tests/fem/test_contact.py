@@ -212,3 +212,31 @@ def test_bad_obstacles_are_refused() -> None:
     points, _ = _beam(4.0, "quad")
     assert "starts inside" in (start_inside([Sphere((4.0, 1.0), 0.5)], points) or "")
     assert start_inside([Sphere((5.0, 1.0), 0.5), Plane((4.0, 0.0), (-1.0, 0.0))], points) is None  # touching
+
+
+def test_a_block_pressed_on_a_floor_has_the_contact_pressure_of_its_stress() -> None:
+    """A block compressed from its top onto a frictionless floor is in a uniform state: every node on the floor
+    carries the pressure of the top's reaction over the (deformed) width, quadratic elements and all."""
+    mesh = fem.Rectangle(b=(2.0, 4.0), n=(5, 9)).add_midpoints_edges()
+    points = np.asarray(mesh.points)
+    field = fem.FieldContainer([fem.FieldPlaneStrain(fem.RegionQuadraticQuad(mesh), dim=2)])
+    solid = fem.SolidBody(fem.NeoHookeCompressible(mu=1.0, lmbda=2.0), field)
+    top = points[:, 1] == 4.0
+    held = {"roller": fem.Boundary(field[0], fx=0.0, skip=(0, 1)), "top": fem.Boundary(field[0], fy=4.0, skip=(1, 0))}
+    dof0, dof1 = fem.dof.partition(field, held)
+    faces, nodes = surface_points(np.asarray(mesh.cells), "quad8")
+    contact = RigidContact(Plane((0.0, 0.0), (0.0, 1.0)), nodes, 1e4, faces)  # stiff: the floor barely let in
+    system = PlaneStrainSystem([solid, contact], field, dof1, dof0)
+    u = np.zeros_like(points)
+    u[:, 1] = -0.05 * points[:, 1] / 4.0  # the top 0.05 mm down
+    u = u.ravel()
+    for _ in range(20):
+        r, _ = system.residual(u)
+        if np.linalg.norm(r[dof1]) < 1e-13:
+            break
+        u[dof1] -= spla.spsolve(system.tangent().tocsc(), r[dof1])
+    x = points + u.reshape(-1, 2)
+    report = contact.report(x)
+    pressure = -r.reshape(-1, 2)[top, 1].sum() / x[top, 0].max()  # MPa: the top's reaction over the width
+    assert pressure > 0.03 and sorted(report["nodes"].tolist()) == np.flatnonzero(points[:, 1] == 0.0).tolist()
+    assert np.allclose(report["node_pressures"], pressure, rtol=1e-3)

@@ -18,7 +18,7 @@ from pneumorph.cli.progress import RunLines, reporter
 _DESIGN_OPTIONS = ("amplitude", "periods", "point", "units", "search", "seed", "certify", "verify", "margin",
                    "epsilon", "refine", "chain_table", "tolerance", "robust", "robust_samples", "executor", "workers",
                    "scheduler", "cache")
-_TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach")
+_TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach", "grip", "wrap")
 
 
 def _kpa(pressure: float | None) -> float:
@@ -32,7 +32,9 @@ def _kpa(pressure: float | None) -> float:
                    "shape: 'path:FILE' (CSV/TXT of x, y[, z] mm, from the base to the free end) or a preset "
                    "(letter-l, letter-s, letter-r, hook, spiral, coil). "
                    "Default (no config file): sin, amplitude 10 mm, one period.")
-@click.option("--objective", type=click.Choice(_TIP_GOALS), help="A tip goal instead of a profile (Table 6.1).")
+@click.option("--objective", type=click.Choice(_TIP_GOALS),
+              help="A tip goal instead of a profile (Table 6.1), or over the model's obstacles (--model-file with "
+                   "[[model.obstacle]]): grip (the force on them, N) or wrap (the contact length or area).")
 @click.option("--amplitude", type=P.POSITIVE_MM, help="Amplitude A of the sin/cos target, mm (default 10).")
 @click.option("--periods", type=P.Real(0.0, 1000.0, low_open=True),
               help="Periods of the sin/cos target over the actuator (default 1).")

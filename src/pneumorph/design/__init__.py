@@ -25,6 +25,7 @@ from pneumorph.design.certified.certificate import certificate_text
 from pneumorph.design.certified.search import CertifiedResult, certified_search
 from pneumorph.design.config import DesignConfig
 from pneumorph.design.driver import run_design
+from pneumorph.design.objectives.contact import CONTACT_GOALS, ContactGoal
 from pneumorph.design.objectives.fitness import Score, score
 from pneumorph.design.objectives.paths import PATH_PRESETS, PathTarget, path_target, preset_path, read_path
 from pneumorph.design.objectives.targets import (
@@ -51,12 +52,14 @@ from pneumorph.design.search.population import PopulationStudy, plot_population_
 from pneumorph.design.search.scoring import Candidate
 
 __all__ = [
+    "CONTACT_GOALS",
     "PATH_PRESETS",
     "PRESETS",
     "TIP_GOALS",
     "Algorithm",
     "Candidate",
     "CertifiedResult",
+    "ContactGoal",
     "DesignConfig",
     "ExhaustiveResult",
     "GAConfig",

@@ -70,6 +70,7 @@ from pneumorph.design.algorithms import algorithm_for
 from pneumorph.design.algorithms.problem import Algorithm, Problem, SearchOutcome
 from pneumorph.design.certified.planning import planned_workers
 from pneumorph.design.config import DesignConfig, to_toml
+from pneumorph.design.objectives.contact import check_contact_goal
 from pneumorph.design.objectives.targets import StagedTarget, on_actuator
 from pneumorph.design.runs.folder import check_folder, created_top, remove_empty, remove_run_files
 from pneumorph.design.runs.report import RunResult, write_outputs, write_report
@@ -120,6 +121,7 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
         raise SearchConfigError(f"the model has {model.n_units} units but the config asks for {config.units}")
     workers = evaluator_workers(evaluator) if evaluator is not None else planned_workers(config)
     objective = config.make_objective()
+    check_contact_goal(objective, model)
     unit = getattr(model, "unit", None)  # a preset path drawn once for the FE model's actuator (its first unit type)
     if unit is not None:
         objective = on_actuator(objective, model.n_units * unit.pitch, unit.height / 2)

@@ -24,15 +24,18 @@ def region_ids(names: Any) -> dict[str, int]:
 
 
 def _contact_forces(contact: Any, k: int, npoints: int) -> dict[str, Any]:
-    """``{"contact_force": (p, 3)}`` of level ``k`` of a response's contact record, or nothing (no obstacles)."""
+    """``{"contact_force": (p, 3), "contact_pressure": (p,)}`` of level ``k`` of a response's contact record, or
+    nothing (no obstacles)."""
     if not contact or k >= len(contact["levels"]):
         return {}
     field = np.zeros((npoints, 3))
+    pressure = np.zeros(npoints)
     for entry in contact["levels"][k]["obstacles"]:
         if entry["nodes_in_contact"]:
             forces = np.asarray(entry["node_forces_n"], dtype=float)
             field[entry["nodes_in_contact"], : forces.shape[1]] += forces
-    return {"contact_force": field}
+            pressure[entry["nodes_in_contact"]] += entry.get("node_pressures_kpa", 0.0)
+    return {"contact_force": field, "contact_pressure": pressure}
 
 
 def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
@@ -43,7 +46,8 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
     ParaView's *Warp By Vector*) and the cell data ``region`` (:func:`region_ids`: 0 body,
     1 stiff layer, 2 filler, then the others; the PVD's comment names them). The PVD's time
     value is the pressure in kPa. A solve with obstacles (:mod:`pneumorph.models.fe.obstacles`) adds the point data
-    ``contact_force``: the force each surface node exerts on the obstacles (N, as the response reports it).
+    ``contact_force``: the force each surface node exerts on the obstacles (N, as the response reports it), and
+    ``contact_pressure``: that force over the node's share of the surface (kPa).
 
     Parameters
     ----------

@@ -114,6 +114,7 @@ def plot_shape(
         else:
             ax = fig.add_subplot(1, len(levels), i + 1, projection="3d")
             _surface(ax, solution, k)
+            _obstacles_3d(ax, resp.metadata.get("contact"), k, solution.mesh.points)
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("z [mm]")
             ax.set_zlabel("y [mm]")
@@ -148,3 +149,36 @@ def _obstacles(ax: Any, contact: Any, k: int) -> None:
             x0, x1, y0, y1 = min(x0, cx - r), max(x1, cx + r), min(y0, cy - r), max(y1, cy + r)  # drawn whole
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
+
+
+def _obstacles_3d(ax: Any, contact: Any, k: int, points: Any) -> None:
+    """The rigid obstacles of a 3D solve as grey surfaces (drawn as (x, z, y), as :func:`_surface`) across the
+    actuator's extent, each labelled with its force at level ``k`` (N)."""
+    if not contact:
+        return
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    size = float((hi - lo).max())
+    level = contact["levels"][k] if k < len(contact["levels"]) else None
+    a, b = np.meshgrid(np.linspace(0.0, 2 * np.pi, 33), np.linspace(-0.5, 0.5, 9))
+    for i, obstacle in enumerate(contact["obstacles"]):
+        force = level["obstacles"][i]["force_magnitude_n"] if level else float("nan")
+        if obstacle["kind"] == "sphere":
+            c, r = np.asarray(obstacle["centre"]), obstacle["radius"]
+            u, v = np.meshgrid(np.linspace(0.0, 2 * np.pi, 33), np.linspace(0.0, np.pi, 17))
+            xyz = c[:, None, None] + r * np.array([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)])
+        else:
+            normal = np.asarray(obstacle.get("normal", obstacle.get("axis", [0.0, 0.0, 1.0])), dtype=float)
+            e1 = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
+            e1 /= np.linalg.norm(e1)
+            e2 = np.cross(normal, e1)
+            if obstacle["kind"] == "plane":  # a square across the actuator's extent
+                c = np.asarray(obstacle["point"])
+                xyz = c[:, None, None] + size * (e1[:, None, None] * (a / np.pi - 1.0) + e2[:, None, None] * b)
+            else:  # a cylinder: its length along the axis as long as the actuator is wide (or deep)
+                c, r = np.asarray(obstacle["centre"]), obstacle["radius"]
+                length = float(np.ptp(points @ normal)) or size
+                along = np.clip(((lo + hi) / 2 - c) @ normal, -size, size)
+                xyz = (c[:, None, None] + r * (e1[:, None, None] * np.cos(a) + e2[:, None, None] * np.sin(a))
+                       + normal[:, None, None] * (along + b * length))
+        ax.plot_surface(xyz[0], xyz[2], xyz[1], color="0.5", alpha=0.35, linewidth=0,
+                        label=f"obstacle {i + 1}: {force:.3g} N")

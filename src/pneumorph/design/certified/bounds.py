@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.design.certified.remainder import CurveRange
+from pneumorph.design.objectives.contact import ContactGoal
 from pneumorph.design.objectives.fitness import path_error_array, profile_error_array, tip_value_array
 from pneumorph.design.objectives.paths import PathTarget
 from pneumorph.design.objectives.targets import Objective, ProfileTarget, StagedTarget, TipGoal
@@ -186,7 +187,16 @@ class ChainScores:
 
 
 def level_values(chain: ChainModel, objective: Objective, bits: NDArray[np.integer]) -> tuple[FloatArray, ...]:
-    """Objective per design and level (m, k), with the predicted centres and references."""
+    """Objective per design and level (m, k), with the predicted centres and references.
+
+    Raises
+    ------
+    SearchConfigError
+        A contact goal (``grip``, ``wrap``): the chain model knows no contact.
+    """
+    if isinstance(objective, ContactGoal):
+        raise SearchConfigError(f"the chain model knows no contact: {objective.name!r} is measured by FE with "
+                                "contact only (search with --search ga or exhaustive)")
     centres, tip, curl = chain.predict(bits)
     ref_c, _ = chain.table.reference(bits)
 

@@ -23,6 +23,9 @@ A path (:class:`~pneumorph.design.objectives.paths.PathTarget`) is matched by th
 reports them, with no datum: each centre's distance to its stretch of the path, summed in
 squares as Eq 4.1 (:mod:`pneumorph.design.objectives.paths`).
 
+Contact goals (``grip``, ``wrap``) read the forces and contact a model with obstacles reports
+(:mod:`pneumorph.design.objectives.contact`).
+
 Tip goals (Table 6.1) use the tip in the same frame: ``X`` = the tip's x, ``Y`` = its
 height above the undeformed tip, the distance to the base ``sqrt(X^2 + Y^2)`` and the curl
 in degrees (counter-clockwise positive).
@@ -39,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.design.objectives.contact import ContactGoal, contact_values
 from pneumorph.design.objectives.paths import PathTarget
 from pneumorph.design.objectives.targets import Objective, ProfileTarget, Sense, StagedTarget
 from pneumorph.models.response import Response
@@ -198,6 +202,8 @@ def objective_values(response: Response, objective: Objective) -> FloatArray:
         return profile_errors(response, objective)
     if isinstance(objective, PathTarget):
         return path_errors(response, objective)
+    if isinstance(objective, ContactGoal):
+        return contact_values(response, objective)
     return tip_values(response, objective.name, objective.point)
 
 

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pneumorph.design.objectives.contact import CONTACT_GOALS, ContactGoal, contact_goal
 from pneumorph.design.objectives.expressions import parse_expression
 from pneumorph.design.objectives.paths import PATH_PRESETS, PathTarget, path_target, preset_path
 from pneumorph.design.objectives.profiles import (
@@ -266,7 +267,7 @@ def staged_target(stages: Any) -> StagedTarget:
 
 
 #: What a search optimises: a target profile, a path, a goal for the tip, or targets at several pressures.
-Objective = ProfileTarget | PathTarget | TipGoal | StagedTarget
+Objective = ProfileTarget | PathTarget | TipGoal | StagedTarget | ContactGoal
 
 #: The tip goals by name: whether they are minimised or maximised, and their label.
 TIP_GOALS: dict[str, tuple[Sense, str]] = {
@@ -300,7 +301,7 @@ def tip_goal(name: str, point: tuple[float, ...] | None = None) -> TipGoal:
     """
     key = _ALIASES.get(_normalise(name), _normalise(name))
     if key not in TIP_GOALS:
-        raise UnknownObjectiveError(name, [*TIP_GOALS, *PRESETS])
+        raise UnknownObjectiveError(name, [*TIP_GOALS, *CONTACT_GOALS, *PRESETS])
     if key == "reach":
         if point is None or len(point) not in (2, 3) or not np.all(np.isfinite(point)):
             raise SearchConfigError("the objective 'reach' needs a tip point (x, y) or (x, y, z) in mm: --point X Y "
@@ -396,7 +397,8 @@ def make_objective(
     curve: ArrayLike | None = None,
     path: ArrayLike | None = None,
 ) -> Objective:
-    """Any objective from its text: a tip goal, a preset, a profile expression or a path.
+    """Any objective from its text: a tip goal, a contact goal (``grip``, ``wrap``:
+    :mod:`~pneumorph.design.objectives.contact`), a preset, a profile expression or a path.
 
     With ``length`` (mm), a profile is also checked to be finite along an actuator that long
     (:meth:`ProfileTarget.check`). ``"curve"`` takes its points from ``curve``
@@ -414,8 +416,8 @@ def make_objective(
     Traceback (most recent call last):
     ...
     pneumorph.errors.UnknownObjectiveError: unknown objective 'max-z'; known objectives: max-x, min-x, max-y,
-    min-y, min-distance, max-curl, reach, sin, cos, helix, helix-left, letter-l, letter-s, letter-r, hook,
-    spiral, coil, path, or a profile 'y = f(x)' / 'r = f(theta)' / 'y = f(x), z = g(x)'
+    min-y, min-distance, max-curl, reach, grip, wrap, sin, cos, helix, helix-left, letter-l, letter-s,
+    letter-r, hook, spiral, coil, path, or a profile 'y = f(x)' / 'r = f(theta)' / 'y = f(x), z = g(x)'
     """
     key = _ALIASES.get(_normalise(spec), _normalise(spec))
     if (key == "path") != (path is not None):
@@ -442,12 +444,16 @@ def make_objective(
         return target if length is None else target.check(length)
     if key in TIP_GOALS:
         return tip_goal(key, point)
+    if key in CONTACT_GOALS:
+        if point is not None:
+            raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {spec!r}")
+        return contact_goal(key)
     if point is not None:
         raise SearchConfigError(f"a tip point is only used by the objective 'reach', not by {spec!r}")
     if key not in PRESETS and "=" not in spec:
         words = re.fullmatch(r"[A-Za-z_][\w\- ]*", spec.strip())
         if words and spec.strip() not in (*CARTESIAN, *POLAR, "pi", "e"):
-            raise UnknownObjectiveError(spec, [*TIP_GOALS, *PRESETS, *PATH_PRESETS, "path"])
+            raise UnknownObjectiveError(spec, [*TIP_GOALS, *CONTACT_GOALS, *PRESETS, *PATH_PRESETS, "path"])
     target = profile_target(spec, amplitude, periods, anchored=anchored)
     return target if length is None else target.check(length)
 
@@ -460,6 +466,7 @@ __all__ = [
     "MIN_CURVE_SPAN",
     "PRESETS",
     "TIP_GOALS",
+    "ContactGoal",
     "Objective",
     "PathTarget",
     "Polyline",

@@ -17,8 +17,8 @@ profile y = f(x)                the original's error against -f(x) (sin <-> -sin
 profile r = f(theta)            the original's error against f(-theta)
 ==============================  ==============================================
 
-This holds only for a model that is mirror-symmetric; before relying on it the search
-solves one design and its mirror and compares them (``verify_symmetry``).
+This holds only for a model that is mirror-symmetric (no gravity across it, no obstacles); before
+relying on it the search solves one design and its mirror and compares them (``verify_symmetry``).
 """
 
 from __future__ import annotations
@@ -137,7 +137,10 @@ def all_designs(n: int, first: str | None = None) -> list[str]:
 
 
 def mirror_holds(model: ActuatorModel) -> bool:
-    """Whether a design and its mirror give mirrored responses: no gravity across the actuator (y)."""
+    """Whether a design and its mirror give mirrored responses: no gravity across the actuator (y) and no
+    obstacles (they are not mirrored with the design)."""
+    if getattr(model, "obstacles", ()):
+        return False
     gravity = getattr(model, "gravity", None)
     return gravity is None or len(gravity) < 2 or gravity[1] == 0.0
 

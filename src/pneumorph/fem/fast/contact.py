@@ -298,6 +298,16 @@ class RigidContact:
     friction : float
         Coulomb's coefficient (:mod:`.friction`; 0: frictionless), with :data:`TANGENTIAL` times the
         penalty as the tangential stiffness; its anchors are kept by :meth:`commit` after each converged state.
+    reach : float
+        The deepest (mm) a Newton step may carry a node into the obstacle from outside the penalty's full
+        stiffness (:meth:`step_fraction`; 0: no limit).
+
+    Once a state is committed (:meth:`commit`), the curvature's term of the tangent ``k phi H`` takes the
+    smaller of the node's penalised gap and the converged one, as FElupe's ``curvature="converged"``: outside
+    a round obstacle the term is a negative stiffness across the normal, and a trial state deep inside (a
+    predictor or Newton step that overshoots) made the tangent of a soft finger touching a cylinder
+    indefinite, with steps of 10-150 mm. Converged states are unchanged; Newton converges linearly in that
+    term while the contact presses harder.
 
     Examples
     --------
@@ -316,8 +326,11 @@ class RigidContact:
     faces: IntArray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     smoothing: float = 0.0
     friction: float = 0.0
+    reach: float = 0.0
     #: the friction anchors of the last converged state (None: every node where it is)
     anchors: FloatArray | None = None
+    #: the penalised gaps of the last converged state (None: no bound on the curvature's term)
+    converged: FloatArray | None = None
     # the assembler's owner data: one "cell" per node
     cells: IntArray = field(init=False)
     take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
@@ -340,8 +353,9 @@ class RigidContact:
         phi, slope = penalty_gap(gap, self.smoothing)
         force = self.stiffness * phi[:, None] * n
         K = self.stiffness * slope[:, None, None] * n[:, :, None] * n[:, None, :]
-        if H is not None:
-            K += self.stiffness * phi[:, None, None] * H
+        if H is not None:  # the curvature's term, at most the last converged state's (see the class notes)
+            bound = phi if self.converged is None else np.maximum(phi, self.converged)
+            K += self.stiffness * bound[:, None, None] * H
         active = phi < 0.0
         anchors = xs.copy()  # out of contact: where a node is
         if self.friction > 0.0 and np.any(active):
@@ -368,22 +382,65 @@ class RigidContact:
         """The nodes' d x d blocks (zero out of contact), (m, d, d) (:meth:`evaluate`)."""
         return self.evaluate(x, symmetric)[1]
 
+    def step_fraction(self, x: FloatArray, dx: FloatArray) -> float:
+        """The fraction of a step ``dx`` from ``x`` (all the body's points, (p, d)) that carries no node from
+        outside the penalty's full stiffness (a gap above ``-smoothing``) deeper than ``reach`` into the obstacle.
+
+        A Newton step is computed with no contact stiffness at the nodes still outside: it can carry one a whole
+        substep's motion (mm) into the obstacle, whose penalty then throws it back far enough to invert the
+        elements next to it. Scaled to land such a node ``reach`` inside (a straight path's gap, linear
+        between its ends), the next step sees the node in contact with its full stiffness.
+
+        >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, reach=0.1)
+        >>> x = np.array([[0.0, 0.0], [0.5, 0.0]])
+        >>> round(contact.step_fraction(x, np.array([[0.0, 0.0], [1.1, 0.0]])), 6)  # 0.6 of its 1.1 mm reach 0.1 mm in
+        0.545455
+        >>> contact.step_fraction(x, np.array([[0.0, 0.0], [0.55, 0.0]]))  # 0.05 mm in: all of it
+        1.0
+        """
+        if self.reach <= 0.0:
+            return 1.0
+        xs = x[self.points]
+        g0 = self.obstacle.kinematics(xs)[0]
+        g1 = self.obstacle.kinematics(xs + dx[self.points])[0]
+        deep = (g0 > -max(self.smoothing, 0.5 * self.reach)) & (g1 < -self.reach)
+        if not np.any(deep):
+            return 1.0
+        return float(np.min((g0[deep] + self.reach) / (g0[deep] - g1[deep])))
+
+    def _tributary(self, measures: FloatArray, share: FloatArray, touching: NDArray[np.bool_]) -> FloatArray:
+        """Every point's share of the faces in contact (those whose corners all touch), or of all its faces
+        where none of its faces is: the area (length in 2D) its contact force acts on."""
+        corners = 2 if self.faces.shape[1] <= 3 else 4
+        full = np.all(touching[self.faces[:, :corners]], axis=1)
+        out, anywhere = np.zeros(len(touching)), np.zeros(len(touching))
+        np.add.at(out, self.faces[full], measures[full, None] * share[None, :])
+        np.add.at(anywhere, self.faces, measures[:, None] * share[None, :])
+        return np.where(out > 0.0, out, anywhere)
+
     def commit(self, x: FloatArray) -> None:
-        """Keep the friction anchors of the converged state ``x`` (positions of all the body's points)."""
+        """Keep the friction anchors and the penalised gaps of the converged state ``x`` (positions of all the
+        body's points)."""
         self.anchors = self.evaluate(x)[3]
+        self.converged = penalty_gap(self.obstacle.kinematics(x[self.points])[0], self.smoothing)[0]
 
     def report(self, x: FloatArray) -> dict[str, Any]:
-        """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and theirs, and the contact
-        length (2D) or area (3D): the nodes' shares of their faces (:data:`SHARES`), summed over those in contact."""
+        """The force on the obstacle (summed, per unit depth in 2D), the nodes in contact and theirs, the contact
+        length (2D) or area (3D): the nodes' shares of their faces (:data:`SHARES`), summed over those in contact,
+        and each node's contact pressure: its force over its share of the faces in contact (MPa)."""
         force, active = self.forces(x)
         touching = np.zeros(x.shape[0], dtype=bool)
         touching[self.points[active]] = True
         measure = 0.0
+        pressures = np.zeros(int(active.sum()))
         if len(self.faces):
             share = SHARES[self.faces.shape[1]]
-            measure = float(np.sum(face_measures(self.faces, x) * (touching[self.faces] @ share)))
+            faces = face_measures(self.faces, x)
+            measure = float(np.sum(faces * (touching[self.faces] @ share)))
+            pressures = np.linalg.norm(force[active], axis=1) / self._tributary(faces, share, touching)[
+                self.points[active]]
         return {"force": force.sum(axis=0), "nodes": self.points[active], "node_forces": force[active],
-                "measure": measure}
+                "measure": measure, "node_pressures": pressures}
 
 
 def surface_points(cells: IntArray, cell_type: str, excluded: NDArray[np.bool_] | None = None) -> tuple[IntArray,

@@ -40,6 +40,9 @@ from pneumorph.models.response import FloatArray
 #: the gap over which the penalty sets in, over the element size
 #: (:func:`~pneumorph.fem.fast.contact.penalty_gap`)
 SMOOTHING = 0.02
+#: the deepest a Newton step may carry a node into an obstacle from outside, over the element size
+#: (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`)
+REACH = 0.1
 #: where an obstacle may touch: the whole outer surface, or the free end face only
 TOUCHES = ("surface", "end")
 
@@ -140,7 +143,8 @@ def contact_items(obstacles: Sequence[ModelObstacle], mesh: ActuatorMesh, shear_
     k = penalty_stiffness(shear_modulus, mesh.spec.element_size, mesh.dim)
     smoothing = SMOOTHING * mesh.spec.element_size
     items = [RigidContact(o.obstacle, np.unique(end_faces) if o.on == "end" else nodes, k,
-                          end_faces if o.on == "end" else faces, smoothing, o.friction) for o in obstacles]
+                          end_faces if o.on == "end" else faces, smoothing, o.friction,
+                          REACH * mesh.spec.element_size) for o in obstacles]
     for item in items:
         item.commit(mesh.points)  # friction's anchors: where the nodes start
     problem = start_inside([o.obstacle for o in obstacles], mesh.points)  # any point: an obstacle in a cavity too
@@ -186,6 +190,7 @@ class ContactRecord:
                             "force_magnitude_n": float(np.linalg.norm(report["force"] * self.scale)),
                             "nodes_in_contact": report["nodes"].tolist(),
                             "node_forces_n": (report["node_forces"] * self.scale).tolist(),
+                            "node_pressures_kpa": (report["node_pressures"] * 1e3).tolist(),
                             "contact_length_mm" if self.mesh.dim == 2 else "contact_area_mm2":
                                 report["measure"] * (2.0 if self.mesh.dim == 3 and self.scale[2] == 0.0 else 1.0)})
         self.levels[k:] = [{"pressure_kpa": pressure * 1e3, "base_reaction_n": reaction.tolist(),
@@ -282,5 +287,5 @@ def blocked_wall(tip0: FloatArray, tip1: FloatArray, end_points: FloatArray) -> 
     return {"kind": "plane", "point": farthest.tolist(), "normal": (-d).tolist(), "on": "end"}
 
 
-__all__ = ["SMOOTHING", "TOUCHES", "ContactRecord", "ModelObstacle", "blocked_obstacle", "blocked_wall",
+__all__ = ["REACH", "SMOOTHING", "TOUCHES", "ContactRecord", "ModelObstacle", "blocked_obstacle", "blocked_wall",
            "check_obstacles", "check_reach", "contact_items", "parse_obstacle"]
