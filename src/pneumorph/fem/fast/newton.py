@@ -226,10 +226,11 @@ class FastSubstep:
         system.tangent_dtype = np.float64
         self._factorised = False
 
-    def _stalled(self, settings: Any) -> str:
-        """Why a substep that used all its iterations failed."""
-        return (f"the residual norm reached {self.best:.3g} in {settings.max_iterations} iterations, not the "
-                f"tolerance {settings.tolerance:.3g} ({self.precision}-precision factorisation)")
+    def _stalled(self, settings: Any, error: float | None = None) -> str:
+        """Why a substep that used all its iterations failed (``error``: its constraints' last relative error)."""
+        constraint = "" if error is None else f" (constraint error {error:.3g})"
+        return (f"the residual norm reached {self.best:.3g}{constraint} in {settings.max_iterations} iterations, "
+                f"not the tolerance {settings.tolerance:.3g} ({self.precision}-precision factorisation)")
 
     def factorize(self) -> None:
         """Assemble the tangent at the state of the system's last residual and factorise it."""
@@ -247,18 +248,24 @@ class FastSubstep:
             return np.asarray(self.solver.solve(b))
         return np.asarray(self.solver(self._data, b))
 
-    def __call__(self, fields: Any, settings: Any) -> tuple[int, str | None]:
+    def __call__(self, fields: Any, settings: Any, border: Any = None) -> tuple[int, str | None]:
+        """Solve one substep from the values in ``fields`` (written back on convergence).
+
+        ``border`` adds unknowns to the displacements (e.g. the load factor of a
+        :class:`~pneumorph.fem.fast.volume.VolumeControl`), with ``start()`` (their values now), ``set(x)``
+        (the load they give), ``error(u)`` (the relative error of their constraints) and ``step(substep, u, r)``
+        (the chord step over the active dofs and them, with ``substep.solve``); None: the load stays as it is.
+        """
         contacts = getattr(self.system, "contacts", ())
         if contacts:
             self._hold_predictor(fields[0].values)
-        if self.reuse is None:
-            iterations, cause = self._newton(fields, settings)
-        else:
-            if self.fresh_start:
-                self._factorised = False
-            iterations, cause = self._chord(fields, settings)
-            if cause is not None:
-                self._factorised = False
+        if self.fresh_start or self.reuse is None:
+            self._factorised = False
+        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            iterations, cause = self._iterate(fields, settings, _FixedLoad() if border is None else border)
+        if cause is not None:
+            self._factorised = False
         if contacts and cause is None:
             self._converged = fields[0].values.ravel().copy()
         return iterations, cause
@@ -278,10 +285,10 @@ class FastSubstep:
             u[dof1] = last[dof1] + fraction * step
             values[:] = u.reshape(values.shape)
 
-    def _trial(self, u: FloatArray, step: FloatArray, fresh: bool, previous: float = np.inf
-               ) -> tuple[FloatArray, FloatArray, FloatArray, float, float]:
-        """The iterate of ``step`` from ``u``: ``(step taken, u_new, its residual, smallest det F, relative
-        residual)``.
+    def _trial(self, u: FloatArray, x: FloatArray, step: FloatArray, fresh: bool, previous: float, border: Any
+               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float, float]:
+        """The iterate of ``step`` (over the active dofs, then the border's unknowns) from ``(u, x)``:
+        ``(step taken, u_new, x_new, its residual, smallest det F, relative residual)``, its load set.
 
         On a body with obstacles, the step is first shortened to carry no node deep into an obstacle it was not
         pressing on (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
@@ -291,116 +298,109 @@ class FastSubstep:
         """
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
+        n = len(dof1)
         backtracks = BACKTRACKS if fresh and len(getattr(system, "contacts", ())) else 0
-        step = contact_fraction(system, u, step) * step
+        step = contact_fraction(system, u, step[:n]) * step
         for trial in range(backtracks + 1):
             if trial:
                 step = 0.5 * step
-            u_new = u.copy()
-            u_new[dof1] += step
+            u_new, x_new = u.copy(), x + step[n:]
+            u_new[dof1] += step[:n]
+            border.set(x_new)
             r_new, jmin = system.residual(u_new)
             fnorm = relative_residual(r_new, dof1, dof0)
             if jmin > 0.0 and fnorm <= min(DIVERGED, GROWTH * previous):  # (a NaN residual norm fails this too)
                 break
-        return step, u_new, r_new, jmin, fnorm
+        return step, u_new, x_new, r_new, jmin, fnorm
 
-    def _newton(self, fields: Any, settings: Any) -> tuple[int, str | None]:
-        system = self.system
-        dof1 = system.dof1
-        values = fields[0].values
-        u = values.ravel().copy()
-        self.best = float("inf")
-        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            warnings.simplefilter("ignore", RuntimeWarning)
-            r, jmin = system.residual(u)
-            if (cause := inadmissible(r, jmin)) is not None:
-                return 0, cause
-            fnorm = relative_residual(r, dof1, system.dof0)
-            for iteration in range(1, settings.max_iterations + 1):
-                try:
-                    self.factorize()
-                    dx = self.solve(-r[dof1])
-                except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
-                    return iteration, f"{type(exc).__name__}: {exc}"
-                if not np.all(np.isfinite(dx)):
-                    return iteration, "the linear solve gave a non-finite increment"
-                _, u, r, jmin, fnorm = self._trial(u, dx, True, fnorm)
-                self.best = min(self.best, fnorm)
-                if self.trace is not None:
-                    self.trace.append((fnorm, True))
-                done, cause = verdict(fnorm, jmin, u, values, settings.tolerance)
-                if done:
-                    return iteration, cause
-        values[:] = u.reshape(values.shape)
-        return settings.max_iterations, self._stalled(settings)
+    def _record(self, fnorm: float, fresh: bool) -> None:
+        self.best = min(self.best, fnorm)
+        if self.trace is not None:
+            self.trace.append((fnorm, fresh))
 
-    def _chord(self, fields: Any, settings: Any) -> tuple[int, str | None]:
-        """Chord iterations with Anderson acceleration and refresh (see the class notes)."""
+    def _iterate(self, fields: Any, settings: Any, border: Any) -> tuple[int, str | None]:
+        """Newton's method or chord iterations with Anderson acceleration and refresh (see the class notes)."""
         system = self.system
-        dof1, dof0 = system.dof1, system.dof0
         reuse = float(self.reuse or 0.5)
         values = fields[0].values
-        u = values.ravel().copy()
-        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            warnings.simplefilter("ignore", RuntimeWarning)
-            r, jmin = system.residual(u)
-            if (cause := inadmissible(r, jmin)) is not None:
-                return 0, cause
-            fnorm = relative_residual(r, dof1, dof0)
-            self.best = fnorm
-            if self.trace is not None:
-                self.trace.append((fnorm, False))
-            f: FloatArray | None = None  # chord step -K0^-1 r at u
-            dU: list[FloatArray] = []
-            dF: list[FloatArray] = []
-            fresh = False
-            poor = 0  # fresh tangents in a row that gained less than the reuse factor
-            for iteration in range(1, settings.max_iterations + 1):
+        u, x = values.ravel().copy(), border.start()
+        r, jmin = system.residual(u)
+        if (cause := inadmissible(r, jmin)) is not None:
+            return 0, cause
+        fnorm, error = relative_residual(r, system.dof1, system.dof0), border.error(u)
+        self.best = float("inf")
+        self._record(fnorm, False)
+        f: FloatArray | None = None  # chord step -K0^-1 r at u
+        dU: list[FloatArray] = []
+        dF: list[FloatArray] = []
+        fresh = False
+        poor = 0  # fresh tangents in a row that gained less than the reuse factor
+        for iteration in range(1, settings.max_iterations + 1):
+            try:
+                if not self._factorised:
+                    self.factorize()  # at the state of the last residual, u
+                    fresh, f, dU, dF = True, None, [], []
+                if f is None:
+                    f = border.step(self, u, r)
+            except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
+                return iteration, f"{type(exc).__name__}: {exc}"
+            step = _anderson(f, dU, dF)
+            if not np.all(np.isfinite(step)):
+                return iteration, "the linear solve gave a non-finite increment"
+            step, u_new, x_new, r_new, jmin, fnorm_new = self._trial(u, x, step, fresh, fnorm, border)
+            error_new = border.error(u_new)
+            self._record(fnorm_new, fresh)
+            if fresh:
+                poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
+            if not fresh and not (fnorm_new + error_new < fnorm + error and jmin > 0.0):
+                # a kept tangent that no longer helps: take the step back, refresh
+                border.set(x)
+                system.residual(u)  # the state the tangent is assembled at
+                self._factorised = False
+                continue
+            done, cause = verdict(fnorm_new, jmin, u_new, values, settings.tolerance, error_new)
+            if done:
+                return iteration, cause
+            if poor >= STALLED_FRESH and self.precision == "single":
+                self.to_double()  # refresh at u_new, in double precision from now on
+                f, poor = None, 0
+            elif self.reuse is None or fnorm_new > reuse * fnorm:
+                self._factorised = False  # refresh at u_new (at every iteration: Newton's method)
+                f = None
+            else:
                 try:
-                    if not self._factorised:
-                        self.factorize()  # at the state of the last residual, u
-                        fresh, f, dU, dF = True, None, [], []
-                    if f is None:
-                        f = -self.solve(r[dof1])
+                    f_new = border.step(self, u_new, r_new)
                 except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
                     return iteration, f"{type(exc).__name__}: {exc}"
-                step = f
-                if dF:
-                    Fm = np.column_stack(dF)
-                    gamma = np.linalg.lstsq(Fm, f, rcond=None)[0]
-                    step = f - (np.column_stack(dU) + Fm) @ gamma
-                if not np.all(np.isfinite(step)):
-                    return iteration, "the linear solve gave a non-finite increment"
-                step, u_new, r_new, jmin, fnorm_new = self._trial(u, step, fresh, fnorm)
-                self.best = min(self.best, fnorm_new)
-                if self.trace is not None:
-                    self.trace.append((fnorm_new, fresh))
-                if fresh:
-                    poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
-                if not fresh and not (fnorm_new < fnorm and jmin > 0.0):
-                    # a kept tangent that no longer helps: take the step back, refresh
-                    system.residual(u)  # the state the tangent is assembled at
-                    self._factorised = False
-                    continue
-                done, cause = verdict(fnorm_new, jmin, u_new, values, settings.tolerance)
-                if done:
-                    return iteration, cause
-                if poor >= STALLED_FRESH and self.precision == "single":
-                    self.to_double()  # refresh at u_new, in double precision from now on
-                    f, poor = None, 0
-                elif fnorm_new > reuse * fnorm:
-                    self._factorised = False  # refresh at u_new
-                    f = None
-                else:
-                    try:
-                        f_new = -self.solve(r_new[dof1])
-                    except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
-                        return iteration, f"{type(exc).__name__}: {exc}"
-                    if self.depth > 0:
-                        dU.append(step)
-                        dF.append(f_new - f)
-                        dU, dF = dU[-self.depth:], dF[-self.depth:]
-                    f = f_new
-                u, r, fnorm, fresh = u_new, r_new, fnorm_new, False
+                if self.depth > 0:
+                    dU, dF = [*dU, step][-self.depth:], [*dF, f_new - f][-self.depth:]
+                f = f_new
+            u, x, r, fnorm, error, fresh = u_new, x_new, r_new, fnorm_new, error_new, False
         values[:] = u.reshape(values.shape)
-        return settings.max_iterations, self._stalled(settings)
+        return settings.max_iterations, self._stalled(settings, error if x.size else None)
+
+
+class _FixedLoad:
+    """The border of a substep without extra unknowns (pressure control): Newton's step ``-K^-1 r``."""
+
+    def start(self) -> FloatArray:
+        return np.zeros(0)
+
+    def set(self, x: FloatArray) -> None:
+        pass
+
+    def error(self, u: FloatArray) -> float:
+        return 0.0
+
+    def step(self, substep: FastSubstep, u: FloatArray, r: FloatArray) -> FloatArray:
+        return -substep.solve(r[substep.system.dof1])
+
+
+def _anderson(f: FloatArray, dU: list[FloatArray], dF: list[FloatArray]) -> FloatArray:
+    """The chord step ``f`` minus the combination of the previous step and chord-step differences that best
+    cancels it (least squares)."""
+    if not dF:
+        return f
+    Fm = np.column_stack(dF)
+    gamma = np.linalg.lstsq(Fm, f, rcond=None)[0]
+    return f - (np.column_stack(dU) + Fm) @ gamma

@@ -21,14 +21,14 @@ elimination with the one factorisation of ``K``: ``a = K^-1 r``, ``b = K^-1 r_la
 
 so the CSR pattern, PARDISO's kept analysis and the tangent's symmetry are those of the
 pressure ramp; past the limit point ``K`` is indefinite and the bordered system is not
-singular. Like :class:`~pneumorph.fem.fast.newton.FastSubstep` it may keep its factorised
-tangent while it converges well (chord steps) and switches a stalled single-precision
-factorisation to double precision.
+singular. The iteration is :class:`~pneumorph.fem.fast.newton.FastSubstep`'s, with the load
+factor as a border (:meth:`VolumeControl.step`): kept tangents with Anderson acceleration,
+the step limit and line search at obstacles and the switch of a stalled single-precision
+factorisation to double precision are those of the pressure ramp.
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -36,8 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import SettingsError
-from pneumorph.fem.fast.newton import STALLED_FRESH, FastSubstep, inadmissible, verdict
-from pneumorph.fem.stepping import relative_residual
+from pneumorph.fem.fast.newton import FastSubstep
 
 FloatArray = NDArray[np.float64]
 
@@ -133,75 +132,36 @@ class VolumeControl:
         self.factor = float(factor)
         self.load(self.factor)
 
-    def _state(self, u: FloatArray) -> tuple[FloatArray, float, float, float]:
-        """Residual, smallest det F, relative residual norm and relative volume error at ``u``."""
-        system = self.system
-        r, jmin = system.residual(u)
-        fnorm = relative_residual(r, system.dof1, system.dof0)
-        return r, jmin, fnorm, abs(system.cavity_volume(u) - self.target) / self.volume0
+    def start(self) -> FloatArray:
+        """The extra unknown of the substep's Newton loop: the load factor now."""
+        return np.array([self.factor])
 
-    def _step(self, u: FloatArray, r: FloatArray, c: float) -> tuple[FloatArray, float]:
-        """The bordered Newton step ``(du over the active dofs, d lambda)`` with the factorised tangent."""
+    def set(self, x: FloatArray) -> None:
+        """Set the load factor ``x[0]``."""
+        self._set(float(x[0]))
+
+    def error(self, u: FloatArray) -> float:
+        """The relative volume error at ``u``."""
+        return float(abs(self.system.cavity_volume(u) - self.target) / self.volume0)
+
+    def step(self, substep: FastSubstep, u: FloatArray, r: FloatArray) -> FloatArray:
+        """The bordered Newton step (du over the active dofs, then d lambda) with the factorised tangent."""
         dof1 = self.system.dof1
         loads = self.system.wall_loads(u)
         r_factor = sum((s * load for s, load in zip(self.slopes, loads, strict=True)), start=np.zeros_like(u))
         g = -sum(loads, start=np.zeros_like(u))[dof1]  # dV/du
-        a = self.substep.solve(r[dof1])
-        b = self.substep.solve(r_factor[dof1])
-        dfactor = (c - g @ a) / (g @ b)
-        return -a - b * dfactor, float(dfactor)
+        a = substep.solve(r[dof1])
+        b = substep.solve(r_factor[dof1])
+        dfactor = (self.system.cavity_volume(u) - self.target - g @ a) / (g @ b)
+        return np.append(-a - b * dfactor, dfactor)
 
     def __call__(self, fields: Any, settings: Any) -> tuple[int, str | None]:
-        """Solve one substep from the values in ``fields`` (written back on convergence)."""
-        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            warnings.simplefilter("ignore", RuntimeWarning)
-            iterations, cause = self._iterate(fields, settings)
+        """Solve one substep from the values in ``fields`` (written back on convergence) with the substep's
+        Newton loop, bordered by the load factor."""
+        iterations, cause = self.substep(fields, settings, border=self)
         if cause is None:
             self.history = [*self.history[-2:], (self._t, self.factor)]
         return iterations, cause
-
-    def _iterate(self, fields: Any, settings: Any) -> tuple[int, str | None]:
-        dof1, substep, tol = self.system.dof1, self.substep, settings.tolerance
-        values = fields[0].values
-        u = values.ravel().copy()
-        factor = self.factor
-        r, jmin, fnorm, dv = self._state(u)
-        if (cause := inadmissible(r, jmin)) is not None:
-            return 0, cause
-        reuse = substep.reuse
-        factorised, fresh, poor = False, False, 0
-        for iteration in range(1, settings.max_iterations + 1):
-            try:
-                if not factorised:
-                    substep.factorize()  # at u, the state of the last residual
-                    factorised, fresh = reuse is not None, True
-                du, dfactor = self._step(u, r, (self.system.cavity_volume(u) - self.target))
-            except (ArithmeticError, np.linalg.LinAlgError, ValueError, RuntimeError) as exc:
-                return iteration, f"{type(exc).__name__}: {exc}"
-            if not (np.all(np.isfinite(du)) and np.isfinite(dfactor)):
-                return iteration, "the linear solve gave a non-finite increment"
-            u_new = u.copy()
-            u_new[dof1] += du
-            self._set(factor + dfactor)
-            r_new, jmin, fnorm_new, dv_new = self._state(u_new)
-            if not fresh and not (fnorm_new + dv_new < fnorm + dv and jmin > 0.0):
-                self._set(factor)  # a kept tangent that no longer helps: back to u, refresh there
-                r, jmin, fnorm, dv = self._state(u)
-                factorised = False
-                continue
-            done, cause = verdict(fnorm_new, jmin, u_new, values, tol, constraint=dv_new)
-            if done:
-                return iteration, cause
-            if fresh and reuse is not None:
-                poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
-                if poor >= STALLED_FRESH and substep.precision == "single":
-                    substep.to_double()
-                    factorised, poor = False, 0
-            if reuse is not None and fnorm_new > reuse * fnorm:
-                factorised = False  # refresh at u_new, the state of the last residual
-            u, factor, r, fnorm, dv, fresh = u_new, factor + dfactor, r_new, fnorm_new, dv_new, False
-        return settings.max_iterations, (f"the residual norm reached {fnorm:.3g} (volume error {dv:.3g}) in "
-                                         f"{settings.max_iterations} iterations, not the tolerance {tol:.3g}")
 
 
 def volume_control(change: float | None, substep: Any, apply: Callable[[float], None],
