@@ -26,8 +26,9 @@ def _pressure_ramp(increments: int, **plate) -> tuple[list[float], list[float], 
     return pressures, volumes, body.displacement.copy()
 
 
-def _volume_ramp(change: float, increments: int, reuse: float | None = None, **plate):
+def _volume_ramp(change: float, increments: int, reuse: float | None = None, depth: int = 0, **plate):
     body, apply, step = example_plate(reuse=reuse, **plate)
+    step.depth = depth  # Anderson acceleration of the kept tangent's steps, the load factor's among them
     control = VolumeControl(step, apply, change, body.displacement.ravel())
     pressures, volumes = [], []
 
@@ -40,11 +41,12 @@ def _volume_ramp(change: float, increments: int, reuse: float | None = None, **p
     return control, pressures, volumes, body.displacement.copy()
 
 
-@pytest.mark.parametrize("reuse", [None, 0.5])
-def test_the_volume_ramp_ends_on_the_pressure_ramps_state(reuse: float | None) -> None:
+@pytest.mark.parametrize(("reuse", "depth"), [(None, 0), (0.5, 0), (0.5, 4)])
+def test_the_volume_ramp_ends_on_the_pressure_ramps_state(reuse: float | None, depth: int) -> None:
     # thin walls below their limit (4.41 kPa): the pressure ramp to 4 kPa, then its volume driven
     _, volumes, u = _pressure_ramp(4, **{**THIN, "pressure": 0.004})
-    control, p, v, u2 = _volume_ramp(volumes[-1] / 6.25 - 1.0, 4, reuse=reuse, **{**THIN, "pressure": 0.004})
+    control, p, v, u2 = _volume_ramp(volumes[-1] / 6.25 - 1.0, 4, reuse=reuse, depth=depth,
+                                     **{**THIN, "pressure": 0.004})
     assert control.volume0 == pytest.approx(6.25, rel=1e-12)  # the 2.5 x 2.5 mm hole
     assert v[-1] == pytest.approx(volumes[-1], rel=1e-9)
     assert p[-1] == pytest.approx(0.004, rel=1e-6)
