@@ -278,7 +278,8 @@ def test_bad_option_value(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd
 
 
 @pytest.mark.parametrize("cmd", ["poisson", "thermal", "bilinear", "fit"])
-@pytest.mark.parametrize("data", ["binary.bin", "folder", "missing.csv", ""])
+@pytest.mark.parametrize("data", ["binary.bin", "folder", "missing.csv", "", "deep.json", "pipe", "huge.bin",
+                                  "/dev/zero", "latin1.toml"])  # deep.json: one line past the csv module's limit
 def test_bad_data_file(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, data: str) -> None:
     argv = [data if a.endswith(".csv") else a for a in BASE[cmd]]
     _refused(sandbox, capsys, argv)
@@ -484,6 +485,7 @@ def test_a_value_outside_a_choice_is_refused(sandbox: Path, capsys: pytest.Captu
     (None, "folder", []), (None, "pipe", []), (None, "huge.bin", []), (None, "/dev/urandom", []),
     (None, "/dev/null", []),  # refused by their kind or size, not as "no such file"
     ("x,y\n" + "".join(f"{0.1 * i},{0.05 * i}\n" for i in range(500)), "line.csv", []),  # on a line: 60 s of FE
+    ("x,y\n" + "1" * 200_000 + ",2\n", "long.csv", []),  # a field past the csv module's limit: csv.Error
     ("ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\nproperty float z\n"
      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
      + "".join(f"{i} {i * i % 7} {i % 3}\n" for i in range(12)) + "3 0 1 99\n", "faces.ply", []),

@@ -12,10 +12,12 @@ are not UTF-8 are refused with where they are. JSON and TOML are refused past a 
 from __future__ import annotations
 
 import codecs
+import csv
 import json
 import os
 import stat
 import tomllib
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -322,6 +324,30 @@ def read_json(path: str | Path, what: str, error: type[PneumorphError] = Setting
     if nested_deeper(data, MAX_JSON_DEPTH):
         raise error(deep)
     return data
+
+
+def csv_rows(lines: Iterable[str], where: str, error: type[PneumorphError] = SettingsError,
+             delimiter: str = ",") -> list[list[str]]:
+    """The rows of CSV ``lines``, or one line saying which row the csv module could not read.
+
+    A field longer than the csv module's limit (128 kB: a file that is one long line) or a stray quote
+    raises ``csv.Error``; here it is ``error``, naming ``where`` and the row.
+
+    >>> csv_rows(["x,y", "1,2"], "scan a.csv")
+    [['x', 'y'], ['1', '2']]
+    >>> csv_rows(["x,y", "[" * 200_000], "scan a.csv")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: scan a.csv, row 2: not CSV (field larger than field limit (131072))
+    """
+    reader = csv.reader(lines, delimiter=delimiter)
+    rows: list[list[str]] = []
+    try:
+        for row in reader:
+            rows.append(row)
+    except csv.Error as exc:
+        raise error(f"{where}, row {reader.line_num}: not CSV ({exc})") from None
+    return rows
 
 
 def nested_deeper(data: Any, limit: int) -> bool:
