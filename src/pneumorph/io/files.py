@@ -20,15 +20,15 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph.errors import OutputPathError
-from pneumorph.io.reading import (  # noqa: F401 - the readers, named here too (their module: pneumorph.io.reading)
-    MAX_SCAN_BYTES,
-    MAX_SETTINGS_BYTES,
-    MAX_TEXT_BYTES,
-    MAX_TOML_DEPTH,
-    nested_deeper,
-    read_text_file,
-    read_toml,
-)
+
+# the readers of a user's files (their module: pneumorph.io.reading), named here too
+from pneumorph.io.reading import MAX_SCAN_BYTES as MAX_SCAN_BYTES
+from pneumorph.io.reading import MAX_SETTINGS_BYTES as MAX_SETTINGS_BYTES
+from pneumorph.io.reading import MAX_TEXT_BYTES as MAX_TEXT_BYTES
+from pneumorph.io.reading import MAX_TOML_DEPTH as MAX_TOML_DEPTH
+from pneumorph.io.reading import nested_deeper as nested_deeper
+from pneumorph.io.reading import read_text_file as read_text_file
+from pneumorph.io.reading import read_toml as read_toml
 
 
 def _existing_ancestor(path: Path) -> Path:
