@@ -36,6 +36,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+ROOT = Path(__file__).resolve().parents[1]
 TIMEOUT = 10.0
 MAX_RSS_MB = 300.0
 
@@ -237,7 +238,9 @@ def run_case(case: Case, python: str = sys.executable) -> Outcome:
         _prepare(folder)
         (folder / "launch.py").write_text(LAUNCHER, encoding="utf-8")
         before = _listing(folder)
-        env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(folder / "xdg")}
+        source = os.pathsep.join([str(ROOT / "src"), *filter(None, [os.environ.get("PYTHONPATH")])])
+        env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(folder / "xdg"),
+               "PYTHONPATH": source}  # the checkout this script is in, whatever the working folder
         env.pop("PNEUMORPH_DEBUG", None)
         env.pop("PNEUMORPH_CACHE", None)
         t0 = time.perf_counter()
