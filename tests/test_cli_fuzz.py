@@ -57,6 +57,7 @@ def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
         fh.truncate(2**30)
     (tmp_path / "latin1.toml").write_bytes("[unit]\nname = 'caf\u00e9'\n".encode("latin-1"))
     (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
+    (tmp_path / "many.csv").write_text("1 2\n" * 1_000_000, encoding="utf-8")  # 4 MB, a million points: 2.5 GB parsed
     (tmp_path / "stress.csv").write_text("stretch,stress\n1.0,0.0\n1.5,0.2\n2.0,0.35\n2.5,0.5\n", encoding="utf-8")
     (tmp_path / "dic.csv").write_text("axial_strain,transverse_strain\n0.1,-0.04\n0.2,-0.08\n", encoding="utf-8")
     (tmp_path / "thermal.csv").write_text("temperature,strain\n20,0\n30,0.002\n40,0.004\n", encoding="utf-8")
@@ -129,7 +130,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')", "path:", "path:missing.csv",
-        "path:binary.bin", "path:folder", "path:a-file", "path:/dev/zero", "letter-q"],
+        "path:binary.bin", "path:folder", "path:a-file", "path:/dev/zero", "path:pipe", "path:huge.bin",
+        "path:many.csv", "letter-q"],
         "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""],

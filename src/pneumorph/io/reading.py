@@ -24,7 +24,7 @@ from typing import Any
 from pneumorph.errors import PneumorphError, SettingsError
 
 #: Largest settings file read (bytes): a design config, a unit, a unit library, a model file, a scan manifest, a
-#: material file, a path file (the shipped ones are under 20 kB)
+#: material file, a path file (the shipped ones are under 20 kB; a path of MAX_PATH_POINTS is about 60 kB)
 MAX_SETTINGS_BYTES = 8 * 2**20
 
 #: Largest text file read as a user's input (bytes): chain tables (the shipped ones are at most 7.3 MB) and test
