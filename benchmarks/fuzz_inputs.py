@@ -3,21 +3,21 @@
 The cases are not drawn at random but enumerated from the command tree: every option or argument that
 reads a file (``InputFile``, and the options that take a file by name: ``--library``, ``--target
 path:FILE``) meets a device (``/dev/zero``, ``/dev/urandom``), a named pipe, a folder, a sparse file of
-1 GB, a file with a byte-order mark, binary garbage and JSON nested 100,000 deep; every number option
-(``Real``, ``Count``, ``RealList``) meets ``nan``, ``inf``, ``-1``, ``0``, ``1e300`` and text. Each case
-starts from a baseline that would run (tiny 2D models, coarse elements) and runs in a subprocess whose
-solvers are tripwires: a solve reached ends it with exit 99 (the value was accepted). A case is judged:
+1 GB, a file with a byte-order mark, binary garbage, JSON nested 100,000 deep and 60 MB of short rows;
+every number option (``Real``, ``Count``, ``RealList``) meets ``nan``, ``inf``, ``-1``, ``0``, ``1e300``
+and text. Each case starts from a baseline that would run (tiny 2D models, coarse elements) and runs in a
+subprocess whose solvers are tripwires: a solve reached ends it with exit 99 (the value was accepted). A case is judged:
 
 - *internal error*: ``internal error`` or a traceback on stderr (exit 1);
 - *accepted bad input*: exit 0 or 99 for a value no option takes (a device, a pipe, a folder, 1 GB,
-  garbage, deep JSON, ``nan``, ``inf``, text, ``1e300``);
+  garbage, deep JSON, 60 MB of rows, ``nan``, ``inf``, text, ``1e300``);
 - *runaway*: more than :data:`TIMEOUT` s or :data:`MAX_RSS_MB` MB (the child's peak resident memory);
 - *untidy refusal*: exit 2 with more than one line, or files left behind;
 - otherwise clean (refused in one line, or, for ``-1``, ``0`` and a byte-order mark, accepted).
 
     OMP_NUM_THREADS=1 python benchmarks/fuzz_inputs.py [--cases 500] [--seed 0] [--json F]
 
-All path cases are run (368); the number cases fill the rest, every number option once (128) before any twice.
+All path cases are run (414); the number cases fill the rest, every number option once (128) before any twice.
 """
 
 from __future__ import annotations
@@ -115,7 +115,8 @@ NAMED_FILES = {"design": ["--library", "--target"], "simulate": ["--library"], "
 
 # The hostile files and what each must get: "refuse" (any value of its kind is bad) or "either" (read correctly).
 PATHS = {"/dev/zero": "refuse", "/dev/urandom": "refuse", "pipe": "refuse", "folder": "refuse",
-         "huge.bin": "refuse", "bom": "either", "garbage.bin": "refuse", "deep.json": "refuse"}
+         "huge.bin": "refuse", "bom": "either", "garbage.bin": "refuse", "deep.json": "refuse", "bulk.csv": "refuse"}
+#: 60 MB of rows "1,2" under a header "x,y": text under the text limit, but fifteen million rows or points
 NUMBERS = {"nan": "refuse", "inf": "refuse", "-1": "either", "0": "either", "1e300": "refuse", "abc": "refuse"}
 
 
@@ -215,7 +216,22 @@ def cases(count: int = 400, seed: int = 0) -> list[Case]:
     return paths + chosen[:max(0, count - len(paths))]
 
 
-def _prepare(folder: Path) -> None:
+_BULK: list[Path] = []
+
+
+def _bulk() -> Path:
+    """The bulk file, written once per round (each case's folder links to it)."""
+    if not _BULK:
+        path = Path(tempfile.mkdtemp(prefix="fuzz-inputs-bulk-")) / "bulk.csv"
+        with path.open("w", encoding="utf-8") as fh:
+            fh.write("x,y\n")
+            for _ in range(15):
+                fh.write("1,2\n" * 2**20)
+        _BULK.append(path)
+    return _BULK[0]
+
+
+def _prepare(folder: Path, bulk: bool = False) -> None:
     for name, text in FILES.items():
         (folder / name).write_text(text, encoding="utf-8")
     (folder / "folder").mkdir()
@@ -225,6 +241,8 @@ def _prepare(folder: Path) -> None:
     (folder / "bom").write_bytes(b"\xef\xbb\xbf" + UNIT.encode())
     (folder / "garbage.bin").write_bytes(random.Random(0).randbytes(4096))
     (folder / "deep.json").write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
+    if bulk:
+        (folder / "bulk.csv").symlink_to(_bulk())
 
 
 def _listing(root: Path) -> set[str]:
@@ -235,7 +253,7 @@ def run_case(case: Case, python: str = sys.executable) -> Outcome:
     """Run one case in a fresh folder, bounded by :data:`TIMEOUT`; judge how it ended."""
     folder = Path(tempfile.mkdtemp(prefix="fuzz-inputs-"))
     try:
-        _prepare(folder)
+        _prepare(folder, bulk=case.value.endswith("bulk.csv"))
         (folder / "launch.py").write_text(LAUNCHER, encoding="utf-8")
         before = _listing(folder)
         source = os.pathsep.join([str(ROOT / "src"), *filter(None, [os.environ.get("PYTHONPATH")])])
@@ -312,6 +330,8 @@ def main() -> int:
         if o.verdict != "clean":
             print(f"FINDING {o.command} {o.option} {o.value!r}: {o.verdict} (exit {o.code}, {o.seconds} s, "
                   f"{o.rss_mb} MB); {' | '.join(o.stderr_tail)[:300]}")
+    for bulk in _BULK:
+        shutil.rmtree(bulk.parent, ignore_errors=True)
     if args.json:
         args.json.write_text(json.dumps({"wall_s": wall, "outcomes": [asdict(o) for o in outcomes]}, indent=1))
     return 1 if any(o.verdict != "clean" for o in outcomes) else 0

@@ -281,8 +281,9 @@ def test_bad_option_value(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd
 
 @pytest.mark.parametrize("cmd", ["poisson", "thermal", "bilinear", "fit"])
 @pytest.mark.parametrize("data", ["binary.bin", "folder", "missing.csv", "", "deep.json", "pipe", "huge.bin",
-                                  "/dev/zero", "latin1.toml"])  # deep.json: one line past the csv module's limit
+                                  "/dev/zero", "latin1.toml", "many.csv"])
 def test_bad_data_file(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, data: str) -> None:
+    """deep.json is one line past the csv module's limit; many.csv a million rows (2 GB and a minute parsed)."""
     argv = [data if a.endswith(".csv") else a for a in BASE[cmd]]
     _refused(sandbox, capsys, argv)
 

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ScanError, interrupts_kept
-from pneumorph.io.reading import MAX_SCAN_BYTES, check_input_file, csv_rows, read_text_file
+from pneumorph.io.reading import MAX_SCAN_BYTES, MAX_TEXT_BYTES, check_input_file, csv_rows, read_text_file
 
 FloatArray = NDArray[np.float64]
 
@@ -182,7 +182,7 @@ def check_spread(path: str | Path, points: FloatArray) -> None:
 
 
 def _read_csv(path: Path) -> FloatArray:
-    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig", limit=MAX_SCAN_BYTES)
+    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig", limit=MAX_TEXT_BYTES)  # 500,000 points: 25 MB
     check_points(path, text.count("\n") - 1)  # the rows below the header, before they are parsed
     rows = [r for r in csv_rows(io.StringIO(text), f"scan {path}", ScanError) if any(c.strip() for c in r)]
     if not rows:

@@ -34,6 +34,10 @@ MAX_TEXT_BYTES = 64 * 2**20
 #: Largest scan read (bytes): a point cloud of about four million points as text
 MAX_SCAN_BYTES = 256 * 2**20
 
+#: Most rows of a table of test data (a stress-strain curve, DIC or thermal strains): a test logged at 100 Hz for
+#: 33 minutes; the rows are held as text while they are parsed (about 200 bytes each), so more would only cost memory
+MAX_DATA_ROWS = 200_000
+
 #: Deepest nesting of tables and arrays a settings file may have (the package's own go 4 deep)
 MAX_TOML_DEPTH = 32
 
@@ -324,6 +328,22 @@ def read_json(path: str | Path, what: str, error: type[PneumorphError] = Setting
     if nested_deeper(data, MAX_JSON_DEPTH):
         raise error(deep)
     return data
+
+
+def check_rows(text: str, where: str, error: type[PneumorphError] = SettingsError, limit: int = MAX_DATA_ROWS) -> None:
+    """Refuse text of more than ``limit`` lines (counted, not split), before its rows are parsed.
+
+    >>> check_rows("x,y\\n" + "1,2\\n" * 300_000, "data file big.csv")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: data file big.csv: 300,001 rows, more than MAX_DATA_ROWS = 200,000
+        (pneumorph.io.reading); thin the data out (one row in 2 keeps 150,001)
+    """
+    rows = text.count("\n") + (not text.endswith("\n"))
+    if rows > limit:
+        every = -(-rows // limit)
+        raise error(f"{where}: {rows:,} rows, more than MAX_DATA_ROWS = {limit:,} (pneumorph.io.reading); thin the "
+                    f"data out (one row in {every} keeps {-(-rows // every):,})")
 
 
 def csv_rows(lines: Iterable[str], where: str, error: type[PneumorphError] = SettingsError,
