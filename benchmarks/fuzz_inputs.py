@@ -11,7 +11,8 @@ subprocess whose solvers are tripwires: a solve reached ends it with exit 99 (th
 - *internal error*: ``internal error`` or a traceback on stderr (exit 1);
 - *accepted bad input*: exit 0 or 99 for a value no option takes (a device, a pipe, a folder, 1 GB,
   garbage, deep JSON, 60 MB of rows, ``nan``, ``inf``, text, ``1e300``);
-- *runaway*: more than :data:`TIMEOUT` s or :data:`MAX_RSS_MB` MB (the child's peak resident memory);
+- *runaway*: more than :data:`TIMEOUT` s of CPU, :data:`WALL_LIMIT` s of wall time or :data:`MAX_RSS_MB` MB
+  (the child's peak resident memory);
 - *untidy refusal*: exit 2 with more than one line, or files left behind;
 - otherwise clean (refused in one line, or, for ``-1``, ``0`` and a byte-order mark, accepted).
 
@@ -37,7 +38,8 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
-TIMEOUT = 10.0
+TIMEOUT = 10.0  # CPU seconds of a case (interpreter start included): past it, a runaway
+WALL_LIMIT = 60.0  # a case still running after this wall time is stopped (a shared machine stretches wall times)
 MAX_RSS_MB = 300.0
 
 LAUNCHER = """
@@ -136,6 +138,7 @@ class Outcome:
     value: str
     code: int
     seconds: float
+    cpu_s: float
     rss_mb: float
     verdict: str
     stderr_tail: list[str] = field(default_factory=list)
@@ -265,36 +268,37 @@ def run_case(case: Case, python: str = sys.executable) -> Outcome:
         with open(folder / "err", "wb") as err, open(os.devnull, "wb") as out:
             child = subprocess.Popen([python, "launch.py", *case.argv], cwd=folder, env=env, stdout=out, stderr=err,
                                      stdin=subprocess.DEVNULL)
-            code, rss = _wait(child)
+            code, cpu, rss = _wait(child)
         seconds = time.perf_counter() - t0
         lines = [x for x in (folder / "err").read_text(errors="replace").splitlines() if x.strip()]
         left = {p for p in _listing(folder) - before - {"err"} if not p.startswith("xdg")}
-        verdict = _judge(case, code, lines, left, seconds, rss)
-        return Outcome(case.command, case.option, case.value, code, round(seconds, 2), round(rss, 1), verdict,
-                       lines[-2:])
+        verdict = _judge(case, code, lines, left, cpu, rss)
+        return Outcome(case.command, case.option, case.value, code, round(seconds, 2), round(cpu, 2), round(rss, 1),
+                       verdict, lines[-2:])
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
 
-def _wait(child: subprocess.Popen[bytes]) -> tuple[int, float]:
-    """The child's exit code (-1: stopped at the timeout) and its peak resident memory, MB."""
-    deadline = time.monotonic() + TIMEOUT
+def _wait(child: subprocess.Popen[bytes]) -> tuple[int, float, float]:
+    """The child's exit code (-1: stopped at :data:`WALL_LIMIT`), its CPU seconds and its peak resident memory, MB."""
+    deadline = time.monotonic() + WALL_LIMIT
     while True:
         pid, status, usage = os.wait4(child.pid, os.WNOHANG)
         if pid:
             child.returncode = os.waitstatus_to_exitcode(status)
-            return child.returncode, usage.ru_maxrss / 1024
+            break
         if time.monotonic() > deadline:
             child.kill()
             _, status, usage = os.wait4(child.pid, 0)
             child.returncode = -1
-            return -1, usage.ru_maxrss / 1024
+            break
         time.sleep(0.05)
+    return child.returncode, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
 
 
-def _judge(case: Case, code: int, lines: list[str], left: set[str], seconds: float, rss: float) -> str:
+def _judge(case: Case, code: int, lines: list[str], left: set[str], cpu: float, rss: float) -> str:
     text = "\n".join(lines)
-    if code == -1 or rss > MAX_RSS_MB:
+    if code == -1 or cpu > TIMEOUT or rss > MAX_RSS_MB:
         return "runaway"
     if "Traceback" in text or "internal error" in text or code == 1:
         return "internal error"
@@ -322,14 +326,16 @@ def main() -> int:
         counts[o.verdict] = counts.get(o.verdict, 0) + 1
     own = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     paths = sum(c.value.removeprefix("path:") in PATHS for c in todo)
-    slowest, largest = max(o.seconds for o in outcomes), max(o.rss_mb for o in outcomes)
+    slowest, cpu, largest = (max(o.seconds for o in outcomes), max(o.cpu_s for o in outcomes),
+                             max(o.rss_mb for o in outcomes))
     print(f"{len(outcomes)} cases ({paths} of files, {len(todo) - paths} of numbers; seed {args.seed}) in "
-          f"{wall:.0f} s; slowest {slowest:.1f} s, largest {largest:.0f} MB (children's peak {own:.0f} MB)")
+          f"{wall:.0f} s; slowest {slowest:.1f} s wall, {cpu:.1f} s CPU; largest {largest:.0f} MB (children's peak "
+          f"{own:.0f} MB)")
     print("  " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
     for o in outcomes:
         if o.verdict != "clean":
             print(f"FINDING {o.command} {o.option} {o.value!r}: {o.verdict} (exit {o.code}, {o.seconds} s, "
-                  f"{o.rss_mb} MB); {' | '.join(o.stderr_tail)[:300]}")
+                  f"{o.cpu_s} s CPU, {o.rss_mb} MB); {' | '.join(o.stderr_tail)[:300]}")
     for bulk in _BULK:
         shutil.rmtree(bulk.parent, ignore_errors=True)
     if args.json:
