@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))  # the command tree of this checkout, as its cases run it
 TIMEOUT = 10.0  # CPU seconds of a case (interpreter start included): past it, a runaway
 WALL_LIMIT = 60.0  # a case still running after this wall time is stopped (a shared machine stretches wall times)
 MAX_RSS_MB = 300.0
