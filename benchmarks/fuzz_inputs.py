@@ -16,7 +16,7 @@ subprocess whose solvers are tripwires: a solve reached ends it with exit 99 (th
 - *untidy refusal*: exit 2 with more than one line, or files left behind;
 - otherwise clean (refused in one line, or, for ``-1``, ``0`` and a byte-order mark, accepted).
 
-    OMP_NUM_THREADS=1 python benchmarks/fuzz_inputs.py [--cases 500] [--seed 0] [--json F]
+    OMP_NUM_THREADS=1 python benchmarks/fuzz_inputs.py [--cases 550] [--seed 0] [--json F]
 
 All path cases are run (414); the number cases fill the rest, every number option once (128) before any twice.
 """
@@ -314,7 +314,7 @@ def _judge(case: Case, code: int, lines: list[str], left: set[str], cpu: float, 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--cases", type=int, default=500)
+    parser.add_argument("--cases", type=int, default=550)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
