@@ -8,6 +8,7 @@ computing: every refusal must come before any solve.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -51,6 +52,12 @@ def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
         '{"format": 3, "kind": "pneumorph chain table", "window": 3, "pressures_mpa": [0.045], "terms": {"window": 2}}',
         encoding="utf-8")
     (tmp_path / "folder").mkdir()
+    os.mkfifo(tmp_path / "pipe")  # opened, it would block: refused by its kind before
+    with (tmp_path / "huge.bin").open("wb") as fh:  # 1 GB that takes no disk (sparse)
+        fh.truncate(2**30)
+    (tmp_path / "latin1.toml").write_bytes("[unit]\nname = 'caf\u00e9'\n".encode("latin-1"))
+    (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
+    (tmp_path / "many.csv").write_text("1 2\n" * 1_000_000, encoding="utf-8")  # 4 MB, a million points: 2.5 GB parsed
     (tmp_path / "stress.csv").write_text("stretch,stress\n1.0,0.0\n1.5,0.2\n2.0,0.35\n2.5,0.5\n", encoding="utf-8")
     (tmp_path / "dic.csv").write_text("axial_strain,transverse_strain\n0.1,-0.04\n0.2,-0.08\n", encoding="utf-8")
     (tmp_path / "thermal.csv").write_text("temperature,strain\n20,0\n30,0.002\n40,0.004\n", encoding="utf-8")
@@ -123,7 +130,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')", "path:", "path:missing.csv",
-        "path:binary.bin", "path:folder", "path:a-file", "path:/dev/zero", "letter-q"],
+        "path:binary.bin", "path:folder", "path:a-file", "path:/dev/zero", "path:pipe", "path:huge.bin",
+        "path:many.csv", "letter-q"],
         "--scheduler": ["not a url", ""],
         "--unit": ["binary.bin", "folder", "missing.toml", ""], "--cache": ["folder", "a-file/x.sqlite", ""],
         "--out": ["a-file", "a-file/sub", ""],
@@ -240,6 +248,16 @@ for _command in ("design", "study", "calibrate", "chain", "optimise", "simplific
     OPTIONS[_command]["--workers"] = [*OPTIONS[_command].get("--workers", POS_COUNT), "1024"]  # past the cores
     OPTIONS[_command].setdefault("--scheduler", ["not a url", ""])
 
+# every option that reads a file: a device, a named pipe, a file of 1 GB, text in another encoding, JSON nested
+# 100,000 deep (pneumorph.io.reading); each refused by its kind or size before it is read
+HOSTILE_FILES = ["/dev/zero", "/dev/urandom", "pipe", "huge.bin", "latin1.toml", "deep.json"]
+for _options in OPTIONS.values():
+    for _option in ("--unit", "--library", "--chain-table", "--model-file", "--manifest", "--photo"):
+        if _option in _options:
+            _options[_option] = [*_options[_option], *HOSTILE_FILES]
+OPTIONS["identify"]["--pressure"] += ["1e-300", "0.5"]  # below MIN_SCAN_PRESSURE_KPA: no deformation to fit
+OPTIONS["mesh"]["--size"] += ["1.0"]  # one size: no convergence to estimate
+
 CASES = [(cmd, opt, bad) for cmd, options in OPTIONS.items() for opt, values in options.items() for bad in values]
 
 
@@ -262,8 +280,10 @@ def test_bad_option_value(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd
 
 
 @pytest.mark.parametrize("cmd", ["poisson", "thermal", "bilinear", "fit"])
-@pytest.mark.parametrize("data", ["binary.bin", "folder", "missing.csv", ""])
+@pytest.mark.parametrize("data", ["binary.bin", "folder", "missing.csv", "", "deep.json", "pipe", "huge.bin",
+                                  "/dev/zero", "latin1.toml", "many.csv"])
 def test_bad_data_file(sandbox: Path, capsys: pytest.CaptureFixture[str], cmd: str, data: str) -> None:
+    """deep.json is one line past the csv module's limit; many.csv a million rows (2 GB and a minute parsed)."""
     argv = [data if a.endswith(".csv") else a for a in BASE[cmd]]
     _refused(sandbox, capsys, argv)
 
@@ -465,11 +485,19 @@ def test_a_value_outside_a_choice_is_refused(sandbox: Path, capsys: pytest.Captu
     (b"", "scan.stl", []), (b"solid x\nnot a facet\n" * 3, "scan.stl", []), (bytes(range(256)), "scan.csv", []),
     (b"x,y\n1,2\n", "scan.csv", []), (b"u,v\n" + b"1,2\n" * 20, "scan.csv", []), (b"1 2 3\n", "scan.dat", []),
     (None, "trace.csv", ["--scan-unit", "m"]),  # a trace in mm read as metres: 1000 times too large
+    (None, "folder", []), (None, "pipe", []), (None, "huge.bin", []), (None, "/dev/urandom", []),
+    (None, "/dev/null", []),  # refused by their kind or size, not as "no such file"
+    ("x,y\n" + "".join(f"{0.1 * i},{0.05 * i}\n" for i in range(500)), "line.csv", []),  # on a line: 60 s of FE
+    ("x,y\n" + "1" * 200_000 + ",2\n", "long.csv", []),  # a field past the csv module's limit: csv.Error
+    ("ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\nproperty float z\n"
+     "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+     + "".join(f"{i} {i * i % 7} {i % 3}\n" for i in range(12)) + "3 0 1 99\n", "faces.ply", []),
 ])
 def test_bad_scans_are_refused_before_the_model_is_solved(sandbox: Path, capsys: pytest.CaptureFixture[str],
-                                                         content: bytes | None, name: str, extra: list[str]) -> None:
+                                                         content: bytes | str | None, name: str,
+                                                         extra: list[str]) -> None:
     if content is not None:
-        (sandbox / name).write_bytes(content)
+        (sandbox / name).write_bytes(content.encode() if isinstance(content, str) else content)
     argv = ["correlate", name, "--design", "0110", "--model", "2d", *extra]
     if not extra:
         argv += ["--scale", "0.2"]

@@ -41,7 +41,9 @@ def test_mesh_study_of_a_short_section(tmp_path: Path, capsys: pytest.CaptureFix
     ("args", "message"),
     [
         (["--design", "01", "--design", "011"], "different lengths"),
-        (["--size", "0.2"], "GB for one solve"),
+        (["--size", "0.3", "--size", "0.2"], "GB for one solve"),
+        (["--size", "1.0", "--order", "2"], "one element size (1 mm) shows no convergence; give two or more"),
+        (["--size", "1.0", "--size", "0.75", "--size", "1"], "1 mm given more than once"),
         (["--design", "0" * 15, "--design", "1" * 15, "--size", "1.0", "--size", "0.9", "--executor", "processes",
           "--workers", "4"], "GB for one solve x 4 at once"),
         (["--target", "max-q"], "unknown objective"),

@@ -85,7 +85,7 @@ def test_bad_path_files_are_refused_in_one_line_with_nothing_written(tmp_path: P
 def test_a_missing_path_file_and_a_curve_that_turns_back_are_refused(tmp_path: Path,
                                                                     capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["design", "--target", f"path:{tmp_path / 'none.csv'}", "--out", str(tmp_path / "a")]) == 2
-    assert "none.csv: cannot be read" in capsys.readouterr().err
+    assert "none.csv: no such file" in capsys.readouterr().err
     config = tmp_path / "curl.toml"
     config.write_text('[design]\nobjective = "curve"\ncurve = [[0, 0], [80, 10], [70, 40]]\n')
     assert main(["design", str(config), "--out", str(tmp_path / "b")]) == 2

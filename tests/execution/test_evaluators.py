@@ -209,3 +209,33 @@ def test_no_worker_process_outlives_its_evaluator(scenario: str) -> None:
     while any(_running(pid) for pid in report["pids"]) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not [pid for pid in report["pids"] if _running(pid)]
+
+
+def test_a_pool_starts_no_more_processes_than_the_batch_has_designs(serial: list,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """--workers 4 for 2 designs started 4 processes (and --workers 1024 for 13 designs, 132): the pool is sized to
+    the batch, says so once, and grows for a larger batch."""
+    monkeypatch.syspath_prepend(str(REPO))
+    model = ToyModel(n_units=6, fail={"111000"})
+    lines: list[str] = []
+    with ProcessPoolEvaluator(workers=4, on_message=lines.append) as ev:
+        out = ev.evaluate_many(model, DESIGNS[:2])
+        assert ev.started == 2 and len({ev._pool.submit(os.getpid).result() for _ in range(8)}) <= 2
+        ev.evaluate_many(model, DESIGNS[:1])
+        assert ev.started == 2  # a smaller batch keeps the pool
+        ev.evaluate_many(model, DESIGNS)
+        assert ev.started == 4  # six designs: the four processes asked for, no more
+    same(out, serial[:2])
+    assert lines == ["starting 2 worker processes, not 4: the batch has 2 designs to solve"]
+
+
+def test_a_local_dask_cluster_starts_its_workers_as_the_batch_needs(model: ToyModel, serial: list) -> None:
+    lines: list[str] = []
+    with DaskEvaluator(workers=3, processes=False, on_message=lines.append) as ev:
+        assert len(ev._cluster.workers) == 0 and ev.workers == 3  # nothing started before a batch
+        out = ev.evaluate_many(model, DESIGNS[:1])
+        assert len(ev._cluster.workers) == 1
+        ev.evaluate_many(model, DESIGNS)
+        assert len(ev._cluster.workers) == 3
+    same(out, serial[:1])
+    assert lines == ["starting 1 Dask worker, not 3: the batch has 1 design to solve"]

@@ -205,7 +205,7 @@ def test_bad_files(tmp_path: Path) -> None:
     ok.write_text("1,0\n2,1\n")
     with pytest.raises(DataFormatError, match="unknown stress unit"):
         read_curve(ok, stress_unit="bar")
-    with pytest.raises(DataFormatError, match=r"missing\.csv: cannot be read"):
+    with pytest.raises(DataFormatError, match=r"missing\.csv: no such file"):
         read_curve(tmp_path / "missing.csv")
 
 

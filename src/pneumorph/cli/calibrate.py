@@ -55,7 +55,8 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
     if len(levels) < 2:
         raise click.BadParameter(f"--pressures needs at least two different pressures, got {pressures}",
                                  param_hint="'--pressures'")
-    unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
+    with P.blame("--unit"):
+        unit = UnitSpec.from_toml(unit_file) if unit_file else UnitSpec()
 
     from pneumorph.calibration.references import reference_jobs
 

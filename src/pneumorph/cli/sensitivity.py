@@ -297,7 +297,7 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
                                  "length", param_hint="--design")
     n = lengths.pop() if lengths else n_units
     designs = tuple(dict.fromkeys(designs)) or ("0" * n,)
-    sizes = tuple(sorted(set(sizes or (1.5, 1.0, 0.75)), reverse=True))
+    sizes = _mesh_sizes(sizes)
     settings: dict[str, Any] = {"fidelity": fidelity, "pressure_kpa": pressure}
     if unit_file:
         P.unit_option(unit_file)
@@ -347,6 +347,24 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     _print_mesh(study, objective.unit)
     if out:
         click.echo(f"written to {Path(out)}/ (mesh.json, mesh.png)")
+
+
+def _mesh_sizes(sizes: tuple[float, ...]) -> tuple[float, ...]:
+    """The element sizes of ``--size`` (default 1.5, 1.0 and 0.75), coarsest first: two or more, each once.
+
+    One size has no convergence to estimate (and no use for ``--order``); a size given twice would be solved once.
+    """
+    if not sizes:
+        return (1.5, 1.0, 0.75)
+    twice = sorted({s for s in sizes if sizes.count(s) > 1})
+    if twice:
+        raise click.BadParameter(f"{', '.join(f'{s:g}' for s in twice)} mm given more than once; give each element "
+                                 "size once", param_hint="--size")
+    if len(sizes) < 2:
+        raise click.BadParameter(f"one element size ({sizes[0]:g} mm) shows no convergence; give two or more (e.g. "
+                                 f"--size {sizes[0]:g} --size {sizes[0] / 1.5:.3g}), or leave --size out for 1.5, "
+                                 "1.0 and 0.75 mm", param_hint="--size")
+    return tuple(sorted(sizes, reverse=True))
 
 
 def _objective_at_best(objective: Any, response: Any) -> tuple[float, int | None]:

@@ -8,7 +8,6 @@ unit (mm, cm, m or in; or a scale in mm per unit, e.g. mm per pixel) converts it
 
 from __future__ import annotations
 
-import csv
 import io
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ScanError, interrupts_kept
-from pneumorph.io.files import MAX_SCAN_BYTES, read_text_file
+from pneumorph.io.reading import MAX_SCAN_BYTES, MAX_TEXT_BYTES, check_input_file, csv_rows, read_text_file
 
 FloatArray = NDArray[np.float64]
 
@@ -126,9 +125,7 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
     factor = SCAN_UNITS[unit] if scale is None else float(scale)
     if not (np.isfinite(factor) and factor > 0):
         raise ScanError(f"the scan's scale must be a positive number of mm per unit, got {scale!r}")
-    if not p.is_file():
-        raise ScanError(f"scan {p}: no such file")
-    if p.stat().st_size == 0:
+    if check_input_file(p, "scan", ScanError, MAX_SCAN_BYTES).st_size == 0:  # a folder, a device, a pipe: by name
         raise ScanError(f"scan {p}: the file is empty")
     suffix = p.suffix.lower()
     if suffix in (".csv", ".txt"):
@@ -142,13 +139,52 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
     check_points(p, len(points))
     if not np.all(np.isfinite(points)):
         raise ScanError(f"scan {p}: some coordinates are not finite")
+    check_spread(p, points)
     return Scan(points * factor, faces, str(p))
 
 
+#: Least spread of a scan across its thinnest direction, relative to its widest (singular values of the centred
+#: points): below it the points lie on a line (2D) or a plane (3D), which no alignment can place
+MIN_SPREAD = 1e-6
+
+
+def check_spread(path: str | Path, points: FloatArray) -> None:
+    """Refuse a scan whose points lie on a line (a 2D trace) or on a plane (a 3D scan), before any solve.
+
+    An actuator's outline is two-dimensional and its surface three-dimensional: points without spread across
+    one direction leave the alignment free along it (and say nothing of a bend), so the fit would not converge.
+
+    Raises
+    ------
+    ScanError
+        The thinnest spread below :data:`MIN_SPREAD` of the widest.
+
+    Examples
+    --------
+    >>> line = np.c_[np.linspace(0, 40, 500), np.linspace(0, 20, 500)]
+    >>> check_spread("line.csv", line)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.ScanError: scan line.csv: its 500 points lie on a straight line (a 2D trace must follow the
+        outline of the actuator, its width too): no alignment can place them
+    >>> check_spread("trace.csv", np.c_[line[:, 0], np.sin(line[:, 0])])
+    """
+    centred = points - points.mean(axis=0)
+    spread = np.sqrt(np.clip(np.linalg.eigvalsh(centred.T @ centred), 0.0, None))  # ascending
+    if spread[-1] > 0 and spread[0] >= MIN_SPREAD * spread[-1]:
+        return
+    dim = points.shape[1]
+    shape = ("a single point" if spread[-1] == 0 else "a straight line" if dim == 2 or spread[1] < MIN_SPREAD *
+             spread[-1] else "a plane")
+    need = ("a 2D trace must follow the outline of the actuator, its width too" if dim == 2 else
+            "a 3D scan must cover the actuator's surface, not one face of it")
+    raise ScanError(f"scan {path}: its {len(points)} points lie on {shape} ({need}): no alignment can place them")
+
+
 def _read_csv(path: Path) -> FloatArray:
-    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig", limit=MAX_SCAN_BYTES)
+    text = read_text_file(path, "scan", ScanError, encoding="utf-8-sig", limit=MAX_TEXT_BYTES)  # 500,000 points: 25 MB
     check_points(path, text.count("\n") - 1)  # the rows below the header, before they are parsed
-    rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    rows = [r for r in csv_rows(io.StringIO(text), f"scan {path}", ScanError) if any(c.strip() for c in r)]
     if not rows:
         raise ScanError(f"scan {path}: no rows")
     header = [c.strip().lower() for c in rows[0]]
@@ -205,4 +241,37 @@ def _read_mesh(path: Path) -> tuple[FloatArray, NDArray[np.int64] | None]:
     if vertices.ndim != 2 or vertices.shape[1] != 3 or len(vertices) == 0:
         raise ScanError(f"scan {path}: no points found")
     faces = getattr(loaded, "faces", None)
-    return vertices, (None if faces is None or len(faces) == 0 else np.asarray(faces, dtype=np.int64))
+    if faces is None or len(faces) == 0:
+        return vertices, None
+    return vertices, check_faces(path, np.asarray(faces), len(vertices))
+
+
+def check_faces(path: str | Path, faces: NDArray[np.int64], vertices: int) -> NDArray[np.int64]:
+    """A mesh's faces as vertex indices, refused if they do not fit its vertices.
+
+    Raises
+    ------
+    ScanError
+        Faces that are not triples of whole numbers, or an index outside ``0 .. vertices - 1`` (a file whose face
+        list refers to vertices it does not have), naming the first such face.
+
+    Examples
+    --------
+    >>> check_faces("a.ply", np.array([[0, 1, 2], [1, 2, 3]]), 4).shape
+    (2, 3)
+    >>> check_faces("a.ply", np.array([[0, 1, 2], [1, 2, 7]]), 4)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.ScanError: scan a.ply: face 2 refers to vertex 7, but the file has 4 vertices (0 to 3); its
+        faces are inconsistent with its vertices
+    """
+    if faces.ndim != 2 or faces.shape[1] != 3 or faces.dtype.kind not in "iu":
+        raise ScanError(f"scan {path}: its faces are not triangles of vertex indices (shape {faces.shape}, "
+                        f"{faces.dtype})")
+    bad = np.flatnonzero((faces < 0).any(axis=1) | (faces >= vertices).any(axis=1))
+    if len(bad):
+        row = faces[bad[0]]
+        index = int(row[(row < 0) | (row >= vertices)][0])
+        raise ScanError(f"scan {path}: face {bad[0] + 1} refers to vertex {index}, but the file has {vertices} "
+                        f"vertices (0 to {vertices - 1}); its faces are inconsistent with its vertices")
+    return faces.astype(np.int64)

@@ -14,6 +14,7 @@ from typing import Any
 
 from pneumorph.errors import (
     ClusterLostError,
+    EvaluationError,
     SchedulerUnreachableError,
     SearchConfigError,
     WorkerVersionError,
@@ -57,6 +58,10 @@ def tune_allocator() -> bool:
         return False
     mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
     return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+
+
+#: seconds a local Dask cluster's workers may take to start (each imports pneumorph: about 2 s)
+WORKER_START_SECONDS = 120.0
 
 
 def _worker_settings() -> dict[str, Any]:
@@ -189,10 +194,12 @@ class DaskEvaluator(EvaluatorBase):
         self.lost_workers = 0
         self._cluster = None
         self._logging = _quiet_distributed()
+        self.requested = workers
+        self._local = 0  # a local cluster's most workers (started as batches need them)
         if address is None:
-            n = workers or os.cpu_count() or 1
+            self._local = workers or os.cpu_count() or 1
             self._cluster = LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=None
+                n_workers=0, threads_per_worker=1, processes=processes, dashboard_address=None
             )
             self.client = Client(self._cluster, timeout=timeout)
         else:
@@ -220,7 +227,10 @@ class DaskEvaluator(EvaluatorBase):
 
     @property
     def workers(self) -> int:
-        """Designs the cluster solves at once now: the threads of its workers (at least 1)."""
+        """Designs the cluster solves at once now: the threads of its workers (at least 1); a local cluster's
+        most workers (it starts them as batches need them)."""
+        if self._local:
+            return self._local
         try:
             info = self.client.scheduler_info()
         except Exception:  # a lost scheduler: the run itself reports it
@@ -258,6 +268,26 @@ class DaskEvaluator(EvaluatorBase):
         """Solve ``(model, design)`` pairs of different models, each sent with its case."""
         yield from self._collect(list(cases))
 
+    def _grow(self, tasks: int) -> None:
+        """Start a local cluster's workers up to what ``tasks`` designs can use (at most ``workers``), saying so once
+        when that is fewer than asked for."""
+        if self._cluster is None:
+            return
+        size = max(1, min(self._local, tasks))
+        have = len(self._cluster.workers)
+        if have >= size:
+            return
+        if self.requested is not None and size < self.requested and not have:
+            self._say(f"starting {size} Dask worker{'s' if size > 1 else ''}, not {self.requested}: the batch has "
+                      f"{tasks} design{'s' if tasks > 1 else ''} to solve")
+        self._cluster.scale(size)
+        try:
+            self.client.wait_for_workers(size, timeout=WORKER_START_SECONDS)
+        except TimeoutError:
+            raise EvaluationError(f"the local Dask cluster's {size} worker(s) did not start within "
+                                  f"{WORKER_START_SECONDS:g} s; check the memory and the processes' limits, or use "
+                                  "--executor processes") from None
+
     def _lost(self, why: str) -> ClusterLostError:
         return ClusterLostError(f"lost the Dask scheduler at {self.where} ({why}); every design finished before "
                                 "is in the evaluation cache")
@@ -271,6 +301,7 @@ class DaskEvaluator(EvaluatorBase):
 
         if not cases:
             return
+        self._grow(len(cases))
         try:
             self._check_versions()  # workers that joined since the last batch, too
             futures = [self.client.submit(_solve_on_dask_worker, m, d, pure=False) for m, d in cases]

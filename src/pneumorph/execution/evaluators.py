@@ -106,7 +106,8 @@ def make_evaluator(
 ) -> SerialEvaluator | ProcessPoolEvaluator | DaskEvaluator:
     """An evaluator by name: ``serial``, ``processes`` or ``dask`` (settings checked by :func:`check_execution`).
 
-    ``on_message`` receives the Dask evaluator's lines about the cluster (a lost worker).
+    ``on_message`` receives the evaluators' lines: the Dask cluster's (a lost worker), a pool's or a local
+    cluster's that starts fewer processes than ``workers`` because the batch has fewer designs.
 
     Examples
     --------
@@ -121,7 +122,7 @@ def make_evaluator(
     if kind == "serial":
         return SerialEvaluator()
     if kind == "processes":
-        return ProcessPoolEvaluator(workers)
+        return ProcessPoolEvaluator(workers, on_message=on_message)
     return DaskEvaluator(scheduler, workers=workers, timeout=timeout, on_message=on_message)
 
 

@@ -149,10 +149,13 @@ class ProcessPoolEvaluator(EvaluatorBase):
     Parameters
     ----------
     workers : int, optional
-        Number of processes; all cores by default.
+        Most processes; all cores by default.
+    on_message : callable, optional
+        Receives one line when fewer processes start than ``workers`` asked for.
 
     The pool starts on first use (processes are spawned, so they import fresh with one
-    BLAS/OpenMP thread each) and is kept while the model's fingerprint stays the same.
+    BLAS/OpenMP thread each) with no more processes than the batch has designs (``started``), and is kept while
+    the model's fingerprint stays the same (started again, larger, for a larger batch).
     At most ``workers`` designs are handed to the pool at a time, so the designs being
     solved are known at every moment.
 
@@ -169,32 +172,43 @@ class ProcessPoolEvaluator(EvaluatorBase):
     process stops them).
     """
 
-    def __init__(self, workers: int | None = None) -> None:
+    def __init__(self, workers: int | None = None, on_message: Any = None) -> None:
         if workers is not None and workers < 1:
             raise SearchConfigError(f"the number of worker processes must be at least 1, got {workers}")
         self.workers = workers or os.cpu_count() or 1
+        self.requested = workers
+        self.on_message = on_message
+        self.started = 0  # processes of the pool now (0: none started)
+        self._said = False
         self._pool: ProcessPoolExecutor | None = None
         self._fingerprint: str | None = None
         self.restarts = 0
         _LIVE_POOLS.add(self)
 
-    def _ensure_pool(self, model: ActuatorModel | None) -> ProcessPoolExecutor:
+    def _ensure_pool(self, model: ActuatorModel | None, tasks: int) -> ProcessPoolExecutor:
+        """The pool for ``model``, of as many processes as ``tasks`` designs can use (at most ``workers``)."""
         fp = _CASES if model is None else model.fingerprint()
-        if self._pool is not None and fp == self._fingerprint:
+        size = max(1, min(self.workers, tasks))
+        if self._pool is not None and fp == self._fingerprint and self.started >= size:
             return self._pool
         self.close()
+        if self.requested is not None and size < self.requested and self.on_message is not None and not self._said:
+            self._said = True  # once: a later, smaller pool says nothing new
+            self.on_message(f"starting {size} worker process{'es' if size > 1 else ''}, not {self.requested}: the "
+                            f"batch has {tasks} design{'s' if tasks > 1 else ''} to solve")
         saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
         os.environ.update({name: "1" for name in THREAD_VARIABLES})  # inherited by spawned workers
         try:
             self._pool = ProcessPoolExecutor(
-                max_workers=self.workers,
+                max_workers=size,
                 mp_context=multiprocessing.get_context("spawn"),
                 initializer=_init_worker,
                 initargs=(model,),
             )
             # start the workers now, while the environment says one thread
-            for f in [self._pool.submit(os.getpid) for _ in range(self.workers)]:
+            for f in [self._pool.submit(os.getpid) for _ in range(size)]:
                 f.result()
+            self.started = size
         except BrokenProcessPool as exc:
             self.close(grace=0.0)
             raise EvaluationError(f"the worker processes died while starting (the model {type(model).__name__} "
@@ -257,7 +271,7 @@ class ProcessPoolEvaluator(EvaluatorBase):
         """Run the tasks of ``source`` with at most ``window`` in flight, yielding them as they
         finish. Returns ``(broken, lost)``: whether a worker died, and the designs it took along
         (those in flight then; the others stay in ``source``)."""
-        pool = self._ensure_pool(model)
+        pool = self._ensure_pool(model, len(source))
         flight: dict[Future[Outcome], int] = {}
         lost: set[int] = set()
         broken = False
@@ -292,13 +306,13 @@ class ProcessPoolEvaluator(EvaluatorBase):
 
     def _restart(self) -> dict[int, int | None]:
         """Discard a broken pool (the next solve starts a new one); the exit codes of its workers."""
-        pool, self._pool, self._fingerprint = self._pool, None, None
+        pool, self._pool, self._fingerprint, self.started = self._pool, None, None, 0
         self.restarts += 1
         return {} if pool is None else _stop_pool(pool, grace=0.0)
 
     def close(self, grace: float = 1.0) -> None:
         """Shut the pool down: cancel queued solves, let idle workers end, terminate busy ones
         after ``grace`` seconds."""
-        pool, self._pool, self._fingerprint = self._pool, None, None
+        pool, self._pool, self._fingerprint, self.started = self._pool, None, None, 0
         if pool is not None:
             _stop_pool(pool, grace)

@@ -297,8 +297,9 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     held = [] if found is None else [
         {"combination": found.combination(j), "scan_change_mm": found.scan_change(j),
          "standard_error": float(found.errors()[j])} for j in map(int, np.flatnonzero(found.held))]
-    weakest = float("nan") if found is None else float(
-        directions(state.normal, found.sigma, found.names, found.spans, found.points).errors().max())
+    spread = np.empty(0) if found is None else directions(state.normal, found.sigma, found.names, found.spans,
+                                                          found.points).errors()
+    weakest = float(spread.max()) if spread.size else float("nan")  # no direction: nothing the scans determine
     advice: list[dict[str, Any]] = []
     if advise and not identified[fitted].all() and found is not None:
         say("weighing further scans that would determine what these do not")

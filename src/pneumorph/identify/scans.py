@@ -33,6 +33,25 @@ from pneumorph.io.files import read_toml
 SCAN_KEYS = ("file", "design", "pressure_kpa", "scan_unit", "scale")
 #: most scans one identification takes (each costs a solve per parameter and iteration)
 MAX_SCANS = 64
+#: least pressure a scan to identify from may be taken at (kPa): at 1 kPa four built-in units lift their tip by
+#: 0.22 mm in the 2D model (``pneumorph simulate -o 0000 --model 2d --pressure 1``), about what a scan or a photo
+#: trace resolves; below it the scan says nothing of the moduli
+MIN_SCAN_PRESSURE_KPA = 1.0
+
+
+def check_scan_pressure(pressure_kpa: float, name: str) -> None:
+    """Refuse a scan's pressure below :data:`MIN_SCAN_PRESSURE_KPA` (``name`` says whose).
+
+    >>> check_scan_pressure(1e-300, "--pressure")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: --pressure 1e-300 kPa is below MIN_SCAN_PRESSURE_KPA = 1 kPa
+        (pneumorph.identify.scans): the actuator barely deforms, so the scan cannot tell the moduli; scan it inflated
+    """
+    if pressure_kpa < MIN_SCAN_PRESSURE_KPA:
+        raise SettingsError(f"{name} {pressure_kpa:g} kPa is below MIN_SCAN_PRESSURE_KPA = {MIN_SCAN_PRESSURE_KPA:g} "
+                            "kPa (pneumorph.identify.scans): the actuator barely deforms, so the scan cannot tell the "
+                            "moduli; scan it inflated")
 
 
 @dataclass(frozen=True)
@@ -76,6 +95,7 @@ class ScanSpec:
         object.__setattr__(self, "pressure_kpa", checks.real(self.pressure_kpa, f"{where}: pressure_kpa", 0.0,
                                                              checks.MAX_PRESSURE_KPA, low_open=True, unit="kPa",
                                                              limit="MAX_PRESSURE_KPA"))
+        check_scan_pressure(self.pressure_kpa, f"{where}: pressure_kpa")
         checks.text(self.scan_unit, f"{where}: scan_unit", tuple(SCAN_UNITS))
         if self.scale is not None:
             object.__setattr__(self, "scale", checks.real(self.scale, f"{where}: scale", 0.0, 1e6, low_open=True))

@@ -1,6 +1,6 @@
 """Outputs: safe file writing (atomic, strict JSON, paths checked first), ParaView (VTK)
 files, provenance records, and the lines a long command says about its work (plan, progress,
-heartbeat)."""
+heartbeat); inputs: the one bounded reader of a user's files (:mod:`pneumorph.io.reading`)."""
 
 from pneumorph.io.files import (
     atomic_write_bytes,

@@ -14,14 +14,21 @@ import json
 import math
 import os
 import shutil
-import stat
 import tempfile
-import tomllib
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from pneumorph.errors import OutputPathError, PneumorphError, SettingsError
+from pneumorph.errors import OutputPathError
+
+# the readers of a user's files (their module: pneumorph.io.reading), named here too
+from pneumorph.io.reading import MAX_SCAN_BYTES as MAX_SCAN_BYTES
+from pneumorph.io.reading import MAX_SETTINGS_BYTES as MAX_SETTINGS_BYTES
+from pneumorph.io.reading import MAX_TEXT_BYTES as MAX_TEXT_BYTES
+from pneumorph.io.reading import MAX_TOML_DEPTH as MAX_TOML_DEPTH
+from pneumorph.io.reading import nested_deeper as nested_deeper
+from pneumorph.io.reading import read_text_file as read_text_file
+from pneumorph.io.reading import read_toml as read_toml
 
 
 def _existing_ancestor(path: Path) -> Path:
@@ -305,113 +312,3 @@ def strict_json(obj: Any, indent: int | None = 1) -> str:
 def write_json(path: str | Path, obj: Any, indent: int | None = 1) -> Path:
     """Write :func:`strict_json` of ``obj`` to ``path`` atomically."""
     return atomic_write_text(path, strict_json(obj, indent=indent) + "\n")
-
-
-#: Largest text file read as a user's input (bytes): settings, libraries, chain tables (the shipped ones are at most
-#: 6 MB), data, paths; scans take :data:`MAX_SCAN_BYTES`
-MAX_TEXT_BYTES = 64 * 2**20
-
-#: Largest scan read (bytes): a point cloud of about four million points as text
-MAX_SCAN_BYTES = 256 * 2**20
-
-
-def read_text_file(path: str | Path, what: str, error: type[PneumorphError] = SettingsError,
-                   encoding: str = "utf-8", limit: int = MAX_TEXT_BYTES, errors: str = "strict") -> str:
-    """The text of a file a user gave, or one line saying why it cannot be read.
-
-    Only a regular file is read (a folder, a device such as ``/dev/zero``, a named pipe or a
-    socket is refused by name before it is opened), and at most ``limit`` bytes of it: a larger
-    file is refused with its size and the limit, so that no input grows without bound.
-
-    Parameters
-    ----------
-    path : str or Path
-    what : str
-        What the file is (named in the message: "unit file", "design config").
-    error : PneumorphError subclass
-        Raised with the message (the caller's own kind of error).
-    encoding, errors : str
-        How the bytes are decoded (``errors="replace"`` keeps a file with a stray byte).
-    limit : int
-        The most bytes read (:data:`MAX_TEXT_BYTES`).
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> p = pathlib.Path(tempfile.mkdtemp()) / "b.toml"
-    >>> _ = p.write_bytes(b"\\xff\\xfe")
-    >>> read_text_file(p, "unit file")
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.SettingsError: unit file ...b.toml: not a text file (byte 0 is not UTF-8)
-    >>> read_text_file("/dev/zero", "design config")
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.SettingsError: design config /dev/zero: not a regular file (a device, a named pipe or a
-    socket); give a file
-    """
-    p = Path(path)
-    try:
-        info = p.stat()
-        if stat.S_ISDIR(info.st_mode):
-            raise error(f"{what} {p}: is a folder, not a file")
-        if not stat.S_ISREG(info.st_mode):
-            raise error(f"{what} {p}: not a regular file (a device, a named pipe or a socket); give a file")
-        if info.st_size > limit:
-            raise error(f"{what} {p}: {info.st_size / 2**20:.4g} MB, more than the {limit / 2**20:g} MB a {what} "
-                        "may have")
-        with p.open("rb") as fh:
-            data = fh.read(limit + 1)
-        if len(data) > limit:  # a file that grew, or one whose size the system does not report
-            raise error(f"{what} {p}: more than the {limit / 2**20:g} MB a {what} may have")
-        return data.decode(encoding, errors)
-    except UnicodeDecodeError as exc:
-        raise error(f"{what} {p}: not a text file (byte {exc.start} is not UTF-8)") from None
-    except OSError as exc:
-        raise error(f"{what} {p}: cannot be read ({exc.strerror or exc})") from None
-
-
-#: Deepest nesting of tables and arrays a settings file may have (the package's own go 4 deep)
-MAX_TOML_DEPTH = 32
-
-
-def read_toml(path: str | Path, what: str, error: type[PneumorphError] = SettingsError) -> dict[str, Any]:
-    """The tables of a TOML file a user gave, or one line saying why it cannot be read.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> p = pathlib.Path(tempfile.mkdtemp()) / "c.toml"
-    >>> _ = p.write_text("[design\\nunits = 3")
-    >>> read_toml(p, "design config")
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.SettingsError: design config ...c.toml: not valid TOML: ...
-    """
-    text = read_text_file(path, what, error)
-    deep = f"{what} {path}: nested more than {MAX_TOML_DEPTH} levels deep (MAX_TOML_DEPTH)"
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise error(f"{what} {path}: not valid TOML: {exc}") from None
-    except RecursionError:
-        raise error(deep) from None
-    if nested_deeper(data, MAX_TOML_DEPTH - 1):  # the values at the bottom count as a level here
-        raise error(deep)
-    return data
-
-
-def nested_deeper(data: Any, limit: int) -> bool:
-    """Whether tables and lists (dicts and lists) nest deeper than ``limit`` levels, found without recursion.
-
-    >>> nested_deeper({"a": [1, {"b": 2}]}, 3), nested_deeper({"a": [1, {"b": [2]}]}, 3)
-    (False, True)
-    """
-    level, depth = [data], 0
-    while level:  # breadth first: the readers of the data recurse
-        depth += 1
-        if depth > limit:
-            return True
-        level = [v for item in level if isinstance(item, (dict, list))
-                 for v in (item.values() if isinstance(item, dict) else item) if isinstance(v, (dict, list))]
-    return False

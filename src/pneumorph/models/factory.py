@@ -86,6 +86,8 @@ def read_model_file(path: str | Path) -> dict[str, Any]:
     if not isinstance(table, dict):
         raise SearchConfigError(f"model file {path}: no [model] table (an identified model from pneumorph identify, "
                                 "or a design config with one)")
+    if "fidelity" in table:  # checked whatever the command line says: a bad value is refused, not overridden
+        checks.text(table["fidelity"], f"model file {path}: [model] fidelity", ("2d", "3d"), error=SearchConfigError)
     return dict(table)
 
 

@@ -18,7 +18,6 @@ solves of a design check it (``docs/sensitivity.md``).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from itertools import combinations
@@ -163,7 +162,7 @@ class ToleranceTables:
                        tuple(ChainTable.from_dict(x, where) for x in data["minus"]),
                        tuple(ChainTable.from_dict(x, where) for x in data["plus"]), dict(data["source"]),
                        tuple(ChainTable.from_dict(x, where) for x in data.get("corners", [])))
-        except (KeyError, TypeError, ValueError) as exc:
+        except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ChainTableError(f"{where}: not a tolerance table file ({exc})") from None
 
     def save(self, path: str | Path) -> Path:
@@ -173,12 +172,10 @@ class ToleranceTables:
 
     @classmethod
     def load(cls, path: str | Path) -> ToleranceTables:
+        from pneumorph.io.reading import read_json
+
         p = Path(path)
-        try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise ChainTableError(f"{p}: cannot read the tolerance tables ({exc})") from None
-        return cls.from_dict(data, str(p))
+        return cls.from_dict(read_json(p, "tolerance tables", ChainTableError), str(p))
 
 
 def _variants(model: Any, tolerance: Tolerance, corners: bool = True) -> list[tuple[str, Any]]:

@@ -27,7 +27,7 @@ _DECK_ONLY = ("pressure",)
 @click.option("--unit", "unit_file", type=P.InputFile(), help="Unit TOML file (default: the built-in unit).")
 @click.option("--library", metavar="builtin|spatial|modes|FILE", type=P.Text(),
               help="A unit library ('builtin', 'spatial' (sideways units), 'modes' or a library TOML file): DESIGN's "
-                   "letters name its unit types; instead of --unit. Its parts only (no --mould yet).")
+                   "letters name its unit types; instead of --unit. Its parts, --mould and --inp as for one unit type.")
 @click.option("--clearance", type=P.Real(0.0, 5.0, unit="mm"), default=0.2, show_default=True,
               help="Mould: gap between mating printed parts (pins, core tenons), mm.")
 @click.option("--draft", type=P.Real(0.0, 45.0, high_open=True, unit="degrees"), default=0.0, show_default=True,

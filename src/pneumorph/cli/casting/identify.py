@@ -128,6 +128,10 @@ def _scan_specs(scan: str | None, design: str | None, pressure: float | None, ma
     if missing:
         raise click.UsageError(f"missing {', '.join(missing)}: give SCAN --design D --pressure P, or --manifest")
     assert scan is not None and design is not None and pressure is not None
+    from pneumorph.identify.scans import check_scan_pressure
+
+    with P.blame("--pressure"):
+        check_scan_pressure(pressure, "--pressure")
     with P.blame("--design"):
         return [ScanSpec(scan, design, pressure, scan_unit, scale)]
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 from typing import Any
@@ -12,7 +11,8 @@ import numpy as np
 
 from pneumorph.cli.options import params as P
 from pneumorph.errors import DataFormatError
-from pneumorph.io.files import read_text_file, strict_json
+from pneumorph.io.files import strict_json
+from pneumorph.io.reading import check_rows, csv_rows, read_text_file
 from pneumorph.materials.characterisation import analyses as ch
 
 _STRAIN_SCALE = {"fraction": 1.0, "percent": 0.01}
@@ -35,12 +35,13 @@ def read_columns(
     """
     p = str(path)
     text = read_text_file(path, "data file", DataFormatError, encoding="utf-8-sig")
+    check_rows(text, f"data file {p}", DataFormatError)  # counted before they are split
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise DataFormatError("empty file; expected a header row with " + ", ".join(required), p, 1)
     header = lines[0]
     delimiter = max((",", ";", "\t"), key=header.count)
-    rows = list(csv.reader(lines, delimiter=delimiter))
+    rows = csv_rows(lines, f"data file {p}", DataFormatError, delimiter)
     names = [h.strip().lower() for h in rows[0]]
     index: dict[str, int] = {}
     for col in (*required, *optional):

@@ -25,7 +25,8 @@ _LABELS = {
 
 def _register(files: tuple[str, ...]) -> None:
     for path in files:
-        library.register_toml(path)
+        with P.blame("--library"):
+            library.register_toml(path)
 
 
 _library_option = click.option(

@@ -7,8 +7,6 @@ option's name in the message: ``--pressure must be a finite number > 0 (kPa), go
 from __future__ import annotations
 
 import contextlib
-import os
-import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -17,7 +15,8 @@ import click
 
 from pneumorph import checks
 from pneumorph.errors import OutputPathError, PneumorphError, SettingsError
-from pneumorph.io.files import MAX_SCAN_BYTES, check_writable_dir, check_writable_file, read_text_file
+from pneumorph.io.files import check_writable_dir, check_writable_file
+from pneumorph.io.reading import MAX_SCAN_BYTES, MAX_TEXT_BYTES, check_input_file, check_text_file
 
 if TYPE_CHECKING:
     from pneumorph.geometry.library import UnitLibrary
@@ -110,32 +109,28 @@ class Text(click.ParamType):
 
 
 class InputFile(click.ParamType):
-    """An existing, readable file; ``text=True`` also requires UTF-8 text (binary files refused)."""
+    """An existing, readable regular file of at most ``limit`` bytes; ``text=True`` also requires text (UTF-8, or
+    with a byte-order mark), checked a chunk at a time: the command's own reader then applies its kind's limit.
+
+    A folder, a device (``/dev/zero``), a named pipe or a socket is refused by name without being opened."""
 
     name = "file"
 
-    def __init__(self, text: bool = True) -> None:
+    def __init__(self, text: bool = True, limit: int | None = None) -> None:
         self.text = text
+        self.limit = limit if limit is not None else (MAX_TEXT_BYTES if text else MAX_SCAN_BYTES)
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> str:
-        path = Path(value)
         name = _name(param)
         if str(value).strip() == "":
             self.fail(f"{name} must not be empty", param, ctx)
-        if not path.exists():
-            self.fail(f"{name} {value}: no such file", param, ctx)
-        if path.is_dir():
-            self.fail(f"{name} {value}: is a folder, not a file", param, ctx)
-        if not stat.S_ISREG(path.stat().st_mode):  # never opened: a named pipe would block, a device never end
-            self.fail(f"{name} {value}: not a regular file (a device, a named pipe or a socket); give a file", param,
-                      ctx)
-        if not os.access(path, os.R_OK):
-            self.fail(f"{name} {value}: the file is not readable", param, ctx)
-        if self.text:
-            try:  # bounded: the command's own reader then applies the limit of its kind of file
-                read_text_file(path, name, limit=MAX_SCAN_BYTES)
-            except PneumorphError as exc:
-                self.fail(str(exc), param, ctx)
+        try:
+            if self.text:
+                check_text_file(value, name, limit=self.limit)
+            else:
+                check_input_file(value, name, limit=self.limit)
+        except PneumorphError as exc:
+            self.fail(str(exc), param, ctx)
         return str(value)
 
 

@@ -312,12 +312,17 @@ def read_path(file: str | Path) -> PathTarget:
     TargetExpressionError
         A file that cannot be read, or whose rows are not two or three numbers each.
     """
-    from pneumorph.io.files import read_text_file
+    import io
 
-    text = read_text_file(file, "path file", TargetExpressionError)
+    from pneumorph.io.reading import MAX_SETTINGS_BYTES, read_text_file
+
+    text = read_text_file(file, "path file", TargetExpressionError, limit=MAX_SETTINGS_BYTES)
     rows: list[list[float]] = []
     header_allowed = True
-    for number, line in enumerate(text.splitlines(), 1):
+    for number, line in enumerate(io.StringIO(text), 1):  # a line at a time: stopped at MAX_PATH_POINTS
+        if len(rows) >= MAX_PATH_POINTS:
+            raise TargetExpressionError(f"{file}: more than MAX_PATH_POINTS = {MAX_PATH_POINTS} points "
+                                        "(pneumorph.design.objectives.paths); thin the path out")
         fields = line.replace(",", " ").replace(";", " ").split()
         if not fields or fields[0].startswith("#"):
             continue

@@ -22,7 +22,7 @@ from typing import Any
 from pneumorph.design.config import DesignConfig
 from pneumorph.design.search.genetic import GenerationStats
 from pneumorph.errors import RunFolderError
-from pneumorph.io.files import atomic_write_text
+from pneumorph.io.files import atomic_write_text, read_text_file
 from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
 
 _COMPARED = ("design", "ga", "model")
@@ -81,7 +81,7 @@ def check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrite
     if not path.exists() or overwrite:
         return False
     try:
-        old = tomllib.loads(path.read_text(encoding="utf-8"))
+        old = tomllib.loads(read_text_file(path, "the output folder's config.toml", RunFolderError))  # a pipe: refused
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise RunFolderError(f"{folder} holds a config.toml that cannot be read ({exc}); choose another output "
                              "folder or overwrite it") from None

@@ -51,7 +51,7 @@ from types import MappingProxyType
 import numpy as np
 
 from pneumorph.errors import DataFormatError
-from pneumorph.io.files import read_text_file
+from pneumorph.io.reading import check_rows, read_text_file
 from pneumorph.materials.characterisation.curves import MAX_STRESS_MPA, MAX_STRETCH, TestCurve, TestData
 from pneumorph.materials.laws.hyperelastic import MODES
 
@@ -276,6 +276,7 @@ def _data_lines(path: Path) -> tuple[list[tuple[int, str]], dict[str, str]]:
     """
     src = str(path)
     text = read_text_file(path, "data file", DataFormatError, encoding="utf-8-sig", errors="replace")
+    check_rows(text, f"data file {src}", DataFormatError)  # counted before they are split
     lines = list(enumerate(text.splitlines(), start=1))
     metadata: dict[str, str] = {}
     body = [(n, s) for n, s in lines if s.strip() and not s.lstrip().startswith("#")]
