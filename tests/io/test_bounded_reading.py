@@ -4,7 +4,8 @@ costs (a device such as /dev/zero, a named pipe, a folder, a file of 1 GB)."""
 from __future__ import annotations
 
 import os
-import time
+import signal
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -12,6 +13,18 @@ import pytest
 from pneumorph.cli import main
 from pneumorph.errors import SettingsError
 from pneumorph.io.files import MAX_TEXT_BYTES, read_text_file
+
+
+@pytest.fixture(autouse=True)
+def no_hang() -> Iterator[None]:
+    """A read that blocks (a pipe opened for reading waits for a writer) fails the test instead of hanging it."""
+    def hung(signum: int, frame: object) -> None:
+        raise AssertionError("the input was read or waited on instead of refused")
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(30)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, previous)
 
 
 @pytest.fixture
@@ -32,7 +45,6 @@ def huge(tmp_path: Path) -> Path:
 
 def test_a_device_a_pipe_a_folder_and_a_huge_file_are_refused_by_name(tmp_path: Path, fifo: Path,
                                                                       huge: Path) -> None:
-    start = time.perf_counter()
     with pytest.raises(SettingsError, match="not a regular file"):
         read_text_file("/dev/zero", "design config")
     with pytest.raises(SettingsError, match="not a regular file"):
@@ -41,7 +53,6 @@ def test_a_device_a_pipe_a_folder_and_a_huge_file_are_refused_by_name(tmp_path: 
         read_text_file(tmp_path, "design config")
     with pytest.raises(SettingsError, match=r"1024 MB, more than the 64 MB a design config may have"):
         read_text_file(huge, "design config")
-    assert time.perf_counter() - start < 2.0
 
 
 def test_the_limit_holds_for_a_file_that_reports_no_size(tmp_path: Path) -> None:
@@ -70,10 +81,9 @@ def test_path_inputs_refuse_them_in_one_line_at_once(args: list[str], kind: str,
                                                      tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bad = {"device": "/dev/zero", "pipe": str(fifo), "huge": str(huge)}[kind]
     out = tmp_path / "run"
-    start = time.perf_counter()
     code = main([a.replace("{bad}", bad) for a in args] + (["--out", str(out)] if args[0] == "design" else []))
     err = capsys.readouterr().err.strip()
-    assert code == 2 and time.perf_counter() - start < 2.0
+    assert code == 2
     assert len(err.splitlines()) == 1 and "Traceback" not in err and "internal error" not in err
     assert ("regular file" in err) if kind != "huge" else ("MB" in err and "may have" in err)
     assert not out.exists()
