@@ -80,7 +80,7 @@ REDUCED = {
     "chain build --model 3d --out runs/chain-3d.json": "--model 2d --window 2 --heldout 2",
     "bimodal --crimp-ratio 0.2 --end-cap 1.5 --bilinear-nu 0.495 --voids 5 --pmax 35 --out runs/bim/":
         "--voids 2 --element-size 4",
-    "calibrate --units 15 --out runs/cal/": "--units 4 --pressures 20 --runs 1 --validate 1 --unit {coarse}",
+    "calibrate --units 15 --out runs/cal/": "--units 4 --pressures 10,20 --runs 1 --validate 1 --unit {coarse}",
     "correlate examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out runs/corr/": "",
     "identify examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out runs/ident/": "--fit wall",
 }
@@ -109,11 +109,13 @@ def reduce(command: str, options: str) -> str:
 
     >>> reduce('pneumorph design --units 6 --target "y = x"', "--units 4 --model 2d")
     "pneumorph design --units 4 --target 'y = x' --model 2d"
+    >>> reduce("pneumorph correlate scan.xyz", "")
+    'pneumorph correlate scan.xyz'
     """
     words = shlex.split(command)
     given = shlex.split(options)
     starts = [i for i, w in enumerate(given) if w.startswith("--")]
-    for start, end in zip(starts, [*starts[1:], len(given)], strict=True):
+    for start, end in zip(starts, [*starts[1:], len(given)][:len(starts)], strict=True):
         name, values = given[start], given[start + 1:end]
         if name in words:
             at = words.index(name)
