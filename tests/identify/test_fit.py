@@ -15,6 +15,9 @@ from pneumorph.identify.linear import LinearisedScan
 from tests.identify.conftest import SIGMA, synthetic
 
 TRUTH = np.array([0.06, 0.0, 0.0, 0.08, 0.0])  # bulk x1.06, wall +0.08 mm
+#: the weakest combination's standard error, plausible changes, that the advice predicts for two traces at 36 kPa
+#: and the straight design again at 18 kPa (the fit with that trace gives 0.330)
+ADVISED_ERROR = 0.333
 
 
 def within(r: Any, truth: np.ndarray, name: str, k: float = 3.0) -> bool:
@@ -62,14 +65,38 @@ def test_two_traces_at_one_pressure_keep_the_wall_and_say_what_to_scan_next(coar
     second = advice[("011001", 18.0)]
     assert second["why"].startswith("the scans at 36 kPa cannot tell body_bulk_scale and body_shear_scale apart: "
                                     "a scan of design 011001 again at 18 kPa")
-    # a 2D trace hardly sees the bulk modulus at any pressure: no further trace identifies it, and the advice says so
-    assert all(not a["determines"] for a in r.advice) and "would not identify" in second["why"]
+    # a 2D trace sees the bulk modulus weakly: the first design again at 18 kPa would not tell the moduli apart
+    # (its columns stay too alike), the straight design at 18 kPa would, and the advice ranks it first
+    assert "would not identify" in second["why"] and not second["determines"]
+    best = r.advice[0]
+    assert (best["design"], best["pressure_kpa"]) == ("000000", 18.0)
+    assert best["determines"] == ["body_bulk_scale", "body_shear_scale"]
+    assert best["weakest_error"] == pytest.approx(ADVISED_ERROR, rel=0.05)
     # the scan weighed, made: the weakest combination's standard error is what the advice predicted
     more = identify([*obs, synthetic(coarse, truth, "011001", "2d", seed=2, pressure_kpa=18.0)], coarse, evaluator,
                     {"fidelity": "2d"}, advise=False)
     assert more.weakest_error == pytest.approx(second["weakest_error"], rel=0.15)
     assert more.weakest_error < r.weakest_error  # 0.48 against 0.84 plausible changes
     assert within(more, truth, "wall") and within(more, truth, "layer")
+
+
+def test_the_advised_scan_at_a_second_pressure_identifies_both_moduli(coarse: ParameterSet) -> None:
+    """The scan the advice ranks first above (the straight design again at 18 kPa), made: the moduli, confounded at
+    one pressure, are both identified, each within its reported error of the truth, as the advice predicted."""
+    truth = coarse.nominal + np.array([-0.06, -0.06, 0.0, -0.08, 0.0])
+    obs = [synthetic(coarse, truth, d, "2d", seed=k) for k, d in enumerate(("011001", "000000"))]
+    obs.append(synthetic(coarse, truth, "000000", "2d", seed=2, pressure_kpa=18.0))
+    r = identify(obs, coarse, SerialEvaluator(), {"fidelity": "2d"}, advise=False)
+    assert r.converged and not r.combinations
+    assert list(np.array(NAMES)[r.identified]) == ["body_bulk_scale", "body_shear_scale", "wall", "layer"]
+    assert all(within(r, truth, name) for name in ("body_bulk_scale", "body_shear_scale", "wall", "layer"))
+    assert np.all(r.confounded_errors[r.identified] == 0.0)
+    # the traces see the bulk modulus weakly (standard error 0.016, a third of a plausible change), the shear
+    # modulus three times better: its nominal lies more than ten of its errors from the fit
+    errors = dict(zip(NAMES, r.standard_errors, strict=True))
+    assert errors["body_bulk_scale"] < 0.4 * SPANS["body_bulk_scale"] and errors["body_shear_scale"] < 0.01
+    assert abs(r.values[1] - 1.0) > 10 * errors["body_shear_scale"]
+    assert r.weakest_error == pytest.approx(ADVISED_ERROR, rel=0.05)
 
 
 def test_a_fit_stopped_early_keeps_its_best_point(coarse: ParameterSet) -> None:

@@ -26,8 +26,9 @@ The standard errors are those of linear least squares, ``s^2 (J^T J)^-1`` with t
 alignment parameters in ``J`` (so a parameter that a rigid motion could mimic is not
 credited), ``s^2`` the residual variance. The combinations of parameters the scans do not
 determine (eigenvectors of ``J^T J`` whose standard error exceeds
-:data:`~pneumorph.identify.linear.MAX_DIRECTION_ERROR` plausible changes, or whose eigenvalue
-is below :data:`~pneumorph.identify.linear.MIN_EIGENVALUE` of the largest) are held at
+:data:`~pneumorph.identify.linear.MAX_DIRECTION_ERROR` plausible changes, and as many of the
+weakest as the correlation form of ``J^T J`` has eigenvalues below
+:data:`~pneumorph.identify.linear.MIN_EIGENVALUE`: columns too alike to tell apart) are held at
 nominal; every parameter outside them is fitted and identified with its standard error, those
 in them are reported as confounded, with the combination (:func:`~pneumorph.identify.advice.next_scans`
 ranks the further scans that would determine it).

@@ -22,8 +22,11 @@ FloatArray = NDArray[np.float64]
 #: a combination of the parameters whose standard error exceeds this many plausible changes
 #: (:data:`~pneumorph.identify.parameters.SPANS`) is not determined by the scans
 MAX_DIRECTION_ERROR = 1.0
-#: nor one whose eigenvalue of the scaled ``J^T J`` is below this fraction of the largest: a near-singular
-#: ``J^T J``, where the linearisation's error rather than the noise decides the step (the step oscillates)
+#: nor, for each eigenvalue of the correlation form of ``J^T J`` (normalised by its diagonal) below this, the
+#: weakest combination: parameters whose columns point alike to within it (a correlation of 0.999 for a pair)
+#: are told apart by less than the forward differences' own error, so the linearisation rather than the noise
+#: would decide the step. The form is blind to the columns' sizes: a parameter that moves the scans strongly
+#: (the wall) does not make the others look undetermined
 MIN_EIGENVALUE = 1e-3
 #: a parameter whose Jacobian column (alignment taken out) is below this fraction of the largest moves no scan
 NO_EFFECT = 1e-4
@@ -256,15 +259,27 @@ class Directions:
 
 def directions(normal: FloatArray, sigma: float, names: Sequence[str], spans: FloatArray, points: int,
                hold: FloatArray | None = None) -> Directions:
-    """The combinations of ``normal`` (``J^T J`` in plausible changes, alignment taken out): those whose
-    standard error exceeds :data:`MAX_DIRECTION_ERROR` plausible changes, or whose eigenvalue is below
-    :data:`MIN_EIGENVALUE` times the largest, are held; or ``hold`` (orthonormal columns) are.
+    """The combinations of ``normal`` (``J^T J`` in plausible changes, alignment taken out), weakest first:
+    those whose standard error exceeds :data:`MAX_DIRECTION_ERROR` plausible changes are held, and as many of
+    the weakest as the correlation form of ``normal`` has eigenvalues below :data:`MIN_EIGENVALUE` (columns
+    too alike to tell apart), whichever are more; or ``hold`` (orthonormal columns) are.
+
+    Examples
+    --------
+    A strong parameter beside two weak ones that the scans tell apart well: nothing held, though the
+    weak combination's eigenvalue is 1e-5 of the largest.
+
+    >>> j = np.array([[100.0, 0.0, 0.0], [0.0, 1.0, 0.5], [0.0, 0.0, 0.3]]) * 10
+    >>> d = directions(j.T @ j, 0.05, ("wall", "a", "b"), np.array([0.1, 0.05, 0.05]), 3)
+    >>> d.held.tolist(), float(d.eigenvalues[0] / d.eigenvalues[-1]) < 1e-4
+    ([False, False, False], True)
     """
     if hold is None:
         eigenvalues, vectors = np.linalg.eigh(normal)
-        top = float(max(eigenvalues.max(initial=0.0), 1e-300))
-        held = (sigma / np.sqrt(np.maximum(eigenvalues, 1e-300)) > MAX_DIRECTION_ERROR) | (
-            eigenvalues < MIN_EIGENVALUE * top)
+        errors = sigma / np.sqrt(np.maximum(eigenvalues, 1e-300))
+        size = np.sqrt(np.maximum(np.diag(normal), 1e-300))
+        alike = np.linalg.eigvalsh(normal / np.outer(size, size)) < MIN_EIGENVALUE
+        held = np.arange(len(eigenvalues)) < max(int(np.sum(errors > MAX_DIRECTION_ERROR)), int(np.sum(alike)))
         return Directions(tuple(names), np.asarray(spans, float), eigenvalues, vectors, held, sigma, points)
     p = np.eye(len(normal)) - hold @ hold.T
     eigenvalues, vectors = np.linalg.eigh(p @ normal @ p)
