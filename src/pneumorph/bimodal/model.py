@@ -263,10 +263,11 @@ class BimodalModel:
                 f"(e.g. step {pmax / max(1, min(round(pmax / step), 1000)) * 1e3:.4g} "
                 "kPa); the ramp must end at pmax, not above it")
         if volume is not None and volume / increments > MAX_VOLUME_STEP:
+            least = math.ceil(volume / MAX_VOLUME_STEP)
             raise SettingsError(
                 f"a volume change of {volume:g} V0 in {increments} step(s) is {volume / increments:g} V0 per step, "
                 f"more than the {MAX_VOLUME_STEP:g} V0 a step can take from rest: use a smaller step (at least "
-                f"{math.ceil(volume / MAX_VOLUME_STEP)} steps, e.g. step {pmax / math.ceil(volume / MAX_VOLUME_STEP) * 1e3:.4g} kPa)")
+                f"{least} steps, e.g. step {pmax / least * 1e3:.4g} kPa)")
         max_cutbacks = self.default_max_cutbacks if max_cutbacks is None else max_cutbacks
         max_iterations = self.default_max_iterations if max_iterations is None else max_iterations
         for name, value, low in (("substeps", substeps, 1), ("max_cutbacks", max_cutbacks, 0),
