@@ -290,16 +290,9 @@ def read_toml(path: str | Path, what: str, error: type[PneumorphError] = Setting
     ...
     pneumorph.errors.SettingsError: design config ...c.toml: not valid TOML: ...
     """
-    text = read_text_file(path, what, error, limit=limit)
-    deep = f"{what} {path}: nested more than {MAX_TOML_DEPTH} levels deep (MAX_TOML_DEPTH)"
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise error(f"{what} {path}: not valid TOML: {exc}") from None
-    except RecursionError:
-        raise error(deep) from None
-    if nested_deeper(data, MAX_TOML_DEPTH - 1):  # the values at the bottom count as a level here
-        raise error(deep)
+    # the values at the bottom count as a level of TOML's depth
+    data: dict[str, Any] = _parsed(read_text_file(path, what, error, limit=limit), f"{what} {path}", error,
+                                   "TOML", MAX_TOML_DEPTH, MAX_TOML_DEPTH - 1)
     return data
 
 
@@ -317,15 +310,22 @@ def read_json(path: str | Path, what: str, error: type[PneumorphError] = Setting
     ...
     pneumorph.errors.SettingsError: chain table ...deep.json: nested more than 32 levels deep (MAX_JSON_DEPTH)
     """
-    text = read_text_file(path, what, error, limit=limit)
-    deep = f"{what} {path}: nested more than {MAX_JSON_DEPTH} levels deep (MAX_JSON_DEPTH)"
+    return _parsed(read_text_file(path, what, error, limit=limit), f"{what} {path}", error, "JSON",
+                   MAX_JSON_DEPTH, MAX_JSON_DEPTH)
+
+
+def _parsed(text: str, where: str, error: type[PneumorphError], kind: str, depth: int, levels: int) -> Any:
+    """``text`` parsed as ``kind`` (TOML or JSON), refused when it nests more than ``levels`` deep."""
+    loads, invalid = (tomllib.loads, tomllib.TOMLDecodeError) if kind == "TOML" else (json.loads,
+                                                                                     json.JSONDecodeError)
+    deep = f"{where}: nested more than {depth} levels deep (MAX_{kind}_DEPTH)"
     try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise error(f"{what} {path}: not valid JSON: {exc}") from None
+        data = loads(text)
+    except invalid as exc:
+        raise error(f"{where}: not valid {kind}: {exc}") from None
     except RecursionError:
         raise error(deep) from None
-    if nested_deeper(data, MAX_JSON_DEPTH):
+    if nested_deeper(data, levels):
         raise error(deep)
     return data
 
