@@ -187,3 +187,23 @@ def test_a_step_that_raises_the_residual_is_taken_back() -> None:
     assert accept(state, [shape], points, 2, lambda text: None)
     assert state.cost == pytest.approx(best, rel=1e-9)  # aligned afresh
     assert state.radius == pytest.approx(0.25 * 0.2 / SPANS["wall"] * 2)
+
+
+@pytest.mark.parametrize(("shear", "trusted"), [(1.2, True), (1.93, False)])
+def test_a_fit_that_moves_a_modulus_beyond_plausibility_identifies_nothing(shear: float, trusted: bool) -> None:
+    """A scan's pressure given wrong (30 kPa scans read as 42 kPa: shear x1.93 in 2D) moves the wall with it: past
+    MAX_PLAUSIBLE_CHANGES plausible changes (0.3 of a modulus) nothing the fit found is called identified."""
+    from pneumorph.identify.gaussnewton import MAX_PLAUSIBLE_CHANGES, verdicts
+    from pneumorph.identify.linear import directions
+
+    free = ["body_shear_scale", "wall"]
+    nominal = np.array([1.0, 1.0, 1.5, 1.5, 3.0])
+    state = FitState(nominal.copy(), free, {name: "" for name in NAMES})
+    state.theta[NAMES.index("body_shear_scale")], state.theta[NAMES.index("wall")] = shear, 1.4613
+    state.directions = directions(np.diag([4.0e4, 9.0e4]), 0.05, free, np.array([SPANS[n] for n in free]), 3000)
+    state.converged = True
+    lower, upper = nominal - np.array([0.5, 0.5, 0.1, 0.1, 0.1]), nominal + np.array([1.5, 1.5, 0.1, 0.1, 0.1])
+    _, _, fitted, identified = verdicts(state, lower, upper, nominal)
+    assert fitted.sum() == 2 and (abs(shear - 1.0) / SPANS["body_shear_scale"] > MAX_PLAUSIBLE_CHANGES) != trusted
+    assert identified[NAMES.index("wall")] == trusted and identified[NAMES.index("body_shear_scale")] == trusted
+    assert trusted or state.notes["wall"].startswith("not trusted: the fit moved body_shear_scale 18.6 plausible")

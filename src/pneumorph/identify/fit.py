@@ -293,7 +293,7 @@ def identify(observations: Sequence[Observation], params: ParameterSet, evaluato
     final_shapes, _ = jacobian_at(specs, params, base, evaluator, state.theta, [])
     state.solves += len(observations)
     rms_after, residual_after = confirmed(observations, final_shapes, points, state.transforms, dim)
-    errors, confounded_errors, fitted, identified = verdicts(state, params.lower, params.upper)
+    errors, confounded_errors, fitted, identified = verdicts(state, params.lower, params.upper, params.nominal)
     found = state.directions
     held = [] if found is None else [
         {"combination": found.combination(j), "scan_change_mm": found.scan_change(j),

@@ -42,6 +42,9 @@ TRUST = 3.0
 STEP_FRACTION = 0.1
 #: ... or below this (scaled) floor
 STEP_FLOOR = 1e-3
+#: a fit that moves a parameter further than this many plausible changes from nominal (a modulus by 30 %)
+#: is not trusted: a scan's pressure or unit given wrong moves the moduli far and the others with them
+MAX_PLAUSIBLE_CHANGES = 6.0
 
 
 @dataclass
@@ -248,11 +251,12 @@ def confirmed(observations: Sequence[Any], shapes: Sequence[ModelShape], points:
     return np.array(after), per_scan_rms(r, points)
 
 
-def verdicts(state: FitState, lower: FloatArray, upper: FloatArray
+def verdicts(state: FitState, lower: FloatArray, upper: FloatArray, nominal: FloatArray | None = None
              ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
     """Standard errors, confounded errors (the change per plausible change of the combinations held),
     which parameters were fitted and which are identified; the notes of those that are not (moving with
-    a held combination, at a bound of the box, loosely determined, still moving) written into ``state``."""
+    a held combination, at a bound of the box, loosely determined, still moving, or in a fit that moved
+    some parameter more than :data:`MAX_PLAUSIBLE_CHANGES` from ``nominal``) written into ``state``."""
     idx = state.idx
     errors, confounded = np.full(len(NAMES), np.nan), np.full(len(NAMES), np.nan)
     fitted = np.isin(np.arange(len(NAMES)), idx)
@@ -283,7 +287,22 @@ def verdicts(state: FitState, lower: FloatArray, upper: FloatArray
         if note:
             identified[i] = False
             state.notes[name] = note
+    if nominal is not None:
+        _distrust_far(state, nominal, identified)
     return errors, confounded, fitted, identified
+
+
+def _distrust_far(state: FitState, nominal: FloatArray, identified: NDArray[np.bool_]) -> None:
+    """Mark every identified parameter not identified when the fit moved one beyond plausibility."""
+    moves = {NAMES[i]: abs(state.theta[i] - nominal[i]) / SPANS[NAMES[i]] for i in state.idx}
+    name, far = max(moves.items(), key=lambda kv: kv[1], default=("", 0.0))
+    if far <= MAX_PLAUSIBLE_CHANGES:
+        return
+    for i in map(int, np.flatnonzero(identified)):
+        identified[i] = False
+        state.notes[NAMES[i]] = (f"not trusted: the fit moved {name} {far:.3g} plausible changes from nominal "
+                                 f"(more than {MAX_PLAUSIBLE_CHANGES:g}); check each scan's pressure and length "
+                                 "unit, or measure the material by a coupon test")
 
 
 def per_scan_rms(r: FloatArray, points: Sequence[FloatArray]) -> FloatArray:
