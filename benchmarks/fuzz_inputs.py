@@ -280,10 +280,28 @@ def run_case(case: Case, python: str = sys.executable) -> Outcome:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def _high_water_mb(pid: int) -> float | None:
+    """The process's own peak resident memory (VmHWM), MB, or None where /proc does not tell.
+
+    Not ``ru_maxrss``: Linux keeps that across ``exec``, so a child forked from a large process (a test
+    worker) would report its parent's size.
+    """
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        return None
+    return None
+
+
 def _wait(child: subprocess.Popen[bytes]) -> tuple[int, float, float]:
     """The child's exit code (-1: stopped at :data:`WALL_LIMIT`), its CPU seconds and its peak resident memory, MB."""
     deadline = time.monotonic() + WALL_LIMIT
+    peak: float | None = None
     while True:
+        seen = _high_water_mb(child.pid)  # read while it runs: its own memory after exec
+        peak = seen if peak is None or (seen is not None and seen > peak) else peak
         pid, status, usage = os.wait4(child.pid, os.WNOHANG)
         if pid:
             child.returncode = os.waitstatus_to_exitcode(status)
@@ -294,7 +312,7 @@ def _wait(child: subprocess.Popen[bytes]) -> tuple[int, float, float]:
             child.returncode = -1
             break
         time.sleep(0.05)
-    return child.returncode, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+    return child.returncode, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024 if peak is None else peak
 
 
 def _judge(case: Case, code: int, lines: list[str], left: set[str], cpu: float, rss: float) -> str:

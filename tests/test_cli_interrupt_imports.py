@@ -174,7 +174,8 @@ TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119)
       "--executor", "serial", "--out", "out"], ["out"]),
     # bimodal: the JSON and the tip-path figure are written; the outline figure is next
     ("call:pneumorph.bimodal.figures:plot_outlines",
-     ["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--out", "out"], ["out"]),
+     ["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--step", "1.25",
+      "--out", "out"], ["out"]),
     # composite coupon: the CSV, the JSON and two figures are written; the third is next
     ("call:pneumorph.composite.figures:plot_surface_strain",
      ["composite", "coupon", "--crimp-ratio", "0.3", "--length", "20", "--per-flute", "1", "--rows", "1", "--levels",

@@ -177,9 +177,9 @@ def write_scan(scan: Scan, path: str | Path) -> Path:
     >>> import tempfile, pathlib
     >>> from pneumorph.correlation.scans import read_scan
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "trace.csv"
-    >>> scan = Scan(np.c_[np.arange(12.0), np.zeros(12)], None, "line")
+    >>> scan = Scan(np.c_[np.arange(12.0), np.arange(12.0) % 2], None, "zigzag")
     >>> read_scan(write_scan(scan, p)).points[-1].tolist()
-    [11.0, 0.0]
+    [11.0, 1.0]
     """
     p = Path(path)
     want = ".xyz" if scan.dim == 3 else ".csv"
