@@ -19,7 +19,7 @@ import stat
 import tomllib
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from pneumorph.errors import PneumorphError, SettingsError
 
@@ -119,6 +119,16 @@ def check_input_file(path: str | Path, what: str, error: type[PneumorphError] = 
     return info
 
 
+def _open_regular(p: Path, what: str, error: type[PneumorphError]) -> BinaryIO:
+    """``p`` opened for reading without blocking (a named pipe with no writer), refused once open unless it is
+    still a regular file (it may have been swapped since it was checked); ``OSError`` is the caller's."""
+    fh = os.fdopen(os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)), "rb")
+    if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+        fh.close()
+        raise error(f"{what} {p}: not a regular file (a device, a named pipe or a socket); give a file")
+    return fh
+
+
 def read_bytes_file(path: str | Path, what: str, error: type[PneumorphError] = SettingsError,
                     limit: int = MAX_TEXT_BYTES) -> bytes:
     """The bytes of a regular file of at most ``limit`` bytes (:func:`check_input_file`), read without blocking.
@@ -138,10 +148,7 @@ def read_bytes_file(path: str | Path, what: str, error: type[PneumorphError] = S
     p = Path(path)
     check_input_file(p, what, error, limit)
     try:
-        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
-        with os.fdopen(fd, "rb") as fh:
-            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
-                raise error(f"{what} {p}: not a regular file (a device, a named pipe or a socket); give a file")
+        with _open_regular(p, what, error) as fh:
             data = fh.read(limit + 1)
     except OSError as exc:
         raise error(f"{what} {p}: cannot be read ({exc.strerror or exc})") from None
@@ -243,10 +250,7 @@ def check_text_file(path: str | Path, what: str, error: type[PneumorphError] = S
     p = Path(path)
     check_input_file(p, what, error, limit)
     try:
-        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
-        with os.fdopen(fd, "rb") as fh:
-            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
-                raise error(f"{what} {p}: not a regular file (a device, a named pipe or a socket); give a file")
+        with _open_regular(p, what, error) as fh:
             block = fh.read(4)
             codec = next((c for bom, c in BOMS if block.startswith(bom)), "utf-8")
             decoder = codecs.getincrementaldecoder(codec)()
