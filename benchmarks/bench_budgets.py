@@ -32,7 +32,7 @@ import numpy as np
 import psutil
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_probe import free_port, query
+from bench_probe import free_port, query, serve
 
 SLOW = [{"target": {"kind": "tip", "goal": "max-x"}, "unit": "spatial"},
         {"target": {"kind": "tip", "goal": "min-y"}, "unit": "spatial"}]
@@ -105,17 +105,8 @@ def main() -> None:
     args = ap.parse_args()
     port = free_port()
     with tempfile.TemporaryDirectory() as tmp:
-        server = subprocess.Popen([sys.executable, "-m", "pneumorph", "serve", "--port", str(port), "--state",
-                                   str(Path(tmp) / "state"), "--cache", str(Path(tmp) / "cache.sqlite")],
-                                  start_new_session=True)
-        url = f"http://127.0.0.1:{port}"
+        server, url = serve(Path(tmp), port)
         try:
-            for _ in range(600):
-                try:
-                    if httpx.get(url + "/api/info", timeout=5).status_code == 200:
-                        break
-                except httpx.HTTPError:
-                    time.sleep(0.2)
             peaks = Peaks(server.pid)
             peaks.start()
             lat, answers, third = asyncio.run(run(url, args.clients, args.think))

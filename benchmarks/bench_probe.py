@@ -49,6 +49,21 @@ def free_port() -> int:
         return int(s.getsockname()[1])
 
 
+def serve(tmp: Path, port: int, env: dict[str, str] | None = None) -> tuple[subprocess.Popen[bytes], str]:
+    """A ``pneumorph serve`` on ``port`` with its state and cache in ``tmp``, its URL once it answers."""
+    server = subprocess.Popen([sys.executable, "-m", "pneumorph", "serve", "--port", str(port), "--state",
+                               str(tmp / "state"), "--cache", str(tmp / "cache.sqlite")], env=env,
+                              start_new_session=True)
+    url = f"http://127.0.0.1:{port}"
+    for _ in range(600):
+        try:
+            if httpx.get(url + "/api/info", timeout=5).status_code == 200:
+                break
+        except httpx.HTTPError:
+            time.sleep(0.2)
+    return server, url
+
+
 def query(rng: random.Random) -> dict:
     kind = rng.choice(["preset", "preset", "expression"])
     if kind == "preset":
@@ -205,17 +220,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         env = {**os.environ, "TMPDIR": tmp}
         state = Path(tmp) / "state"
-        server = subprocess.Popen([sys.executable, "-m", "pneumorph", "serve", "--port", str(port), "--state",
-                                   str(state), "--cache", str(Path(tmp) / "cache.sqlite")], env=env,
-                                  start_new_session=True)
-        url = f"http://127.0.0.1:{port}"
+        server, url = serve(Path(tmp), port, env)
         try:
-            for _ in range(600):
-                try:
-                    if httpx.get(url + "/api/info", timeout=5).status_code == 200:
-                        break
-                except httpx.HTTPError:
-                    time.sleep(0.2)
             memory = Memory(server.pid)
             memory.start()
             lat, errors, found, _quiet = asyncio.run(run(url, port, args.clients, args.seconds, args.think))
