@@ -10,34 +10,22 @@ traceback and nothing written; a case that reaches a 3D solve is stopped and cou
 
 from __future__ import annotations
 
-import importlib.util
 import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from tests.benchmark import load
 
-
-def _round() -> object:
-    spec = importlib.util.spec_from_file_location("fuzz_round", ROOT / "benchmarks" / "fuzz_round.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["fuzz_round"] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-FUZZ = _round()
-SUBSET = FUZZ.cases(48, seed=28)  # type: ignore[attr-defined]
+FUZZ = load("fuzz_round")
+SUBSET = FUZZ.cases(48, seed=28)
 # Cases found by the round of 400 (BENCHMARKS.md), kept as regression cases whatever the seed draws.
-_C = FUZZ.case  # type: ignore[attr-defined]
-_BASE = FUZZ.BASE  # type: ignore[attr-defined]
-_TOML = FUZZ.RUN_TOML  # type: ignore[attr-defined]
+_C = FUZZ.case
+_BASE = FUZZ.BASE
+_TOML = FUZZ.RUN_TOML
 FOUND: list[object] = [
     # a photo whose header is whole over a truncated body: read after the solve (internal error, OSError)
     _C("correlate", "photo", "truncated", [*_BASE["correlate"], "--photo", "bad.png"],
-       {"bad.png": "BYTES:" + FUZZ._png(64, 48)[:60].hex()}, "refuse"),  # type: ignore[attr-defined]
+       {"bad.png": "BYTES:" + FUZZ._png(64, 48)[:60].hex()}, "refuse"),
     # --plot into a new nested folder: the writer did not make the folder (internal error, FileNotFoundError)
     _C("materials", "out", "nested", ["materials", "fit", "stress.csv", "--model", "yeoh", "--plot",
                                       "deep/new/fit.png"], {}, "run"),
@@ -55,7 +43,7 @@ FOUND: list[object] = [
 
 def test_the_subset_covers_every_command_and_the_blind_spots() -> None:
     commands = {c.command for c in SUBSET}
-    assert commands == set(FUZZ.BASE), set(FUZZ.BASE) - commands  # type: ignore[attr-defined]
+    assert commands == set(FUZZ.BASE), set(FUZZ.BASE) - commands
     kinds = {c.mutation for c in SUBSET}
     assert {"out", "unit", "repeat", "valid"} <= kinds, kinds
 
@@ -63,15 +51,15 @@ def test_the_subset_covers_every_command_and_the_blind_spots() -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [*SUBSET, *FOUND], ids=lambda c: f"{c.number}-{c.command}-{c.mutation}")
 def test_a_fuzz_case_ends_cleanly(case: object) -> None:
-    outcome = FUZZ.run_case(case)  # type: ignore[attr-defined]
+    outcome = FUZZ.run_case(case)
     assert outcome.verdict in ("ok", "refused", "3d"), (
-        f"{outcome.verdict} (exit {outcome.code}) for {outcome.argv} {case.files}: {outcome.stderr_tail}")  # type: ignore[attr-defined]
+        f"{outcome.verdict} (exit {outcome.code}) for {outcome.argv} {case.files}: {outcome.stderr_tail}")
 
 
 @pytest.mark.parametrize("command", sorted(c for c, argv in _BASE.items() if "--unit" in argv))
 def test_a_bad_unit_file_is_blamed_on_the_option(command: str) -> None:
     """sensitivity and chain build named the factory's key ("[model] unit_file: ...") for a bad --unit file."""
-    outcome = FUZZ.run_case(_C(command, "unit", "empty", _BASE[command], {"unit.toml": ""}, "refuse"))  # type: ignore[attr-defined]
+    outcome = FUZZ.run_case(_C(command, "unit", "empty", _BASE[command], {"unit.toml": ""}, "refuse"))
     assert outcome.verdict == "refused" and "'--unit'" in outcome.stderr_tail[-1], outcome.stderr_tail
 
 

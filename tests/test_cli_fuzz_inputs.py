@@ -3,40 +3,27 @@ command tree, and a case is judged by how the command ended (a hostile file refu
 
 from __future__ import annotations
 
-import importlib.util
 import sys
-from pathlib import Path
 
 import click
 import pytest
 
 from pneumorph.cli.options import params as P
+from tests.benchmark import load
 
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def _round() -> object:
-    spec = importlib.util.spec_from_file_location("fuzz_inputs", ROOT / "benchmarks" / "fuzz_inputs.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["fuzz_inputs"] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-FUZZ = _round()
+FUZZ = load("fuzz_inputs")
 
 
 def test_every_file_and_number_option_has_its_cases() -> None:
-    paths, numbers = FUZZ.all_cases()  # type: ignore[attr-defined]
+    paths, numbers = FUZZ.all_cases()
     covered = {(c.command.removesuffix("-config"), c.option) for c in [*paths, *numbers]}
-    for key, command in FUZZ._leaves().items():  # type: ignore[attr-defined]
-        assert key in FUZZ.BASE, f"no baseline for pneumorph {key}"  # type: ignore[attr-defined]
+    for key, command in FUZZ._leaves().items():
+        assert key in FUZZ.BASE, f"no baseline for pneumorph {key}"
         for param in command.params:
             if isinstance(param, click.Option) and isinstance(param.type, (P.InputFile, P.Real, P.Count, P.RealList)):
                 assert (key, max(param.opts, key=len)) in covered, (key, param.opts)
     options = {(c.command, c.option) for c in numbers}
-    drawn = FUZZ.cases(len(paths) + len(options), seed=0)  # type: ignore[attr-defined]
+    drawn = FUZZ.cases(len(paths) + len(options), seed=0)
     assert len(drawn) == len(paths) + len(options)
     assert options <= {(c.command, c.option) for c in drawn}  # every number option once before any twice
 
@@ -47,9 +34,9 @@ def test_every_file_and_number_option_has_its_cases() -> None:
 def test_a_case_ends_as_its_input_deserves(option: str, value: str, code: int) -> None:
     """A named pipe is refused by name (exit 2, one line); a unit file with a byte-order mark is read and the run
     goes on to its solve (the tripwire's exit 99); nan refused."""
-    case = FUZZ.Case("simulate", option, value, FUZZ._with(FUZZ.BASE["simulate"], option, value),  # type: ignore[attr-defined]
-                     FUZZ.PATHS.get(value, "refuse"))  # type: ignore[attr-defined]
-    outcome = FUZZ.run_case(case)  # type: ignore[attr-defined]
+    case = FUZZ.Case("simulate", option, value, FUZZ._with(FUZZ.BASE["simulate"], option, value),
+                     FUZZ.PATHS.get(value, "refuse"))
+    outcome = FUZZ.run_case(case)
     assert outcome.verdict == "clean" and outcome.code == code, outcome
 
 

@@ -7,22 +7,16 @@ known at once; ``benchmarks/ga_defaults.py`` measures the same at 6-10 units and
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
 from pneumorph.design import GAConfig, make_objective, run_exhaustive, run_ga
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
 from pneumorph.models import ChainModel, ChainTable
 from pneumorph.models.chain.sources import shipped_path
+from tests.benchmark import load
 
 # the benchmark's targets and its notion of a find, loaded from its file (benchmarks/ is no package)
-_spec = importlib.util.spec_from_file_location("ga_defaults", Path(__file__).resolve().parents[2] / "benchmarks"
-                                               / "ga_defaults.py")
-assert _spec is not None and _spec.loader is not None
-bench = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(bench)
+bench = load("ga_defaults")
 TARGETS, chance, found = bench.TARGETS, bench.chance, bench.found
 
 
