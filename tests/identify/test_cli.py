@@ -113,6 +113,17 @@ def test_identify_writes_a_model_that_simulate_reads(trace: Path, unit: Path, tm
     assert simulated["levels"][-1]["tip_mm"] == pytest.approx(expected.tolist(), abs=1e-9)
     nominal = make_model(6, {"pressure_kpa": 36, "unit": {"element_size": 3.0}}).evaluate("011001").tip[-1]
     assert np.linalg.norm(np.array(simulated["levels"][-1]["tip_mm"]) - nominal) > 0.1
+    # the folder now holds an identification: a second one is refused before any solve, the first kept
+    written = (out / "identified.toml").read_bytes()
+    again = ["identify", "--manifest", str(manifest), "--model", "2d", "--unit", str(unit), "--executor", "serial",
+             "--cache", str(tmp_path / "c.sqlite"), "--out", str(out), "--fit", "wall"]
+    code, _, err = run(again, capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "--overwrite" in err and "identifying" not in err
+    assert (out / "identified.toml").read_bytes() == written
+    code, _, err = run([*again, "--overwrite"], capsys)  # replaced: the wall alone, the moduli at nominal
+    assert code == 0, err
+    assert tomllib.loads((out / "identified.toml").read_text())["model"]["unit"]["wall"] == pytest.approx(
+        wall["value"], abs=0.02)
 
 
 def test_the_command_names_what_it_cannot_identify_and_what_to_scan_next(trace: Path, unit: Path, tmp_path: Path,

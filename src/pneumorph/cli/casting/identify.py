@@ -36,11 +36,12 @@ from pneumorph.cli.options.execution import cluster_report, execution_options, o
 @click.option("--cache", metavar="FILE", type=P.CacheFile(),
               help="Evaluation cache (SQLite); default ~/.cache/pneumorph/evaluations.sqlite.")
 @click.option("--out", type=P.OutputDir(), help="Folder for identified.toml and identify.json.")
+@click.option("--overwrite", is_flag=True, help="Replace the identification an --out folder already holds.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def identify(scan: str | None, design: str | None, pressure: float | None, manifest: str | None, fidelity: str,
              unit_file: str | None, scan_unit: str | None, scale: float | None, fit_names: str | None, tolerance: float,
              seed: int, executor: str, workers: int | None, scheduler: str | None, cache: str | None,
-             out: str | None, as_json: bool) -> None:
+             out: str | None, overwrite: bool, as_json: bool) -> None:
     """Fit the body silicone's bulk and shear modulus scales and the three mould thicknesses (side walls,
     Mold Star wall, Smooth-Sil layer) to scans of cast actuators, by least squares on the distances
     `correlate` measures; report each with its standard error, the correlations, the residuals before and
@@ -66,6 +67,8 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
 
     scan_unit = P.scan_unit(scan_unit, scale)
     check_options(executor, workers, scheduler)
+    if out and not overwrite:
+        _check_out(out)
     specs = _scan_specs(scan, design, pressure, manifest, scan_unit, scale)
     unit = UnitSpec()
     if unit_file is not None:
@@ -110,6 +113,18 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
         click.echo(strict_json(summary))
     else:
         _print_identification(result, observations, scans[0].dim, out)
+
+
+def _check_out(out: str) -> None:
+    """Refuse an output folder that holds an earlier identification, before anything is read or solved."""
+    from pathlib import Path
+
+    from pneumorph.errors import OutputPathError
+
+    held = [name for name in ("identified.toml", "identify.json") if (Path(out) / name).exists()]
+    if held:
+        raise OutputPathError(f"--out {out} holds an earlier identification ({', '.join(held)}); give another "
+                              "folder or replace it with --overwrite")
 
 
 def _scan_specs(scan: str | None, design: str | None, pressure: float | None, manifest: str | None, scan_unit: str,
