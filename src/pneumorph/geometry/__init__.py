@@ -1,5 +1,6 @@
 """Geometry: orientation vectors, the articulating unit and the actuator assembly."""
 
 from pneumorph.geometry.orientation import mirror, parse_orientation
+from pneumorph.geometry.unit import UnitSpec
 
-__all__ = ["mirror", "parse_orientation"]
+__all__ = ["UnitSpec", "mirror", "parse_orientation"]
