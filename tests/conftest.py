@@ -13,6 +13,12 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 import pytest  # noqa: E402 - after the environment above
 
+# The package imported the normal way before pytest collects the doctests of its modules: in
+# importlib mode pytest executes a collected module from its file, and a module that its own
+# imports reach again through its package (paths -> objectives -> fitness -> paths) would then
+# exist twice, with two classes of one name that isinstance tells apart.
+import pneumorph.design  # noqa: E402, F401
+
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"
 
