@@ -168,6 +168,11 @@ def test_generation_log_rules(tmp_path: Path) -> None:
     assert path.read_text().splitlines() == [fields, "0,1,2,3,4,5,6,7,8,9,01,"]
     GenerationLog(path, resume=False).close()  # a new run starts the file afresh
     assert path.read_text().splitlines() == [fields]
+    # a named pipe in its place is not read (that would wait for a writer for ever): the log starts afresh
+    path.unlink()
+    os.mkfifo(path)
+    GenerationLog(path, resume=True).close()
+    assert path.is_file() and path.read_text().splitlines() == [fields]
 
 
 # -- overwrite --------------------------------------------------------------------------------------------

@@ -104,3 +104,15 @@ def test_bad_settings_are_refused_before_any_solve() -> None:
     bad = DesignSpace((Variable("end_wall", 2.0, 5.5),), base=UnitSpec(element_size=3.0))
     with pytest.raises(GeometryError, match=r"end_wall=5\.5"):
         optimise(_settings(space=bad), object())  # an evaluator that cannot solve: refused before it is asked
+
+
+def test_a_pipe_in_place_of_pareto_json_is_not_read_and_the_folder_is_refused(tmp_path) -> None:
+    import os
+
+    from pneumorph.errors import RunFolderError
+    from pneumorph.unitopt.run import check_folder
+
+    os.mkfifo(tmp_path / "pareto.json")  # reading it would wait for a writer for ever
+    with pytest.raises(RunFolderError, match=r"another run's files \(pareto\.json\); give another folder"):
+        check_folder(tmp_path, _settings())
+    check_folder(tmp_path, _settings(), overwrite=True)  # taken: its outputs are replaced

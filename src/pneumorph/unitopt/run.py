@@ -214,6 +214,7 @@ def check_folder(folder: str | Path, settings: OptimiseSettings, overwrite: bool
 
     from pneumorph.io.files import strict_json
     from pneumorph.io.lock import LOCK_NAME
+    from pneumorph.io.reading import read_json
 
     path = Path(folder)
     if overwrite or not path.is_dir():
@@ -224,9 +225,10 @@ def check_folder(folder: str | Path, settings: OptimiseSettings, overwrite: bool
     others = [name for name in entries if name not in OUTPUTS]
     old = None
     if not others:
-        try:
-            old = json.loads((path / "pareto.json").read_text(encoding="utf-8"))["provenance"]["settings"]
-        except (OSError, ValueError, KeyError, TypeError):
+        try:  # the one bounded reader: a pipe, a device or a huge file in its place is not read
+            old = read_json(path / "pareto.json", "the output folder's pareto.json", RunFolderError)
+            old = old["provenance"]["settings"]
+        except (RunFolderError, KeyError, TypeError):
             old = None
         if old == json.loads(strict_json(settings.to_dict())):
             return

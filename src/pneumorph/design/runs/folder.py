@@ -138,9 +138,9 @@ class GenerationLog:
 
     def _existing(self) -> tuple[list[list[str]], bool]:
         """The readable rows of the file, and whether it is exactly its header and those rows."""
-        try:
-            text = self.path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError):
+        try:  # the one bounded reader: a pipe, a device or a huge file in its place is not read
+            text = read_text_file(self.path, "the run's generations.csv", RunFolderError)
+        except RunFolderError:
             return [], False
         lines = text.splitlines(keepends=True)
         clean = True
