@@ -30,6 +30,9 @@ def test_mesh_study_of_a_short_section(tmp_path: Path, capsys: pytest.CaptureFix
     assert (out / "mesh.png").stat().st_size > 10_000
     saved = json.loads((out / "mesh.json").read_text())
     assert saved["provenance"]["model"]["fidelity"] == "2d" and saved["convergence"] == data["convergence"]
+    # tips and curls are the last level's (the top of the ramp), the objective's pressure its own level's
+    top = saved["provenance"]["model"]["pressure_mpa"] * 1e3
+    assert [p["tip_pressure_kpa"] for p in saved["points"]] == pytest.approx([top] * 3)
     # a rerun answers from the cache, with the same numbers
     assert main(["sensitivity", "mesh", "--model", "2d", "--units", "1", "--size", "0.75", "--size", "1.5",
                  "--size", "0.375", "--json"]) == 0

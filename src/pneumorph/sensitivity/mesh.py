@@ -181,7 +181,7 @@ class MeshPoint:
     cells, dofs : int
         Cells of the mesh and unknowns of the model.
     tip : tuple of float or None
-        Tip position (x, y) at the last level, mm.
+        Tip position (x, y) at the last level, mm (its pressure is ``tip_pressure_kpa`` in ``extra``).
     curl : float or None
         End-face rotation at the last level, degrees.
     value : float or None
@@ -360,7 +360,8 @@ def mesh_points(model: Any, designs: Iterable[str], sizes: Iterable[float],
             point = MeshPoint(design, h, size, cells, int(meta.get("dofs", 0)),
                               (float(r.tip[-1, 0]), float(r.tip[-1, 1])), float(r.curl[-1]), float(value),
                               float(r.pressures[level] * 1e3), float(outcome.wall_time),
-                              extra={"precision": meta.get("precision")})
+                              extra={"precision": meta.get("precision"),
+                                     "tip_pressure_kpa": float(r.pressures[-1] * 1e3)})
         else:
             point = MeshPoint(design, h, size, cells, int(meta.get("dofs", 0)), None, None, None, None,
                               float(outcome.wall_time), outcome.failure or "did not converge")
