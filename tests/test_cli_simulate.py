@@ -94,3 +94,18 @@ def test_a_unit_with_a_bottom_wall_of_another_material_writes_its_region(tmp_pat
     assert '"regions": {"body": 0, "layer": 1, "filler": 2, "bottom:smooth_sil_950": 3}' in pvd
     region = meshio.read(out / "vtk" / "actuator_01.vtu").cell_data["region"][0]
     assert sorted(set(region.tolist())) == [0, 1, 2, 3]
+
+
+@pytest.mark.slow
+def test_a_ramp_stopped_by_ballooning_says_so_and_names_the_volume_control(tmp_path: Path,
+                                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """A 4-unit 2D actuator of Ecoflex 00-30 balloons near 26 kPa: the cavity volume falls under a higher pressure,
+    the ramp stops, and the one-line error says what that means and what follows past it; nothing is written."""
+    settings = tmp_path / "soft.toml"
+    settings.write_text('[model]\nfidelity = "2d"\n[model.unit]\nbody_material = "ecoflex_00_30"\n')
+    out = tmp_path / "out"
+    code = main(["simulate", "-o", "0110", "--model-file", str(settings), "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert code != 0 and err.startswith("error: design 0110: simulation failed, converged up to 26.")
+    assert "the cavity volume fell from" in err and "--volume-change" in err
+    assert not out.exists()

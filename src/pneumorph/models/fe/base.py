@@ -37,7 +37,7 @@ from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.gravity import gravity_vector
 from pneumorph.models.fe.obstacles import ContactRecord, check_obstacles, contact_items
-from pneumorph.models.fe.ramp import RampSpec
+from pneumorph.models.fe.ramp import RampSpec, past_the_maximum
 from pneumorph.models.fe.stages import before_the_ramp
 from pneumorph.models.fe.volumetric import FORMULATIONS, element_volume
 from pneumorph.models.frames import record_frames
@@ -442,10 +442,10 @@ class FEModel:
                          carry=self.carry_step)
         except SimulationFailed as exc:
             reached = exc.reached if control is None else control.factor
-            partial = replace(response, converged=False, reached=reached * self.ramp.pressure,
-                              failure=exc.cause)
+            cause = exc.cause if control is not None else past_the_maximum(exc.cause)
+            partial = replace(response, converged=False, reached=reached * self.ramp.pressure, failure=cause)
             raise SimulationFailed(
-                reached=exc.reached, cause=exc.cause, design=design, pressure=self.ramp.pressure, partial=partial
+                reached=exc.reached, cause=cause, design=design, pressure=self.ramp.pressure, partial=partial
             ) from None
         final = self._converged(response, stats, substep, gravity_iterations, int(body.displacement.size), t0)
         return Solution(final, mesh, displacements)
