@@ -296,8 +296,8 @@ class Bench:
         at every level, heights above the undeformed axis), ``stages``, ``path`` (a path's
         polyline placed on the actuator, mm, or None), ``axis_mm`` (the undeformed axis above
         the bottom face), ``centrelines`` (for a path or stages with one: the winner's base,
-        centres and tip at every level as the model reports them, the path's frame; else
-        None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``; with an object on the page, ``contact``:
+        centres and tip at every level as the model reports them, the path's frame, as with an object on the page;
+        else None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``; with an object on the page, ``contact``:
         the winner solved against it by the 2D FE model (:func:`~pneumorph.bench.contact.contact_answer`).
         """
         hit = self.recall(query)
@@ -372,7 +372,7 @@ class Bench:
             "stages": stage_samples(objective, chain.pressures(), length, axis),
             "path": path_samples(objective, length, axis),
             "axis_mm": axis,
-            "centrelines": centrelines(response) if uses_path(objective) else None,
+            "centrelines": centrelines(response) if uses_path(objective) or query.obstacle is not None else None,
         }
         if query.obstacle is not None:  # the winner solved against the object: its force and contact
             out["contact"] = contact_answer(self.model("2d", query.unit), winner, query.obstacle)
