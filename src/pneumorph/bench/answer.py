@@ -297,8 +297,8 @@ class Bench:
         polyline placed on the actuator, mm, or None), ``axis_mm`` (the undeformed axis above
         the bottom face), ``centrelines`` (for a path or stages with one: the winner's base,
         centres and tip at every level as the model reports them, the path's frame, as with an object on the page;
-        else None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``; with an object on the page, ``contact``:
-        the winner solved against it by the 2D FE model (:func:`~pneumorph.bench.contact.contact_answer`).
+        else None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``; with an object on the page,
+        ``contact``: the winner solved against it by the 2D FE model (:func:`~pneumorph.bench.contact.contact_answer`).
         """
         hit = self.recall(query)
         if hit is not None:

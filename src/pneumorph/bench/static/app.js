@@ -184,7 +184,7 @@ function contactAt(k) {
   $("contact-text").textContent = `Against the object (design ${c.design}, 2D FE with contact) at ` +
     `${lv.pressure_kpa.toFixed(1)} kPa: force ${lv.force_magnitude_n.toFixed(4)} N ` +
     `(${lv.force_n.map((v) => v.toFixed(4)).join(", ")}), contact length ${lv.contact_length_mm.toFixed(2)} mm, ` +
-    `clearance ${lv.clearance_mm.toFixed(3)} mm, ${lv.points.length} nodes in contact` +
+    `clearance ${lv.clearance_mm.toFixed(3)} mm, ${lv.points.length} node${lv.points.length === 1 ? "" : "s"} in contact` +
     (shown ? "" : "; the design shown is not the one solved against it");
   // an answer with an object has its centrelines: the plot is in the model's frame, as the object's
   return { circle: { centre: c.obstacle.centre, radius: c.obstacle.radius }, points: shown ? lv.points : [],
