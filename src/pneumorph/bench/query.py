@@ -113,8 +113,12 @@ class Query:
                               path=self.path)
 
     def key(self) -> str:
-        """A canonical text of the query (equal queries, equal keys)."""
-        return json.dumps(asdict(self), sort_keys=True)
+        """A canonical text of the query (equal queries, equal keys; without an object, the key it had before objects
+        were offered)."""
+        fields = asdict(self)
+        if fields["obstacle"] is None:
+            del fields["obstacle"]
+        return json.dumps(fields, sort_keys=True)
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Query:

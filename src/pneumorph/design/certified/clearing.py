@@ -95,8 +95,9 @@ class ClearingScreen:
     def iter_evaluate(self, model: Any, designs: Iterable[str]) -> Iterator[tuple[int, Outcome]]:
         designs = list(designs)
         keep = [i for i, d in enumerate(designs) if self.verdict(d) is None]
+        kept = set(keep)
         for i, d in enumerate(designs):
-            if i not in set(keep):
+            if i not in kept:
                 yield i, Outcome(d, None, failure=self.rejected[d])
         if keep:
             for j, outcome in self.inner.iter_evaluate(model, [designs[i] for i in keep]):
