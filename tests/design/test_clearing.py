@@ -120,3 +120,17 @@ def test_a_clearing_design_in_2d_end_to_end(tmp_path: Path) -> None:
                            str(tmp_path / "cache.sqlite")], capture_output=True, text=True, timeout=1800)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "best design 00110" in done.stdout
+
+
+def test_the_command_line_takes_the_clearance_to_the_run(tmp_path: Path) -> None:
+    """``--clear KPA:MM`` reaches the run: a pressure off the ramp's levels is refused there, before any solve."""
+    model = tmp_path / "model.toml"
+    model.write_text('[model]\nfidelity = "2d"\n\n[[model.obstacle]]\nkind = "cylinder"\ncentre = [50.0, 24.0]\n'
+                     'radius = 5.0\n', encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "pneumorph", "design", "--objective", "grip", "--clear", "25:1",
+                           "--model-file", str(model), "--units", "5", "--search", "exhaustive", "--out",
+                           str(tmp_path / "run"), "--cache", str(tmp_path / "cache.sqlite")],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert "[design.clear] pressure_kpa = 25: must be a level of the model's ramp below its top" in done.stderr
+    assert "Traceback" not in done.stderr and not (tmp_path / "run").exists()
