@@ -113,8 +113,8 @@ class Query:
                               path=self.path)
 
     def key(self) -> str:
-        """A canonical text of the query (equal queries, equal keys; without an object, the key it had before objects
-        were offered)."""
+        """A canonical text of the query (equal queries, equal keys); an absent object is left out, so that the key
+        (and the query id) of a query without one does not depend on the field."""
         fields = asdict(self)
         if fields["obstacle"] is None:
             del fields["obstacle"]

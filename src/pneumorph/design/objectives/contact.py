@@ -158,7 +158,7 @@ def clearance(contact: dict[str, Any], level: int) -> float:
     Raises
     ------
     SearchConfigError
-        A level without clearances (a response solved before they were reported).
+        A level without clearances (a cached response of a pneumorph that did not report them).
 
     >>> clearance({"levels": [{"obstacles": [{"clearance_mm": 2.5}, {"clearance_mm": 0.75}]}]}, 0)
     0.75
@@ -167,8 +167,8 @@ def clearance(contact: dict[str, Any], level: int) -> float:
     if level >= len(levels):
         return float("nan")
     if any("clearance_mm" not in o for o in levels[level]["obstacles"]):
-        raise SearchConfigError("a response with obstacles but no clearance (solved before pneumorph reported it, "
-                                "and kept in the evaluation cache): give the run a fresh --cache")
+        raise SearchConfigError("a response with obstacles but no clearance (an evaluation cache entry of a "
+                                "pneumorph that did not report it): give the run a fresh --cache")
     return float(min((o["clearance_mm"] for o in levels[level]["obstacles"]), default=np.nan))
 
 
