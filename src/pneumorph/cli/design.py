@@ -48,7 +48,7 @@ def _kpa(pressure: float | None) -> float:
 @click.option("--clear", metavar="KPA[:MM]", type=P.Text(),
               help="With --objective grip or wrap: keep MM mm (default 0) from every obstacle at the pressure KPA, a "
                    "level of the ramp below its top, and grip above it; the chain rejects the designs that cannot "
-                   "([design.clear] in a config file; docs/grasping.md).")
+                   "([design.clear] in a config file; documentation page grasping, docs/grasping.md in the source).")
 @click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
 @click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"),
               help="GA population (default 100; also the GA a certified search falls back to).")
