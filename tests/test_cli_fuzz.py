@@ -140,6 +140,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--stage": ["", "abc", "18", "18:", "x:sin", "nan:sin", "18:reach", "18:reach 1", "18:max-x", "20:sin",
                     "18:r = 20 + theta", "18:y = 1/0"],
         "--model-file": ["binary.bin", "folder", "missing.toml", ""],
+        "--clear": ["", "abc", "27:x", "nan", "27:inf", "27:1:2", "27:-1", "-5", "27"],
     },
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
@@ -308,6 +309,7 @@ CONFIG_KEYS: list[tuple[str, str, str]] = [
         ("design", "path", ['"abc"', "[1, 2]", "[[0, 0]]", '[[0, "a"], [1, 2]]']),
         ("design", "anchored", ["1"]),
         ("design", "chain_table", ["1", '""']),
+        ("design", "clear", ["1", '"x"', "{pressure_kpa = nan}", "{pressure_kpa = 27, clearance_mm = -1}"]),
         ("ga", "population", ["1", "1.5", "true", '"100"', "100000000"]),
         ("ga", "generations", ["1.5", "-1", "true", "100000000"]),
         ("ga", "cxpb", ["nan", "2", '"x"']),

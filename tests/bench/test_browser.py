@@ -319,3 +319,34 @@ def test_a_tip_goal_the_spatial_chain_cannot_score_is_refused_beside_the_target(
     assert "searching" not in _el(browser, "answer-time").text
     Select(_el(browser, "unit")).select_by_value("builtin")
     _wait(lambda: _answered(browser) and _el(browser, "target-error").text == "", timeout=30)
+
+
+@pytest.mark.slow
+def test_an_object_on_the_page_is_drawn_with_its_contact(browser) -> None:  # type: ignore[no-untyped-def]
+    """A circle before the 2D sin winner's free end: a bad radius is refused beside the object's fields; a good one
+    brings the answer solved against it (2D FE with contact), the circle drawn and the nodes in contact in red."""
+    Select(_el(browser, "target-kind")).select_by_value("preset")
+    Select(_el(browser, "preset")).select_by_value("sin")
+    Select(_el(browser, "model")).select_by_value("2d")
+    _wait(lambda: _answered(browser), timeout=30)
+    _retype(_el(browser, "object-r"), "0")
+    _el(browser, "object-on").click()
+    _wait(lambda: "radius must be a finite number > 0" in _el(browser, "obstacle-error").text, timeout=30)
+    assert _el(browser, "answer").get_attribute("data-state") == "error"
+    _retype(_el(browser, "object-r"), "4")
+    _wait(lambda: _answered(browser) and _el(browser, "contact-text").is_displayed(), timeout=600)
+    assert _el(browser, "obstacle-error").text == ""
+    browser.execute_script("const s = document.getElementById('pressure-slider'); s.value = s.max;"
+                           "s.dispatchEvent(new Event('input'));")
+    text = _el(browser, "contact-text").text
+    assert "2D FE with contact) at 45.0 kPa: force" in text and "in contact" in text
+    red = browser.execute_script("const c = document.getElementById('profile-plot');"
+                                 "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+                                 "let n = 0; for (let i = 0; i < d.length; i += 4)"
+                                 "  if (d[i] === 207 && d[i + 1] === 34 && d[i + 2] === 46) n++;"
+                                 "return n;")
+    assert red > 10  # the nodes in contact (#cf222e)
+    _shot(browser, "object")
+    _el(browser, "object-on").click()
+    Select(_el(browser, "model")).select_by_value("3d")
+    _wait(lambda: _answered(browser) and not _el(browser, "contact-text").is_displayed(), timeout=30)

@@ -126,7 +126,9 @@ def answer_schema(path: str, method: str) -> dict[str, Any]:
         {"pressure_kpa": 45, "target": {"kind": "preset", "name": "sin"}, "weight": 2}]}, "model": "2d", "top": 2},
     {"target": {"kind": "curve", "points": [[0, 0], [80, 5], [157.5, 20]], "top_points": [[0, 0], [157.5, 10]]},
      "model": "2d", "top": 2},
-], ids=["preset", "path", "tip", "stages", "curve-in-space"])
+    {"target": {"kind": "preset", "name": "sin"}, "model": "2d", "top": 1,
+     "obstacle": {"centre": [170.0, 4.0], "radius": 4.0}},  # the winner solved against it by 2D FE
+], ids=["preset", "path", "tip", "stages", "curve-in-space", "object"])
 def test_answers_have_exactly_the_described_fields(client: TestClient, query: dict[str, Any]) -> None:
     got = client.post("/api/design", json=query)
     assert got.status_code == 200, got.text[:300]

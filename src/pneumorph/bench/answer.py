@@ -17,11 +17,13 @@ import re
 import threading
 import time
 from collections import OrderedDict
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from pneumorph.bench.contact import contact_answer, parse_obstacle
 from pneumorph.bench.query import MODELS, Query, QueryError, choice, parse_query
 from pneumorph.bench.samples import centrelines, path_samples, profiles, stage_samples, target_samples, uses_path
 from pneumorph.bench.shapes import chain_placement, surface
@@ -249,18 +251,22 @@ class Bench:
                 objective.levels(chain.pressures(), how="")
             except SearchConfigError as exc:
                 raise QueryError("stages", str(exc)) from None
-        return query
+        circle = parse_obstacle(body.get("obstacle"), length)
+        if circle is not None and model != "2d":
+            raise QueryError("obstacle", "an object is solved by the 2D FE model with contact: choose the 2D model")
+        return query if circle is None else replace(query, obstacle=circle)
 
     def slow(self, query: Query) -> bool:
         """Whether ``query`` is answered by the branch-and-bound of a chain in space (seconds to a minute, within
-        :data:`QUERY_MEMORY`): the bench answers such queries on a worker of their own.
+        :data:`QUERY_MEMORY`) or has its winner solved against an object by FE (:mod:`pneumorph.bench.contact`):
+        the bench answers such queries on a worker of their own.
 
         >>> from pneumorph.bench.query import Query
         >>> bench = Bench()
         >>> bench.slow(Query("preset", "sin")), bench.slow(Query("tip", "max-x", unit="spatial"))
         (False, True)
         """
-        return self.chain(query.model, query.unit).table.axes == 3
+        return query.obstacle is not None or self.chain(query.model, query.unit).table.axes == 3
 
     def recall(self, query: Query) -> dict[str, Any] | None:
         """A remembered answer to ``query`` (marked ``memo``), or None."""
@@ -290,8 +296,9 @@ class Bench:
         at every level, heights above the undeformed axis), ``stages``, ``path`` (a path's
         polyline placed on the actuator, mm, or None), ``axis_mm`` (the undeformed axis above
         the bottom face), ``centrelines`` (for a path or stages with one: the winner's base,
-        centres and tip at every level as the model reports them, the path's frame; else
-        None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``.
+        centres and tip at every level as the model reports them, the path's frame, as with an object on the page;
+        else None; :mod:`pneumorph.bench.samples`), ``elapsed_ms`` and ``memo``; with an object on the page,
+        ``contact``: the winner solved against it by the 2D FE model (:func:`~pneumorph.bench.contact.contact_answer`).
         """
         hit = self.recall(query)
         if hit is not None:
@@ -312,7 +319,7 @@ class Bench:
         chain = self.chain(query.model, query.unit)
         length, axis = chain.length, float(chain.table.tip_ref[1])
         objective = query.objective(length)
-        if self.slow(query):  # within the query's memory budget (QUERY_NODES)
+        if chain.table.axes == 3:  # within the query's memory budget (QUERY_NODES)
             scores = space_scores(chain, objective, max_nodes=QUERY_NODES)
         else:
             scores = best_scores(chain, objective, top=query.top)
@@ -344,7 +351,7 @@ class Bench:
             "statement": _statement(query.model, float(scores.bound[best]), unit, candidates, every, certain,
                                     sign * float(scores.floor)),
         }
-        return {
+        out = {
             "query_id": key_id(query.key()),
             "label": objective.label,
             "model": query.model,
@@ -365,8 +372,11 @@ class Bench:
             "stages": stage_samples(objective, chain.pressures(), length, axis),
             "path": path_samples(objective, length, axis),
             "axis_mm": axis,
-            "centrelines": centrelines(response) if uses_path(objective) else None,
+            "centrelines": centrelines(response) if uses_path(objective) or query.obstacle is not None else None,
         }
+        if query.obstacle is not None:  # the winner solved against the object: its force and contact
+            out["contact"] = contact_answer(self.model("2d", query.unit), winner, query.obstacle)
+        return out
 
     def chain_lines(self, design: str, fidelity: str, unit: str = BUILTIN) -> dict[str, Any]:
         """A design's predicted lines at every level: ``profiles`` (heights above the axis, :func:`profiles`) and

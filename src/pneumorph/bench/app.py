@@ -158,8 +158,9 @@ class AnswerPool:
         if not self.bench.slow(query):
             return await self._run(query, slow=False)
         if self._slow >= SLOW_QUEUE:
-            raise SlowQueriesBusy(f"{self._slow} slow queries (a chain in space searched by branch-and-bound, up to a "
-                                  "minute each) are being answered or waiting; ask again when they are done")
+            raise SlowQueriesBusy(f"{self._slow} slow queries (a chain in space searched by branch-and-bound, or an "
+                                  "answer solved against an object by FE, up to a minute each) are being answered or "
+                                  "waiting; ask again when they are done")
         self._slow += 1
         try:
             return await self._run(query, slow=True)

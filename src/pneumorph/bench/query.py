@@ -87,6 +87,9 @@ class Query:
         A path's points (mm, in the frame of the unit centres: y from the actuator's bottom
         face, z from its mid-plane), for ``spec = "path"``: given, or a drawn stroke that
         turns back in x, smoothed (:func:`~pneumorph.bench.strokes.smooth_path`).
+    obstacle : (float, float, float) or None
+        A circle ``(x, y, r)`` beside the actuator (mm, the model's frame) that the answer's design is solved
+        against by the 2D FE model with contact (:mod:`pneumorph.bench.contact`).
     """
 
     kind: str
@@ -100,6 +103,7 @@ class Query:
     unit: str = "builtin"
     stages: tuple[tuple[float, float, Query], ...] | None = None
     path: tuple[tuple[float, ...], ...] | None = None
+    obstacle: tuple[float, float, float] | None = None
 
     def objective(self, length: float) -> Objective:
         """The objective, a profile checked along ``length`` mm (stages: their staged target)."""
@@ -109,8 +113,12 @@ class Query:
                               path=self.path)
 
     def key(self) -> str:
-        """A canonical text of the query (equal queries, equal keys)."""
-        return json.dumps(asdict(self), sort_keys=True)
+        """A canonical text of the query (equal queries, equal keys); an absent object is left out, so that the key
+        (and the query id) of a query without one does not depend on the field."""
+        fields = asdict(self)
+        if fields["obstacle"] is None:
+            del fields["obstacle"]
+        return json.dumps(fields, sort_keys=True)
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Query:
@@ -123,7 +131,9 @@ class Query:
         True
         """
         point, curve, stages, path = data.get("point"), data.get("curve"), data.get("stages"), data.get("path")
+        obstacle = data.get("obstacle")
         return cls(**{**data, "point": None if point is None else tuple(float(v) for v in point),
+                      "obstacle": None if obstacle is None else tuple(float(v) for v in obstacle),
                       "curve": None if curve is None else tuple(tuple(float(v) for v in c) for c in curve),
                       "path": None if path is None else tuple(tuple(float(v) for v in c) for c in path),
                       "stages": None if stages is None else tuple((float(p), float(w), cls.from_dict(q))

@@ -67,7 +67,12 @@ TARGET = _obj("The target; `kind` says which other fields it reads.", {
 QUERY = _obj("A design query.", {"target": TARGET}, {
     "model": _t("string", "the model (default 3d)", enum=list(MODELS)),
     "top": _t("integer", f"how many designs to list, 1 to {MAX_TOP} (default 10)"),
-    "unit": _t("string", "builtin (default), a library, or an uploaded unit's id (`GET /api/units`)")})
+    "unit": _t("string", "builtin (default), a library, or an uploaded unit's id (`GET /api/units`)"),
+    "obstacle": _obj("An object beside the actuator (2D model only): the answer's winner is solved against it by the "
+                     "2D FE model with contact", {
+                         "centre": _list(_NUMBER, "the circle's centre [x, y] (mm: x from the clamped base, y from "
+                                                  "the bottom face), within 1.25 lengths of the base"),
+                         "radius": _t("number", "its radius (mm), > 0 and at most half the length")})})
 
 _SAMPLES = _null(_obj("The target's samples over the actuator (heights above the axis, mm); null for a tip goal "
                       "or a path", {"x": _list(_NUMBER, "x (mm)"), "y": _list(_NUMBER, "y (mm)")},
@@ -112,10 +117,28 @@ ANSWER = _obj("The chain model's certified answer.", {
         "target": _SAMPLES, "path": _PATH, "point": _POINT}), "a staged target's stages; null otherwise")),
     "path": _PATH,
     "axis_mm": _t("number", "the axis's height above the actuator's bottom face (mm)"),
-    "centrelines": _null({**_LEVELS, "description": "a path's target: the winner's centres at every level as the "
-                                                    "model reports them (mm); null otherwise"}),
+    "centrelines": _null({**_LEVELS, "description": "a path's target or an object on the page: the winner's base, "
+                                                    "centres and tip at every level as the model reports them (mm); "
+                                                    "null otherwise"}),
     "elapsed_ms": _t("number", "time to compute the answer (ms)"),
-    "memo": _t("boolean", "whether the answer was remembered from an earlier query")})
+    "memo": _t("boolean", "whether the answer was remembered from an earlier query")}, {
+    "contact": _obj("With an object: the winner solved against it by the 2D FE model with contact", {
+        "obstacle": _obj("The object as an obstacle table", {
+            "kind": _t("string", "cylinder (a circle in 2D)"), "centre": _list(_NUMBER, "[x, y] (mm)"),
+            "radius": _t("number", "mm")}),
+        "design": _t("string", "the design solved (the winner)"),
+        "failure": _null(_t("string", "why the ramp stopped (then no levels); null when it converged")),
+        "levels": _list(_obj("One pressure level", {
+            "pressure_kpa": _t("number", "the level's pressure (kPa)"),
+            "force_n": _list(_NUMBER, "the force on the object [fx, fy] (N; 2D: per mm of depth times the width)"),
+            "force_magnitude_n": _t("number", "its magnitude (N)"),
+            "contact_length_mm": _t("number", "the contact length (mm)"),
+            "clearance_mm": _t("number", "the least gap of the surface nodes to the object (mm; <= 0 in contact)"),
+            "base_reaction_n": _list(_NUMBER, "the clamp's force on the actuator (N): the object's, balanced"),
+            "points": _POINTS,
+            "node_pressures_kpa": _list(_NUMBER, "the contact pressure of each node in contact (kPa)"),
+            "centreline": _list(_list(_NUMBER, "x, y (mm)"), "the base, unit centres and tip (mm)")}),
+            "every level of the ramp")})})
 
 INFO = _obj("The bench's settings.", {
     "version": _t("string", "pneumorph's version"),

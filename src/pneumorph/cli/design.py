@@ -45,6 +45,10 @@ def _kpa(pressure: float | None) -> float:
                    "'KPA:reach X Y' (a tip point, mm; X Y Z off the plane); --amplitude and --periods shape the "
                    "presets. The cost is the root-sum-square of the stages (weights: [[design.stage]] in a config "
                    "file).")
+@click.option("--clear", metavar="KPA[:MM]", type=P.Text(),
+              help="With --objective grip or wrap: keep MM mm (default 0) from every obstacle at the pressure KPA, a "
+                   "level of the ramp below its top, and grip above it; the chain rejects the designs that cannot "
+                   "([design.clear] in a config file; documentation page grasping, docs/grasping.md in the source).")
 @click.option("--units", type=P.UNITS, help="Number of articulating units (default 15).")
 @click.option("--pop", "population", type=P.Count(2, MAX_POPULATION, limit="MAX_POPULATION"),
               help="GA population (default 100; also the GA a certified search falls back to).")
@@ -196,6 +200,8 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any
             data["design"].update(target)
             config = DesignConfig.from_dict(data)
     design.update(_stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods, o.units))
+    if o.clear is not None:
+        design["clear"] = _clear_option(o.clear, design["objective"] or config.objective)
     identified = None
     if o.model_file is not None:  # the identified model's settings over the config's
         from pneumorph.models.factory import read_model_file
@@ -362,6 +368,32 @@ def _stage_changes(stages: tuple[str, ...], other_target: bool, amplitude: float
     with P.blame("--stage"):
         DesignConfig(objective="stages", stage=stage, units=units or DesignConfig.units)
     return {"objective": "stages", "stage": stage}
+
+
+def _clear_option(text: str, objective: str) -> dict[str, Any]:
+    """``--clear KPA[:MM]`` as a ``[design.clear]`` table, checked for the contact goal ``objective``
+    (:func:`~pneumorph.design.objectives.contact.clearing`; the level of the ramp when the run starts).
+
+    >>> _clear_option("27:1.5", "grip"), _clear_option("27", "wrap")
+    ({'pressure_kpa': 27.0, 'clearance_mm': 1.5}, {'pressure_kpa': 27.0})
+    """
+    from pneumorph.design.objectives.contact import CONTACT_GOALS, clearing, contact_goal
+
+    parts = text.split(":")
+    try:
+        numbers = [float(v) for v in parts]
+    except ValueError:
+        numbers = []
+    if len(numbers) not in (1, 2) or not all(math.isfinite(v) for v in numbers):
+        raise click.BadParameter(f"{text!r} is not KPA[:MM] (e.g. 27:1, a clearance of 1 mm at 27 kPa)",
+                                 param_hint="'--clear'")
+    if objective not in CONTACT_GOALS:
+        raise click.BadParameter(f"applies to --objective {' or '.join(CONTACT_GOALS)}, not to {objective!r}",
+                                 param_hint="'--clear'")
+    table = {"pressure_kpa": numbers[0], **({"clearance_mm": numbers[1]} if len(numbers) == 2 else {})}
+    with P.blame("--clear"):
+        clearing(contact_goal(objective), table)
+    return table
 
 
 def _stage_option(text: str, amplitude: float | None, periods: float | None) -> dict[str, Any]:

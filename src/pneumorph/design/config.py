@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from pneumorph import checks
+from pneumorph.design.objectives.contact import clearing
 from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
 from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.search.genetic import GAConfig
@@ -100,6 +101,7 @@ class DesignConfig:
     path: tuple[tuple[float, ...], ...] | None = None
     anchored: bool = True
     stage: tuple[dict[str, Any], ...] | None = None
+    clear: dict[str, Any] | None = None
     units: int = 15
     search: str = "certified"
     seed: int = 0
@@ -258,8 +260,8 @@ class DesignConfig:
                  make_objective(s["objective"], s.get("amplitude", 10.0), s.get("periods", 1.0), s.get("point"),
                                 s.get("anchored", True), length, s.get("curve"), s.get("path")),
                  s.get("weight", 1.0)) for s in self.stage])
-        return make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored, length,
-                              self.curve, self.path)
+        return clearing(make_objective(self.objective, self.amplitude, self.periods, self.point, self.anchored,
+                                       length, self.curve, self.path), self.clear)
 
     def with_options(self, design: dict[str, Any], ga: dict[str, Any] | None = None,
                      model: dict[str, Any] | None = None, model_file: dict[str, Any] | None = None) -> DesignConfig:
@@ -317,11 +319,9 @@ class DesignConfig:
         ``refine = 0`` left out)."""
         design = {
             k: getattr(self, k)
-            for k in ("objective", "amplitude", "periods", "point", "curve", "path", "anchored", "stage", "units",
-                      "search",
-                      "seed",
-                      "certify", "verify", "margin", "epsilon", "refine", "chain_table", "tolerance", "robust",
-                      "robust_samples")
+            for k in ("objective", "amplitude", "periods", "point", "curve", "path", "anchored", "stage", "clear",
+                      "units", "search", "seed", "certify", "verify", "margin", "epsilon", "refine", "chain_table",
+                      "tolerance", "robust", "robust_samples")
         }
         for key in ("epsilon", "refine"):  # absent by default: the settings of earlier run folders stay the same
             if design[key] == 0.0:

@@ -68,9 +68,10 @@ from typing import Any
 
 from pneumorph.design.algorithms import algorithm_for
 from pneumorph.design.algorithms.problem import Algorithm, Problem, SearchOutcome
+from pneumorph.design.certified.clearing import clearing_screen
 from pneumorph.design.certified.planning import planned_workers
 from pneumorph.design.config import DesignConfig, to_toml
-from pneumorph.design.objectives.contact import check_contact_goal
+from pneumorph.design.objectives.contact import ContactGoal, check_contact_goal
 from pneumorph.design.objectives.targets import StagedTarget, on_actuator
 from pneumorph.design.runs.folder import check_folder, created_top, remove_empty, remove_run_files
 from pneumorph.design.runs.report import RunResult, write_outputs, write_report
@@ -131,12 +132,18 @@ def run_design(config: DesignConfig, model: ActuatorModel, folder: str | Path, e
     algorithm, problem = (algorithm or algorithm_for(config)).plan(problem)
     if isinstance(problem.objective, StagedTarget):  # a stage off the levels of the ramp: refused here
         problem.objective.levels(problem.model.pressures())
+    if isinstance(problem.objective, ContactGoal):  # a clearance off the levels below the top: likewise
+        problem.objective.clear_level(problem.model.pressures())
     fingerprint = problem.model.fingerprint()
     check_folder(folder, config, fingerprint, overwrite)  # checked again under the lock
     with _Claim(folder, config, evaluator, cache) as claim:
         resumed = claim.take(fingerprint, overwrite, problem.say)
-        problem = replace(problem, evaluator=claim.cached, workers=evaluator_workers(claim.inner), folder=folder,
+        screened, clearing = clearing_screen(claim.cached, problem.model, problem.objective, problem.table_dir,
+                                             config.margin)
+        problem = replace(problem, evaluator=screened, workers=evaluator_workers(claim.inner), folder=folder,
                           resumed=resumed)
+        if clearing:
+            problem.say(clearing)
         if algorithm.note:
             problem.say(algorithm.note)
         problem, entries = algorithm.setup(problem)

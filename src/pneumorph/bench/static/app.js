@@ -8,7 +8,7 @@ const state = { info: null, answer: null, seq: 0, selected: null, profiles: null
   job: null, polling: new Set(), shapeSeq: 0, stages: [], stageCurve: null };
 const ACTIVE = ["queued", "running"];
 const FIELDS = ["target", "preset", "amplitude", "periods", "expression", "goal", "point", "points", "stages", "model", "unit",
-  "top"];
+  "top", "obstacle"];
 const STAGE_COLOURS = ["#e07b1a", "#8250df", "#1a7f37", "#cf222e", "#bf8700", "#0a7ea4"];
 
 async function api(path, options = {}) {
@@ -47,7 +47,10 @@ function currentBody() {
     target = { kind, points: state.curve || [] };
     if (state.curveTop) target.top_points = state.curveTop;   // the view from above: the curve's z
   }
-  return { target, model: $("model").value, unit: $("unit").value, top: 10 };
+  const body = { target, model: $("model").value, unit: $("unit").value, top: 10 };
+  // an object on the page: the answer's design is solved against it by the 2D FE model with contact
+  if ($("object-on").checked) body.obstacle = { centre: [number("object-x"), number("object-y")], radius: number("object-r") };
+  return body;
 }
 
 function clearErrors() {
@@ -148,10 +151,13 @@ function redraw() {
     colour: STAGE_COLOURS[i % STAGE_COLOURS.length], current: st.level === k,
     label: `${st.pressure_kpa} kPa ${st.path ? "path" : "target"}`,
   }));
-  $("plot-title").textContent = state.centrelines ? "Path: the unit centres as the model reports them" : "Profile";
+  $("plot-title").textContent = a.path ? "Path: the unit centres as the model reports them"
+    : state.centrelines ? "The unit centres as the model reports them" : "Profile";
+  const touch = contactAt(k);
   drawProfile($("profile-plot"), { target, point: up(a.point), profile: lines[k], label: `design ${state.selected}`,
     stages, ramp: a.stages ? lines : null, axis: lift, vertical: lift ? "y (mm) from the bottom face" : "y (mm)",
-    targetLabel: a.path ? `path${a.path.name === "path" ? "" : ` ${a.path.name}`}: the centres along it, in order` : "target" });
+    targetLabel: a.path ? `path${a.path.name === "path" ? "" : ` ${a.path.name}`}: the centres along it, in order` : "target",
+    circle: touch && touch.circle, contact: touch ? touch.points : [], fe: touch ? touch.line : null });
   // a space curve or a design that leaves the plane: the view from above, the target's z against the
   // actuator's (z = 0 where the chain is planar: it bends in its plane)
   const shape = a.path || a.target;
@@ -164,6 +170,25 @@ function redraw() {
       point: pointZ ? [a.point[0], a.point[2]] : null, targetLabel: a.path ? "path" : "target",
       profile: lines[k].map(([x, , z]) => [x, z || 0]), label: `design ${state.selected}`, vertical: "z (mm)" });
   }
+}
+
+// the answer solved against the object at level k, drawn in the frame of the unit centres (y from the bottom face):
+// the circle, the FE centreline and the nodes in contact
+function contactAt(k) {
+  const a = state.answer, c = a && a.contact;
+  $("contact-text").hidden = !c;
+  if (!c) return null;
+  if (c.failure || !c.levels.length) { $("contact-text").textContent = `Against the object: ${c.failure}`; return null; }
+  const lv = c.levels[k];
+  const shown = state.selected === c.design;
+  $("contact-text").textContent = `Against the object (design ${c.design}, 2D FE with contact) at ` +
+    `${lv.pressure_kpa.toFixed(1)} kPa: force ${lv.force_magnitude_n.toFixed(4)} N ` +
+    `(${lv.force_n.map((v) => v.toFixed(4)).join(", ")}), contact length ${lv.contact_length_mm.toFixed(2)} mm, ` +
+    `clearance ${lv.clearance_mm.toFixed(3)} mm, ${lv.points.length} node${lv.points.length === 1 ? "" : "s"} in contact` +
+    (shown ? "" : "; the design shown is not the one solved against it");
+  // an answer with an object has its centrelines: the plot is in the model's frame, as the object's
+  return { circle: { centre: c.obstacle.centre, radius: c.obstacle.radius }, points: shown ? lv.points : [],
+    line: shown ? lv.centreline : null };
 }
 
 function renderStages() {
@@ -306,7 +331,7 @@ async function main() {
   topArea = new DrawArea($("draw-top-canvas"), state.info.length_mm, (points) => { state.curveTop = points; schedule(); });
   const changed = () => { showKind(); schedule(); };
   for (const id of ["target-kind", "preset", "amplitude", "periods", "expression", "expr-amplitude", "goal", "point-x",
-    "point-y", "point-z", "model", "unit"]) {
+    "point-y", "point-z", "model", "unit", "object-on", "object-x", "object-y", "object-r"]) {
     $(id).addEventListener("input", changed);
     if ($(id).tagName === "SELECT") $(id).addEventListener("change", changed);
   }

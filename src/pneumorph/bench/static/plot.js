@@ -27,9 +27,10 @@ function bounds(sets) {
 // ramp: the profiles of every level (drawn faint behind the profile), both optional;
 // vertical: the vertical axis's label, "y (mm)" unless a view from above; axis: the height of the
 // undeformed axis, drawn dashed (0 for heights above it; a path's frame has it 6 mm up);
-// targetLabel: the target's legend ("target", or what the path is)}.
+// targetLabel: the target's legend ("target", or what the path is); circle: an object {centre, radius},
+// contact: the nodes in contact with it [[x, y]...], fe: the FE centreline solved against it, or null}.
 export function drawProfile(canvas, { target, point, profile, label, stages = [], ramp = null, vertical = "y (mm)",
-  axis = 0, targetLabel = "target" }) {
+  axis = 0, targetLabel = "target", circle = null, contact = [], fe = null }) {
   const ctx = canvas.getContext("2d");
   const W = canvas.width, H = canvas.height, pad = { l: 48, r: 14, t: 14, b: 34 };
   ctx.clearRect(0, 0, W, H);
@@ -38,6 +39,11 @@ export function drawProfile(canvas, { target, point, profile, label, stages = []
   if (point) sets.push([point]);
   for (const st of stages) { if (st.points) sets.push(st.points); if (st.point) sets.push([st.point]); }
   if (ramp) ramp.forEach((pts) => sets.push(pts));
+  if (circle) {
+    const [ox, oy] = circle.centre, r = circle.radius;
+    sets.push([[ox - r, oy - r], [ox + r, oy + r]]);
+  }
+  if (fe) sets.push(fe);
   let [x0, x1, y0, y1] = bounds(sets);
   const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
   const pw = W - pad.l - pad.r, ph = H - pad.t - pad.b;
@@ -88,6 +94,14 @@ export function drawProfile(canvas, { target, point, profile, label, stages = []
     if (st.points) line(st.points, st.colour, st.current ? 3 : 1.5);
     if (st.point) cross(st.point, st.colour);
   }
+  if (circle) {
+    ctx.strokeStyle = "#57606a"; ctx.fillStyle = "rgba(87, 96, 106, 0.15)"; ctx.lineWidth = 2;
+    ctx.beginPath(); ctx.arc(X(circle.centre[0]), Y(circle.centre[1]), circle.radius * scale, 0, 2 * Math.PI);
+    ctx.fill(); ctx.stroke();
+  }
+  if (fe) line(fe, "#1a7f37", 2);
+  ctx.fillStyle = "#cf222e";
+  for (const [x, y] of contact) { ctx.beginPath(); ctx.arc(X(x), Y(y), 4, 0, 2 * Math.PI); ctx.fill(); }
   if (profile && profile.length) {
     line(profile, "#0b6bcb", 2);
     ctx.fillStyle = "#0b6bcb";
@@ -105,4 +119,6 @@ export function drawProfile(canvas, { target, point, profile, label, stages = []
   for (const st of stages) legend(st.colour, st.current ? `${st.label} (this level)` : st.label);
   if (ramp) legend("#d0d7de", "the ramp: every level");
   if (profile) legend("#0b6bcb", label || "unit centres");
+  if (circle) legend("#57606a", "object");
+  if (fe) legend("#1a7f37", "FE with contact (nodes in contact in red)");
 }

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pneumorph.design.objectives.contact import CONTACT_GOALS, ContactGoal, contact_goal
+from pneumorph.design.objectives.contact import CONTACT_GOALS, LEVEL_MATCH, ContactGoal, contact_goal
 from pneumorph.design.objectives.expressions import parse_expression
 from pneumorph.design.objectives.paths import PATH_PRESETS, PathTarget, path_target, preset_path
 from pneumorph.design.objectives.profiles import (
@@ -94,8 +94,6 @@ class TipGoal:
         return TIP_GOALS[self.name][1]
 
 
-#: relative difference within which a stage's pressure is a level of the ramp
-LEVEL_MATCH = 1e-6
 #: most stages of one staged target
 MAX_STAGES = 20
 

@@ -281,15 +281,24 @@ def _write_certificate(result: RunResult, folder: Path) -> list[Path]:
     return [path, atomic_write_text(folder / "top.csv", text)]
 
 
-def _contact_lines(model: ActuatorModel) -> list[str]:
-    """How a run over obstacles measured and searched: by FE with contact on every design, nothing certified."""
+def _contact_lines(model: ActuatorModel, objective: Any = None) -> list[str]:
+    """How a run over obstacles measured and searched: by FE with contact on every design solved, nothing of the
+    grip certified; with a clearance, the designs the chain's bound rejected (certified not to clear)."""
     obstacles = getattr(model, "obstacles", ())
     if not obstacles:
         return []
     tables = "; ".join(", ".join(f"{k} {v}" for k, v in o.to_dict().items()) for o in obstacles)
-    return [f"- contact: obstacles {tables}. Every design searched was solved by FE with contact and scored by "
-            "what that solve reports; the chain model knows no contact, so nothing is certified: the winner is "
-            "the best of the designs searched"]
+    clear = getattr(objective, "clear", None)
+    lines = [f"- contact: obstacles {tables}. Every design searched{' but those rejected below' if clear else ''} "
+             "was solved by FE with contact and scored by what that solve reports; the chain model knows no contact, "
+             f"so nothing {'of the grip ' if clear else ''}is certified: the winner is the best of the designs "
+             "searched"]
+    if clear is not None:
+        lines.append(f"- clearing: {clear.label}. Certified by the chain's bound: a design whose free shape by the "
+                     "chain comes closer than the clearance less the chain's validated error cannot clear; it was "
+                     "rejected without a solve (its failure says so). Searched by FE with contact: the clearance "
+                     "and the grip of every other design (a design that does not clear scores as failed)")
+    return lines
 
 
 def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, files: list[str]) -> str:
@@ -310,7 +319,7 @@ def report_text(result: RunResult, config: DesignConfig, model: ActuatorModel, f
         f"- objective: {o.label} ({'minimised' if o.sense == 'min' else 'maximised'})",
         f"- actuator: {config.units} units, model {getattr(model, 'fidelity', '?')} ({model.fingerprint()})",
         f"- search: {search}",
-        *_contact_lines(model),
+        *_contact_lines(model, o),
         (f"- new solves: {result.solves}, answered by the cache: {result.cache_hits}, "
         f"wall time {result.wall_time:.1f} s"
          + (f"; {result.rejected} damaged cache entries were solved again, not used" if result.rejected else "")),

@@ -4,7 +4,8 @@ An obstacle (:mod:`pneumorph.fem.fast.contact`: a plane, a cylinder - a circle i
 frictionless or with Coulomb ``friction``) touches the actuator's outer surface nodes, or with
 ``on = "end"`` the nodes of its free end face only (a load cell against the tip: :func:`blocked_wall`).
 Every reported level records, per obstacle, the force the actuator exerts on it (N), the nodes in contact and the
-contact length (2D, mm) or area (3D, mm^2), and the reaction of the clamped base on the actuator
+contact length (2D, mm) or area (3D, mm^2), the clearance (the least gap of the nodes it may touch, mm; <= 0 in
+contact), and the reaction of the clamped base on the actuator
 (N): with no gravity it equals the sum of the obstacles' forces, since the cavity pressure is
 internal. The 2D section's forces per mm of depth are multiplied by the unit's width; a 3D half
 model's by two (their z components vanish by symmetry).
@@ -191,6 +192,7 @@ class ContactRecord:
                             "nodes_in_contact": report["nodes"].tolist(),
                             "node_forces_n": (report["node_forces"] * self.scale).tolist(),
                             "node_pressures_kpa": (report["node_pressures"] * 1e3).tolist(),
+                            "clearance_mm": float(contact.obstacle.kinematics(x[contact.points])[0].min()),
                             "contact_length_mm" if self.mesh.dim == 2 else "contact_area_mm2":
                                 report["measure"] * (2.0 if self.mesh.dim == 3 and self.scale[2] == 0.0 else 1.0)})
         self.levels[k:] = [{"pressure_kpa": pressure * 1e3, "base_reaction_n": reaction.tolist(),
