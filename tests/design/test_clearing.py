@@ -14,6 +14,7 @@ import pytest
 from pneumorph.design import DesignConfig, run_design
 from pneumorph.design.certified.clearing import ClearingScreen, chain_clearance, clearing_screen
 from pneumorph.design.objectives.contact import Clearance, ContactGoal, contact_values
+from pneumorph.design.search.scoring import ScoreBook
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution import EvaluationCache, SerialEvaluator
 from pneumorph.models.fe import Reduced2D
@@ -80,6 +81,10 @@ def test_the_chain_rejects_only_designs_fe_finds_too_close() -> None:
     outcomes = screen.evaluate_many(model, ["00000", "00110"])
     assert outcomes[0] is not None and "does not clear at 27 kPa" in (outcomes[0].failure or "")
     assert solved == ["00110"]  # only the kept design goes on to FE
+    assert outcomes[0].screened and not outcomes[0].solved
+    book = ScoreBook(model, goal, screen)  # a search's count of solves leaves out what the screen answered
+    book.score_many(["00000"])
+    assert (book.solves, book.hits) == (0, 0) and solved == ["00110"]
     assert chain_clearance(screen.chain, "00000", 5, screen.obstacles) < 1.0 - screen.error
     c = np.array(CYLINDER["centre"])
     for design, clears in (("00000", False), ("00110", True)):

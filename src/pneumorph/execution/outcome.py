@@ -32,6 +32,9 @@ class Outcome:
         True for a failure that says nothing about the design itself (the worker process
         solving it died: ``failure`` starts with ``"worker died"``). Such an outcome is
         not to be stored in the evaluation cache; the next run solves the design again.
+    screened : bool
+        True for a design a screen answered without a solve (the chain's certified rejection of
+        a design that cannot clear an obstacle): neither solved nor cached.
 
     Examples
     --------
@@ -39,6 +42,8 @@ class Outcome:
     False
     >>> Outcome("01", None, failure="worker died: exit code 1", transient=True).transient
     True
+    >>> Outcome("01", None).solved, Outcome("01", None, cached=True).solved, Outcome("01", None, screened=True).solved
+    (True, False, False)
     """
 
     design: str
@@ -48,6 +53,12 @@ class Outcome:
     cached: bool = False
     wall_time: float = 0.0
     transient: bool = False
+    screened: bool = False
+
+    @property
+    def solved(self) -> bool:
+        """True for an outcome of a solve (neither the cache's answer nor a screen's)."""
+        return not (self.cached or self.screened)
 
     @property
     def ok(self) -> bool:

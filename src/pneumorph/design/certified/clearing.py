@@ -98,7 +98,7 @@ class ClearingScreen:
         kept = set(keep)
         for i, d in enumerate(designs):
             if i not in kept:
-                yield i, Outcome(d, None, failure=self.rejected[d])
+                yield i, Outcome(d, None, failure=self.rejected[d], screened=True)
         if keep:
             for j, outcome in self.inner.iter_evaluate(model, [designs[i] for i in keep]):
                 yield keep[j], outcome

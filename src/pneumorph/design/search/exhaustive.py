@@ -222,7 +222,7 @@ def _score_batch(book: ScoreBook, batch: list[str], symmetry: bool, said: Callab
     solved in parallel; its outcomes come as they end) and once more at the end."""
     new = [d for d in batch if d not in book.outcomes]
     for _, outcome in book.evaluator.iter_evaluate(book.model, new) if new else ():
-        book.solves += not outcome.cached
+        book.solves += outcome.solved
         book.add(outcome)
         if symmetry and mirror(outcome.design) not in book.scores:
             book.add(mirror_outcome(outcome))
@@ -237,7 +237,7 @@ def _score_batch(book: ScoreBook, batch: list[str], symmetry: bool, said: Callab
 def _verify(book: ScoreBook, design: str) -> None:
     a, b = book.evaluator.evaluate_many(book.model, [design, mirror(design)])
     for o in (a, b):
-        book.solves += not o.cached
+        book.solves += o.solved
         book.add(o)
     if a.ok != b.ok:
         raise SearchConfigError(

@@ -99,7 +99,7 @@ class ScoreBook:
         new = [d for d in dict.fromkeys(designs) if d not in self.scores]
         if new:
             for outcome in self.evaluator.evaluate_many(self.model, new):
-                self.solves += not outcome.cached
+                self.solves += outcome.solved
                 self.hits += outcome.cached
                 self.add(outcome)
         return [self.scores[d] for d in designs]
