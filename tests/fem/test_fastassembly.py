@@ -62,3 +62,24 @@ def test_a_shared_pattern_is_read_only() -> None:
         system.indices[0] = 1
     with pytest.raises(ValueError):
         system.solids[0].scatter[0] = 0
+
+
+def test_a_second_solver_of_a_pattern_takes_the_first_ones_ordering_and_factors_alike() -> None:
+    pytest.importorskip("pypardiso")
+    from pneumorph.fem.fast.newton import FastSubstep
+
+    model = Full3D(2, UnitSpec(element_size=3.0))
+    steps = []
+    for _ in range(2):
+        system = _system(model, "01")
+        substep = FastSubstep(system, reuse=0.7)
+        u = np.zeros(system.ndof)
+        u[system.dof1] = 1e-3 * np.random.default_rng(5).standard_normal(system.dof1.size)
+        r, _ = system.residual(u)
+        substep.factorize()
+        steps.append((substep.solver, substep.solve(r[system.dof1])))
+    (first, x1), (second, x2) = steps
+    assert first.iparm[4] == 2 and second.iparm[4] == 1  # computed, then given
+    assert np.array_equal(np.sort(first.perm), np.arange(1, first.n + 1))  # a permutation (1-based)
+    assert np.array_equal(first.perm, second.perm)
+    np.testing.assert_array_equal(x1, x2)

@@ -40,6 +40,8 @@ class Pattern:
     nnz: int
     scatter: IntArray  # every owner's CSR positions side by side
     owners: tuple[tuple[IntArray, IntArray, int, int], ...]  # (edofs, take, start, size) per owner
+    #: the linear solver's fill-reducing permutations of the pattern, by the solver's kind (set by its first user)
+    orderings: dict[Any, NDArray[np.int32]] = field(default_factory=dict)
 
 
 _patterns: OrderedDict[str, Pattern] = OrderedDict()
