@@ -285,10 +285,9 @@ class FastSystem:
         ``Q`` and the components before its own. Only the entries some element assembles
         are kept, so the pattern is exactly theirs.
         """
-        d, npts = self.dim, self.npoints
+        d, npts, n1 = self.dim, self.npoints, self.dof1.size
         active = np.full(self.ndof, -1, dtype=np.int32)  # (int32: half the memory traffic of the gathers)
-        active[self.dof1] = np.arange(self.dof1.size)
-        n1 = self.dof1.size
+        active[self.dof1] = np.arange(n1)
         owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
         # 1. the node pairs every owner's cells couple, numbered
         pair_keys = []
