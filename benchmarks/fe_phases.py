@@ -54,7 +54,7 @@ def main() -> None:
     starts: list[tuple[float, float]] = []  # the first substep's start
     original = FastSubstep.__call__
 
-    def traced(self, fields, settings, border=None):  # type: ignore[no-untyped-def]
+    def traced(self, fields, settings, border=None):
         if not starts:
             starts.append(clocks())
         iterations, cause = original(self, fields, settings, border)
@@ -62,13 +62,13 @@ def main() -> None:
         levels.append((wall, cpu, iterations, self.factorisations, int(cause is not None)))
         return iterations, cause
 
-    FastSubstep.__call__ = traced  # type: ignore[method-assign]
+    FastSubstep.__call__ = traced
     writers: dict[str, float] = {}
 
     def timed(module: object, name: str) -> None:
         function = getattr(module, name)
 
-        def wrapper(*a, **k):  # type: ignore[no-untyped-def]
+        def wrapper(*a, **k):
             c0 = time.process_time()
             try:
                 return function(*a, **k)
@@ -87,7 +87,7 @@ def main() -> None:
     solve = FEModel.solve
     marks: list[tuple[float, float]] = []
 
-    def solve_traced(self, design, on_level=None):  # type: ignore[no-untyped-def]
+    def solve_traced(self, design, on_level=None):
         marks.append(clocks())
         levels.clear()
         starts.clear()
@@ -105,7 +105,7 @@ def main() -> None:
         report(begin, levels, levels_at)
         return solution
 
-    FEModel.solve = solve_traced  # type: ignore[method-assign]
+    FEModel.solve = solve_traced
     print(f"threads: OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}, "
           f"MKL_NUM_THREADS={os.environ.get('MKL_NUM_THREADS', 'unset')}; load {os.getloadavg()[0]:.2f}")
     for run in range(args.repeat):

@@ -12,14 +12,14 @@ from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Full3D, Reduced2D
 
 
-def _system(model, design: str):  # type: ignore[no-untyped-def]
+def _system(model, design: str):
     _, body, set_pressure = model.build(design)
     set_pressure(0.02)
     kind = SolidSystem3D if body.dim == 3 else PlaneStrainSystem
     return kind(body.items, body.field, body.dof1, body.dof0)
 
 
-def _entries(system):  # type: ignore[no-untyped-def]
+def _entries(system):
     owners = [*system.solids, *system.walls, *system.contacts]
     return [system.indptr, system.indices, *(o.edofs for o in owners), *(o.take for o in owners),
             *(o.scatter for o in owners)]
@@ -27,7 +27,7 @@ def _entries(system):  # type: ignore[no-untyped-def]
 
 @pytest.mark.parametrize("model", [Full3D(2, UnitSpec(element_size=3.0)), Reduced2D(2, UnitSpec(element_size=2.0))],
                          ids=["3d", "2d"])
-def test_a_second_system_of_a_mesh_shares_the_pattern_a_fresh_one_equals(model, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+def test_a_second_system_of_a_mesh_shares_the_pattern_a_fresh_one_equals(model, monkeypatch) -> None:
     first = _system(model, "10")
     second = _system(model, "10")
     assert second.pattern is first.pattern

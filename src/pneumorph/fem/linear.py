@@ -140,9 +140,9 @@ class PardisoPattern:
         Newton method whose residual is evaluated in double precision (the same
         equilibrium, reached in about the same iterations).
     perm : ndarray, optional
-        The fill-reducing permutation of an earlier solver's analysis of this pattern (its :attr:`perm`): the
+        The fill-reducing permutation of an earlier solver's analysis of this pattern (its ``perm``): the
         analysis skips the ordering (about 0.4 s of the 15-unit 3D half model's 0.7 s) and the factors are the
-        same. Without it, the analysis computes one and keeps it in :attr:`perm`.
+        same. Without it, the analysis computes one and keeps it in ``perm``.
 
     Examples
     --------
