@@ -27,7 +27,7 @@ TANGENT_CHUNK = 256
 
 #: CSR patterns (with every owner's entries and positions) kept for systems of the same mesh: a design solved
 #: again (a verification, an identification's solves, a benchmark's repeats) skips the 1 s of a 15-unit 3D
-#: pattern. About 100 MB each on the 15-unit 3D half model, so only the last few.
+#: pattern. About 140 MB each on the 15-unit 3D half model, so only the last few.
 PATTERN_CACHE_SIZE = 2
 
 
