@@ -83,3 +83,15 @@ def test_a_second_solver_of_a_pattern_takes_the_first_ones_ordering_and_factors_
     assert np.array_equal(np.sort(first.perm), np.arange(1, first.n + 1))  # a permutation (1-based)
     assert np.array_equal(first.perm, second.perm)
     np.testing.assert_array_equal(x1, x2)
+
+
+def test_a_design_solved_again_on_the_kept_pattern_and_ordering_gives_the_same_answer() -> None:
+    from pneumorph.fem.stepping import StepSettings
+    from pneumorph.models.fe import RampSpec
+
+    model = Full3D(2, UnitSpec(element_size=3.0), RampSpec(pressure=0.02, steps=StepSettings(
+        increments=3, substeps=1, max_iterations=25)))
+    first, second = model.solve("01"), model.solve("01")
+    assert second.response.metadata["newton_iterations"] == first.response.metadata["newton_iterations"]
+    np.testing.assert_array_equal(second.displacements, first.displacements)
+    assert np.abs(first.displacements[-1]).max() > 1.0  # it bent (mm)
