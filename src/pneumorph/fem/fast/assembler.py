@@ -237,7 +237,8 @@ class FastSystem:
         digest = hashlib.blake2b(digest_size=20)
         digest.update(f"{type(self).__name__} {self.symmetric} {self.ndof}".encode())
         digest.update(np.ascontiguousarray(self.dof1).tobytes())
-        for owner in [*self.solids, *self.walls, *self.contacts]:
+        owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
+        for owner in owners:
             cells = np.ascontiguousarray(owner.cells, dtype=np.int64)
             digest.update(f"{type(owner).__name__} {cells.shape}".encode())
             digest.update(cells.tobytes())
@@ -253,14 +254,10 @@ class FastSystem:
             if pattern is not None:
                 _patterns.move_to_end(key)
         if pattern is None:
-            self._compute_pattern()
-            for array in (self.indptr, self.indices, self._scatter, *(o.edofs for o in owners),
-                          *(o.take for o in owners)):
+            pattern = self._compute_pattern()
+            arrays: list[NDArray[Any]] = [pattern.indptr, pattern.indices, pattern.scatter]
+            for array in arrays + [a for owner in pattern.owners for a in (owner[0], owner[1])]:
                 array.flags.writeable = False
-            spans = np.cumsum([0, *(o.scatter.size for o in owners)])
-            pattern = Pattern(self.indptr, self.indices, self.nnz, self._scatter,
-                              tuple((o.edofs, o.take, int(spans[i]), int(spans[i + 1] - spans[i]))
-                                    for i, o in enumerate(owners)))
             if key:
                 with _patterns_lock:
                     _patterns[key] = pattern
@@ -273,7 +270,7 @@ class FastSystem:
         self.pattern = pattern
         self._values = np.empty(self._scatter.size)  # kept: a tangent fills it anew
 
-    def _compute_pattern(self) -> None:
+    def _compute_pattern(self) -> Pattern:
         """CSR pattern and every element entry's position in it.
 
         No sort of the element entries: the nodes a cell couples are paired once
@@ -337,21 +334,16 @@ class FastSystem:
             pos = full_flat[index]
             used[pos] = True
             positions.append(pos)
-        # 4. keep the entries some element assembles
+        # 4. keep the entries some element assembles; every owner's CSR positions side by side
         renumber = np.cumsum(used) - 1
-        self.nnz = int(used.sum())
         kept_rows = np.repeat(np.arange(n1), np.diff(indptr))[used]
-        self.indptr = np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32)
         columns = np.empty(int(indptr[-1]), dtype=np.int32)
         columns[full[exists]] = np.broadcast_to(cols[:, None, :], exists.shape)[exists]
-        self.indices = columns[used]
-        # every owner's CSR positions side by side (each owner's scatter is its slice)
-        self._scatter = np.empty(sum(pos.size for pos in positions), dtype=np.int64)
-        start = 0
-        for owner, pos in zip(owners, positions, strict=True):
-            owner.scatter = self._scatter[start : start + pos.size]
-            np.take(renumber, pos, out=owner.scatter)
-            start += pos.size
+        spans = np.cumsum([0, *(pos.size for pos in positions)])
+        return Pattern(np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32), columns[used],
+                       int(used.sum()), np.take(renumber, np.concatenate(positions)),
+                       tuple((o.edofs, o.take, int(spans[i]), int(spans[i + 1] - spans[i]))
+                             for i, o in enumerate(owners)))
 
     # -- evaluation -----------------------------------------------------------------------
     def residual(self, u: FloatArray) -> tuple[FloatArray, float]:
