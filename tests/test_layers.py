@@ -45,7 +45,6 @@ LONG_MODULES: dict[str, int] = {}
 LONG_FUNCTIONS: dict[str, int] = {
     "pneumorph.fem.fast.kernels:ogden_3d": 121,
     "pneumorph.fem.fast.kernels:ogden_plane_strain": 82,
-    "pneumorph.fem.fast.assembler:FastSystem._build_pattern": 81,
     "pneumorph.fem.stepping:ramp": 130,
 }
 

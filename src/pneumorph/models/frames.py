@@ -28,7 +28,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 FloatArray = NDArray[np.float64]
 
@@ -38,6 +37,8 @@ def unit_frames(mesh: Any, displacement: FloatArray) -> FloatArray:
 
     ``mesh`` is a 3D :class:`~pneumorph.geometry.assembly.ActuatorMesh`.
     """
+    from scipy.spatial.transform import Rotation  # (a third of a second to import: only where frames are kept)
+
     p = mesh.points[mesh.tracked]  # (n, 4, 3): the cavity's corners on the mid-width plane
     q = p + displacement[mesh.tracked][..., :3]
     out = np.empty((len(p), 3))
@@ -59,10 +60,13 @@ def end_frame(mesh: Any, displacement: FloatArray) -> FloatArray:
     >>> from pneumorph.geometry.assembly import assemble
     >>> from pneumorph.geometry.unit import UnitSpec
     >>> mesh = assemble(UnitSpec(element_size=3.0), "0", dim=3, half=False)
+    >>> from scipy.spatial.transform import Rotation
     >>> turn = Rotation.from_rotvec([0.2, 0.0, 0.5])
     >>> end_frame(mesh, turn.apply(mesh.points) - mesh.points).round(12).tolist()
     [0.2, 0.0, 0.5]
     """
+    from scipy.spatial.transform import Rotation
+
     points = np.asarray(mesh.points, dtype=float)[:, :3]
     ends = mesh.end_points
     face = np.flatnonzero(np.isclose(points[:, 0], points[ends[0], 0]))
@@ -106,6 +110,8 @@ def twist(rotations: FloatArray) -> FloatArray:
     out = np.full(len(flat), np.nan)
     ok = np.isfinite(flat).all(axis=1)
     if ok.any():
+        from scipy.spatial.transform import Rotation
+
         q = Rotation.from_rotvec(flat[ok]).as_quat()  # (x, y, z, w)
         angle = np.degrees(2.0 * np.arctan2(q[:, 0], q[:, 3]))
         out[ok] = (angle + 180.0) % 360.0 - 180.0

@@ -5,6 +5,9 @@ into a fixed CSR pattern of the free unknowns, any dimension; its plane-strain a
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -21,6 +24,28 @@ IntArray = NDArray[np.int64]
 
 #: cells per chunk of the 3D tangent (keeps the temporaries in the tens of MB)
 TANGENT_CHUNK = 256
+
+#: CSR patterns (with every owner's entries and positions) kept for systems of the same mesh: a design solved
+#: again (a verification, an identification's solves, a benchmark's repeats) skips the 1 s of a 15-unit 3D
+#: pattern. About 140 MB each on the 15-unit 3D half model, so only the last few.
+PATTERN_CACHE_SIZE = 2
+
+
+@dataclass(frozen=True)
+class Pattern:
+    """A system's CSR pattern of the active block and every owner's assembled entries and their positions."""
+
+    indptr: NDArray[np.int32]
+    indices: NDArray[np.int32]
+    nnz: int
+    scatter: IntArray  # every owner's CSR positions side by side
+    owners: tuple[tuple[IntArray, IntArray, int, int], ...]  # (edofs, take, start, size) per owner
+    #: the linear solver's fill-reducing permutations of the pattern, by the solver's kind (set by its first user)
+    orderings: dict[Any, NDArray[np.int32]] = field(default_factory=dict)
+
+
+_patterns: OrderedDict[str, Pattern] = OrderedDict()
+_patterns_lock = threading.Lock()
 
 
 @dataclass
@@ -85,6 +110,9 @@ class FastSystem:
     ----------
     indptr, indices : ndarray
         CSR pattern of ``K[dof1, dof1]`` (its upper triangle if :attr:`symmetric`).
+    pattern : Pattern
+        The pattern and every owner's entries and positions, shared (read-only) by the systems of one mesh: the
+        last :data:`PATTERN_CACHE_SIZE` meshes' are kept, by a key of the active dofs and every owner's cells.
     """
 
     dim: ClassVar[int]
@@ -204,7 +232,45 @@ class FastSystem:
         raise NotImplementedError  # pragma: no cover
 
     # -- pattern ------------------------------------------------------------------------
+    def _pattern_key(self) -> str:
+        """What the pattern follows from: the system's kind, its active dofs, every owner's kind and cells."""
+        digest = hashlib.blake2b(digest_size=20)
+        digest.update(f"{type(self).__name__} {self.symmetric} {self.ndof}".encode())
+        digest.update(np.ascontiguousarray(self.dof1).tobytes())
+        owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
+        for owner in owners:
+            cells = np.ascontiguousarray(owner.cells, dtype=np.int64)
+            digest.update(f"{type(owner).__name__} {cells.shape}".encode())
+            digest.update(cells.tobytes())
+        return digest.hexdigest()
+
     def _build_pattern(self) -> None:
+        """The CSR pattern and every owner's entries: the cached ones of the same mesh (:data:`PATTERN_CACHE_SIZE`,
+        the arrays shared read-only), else computed (:meth:`_compute_pattern`) and kept."""
+        owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
+        key = self._pattern_key() if PATTERN_CACHE_SIZE > 0 else ""
+        with _patterns_lock:
+            pattern = _patterns.get(key)
+            if pattern is not None:
+                _patterns.move_to_end(key)
+        if pattern is None:
+            pattern = self._compute_pattern()
+            arrays: list[NDArray[Any]] = [pattern.indptr, pattern.indices, pattern.scatter]
+            for array in arrays + [a for owner in pattern.owners for a in (owner[0], owner[1])]:
+                array.flags.writeable = False
+            if key:
+                with _patterns_lock:
+                    _patterns[key] = pattern
+                    while len(_patterns) > PATTERN_CACHE_SIZE:
+                        _patterns.popitem(last=False)
+        self.indptr, self.indices, self.nnz, self._scatter = pattern.indptr, pattern.indices, pattern.nnz, \
+            pattern.scatter
+        for owner, (edofs, take, start, size) in zip(owners, pattern.owners, strict=True):
+            owner.edofs, owner.take, owner.scatter = edofs, take, pattern.scatter[start : start + size]
+        self.pattern = pattern
+        self._values = np.empty(self._scatter.size)  # kept: a tangent fills it anew
+
+    def _compute_pattern(self) -> Pattern:
         """CSR pattern and every element entry's position in it.
 
         No sort of the element entries: the nodes a cell couples are paired once
@@ -216,10 +282,9 @@ class FastSystem:
         ``Q`` and the components before its own. Only the entries some element assembles
         are kept, so the pattern is exactly theirs.
         """
-        d, npts = self.dim, self.npoints
+        d, npts, n1 = self.dim, self.npoints, self.dof1.size
         active = np.full(self.ndof, -1, dtype=np.int32)  # (int32: half the memory traffic of the gathers)
-        active[self.dof1] = np.arange(self.dof1.size)
-        n1 = self.dof1.size
+        active[self.dof1] = np.arange(n1)
         owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
         # 1. the node pairs every owner's cells couple, numbered
         pair_keys = []
@@ -269,22 +334,16 @@ class FastSystem:
             pos = full_flat[index]
             used[pos] = True
             positions.append(pos)
-        # 4. keep the entries some element assembles
+        # 4. keep the entries some element assembles; every owner's CSR positions side by side
         renumber = np.cumsum(used) - 1
-        self.nnz = int(used.sum())
         kept_rows = np.repeat(np.arange(n1), np.diff(indptr))[used]
-        self.indptr = np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32)
         columns = np.empty(int(indptr[-1]), dtype=np.int32)
         columns[full[exists]] = np.broadcast_to(cols[:, None, :], exists.shape)[exists]
-        self.indices = columns[used]
-        # every owner's CSR positions side by side (each owner's scatter is its slice)
-        self._scatter = np.empty(sum(pos.size for pos in positions), dtype=np.int64)
-        start = 0
-        for owner, pos in zip(owners, positions, strict=True):
-            owner.scatter = self._scatter[start : start + pos.size]
-            np.take(renumber, pos, out=owner.scatter)
-            start += pos.size
-        self._values = np.empty(self._scatter.size)  # kept: a tangent fills it anew
+        spans = np.cumsum([0, *(pos.size for pos in positions)])
+        return Pattern(np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32), columns[used],
+                       int(used.sum()), np.take(renumber, np.concatenate(positions)),
+                       tuple((o.edofs, o.take, int(spans[i]), int(spans[i + 1] - spans[i]))
+                             for i, o in enumerate(owners)))
 
     # -- evaluation -----------------------------------------------------------------------
     def residual(self, u: FloatArray) -> tuple[FloatArray, float]:

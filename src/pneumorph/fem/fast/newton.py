@@ -71,17 +71,19 @@ def pattern_solver(
     symmetric: bool = False,
     ordering: int = 0,
     single: bool = False,
+    perm: NDArray[np.int32] | None = None,
 ) -> Any:
     """A solver for matrices on one CSR pattern: PARDISO if available, else SuperLU.
 
     It is called as ``solve(data, b)`` or as ``factorize(data)`` then ``solve(b)``. With
     ``symmetric`` the pattern is the upper triangle of a symmetric matrix; ``single``
-    asks PARDISO for a single-precision factorisation.
+    asks PARDISO for a single-precision factorisation; ``perm`` is the fill-reducing permutation of an earlier
+    PARDISO analysis of the pattern (:class:`~pneumorph.fem.linear.PardisoPattern`).
     """
     from pneumorph.fem.linear import PardisoPattern, SuperLUPattern
 
     try:
-        return PardisoPattern(indptr, indices, symmetric=symmetric, ordering=ordering, single=single)
+        return PardisoPattern(indptr, indices, symmetric=symmetric, ordering=ordering, single=single, perm=perm)
     except ImportError:
         return SuperLUPattern(indptr, indices, symmetric=symmetric)
 
@@ -198,6 +200,7 @@ class FastSubstep:
             getattr(system, "ordering", 0),
             single=(reuse is not None and getattr(system, "single_precision", False)
                     and len(getattr(system, "dof1", ())) <= limit),
+            perm=self._ordering(),
         )
         if getattr(self.solver, "dtype", None) == np.float32:
             # a tangent factorised in single precision may as well be assembled in it
@@ -218,11 +221,28 @@ class FastSubstep:
     def precision(self) -> str:
         return "single" if getattr(self.solver, "dtype", None) == np.float32 else "double"
 
+    def _ordering(self) -> NDArray[np.int32] | None:
+        """The fill-reducing permutation an earlier solver of the system's pattern found (the pattern is shared by
+        the systems of one mesh: :attr:`~pneumorph.fem.fast.assembler.FastSystem.pattern`), or None."""
+        orderings = getattr(getattr(self.system, "pattern", None), "orderings", {})
+        return orderings.get((getattr(self.system, "symmetric", False), getattr(self.system, "ordering", 0)))
+
+    def _keep_ordering(self) -> None:
+        """Keep the solver's permutation for the next solver of the pattern (:meth:`_ordering`)."""
+        orderings = getattr(getattr(self.system, "pattern", None), "orderings", None)
+        perm = getattr(self.solver, "perm", None)
+        if orderings is not None and perm is not None and getattr(self.solver, "analysed", False):
+            key = (getattr(self.system, "symmetric", False), getattr(self.system, "ordering", 0))
+            if key not in orderings:
+                perm = perm.copy()
+                perm.flags.writeable = False
+                orderings[key] = perm
+
     def to_double(self) -> None:
         """Factorise in double precision from now on (tangents assembled in double too)."""
         system = self.system
         self.solver = pattern_solver(system.indptr, system.indices, getattr(system, "symmetric", False),
-                                     getattr(system, "ordering", 0), single=False)
+                                     getattr(system, "ordering", 0), single=False, perm=self._ordering())
         system.tangent_dtype = np.float64
         self._factorised = False
 
@@ -237,6 +257,8 @@ class FastSubstep:
         data = self.system.tangent_data()
         if hasattr(self.solver, "factorize"):
             self.solver.factorize(data)
+            if self.factorisations == 0:
+                self._keep_ordering()
         else:
             self._data = data
         self._factorised = True

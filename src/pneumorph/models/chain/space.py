@@ -43,7 +43,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 FloatArray = NDArray[np.float64]
 
@@ -245,6 +244,7 @@ def chain_points(chords: FloatArray, turns: FloatArray, start: FloatArray) -> Fl
     Examples
     --------
     >>> import numpy as np
+    >>> from scipy.spatial.transform import Rotation
     >>> chords = np.array([[10.0, 0, 0], [10.0, 0, 0]])
     >>> quarter = Rotation.from_rotvec([[0, 0, 0], [0, np.pi / 2, 0]]).as_matrix()   # the second frame turned about y
     >>> chain_points(chords, quarter, np.zeros(3)).round(9).tolist()
@@ -259,6 +259,7 @@ def chain_points(chords: FloatArray, turns: FloatArray, start: FloatArray) -> Fl
 def chain_frames(turns: FloatArray) -> FloatArray:
     """Each point's frame in the actuator's (..., n + 1, 3, 3): the turns (..., n + 1, 3, 3) composed from the base.
 
+    >>> from scipy.spatial.transform import Rotation
     >>> quarter = Rotation.from_rotvec([[0, 0, np.pi / 2]] * 2).as_matrix()
     >>> chain_frames(quarter)[-1].round(12).tolist()   # two quarter turns about z: a half turn
     [[-1.0, -0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]
@@ -293,11 +294,15 @@ def angle_between(a: FloatArray, b: FloatArray) -> FloatArray:
 
 def _rotvec(matrix: FloatArray) -> FloatArray:
     """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3)."""
+    from scipy.spatial.transform import Rotation  # (a third of a second to import: not on every command's path)
+
     return Rotation.from_matrix(matrix.reshape(-1, 3, 3)).as_rotvec().reshape(*matrix.shape[:-2], 3)
 
 
 def _rotation(vector: FloatArray) -> FloatArray:
     """Rotation matrices of rotation vectors (..., 3) -> (..., 3, 3)."""
+    from scipy.spatial.transform import Rotation
+
     return Rotation.from_rotvec(vector.reshape(-1, 3)).as_matrix().reshape(*vector.shape[:-1], 3, 3)
 
 

@@ -1,0 +1,97 @@
+"""The fast system's CSR pattern, kept per mesh: a second system of the same mesh shares the first one's pattern,
+which equals one computed afresh, and assembles the same tangent; another mesh gets its own."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pneumorph.fem.fast import assembler
+from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
+from pneumorph.geometry.unit import UnitSpec
+from pneumorph.models.fe import Full3D, Reduced2D
+
+
+def _system(model, design: str):
+    _, body, set_pressure = model.build(design)
+    set_pressure(0.02)
+    kind = SolidSystem3D if body.dim == 3 else PlaneStrainSystem
+    return kind(body.items, body.field, body.dof1, body.dof0)
+
+
+def _entries(system):
+    owners = [*system.solids, *system.walls, *system.contacts]
+    return [system.indptr, system.indices, *(o.edofs for o in owners), *(o.take for o in owners),
+            *(o.scatter for o in owners)]
+
+
+@pytest.mark.parametrize("model", [Full3D(2, UnitSpec(element_size=3.0)), Reduced2D(2, UnitSpec(element_size=2.0))],
+                         ids=["3d", "2d"])
+def test_a_second_system_of_a_mesh_shares_the_pattern_a_fresh_one_equals(model, monkeypatch) -> None:
+    first = _system(model, "10")
+    second = _system(model, "10")
+    assert second.pattern is first.pattern
+    assert all(np.shares_memory(a, b) for a, b in zip(_entries(first), _entries(second), strict=True))
+    monkeypatch.setattr(assembler, "PATTERN_CACHE_SIZE", 0)
+    fresh = _system(model, "10")
+    assert fresh.pattern is not first.pattern
+    assert fresh.nnz == first.nnz
+    for a, b in zip(_entries(first), _entries(fresh), strict=True):
+        assert not np.shares_memory(a, b) and np.array_equal(a, b)
+    # the same tangent at a deformed state, from the shared pattern and from the fresh one
+    u = np.zeros(first.ndof)
+    u[first.dof1] = 1e-3 * np.random.default_rng(3).standard_normal(first.dof1.size)
+    first.residual(u)
+    fresh.residual(u)
+    np.testing.assert_array_equal(first.tangent_data(), fresh.tangent_data())
+
+
+def test_another_mesh_gets_its_own_pattern_and_the_cache_stays_small() -> None:
+    model = Full3D(2, UnitSpec(element_size=3.0))
+    a, b = _system(model, "00"), _system(model, "01")  # a turned unit: other cells
+    assert a.pattern is not b.pattern
+    assert a.indptr.size == b.indptr.size  # as many active dofs, numbered otherwise
+    for design in ("10", "11", "00"):
+        _system(model, design)
+    assert len(assembler._patterns) == assembler.PATTERN_CACHE_SIZE
+
+
+def test_a_shared_pattern_is_read_only() -> None:
+    system = _system(Full3D(1, UnitSpec(element_size=3.0)), "0")
+    with pytest.raises(ValueError):
+        system.indices[0] = 1
+    with pytest.raises(ValueError):
+        system.solids[0].scatter[0] = 0
+
+
+def test_a_second_solver_of_a_pattern_takes_the_first_ones_ordering_and_factors_alike() -> None:
+    pytest.importorskip("pypardiso")
+    from pneumorph.fem.fast.newton import FastSubstep
+
+    model = Full3D(2, UnitSpec(element_size=3.0))
+    steps = []
+    for _ in range(2):
+        system = _system(model, "01")
+        substep = FastSubstep(system, reuse=0.7)
+        u = np.zeros(system.ndof)
+        u[system.dof1] = 1e-3 * np.random.default_rng(5).standard_normal(system.dof1.size)
+        r, _ = system.residual(u)
+        substep.factorize()
+        steps.append((substep.solver, substep.solve(r[system.dof1])))
+    (first, x1), (second, x2) = steps
+    assert first.iparm[4] == 2 and second.iparm[4] == 1  # computed, then given
+    assert np.array_equal(np.sort(first.perm), np.arange(1, first.n + 1))  # a permutation (1-based)
+    assert np.array_equal(first.perm, second.perm)
+    np.testing.assert_array_equal(x1, x2)
+
+
+def test_a_design_solved_again_on_the_kept_pattern_and_ordering_gives_the_same_answer() -> None:
+    from pneumorph.fem.stepping import StepSettings
+    from pneumorph.models.fe import RampSpec
+
+    model = Full3D(2, UnitSpec(element_size=3.0), RampSpec(pressure=0.02, steps=StepSettings(
+        increments=3, substeps=1, max_iterations=25)))
+    first, second = model.solve("01"), model.solve("01")
+    assert second.response.metadata["newton_iterations"] == first.response.metadata["newton_iterations"]
+    np.testing.assert_array_equal(second.displacements, first.displacements)
+    assert np.abs(first.displacements[-1]).max() > 1.0  # it bent (mm)
