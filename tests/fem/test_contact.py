@@ -103,6 +103,34 @@ def test_friction_tangent_is_the_residuals_derivative(obstacle: object) -> None:
     assert _fd_check(system, u) < 1e-5
 
 
+@pytest.mark.parametrize("obstacle", [Plane((2.9, 0.0, 0.0), (-0.8, -0.6, 0.0)),
+                                      Cylinder((3.5, 0.5, 0.5), 0.8, (0.0, 0.6, 0.8))], ids=["plane", "cylinder"])
+def test_friction_tangent_is_the_residuals_derivative_3d(obstacle: object) -> None:
+    """The symmetric 3D tangent and its remainder (the non-symmetric rest of the friction blocks) together are the
+    residual's derivative, with some nodes sticking and others sliding; the remainder is no rounding."""
+    mesh = fem.Cube(b=(3.0, 1.0, 1.0), n=(4, 2, 2))
+    points, cells = np.asarray(mesh.points), np.asarray(mesh.cells)
+    body = _body(points, cells, "hexahedron")
+    faces, nodes = surface_points(cells, "hexahedron")
+    contact = RigidContact(obstacle, nodes, 2.0, faces, 0.05, friction=0.5)
+    body.contacts.append(contact)
+    system = SolidSystem3D(body.items, body.field, body.dof1, body.dof0)
+    u = np.zeros(system.ndof)
+    u[0::3] = 0.05 * points[:, 0]
+    x = points + u.reshape(-1, 3)
+    contact.anchors = x[nodes] + np.random.default_rng(1).normal(0.0, 0.3, (len(nodes), 3))
+    force, active = contact.forces(x)
+    n = obstacle.kinematics(x[nodes])[1]
+    normal = np.einsum("ai,ai->a", force, n)
+    along = np.linalg.norm(force - normal[:, None] * n, axis=1)
+    sliding = active & np.isclose(along, 0.5 * np.abs(normal), rtol=1e-9)
+    assert np.any(sliding) and np.any(active & ~sliding)
+    assert _fd_check(system, u) < 1e-5
+    system.residual(u)
+    upper = system.tangent_data()
+    assert system.remainder is not None and abs(system.remainder).max() > 1e-2 * np.abs(upper).max()
+
+
 def test_penalty_blend_is_continuous_and_its_slope_too() -> None:
     s = 0.1
     gap = np.array([-s - 1e-9, -s + 1e-9, s - 1e-9, s + 1e-9])
