@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.fem.linear import corrected, pattern_operator
 from pneumorph.fem.stepping import relative_residual
 
 FloatArray = NDArray[np.float64]
@@ -209,6 +210,7 @@ class FastSubstep:
         self.fresh_start = bool(fresh_start)
         self.factorisations = 0
         self._factorised = False
+        self._product: Any = None  # the whole tangent's product, where the factorised one is not all of it
         self.best = float("inf")
         self._converged: FloatArray | None = None  # the last converged state, on a body with obstacles
         #: set to a list to record ``(residual norm, tangent fresh)`` after every iteration
@@ -234,16 +236,27 @@ class FastSubstep:
 
     def factorize(self) -> None:
         """Assemble the tangent at the state of the system's last residual and factorise it."""
-        data = self.system.tangent_data()
+        system = self.system
+        data = system.tangent_data()
         if hasattr(self.solver, "factorize"):
             self.solver.factorize(data)
         else:
             self._data = data
+        remainder = getattr(system, "remainder", None)  # a symmetric tangent's non-symmetric rest (friction)
+        self._product = None if remainder is None else pattern_operator(
+            system.indptr, system.indices, data, getattr(system, "symmetric", False), remainder)
         self._factorised = True
         self.factorisations += 1
 
     def solve(self, b: FloatArray) -> FloatArray:
-        """``K^-1 b`` with the last factorised tangent (``b`` over the active dofs)."""
+        """``K^-1 b`` with the last factorised tangent (``b`` over the active dofs); a symmetric factorisation
+        with a remainder (:attr:`~pneumorph.fem.fast.assembler.FastSystem.remainder`) corrected by GMRES
+        (:func:`~pneumorph.fem.linear.corrected`)."""
+        if self._product is not None:
+            return corrected(self._solve, self._product, b)
+        return self._solve(b)
+
+    def _solve(self, b: FloatArray) -> FloatArray:
         if hasattr(self.solver, "factorize"):
             return np.asarray(self.solver.solve(b))
         return np.asarray(self.solver(self._data, b))
