@@ -194,6 +194,40 @@ def test_friction_holds_the_landing_tip_within_its_cone() -> None:
     assert np.allclose(r[points[:, 0] == 0.0].sum(axis=0), force.sum(axis=0) - weight, atol=1e-6 * abs(weight[1]))
 
 
+@pytest.mark.parametrize("friction", [0.0, 0.5])
+def test_a_3d_cantilever_lands_on_a_rough_floor(friction: float) -> None:
+    """In 3D (a symmetric factorisation, the friction's non-symmetric rest solved by GMRES) the landing tip slides
+    at the edge of its cone; clamp + floor = weight; friction 0 is the frictionless path (no remainder, no
+    tangential force)."""
+    mesh = fem.Cube(b=(20.0, 2.0, 2.0), n=(11, 3, 3))
+    points, cells = np.asarray(mesh.points), np.asarray(mesh.cells)
+    body = _body(points, cells, "hexahedron", density=1.1e-9)
+    faces, nodes = surface_points(cells, "hexahedron")
+    contact = RigidContact(Plane((0.0, -1.5, 0.0), (0.0, 1.0, 0.0)), nodes, 3.0, faces, 0.02, friction=friction)
+    contact.commit(points)
+    body.contacts.append(contact)
+    substep, _ = body.stepper("fast", reuse=0.5, depth=2)
+    remainders = []
+
+    def committed(t: float) -> None:
+        contact.commit(points + body.displacement)
+        remainders.append(substep.system.remainder is not None)
+
+    g = np.array([0.0, -9810.0, 0.0])
+    ramp(body.items, body.field, lambda t: body.set_gravity(t * g), body.dof1, body.dof0,
+         StepSettings(increments=5, substeps=2), substep=substep, on_substep=committed)
+    force, active = contact.forces(points + body.displacement)
+    assert active.sum() >= 2 and force[:, 1].sum() < 0.0  # pressed down
+    if friction == 0.0:
+        assert not any(remainders) and np.all(force[:, [0, 2]] == 0.0)
+    else:  # the tip slides back along the floor as it lands: friction at the cone's edge, against it
+        assert any(remainders) and force[:, 0].sum() > 0.0
+        assert np.allclose(np.linalg.norm(force[active][:, [0, 2]], axis=1), 0.5 * np.abs(force[active, 1]), rtol=1e-6)
+    r = substep.system.residual(body.displacement.ravel())[0].reshape(-1, 3)
+    weight = substep.system.dead.vector().reshape(-1, 3).sum(axis=0)
+    assert np.allclose(r[points[:, 0] == 0.0].sum(axis=0), force.sum(axis=0) - weight, atol=1e-6 * abs(weight[1]))
+
+
 def test_the_same_penalty_as_felupes_rigid_plane() -> None:
     """FElupe's ``ContactRigidPlane`` (its multiplier the penalty, no friction) on the same block: the same state."""
     mesh = fem.Rectangle(b=(4.0, 1.0), n=(9, 3))
