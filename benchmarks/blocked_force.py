@@ -31,8 +31,8 @@ def main() -> None:
                         "the wall, centred there or where the free tip ends")
     parser.add_argument("--friction", type=float, default=0.0, help="Coulomb's coefficient on the obstacle")
     args = parser.parse_args()
-    print("| design | free: wall, iterations, cut-backs | with contact: wall, iterations, cut-backs | "
-          "force at mid / last level (N) | base reaction at last level (N) |")
+    print("| design | free: wall, iterations, factorisations, cut-backs | with contact: wall, iterations, "
+          "factorisations, cut-backs | force at mid / last level (N) | base reaction at last level (N) |")
     print("|---|---|---|---|---|")
     for design in args.designs.split(","):
         model = make_model(len(design), {"fidelity": args.model})
@@ -57,8 +57,9 @@ def main() -> None:
         levels = contact.metadata["contact"]["levels"]
         mid, last = levels[len(levels) // 2 - 1], levels[-1]
         m, f = contact.metadata, free.metadata
-        print(f"| `{design}` | {t_free:.1f} s, {f['newton_iterations']}, {f['cutbacks']} | {t_contact:.1f} s, "
-              f"{m['newton_iterations']}, {m['cutbacks']} | {mid['obstacles'][0]['force_magnitude_n']:.3f} at "
+        print(f"| `{design}` | {t_free:.1f} s, {f['newton_iterations']}, {f['factorisations']}, {f['cutbacks']} | "
+              f"{t_contact:.1f} s, {m['newton_iterations']}, {m['factorisations']}, {m['cutbacks']} | "
+              f"{mid['obstacles'][0]['force_magnitude_n']:.3f} at "
               f"{mid['pressure_kpa']:.1f} kPa / {last['obstacles'][0]['force_magnitude_n']:.3f} | "
               f"{np.linalg.norm(last['base_reaction_n']):.3f} |", flush=True)
 
