@@ -323,7 +323,7 @@ class FastSystem:
 
         A symmetric system keeps the symmetric part of its obstacles' blocks without the coupling of a sliding
         node's friction to its normal force (:func:`~pneumorph.fem.fast.friction.coulomb`), and sets
-        :attr:`remainder` to the rest of them.
+        ``remainder`` to the rest of them.
         """
         # every owner's assembled entries side by side, then one scatter-add of them all
         values, start = self._values, 0
@@ -337,7 +337,7 @@ class FastSystem:
         remainders = []
         for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike
             K = c.tangent(self.points + self._U, self.symmetric)
-            if self.symmetric:  # friction's blocks are not: the rest of them apart (:attr:`remainder`)
+            if self.symmetric:  # friction's blocks are not: the rest of them apart (``remainder``)
                 K = 0.5 * (K + K.transpose(0, 2, 1))
                 if c.friction > 0.0:
                     remainders.append((c.edofs, c.tangent(self.points + self._U) - K))
@@ -367,7 +367,7 @@ class FastSystem:
         return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n1, n1))
 
     def tangent(self) -> Any:
-        """``K[dof1, dof1]`` as ``scipy.sparse.csr_matrix``, :attr:`remainder` included (state of the last residual)."""
+        """``K[dof1, dof1]`` as ``scipy.sparse.csr_matrix``, ``remainder`` included (state of the last residual)."""
         import scipy.sparse as sp
 
         n1 = self.dof1.size

@@ -15,7 +15,7 @@ last converged state.
 The sliding tangent is not symmetric, nor is a sticking node's on a curved obstacle. The 3D
 assembler factorises a symmetric tangent (its upper triangle): there a sliding node's block
 without its coupling to the normal force is symmetrised into it, and the rest of the block is
-kept apart (:attr:`~pneumorph.fem.fast.assembler.FastSystem.remainder`), for Newton steps solved
+kept apart (``FastSystem.remainder``), for Newton steps solved
 by GMRES on the whole tangent with the symmetric factorisation as its preconditioner
 (:func:`~pneumorph.fem.linear.corrected`). A 3-unit 3D finger pressed on a cylinder with
 friction 0.5 took 290 Newton iterations and 7 cut-backs with the symmetric tangent alone,

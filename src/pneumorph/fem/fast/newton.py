@@ -48,8 +48,9 @@ GROWTH = 2.0
 
 #: :data:`GROWTH` on a body with friction on an obstacle: a fresh tangent's iterate must lower the residual norm.
 #: A node's switches between sticking and sliding, and in and out of contact, made the fresh steps of a 3-unit 3D
-#: finger on a cylinder with friction 0.5 cycle at a residual norm of 1e-2 (290 Newton iterations and 7
-#: cut-backs with 2; 99 and 1 with 1). Frictionless contact keeps :data:`GROWTH` (85 iterations either way).
+#: finger on a cylinder with friction 0.5 cycle at a residual norm of 1e-2: 290 Newton iterations and 7 cut-backs
+#: with 2, 118 and 1 with 1 (99 and 1 with the whole tangent, :meth:`FastSubstep.solve`). Frictionless contact
+#: keeps :data:`GROWTH` (85 iterations either way).
 FRICTION_GROWTH = 1.0
 
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
@@ -263,7 +264,7 @@ class FastSubstep:
 
     def solve(self, b: FloatArray) -> FloatArray:
         """``K^-1 b`` with the last factorised tangent (``b`` over the active dofs); a symmetric factorisation
-        with a remainder (:attr:`~pneumorph.fem.fast.assembler.FastSystem.remainder`) corrected by GMRES
+        with a remainder (``FastSystem.remainder``) corrected by GMRES
         (:func:`~pneumorph.fem.linear.corrected`)."""
         if self._product is not None:
             return corrected(self._solve, self._product, b)
