@@ -273,7 +273,7 @@ def corrected(solve: Callable[[np.ndarray], np.ndarray], product: Callable[[np.n
     m = CORRECTED_ITERATIONS
     V, Z = [b / beta], []
     H = np.zeros((m + 1, m))
-    y = np.zeros(0)
+    y: np.ndarray = np.zeros(0)
     for j in range(m):
         Z.append(np.asarray(solve(V[j]), dtype=np.float64))
         w = product(Z[j])
