@@ -4,8 +4,9 @@ For each design: the free ramp, then the blocked-force ramp (``simulate --blocke
 normal to the free tip's motion at the first level, through the end face's farthest point,
 touching the end face), or with ``--cylinder X,Y[,Z];R`` a cylinder against the whole surface
 (``--cylinder "tip;R"``: centred where the free tip ends), with Coulomb ``--friction``.
-Prints a Markdown table row per design: the wall times, Newton iterations and cut-backs of both
-ramps, and the force on the obstacle at the middle and last levels.
+Prints a Markdown table row per design: the wall and CPU times (on a shared machine the CPU time
+is what compares), Newton iterations, factorisations and cut-backs of both ramps, and the force on
+the obstacle at the middle and last levels.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --model 3d --designs 00000,01010,00011
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/blocked_force.py --designs 111000000111111 --cylinder "tip;4"
@@ -31,15 +32,15 @@ def main() -> None:
                         "the wall, centred there or where the free tip ends")
     parser.add_argument("--friction", type=float, default=0.0, help="Coulomb's coefficient on the obstacle")
     args = parser.parse_args()
-    print("| design | free: wall, iterations, cut-backs | with contact: wall, iterations, cut-backs | "
-          "force at mid / last level (N) | base reaction at last level (N) |")
+    print("| design | free: wall (CPU), iterations, factorisations, cut-backs | with contact: wall (CPU), iterations, "
+          "factorisations, cut-backs | force at mid / last level (N) | base reaction at last level (N) |")
     print("|---|---|---|---|---|")
     for design in args.designs.split(","):
         model = make_model(len(design), {"fidelity": args.model})
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         free = model.solve(design).response
-        t_free = time.perf_counter() - t0
-        t0 = time.perf_counter()
+        t_free, c_free = time.perf_counter() - t0, time.process_time() - c0
+        t0, c0 = time.perf_counter(), time.process_time()
         if args.cylinder is None:
             obstacle = blocked_obstacle(model, design)
         else:
@@ -53,12 +54,14 @@ def main() -> None:
         if args.friction > 0.0:
             obstacle["friction"] = args.friction
         contact = model.variant(obstacles=[obstacle]).solve(design).response
-        t_contact = time.perf_counter() - t0
+        t_contact, c_contact = time.perf_counter() - t0, time.process_time() - c0
         levels = contact.metadata["contact"]["levels"]
         mid, last = levels[len(levels) // 2 - 1], levels[-1]
         m, f = contact.metadata, free.metadata
-        print(f"| `{design}` | {t_free:.1f} s, {f['newton_iterations']}, {f['cutbacks']} | {t_contact:.1f} s, "
-              f"{m['newton_iterations']}, {m['cutbacks']} | {mid['obstacles'][0]['force_magnitude_n']:.3f} at "
+        print(f"| `{design}` | {t_free:.1f} s ({c_free:.1f} s CPU), {f['newton_iterations']}, {f['factorisations']}, "
+              f"{f['cutbacks']} | {t_contact:.1f} s ({c_contact:.1f} s CPU), {m['newton_iterations']}, "
+              f"{m['factorisations']}, {m['cutbacks']} | "
+              f"{mid['obstacles'][0]['force_magnitude_n']:.3f} at "
               f"{mid['pressure_kpa']:.1f} kPa / {last['obstacles'][0]['force_magnitude_n']:.3f} | "
               f"{np.linalg.norm(last['base_reaction_n']):.3f} |", flush=True)
 

@@ -103,6 +103,34 @@ def test_friction_tangent_is_the_residuals_derivative(obstacle: object) -> None:
     assert _fd_check(system, u) < 1e-5
 
 
+@pytest.mark.parametrize("obstacle", [Plane((2.9, 0.0, 0.0), (-0.8, -0.6, 0.0)),
+                                      Cylinder((3.5, 0.5, 0.5), 0.8, (0.0, 0.6, 0.8))], ids=["plane", "cylinder"])
+def test_friction_tangent_is_the_residuals_derivative_3d(obstacle: object) -> None:
+    """The symmetric 3D tangent and its remainder (the non-symmetric rest of the friction blocks) together are the
+    residual's derivative, with some nodes sticking and others sliding; the remainder is no rounding."""
+    mesh = fem.Cube(b=(3.0, 1.0, 1.0), n=(4, 2, 2))
+    points, cells = np.asarray(mesh.points), np.asarray(mesh.cells)
+    body = _body(points, cells, "hexahedron")
+    faces, nodes = surface_points(cells, "hexahedron")
+    contact = RigidContact(obstacle, nodes, 2.0, faces, 0.05, friction=0.5)
+    body.contacts.append(contact)
+    system = SolidSystem3D(body.items, body.field, body.dof1, body.dof0)
+    u = np.zeros(system.ndof)
+    u[0::3] = 0.05 * points[:, 0]
+    x = points + u.reshape(-1, 3)
+    contact.anchors = x[nodes] + np.random.default_rng(1).normal(0.0, 0.3, (len(nodes), 3))
+    force, active = contact.forces(x)
+    n = obstacle.kinematics(x[nodes])[1]
+    normal = np.einsum("ai,ai->a", force, n)
+    along = np.linalg.norm(force - normal[:, None] * n, axis=1)
+    sliding = active & np.isclose(along, 0.5 * np.abs(normal), rtol=1e-9)
+    assert np.any(sliding) and np.any(active & ~sliding)
+    assert _fd_check(system, u) < 1e-5
+    system.residual(u)
+    upper = system.tangent_data()
+    assert system.remainder is not None and abs(system.remainder).max() > 1e-2 * np.abs(upper).max()
+
+
 def test_penalty_blend_is_continuous_and_its_slope_too() -> None:
     s = 0.1
     gap = np.array([-s - 1e-9, -s + 1e-9, s - 1e-9, s + 1e-9])
@@ -163,6 +191,40 @@ def test_friction_holds_the_landing_tip_within_its_cone() -> None:
     assert np.all(np.abs(force[:, 0]) <= 0.5 * np.abs(force[:, 1]) * (1 + 1e-9) + 1e-15)  # within the cone
     r = substep.system.residual(body.displacement.ravel())[0].reshape(-1, 2)
     weight = substep.system.dead.vector().reshape(-1, 2).sum(axis=0)
+    assert np.allclose(r[points[:, 0] == 0.0].sum(axis=0), force.sum(axis=0) - weight, atol=1e-6 * abs(weight[1]))
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.5])
+def test_a_3d_cantilever_lands_on_a_rough_floor(friction: float) -> None:
+    """In 3D (a symmetric factorisation, the friction's non-symmetric rest solved by GMRES) the landing tip slides
+    at the edge of its cone; clamp + floor = weight; friction 0 is the frictionless path (no remainder, no
+    tangential force)."""
+    mesh = fem.Cube(b=(20.0, 2.0, 2.0), n=(11, 3, 3))
+    points, cells = np.asarray(mesh.points), np.asarray(mesh.cells)
+    body = _body(points, cells, "hexahedron", density=1.1e-9)
+    faces, nodes = surface_points(cells, "hexahedron")
+    contact = RigidContact(Plane((0.0, -1.5, 0.0), (0.0, 1.0, 0.0)), nodes, 3.0, faces, 0.02, friction=friction)
+    contact.commit(points)
+    body.contacts.append(contact)
+    substep, _ = body.stepper("fast", reuse=0.5, depth=2)
+    remainders = []
+
+    def committed(t: float) -> None:
+        contact.commit(points + body.displacement)
+        remainders.append(substep.system.remainder is not None)
+
+    g = np.array([0.0, -9810.0, 0.0])
+    ramp(body.items, body.field, lambda t: body.set_gravity(t * g), body.dof1, body.dof0,
+         StepSettings(increments=5, substeps=2), substep=substep, on_substep=committed)
+    force, active = contact.forces(points + body.displacement)
+    assert active.sum() >= 2 and force[:, 1].sum() < 0.0  # pressed down
+    if friction == 0.0:
+        assert not any(remainders) and np.all(force[:, [0, 2]] == 0.0)
+    else:  # the tip slides back along the floor as it lands: friction at the cone's edge, against it
+        assert any(remainders) and force[:, 0].sum() > 0.0
+        assert np.allclose(np.linalg.norm(force[active][:, [0, 2]], axis=1), 0.5 * np.abs(force[active, 1]), rtol=1e-6)
+    r = substep.system.residual(body.displacement.ravel())[0].reshape(-1, 3)
+    weight = substep.system.dead.vector().reshape(-1, 3).sum(axis=0)
     assert np.allclose(r[points[:, 0] == 0.0].sum(axis=0), force.sum(axis=0) - weight, atol=1e-6 * abs(weight[1]))
 
 

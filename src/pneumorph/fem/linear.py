@@ -222,6 +222,81 @@ class PardisoPattern:
                 self._call(-1, np.zeros(0, dtype=self.dtype), np.zeros(0, dtype=self.dtype))
 
 
+def pattern_operator(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, symmetric: bool = False,
+                     remainder: Any = None) -> Callable[[np.ndarray], np.ndarray]:
+    """The product ``x -> A x`` of the matrix with CSR values ``data`` on a pattern (its upper triangle if
+    ``symmetric``) plus a sparse ``remainder`` (None: none), in double precision.
+
+    >>> import numpy as np, scipy.sparse as sp
+    >>> A = pattern_operator(np.array([0, 2, 3]), np.array([0, 1, 1]), np.array([4.0, 1.0, 3.0]), True,
+    ...                      sp.csr_matrix(np.array([[0.0, 0.5], [-0.5, 0.0]])))
+    >>> A(np.array([1.0, 1.0])).tolist()
+    [5.5, 3.5]
+    """
+    import scipy.sparse as sp
+
+    n = len(indptr) - 1
+    matrix = sp.csr_matrix((np.asarray(data, dtype=np.float64), indices, indptr), shape=(n, n))
+    diagonal = matrix.diagonal() if symmetric else None
+
+    def product(x: np.ndarray) -> np.ndarray:
+        y = matrix @ x
+        if diagonal is not None:
+            y += matrix.T @ x - diagonal * x
+        if remainder is not None:
+            y += remainder @ x
+        return np.asarray(y, dtype=np.float64)
+
+    return product
+
+
+#: GMRES's tolerance (the residual over the right-hand side) and its most iterations in :func:`corrected`
+CORRECTED_TOLERANCE = 1e-6
+CORRECTED_ITERATIONS = 30
+
+
+def corrected(solve: Callable[[np.ndarray], np.ndarray], product: Callable[[np.ndarray], np.ndarray],
+              b: np.ndarray) -> np.ndarray:
+    """The solution of ``A x = b`` by GMRES on the product ``x -> A x``, preconditioned on the right by ``solve``,
+    an approximate inverse of ``A`` (the factorisation of most of it).
+
+    The non-symmetric mode of a symmetric solver: the 3D tangent is factorised as a symmetric matrix, and the
+    non-symmetric rest of the friction blocks (a few nodes' 3 x 3 blocks) is a matrix of low rank next to it,
+    which GMRES resolves in a few products. Each iteration costs one ``solve`` and one ``product``; the first
+    is the preconditioned solve itself, scaled, so a remainder that does not matter costs one product more.
+    Right preconditioning minimises the true residual, which stops the iteration at :data:`CORRECTED_TOLERANCE`
+    times ``|b|``, or after :data:`CORRECTED_ITERATIONS` with the best it found (a Newton step may be inexact).
+
+    >>> import numpy as np
+    >>> A = np.array([[4.0, 1.5], [0.5, 3.0]])
+    >>> x = corrected(lambda b: b / np.diag(A), lambda x: A @ x, np.array([1.0, 2.0]))
+    >>> np.allclose(A @ x, [1.0, 2.0])
+    True
+    """
+    b = np.asarray(b, dtype=np.float64)
+    beta = float(np.linalg.norm(b))
+    if beta == 0.0:
+        return np.zeros_like(b)
+    m = CORRECTED_ITERATIONS
+    V, Z = [b / beta], []
+    H = np.zeros((m + 1, m))
+    y: np.ndarray = np.zeros(0)
+    for j in range(m):
+        Z.append(np.asarray(solve(V[j]), dtype=np.float64))
+        w = product(Z[j])
+        for i in range(j + 1):  # modified Gram-Schmidt
+            H[i, j] = float(V[i] @ w)
+            w = w - H[i, j] * V[i]
+        H[j + 1, j] = float(np.linalg.norm(w))
+        e = np.zeros(j + 2)
+        e[0] = beta
+        y = np.linalg.lstsq(H[: j + 2, : j + 1], e, rcond=None)[0]
+        if np.linalg.norm(H[: j + 2, : j + 1] @ y - e) <= CORRECTED_TOLERANCE * beta or H[j + 1, j] == 0.0:
+            break
+        V.append(w / H[j + 1, j])
+    return np.asarray(np.column_stack(Z) @ y, dtype=np.float64)
+
+
 class SuperLUPattern:
     """SciPy's SuperLU with :class:`PardisoPattern`'s interface (where MKL is missing).
 

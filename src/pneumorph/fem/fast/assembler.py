@@ -113,6 +113,10 @@ class FastSystem:
     pattern : Pattern
         The pattern and every owner's entries and positions, shared (read-only) by the systems of one mesh: the
         last :data:`PATTERN_CACHE_SIZE` meshes' are kept, by a key of the active dofs and every owner's cells.
+    remainder : scipy.sparse.csr_matrix or None
+        Of a symmetric system, what the last :meth:`tangent_data` left out of ``K[dof1, dof1]``: the
+        non-symmetric rest of the friction blocks of its obstacles (None: nothing), for a solver that corrects
+        the symmetric factorisation (:func:`~pneumorph.fem.linear.corrected`).
     """
 
     dim: ClassVar[int]
@@ -167,6 +171,7 @@ class FastSystem:
         self._build_pattern()
         self._state: list[Any] = []
         self._U = np.zeros((self.npoints, d))
+        self.remainder: Any = None
 
     # -- dimension hooks ---------------------------------------------------------------
     def _check_field(self, sub: Any) -> None:
@@ -373,7 +378,12 @@ class FastSystem:
         return r, jmin
 
     def tangent_data(self) -> FloatArray:
-        """CSR ``data`` of ``K[dof1, dof1]`` (its upper triangle if symmetric), state of the last residual."""
+        """CSR ``data`` of ``K[dof1, dof1]`` (its upper triangle if symmetric), state of the last residual.
+
+        A symmetric system keeps the symmetric part of its obstacles' blocks without the coupling of a sliding
+        node's friction to its normal force (:func:`~pneumorph.fem.fast.friction.coulomb`), and sets
+        ``remainder`` to the rest of them.
+        """
         # every owner's assembled entries side by side, then one scatter-add of them all
         values, start = self._values, 0
         for s, state in zip(self.solids, self._state, strict=True):
@@ -383,22 +393,48 @@ class FastSystem:
             K = self._wall_tangent(w, float(w.item.results.pressure), self._U)
             values[start : start + w.take.size] = K.ravel()[w.take]
             start += w.take.size
+        remainders = []
         for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike
             K = c.tangent(self.points + self._U, self.symmetric)
-            if self.symmetric:  # (sliding friction's blocks are not)
+            if self.symmetric:  # friction's blocks are not: the rest of them apart (``remainder``)
                 K = 0.5 * (K + K.transpose(0, 2, 1))
+                if c.friction > 0.0:
+                    remainders.append((c.edofs, c.tangent(self.points + self._U) - K))
             values[start : start + c.take.size] = K.ravel()[c.take]
             start += c.take.size
+        self.remainder = self._remainder(remainders)
         return np.asarray(np.bincount(self._scatter, weights=values, minlength=self.nnz), dtype=np.float64)
 
+    def _remainder(self, blocks: list[tuple[IntArray, FloatArray]]) -> Any:
+        """The nodes' blocks ``(edofs, K (m, d, d))`` as a sparse matrix over the active dofs, or None if all zero."""
+        import scipy.sparse as sp
+
+        blocks = [(edofs, K) for edofs, K in blocks if np.any(K)]
+        if not blocks:
+            return None
+        d, n1 = self.dim, self.dof1.size
+        active = np.full(self.ndof, -1, dtype=np.int64)
+        active[self.dof1] = np.arange(n1)
+        rows, cols, vals = [], [], []
+        for edofs, K in blocks:
+            dofs = active[edofs.reshape(-1, d)]  # (m, d)
+            r, c = np.broadcast_arrays(dofs[:, :, None], dofs[:, None, :])
+            keep = (r >= 0) & (c >= 0) & (K != 0.0)
+            rows.append(r[keep])
+            cols.append(c[keep])
+            vals.append(K[keep])
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n1, n1))
+
     def tangent(self) -> Any:
-        """``K[dof1, dof1]`` as ``scipy.sparse.csr_matrix`` (state of the last residual)."""
+        """``K[dof1, dof1]`` as ``scipy.sparse.csr_matrix``, ``remainder`` included (state of the last residual)."""
         import scipy.sparse as sp
 
         n1 = self.dof1.size
         matrix = sp.csr_matrix((self.tangent_data(), self.indices, self.indptr), shape=(n1, n1))
         if self.symmetric:
             matrix = (matrix + sp.triu(matrix, k=1).T).tocsr()
+            if self.remainder is not None:
+                matrix = (matrix + self.remainder).tocsr()
         return matrix
 
     def wall_loads(self, u: FloatArray) -> list[FloatArray]:
