@@ -152,8 +152,8 @@ def measured_composite(crimp_ratio: float, matrix: str = "ecoflex_0030", bulk: f
         primary, straight, slope = MEASURED_PAPER[cr]
     else:
         primary, straight, slope = calibrate_measured(cr, matrix, base.bulk)
-    return CrimpedFibreOgden(base.mu, base.alpha, base.bulk, base.direction, straight, slope, BLEND, mixed=mixed,
-                             primary=primary)
+    return CrimpedFibreOgden(base.mu.tolist(), base.alpha.tolist(), base.bulk, base.direction, straight, slope, BLEND,
+                             mixed=mixed, primary=primary)
 
 
 def calibrate_measured(crimp_ratio: float, matrix: str = "ecoflex_0030", bulk: float | None = None,
@@ -184,8 +184,8 @@ def calibrate_measured(crimp_ratio: float, matrix: str = "ecoflex_0030", bulk: f
     matrix_slope = two_line(base, 1.0).primary_modulus  # the matrix alone (its paper straightens at 100 %)
     primary, straight, slope = max(0.0, e1 - matrix_slope), 1.0 + eps, e2 - e1
     for _ in range(iterations):
-        law = CrimpedFibreOgden(base.mu, base.alpha, base.bulk, base.direction, straight, slope, BLEND,
-                                primary=primary)
+        law = CrimpedFibreOgden(base.mu.tolist(), base.alpha.tolist(), base.bulk, base.direction, straight, slope,
+                                BLEND, primary=primary)
         r = two_line(law, eps)
         primary = max(0.0, primary + e1 - r.primary_modulus)
         slope += e2 - r.secondary_modulus
