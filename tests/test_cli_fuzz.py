@@ -175,6 +175,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE,
         "--element-size": [*POSITIVE, "1e-4"], "--end-cap": NONNEG, "--bilinear-nu": ["0.5", "-1.5", *REAL],
         "--control": ["", "arc-length"], "--volume-change": [*POSITIVE, "1e3"], "--composite": ["", "rebar"],
+        "--paper": ["", "crimped", "Measured"],
         "--max-cutbacks": COUNT + HUGE, "--max-iterations": POS_COUNT + HUGE, "--out": ["a-file", "a-file/sub", ""],
     },
     "coupon": {

@@ -1,7 +1,8 @@
 """Regenerate the bimodal-actuator table and figures of docs/bimodal.md.
 
 Runs the 3D model for the three crimp ratios, each with the composite's variants: the Ecoflex
-matrix with the crimped paper as fibres (``fibre``, the default model), and the Table B.1
+matrix with the crimped paper as fibres, the paper of the cast coupons (the default
+model, Table 3.2: ``cast``) or the ideal crimp (``ideal``), and the Table B.1
 homogeneous material with a nearly incompressible composite (``homogenised``, nu = 0.495) or
 the library's assumed bulk modulus (``library``); one process, one run after the other;
 every run's result is kept as JSON in ``--out`` and reused when the script is started again
@@ -10,7 +11,7 @@ volume (``--control volume``, the default) or the pressure.
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/bimodal_table.py [--voids 15]
         [--element-size 2.5] [--pmax 60] [--end-cap 0] [--max-cutbacks N] [--max-iterations N]
-        [--control volume] [--volume-change 8] [--variants fibre homogenised]
+        [--control volume] [--volume-change 8] [--variants cast ideal homogenised library]
         [--out /tmp/bimodal-runs] [--only 0.2] [--tag=-v5]
 """
 
@@ -31,7 +32,8 @@ from pneumorph.materials import get
 
 DOCS = Path(__file__).resolve().parents[1]
 #: variant: (composite model, the composite's Poisson's ratio or None for the library's bulk modulus, label)
-VARIANTS = {"fibre": ("fibre", None, "paper as fibres"),
+VARIANTS = {"cast": ("fibre", None, "cast paper as fibres"),
+            "ideal": ("fibre", None, "ideal crimp as fibres"),
             "homogenised": ("homogenised", 0.495, "homogenised, nu = 0.495"),
             "library": ("homogenised", None, "homogenised, library K")}
 
@@ -64,7 +66,8 @@ def run(cr: float, variant: str, args: argparse.Namespace, path: Path) -> Bimoda
     spec = BimodalSpec(voids=args.voids, element_size=args.element_size, end_cap=args.end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=args.pmax / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=args.max_cutbacks, max_iterations=args.max_iterations, composite=composite,
-                         volume=args.volume_change if args.control == "volume" else None)
+                         volume=args.volume_change if args.control == "volume" else None,
+                         paper="ideal" if variant == "ideal" else "measured")
     t0 = time.perf_counter()
     print(f"CR {cr} {variant}: ", end="", flush=True)
     r = model.solve(on_level=lambda k, p, v: print(f"{1e3 * p:g}:{v:+.2f} ", end="", flush=True))

@@ -19,7 +19,7 @@ def test_json_run(tmp_path, capsys) -> None:
     assert d["pressures_kpa"] == [5.0] and d["completed"]
     # the default composite: the Ecoflex matrix with the paper along the actuator
     assert d["metadata"]["model"]["materials"]["bilinear"] == "ecoflex_0030"
-    assert d["metadata"]["model"]["composite"].startswith("fibre")
+    assert d["metadata"]["model"]["composite"].startswith("fibre") and d["metadata"]["model"]["paper"] == "measured"
     assert {p.split("/")[-1] for p in d["files"]} == {"bimodal-cr0_3.json", "bimodal-cr0_3-tip.png",
                                                       "bimodal-cr0_3-shape.png"}
 
@@ -53,6 +53,20 @@ def test_homogenised_composite_and_its_poisson_ratio(capsys) -> None:
         m = json.loads(capsys.readouterr().out)["metadata"]["model"]
         assert m["materials"]["bilinear"] == material
         assert m["bulk_moduli_kpa"]["bilinear"] == pytest.approx(1e3 * get(material).shear_modulus * 2 * 1.45 / 0.3)
+
+
+def test_the_ideal_paper(capsys) -> None:
+    """``--paper ideal``: the crimp slack until its analytic straightening, below it the plain Ecoflex layer's
+    actuator (the same as ``--paper measured`` would be only if the cast paper carried nothing before)."""
+    base = ["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
+            "--json"]
+    tips = {}
+    for paper in ("ideal", "measured"):
+        assert main([*base, "--paper", paper]) == 0
+        d = json.loads(capsys.readouterr().out)
+        assert d["metadata"]["model"]["paper"] == paper
+        tips[paper] = d["tip_uy_mm"][0]
+    assert abs(tips["ideal"] - tips["measured"]) > 0.01 * abs(tips["ideal"])
 
 
 def test_bad_crimp_ratio(capsys) -> None:

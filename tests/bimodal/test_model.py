@@ -58,12 +58,24 @@ def test_slack_paper_leaves_the_ecoflex_alone() -> None:
     """Below the crimp's straightening (28 % for CR 0.2) the paper carries nothing: the fibre composite's actuator
     is the one with a plain Ecoflex 0030 layer, and both differ from the homogenised Table B.1 layer."""
     spec = BimodalSpec(voids=1, element_size=5.0)
-    fibre = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005).solve()
+    fibre = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005, paper="ideal").solve()
     plain = BimodalModel(spec, crimp_ratio=None, pmax=0.005, materials={"bilinear": "ecoflex_0030"}).solve()
     homogenised = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005, composite="homogenised").solve()
     np.testing.assert_allclose(fibre.tip, plain.tip, rtol=1e-9, atol=1e-12)
     assert abs(fibre.tip[0, 1] - homogenised.tip[0, 1]) > 0.05 * abs(homogenised.tip[0, 1])
     assert fibre.metadata["model"]["composite"].startswith("fibre")
+    # the cast paper (the default) carries load from the start (216 kPa primary modulus against the Ecoflex's 68)
+    cast = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005).solve()
+    assert cast.metadata["model"]["paper"] == "measured"
+    assert cast.tip[0, 1] > 0.0 and abs(cast.tip[0, 1] - fibre.tip[0, 1]) > 0.01 * fibre.tip[0, 1]
+
+
+def test_a_transition_strain_only_with_the_ideal_paper() -> None:
+    assert BimodalModel(TINY, crimp_ratio=0.2, paper="ideal", transition=0.152).transition == 0.152
+    with pytest.raises(SettingsError, match="ideal"):
+        BimodalModel(TINY, crimp_ratio=0.2, transition=0.152)
+    with pytest.raises(SettingsError, match="crimped"):
+        BimodalModel(TINY, crimp_ratio=0.2, paper="crimped")
 
 
 def test_unknown_composite() -> None:

@@ -16,10 +16,13 @@ MU = (-0.0143, -3.646e-10, 9.594e-08)
 ALPHA = (-5.224, -0.1628, 11.38)
 K = 0.0338
 STRAIGHT, SLOPE, BLEND = 1.1, 100.0, 0.05
+#: the crimp's own stiffness before it straightens (the cast paper's, Table 3.2)
+PRIMARY = 0.15
 
 
 def energy(F: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """Eq 2.12 plus the fibres' ``slope * G(l - straight)``, ``G`` the integral of the blend, written anew."""
+    """Eq 2.12 plus the fibres' ``primary (l - 1)^2 / 2 + slope * G(l - straight)``, ``G`` the integral of the
+    blend, written anew."""
     Ft = np.moveaxis(F, (0, 1), (-2, -1))
     C = np.einsum("...ki,...kj->...ij", Ft, Ft)
     c = np.linalg.eigvalsh(C)
@@ -27,9 +30,10 @@ def energy(F: np.ndarray, a: np.ndarray) -> np.ndarray:
     lbar = J[..., None] ** (-1 / 3) * np.sqrt(c)
     W = sum(m / al * ((lbar**al).sum(-1) - 3) for m, al in zip(MU, ALPHA, strict=True))
     W = W + 4.5 * K * (J ** (1 / 3) - 1) ** 2
-    x = np.sqrt(np.einsum("...i,...ij,...j->...", a, C, a)) - STRAIGHT
+    stretch = np.sqrt(np.einsum("...i,...ij,...j->...", a, C, a))
+    x = stretch - STRAIGHT
     G = np.where(x <= -BLEND, 0.0, np.where(x >= BLEND, x**2 / 2 + BLEND**2 / 6, (x + BLEND) ** 3 / (12 * BLEND)))
-    return W + SLOPE * G
+    return W + SLOPE * G + PRIMARY * (stretch - 1.0) ** 2 / 2
 
 
 @pytest.fixture
@@ -37,7 +41,7 @@ def law() -> CrimpedFibreOgden:
     """Five elements of four points each, every element with a fibre direction of its own."""
     rng = np.random.default_rng(7)
     return CrimpedFibreOgden(MU, ALPHA, K, direction=rng.standard_normal((5, 3)), straight=STRAIGHT, slope=SLOPE,
-                             blend=BLEND)
+                             blend=BLEND, primary=PRIMARY)
 
 
 def deformations(law: CrimpedFibreOgden) -> np.ndarray:
@@ -84,15 +88,17 @@ def test_fast_layout_and_blocks_equal_the_felupe_path(law: CrimpedFibreOgden) ->
 
 
 def test_uniaxial_closed_form_along_and_across() -> None:
-    """Pulled along the fibres, the law is the matrix plus ``slope (l - straight)`` once straight and the matrix
-    alone before the blend; pulled across, the matrix alone at every stretch."""
-    law = CrimpedFibreOgden(MU, ALPHA, K, [1.0, 0.0, 0.0], STRAIGHT, SLOPE, BLEND)
+    """Pulled along the fibres, the law is the matrix plus ``primary (l - 1)``, and ``slope (l - straight)`` more
+    once straight; pulled across, the ideal crimp (``primary = 0``) leaves the matrix alone at every stretch."""
     matrix = OgdenCompressible(MU, ALPHA, K)
     lam = np.array([0.8, 1.0, 1.02, STRAIGHT - BLEND, STRAIGHT, STRAIGHT + BLEND, 1.3, 1.6])
-    extra = uniaxial_stress(law, lam) - uniaxial_stress(matrix, lam)
     fibre = SLOPE * np.array([0, 0, 0, 0, BLEND / 4, BLEND, 1.3 - STRAIGHT, 1.6 - STRAIGHT])
-    np.testing.assert_allclose(extra, fibre, rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(uniaxial_stress(law, lam, axis=1), uniaxial_stress(matrix, lam, axis=1),
+    for primary in (0.0, PRIMARY):
+        law = CrimpedFibreOgden(MU, ALPHA, K, [1.0, 0.0, 0.0], STRAIGHT, SLOPE, BLEND, primary=primary)
+        extra = uniaxial_stress(law, lam) - uniaxial_stress(matrix, lam)
+        np.testing.assert_allclose(extra, fibre + primary * (lam - 1.0), rtol=1e-9, atol=1e-12)
+    ideal = CrimpedFibreOgden(MU, ALPHA, K, [1.0, 0.0, 0.0], STRAIGHT, SLOPE, BLEND)
+    np.testing.assert_allclose(uniaxial_stress(ideal, lam, axis=1), uniaxial_stress(matrix, lam, axis=1),
                                rtol=1e-12, atol=1e-15)
 
 
@@ -115,7 +121,7 @@ def test_a_fibre_layer_in_the_fast_3d_assembly() -> None:
 
     mesh = fem.Cube(n=2)
     field = fem.FieldContainer([fem.Field(fem.RegionHexahedron(mesh), dim=3)])
-    law = CrimpedFibreOgden(MU, ALPHA, K, [1.0, 0.2, 0.0], STRAIGHT, SLOPE, BLEND)
+    law = CrimpedFibreOgden(MU, ALPHA, K, [1.0, 0.2, 0.0], STRAIGHT, SLOPE, BLEND, primary=PRIMARY)
     solid = fem.SolidBody(law, field)
     dof0, dof1 = fem.dof.partition(field, {"x0": fem.Boundary(field[0], fx=0.0)})
     system = SolidSystem3D([solid], field, dof1, dof0)
@@ -136,7 +142,8 @@ def test_a_fibre_layer_in_the_fast_3d_assembly() -> None:
 
 
 @pytest.mark.parametrize("kwargs", [dict(direction=[0.0, 0.0, 0.0]), dict(direction=[1.0, 0.0]),
-                                    dict(straight=1.01), dict(slope=-1.0), dict(blend=0.0)])
+                                    dict(straight=1.01), dict(slope=-1.0), dict(blend=0.0),
+                                    dict(primary=-0.1), dict(primary=float("nan"))])
 def test_invalid_parameters(kwargs: dict) -> None:
     args = dict(direction=[1.0, 0.0, 0.0], straight=STRAIGHT, slope=SLOPE, blend=BLEND) | kwargs
     with pytest.raises(ValueError):

@@ -40,7 +40,7 @@ from pneumorph.bimodal.geometry import (
     BimodalSpec,
     mesh_actuator,
 )
-from pneumorph.bimodal.paper import paper_composite
+from pneumorph.bimodal.paper import PAPER_MODELS, measured_composite, paper_composite
 from pneumorph.bimodal.switch import Switch, find_switch
 from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
@@ -203,9 +203,13 @@ class BimodalModel:
         crimped paper along the actuator (:func:`~pneumorph.bimodal.paper.paper_composite`);
         ``"homogenised"``: the Table B.1 Ogden material of the crimp ratio, isotropic (the
         dissertation's model). Without a crimp ratio the layer is ``materials["bilinear"]`` alone.
+    paper : {"measured", "ideal"}
+        With ``composite="fibre"``: the paper of the cast coupons (default; Table 3.2's primary
+        modulus, transition strain and secondary modulus,
+        :func:`~pneumorph.bimodal.paper.measured_composite`) or the ideal crimp (slack until the
+        analytic straightening stretch, then the library paper's stiffness).
     transition : float, optional
-        With ``composite="fibre"``: the paper's straightening strain instead of the crimp's
-        analytic one (e.g. Table 3.2's measured transition strain).
+        With ``paper="ideal"``: the paper's straightening strain instead of the crimp's analytic one.
 
     Examples
     --------
@@ -221,10 +225,12 @@ class BimodalModel:
     #: ramp ended at 25 kPa instead of 35
     predictor_order = 1
     tangent_reuse = Full3D.tangent_reuse
-    #: with the paper as fibres (about 3,000 times stiffer than the Ecoflex once straight) a kept tangent
+    #: with the ideal paper as fibres (about 3,000 times stiffer than the Ecoflex once straight) a kept tangent
     #: contracts the residual by about 0.6 per iteration, under the 0.7 that keeps it: the volume-controlled
     #: 3-void actuator (CR 0.2) crawled to a 1.7e-8 residual in 25 iterations and the ramp ended at 21 kPa;
-    #: refreshed below 0.3 it reached 9 V0 (85 factorisations, 31 s)
+    #: refreshed below 0.3 it reached 9 V0 (85 factorisations, 31 s). The cast paper (``paper="measured"``), 4-5 times
+    #: softer once straight, keeps the silicones' :attr:`tangent_reuse`: the full-size CR 0.25 with a 1.5 mm end cap
+    #: took 69 s of CPU with it, 79 s with 0.5 and 105 s with 0.3, the same tip to 1e-4 mm
     fibre_tangent_reuse = 0.3
     anderson_depth = Full3D.anderson_depth
     #: halvings of a step before the ramp ends there: the ramp ends where a wall balloons,
@@ -251,6 +257,7 @@ class BimodalModel:
         volume: float | None = None,
         composite: str = "fibre",
         transition: float | None = None,
+        paper: str = "measured",
     ) -> None:
         pmax = checks.real(pmax, "pmax", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                            limit="MAX_PRESSURE_KPA")
@@ -275,6 +282,10 @@ class BimodalModel:
             checks.integer(value, name, low, 1000)
         if composite not in COMPOSITES:
             raise SettingsError(f"composite must be one of {', '.join(COMPOSITES)}, got {composite!r}")
+        if paper not in PAPER_MODELS or (transition is not None and paper != "ideal"):
+            raise SettingsError(f"paper must be one of {', '.join(PAPER_MODELS)} (a transition strain only with "
+                                f"the ideal paper), got {paper!r} and transition {transition!r}")
+        self.paper = paper
         # without a crimp ratio there is no paper: the layer is the named material alone
         self.composite = composite if crimp_ratio is not None else "homogenised"
         self.transition = None if transition is None else checks.real(transition, "transition", 0.0, 10.0,
@@ -328,6 +339,7 @@ class BimodalModel:
             "element": "hexahedron20",
             "composite": self.composite if self.composite == "homogenised" else
             f"fibre: {self.names['bilinear']} with {PAPER} along x",
+            "paper": self.paper if self.composite == "fibre" else None,
             "paper_transition": self.transition,
             "control": "pressure" if self.volume is None else f"volume (V/V0 - 1 = {self.volume:g} at the end)",
         }
@@ -343,7 +355,10 @@ class BimodalModel:
             # a nearly incompressible layer (the composite at nu = 0.495) on the u-p-J form, by the models' rule
             mixed = nearly_incompressible(self.bulk(name), self.materials[name].shear_modulus)
             umat = OgdenCompressible(m.mu, m.alpha, self.bulk(name), mixed=mixed)
-            if code == BILINEAR and self.composite == "fibre":  # the paper along the actuator, the layer's thickness
+            if code == BILINEAR and self.composite == "fibre" and self.paper == "measured":  # Table 3.2's paper
+                umat = measured_composite(float(self.crimp_ratio or 0.0), matrix=str(self.names[name]),
+                                          bulk=self.bulk(name), mixed=mixed)
+            elif code == BILINEAR and self.composite == "fibre":  # the ideal crimp, the layer's thickness
                 umat = paper_composite(float(self.crimp_ratio or 0.0), thickness=self.spec.bilinear,
                                        matrix=str(self.names[name]), paper=PAPER, bulk=self.bulk(name), mixed=mixed,
                                        transition=self.transition)
@@ -374,7 +389,8 @@ class BimodalModel:
         def apply(t: float) -> None:
             body.pressure.update(t * self.pmax)
 
-        reuse = self.fibre_tangent_reuse if self.composite == "fibre" else self.tangent_reuse
+        ideal = self.composite == "fibre" and self.paper == "ideal"
+        reuse = self.fibre_tangent_reuse if ideal else self.tangent_reuse
         substep, monitor = body.stepper(self.backend, reuse, self.anderson_depth)
         control = volume_control(self.volume, substep, apply, body.displacement)
         if control is not None:  # the voids' volume drives, the pressure is an output

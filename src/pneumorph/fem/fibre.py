@@ -1,11 +1,13 @@
 """A compressible Ogden matrix reinforced by crimped fibres: the paper in the silicone, in 3D.
 
 The energy is the matrix's (Eq 2.12, :class:`~pneumorph.fem.ogden.OgdenCompressible`) plus
-that of fibres along a unit vector ``a`` of the reference configuration, which are slack
-until their crimp has straightened at the stretch ``straight`` and then carry ``slope``
-(MPa) of nominal stress per unit stretch (:func:`~pneumorph.fem.fast.kernels.crimped_fibre_3d`,
-a quadratic blend of half-width ``blend`` joining the two). Across the fibres the material
-is the matrix alone: it stiffens along ``a`` and not across it.
+that of fibres along a unit vector ``a`` of the reference configuration, which carry
+``primary`` (MPa; 0 for an ideal crimp, slack) of nominal stress per unit stretch until
+their crimp has straightened at the stretch ``straight`` and then ``slope`` more
+(:func:`~pneumorph.fem.fast.kernels.crimped_fibre_3d`, a quadratic blend of half-width
+``blend`` joining the two). Pulled across the fibres the material is the matrix alone (with
+``primary`` > 0, the matrix and the fibres' resistance to the contraction along them): it
+stiffens along ``a`` and not across it.
 
 The direction is a field: one unit vector for the whole material or one per element, so a
 curved layer can carry its fibres along it.
@@ -56,6 +58,9 @@ class CrimpedFibreOgden(OgdenCompressible):
         Nominal stress of the straight fibres per unit stretch (MPa), smeared over the layer.
     blend : float
         Half-width of the slack-to-taut blend in stretch (default 0.02).
+    primary : float
+        Nominal stress per unit stretch of the fibres before they straighten (MPa; default 0,
+        an ideal crimp), in tension and compression.
 
     Examples
     --------
@@ -67,7 +72,7 @@ class CrimpedFibreOgden(OgdenCompressible):
     """
 
     def __init__(self, mu: Sequence[float], alpha: Sequence[float], bulk: float, direction: Any, straight: float,
-                 slope: float, blend: float = 0.02, mixed: bool = False) -> None:
+                 slope: float, blend: float = 0.02, mixed: bool = False, primary: float = 0.0) -> None:
         super().__init__(mu, alpha, bulk, mixed=mixed)
         a = np.asarray(direction, dtype=float)
         if a.ndim not in (1, 2) or a.shape[-1] != 3:
@@ -79,11 +84,13 @@ class CrimpedFibreOgden(OgdenCompressible):
             raise ValueError(f"the blend must be positive, got {blend}")
         if not (np.isfinite(straight) and straight > 1.0 + blend):
             raise ValueError(f"the straightening stretch must exceed 1 + blend = {1 + blend:g}, got {straight}")
-        if not (np.isfinite(slope) and slope >= 0):
-            raise ValueError(f"the fibre slope must be a non-negative number, got {slope}")
+        if not (np.isfinite(slope) and slope >= 0 and np.isfinite(primary) and primary >= 0):
+            raise ValueError(f"the fibre slopes must be non-negative numbers, got {slope} and {primary}")
         self.direction = (a / norm).reshape(-1, 3)
         self.straight, self.slope, self.blend = float(straight), float(slope), float(blend)
-        self.kwargs = {**self.kwargs, "straight": self.straight, "slope": self.slope, "blend": self.blend}
+        self.primary = float(primary)
+        self.kwargs = {**self.kwargs, "straight": self.straight, "slope": self.slope, "blend": self.blend,
+                       "primary": self.primary}
 
     def directions(self, points: int) -> FloatArray:
         """The unit vectors at ``points`` points ordered by element, then point, as (3, points)."""
@@ -107,7 +114,7 @@ class CrimpedFibreOgden(OgdenCompressible):
         """
         P, A, J = super().kernel(F, tangent, principal, pairs, volumetric)
         Pf, Af = crimped_fibre_3d(F, self.directions(F.shape[-1]), self.straight, self.slope, self.blend,
-                                  tangent, pairs)
+                                  tangent, pairs, self.primary)
         return P + Pf, None if A is None or Af is None else A + Af, J
 
     def _evaluate(self, F: FloatArray, tangent: bool) -> tuple[FloatArray, FloatArray | None]:

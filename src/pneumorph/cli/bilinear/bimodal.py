@@ -32,6 +32,10 @@ DEFAULT_VOLUME_CHANGE = 8.0
 @click.option("--composite", type=click.Choice(["fibre", "homogenised"]), default="fibre", show_default=True,
               help="The composite: the Ecoflex matrix with the crimped paper along the actuator, or the "
                    "Table B.1 homogeneous Ogden material (isotropic, the dissertation's model).")
+@click.option("--paper", type=click.Choice(["measured", "ideal"]), default="measured", show_default=True,
+              help="With --composite fibre: the paper of the cast coupons (Table 3.2: it straightens at the measured "
+                   "transition strain and resists unfolding before it) or the ideal crimp (slack until the analytic "
+                   "straightening stretch, then the library paper's stiffness).")
 @click.option("--bilinear-nu", type=P.Real(-1.0, 0.5, low_open=True, high_open=True), default=None,
               help="Small-strain Poisson's ratio of the composite (with --composite fibre: of its matrix), sets "
                    "its bulk modulus [default: the library's assumed bulk modulus].")
@@ -53,7 +57,7 @@ DEFAULT_VOLUME_CHANGE = 8.0
 def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
             bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
             as_json: bool, quiet: bool, control: str = "volume", volume_change: float = DEFAULT_VOLUME_CHANGE,
-            composite: str = "fibre") -> None:
+            composite: str = "fibre", paper: str = "measured") -> None:
     """3D FE of the bimodal actuator: tip displacement in volume or pressure steps, switch pressure.
 
     Volume control (default) follows the pressure past its maximum where a wall balloons and
@@ -82,7 +86,8 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations,  # None: the model's own
-                         volume=volume_change if control == "volume" else None, composite=composite)
+                         volume=volume_change if control == "volume" else None, composite=composite,
+                         paper=paper)
 
     from pneumorph.io.progress import Progress
 
@@ -115,7 +120,8 @@ def format_result(d: dict[str, Any]) -> str:
     m = d["metadata"]
     s = d["switch"]
     head = (f"bimodal actuator, CR {d['crimp_ratio']:g}: {m['dofs']} dofs, {m['wall_time_s']:.0f} s, "
-            f"composite {m['model'].get('composite', 'homogenised')}, "
+            f"composite {m['model'].get('composite', 'homogenised')}"
+            f"{', paper ' + m['model']['paper'] if m['model'].get('paper') else ''}, "
             f"its bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa")
     lines = [head, "pressure (kPa)   tip u_x (mm)   tip u_y (mm)"]
     for p, ux, uy in zip(d["pressures_kpa"], d["tip_ux_mm"], d["tip_uy_mm"], strict=False):

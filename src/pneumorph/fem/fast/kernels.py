@@ -395,13 +395,16 @@ def crimped_fibre_3d(
     blend: float,
     tangent: bool = True,
     pairs: Sequence[tuple[int, int]] | None = None,
+    primary: float = 0.0,
 ) -> tuple[FloatArray, FloatArray | None]:
     """Stress and tangent of crimped fibres along unit vectors ``a`` (points last).
 
     The fibres' nominal stress (force per reference area across them) is
-    ``s(l) = slope g(l - straight)`` with ``l = |F a|`` their stretch and ``g``
-    :func:`crimp_blend`: nothing until the crimp has straightened at the stretch
-    ``straight``, then ``slope`` per unit stretch. With ``f = F a``,
+    ``s(l) = primary (l - 1) + slope g(l - straight)`` with ``l = |F a|`` their stretch and
+    ``g`` :func:`crimp_blend`: ``primary`` per unit stretch (a crimp that resists being
+    unfolded or folded further, a linear spring; 0 for an ideal crimp that carries nothing)
+    until the crimp has straightened at the stretch ``straight``, then ``slope`` more per
+    unit stretch. With ``f = F a``,
 
         P = s / l  f (x) a,
         A_iJkL = s / l  d_ik a_J a_L + (s' - s / l) / l^2  f_i a_J f_k a_L.
@@ -422,6 +425,8 @@ def crimped_fibre_3d(
     pairs : sequence of (int, int), optional
         Return only the blocks ``A[i, :, k, :]`` of these component pairs, as
         ``(len(pairs), 3, 3, n)`` (the layout of :func:`ogden_3d`'s).
+    primary : float
+        Nominal stress per unit stretch of the crimped fibres before they straighten (MPa).
 
     Returns
     -------
@@ -439,12 +444,12 @@ def crimped_fibre_3d(
     f = np.einsum("iJp,Jp->ip", F, direction)
     lam = np.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
     g, dg = crimp_blend(lam, straight, blend)
-    over = slope * g / lam  # s / l
+    over = (primary * (lam - 1.0) + slope * g) / lam  # s / l
     P = (over * f)[:, None] * direction[None, :]
     if not tangent:
         return P, None
     aa = direction[:, None] * direction[None, :]  # a_J a_L
-    second = (slope * dg - over) / (lam * lam)
+    second = (primary + slope * dg - over) / (lam * lam)
     if pairs is not None:
         Ab = np.empty((len(pairs), 3, 3, F.shape[-1]))
         for q, (i, k) in enumerate(pairs):
