@@ -51,7 +51,8 @@ from pneumorph.models.chain.sources import (
 )
 
 #: the model settings `pneumorph chain build` takes as options (the command of a missing table names them)
-_BUILD_OPTIONS = {"fidelity": "--model", "pressure_kpa": "--pressure", "unit_file": "--unit", "library": "--library"}
+_BUILD_OPTIONS = {"fidelity": "--model", "pressure_kpa": "--pressure", "unit_file": "--unit", "library": "--library",
+                  "quadrature": "--quadrature"}
 
 
 @dataclass(frozen=True)
