@@ -98,6 +98,7 @@ def ogden_plane_strain(
     # (powers as exponentials of logarithms: several times faster than np.power)
     lnJ = np.log(J)
     ln1, ln2 = np.log(c1) - lnJ / 1.5, np.log(c2) - lnJ / 1.5  # ln of c_a J^(-2/3)
+    Jn = [np.exp((-a / 3.0) * lnJ) for a in alpha_]
     lb = [(np.exp((0.5 * a) * ln1), np.exp((0.5 * a) * ln2), Jn[n]) for n, a in enumerate(alpha_)]
     m = [(lb_n[0] + lb_n[1] + lb_n[2]) / 3.0 for lb_n in lb]
     J13 = np.exp(lnJ / 3.0)
