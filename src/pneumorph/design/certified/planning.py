@@ -255,6 +255,8 @@ def build_command(settings: dict[str, Any], out: Path) -> str | None:
 
     >>> build_command({"fidelity": "3d", "pressure_kpa": 25.0}, Path("t/chain.json"))
     'pneumorph chain build --model 3d --pressure 25 --out t/chain.json'
+    >>> build_command({"fidelity": "3d", "quadrature": "reduced"}, Path("t.json"))
+    'pneumorph chain build --model 3d --quadrature reduced --out t.json'
     >>> build_command({"fidelity": "2d", "increments": 20}, Path("t.json")) is None
     True
     """
