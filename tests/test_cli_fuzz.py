@@ -169,7 +169,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--pressure": POSITIVE, "--units": POS_COUNT + HUGE, "--window": [*POS_COUNT, "50"],
         "--tolerance": POSITIVE, "--heldout": COUNT + HUGE, "--workers": POS_COUNT, "--unit": ["binary.bin", ""],
         "--cache": ["folder", ""], "--out": ["folder", "a-file/t.json", ""],
-        "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
+        "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"], "--quadrature": ["", "gauss", "27"],
     },
     "bimodal": {
         "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE,

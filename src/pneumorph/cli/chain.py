@@ -34,6 +34,9 @@ def chain() -> None:
                    "types "
                    "(documentation page unit-library, docs/unit-library.md in the source); instead of --unit.")
 @click.option("--pressure", type=P.PRESSURE_KPA, help="Maximum pressure, kPa (default 45).")
+@click.option("--quadrature", type=click.Choice(["full", "reduced", "irons"]),
+              help="The quadrature rule of the model's quadratic cells (default full; the model's [model] quadrature, "
+                   "documentation page notes/fe-core); the table is served with the model at this rule.")
 @click.option("--units", "n_units", type=P.Count(3, MAX_UNITS, limit="MAX_UNITS"), default=15, show_default=True,
               help="Units of the training designs.")
 @click.option("--window", type=P.Count(1, 3),
@@ -62,7 +65,8 @@ def chain() -> None:
                    "docs/chain-model.md in the source): far fewer training designs over several unit types. "
                    "Default: as the shipped table of a built-in library.")
 @click.option("--json", "as_json", is_flag=True, help="Print the validation as JSON.")
-def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, n_units: int,
+def build(fidelity: str, unit_file: str | None, library: str | None, pressure: float | None, quadrature: str | None,
+          n_units: int,
           window: int | None, tolerance: float, heldout: int, executor: str, workers: int | None,
           scheduler: str | None, cache: str | None, out: str, short: bool, all_heldout: bool, far: bool | None,
           split: bool, as_json: bool) -> None:
@@ -79,12 +83,13 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     from pneumorph.io import strict_json
     from pneumorph.io.files import all_or_nothing_file
     from pneumorph.models.chain.fit import build_table
+    from pneumorph.models.chain.model import fitted_quadrature
     from pneumorph.models.chain.plan import build_plan, cached_counter, evaluator_workers
     from pneumorph.models.chain.sources import build_options
     from pneumorph.models.factory import make_model
 
     check_options(executor, workers, scheduler)
-    settings: dict = {"fidelity": fidelity}
+    settings: dict = {"fidelity": fidelity, **({"quadrature": quadrature} if quadrature is not None else {})}
     if unit_file:
         P.unit_option(unit_file)
         settings["unit_file"] = unit_file
@@ -129,7 +134,8 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
         click.echo(strict_json({"file": str(target), "window": table.window, "training": list(table.training),
                                 "validation": v, **({"cluster": cluster} if cluster else {})}))
     else:
-        click.echo(f"{target}: window +-{table.window}, {len(table.training)} covering designs, "
+        click.echo(f"{target}: window +-{table.window}, {len(table.training)} covering designs at the "
+                   f"{fitted_quadrature(table)} quadrature rule, "
                    f"{len(v['designs'])} held-out: worst centre error {max(v['centre_worst_mm']):.4f} mm, "
                    f"mean at {table.pressures[-1] * 1e3:g} kPa {v['centre_mean_mm'][-1]:.4f} mm")
         for symbol, errs in v.get("per_type", {}).items():

@@ -14,6 +14,7 @@ its ramp the same way.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -40,6 +41,16 @@ _REGIONS = {
 #: The backends that solve a body's ramp.
 BACKENDS = ("fast", "felupe")
 
+#: The quadrature rules of a body's quadratic cells: ``"full"`` (FElupe's default Gauss rule,
+#: 3x3x3 = 27 points per hex20, 3x3 = 9 per quad8), ``"reduced"`` (Gauss, one order lower: 8
+#: points per hex20 as Abaqus' C3D20R, 4 per quad8) and ``"irons"`` (Irons' 14-point rule of the
+#: cube, exact to degree 5 like the full rule, hex20 only).
+QUADRATURES = ("full", "reduced", "irons")
+
+#: Irons' 14-point rule on [-1, 1]^3: 6 points on the axes at +-a, 8 at the corners of the cube
+#: of half-side b (B. M. Irons, Int. J. Numer. Meth. Eng. 3 (1971) 293-294); the weights sum to 8.
+_IRONS = (0.795822425754222, 0.758786910639328, 0.886426592797784, 0.335180055401662)
+
 
 def check_backend(backend: str, allowed: Sequence[str] = BACKENDS) -> str:
     """``backend`` if it is one of ``allowed``, else :class:`SettingsError` naming them.
@@ -52,11 +63,16 @@ def check_backend(backend: str, allowed: Sequence[str] = BACKENDS) -> str:
     return backend
 
 
-def regions_of(cell_type: str) -> tuple[Any, Any, Any]:
+def regions_of(cell_type: str, quadrature: str = "full") -> tuple[Any, Any, Any]:
     """FElupe's region, boundary-region and field classes for a cell type.
+
+    With a ``quadrature`` rule other than the full one, the region is that class with the
+    rule's scheme (:func:`quadrature_scheme`) given.
 
     >>> [c.__name__ for c in regions_of("hexahedron20")]
     ['RegionQuadraticHexahedron', 'RegionQuadraticHexahedronBoundary', 'Field']
+    >>> regions_of("hexahedron20", "reduced")[0].keywords["quadrature"].points.shape
+    (8, 3)
     """
     import felupe as fem
 
@@ -64,7 +80,46 @@ def regions_of(cell_type: str) -> tuple[Any, Any, Any]:
         names = _REGIONS[cell_type]
     except KeyError:
         raise SettingsError(f"no pressurised body on {cell_type!r} cells; cell types: {', '.join(_REGIONS)}") from None
-    return tuple(getattr(fem, name) for name in names)
+    region, boundary, field = (getattr(fem, name) for name in names)
+    scheme = quadrature_scheme(cell_type, quadrature)
+    return (region if scheme is None else functools.partial(region, quadrature=scheme)), boundary, field
+
+
+def quadrature_scheme(cell_type: str, rule: str = "full") -> Any:
+    """FElupe's quadrature scheme of ``rule`` on ``cell_type`` cells (None: the region's default).
+
+    Raises
+    ------
+    SettingsError
+        A rule not in :data:`QUADRATURES`, a cheaper rule on linear cells (whose full rule
+        is already the lowest that keeps their rank) or Irons' rule on other cells than hex20.
+
+    Examples
+    --------
+    >>> quadrature_scheme("hexahedron20") is None
+    True
+    >>> [quadrature_scheme("hexahedron20", r).points.shape for r in ("reduced", "irons")]
+    [(8, 3), (14, 3)]
+    >>> round(float(quadrature_scheme("hexahedron20", "irons").weights.sum()), 12)
+    8.0
+    >>> quadrature_scheme("quad8", "reduced").points.shape
+    (4, 2)
+    """
+    import felupe as fem
+
+    if rule not in QUADRATURES:
+        raise SettingsError(f"quadrature must be one of {', '.join(QUADRATURES)}, got {rule!r}")
+    if rule == "full":
+        return None
+    if cell_type not in ("quad8", "hexahedron20") or (rule == "irons" and cell_type != "hexahedron20"):
+        raise SettingsError(f"quadrature {rule!r} is not a rule of {cell_type!r} cells (the reduced rule is one of "
+                            "quad8 and hex20 cells, Irons' of hex20)")
+    if rule == "reduced":
+        return fem.GaussLegendre(order=1, dim=2 if cell_type == "quad8" else 3)
+    a, b, wa, wb = _IRONS
+    axes = [[s * a if j == axis else 0.0 for j in range(3)] for axis in range(3) for s in (-1, 1)]
+    corners = [[x * b, y * b, z * b] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    return fem.quadrature.Scheme(np.array(axes + corners), np.array([wa] * 6 + [wb] * 8))
 
 
 @dataclass
@@ -182,6 +237,7 @@ def pressurised_body(
     symmetry_points: BoolArray | None = None,
     walls_of: Sequence[str] | None = None,
     densities: Mapping[str, float] | None = None,
+    quadrature: str = "full",
 ) -> PressurisedBody:
     """Build the FElupe objects of a pressurised body.
 
@@ -207,6 +263,8 @@ def pressurised_body(
     densities : mapping of str to float, optional
         Mass densities (t/mm^3) of the regions that carry their weight (dead loads that
         :meth:`PressurisedBody.set_gravity` switches on); default none.
+    quadrature : {"full", "reduced", "irons"}
+        The material regions' rule (:func:`quadrature_scheme`; the walls keep theirs).
 
     Examples
     --------
@@ -227,9 +285,8 @@ def pressurised_body(
     points = np.asarray(points, dtype=float)
     cells = np.asarray(cells)
     dim = points.shape[1]
-    Region, BoundaryRegion, Field = regions_of(cell_type)
-    mesh = fem.Mesh(points, cells, cell_type)
-    global_field = fem.FieldContainer([Field(Region(mesh), dim=dim)])
+    Region, BoundaryRegion, Field = regions_of(cell_type, quadrature)
+    global_field = fem.FieldContainer([Field(Region(fem.Mesh(points, cells, cell_type)), dim=dim)])
     solids: dict[str, Any] = {}
     selected: dict[str, IntArray] = {}
     for name, which, umat in materials:
@@ -252,4 +309,5 @@ def pressurised_body(
                            half=symmetry_points is not None)
 
 
-__all__ = ["BACKENDS", "PressurisedBody", "check_backend", "pressurised_body", "regions_of"]
+__all__ = ["BACKENDS", "QUADRATURES", "PressurisedBody", "check_backend", "pressurised_body", "quadrature_scheme",
+           "regions_of"]

@@ -10,18 +10,20 @@ from typing import Any
 from pneumorph import checks
 from pneumorph.errors import GeometryError, SearchConfigError, SettingsError
 from pneumorph.fem import StepSettings
+from pneumorph.fem.body import quadrature_scheme
 from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import BUILTIN_LIBRARIES, UnitLibrary, builtin_library
 from pneumorph.geometry.meshsize import available_memory, check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
+from pneumorph.models.fe.base import CELL_TYPES
 from pneumorph.models.fe.gravity import gravity_vector
 from pneumorph.models.fe.obstacles import check_obstacles
 from pneumorph.models.fe.volumetric import FORMULATIONS
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
               "temperature_change", "passage", "base_block", "library", "body_bulk_scale", "body_shear_scale",
-              "formulation", "volume_change", "obstacle")
+              "formulation", "volume_change", "obstacle", "quadrature")
 #: the range of ``body_shear_scale`` (a factor on the body silicone's Ogden moduli), and of the identified scales
 SCALE_RANGE = (0.1, 10.0)
 #: the range of ``body_bulk_scale``: up to a nearly incompressible body (x1000 gives Mold Star 15 a Poisson's ratio of
@@ -121,6 +123,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
         ``formulation``: how the silicones' volumetric term is integrated (``"auto"``, the default:
         the u-p-J form for a nearly incompressible silicone; ``"displacement"``; ``"u-p-J"``;
         :meth:`~pneumorph.models.fe.base.FEModel.element_volume`); ``volume_change`` (RampSpec's ``volume``);
+        ``quadrature``: the cells' rule (``"full"``, default; ``"reduced"``; ``"irons"``, 3D: ``quadrature_scheme``);
         ``obstacle``: a list of rigid obstacles (``[[model.obstacle]]`` tables,
         :func:`pneumorph.models.fe.obstacles.check_obstacles`).
 
@@ -151,6 +154,7 @@ def make_model(units: int, settings: Mapping[str, Any] | None = None) -> FEModel
     block = _base_block(s.get("base_block"))  # its mesh counts too
     for spec in ([unit] if unit is not None else list(library.units) if library is not None else []):
         check_mesh(spec, units, Model.dim, memory=free, base=block)  # before any mesh: the estimate in the message
+        _check_quadrature(s.get("quadrature", "full"), Model.dim, spec)
     ramp = _ramp(s, Model.default_steps)
     try:
         gravity = gravity_vector(s.get("gravity"), Model.dim)
@@ -179,12 +183,22 @@ def _model_options(s: Mapping[str, Any], unit: UnitSpec | None, library: UnitLib
     if "formulation" in s:
         extra["formulation"] = checks.text(s["formulation"], "[model] formulation", FORMULATIONS,
                                            error=SearchConfigError)
+    if "quadrature" in s:
+        extra["quadrature"] = s["quadrature"]  # checked against the model's cells by make_model
     if library is not None:
         extra["library"] = library
     body = _scaled_body(s, unit if unit is not None else library.units[0] if library is not None else UnitSpec())
     if body is not None:
         extra["materials"] = {body.name: body}
     return extra
+
+
+def _check_quadrature(rule: Any, dim: int, spec: UnitSpec) -> None:
+    """Refuse a ``[model] quadrature`` that is no rule of the cells of ``spec`` in ``dim`` dimensions."""
+    try:
+        quadrature_scheme(CELL_TYPES[dim, spec.element_order], rule)
+    except SettingsError as exc:
+        raise SearchConfigError(f"[model] {exc}") from None
 
 
 def unit_or_library(s: Mapping[str, Any]) -> tuple[UnitSpec | None, UnitLibrary | None]:

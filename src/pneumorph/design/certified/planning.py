@@ -51,7 +51,8 @@ from pneumorph.models.chain.sources import (
 )
 
 #: the model settings `pneumorph chain build` takes as options (the command of a missing table names them)
-_BUILD_OPTIONS = {"fidelity": "--model", "pressure_kpa": "--pressure", "unit_file": "--unit", "library": "--library"}
+_BUILD_OPTIONS = {"fidelity": "--model", "pressure_kpa": "--pressure", "unit_file": "--unit", "library": "--library",
+                  "quadrature": "--quadrature"}
 
 
 @dataclass(frozen=True)
@@ -254,6 +255,8 @@ def build_command(settings: dict[str, Any], out: Path) -> str | None:
 
     >>> build_command({"fidelity": "3d", "pressure_kpa": 25.0}, Path("t/chain.json"))
     'pneumorph chain build --model 3d --pressure 25 --out t/chain.json'
+    >>> build_command({"fidelity": "3d", "quadrature": "reduced"}, Path("t.json"))
+    'pneumorph chain build --model 3d --quadrature reduced --out t.json'
     >>> build_command({"fidelity": "2d", "increments": 20}, Path("t.json")) is None
     True
     """

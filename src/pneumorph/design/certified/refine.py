@@ -117,7 +117,7 @@ def mesh_note(model: Any, objective: Any, values: dict[str, float], winner: str,
         return None
     described = study.get("provenance", {}).get("model", {})
     mine = model.describe()
-    keys = ("fidelity", "unit", "n_units", "materials", "pressure_mpa", "library")
+    keys = ("fidelity", "unit", "n_units", "materials", "pressure_mpa", "library", "quadrature")
     if any(described.get(k) != mine.get(k) for k in keys) or study.get("objective") != objective.label:
         return None
     by_design: dict[str, dict[float, float]] = {}

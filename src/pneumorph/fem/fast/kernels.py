@@ -301,7 +301,6 @@ def ogden_3d(
     )
     lnJ = np.log(J)
     lnc = [np.log(ca) - lnJ / 1.5 for ca in c]  # ln of c_a J^(-2/3)
-    Jn = [np.exp((-a / 3.0) * lnJ) for a in alpha_]
     lb = [[np.exp((0.5 * a) * lnc[b]) for b in range(3)] for a in alpha_]  # lb[n][b]
     m = [(lb_n[0] + lb_n[1] + lb_n[2]) / 3.0 for lb_n in lb]
     J13 = np.exp(lnJ / 3.0)
@@ -314,6 +313,7 @@ def ogden_3d(
     P = S[0] * G[0][0] + S[1] * G[1][1] + S[2] * G[2][2]
     if not tangent:
         return P, None, J
+    Jn = [np.exp((-a / 3.0) * lnJ) for a in alpha_]  # J^(-alpha/3): the tangent's only (a residual skips them)
     for a, b in ((0, 1), (0, 2), (1, 2), (1, 0), (2, 0), (2, 1)):
         G[a][b] = f[a][:, None] * Nv[b][None, :]
     dh = bulk * (2.0 * J13 * J13 - J13)

@@ -269,7 +269,8 @@ class SolidSystem3D(FastSystem):
             A += geometric_blocks(cof, detF, p, _UPPER)
         dtype = self.tangent_dtype
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
-        Ap = (A * s.dV.reshape(-1)).transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
+        A *= s.dV.reshape(-1)  # in place: the kernel's own array, tens of MB
+        Ap = A.transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
         key = f"blocks-{np.dtype(dtype).name}"
         if key not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
             s.layouts[key] = np.empty((c, n, 6, n), dtype=dtype)

@@ -133,15 +133,30 @@ def source_key(model: Any) -> str:
     return digest(source_description(model))
 
 
+def fitted_quadrature(table: ChainTable) -> str:
+    """The quadrature rule of the FE model ``table`` was fitted to (:data:`pneumorph.fem.body.QUADRATURES`).
+
+    A model's description names a rule other than the full one (``"full"`` is left out, so
+    that the tables fitted before the rule was a setting keep their keys); the rule is part
+    of the source key, so a table is served only with the model at its rule.
+
+    >>> from pneumorph.models.chain.sources import shipped_path
+    >>> fitted_quadrature(ChainTable.load(shipped_path("3d")))
+    'full'
+    """
+    return str(table.source.get("description", {}).get("quadrature", "full"))
+
+
 def check_source(table: ChainTable, model: Any) -> None:
-    """Refuse a table fitted to another model (unit, materials, ramp or fidelity)."""
+    """Refuse a table fitted to another model (unit, materials, ramp, fidelity or quadrature rule)."""
     key = source_key(model)
     if table.source.get("key") != key:
         theirs = table.source.get("fidelity", "?")
+        rule, mine = fitted_quadrature(table), getattr(model, "quadrature", "full")
         raise ChainTableError(
-            f"the chain table was fitted to another model ({theirs}, source {table.source.get('key')}) than the "
-            f"one asked for ({getattr(model, 'fidelity', '?')}, source {key}); rebuild it for this unit and model "
-            "with `pneumorph chain build`"
+            f"the chain table was fitted to another model ({theirs}, {rule} quadrature, source "
+            f"{table.source.get('key')}) than the one asked for ({getattr(model, 'fidelity', '?')}, {mine} "
+            f"quadrature, source {key}); rebuild it for this unit and model with `pneumorph chain build`"
         )
 
 
@@ -180,7 +195,8 @@ class ChainModel:
 
     def describe(self) -> dict[str, Any]:
         return {"fidelity": self.fidelity, "n_units": self.n_units, "window": self.table.window,
-                "table": self.table.fingerprint(), "source": self.table.source.get("key")}
+                "table": self.table.fingerprint(), "source": self.table.source.get("key"),
+                "quadrature": fitted_quadrature(self.table)}
 
     def pressures(self) -> FloatArray:
         return self.table.pressures.copy()

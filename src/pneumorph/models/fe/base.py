@@ -25,7 +25,7 @@ import numpy as np
 from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
-from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
+from pneumorph.fem.body import QUADRATURES, PressurisedBody, check_backend, pressurised_body, quadrature_scheme
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -42,6 +42,9 @@ from pneumorph.models.fe.stages import before_the_ramp
 from pneumorph.models.fe.volumetric import FORMULATIONS, element_volume
 from pneumorph.models.frames import record_frames
 from pneumorph.models.response import FloatArray, Response
+
+#: The cells of a model's meshes by dimension and element order (:attr:`UnitSpec.element_order`).
+CELL_TYPES = {(2, 1): "quad", (2, 2): "quad8", (3, 1): "hexahedron", (3, 2): "hexahedron20"}
 
 #: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
 MODEL_REVISION = 1
@@ -123,16 +126,19 @@ class FEModel:
         filler: FillerLaw | None = None, backend: str | None = None, gravity: str | Sequence[float] | None = None,
         temperature_change: float = 0.0, passage: float = 0.0, base_block: BaseBlock | None = None,
         materials: Mapping[str, Material] | None = None, library: UnitLibrary | None = None,
-        formulation: str = "auto", obstacles: Sequence[Any] | None = None,
+        formulation: str = "auto", obstacles: Sequence[Any] | None = None, quadrature: str = "full",
     ) -> None:
         self.backend = check_backend(backend or self.backends[0], self.backends)
         self.obstacles = check_obstacles(obstacles, self.dim)  # rigid, against the outer surface (fast backend)
         if self.obstacles and self.backend != "fast":
             raise SettingsError("contact with obstacles is solved by the fast backend only (the default)")
         self.formulation = checks.text(formulation, "formulation", FORMULATIONS)
+        self.quadrature = checks.text(quadrature, "quadrature", QUADRATURES)
         self.n_units = checks.integer(n_units, "n_units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
         self.library = model_library(unit, library)
         self.unit = self.library[self.library.default]
+        for order in {spec.element_order for spec in self.library.units}:  # a rule of the model's cells
+            quadrature_scheme(CELL_TYPES[self.dim, order], self.quadrature)
         if all(spec.solid for spec in self.library.units):
             raise SettingsError("every unit type is solid (solid = true: no cavity), so there is nothing to "
                                 "inflate; a solid unit joins units with a cavity in a library (docs/unit-library.md)")
@@ -188,7 +194,8 @@ class FEModel:
         out: dict[str, Any] = {"n_units": self.n_units, "unit": self.unit, "ramp_spec": self.ramp,
                                "backend": self.backend, "gravity": None if self.gravity is None else list(self.gravity),
                                "base_block": self.base_block, "materials": dict(self.materials),
-                               "formulation": self.formulation, "obstacles": self.obstacles}
+                               "formulation": self.formulation, "obstacles": self.obstacles,
+                               "quadrature": self.quadrature}
         if not self.library.is_single:
             out["library"] = self.library
         return out
@@ -247,6 +254,8 @@ class FEModel:
             out["formulation"] = self.formulation
         if self.obstacles:  # likewise
             out["obstacles"] = [o.to_dict() for o in self.obstacles]
+        if self.quadrature != "full":  # likewise: a chain table's source names the rule it was fitted at
+            out["quadrature"] = self.quadrature
         return out
 
     def with_units(self, n_units: int) -> FEModel:
@@ -348,7 +357,7 @@ class FEModel:
             densities = {name: material.density.value for name, material in silicones.items()}
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, [*regions, *extra], mesh.cavity_points,
                                 mesh.base_points, mesh.symmetry_points, walls_of=list(silicones),
-                                densities=densities)
+                                densities=densities, quadrature=self.quadrature)
         body.contacts = contact_items(self.obstacles, mesh, self.body.shear_modulus)
 
         def set_pressure(p: float) -> None:
@@ -475,6 +484,7 @@ class FEModel:
             wall_time_s=time.perf_counter() - t0,
             dofs=dofs,
             backend=self.backend,
+            quadrature=self.quadrature,
             pneumorph=__version__,
         )
         return replace(response, converged=True, reached=float(response.pressures[-1]), metadata=meta)

@@ -89,9 +89,10 @@ class Full3D(FEModel):
         backend: str | None = None, gravity: str | Sequence[float] | None = None, temperature_change: float = 0.0,
         passage: float = 0.0, base_block: BaseBlock | None = None, materials: Mapping[str, Material] | None = None,
         library: UnitLibrary | None = None, formulation: str = "auto", obstacles: Sequence[Any] | None = None,
+        quadrature: str = "full",
     ) -> None:
         super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block,
-                         materials, library, formulation, obstacles)
+                         materials, library, formulation, obstacles, quadrature)
         self.half = bool(half)
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "

@@ -56,6 +56,12 @@ class Reduced2D(FEModel):
         Rigid obstacles (frictionless, or with Coulomb ``friction``) against the outer surface, as
         ``[[model.obstacle]]`` tables (:mod:`pneumorph.models.fe.obstacles`): each level's forces on
         them and the base reaction go to the response's ``metadata["contact"]``. Default none.
+    quadrature : {"full", "reduced", "irons"}
+        The quadrature rule of the quadratic cells (:func:`pneumorph.fem.body.quadrature_scheme`):
+        ``"full"`` (default; 9 points per quad8, 27 per hex20), ``"reduced"`` (4 and 8 points) or,
+        in 3D, ``"irons"`` (14 points). A rule other than the full one is part of the
+        fingerprint, so that a chain table fitted at one rule is served with the model at
+        that rule.
 
     A library or unit with a sideways unit (``layer_side``) is refused: it bends out of the
     section's plane (:class:`~pneumorph.models.fe.full3d.Full3D` solves it).
@@ -90,6 +96,7 @@ class Reduced2D(FEModel):
         library: UnitLibrary | None = None,
         formulation: str = "auto",
         obstacles: Sequence[Any] | None = None,
+        quadrature: str = "full",
     ) -> None:
         lib = model_library(unit, library)
         sideways = [s for s, spec in zip(lib.symbols, lib.units, strict=True) if spec.layer_side]
@@ -100,7 +107,7 @@ class Reduced2D(FEModel):
         first = lib[lib.default]
         super().__init__(n_units, unit, ramp_spec, filler or first.filler_law() or get_filler(), backend, gravity,
                          base_block=base_block, materials=materials, library=library, formulation=formulation,
-                         obstacles=obstacles)
+                         obstacles=obstacles, quadrature=quadrature)
         # (a temperature change is a 3D model option: the 2D model's filler has no expansion of its own)
         assert self.filler is not None
         #: the filler law of every unit type: the given one for all, else each unit's calibrated law, else
