@@ -2,9 +2,9 @@
 
 Runs the command in this process (as the console script does) and splits its CPU time into
 the imports of the command line, the model's set-up (mesh, FE objects, the fast system's
-pattern, up to the first Newton iteration; with the first imports of FElupe and MKL), the solve of every reported level (Newton
-iterations, factorisations, cut-backs, CPU) and the writing (response, VTK series, shape
-figure). One thread, as a search worker runs:
+pattern, up to the first Newton iteration; with the first imports of FElupe and MKL), the
+solve of every reported level (Newton iterations, factorisations, cut-backs, CPU) and the
+writing (response, VTK series, shape figure). One thread, as a search worker runs:
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/fe_phases.py -o 011100110010010
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/fe_phases.py -o 000000000000000 --no-write
