@@ -182,8 +182,6 @@ class UnitSpec:
     left out of :meth:`to_dict` while they hold their default, so the description of every
     earlier unit, and the fingerprints of models and chain tables built on it, stay the same.
 
-    Notes
-    -----
     The defaults are the unit of the geometry study (``docs/unit-geometry.md``): 3 mm end
     walls and a 6 mm high cavity make 15 aligned units curl about 300 degrees at 45 kPa in
     3D, where the closed 1.5 mm-walled 7.5 x 12 mm cavity balloons instead of bending.
