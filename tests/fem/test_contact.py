@@ -52,6 +52,17 @@ def _fd_check(system: object, u: np.ndarray, h: float = 1e-7) -> float:
     return float(np.abs(K - fd).max() / np.abs(K).max())
 
 
+def _stick_and_slide(contact: RigidContact, obstacle: object, x: np.ndarray, nodes: np.ndarray) -> None:
+    """Anchors a little off the nodes at ``x``: some nodes in contact stick, the others slide (friction 0.5)."""
+    contact.anchors = x[nodes] + np.random.default_rng(1).normal(0.0, 0.3, (len(nodes), x.shape[1]))
+    force, active = contact.forces(x)
+    n = obstacle.kinematics(x[nodes])[1]  # type: ignore[attr-defined]
+    normal = np.einsum("ai,ai->a", force, n)
+    along = np.linalg.norm(force - normal[:, None] * n, axis=1)
+    sliding = active & np.isclose(along, 0.5 * np.abs(normal), rtol=1e-9)
+    assert np.any(sliding) and np.any(active & ~sliding)
+
+
 @pytest.mark.parametrize("obstacle", [Plane((3.75, 0.0), (-0.8, -0.6)), Cylinder((4.6, 1.0), 0.9),
                                       Sphere((4.6, 1.0), 0.9)], ids=["plane", "circle", "sphere"])
 @pytest.mark.parametrize("smoothing", [0.0, 0.2])
@@ -93,13 +104,7 @@ def test_friction_tangent_is_the_residuals_derivative(obstacle: object) -> None:
     u = np.zeros(system.ndof)
     u[0::2] = 0.05 * points[:, 0]
     x = points + u.reshape(-1, 2)
-    contact.anchors = x[nodes] + np.random.default_rng(1).normal(0.0, 0.3, (len(nodes), 2))
-    force, active = contact.forces(x)
-    n = obstacle.kinematics(x[nodes])[1]
-    normal = np.einsum("ai,ai->a", force, n)
-    along = np.linalg.norm(force - normal[:, None] * n, axis=1)
-    sliding = active & np.isclose(along, 0.5 * np.abs(normal), rtol=1e-9)
-    assert np.any(sliding) and np.any(active & ~sliding)
+    _stick_and_slide(contact, obstacle, x, nodes)
     assert _fd_check(system, u) < 1e-5
 
 
@@ -118,13 +123,7 @@ def test_friction_tangent_is_the_residuals_derivative_3d(obstacle: object) -> No
     u = np.zeros(system.ndof)
     u[0::3] = 0.05 * points[:, 0]
     x = points + u.reshape(-1, 3)
-    contact.anchors = x[nodes] + np.random.default_rng(1).normal(0.0, 0.3, (len(nodes), 3))
-    force, active = contact.forces(x)
-    n = obstacle.kinematics(x[nodes])[1]
-    normal = np.einsum("ai,ai->a", force, n)
-    along = np.linalg.norm(force - normal[:, None] * n, axis=1)
-    sliding = active & np.isclose(along, 0.5 * np.abs(normal), rtol=1e-9)
-    assert np.any(sliding) and np.any(active & ~sliding)
+    _stick_and_slide(contact, obstacle, x, nodes)
     assert _fd_check(system, u) < 1e-5
     system.residual(u)
     upper = system.tangent_data()
