@@ -119,11 +119,11 @@ def _check_out(out: str) -> None:
     """Refuse an output folder that holds an earlier identification, before anything is read or solved."""
     from pathlib import Path
 
-    from pneumorph.errors import OutputPathError
+    from pneumorph.errors import RunFolderError
 
     held = [name for name in ("identified.toml", "identify.json") if (Path(out) / name).exists()]
     if held:
-        raise OutputPathError(f"--out {out} holds an earlier identification ({', '.join(held)}); give another "
+        raise RunFolderError(f"--out {out} holds an earlier identification ({', '.join(held)}); give another "
                               "folder or replace it with --overwrite")
 
 
