@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.bench.query import QueryError
+from pneumorph.bench.samples import centrelines
 from pneumorph.errors import SettingsError, SimulationFailed
 from pneumorph.fem.fast.contact import Cylinder, obstacle_from_dict
 from pneumorph.models.fe.obstacles import check_reach
@@ -100,11 +101,10 @@ def contact_answer(model: Any, design: str, circle: tuple[float, float, float]) 
         out["failure"] = str(exc.cause or exc)[:300]
         return out
     response = solution.response
-    axis = float(response.reference_tip[1])
+    lines = centrelines(response)  # base, unit centres and tip per level, as a path is matched
     for k, level in enumerate(response.metadata["contact"]["levels"]):
         touch = level["obstacles"][0]
         x = solution.mesh.points[touch["nodes_in_contact"]] + solution.displacements[k][touch["nodes_in_contact"]]
-        line = np.vstack([[0.0, axis], response.centres[k], response.tip[k]])
         out["levels"].append({
             "pressure_kpa": round(float(level["pressure_kpa"]), 9),
             "force_n": touch["force_n"], "force_magnitude_n": touch["force_magnitude_n"],
@@ -112,7 +112,7 @@ def contact_answer(model: Any, design: str, circle: tuple[float, float, float]) 
             "base_reaction_n": level["base_reaction_n"],
             "points": np.round(x, DECIMALS).tolist(),
             "node_pressures_kpa": np.round(touch["node_pressures_kpa"], DECIMALS).tolist(),
-            "centreline": np.round(line, DECIMALS).tolist(),
+            "centreline": lines[k],
         })
     return out
 
