@@ -179,6 +179,47 @@ class SimulationFailed(PneumorphError, RuntimeError):
         super().__init__(f"{what}simulation failed, {where}: {cause}")
 
 
+class LimitPointError(SimulationFailed):
+    """A load ramp stopped because its monitored quantity fell under a larger load: a limit point.
+
+    Along a stable, rising pressure ramp the cavity volume (the work-conjugate of the pressure)
+    cannot fall; a substep that converges to a smaller one has passed a maximum of the load the
+    body holds, which no load-controlled ramp can follow. The ramp raises this kind of failure
+    (the last cut-back still fell), so that a model can say what it means in its own terms.
+
+    Parameters
+    ----------
+    reached : float
+        The last converged load factor.
+    cause : str
+        Why it stopped, as :class:`SimulationFailed` says it.
+    design, pressure, partial : optional
+        As :class:`SimulationFailed`.
+    before, after : float
+        The monitored quantity at the last converged state and at the substep that fell.
+    tried : float
+        The load factor of the last substep tried.
+    cutbacks : int
+        The cut-backs allowed per substep (all used).
+
+    Examples
+    --------
+    >>> exc = LimitPointError(0.5, "the monitored quantity fell", before=10.0, after=9.9, tried=0.52, cutbacks=6)
+    >>> isinstance(exc, SimulationFailed), exc.before - exc.after
+    (True, 0.09999999999999964)
+    """
+
+    def __init__(
+        self, reached: float, cause: str, design: str | None = None, pressure: float | None = None,
+        partial: object = None, *, before: float, after: float, tried: float, cutbacks: int,
+    ) -> None:
+        self.before = before
+        self.after = after
+        self.tried = tried
+        self.cutbacks = cutbacks
+        super().__init__(reached, cause, design=design, pressure=pressure, partial=partial)
+
+
 class UnknownDatasetError(UnknownNameError):
     """A name that is neither a readable data file nor a bundled test-data set."""
 

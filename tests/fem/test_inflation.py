@@ -15,7 +15,7 @@ import felupe as fem
 import numpy as np
 import pytest
 
-from pneumorph.errors import SimulationFailed
+from pneumorph.errors import LimitPointError, SimulationFailed
 from pneumorph.fem import StepSettings, cavity_volume, ramp
 
 MU = 0.1  # MPa
@@ -134,6 +134,8 @@ def test_pressure_control_stops_at_the_limit_point_of_a_thin_sphere() -> None:
     reached_pressure = info.value.reached * 0.07 * MU
     assert 0.060 * MU <= reached_pressure <= 0.0636 * MU * 1.002
     assert "cut-backs" in str(info.value)
+    # the kind of failure: the cavity volume fell under the higher pressure, a limit point, not a failed solve
+    assert isinstance(info.value, LimitPointError) and info.value.after < info.value.before
 
 
 def test_enforced_displacement_ramp_matches_the_closed_form() -> None:

@@ -10,7 +10,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import pytest
 
+from pneumorph.errors import LimitPointError, SimulationFailed
 from pneumorph.fem import StepSettings, ramp
 
 
@@ -72,3 +74,45 @@ def test_without_carry_every_level_starts_at_the_nominal_substep() -> None:
     assert late[:3] == [(0.8, 0.9, False), (0.8, 0.85, True), (0.85, 0.9, True)]
     assert len(set(hard.attempts)) == len(hard.attempts)
     assert (stats.substeps, stats.cutbacks, stats.reached) == (14, 4, 1.0)
+
+
+class _Peaked:
+    """Converges everywhere; the monitored quantity -(t - 0.53)^2 peaks at t = 0.53, like the cavity volume of a
+    body that passes a pressure maximum."""
+
+    def __init__(self) -> None:
+        self.t_try = 0.0
+
+    def apply(self, t: float) -> None:
+        self.t_try = t
+
+    def monitor(self) -> float:
+        return -((self.t_try - 0.53) ** 2)
+
+    def __call__(self, fields: Any, settings: StepSettings) -> tuple[int, str | None]:
+        return 1, None
+
+
+def test_a_monitor_that_falls_past_every_cut_back_stops_the_ramp_as_a_limit_point() -> None:
+    """From 0.55 every trial of the level to 0.6, halved six times down to 0.5508, lands past the peak: the ramp
+    raises the limit-point kind of failure with the monitored values, the factor tried and the cut-backs."""
+    peaked = _Peaked()
+    with pytest.raises(LimitPointError) as info:
+        ramp([], _Fields(), peaked.apply, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+             StepSettings(increments=10, substeps=1), substep=peaked, monitor=peaked.monitor)
+    failure = info.value
+    assert failure.reached == pytest.approx(0.55) and failure.tried == pytest.approx(0.55 + 0.05 / 64)
+    assert failure.before == pytest.approx(-0.02**2) and failure.after == pytest.approx(-(0.02 + 0.05 / 64) ** 2)
+    assert failure.cutbacks == 6 and failure.after < failure.before
+
+
+def test_a_substep_that_fails_to_converge_is_not_a_limit_point() -> None:
+    """A ramp whose Newton solves fail (the monitor never consulted) stops with the plain failure, not the kind a
+    model explains as a pressure maximum."""
+    def failing(fields: Any, settings: StepSettings) -> tuple[int, str | None]:
+        return 16, "Newton iterations did not reach the tolerance"
+
+    with pytest.raises(SimulationFailed) as info:
+        ramp([], _Fields(), lambda t: None, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+             StepSettings(increments=10, substeps=1), substep=failing, monitor=lambda: 1.0)
+    assert not isinstance(info.value, LimitPointError) and info.value.reached == 0.0

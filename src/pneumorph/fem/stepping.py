@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph import checks
-from pneumorph.errors import SimulationFailed
+from pneumorph.errors import LimitPointError, SimulationFailed
 
 
 @dataclass(frozen=True)
@@ -236,6 +236,18 @@ def _restore(fields: Any, values: Sequence[NDArray[np.float64]]) -> None:
         f.values[:] = v
 
 
+def _failure(t_now: float, t_try: float, cutbacks: int, cause: str,
+             fell: tuple[float, float] | None) -> SimulationFailed:
+    """The failure of a ramp whose last cut-back failed too: a limit point if ``fell`` (the monitored values
+    before and after), the kind a model explains in its own terms; else the plain failure."""
+    first = (f"; it failed on the first load step, cut to {t_try:.3g} of the full load: not the size "
+             "of the load but the model or the solver settings") if t_now == 0.0 else ""
+    why = f"no convergence at load factor {t_try:.4g} after {cutbacks} cut-backs ({cause}){first}"
+    if fell is not None:
+        return LimitPointError(reached=t_now, cause=why, before=fell[0], after=fell[1], tried=t_try, cutbacks=cutbacks)
+    return SimulationFailed(reached=t_now, cause=why)
+
+
 def ramp(
     items: Sequence[Any],
     fields: Any,
@@ -306,7 +318,9 @@ def ramp(
     ------
     SimulationFailed
         If a substep still fails after ``max_cutbacks`` halvings; ``reached`` is the last
-        converged load factor and the fields hold that state.
+        converged load factor and the fields hold that state. Its subclass
+        :class:`~pneumorph.errors.LimitPointError` when the last halving converged but the
+        ``monitor`` fell: a limit point of the load, with the monitored values.
     """
     strategy = substep or FElupeSubstep(items, dof1, dof0, solver, check)
     stats = RampStatistics()
@@ -329,10 +343,11 @@ def ramp(
             apply(t_try)
             iterations, cause = strategy(fields, settings)
             stats.newton_iterations += iterations
-            value = watched
+            value, fell = watched, False
             if cause is None and monitor is not None:
                 value = monitor()
-                if value < watched:
+                fell = value < watched
+                if fell:
                     cause = f"the monitored quantity fell from {watched:.6g} to {value:.6g}"
             if cause is None:
                 watched = value
@@ -354,13 +369,7 @@ def ramp(
             stats.cutbacks += 1
             if cutbacks_here > settings.max_cutbacks:
                 stats.reached = t_now
-                first = (f"; it failed on the first load step, cut to {t_try:.3g} of the full load: not the size "
-                         "of the load but the model or the solver settings") if t_now == 0.0 else ""
-                raise SimulationFailed(
-                    reached=t_now,
-                    cause=f"no convergence at load factor {t_try:.4g} after "
-                    f"{settings.max_cutbacks} cut-backs ({cause}){first}",
-                )
+                raise _failure(t_now, t_try, settings.max_cutbacks, str(cause), (watched, value) if fell else None)
             dt = (t_try - t_now) / 2.0  # the step that failed, halved (dt may reach past the level)
         stats.reached = t_now
         if on_level is not None:

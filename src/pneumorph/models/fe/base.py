@@ -451,7 +451,7 @@ class FEModel:
                          carry=self.carry_step)
         except SimulationFailed as exc:
             reached = exc.reached if control is None else control.factor
-            cause = exc.cause if control is not None else past_the_maximum(exc.cause)
+            cause = exc.cause if control is not None else past_the_maximum(exc)
             partial = replace(response, converged=False, reached=reached * self.ramp.pressure, failure=cause)
             raise SimulationFailed(
                 reached=exc.reached, cause=cause, design=design, pressure=self.ramp.pressure, partial=partial

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from pneumorph import checks
+from pneumorph.errors import LimitPointError, SimulationFailed
 from pneumorph.fem import StepSettings
 from pneumorph.models.response import FloatArray
 
@@ -40,37 +41,33 @@ class RampSpec:
         return self.pressure * self.steps.levels()
 
 
-#: what the pressure ramp's monitor (:meth:`~pneumorph.fem.body.PressurisedBody.stepper`: the cavity volume) says
-#: when a higher pressure gave a smaller volume
-_MONITOR_FELL = "the monitored quantity fell"
+def past_the_maximum(failure: SimulationFailed) -> str:
+    """A pressure ramp's failure cause, said in the model's terms where it stopped at a limit point.
 
-
-def past_the_maximum(cause: str) -> str:
-    """A pressure ramp's failure cause, said in the model's terms where the cavity volume fell under more pressure.
-
-    A smaller cavity at a higher pressure marks the approach of a pressure maximum: the walls
-    balloon and the pressure an actuator holds levels off or falls as it inflates further (Ellis
-    2020, 3.3.4), which no pressure-controlled ramp can pass; a volume-controlled one can. (A 4-unit
-    2D actuator of Ecoflex 00-30 stops at 26 kPa; volume-controlled to 5 V0 its pressure creeps
-    from 22 to 23.6 kPa over the last 2 V0.)
+    The ramp's monitor is the cavity volume
+    (:meth:`~pneumorph.fem.body.PressurisedBody.stepper`); a smaller cavity at a higher pressure
+    (:class:`~pneumorph.errors.LimitPointError`) marks the approach of a pressure maximum: the
+    walls balloon and the pressure an actuator holds levels off or falls as it inflates further
+    (Ellis 2020, 3.3.4), which no pressure-controlled ramp can pass; a volume-controlled one can. (A
+    4-unit 2D actuator of Ecoflex 00-30 stops at 26 kPa; volume-controlled to 5 V0 its pressure
+    creeps from 22 to 23.6 kPa over the last 2 V0.) Any other failure keeps its cause.
 
     Examples
     --------
-    >>> print(past_the_maximum("no convergence at load factor 0.58 (the monitored quantity fell from 5976.5 to "
-    ...                        "5976.48)"))
-    no convergence at load factor 0.58 (the cavity volume fell from 5976.5 to 5976.48 mm^3 under a higher pressure:
-    near a pressure maximum, where the walls balloon; a volume-controlled ramp can follow past it: simulate
-    --volume-change, or [model] volume_change)
-    >>> past_the_maximum("no convergence (det F <= 0)")
+    >>> fell = LimitPointError(0.56, "no convergence", before=5976.5, after=5976.48, tried=0.58, cutbacks=6)
+    >>> print(past_the_maximum(fell))
+    no convergence at load factor 0.58 after 6 cut-backs (the cavity volume fell from 5976.5 to 5976.48 mm^3 under a
+    higher pressure: near a pressure maximum, where the walls balloon; a volume-controlled ramp can follow past it:
+    simulate --volume-change, or [model] volume_change)
+    >>> past_the_maximum(SimulationFailed(0.3, "no convergence (det F <= 0)"))
     'no convergence (det F <= 0)'
     """
-    if _MONITOR_FELL not in cause:
-        return cause
-    head, _, tail = cause.partition(_MONITOR_FELL)
-    numbers, _, rest = tail.partition(")")
-    return (f"{head}the cavity volume fell{numbers} mm^3 under a higher pressure: near a pressure maximum, where the "
-            f"walls balloon; a volume-controlled ramp can follow past it: simulate --volume-change, or [model] "
-            f"volume_change){rest}")
+    if not isinstance(failure, LimitPointError):
+        return failure.cause
+    return (f"no convergence at load factor {failure.tried:.4g} after {failure.cutbacks} cut-backs (the cavity volume "
+            f"fell from {failure.before:.6g} to {failure.after:.6g} mm^3 under a higher pressure: near a pressure "
+            "maximum, where the walls balloon; a volume-controlled ramp can follow past it: simulate --volume-change, "
+            "or [model] volume_change)")
 
 
 __all__ = ["RampSpec", "past_the_maximum"]
