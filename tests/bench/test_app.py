@@ -256,7 +256,7 @@ def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient
         r = client.post("/api/jobs/table", files={"unit": ("u.toml", content)}, data={"model": model})
         return {"status": r.status_code, **r.json()}
 
-    for content, words in [(b"\xff\xfe", "UTF-8"), (b"[unit\n", "TOML"), (b"pitch = 1\n", "[unit] table"),
+    for content, words in [(b"\xff\xff", "not UTF-8 text: byte 0xff at line 1, column 1"), (b"[unit\n", "TOML"), (b"pitch = 1\n", "[unit] table"),
                            (b"[unit]\nflux = 1\n", "unknown unit parameter"), (b"[unit]\npitch = -1\n", "pitch"),
                            (b"#" * (65 * 1024), "at most 64 kB")]:
         r = upload(content)
@@ -269,6 +269,29 @@ def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient
     assert job["result"]["unit_id"] == "builtin" and job["result"]["window"] >= 1
     assert job["result"]["centre_worst_mm"] < 0.2  # the table's held-out tolerance (docs/chain-model.md)
     assert client.post("/api/design", json={**SIN, "unit": "u0123"}).json()["error"]["field"] == "unit"
+
+
+def test_a_byte_order_mark_before_an_upload_reads_as_without(client: TestClient) -> None:
+    """An editor's UTF-8 byte-order mark before a unit file or a request's JSON is not part of it: the same unit,
+    the same answer."""
+    import json
+
+    from pneumorph.bench.app import read_unit
+    from pneumorph.bench.query import load_json
+    from pneumorph.design.config import to_toml
+    from pneumorph.geometry.unit import UnitSpec
+
+    unit = to_toml({"unit": {**UnitSpec().to_dict(), "pitch": 7.5}}).encode()
+    assert read_unit(b"\xef\xbb\xbf" + unit) == read_unit(unit) and read_unit(unit).pitch == 7.5
+    text = json.dumps(SIN)
+    assert load_json("\ufeff" + text) == load_json(text.encode()) == SIN
+    plain = client.post("/api/design", content=text.encode(), headers={"Content-Type": "application/json"})
+    marked = client.post("/api/design", content=b"\xef\xbb\xbf" + text.encode(),
+                         headers={"Content-Type": "application/json"})
+    assert plain.status_code == marked.status_code == 200
+    timing = {"elapsed_ms", "memo"}  # how the answer was served, not what it is (the second from the memo)
+    assert {k: v for k, v in marked.json().items() if k not in timing} == \
+        {k: v for k, v in plain.json().items() if k not in timing}
 
 
 def test_export_zips_the_parts_the_mould_and_the_deck(client: TestClient) -> None:

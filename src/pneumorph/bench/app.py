@@ -40,11 +40,12 @@ from pneumorph.bench.query import MODELS, Query, QueryError, choice, load_json
 from pneumorph.bench.schema import describe
 from pneumorph.design.objectives.paths import PATH_PRESETS
 from pneumorph.design.objectives.targets import PRESETS, TIP_GOALS
-from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, StateQuotaError
+from pneumorph.errors import BodyTooLargeError, JobLimitError, PneumorphError, SettingsError, StateQuotaError
 from pneumorph.geometry.limits import MeshLimitError, check_manufacturable
 from pneumorph.geometry.meshsize import check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import json_safe
+from pneumorph.io.reading import decode_text
 
 
 def read_unit(raw: bytes) -> UnitSpec:
@@ -60,10 +61,10 @@ def read_unit(raw: bytes) -> UnitSpec:
 
     if len(raw) > MAX_UNIT_FILE:
         raise QueryError("unit", f"a unit file is at most {MAX_UNIT_FILE // 1024} kB")
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise QueryError("unit", "the unit file is not UTF-8 text") from None
+    try:  # the one decoder of a user's text: a byte-order mark (an editor's UTF-8 one) read as the file's encoding
+        data = tomllib.loads(decode_text(raw, "the unit file"))
+    except SettingsError as exc:
+        raise QueryError("unit", str(exc)) from None
     except tomllib.TOMLDecodeError as exc:
         raise QueryError("unit", f"the unit file is not valid TOML: {exc}") from None
     except RecursionError:

@@ -172,11 +172,15 @@ def load_json(raw: bytes | str, field: str = "target") -> Any:
     {'top': 3, 'a': [1.5]}
     >>> load_json("1" * 400)
     inf
+    >>> load_json("\\ufeff[1]"), load_json(b"\\xef\\xbb\\xbf[1]")  # a byte-order mark is not part of the value
+    ([1], [1])
     >>> load_json("[" * 40 + "]" * 40)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     pneumorph.bench.query.QueryError: the request is nested deeper than 32 levels
     """
+    if isinstance(raw, str):  # json reads a byte-order mark off bytes, not off text
+        raw = raw.removeprefix("\ufeff")
     try:
         data = json.loads(raw or b"null", parse_int=lambda t: int(t) if len(t) <= MAX_INT_DIGITS else float(t))
     except RecursionError:
