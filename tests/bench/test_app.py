@@ -256,7 +256,8 @@ def test_units_can_be_uploaded_and_bad_unit_files_are_refused(client: TestClient
         r = client.post("/api/jobs/table", files={"unit": ("u.toml", content)}, data={"model": model})
         return {"status": r.status_code, **r.json()}
 
-    for content, words in [(b"\xff\xff", "not UTF-8 text: byte 0xff at line 1, column 1"), (b"[unit\n", "TOML"), (b"pitch = 1\n", "[unit] table"),
+    for content, words in [(b"\xff\xff", "not UTF-8 text: byte 0xff at line 1, column 1"), (b"[unit\n", "TOML"),
+                           (b"pitch = 1\n", "[unit] table"),
                            (b"[unit]\nflux = 1\n", "unknown unit parameter"), (b"[unit]\npitch = -1\n", "pitch"),
                            (b"#" * (65 * 1024), "at most 64 kB")]:
         r = upload(content)
