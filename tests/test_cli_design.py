@@ -121,7 +121,7 @@ def test_certified_design_refuses_bad_tables_before_writing(tmp_path: Path, caps
     bad.write_text('{"kind": "pneumorph chain table", "format": 1, "window": 2')
     assert main(_certified(tmp_path, "--chain-table", str(bad))) == 2
     err = capsys.readouterr().err
-    assert "not a chain table" in err and "Traceback" not in err and len(err.strip().splitlines()) <= 2
+    assert f"chain table {bad}: not valid JSON" in err and "Traceback" not in err and len(err.strip().splitlines()) <= 2
     assert not (tmp_path / "run").exists()
     # the 3D table for the 2D model
     assert main(_certified(tmp_path, "--chain-table", str(shipped_path("3d")))) == 2

@@ -89,15 +89,32 @@ def test_path_inputs_refuse_them_in_one_line_at_once(args: list[str], kind: str,
     assert not out.exists()
 
 
-def test_a_chain_table_nested_too_deep_is_refused_in_one_line(tmp_path: Path,
+@pytest.mark.parametrize("levels", [33, 100_000])
+def test_a_chain_table_nested_too_deep_is_refused_in_one_line(levels: int, tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """Through the one bounded JSON reader: past MAX_JSON_DEPTH (32) levels, whether Python's parser could follow
+    (33 objects) or not (100,000 arrays)."""
     deep = tmp_path / "deep.json"
-    deep.write_text("[" * 100_000 + "]" * 100_000)
+    deep.write_text('{"a": ' * levels + "1" + "}" * levels)
     out = tmp_path / "run"
     assert main(["design", "--chain-table", str(deep), "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
-    assert "nests too deep" in err and len(err.splitlines()) == 1 and "internal error" not in err
+    assert len(err.splitlines()) == 1 and "internal error" not in err
+    assert err.endswith(f"chain table {deep}: nested more than 32 levels deep (MAX_JSON_DEPTH)")
     assert not out.exists()
+
+
+def test_a_chain_table_past_its_size_is_refused_in_one_line(tmp_path: Path,
+                                                            capsys: pytest.CaptureFixture[str]) -> None:
+    """A sparse file of 1 GB named as the chain table (bigger than MAX_TEXT_BYTES, 64 MB): refused by its size."""
+    from pneumorph.errors import ChainTableError
+    from pneumorph.models.chain.table import ChainTable
+
+    huge = tmp_path / "huge.json"
+    with huge.open("wb") as fh:
+        fh.truncate(2**30)
+    with pytest.raises(ChainTableError, match=r"1024 MB, more than the 64 MB a chain table may have"):
+        ChainTable.load(huge)
 
 
 def test_a_scan_listed_twice_in_a_manifest_is_refused(tmp_path: Path) -> None:

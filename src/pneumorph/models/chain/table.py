@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pneumorph.errors import ChainTableError, UnitLibraryError
-from pneumorph.io.files import read_text_file
+from pneumorph.io.reading import read_json
 from pneumorph.models.chain.space import chain_frames, rotation_matrices, rotation_vectors
 from pneumorph.models.chain.tablefile import (
     ALPHABET_FORMAT,
@@ -485,13 +485,8 @@ class ChainTable:
     def _read(cls, path: Path) -> ChainTable:
         if not path.exists():
             raise ChainTableError(f"{path}: no such chain table")
-        text = read_text_file(path, "chain table", ChainTableError)  # a regular file of bounded size
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ChainTableError(f"{path}: not a chain table (unreadable JSON: {type(exc).__name__})") from None
-        except RecursionError:
-            raise ChainTableError(f"{path}: not a chain table (its JSON nests too deep)") from None
+        # the one bounded reader: a regular file of bounded size, valid JSON, nested no deeper than MAX_JSON_DEPTH
+        data = read_json(path, "chain table", ChainTableError)
         if not isinstance(data, dict):
             raise ChainTableError(f"{path}: not a chain table")
         return cls.from_dict(data, where=str(path))
