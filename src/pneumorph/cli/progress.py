@@ -41,22 +41,25 @@ def plan_solves(lines: Progress, what: str, total: int, model: Any, executor: st
     from types import SimpleNamespace
 
     from pneumorph.design.certified.planning import planned_workers
-    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
+    from pneumorph.models.chain.plan import model_seconds
 
-    each = solve_seconds(cost_fidelity(model), int(getattr(model, "n_units", 0) or 0))
+    each = model_seconds(model)
     lines.plan(what, total, each=each, workers=planned_workers(SimpleNamespace(executor=executor, workers=workers)),
                where=where, title=title)
 
 
 def solve_levels(model: Any, design: str, what: str, title: str, where: str | None = None) -> Any:
-    """Solve ``design`` on ``model``, saying the plan (its levels, estimated by its fidelity's measured solve time)
-    and counting each level as it converges; the :class:`~pneumorph.models.fe.base.Solution`."""
-    from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
+    """Solve ``design`` on ``model``, saying the plan (its levels, estimated by its fidelity's measured solve time
+    and, for a volume-controlled ramp, its measured cost) and counting each level as it converges; the
+    :class:`~pneumorph.models.fe.base.Solution`."""
+    from pneumorph.models.chain.plan import model_seconds, volume_ramp_note
 
-    each, levels = solve_seconds(cost_fidelity(model), len(design)), len(model.pressures())
+    each, levels = model_seconds(model, len(design)), len(model.pressures())
     with reporter() as lines:
         lines.plan(what, levels, each=None if each is None else each / levels, noun="levels", where=where,
                    title=title)
+        if note := volume_ramp_note(model):
+            lines.say(f"  {note}")
         return model.solve(design, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
                                                                       always=True))
 
@@ -95,10 +98,10 @@ class RunLines:
         if not self.counting:  # before the first solve: the plan, estimated by the model's measured solve time
             from pneumorph.design.certified.planning import planned_workers
             from pneumorph.design.search.exhaustive import mirror_holds
-            from pneumorph.models.chain.plan import cost_fidelity, solve_seconds
+            from pneumorph.models.chain.plan import model_seconds
 
             self.counting = True
-            each = solve_seconds(cost_fidelity(self.model), int(self.model.n_units))
+            each = model_seconds(self.model)
             mirrored = mirror_holds(self.model)
             if each is not None and mirrored:
                 each /= 2  # a solve scores a design and its mirror

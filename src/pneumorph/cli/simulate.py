@@ -82,8 +82,10 @@ def simulate(
     model = make_model(len(design), settings)
     model = _with_obstacles(model, design, bool(obstacles), blocked)
     weight = "" if gravity == "none" else f", {gravity} under gravity"
+    volume = model.ramp.volume
+    load = f"{pressure:g} kPa" if volume is None else f"the cavities' volume to {1 + volume:g} V0"
     solution = solve_levels(model, design, f"design {design}", f"simulating design {design} ({fidelity} model, "
-                            f"{len(design)} units, {pressure:g} kPa{weight})")
+                            f"{len(design)} units, {load}{weight})")
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
         _write(out, solution, meta)

@@ -56,6 +56,77 @@ def solve_seconds(fidelity: str, n_units: int) -> float | None:
     return None if per is None else per * int(n_units) / SOLVE_UNITS
 
 
+#: a volume-controlled ramp's CPU time over the pressure ramp's of the built-in unit (the figure :data:`SOLVE_SECONDS`
+#: measures), measured on a 4-unit 2D design (``benchmarks/volume_ramp.py``, BENCHMARKS.md), by how much stiffer the
+#: layer is than the body (initial shear moduli): (ratio, the factor to 0.5 V0, its growth per V0 past 0.5 V0). A body
+#: much softer than its layer balloons past 0.5 V0, where the ramp needs cut-back after cut-back (Ecoflex 00-30 in
+#: Smooth-Sil 950: 82 to 1 V0, 560 to 5 V0)
+VOLUME_RAMP_COST = ((4.06, 3.4, 0.2), (9.8, 7.3, 86.0), (25.9, 10.8, 173.0), (34.5, 9.2, 169.0))
+#: the factor of a volume-controlled ramp beyond which its plan says that it may need many cut-backs
+MANY_CUTBACKS = 20.0
+
+
+def softness(model: Any) -> float | None:
+    """How much stiffer a model's layer is than its body (the ratio of their initial shear moduli), or None for a
+    model without both.
+
+    >>> from pneumorph.models import make_model
+    >>> round(softness(make_model(4, {"fidelity": "2d"})), 2)
+    4.06
+    >>> round(softness(make_model(4, {"fidelity": "2d", "unit": {"body_material": "ecoflex_00_30"}})), 1)
+    34.5
+    """
+    body, layer = getattr(model, "body", None), getattr(model, "layer", None)
+    try:
+        return float(layer.shear_modulus) / float(body.shear_modulus)  # type: ignore[union-attr]
+    except (AttributeError, TypeError, ValueError, ZeroDivisionError):
+        return None
+
+
+def volume_ramp_factor(model: Any) -> float:
+    """A model's solve time over the pressure ramp's of the built-in unit: 1 for a pressure ramp; for a volume
+    ramp (``RampSpec.volume``, ``V / V0 - 1``) interpolated in :data:`VOLUME_RAMP_COST` by :func:`softness` (in its
+    logarithm, held at the ends): the factor to 0.5 V0 and its growth per V0 past it.
+
+    >>> from pneumorph.models import make_model
+    >>> soft = {"fidelity": "2d", "volume_change": 4.0, "unit": {"body_material": "ecoflex_00_30"}}
+    >>> volume_ramp_factor(make_model(4, {"fidelity": "2d"})), round(volume_ramp_factor(make_model(4, soft)))
+    (1.0, 601)
+    """
+    volume = getattr(getattr(model, "ramp", None), "volume", None)
+    if volume is None:
+        return 1.0
+    ratios, bases, growths = (np.log([row[k] for row in VOLUME_RAMP_COST]) if k == 0 else
+                              np.array([row[k] for row in VOLUME_RAMP_COST]) for k in range(3))
+    at = math.log(softness(model) or VOLUME_RAMP_COST[0][0])
+    base, growth = float(np.interp(at, ratios, bases)), float(np.interp(at, ratios, growths))
+    return base + growth * max(0.0, float(volume) - 0.5)
+
+
+def model_seconds(model: Any, n_units: int | None = None) -> float | None:
+    """Estimated wall time of one FE solve of ``model`` over ``n_units`` units (default its own) on one core (s):
+    :func:`solve_seconds` of its :func:`cost_fidelity`, times :func:`volume_ramp_factor`; None without a figure.
+
+    >>> from pneumorph.models import make_model
+    >>> model_seconds(make_model(15, {"fidelity": "2d"})), round(model_seconds(make_model(4, {"fidelity": "2d",
+    ...     "volume_change": 1.0})), 2)
+    (0.55, 0.51)
+    """
+    seconds = solve_seconds(cost_fidelity(model), int(getattr(model, "n_units", 0) or 0) if n_units is None
+                            else int(n_units))
+    return None if seconds is None else seconds * volume_ramp_factor(model)
+
+
+def volume_ramp_note(model: Any) -> str:
+    """What a plan says of a volume-controlled ramp that may cost many cut-backs (its walls balloon), or ""."""
+    factor, ratio = volume_ramp_factor(model), softness(model)
+    if factor < MANY_CUTBACKS or ratio is None:
+        return ""
+    return (f"volume control of a body {ratio:.3g} times softer than its layer may need many cut-backs where its "
+            f"walls balloon (about {factor:.0f} times the built-in unit's pressure ramp, measured in 2D; the count "
+            "below gives the real rate)")
+
+
 def cost_fidelity(model: Any) -> str:
     """The key of :data:`SOLVE_SECONDS` a model's build is estimated by: its fidelity, or :data:`FULL_WIDTH` for a 3D
     model over sideways units (its training designs are solved on the full width)."""
@@ -308,7 +379,7 @@ def solve_estimate(model: Any, count: int, scale: float = 1.0) -> str:
     the full width's; times ``scale``, e.g. a finer mesh's cells over the measured mesh's), slowed by what else
     runs on this machine now (:func:`pneumorph.io.progress.load_factor`), or nothing."""
     fidelity = cost_fidelity(model)
-    seconds = solve_seconds(fidelity, int(getattr(model, "n_units", 0) or 0))
+    seconds = model_seconds(model)
     if not seconds:
         return ""
     each = " each" if count > 1 else ""
@@ -316,5 +387,6 @@ def solve_estimate(model: Any, count: int, scale: float = 1.0) -> str:
     return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
-__all__ = ["HELDOUT", "SOLVE_SECONDS", "SOLVE_UNITS", "BuildPlan", "build_plan", "cached_counter", "cost_fidelity",
-           "estimate_text", "evaluator_workers", "solve_estimate", "solve_seconds", "unit_text"]
+__all__ = ["HELDOUT", "MANY_CUTBACKS", "SOLVE_SECONDS", "SOLVE_UNITS", "VOLUME_RAMP_COST", "BuildPlan", "build_plan",
+           "cached_counter", "cost_fidelity", "estimate_text", "evaluator_workers", "model_seconds", "softness",
+           "solve_estimate", "solve_seconds", "unit_text", "volume_ramp_factor", "volume_ramp_note"]
