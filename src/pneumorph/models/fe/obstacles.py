@@ -238,8 +238,8 @@ def parse_obstacle(text: str) -> dict[str, Any]:
     Raises
     ------
     SettingsError
-        No ``KIND:``, a part without ``=``, a value that is no list of numbers; the table itself is
-        checked by :func:`check_obstacles`.
+        No ``KIND:``, a part without ``=``, a key given twice, a value that is no list of numbers; the
+        table itself is checked by :func:`check_obstacles`.
 
     Examples
     --------
@@ -258,6 +258,8 @@ def parse_obstacle(text: str) -> dict[str, Any]:
         if not eq or not key.strip():
             raise SettingsError(f"obstacle {text!r}: {part!r} is no key=value")
         key = key.strip()
+        if key in table:  # a second value would silently replace the first
+            raise SettingsError(f"obstacle {text!r}: {key} is given twice")
         if key == "on":
             table[key] = value.strip()
             continue
