@@ -9,6 +9,7 @@ import click
 
 from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import solve_levels
+from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
 
 
 @click.command("simulate")
@@ -17,7 +18,7 @@ from pneumorph.cli.progress import solve_levels
                    "over a --library, one letter per unit, upper case = turned (e.g. aRRa).")
 @click.option("--pressure", type=P.PRESSURE_KPA, default=45.0, show_default=True, help="Final pressure in kPa.")
 @click.option("--increments", type=P.INCREMENTS, default=10, show_default=True, help="Reported pressure levels.")
-@click.option("--volume-change", type=P.Real(0.0, 100.0, low_open=True), default=None,
+@click.option("--volume-change", type=P.Real(MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE), default=None,
               help="Drive the cavities' volume instead of the pressure, to this relative change V/V0 - 1 in "
                    "--increments equal steps: the pressure is an output and may pass a maximum (a wall that "
                    "balloons); --pressure then only scales the solver's load factor.")

@@ -19,6 +19,7 @@ from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.fe.base import CELL_TYPES
 from pneumorph.models.fe.gravity import gravity_vector
 from pneumorph.models.fe.obstacles import check_obstacles
+from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
 from pneumorph.models.fe.volumetric import FORMULATIONS
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
@@ -247,7 +248,8 @@ def _ramp(s: Mapping[str, Any], defaults: StepSettings) -> RampSpec:
                               limit="MAX_SUBSTEPS", error=SearchConfigError)
     volume = s.get("volume_change")
     if volume is not None:
-        volume = checks.real(volume, "[model] volume_change", 0.0, 100.0, low_open=True, error=SearchConfigError)
+        volume = checks.real(volume, "[model] volume_change", MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE,
+                             error=SearchConfigError)
     return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps),
                     volume=volume)
 

@@ -14,6 +14,7 @@ from pneumorph.checks import MAX_INCREMENTS
 from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import reporter
 from pneumorph.io.files import all_or_nothing, strict_json, write_json
+from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
 
 #: the voids' relative volume change V/V0 - 1 at the end of the default volume-controlled ramp: the full-size
 #: actuator (CR 0.2, library bulk modulus) passes the pressure ramp's end (about 35 kPa) and its pressure maximum
@@ -47,7 +48,7 @@ DEFAULT_VOLUME_CHANGE = 8.0
 @click.option("--control", type=click.Choice(["volume", "pressure"]), default="volume", show_default=True,
               help="What the ramp drives: the voids' volume (the pressure an output, followed past its maximum "
                    "where a wall balloons) or the pressure (the ramp ends where a wall balloons).")
-@click.option("--volume-change", type=P.Real(0.0, 100.0, low_open=True), default=DEFAULT_VOLUME_CHANGE,
+@click.option("--volume-change", type=P.Real(MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE), default=DEFAULT_VOLUME_CHANGE,
               show_default=True, help="With --control volume: the voids' relative volume change V/V0 - 1 at the "
                                       "ramp's end, in --pmax/--step equal steps (--pmax then scales the solver).")
 @click.option("--out", type=P.OutputDir(), default=None,

@@ -9,6 +9,11 @@ from pneumorph.errors import LimitPointError, SimulationFailed
 from pneumorph.fem import StepSettings
 from pneumorph.models.response import FloatArray
 
+#: the range of a volume-controlled ramp's relative volume change ``V / V0 - 1``: a smaller change is lost in the
+#: cavity volume's rounding and the solver's tolerance (the ramp would report an unloaded actuator ten times); a
+#: larger one is a hundredfold inflation no silicone survives
+MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE = 1e-6, 100.0
+
 
 @dataclass(frozen=True)
 class RampSpec:
@@ -35,7 +40,7 @@ class RampSpec:
         checks.real(self.pressure, "pressure", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                     limit="MAX_PRESSURE_KPA")
         if self.volume is not None:
-            checks.real(self.volume, "volume change", 0.0, 100.0, low_open=True)
+            checks.real(self.volume, "volume change", MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE)
 
     def pressures(self) -> FloatArray:
         return self.pressure * self.steps.levels()
@@ -70,4 +75,4 @@ def past_the_maximum(failure: SimulationFailed) -> str:
             "or [model] volume_change)")
 
 
-__all__ = ["RampSpec", "past_the_maximum"]
+__all__ = ["MAX_VOLUME_CHANGE", "MIN_VOLUME_CHANGE", "RampSpec", "past_the_maximum"]
