@@ -432,6 +432,12 @@ def test_exhaustive_search_beyond_its_limit_is_refused_before_anything_is_said(
     assert "at most 20 units" in line and "1,073,741,824" in line
 
 
+def test_overwrite_without_a_folder_to_overwrite_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = [a for a in BASE["identify"] if a not in ("--out", "run")]
+    line = _refused(sandbox, capsys, [*argv, "--overwrite"])
+    assert "--overwrite" in line and "--out" in line
+
+
 def test_snapshot_beyond_the_final_strain_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:
     line = _refused(sandbox, capsys, [*BASE["coupon"], "--snapshot", "5"])
     assert "--snapshot" in line and "final strain" in line

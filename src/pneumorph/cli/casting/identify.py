@@ -67,6 +67,9 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
 
     scan_unit = P.scan_unit(scan_unit, scale)
     check_options(executor, workers, scheduler)
+    if overwrite and not out:  # an option that would do nothing is refused, not ignored
+        raise click.UsageError("--overwrite replaces the identification an --out folder holds: give --out DIR, or "
+                               "leave out --overwrite")
     if out and not overwrite:
         _check_out(out)
     specs = _scan_specs(scan, design, pressure, manifest, scan_unit, scale)
