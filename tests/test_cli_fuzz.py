@@ -179,7 +179,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     },
     "bimodal": {
         "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE + ["10000", "101"],
-        "--element-size": [*POSITIVE, "1e-4"], "--end-cap": [*NONNEG, "1e9", "10001"],
+        "--element-size": [*POSITIVE, "1e-4", "0.3"], "--end-cap": [*NONNEG, "1e9", "10001"],
         "--bilinear-nu": ["0.5", "-1.5", *REAL],
         "--control": ["", "arc-length"], "--volume-change": [*POSITIVE, "1e3", "1e-300"], "--composite": ["", "rebar"],
         "--paper": ["", "crimped", "Measured"],

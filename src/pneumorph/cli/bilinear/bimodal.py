@@ -19,6 +19,10 @@ from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
 #: the voids' relative volume change V/V0 - 1 at the end of the default volume-controlled ramp: the full-size
 #: actuator (CR 0.2, library bulk modulus) passes the pressure ramp's end (about 35 kPa) and its pressure maximum
 DEFAULT_VOLUME_CHANGE = 8.0
+#: CPU seconds of one level of a bimodal ramp per ``nodes ** (4 / 3)`` of its half mesh (hex20, one thread; the
+#: direct solver's growth, as :data:`~pneumorph.geometry.meshsize.BYTES_3D`'s): the full-size actuator's 12-step
+#: volume ramps, 15,807 nodes, took 72-113 s of CPU, 92 s on average (docs/bimodal.md, "Cost")
+LEVEL_SECONDS = 1.9e-5
 
 
 @click.command("bimodal")
@@ -85,6 +89,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
             # one field at a time, so that an error names its option
             BimodalSpec(**{field: value})  # type: ignore[arg-type]
     spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
+    each = _level_seconds(spec)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations,  # None: the model's own
                          volume=volume_change if control == "volume" else None, composite=composite,
@@ -94,7 +99,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
 
     lines = Progress(lambda text: None, heartbeat=0) if quiet or as_json else reporter()
     with lines:
-        lines.plan("bimodal ramp", max(1, round(pmax / step)), noun="levels",
+        lines.plan("bimodal ramp", max(1, round(pmax / step)), noun="levels", each=each,
                    title=f"bimodal ramp to {pmax:g} kPa in steps of {step:g} kPa" if control == "pressure" else
                    f"bimodal ramp of the voids' volume to {1 + volume_change:g} V0 in {n} steps")
         result = model.solve(on_level=lambda k, p, v: lines.count(k + 1, f"{1e3 * p:6.1f} kPa  tip u_y {v:+8.3f} mm",
@@ -114,6 +119,25 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
         reached = float(result.pressures[-1]) / result.pmax if len(result.pressures) else 0.0
         kept = "the levels before it are printed" + (" and written" if out is not None else "")
         raise SimulationFailed(reached=reached, cause=f"{result.cause.strip()}; {kept}", pressure=result.pmax)
+
+
+def _level_seconds(spec: Any) -> float:
+    """CPU seconds of one level of the bimodal actuator ``spec`` (:data:`LEVEL_SECONDS`), its nodes counted from
+    meshes of one and two voids (the grid repeats void by void); a solve estimated to need more memory than is
+    available (:func:`~pneumorph.geometry.meshsize.solve_memory`) is refused, naming --voids and --element-size."""
+    from dataclasses import replace
+
+    from pneumorph.bimodal.geometry import mesh_actuator
+    from pneumorph.geometry.meshsize import available_memory, solve_memory
+
+    one, two = (len(mesh_actuator(replace(spec, voids=n)).points) for n in (1, 2))
+    nodes = one + (spec.voids - 1) * (two - one)
+    need, free = solve_memory(nodes, 3), available_memory()
+    if need > free:
+        raise click.UsageError(f"--voids {spec.voids} --element-size {spec.element_size:g}: a mesh of about "
+                               f"{nodes:,} nodes, {need / 1e9:.1f} GB for the solve; {free / 1e9:.1f} GB are "
+                               "available: fewer voids or larger elements")
+    return LEVEL_SECONDS * nodes ** (4 / 3)
 
 
 def format_result(d: dict[str, Any]) -> str:
