@@ -19,6 +19,10 @@ subprocess whose solvers are tripwires: a solve reached ends it with exit 99 (th
     OMP_NUM_THREADS=1 python benchmarks/fuzz_inputs.py [--cases 550] [--seed 0] [--json F]
 
 All path cases are run (414); the number cases fill the rest, every number option once (128) before any twice.
+``--only COMMAND`` (or ``--only "COMMAND OPTION"``, repeatable) runs every case of those commands or options
+alone, e.g. a command's newest options:
+
+    OMP_NUM_THREADS=1 python benchmarks/fuzz_inputs.py --only simulate --only bimodal
 """
 
 from __future__ import annotations
@@ -207,9 +211,12 @@ def all_cases() -> tuple[list[Case], list[Case]]:
     return paths, numbers
 
 
-def cases(count: int = 400, seed: int = 0) -> list[Case]:
-    """Every path case, then number cases up to ``count``: every number option once, then drawn (seeded)."""
+def cases(count: int = 400, seed: int = 0, only: list[str] | None = None) -> list[Case]:
+    """Every path case, then number cases up to ``count``: every number option once, then drawn (seeded); with
+    ``only``, every case of those commands (``"simulate"``) or options (``"simulate --volume-change"``)."""
     paths, numbers = all_cases()
+    if only:
+        return [c for c in paths + numbers if c.command in only or f"{c.command} {c.option}" in only]
     rng = random.Random(seed)
     rng.shuffle(numbers)
     first: dict[tuple[str, str], Case] = {}
@@ -335,8 +342,12 @@ def main() -> int:
     parser.add_argument("--cases", type=int, default=550)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--only", action="append", metavar="COMMAND[ OPTION]",
+                        help="every case of this command or option alone (repeatable)")
     args = parser.parse_args()
-    todo = cases(args.cases, args.seed)
+    todo = cases(args.cases, args.seed, args.only)
+    if not todo:
+        parser.error(f"no case of {args.only}: a command is named as BASE names it ('chain build')")
     t0 = time.perf_counter()
     outcomes = [run_case(c) for c in todo]  # one at a time: each case's time and memory are its own
     wall = time.perf_counter() - t0
