@@ -60,7 +60,7 @@ def solve_seconds(fidelity: str, n_units: int) -> float | None:
 #: measures), measured on a 4-unit 2D design (``benchmarks/volume_ramp.py``, BENCHMARKS.md), by how much stiffer the
 #: layer is than the body (initial shear moduli): (ratio, the factor to 0.5 V0, its growth per V0 past 0.5 V0). A body
 #: much softer than its layer balloons past 0.5 V0, where the ramp needs cut-back after cut-back (Ecoflex 00-30 in
-#: Smooth-Sil 950: 82 to 1 V0, 560 to 5 V0)
+#: Smooth-Sil 950: 82 cut-backs to a change of 1 V0, 546 to 4 V0)
 VOLUME_RAMP_COST = ((4.06, 3.4, 0.2), (9.8, 7.3, 86.0), (25.9, 10.8, 173.0), (34.5, 9.2, 169.0))
 #: the factor of a volume-controlled ramp beyond which its plan says that it may need many cut-backs
 MANY_CUTBACKS = 20.0
