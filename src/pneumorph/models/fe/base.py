@@ -357,6 +357,8 @@ class FEModel:
         mesh = self.mesh(orientation)
         # a design of extending units has no layer cells: the empty region is left out
         silicones = {name: material for name, material in self.silicones.items() if len(mesh.regions[name])}
+        if self.dim == 2 and (paper := sorted(set(CAST_PAPER) & {m.name for m in silicones.values()})):
+            raise SettingsError(f"{', '.join(paper)}: the paper along the unit's axis is a 3D law; use the 3D model")
         regions = [(name, mesh.regions[name], self._silicone_umat(material)) for name, material in silicones.items()]
         extra, set_extra = self._extra_regions(mesh)
         densities = None
