@@ -7,7 +7,7 @@ import pytest
 
 from pneumorph.bimodal.geometry import BimodalSpec
 from pneumorph.bimodal.model import BimodalModel, bilinear_material
-from pneumorph.errors import SettingsError, UnknownMaterialError
+from pneumorph.errors import MaterialDataError, SettingsError, UnknownMaterialError
 from pneumorph.materials import drucker_stability, get
 
 TINY = BimodalSpec(voids=3, element_size=5.0)
@@ -123,3 +123,5 @@ def test_the_weight_is_a_small_load_that_acts_both_ways() -> None:
     down, up = tips["down"] - tips["none"], tips["up"] - tips["none"]
     assert down[1] < -0.05 and up[1] == pytest.approx(-down[1], rel=0.05)
     assert tips["hanging"][0] > tips["none"][0]
+    with pytest.raises(MaterialDataError, match="density of ecoflex_00_10"):  # before any solve
+        BimodalModel(spec, crimp_ratio=0.2, materials={"strip": "ecoflex_00_10"}, gravity="hanging")

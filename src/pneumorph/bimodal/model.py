@@ -43,7 +43,7 @@ from pneumorph.bimodal.geometry import (
 )
 from pneumorph.bimodal.paper import PAPER_MODELS, measured_composite, paper_composite
 from pneumorph.bimodal.switch import Switch, find_switch
-from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
+from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.fem.fast.mixed import nearly_incompressible
@@ -324,6 +324,8 @@ class BimodalModel:
         self.backend = check_backend(backend)
         self.volume = None if volume is None else checks.real(volume, "volume", 0.0, 100.0, low_open=True)
         self.gravity = gravity_vector(gravity, 3)
+        if self.gravity is not None and (light := sorted(m.name for m in self.materials.values() if m.density is None)):
+            raise MaterialDataError(f"gravity needs the density of {', '.join(light)}, which has none")
 
     def bulk(self, layer: str) -> float:
         """Bulk modulus (MPa) used for a layer."""
@@ -372,8 +374,8 @@ class BimodalModel:
                                        matrix=str(self.names[name]), paper=PAPER, bulk=self.bulk(name), mixed=mixed,
                                        transition=self.transition)
             regions.append((name, mesh.label == code, umat))
-        densities = None if self.gravity is None else {
-            name: float(self.materials[name].density.value) for name in LABELS.values() if name in self.materials}
+        densities = None if self.gravity is None else {  # every layer has one (checked at construction)
+            name: float(m.density.value) for name, m in self.materials.items() if m.density is not None}
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
                                 mesh.symmetry_points, densities=densities)
         return mesh, body
