@@ -231,10 +231,9 @@ class FEModel:
             "revision": MODEL_REVISION,
             "n_units": self.n_units,
             "unit": self.unit.to_dict(),
-            "materials": {"body": self.body.to_dict(), "layer": self.layer.to_dict(),
-                          **{name: material.to_dict() | ({"paper": CAST_PAPER[material.name].to_dict()}
-                                                         if material.name in CAST_PAPER else {})
-                             for name, material in self.bottoms.items()}},
+            "materials": {name: material.to_dict() | ({"paper": CAST_PAPER[material.name].to_dict()}  # its paper too
+                                                      if material.name in CAST_PAPER else {})
+                          for name, material in {"body": self.body, "layer": self.layer, **self.bottoms}.items()},
             "pressure_mpa": self.ramp.pressure,
             "steps": asdict(self.ramp.steps),
         }
