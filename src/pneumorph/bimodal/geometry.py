@@ -76,8 +76,9 @@ ASSUMED: dict[str, str] = {
     "pierces, section 3.3.2, Appendix B.2 step 13) but not the free end. In this model a 1.5 mm free end "
     "wall balloons (about 29 kPa) before any crimp ratio crosses and a 3 mm one before CR 0.25 and 0.3 do; "
     "the cast actuators all reversed and were inflated until rupture (section 3.3.4), so their end bore "
-    "the pressure of the reversal: 6 mm is the thinnest end of those run (1.5, 3, 6 mm) with which all "
-    "three crimp ratios cross, as the casts did",
+    "the pressure of the reversal: 6 mm is the thinnest end of those run (1.5, 3, 4.5, 6 mm) with which "
+    "all three crimp ratios cross within the default ramp (9 V0), as the casts did; with 4.5 mm CR 0.3 "
+    "crosses only past it (39.9 kPa at 9.67 V0) and its ramp stops at the next step",
     "holes": "the 1.5 mm holes joining neighbouring voids (section 6.x) are not modelled: every "
     "void carries the same pressure, as after a slow quasi-static ramp",
 }
