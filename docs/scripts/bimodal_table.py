@@ -83,7 +83,7 @@ def main() -> None:
     ap.add_argument("--voids", type=int, default=15)
     ap.add_argument("--element-size", type=float, default=2.5)
     ap.add_argument("--pmax", type=float, default=60.0)
-    ap.add_argument("--end-cap", type=float, default=0.0)
+    ap.add_argument("--end-cap", type=float, default=0.0)  # the tables of docs/bimodal.md: none unless named
     ap.add_argument("--max-cutbacks", type=int, default=BimodalModel.default_max_cutbacks)
     ap.add_argument("--max-iterations", type=int, default=BimodalModel.default_max_iterations)
     ap.add_argument("--control", choices=["volume", "pressure"], default="volume")

@@ -10,6 +10,8 @@ a second run reads its results back; writes a figure and a JSON table with prove
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/unit_types.py --out docs/figures/unit-types.png
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/unit_types.py --library modes --pressure 42 \
         --increments 14 --out docs/figures/unit-modes.png
+    OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python docs/scripts/unit_types.py --library modes --symbols bp \
+        --pressure 42 --increments 14 --out docs/figures/unit-modes-paper.png
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ def main() -> None:
     parser.add_argument("--units", type=int, default=15, help="units of the aligned actuator")
     parser.add_argument("--library", default="builtin", help="a built-in library: builtin, spatial, modes")
     parser.add_argument("--increments", type=int, default=Full3D.default_steps.increments, help="reported levels")
+    parser.add_argument("--symbols", default="", help="only these types of the library (default: all)")
     parser.add_argument("--cache", default=str(default_cache_path()))
     parser.add_argument("--out", default="docs/figures/unit-types.png")
     args = parser.parse_args()
@@ -40,8 +43,8 @@ def main() -> None:
     ramp = RampSpec(pressure=args.pressure / 1e3, steps=replace(Full3D.default_steps, increments=args.increments))
     cases = []
     for symbol, spec in zip(library.symbols, library.units, strict=True):
-        if spec.solid:  # nothing to inflate: a solid unit alone is refused; it only follows its neighbours
-            continue
+        if spec.solid or (args.symbols and symbol not in args.symbols):
+            continue  # a solid unit alone is refused (nothing to inflate); it only follows its neighbours
         cases.append((symbol, "single", Full3D(1, unit=spec, ramp_spec=ramp), "0"))
         cases.append((symbol, "aligned", Full3D(args.units, unit=spec, ramp_spec=ramp), "0" * args.units))
     evaluator = CachedEvaluator(SerialEvaluator(), EvaluationCache(args.cache))
@@ -70,7 +73,7 @@ def main() -> None:
     evaluator.close()
     fig = new_figure(9.0, 3.2)
     ax_angle, ax_ext, ax_curl = fig.subplots(1, 3)
-    for symbol, entry in results.items():
+    for row, (symbol, entry) in enumerate(results.items()):
         single = entry.get("single")
         if isinstance(single, dict) and "curl_deg" in single:
             label = f"{symbol}: {entry['mode']}"
@@ -80,7 +83,7 @@ def main() -> None:
             if switch is not None:  # where the unit's bending changes direction
                 ax_angle.plot([switch], [0.0], "kx", ms=8)
                 ax_angle.annotate(f"{symbol} switches at {switch:.1f} kPa", (switch, 0.0), textcoords="offset points",
-                                  xytext=(-100, -14), fontsize=7)
+                                  xytext=(6, -14 - 10 * row), fontsize=7)  # one line per type
         aligned = entry.get("aligned")
         if isinstance(aligned, dict) and "curl_deg" in aligned:
             ax_curl.plot(aligned["pressures_kpa"], aligned["curl_deg"], "o-", ms=3, label=f"{symbol}")
@@ -93,7 +96,8 @@ def main() -> None:
     out = Path(args.out)
     save_figure(fig, out, description=f"built-in unit types ({args.library}): single-unit response and "
                 "aligned-actuator curl (3D)")
-    table = {"provenance": provenance(), "library": args.library, "pressure_kpa": args.pressure, "types": results}
+    table = {"provenance": provenance(), "library": args.library, "pressure_kpa": args.pressure,
+             "increments": args.increments, "types": results}
     out.with_suffix(".json").write_text(json.dumps(table, indent=1, default=str), encoding="utf-8")
     print(f"wrote {out} and {out.with_suffix('.json')}")
 

@@ -69,6 +69,19 @@ def test_the_ideal_paper(capsys) -> None:
     assert abs(tips["ideal"] - tips["measured"]) > 0.01 * abs(tips["ideal"])
 
 
+def test_the_default_end_is_the_geometrys(capsys) -> None:
+    """``--end-cap`` left out is :class:`BimodalSpec`'s end cap (its help says which), kept in the JSON's spec."""
+    from pneumorph.bimodal.geometry import BimodalSpec
+
+    assert main(["bimodal", "--help"]) == 0
+    assert f"the geometry's, {BimodalSpec().end_cap:g} mm" in " ".join(capsys.readouterr().out.split())
+    base = ["bimodal", "-c", "0.3", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure",
+            "--json"]
+    for given, cap in (([], BimodalSpec().end_cap), (["--end-cap", "0"], 0.0)):
+        assert main([*base, *given]) == 0
+        assert json.loads(capsys.readouterr().out)["metadata"]["model"]["spec"]["end_cap"] == cap
+
+
 def test_bad_crimp_ratio(capsys) -> None:
     assert main(["bimodal", "-c", "0.35"]) == 2
     assert "0.35" in capsys.readouterr().err

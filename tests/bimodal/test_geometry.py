@@ -11,7 +11,9 @@ from pneumorph.errors import GeometryError
 def test_defaults_are_the_dissertations_actuator() -> None:
     s = BimodalSpec()
     # section 3.3.1: 157.5 x 15 x 17.5 mm Mold Star body, 15 voids; 3.3.2: 1 mm seal; 5 mm composite
-    assert (s.length, s.width, s.body_height, s.voids, s.seal, s.bilinear) == (157.5, 15.0, 17.5, 15, 1.0, 5.0)
+    assert (s.voids * s.pitch, s.width, s.body_height, s.voids, s.seal, s.bilinear) == (157.5, 15.0, 17.5, 15, 1.0, 5.0)
+    # the free end (not given): a 6 mm wall beyond the last void, with which all three crimp ratios reverse
+    assert (s.end_wall + s.end_cap, s.length) == (6.0, 162.0)
     assert s.height == pytest.approx(5.0 + 1.0 + 17.5 + 2.0)
     # the void runs from the seal (y = 6) to the top wall (y = 6 + 17.5 - 1.5)
     assert s.void == (1.5, 9.0, 6.0, 22.0)

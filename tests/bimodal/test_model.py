@@ -7,7 +7,7 @@ import pytest
 
 from pneumorph.bimodal.geometry import BimodalSpec
 from pneumorph.bimodal.model import BimodalModel, bilinear_material
-from pneumorph.errors import SettingsError, UnknownMaterialError
+from pneumorph.errors import MaterialDataError, SettingsError, UnknownMaterialError
 from pneumorph.materials import drucker_stability, get
 
 TINY = BimodalSpec(voids=3, element_size=5.0)
@@ -105,3 +105,23 @@ def test_a_volume_step_too_large_to_take_from_rest_is_refused_before_any_solve()
     with pytest.raises(SettingsError, match=r"4 V0 per step, more than the 2 V0 .*at least 4 steps, e\.g\. step 2\.5"):
         BimodalModel(BimodalSpec(voids=2), crimp_ratio=0.2, pmax=0.010, step=0.005, volume=8.0)
     BimodalModel(BimodalSpec(voids=2), crimp_ratio=0.2, pmax=0.010, step=0.0025, volume=8.0)  # 2 V0 per step
+
+
+def test_the_weight_is_a_small_load_that_acts_both_ways() -> None:
+    """``gravity``: the layers' weight is loaded before the ramp and held. Across the actuator it is a small
+    dead load: its weight turned over moves the tip the other way by the same amount (to 5 %); hung from its base
+    (the bench, section 3.3.2) it pulls the tip along the axis. The description names it; without it, none."""
+    spec = BimodalSpec(voids=2, element_size=5.0)
+    tips = {}
+    for name, g in (("none", None), ("down", [0.0, -9806.65, 0.0]), ("up", [0.0, 9806.65, 0.0]),
+                    ("hanging", "hanging")):
+        model = BimodalModel(spec, crimp_ratio=0.2, pmax=0.005, gravity=g)
+        r = model.solve()
+        assert r.completed
+        tips[name] = r.tip[-1]
+        assert ("gravity_mm_s2" in model.describe()) == (g is not None)
+    down, up = tips["down"] - tips["none"], tips["up"] - tips["none"]
+    assert down[1] < -0.05 and up[1] == pytest.approx(-down[1], rel=0.05)
+    assert tips["hanging"][0] > tips["none"][0]
+    with pytest.raises(MaterialDataError, match="density of ecoflex_00_10"):  # before any solve
+        BimodalModel(spec, crimp_ratio=0.2, materials={"strip": "ecoflex_00_10"}, gravity="hanging")

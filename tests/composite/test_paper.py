@@ -136,3 +136,21 @@ def test_a_matrix_stiffer_than_the_table_leaves_the_crimp_slack() -> None:
 def test_measured_only_for_table_3_2() -> None:
     with pytest.raises(CrimpError, match=r"Table 3\.2"):
         measured_composite(0.35)
+
+
+def test_the_cast_composites_are_library_materials_of_the_calibrated_matrix() -> None:
+    """``paper_0_2`` etc. (the units' bottom walls): their entries are the Ecoflex matrix the paper was calibrated
+    for, and their paper is :data:`MEASURED_PAPER`'s, so a region of one is the actuator's measured composite."""
+    from pneumorph.fem.fibre import CAST_PAPER
+
+    ecoflex = get("ecoflex_0030")
+    assert {p.crimp_ratio for p in CAST_PAPER.values()} == set(MEASURED)
+    for name, paper in CAST_PAPER.items():
+        entry = get(name)
+        assert name == "paper_" + f"{paper.crimp_ratio:g}".replace(".", "_")
+        assert entry.model == ecoflex.model and entry.bulk_modulus.value == ecoflex.bulk_modulus.value
+        assert entry.density.value == ecoflex.density.value
+        law = paper.law(entry.model.mu, entry.model.alpha, entry.bulk_modulus.value)
+        cast = measured_composite(paper.crimp_ratio)
+        assert (law.primary, law.straight, law.slope, law.blend) == (cast.primary, cast.straight, cast.slope,
+                                                                      cast.blend)

@@ -33,7 +33,7 @@ COST = {
     "api.md": ("docs", "a certified design run (its 2D twin: about 10 s)"),
     "extending.md": ("docs", "a design run of 16 designs by 2D FE"),
     "tutorials/certified-design.md": ("docs", "a certified 3D design run: about a minute"),
-    "bimodal.md": ("slow", "a 3-void bimodal actuator's volume ramp, 9,909 dofs: 12 s of CPU, 19-34 s on 2 busy cores"),
+    "bimodal.md": ("slow", "a 3-void bimodal actuator's volume ramp, 11,361 dofs: 10-34 s on 2 busy cores"),
     "composite.md": ("slow", "a 3D coupon's tension test, 27 s"),
     "unit-library.md": ("slow", "a full-width 3D solve, 108,894 unknowns"),
 }

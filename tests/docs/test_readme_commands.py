@@ -52,7 +52,7 @@ SKIPPED = {
     "chain build --model 3d --out runs/chain-3d-cluster.json --executor dask --scheduler tcp://ws1:8786":
         "needs a Dask cluster",
     "study --units 8 --populations 20,40 --seeds 3": "many GA runs on the 3D model: minutes (no --model option)",
-    "bimodal --crimp-ratio 0.2 --end-cap 4.5 --voids 5 --out runs/bim/":
+    "bimodal --crimp-ratio 0.2 --voids 5 --out runs/bim/":
         "a 3D ramp: about 30 s",
     "calibrate --units 15 --out runs/cal/": "3D references: long",
     "correlate examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out runs/corr/": "a 3D solve",
@@ -78,7 +78,7 @@ REDUCED = {
     "sensitivity tolerances --samples 30 --out runs/tol/": "--model 2d --units 4 --samples 2",
     "sensitivity simplifications --design 001111010001001": "--design 0110 --unit {coarse}",
     "chain build --model 3d --out runs/chain-3d.json": "--model 2d --window 2 --heldout 2",
-    "bimodal --crimp-ratio 0.2 --end-cap 4.5 --voids 5 --out runs/bim/":
+    "bimodal --crimp-ratio 0.2 --voids 5 --out runs/bim/":
         "--voids 2 --element-size 4",
     "calibrate --units 15 --out runs/cal/": "--units 4 --pressures 10,20 --runs 1 --validate 1 --unit {coarse}",
     "correlate examples/data/scan-0110-30kpa.xyz --design 0110 --pressure 30 --out runs/corr/": "",

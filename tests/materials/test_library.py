@@ -148,6 +148,9 @@ def test_assumed_values_are_flagged_with_reasons() -> None:
         "bilinear_0_25": ("density", "bulk_modulus"),
         "bilinear_0_3": ("density", "bulk_modulus"),
         "paper_purco_80gsm": ("density", "youngs_modulus", "poisson_ratio", "thickness"),
+        "paper_0_2": ("density", "bulk_modulus"),
+        "paper_0_25": ("density", "bulk_modulus"),
+        "paper_0_3": ("density", "bulk_modulus"),
     }
     # then the silicones fitted to the Soft Robotics Materials Database (tests/materials/test_database_silicones.py)
     database = library.names()[len(expected):]

@@ -16,9 +16,10 @@ base at x = 0 is clamped, the free end at x = length)::
                 |  bilinear composite (``bilinear``, 5 mm)              |
     y = 0       +------------------------------------------------------+
 
-The Mold Star 15 body (157.5 x 15 x 17.5 mm, 15 voids) is cast with its voids open on the
-underside; a 1 mm Mold Star 15 strip seals them and is the interface to the bilinear
-composite glued below it, so the Ecoflex of the composite never sees the pressure; a
+The Mold Star 15 body (157.5 x 15 x 17.5 mm, 15 voids, closed at the free end by an assumed
+``end_cap`` beyond the last void's end wall) is cast with its voids open on the underside; a
+1 mm Mold Star 15 strip seals them and is the interface to the bilinear composite glued below
+it, so the Ecoflex of the composite never sees the pressure; a
 Smooth-Sil 950 strip is glued on top (section 3.3.2, Appendix B.2 steps 9-12). Along x a
 void is ``end_wall | void | end_wall``, so neighbouring voids are ``2 end_wall`` apart.
 In z each void stops ``side_wall`` short of both sides.
@@ -29,8 +30,8 @@ and why the default was chosen.
 Examples
 --------
 >>> s = BimodalSpec()
->>> s.length, s.height, s.void
-(157.5, 25.5, (1.5, 9.0, 6.0, 22.0))
+>>> s.voids * s.pitch, s.length, s.height, s.void   # 15 voids of 10.5 mm and the 4.5 mm end cap
+(157.5, 162.0, 25.5, (1.5, 9.0, 6.0, 22.0))
 """
 
 from __future__ import annotations
@@ -69,8 +70,15 @@ ASSUMED: dict[str, str] = {
     "tip_point": "the tracked tip (red dot, Fig 3.11; its position is not given) is the mid-point of "
     "the end face's chord on the mid-plane, between its bottom and top corners: the centre of the "
     "end section as a beam sees it, unaffected by the bulging of the end wall over the last void",
-    "end_cap": "0 mm: extra solid closing the last void (the free end wall is end_wall thick, as "
-    "the base wall); not given",
+    "end_cap": "4.5 mm: extra solid beyond the last void, so that the free end wall is 6 mm (end_wall + "
+    "end_cap) and the actuator 162 mm long (the voids keep the 10.5 mm pitch of section 3.3.1's 157.5 mm). "
+    "Not given: the dissertation describes the inlet end (a thick slab on the base unit that the needle "
+    "pierces, section 3.3.2, Appendix B.2 step 13) but not the free end. In this model a 1.5 mm free end "
+    "wall balloons (about 29 kPa) before any crimp ratio crosses and a 3 mm one before CR 0.25 and 0.3 do; "
+    "the cast actuators all reversed and were inflated until rupture (section 3.3.4), so their end bore "
+    "the pressure of the reversal: 6 mm is the thinnest end of those run (1.5, 3, 4.5, 6 mm) with which "
+    "all three crimp ratios cross within the default ramp (9 V0), as the casts did; with 4.5 mm CR 0.3 "
+    "crosses only past it (39.9 kPa at 9.67 V0) and its ramp stops at the next step",
     "holes": "the 1.5 mm holes joining neighbouring voids (section 6.x) are not modelled: every "
     "void carries the same pressure, as after a slow quasi-static ramp",
 }
@@ -96,7 +104,7 @@ class BimodalSpec:
     Parameters
     ----------
     voids : int
-        Number of voids (15; the length is ``voids * pitch``).
+        Number of voids (15; the length is ``voids * pitch + end_cap``).
     pitch : float
         Length per void (10.5 mm: 15 voids = 157.5 mm, section 3.3.1).
     width : float
@@ -112,7 +120,8 @@ class BimodalSpec:
     bilinear : float
         The bilinear composite, 5 mm (section 3.3.1).
     end_cap : float
-        Extra solid beyond the last void's end wall (assumed 0, see :data:`ASSUMED`).
+        Extra solid beyond the last void's end wall (assumed 4.5 mm, a 6 mm free end wall that lets
+        the actuator reverse, see :data:`ASSUMED`; 0 leaves the 1.5 mm end wall alone).
     element_size : float
         Target edge length of the hexahedra (the grid also has a line on every interface).
 
@@ -132,7 +141,7 @@ class BimodalSpec:
     seal: float = 1.0
     strip: float = 2.0
     bilinear: float = 5.0
-    end_cap: float = 0.0
+    end_cap: float = 4.5
     element_size: float = 1.5
 
     def __post_init__(self) -> None:
@@ -336,8 +345,8 @@ def cell_volumes(mesh: BimodalMesh) -> dict[str, float]:
     Examples
     --------
     >>> v = cell_volumes(mesh_actuator(BimodalSpec(voids=1, element_size=3.0), half=False))
-    >>> round(v["bilinear"], 6)   # 10.5 x 5 x 15
-    787.5
+    >>> round(v["bilinear"], 6)   # (10.5 + 4.5) x 5 x 15
+    1125.0
     """
     x = mesh.points[mesh.cells]
     size = x.max(axis=1) - x.min(axis=1)

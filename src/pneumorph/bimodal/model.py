@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,7 +43,7 @@ from pneumorph.bimodal.geometry import (
 )
 from pneumorph.bimodal.paper import PAPER_MODELS, measured_composite, paper_composite
 from pneumorph.bimodal.switch import Switch, find_switch
-from pneumorph.errors import SettingsError, SimulationFailed, UnknownMaterialError
+from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed, UnknownMaterialError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import PressurisedBody, check_backend, pressurised_body
 from pneumorph.fem.fast.mixed import nearly_incompressible
@@ -50,6 +51,8 @@ from pneumorph.fem.fast.volume import volume_control
 from pneumorph.materials import get
 from pneumorph.materials.laws.hyperelastic import Ogden
 from pneumorph.models.fe import Full3D
+from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.stages import gravity_steps
 
 FloatArray = np.ndarray
 
@@ -210,6 +213,10 @@ class BimodalModel:
         analytic straightening stretch, then the library paper's stiffness).
     transition : float, optional
         With ``paper="ideal"``: the paper's straightening strain instead of the crimp's analytic one.
+    gravity : str or sequence of float, optional
+        The layers' weight (:func:`~pneumorph.models.fe.gravity.gravity_vector`): ``"hanging"``
+        hangs the actuator from its base as the bench did (section 3.3.2), loaded before the
+        ramp; none by default.
 
     Examples
     --------
@@ -258,6 +265,7 @@ class BimodalModel:
         composite: str = "fibre",
         transition: float | None = None,
         paper: str = "measured",
+        gravity: str | Sequence[float] | None = None,
     ) -> None:
         pmax = checks.real(pmax, "pmax", 0.0, checks.MAX_PRESSURE_KPA / 1e3, low_open=True, unit="MPa",
                            limit="MAX_PRESSURE_KPA")
@@ -315,6 +323,9 @@ class BimodalModel:
         self.half = bool(half)
         self.backend = check_backend(backend)
         self.volume = None if volume is None else checks.real(volume, "volume", 0.0, 100.0, low_open=True)
+        self.gravity = gravity_vector(gravity, 3)
+        if self.gravity is not None and (light := sorted(m.name for m in self.materials.values() if m.density is None)):
+            raise MaterialDataError(f"gravity needs the density of {', '.join(light)}, which has none")
 
     def bulk(self, layer: str) -> float:
         """Bulk modulus (MPa) used for a layer."""
@@ -342,7 +353,7 @@ class BimodalModel:
             "paper": self.paper if self.composite == "fibre" else None,
             "paper_transition": self.transition,
             "control": "pressure" if self.volume is None else f"volume (V/V0 - 1 = {self.volume:g} at the end)",
-        }
+        } | ({} if self.gravity is None else {"gravity_mm_s2": list(self.gravity)})
 
     def build(self) -> tuple[BimodalMesh, PressurisedBody]:
         """The layered mesh and its pressurised body (one Ogden solid per layer, void walls)."""
@@ -363,8 +374,10 @@ class BimodalModel:
                                        matrix=str(self.names[name]), paper=PAPER, bulk=self.bulk(name), mixed=mixed,
                                        transition=self.transition)
             regions.append((name, mesh.label == code, umat))
+        densities = None if self.gravity is None else {  # every layer has one (checked at construction)
+            name: float(m.density.value) for name, m in self.materials.items() if m.density is not None}
         body = pressurised_body(mesh.points, mesh.cells, mesh.cell_type, regions, mesh.void_points, mesh.base_points,
-                                mesh.symmetry_points)
+                                mesh.symmetry_points, densities=densities)
         return mesh, body
 
     def solve(self, on_level: Any = None) -> BimodalResult:
@@ -392,6 +405,10 @@ class BimodalModel:
         ideal = self.composite == "fibre" and self.paper == "ideal"
         reuse = self.fibre_tangent_reuse if ideal else self.tangent_reuse
         substep, monitor = body.stepper(self.backend, reuse, self.anderson_depth)
+        if self.gravity is not None:  # the weight first, held through the ramp (the tips include its sag)
+            g = np.asarray(self.gravity)
+            ramp(body.items, body.field, lambda t: body.set_gravity(t * g), body.dof1, body.dof0,
+                 gravity_steps(settings), substep=substep, predictor_order=self.predictor_order)
         control = volume_control(self.volume, substep, apply, body.displacement)
         if control is not None:  # the voids' volume drives, the pressure is an output
             apply, substep = control.apply, control

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pneumorph.errors import CrimpError
-from pneumorph.fem.fibre import CrimpedFibreOgden, straight_stretch
+from pneumorph.fem.fibre import CAST_PAPER, CrimpedFibreOgden, straight_stretch
 
 FloatArray = NDArray[np.float64]
 
@@ -51,8 +51,7 @@ BLEND = 0.02
 MEASURED = {0.2: (0.216, 0.152, 25.2), 0.25: (0.0819, 0.300, 20.7), 0.3: (0.0800, 0.356, 16.5)}
 #: the paper of the measured law with the library's Ecoflex (bulk modulus 33.8 kPa) and :data:`BLEND`: its
 #: pre-transition slope (MPa), straightening stretch and slope once straight (MPa), from :func:`calibrate_measured`
-MEASURED_PAPER = {0.2: (0.148554, 1.151974, 25.0157), 0.25: (0.0146595, 1.299745, 20.6591),
-                  0.3: (0.0122235, 1.355537, 16.4637)}
+MEASURED_PAPER = {p.crimp_ratio: (p.primary, p.straight, p.slope) for p in CAST_PAPER.values()}
 #: the paper laws: the cast coupons' (Table 3.2) or the ideal crimp's
 PAPER_MODELS = ("measured", "ideal")
 

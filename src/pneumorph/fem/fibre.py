@@ -16,6 +16,7 @@ curved layer can carry its fibres along it.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -127,4 +128,57 @@ class CrimpedFibreOgden(OgdenCompressible):
         return P, None if A is None else A.reshape(3, 3, 3, 3, c, q).transpose(0, 1, 2, 3, 5, 4)
 
 
-__all__ = ["CrimpedFibreOgden", "straight_stretch"]
+@dataclass(frozen=True)
+class CastPaper:
+    """The cast crimped paper of Table 3.2 as the fibres of a composite region (its matrix the region's material).
+
+    The paper's numbers of :class:`CrimpedFibreOgden` for the library's Ecoflex 0030 matrix (bulk
+    modulus 33.8 kPa), calibrated by :func:`pneumorph.bimodal.paper.calibrate_measured` so that the
+    law pulled as the coupons were reads as Table 3.2; the fibres run along x, the actuator's
+    long axis (a unit turned about it keeps them there).
+
+    Attributes
+    ----------
+    crimp_ratio : float
+    primary : float
+        The paper's nominal stress per unit stretch before it is straight (MPa).
+    straight : float
+        The stretch at which it is straight.
+    slope : float
+        Its nominal stress per unit stretch once straight (MPa).
+    blend : float
+        Half-width of the slack-to-taut blend in stretch.
+
+    Examples
+    --------
+    >>> law = CAST_PAPER["paper_0_2"].law([0.1], [2.0], 1.0)
+    >>> law.direction.tolist(), round(law.straight, 6), law.slope
+    ([[1.0, 0.0, 0.0]], 1.151974, 25.0157)
+    """
+
+    crimp_ratio: float
+    primary: float
+    straight: float
+    slope: float
+    blend: float = 0.02
+
+    def law(self, mu: Sequence[float], alpha: Sequence[float], bulk: float, mixed: bool = False) -> CrimpedFibreOgden:
+        """The matrix ``mu, alpha, bulk`` with this paper along x."""
+        return CrimpedFibreOgden(mu, alpha, bulk, (1.0, 0.0, 0.0), self.straight, self.slope, self.blend, mixed=mixed,
+                                 primary=self.primary)
+
+    def to_dict(self) -> dict[str, float]:
+        return asdict(self)
+
+
+#: the cast composites by their material names (``paper_0_2``: Ecoflex 0030 with the paper of CR 0.2; the
+#: library entries hold the matrix): :func:`pneumorph.bimodal.paper.calibrate_measured`'s paper for the
+#: library's Ecoflex and a blend of 0.02
+CAST_PAPER = {
+    "paper_0_2": CastPaper(0.2, 0.148554, 1.151974, 25.0157),
+    "paper_0_25": CastPaper(0.25, 0.0146595, 1.299745, 20.6591),
+    "paper_0_3": CastPaper(0.3, 0.0122235, 1.355537, 16.4637),
+}
+
+
+__all__ = ["CAST_PAPER", "CastPaper", "CrimpedFibreOgden", "straight_stretch"]

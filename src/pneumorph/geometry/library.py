@@ -408,8 +408,8 @@ def builtin_library(name: str = "builtin") -> UnitLibrary:
     :class:`UnitSpec`), ``e`` an extending unit, ``r`` a near-rigid one and ``s`` a
     short-pitch one. ``"spatial"`` (``spatial.toml``): ``a`` and ``l``, a sideways unit
     (``layer_side``) that bends out of the plane of ``a``. ``"modes"`` (``modes.toml``):
-    ``a``, ``b`` a bimodal unit and ``m`` a low-bending one (``bottom_material``)
-    (``docs/unit-library.md``).
+    ``a``, ``b`` a bimodal unit, ``m`` a low-bending one and ``p`` the bimodal unit with the
+    composite as cast (``bottom_material``) (``docs/unit-library.md``).
 
     Raises
     ------

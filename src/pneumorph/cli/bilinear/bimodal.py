@@ -32,8 +32,10 @@ LEVEL_SECONDS = 1.9e-5
 @click.option("--step", type=P.PRESSURE_KPA, default=5.0, show_default=True, help="Pressure step in kPa.")
 @click.option("--voids", type=P.UNITS, default=15, show_default=True, help="Number of voids (10.5 mm each).")
 @click.option("--element-size", type=P.POSITIVE_MM, default=2.5, show_default=True, help="Target element edge in mm.")
-@click.option("--end-cap", type=P.Real(0.0, 1e4, unit="mm"), default=0.0, show_default=True,
-              help="Extra solid beyond the last void in mm (the free end wall is 1.5 mm + this).")
+@click.option("--end-cap", type=P.Real(0.0, 1e4, unit="mm"), default=None,
+              help="Extra solid beyond the last void in mm (the free end wall is 1.5 mm + this; 0: the 1.5 mm wall "
+                   "alone, which balloons before the actuator reverses) [default: the geometry's, 4.5 mm: a 6 mm "
+                   "free end, with which all three crimp ratios reverse].")
 @click.option("--composite", type=click.Choice(["fibre", "homogenised"]), default="fibre", show_default=True,
               help="The composite: the Ecoflex matrix with the crimped paper along the actuator, or the "
                    "Table B.1 homogeneous Ogden material (isotropic, the dissertation's model).")
@@ -59,7 +61,7 @@ LEVEL_SECONDS = 1.9e-5
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
-def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float,
+def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float | None,
             bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
             as_json: bool, quiet: bool, control: str = "volume", volume_change: float = DEFAULT_VOLUME_CHANGE,
             composite: str = "fibre", paper: str = "measured") -> None:
@@ -83,12 +85,12 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     if bilinear_nu is not None:
         matrix = MATRIX if composite == "fibre" else bilinear_material(cr)
         bulk = bulk_from_poisson(get(matrix).shear_modulus, bilinear_nu)
-    for option, field, value in (("--voids", "voids", voids), ("--element-size", "element_size", element_size),
-                                 ("--end-cap", "end_cap", end_cap)):
-        with P.blame(option):
+    given = {"voids": voids, "element_size": element_size} | ({} if end_cap is None else {"end_cap": end_cap})
+    for field, value in given.items():
+        with P.blame("--" + field.replace("_", "-")):
             # one field at a time, so that an error names its option
             BimodalSpec(**{field: value})  # type: ignore[arg-type]
-    spec = BimodalSpec(voids=voids, element_size=element_size, end_cap=end_cap)
+    spec = BimodalSpec(**given)  # type: ignore[arg-type]
     each = _level_seconds(spec)
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations,  # None: the model's own

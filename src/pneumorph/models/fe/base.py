@@ -26,6 +26,7 @@ from pneumorph import __version__, checks
 from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
 from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
 from pneumorph.fem.body import QUADRATURES, PressurisedBody, check_backend, pressurised_body, quadrature_scheme
+from pneumorph.fem.fibre import CAST_PAPER
 from pneumorph.geometry.alphabet import Design, parse_design
 from pneumorph.geometry.assembly import ActuatorMesh, assemble, bottom_materials
 from pneumorph.geometry.features import BaseBlock, check_passage
@@ -230,8 +231,9 @@ class FEModel:
             "revision": MODEL_REVISION,
             "n_units": self.n_units,
             "unit": self.unit.to_dict(),
-            "materials": {"body": self.body.to_dict(), "layer": self.layer.to_dict(),
-                          **{name: material.to_dict() for name, material in self.bottoms.items()}},
+            "materials": {name: material.to_dict() | ({"paper": CAST_PAPER[material.name].to_dict()}  # its paper too
+                                                      if material.name in CAST_PAPER else {})
+                          for name, material in {"body": self.body, "layer": self.layer, **self.bottoms}.items()},
             "pressure_mpa": self.ramp.pressure,
             "steps": asdict(self.ramp.steps),
         }
@@ -288,6 +290,10 @@ class FEModel:
         return element_volume(material, self.formulation)
 
     def _silicone_umat(self, material: Any) -> OgdenCompressible:
+        paper = CAST_PAPER.get(material.name)  # a cast composite: its matrix with the paper along x (no thermal
+        if paper is not None:  # expansion in its entry: a temperature change is refused with its material's name)
+            return paper.law(material.model.mu, material.model.alpha, material.bulk_modulus.value,
+                             mixed=self.element_volume(material))
         return OgdenCompressible(material.model.mu, material.model.alpha, material.bulk_modulus.value,
                                  self.thermal_stretch(material), mixed=self.element_volume(material))
 
@@ -350,6 +356,8 @@ class FEModel:
         mesh = self.mesh(orientation)
         # a design of extending units has no layer cells: the empty region is left out
         silicones = {name: material for name, material in self.silicones.items() if len(mesh.regions[name])}
+        if self.dim == 2 and (paper := sorted(set(CAST_PAPER) & {m.name for m in silicones.values()})):
+            raise SettingsError(f"{', '.join(paper)}: the paper along the unit's axis is a 3D law; use the 3D model")
         regions = [(name, mesh.regions[name], self._silicone_umat(material)) for name, material in silicones.items()]
         extra, set_extra = self._extra_regions(mesh)
         densities = None
