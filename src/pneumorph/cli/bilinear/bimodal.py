@@ -21,7 +21,8 @@ from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
 DEFAULT_VOLUME_CHANGE = 8.0
 #: CPU seconds of one level of a bimodal ramp per ``nodes ** (4 / 3)`` of its half mesh (hex20, one thread; the
 #: direct solver's growth, as :data:`~pneumorph.geometry.meshsize.BYTES_3D`'s): the full-size actuator's 12-step
-#: volume ramps, 15,807 nodes, took 72-113 s of CPU, 92 s on average (docs/bimodal.md, "Cost")
+#: volume ramps, 15,807 nodes (a 1.5 mm end wall) and 16,291 (the 6 mm one), took 69-113 s of CPU, 92 s on
+#: average (docs/bimodal.md)
 LEVEL_SECONDS = 1.9e-5
 
 
