@@ -185,3 +185,13 @@ def test_a_run_folders_config_nested_too_deep_is_one_line(tmp_path: Path, capsys
     assert len(err.splitlines()) == 1 and "internal error" not in err and "Traceback" not in err
     assert f"config.toml {out / 'config.toml'}: nested more than 32 levels deep (MAX_TOML_DEPTH)" in err
     assert [p.name for p in out.iterdir()] == ["config.toml"] and (out / "config.toml").read_text() == body
+
+
+@pytest.mark.parametrize("levels", [40, 10_000])  # what Python's parser follows, and what it cannot (in 64 kB)
+def test_an_uploaded_unit_nested_too_deep_is_refused_by_the_one_reader(levels: int) -> None:
+    """The bench's unit upload is parsed as a unit file is read: past MAX_TOML_DEPTH, one line naming the field."""
+    from pneumorph.bench.app import read_unit
+    from pneumorph.bench.query import QueryError
+
+    with pytest.raises(QueryError, match=re.escape("the unit file: nested more than 32 levels deep (MAX_TOML_DEPTH)")):
+        read_unit(("[unit]\npitch = " + "[" * levels + "]" * levels + "\n").encode())
