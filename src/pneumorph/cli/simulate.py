@@ -86,7 +86,7 @@ def simulate(
     volume = model.ramp.volume
     load = f"{pressure:g} kPa" if volume is None else f"the cavities' volume to {1 + volume:g} V0"
     solution = solve_levels(model, design, f"design {design}", f"simulating design {design} ({fidelity} model, "
-                            f"{len(design)} units, {load}{weight})")
+                            f"{len(design)} units, {load}{weight})", where=out)
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
         _write(out, solution, meta)
