@@ -172,3 +172,21 @@ def test_the_plan_of_a_pressure_ramp_of_a_soft_body_says_what_its_limit_point_ma
     note = ("  a body 34.5 times softer than its layer may reach a limit point (its walls balloon) past 24 kPa: the "
             "ramp then creeps to it with cut-backs and stops, which took up to 40 times the estimate (measured in 2D)")
     assert (lines[1] == note) if pressure == 45.0 else not lines[1].startswith("  a body")
+
+
+def test_volume_change_typed_wins_over_a_model_files(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--volume-change`` given on the command line wins over the model file's ``volume_change``, as the other
+    options do (the file's 30 V0 in 10 increments would be refused: 3 V0 a step). The solve is stubbed."""
+    from pneumorph.models.fe.base import FEModel
+
+    def interrupted(self: FEModel, orientation: str, on_level: object = None) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(FEModel, "solve", interrupted)
+    settings = tmp_path / "model.toml"
+    settings.write_text('[model]\nfidelity = "2d"\nvolume_change = 30\n')
+    code = main(["simulate", "-o", "0110", "--model-file", str(settings), "--volume-change", "1"])
+    lines = capsys.readouterr().err.splitlines()
+    assert code == 130 and lines[0].startswith("simulating design 0110 (2d model, 4 units, the cavities' volume to "
+                                               "2 V0): 10 levels")
