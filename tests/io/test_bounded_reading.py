@@ -195,3 +195,13 @@ def test_an_uploaded_unit_nested_too_deep_is_refused_by_the_one_reader(levels: i
 
     with pytest.raises(QueryError, match=re.escape("the unit file: nested more than 32 levels deep (MAX_TOML_DEPTH)")):
         read_unit(("[unit]\npitch = " + "[" * levels + "]" * levels + "\n").encode())
+
+
+def test_a_pipe_in_place_of_an_old_runs_report_is_not_read(tmp_path: Path) -> None:
+    """The files an earlier run wrote are listed from its report.md: a named pipe in its place is passed over (read,
+    it would wait for a writer), the run's own files still found."""
+    from pneumorph.design.runs.folder import run_files
+
+    os.mkfifo(tmp_path / "report.md")
+    (tmp_path / "config.toml").write_text("[design]\n")
+    assert run_files(tmp_path) == [tmp_path / "config.toml"]

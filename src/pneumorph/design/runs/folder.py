@@ -207,9 +207,9 @@ def remove_empty(folder: Path, top: Path) -> None:
 
 def _reported_files(folder: Path) -> list[Path]:
     """The files of ``folder`` that its ``report.md`` lists (what the last run wrote)."""
-    try:
-        text = (folder / "report.md").read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+    try:  # the one bounded reader: a pipe, a device or a huge file in its place is not read
+        text = read_text_file(folder / "report.md", "the output folder's report.md", RunFolderError)
+    except RunFolderError:
         return []
     _, found, files = text.partition("\n## Files\n")
     out = []
