@@ -205,3 +205,12 @@ def test_a_pipe_in_place_of_an_old_runs_report_is_not_read(tmp_path: Path) -> No
     os.mkfifo(tmp_path / "report.md")
     (tmp_path / "config.toml").write_text("[design]\n")
     assert run_files(tmp_path) == [tmp_path / "config.toml"]
+
+
+def test_a_pipe_in_place_of_a_lock_file_is_not_waited_on(tmp_path: Path, fifo: Path) -> None:
+    """Who holds a lock is read from its file: a named pipe there reads as no holder, at once."""
+    from pneumorph.io.lock import FileLock
+
+    assert FileLock.read(fifo) == {}
+    (tmp_path / "held.lock").write_text("pid=12\nhost=h\n")
+    assert FileLock.read(tmp_path / "held.lock") == {"pid": "12", "host": "h"}
