@@ -145,7 +145,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
     },
     "simulate": {
         "--pressure": [*POSITIVE, "1e9"], "--increments": POS_COUNT + HUGE, "--orientation": ["", "0120", "abc"],
-        "--volume-change": [*POSITIVE, "1e3", "1e-300"],
+        "--volume-change": [*POSITIVE, "1e3", "1e-300", "25"],  # 25 V0 in the default 10 increments: 2.5 a step
         "--unit": ["binary.bin", "folder", ""], "--out": ["a-file", "a-file/sub", ""],
         "--library": ["binary.bin", "folder", "missing.toml", "", "a-file"],
         "--model-file": ["binary.bin", "folder", "missing.toml", ""],
@@ -181,7 +181,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--pmax": [*POSITIVE, "1e9"], "--step": [*POSITIVE, "100"], "--voids": POS_COUNT + HUGE + ["10000", "101"],
         "--element-size": [*POSITIVE, "1e-4", "0.3"], "--end-cap": [*NONNEG, "1e9", "10001"],
         "--bilinear-nu": ["0.5", "-1.5", *REAL],
-        "--control": ["", "arc-length"], "--volume-change": [*POSITIVE, "1e3", "1e-300"], "--composite": ["", "rebar"],
+        "--control": ["", "arc-length"], "--composite": ["", "rebar"],
+        "--volume-change": [*POSITIVE, "1e3", "1e-300", "30"],  # 30 V0 in the default 12 steps: 2.5 a step
         "--paper": ["", "crimped", "Measured"],
         "--max-cutbacks": COUNT + HUGE, "--max-iterations": POS_COUNT + HUGE, "--out": ["a-file", "a-file/sub", ""],
     },
@@ -337,7 +338,7 @@ CONFIG_KEYS: list[tuple[str, str, str]] = [
         ("model", "gravity", ['"sideways"', "1"]),
         ("model", "unit_file", ['"binary.bin"', '"missing.toml"', "1"]),
         ("model", "quadrature", ['"gauss"', "27", "true", '""', '"Full"', "[1]"]),
-        ("model", "volume_change", ["nan", "inf", "0", "-1", '"1"', "true", "1e3", "[1]", "1e-9"]),
+        ("model", "volume_change", ["nan", "inf", "0", "-1", '"1"', "true", "1e3", "[1]", "1e-9", "25"]),
         ("model", "obstacle", ["1", '"sphere"', "[1]", "[{}]", '[{kind = "cube"}]', '[{kind = "sphere"}]',
                                '[{kind = "sphere", centre = [60, 20], radius = -1}]',
                                '[{kind = "sphere", centre = [60, 20], radius = 2, colour = "red"}]',
@@ -382,6 +383,21 @@ def test_bad_unit_file(sandbox: Path, capsys: pytest.CaptureFixture[str], conten
     unit.write_bytes(content)
     for argv in (BASE["simulate"], BASE["design"], BASE["chain"]):
         _refused(sandbox, capsys, [*argv, "--unit", str(unit)])
+
+
+@pytest.mark.parametrize(("argv", "names", "least"), [
+    (["simulate", "-o", "0110", "--volume-change", "100", "--increments", "1", "--out", "run"],
+     ("--volume-change 100 over --increments 1 is 100 V0 per step", "--increments"), 50),
+    (["bimodal", "-c", "0.2", "--volume-change", "8", "--pmax", "10", "--step", "5", "--out", "run"],
+     ("--volume-change 8 over --pmax/--step 2 is 4 V0 per step", "--step 2.5 kPa or smaller"), 4),
+])
+def test_a_volume_step_past_its_largest_is_refused_alike(sandbox: Path, capsys: pytest.CaptureFixture[str],
+                                                         argv: list[str], names: tuple[str, str], least: int) -> None:
+    """One rule for simulate and bimodal (MAX_VOLUME_STEP, 2 V0 a step from rest), said in each command's options
+    with the fewest steps that keep to it, before any solve."""
+    line = _refused(sandbox, capsys, argv)
+    assert names[0] in line and "more than the 2 V0 a step can take from rest (MAX_VOLUME_STEP" in line
+    assert names[1] in line and f"{least}" in line.split("from rest")[1]
 
 
 def test_target_and_objective_together(sandbox: Path, capsys: pytest.CaptureFixture[str]) -> None:

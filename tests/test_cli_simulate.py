@@ -141,3 +141,52 @@ def test_the_plan_of_a_volume_ramp_of_a_soft_body_is_estimated_from_its_measured
     assert lines[1] == ("  volume control of a body 34.5 times softer than its layer may need many cut-backs where "
                         "its walls balloon (about 601 times the built-in unit's pressure ramp, measured in 2D; the "
                         "count below gives the real rate)")
+
+
+@pytest.mark.parametrize("pressure", [45.0, 20.0])
+def test_the_plan_of_a_pressure_ramp_of_a_soft_body_says_what_its_limit_point_may_cost(
+        pressure: float, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """A 4-unit Ecoflex 00-30 actuator (34.5 times softer than its layer) ramped to 45 kPa passes the lowest limit
+    point measured (24.2 kPa): its plan keeps the converged ramp's estimate (0.147 s on a quiet machine) and says
+    that creeping to the limit point took up to 40 times that; ramped to 20 kPa (measured: as fast as the built-in
+    unit) nothing is added. The solve is stubbed: interrupted after its first level, it writes nothing."""
+    from pneumorph.io.progress import duration_text
+    from pneumorph.models.fe.base import FEModel
+
+    def first_level_then_interrupted(self: FEModel, orientation: str, on_level: object = None) -> None:
+        on_level(0, 0.001)  # type: ignore[operator]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(FEModel, "solve", first_level_then_interrupted)
+    monkeypatch.setattr("pneumorph.io.progress.os.getloadavg", lambda: (0.0, 0.0, 0.0))  # a quiet machine
+    settings = tmp_path / "soft.toml"
+    settings.write_text('[model]\nfidelity = "2d"\n[model.unit]\nbody_material = "ecoflex_00_30"\n')
+    out = tmp_path / "out"
+    code = main(["simulate", "-o", "0110", "--model-file", str(settings), "--pressure", str(pressure),
+                 "--out", str(out)])
+    lines = capsys.readouterr().err.splitlines()
+    assert code == 130 and not out.exists()
+    seconds = 0.55 * 4 / 15
+    assert lines[0] == (f"simulating design 0110 (2d model, 4 units, {pressure:g} kPa): 10 levels, estimated "
+                        f"{duration_text(seconds)} ({duration_text(seconds / 10)} each, 1 worker) -> {out}")
+    note = ("  a body 34.5 times softer than its layer may reach a limit point (its walls balloon) past 24 kPa: the "
+            "ramp then creeps to it with cut-backs and stops, which took up to 40 times the estimate (measured in 2D)")
+    assert (lines[1] == note) if pressure == 45.0 else not lines[1].startswith("  a body")
+
+
+def test_volume_change_typed_wins_over_a_model_files(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--volume-change`` given on the command line wins over the model file's ``volume_change``, as the other
+    options do (the file's 30 V0 in 10 increments would be refused: 3 V0 a step). The solve is stubbed."""
+    from pneumorph.models.fe.base import FEModel
+
+    def interrupted(self: FEModel, orientation: str, on_level: object = None) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(FEModel, "solve", interrupted)
+    settings = tmp_path / "model.toml"
+    settings.write_text('[model]\nfidelity = "2d"\nvolume_change = 30\n')
+    code = main(["simulate", "-o", "0110", "--model-file", str(settings), "--volume-change", "1"])
+    lines = capsys.readouterr().err.splitlines()
+    assert code == 130 and lines[0].startswith("simulating design 0110 (2d model, 4 units, the cavities' volume to "
+                                               "2 V0): 10 levels")

@@ -45,7 +45,7 @@ from pneumorph.geometry.limits import MeshLimitError, check_manufacturable
 from pneumorph.geometry.meshsize import check_mesh
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import json_safe
-from pneumorph.io.reading import decode_text
+from pneumorph.io.reading import decode_text, parse_toml
 
 
 def read_unit(raw: bytes) -> UnitSpec:
@@ -57,18 +57,12 @@ def read_unit(raw: bytes) -> UnitSpec:
     QueryError
         Field ``unit``, saying what is wrong.
     """
-    import tomllib
-
     if len(raw) > MAX_UNIT_FILE:
         raise QueryError("unit", f"a unit file is at most {MAX_UNIT_FILE // 1024} kB")
-    try:  # the one decoder of a user's text: a byte-order mark (an editor's UTF-8 one) read as the file's encoding
-        data = tomllib.loads(decode_text(raw, "the unit file"))
+    try:  # the one reader of a user's text: a byte-order mark read as the file's encoding, TOML's depth bounded
+        data = parse_toml(decode_text(raw, "the unit file"), "the unit file")
     except SettingsError as exc:
         raise QueryError("unit", str(exc)) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise QueryError("unit", f"the unit file is not valid TOML: {exc}") from None
-    except RecursionError:
-        raise QueryError("unit", "the unit file is nested too deep to be a unit") from None
     table = data.get("unit")
     if not isinstance(table, dict):
         raise QueryError("unit", "the unit file needs a [unit] table (lengths in mm)")

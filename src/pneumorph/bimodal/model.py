@@ -22,7 +22,6 @@ first bending mode, composite on the outside).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -52,6 +51,7 @@ from pneumorph.materials import get
 from pneumorph.materials.laws.hyperelastic import Ogden
 from pneumorph.models.fe import Full3D
 from pneumorph.models.fe.gravity import gravity_vector
+from pneumorph.models.fe.ramp import check_volume_steps
 from pneumorph.models.fe.stages import gravity_steps
 
 FloatArray = np.ndarray
@@ -61,9 +61,6 @@ CRIMP_MATERIALS = {0.2: "bilinear_0_2", 0.25: "bilinear_0_25", 0.3: "bilinear_0_
 #: the composite's models: the Ecoflex matrix with the crimped paper as fibres along the actuator, or
 #: the Table B.1 homogeneous Ogden material
 COMPOSITES = ("fibre", "homogenised")
-#: the largest relative volume change V/V0 - 1 of one step of a volume-controlled ramp: 0.67 V0 per step (the
-#: default 8 V0 in 12 steps) and 1.6 V0 (two voids, 5 steps) converge; 4 V0 in one step from rest does not
-MAX_VOLUME_STEP = 2.0
 #: the fibre composite's matrix and paper (library names)
 MATRIX, PAPER = "ecoflex_0030", "paper_purco_80gsm"
 
@@ -277,12 +274,9 @@ class BimodalModel:
                 f"{checks.MAX_INCREMENTS} equal steps "
                 f"(e.g. step {pmax / max(1, min(round(pmax / step), 1000)) * 1e3:.4g} "
                 "kPa); the ramp must end at pmax, not above it")
-        if volume is not None and volume / increments > MAX_VOLUME_STEP:
-            least = math.ceil(volume / MAX_VOLUME_STEP)
-            raise SettingsError(
-                f"a volume change of {volume:g} V0 in {increments} step(s) is {volume / increments:g} V0 per step, "
-                f"more than the {MAX_VOLUME_STEP:g} V0 a step can take from rest: use a smaller step (at least "
-                f"{least} steps, e.g. step {pmax / least * 1e3:.4g} kPa)")
+        if volume is not None:  # the one rule of a volume step, before any mesh is made
+            check_volume_steps(volume, increments, ("volume", "pmax / step"), advice=lambda least: (
+                f"use a smaller step (at least {least} steps, e.g. step {pmax / least * 1e3:.4g} kPa)"))
         max_cutbacks = self.default_max_cutbacks if max_cutbacks is None else max_cutbacks
         max_iterations = self.default_max_iterations if max_iterations is None else max_iterations
         for name, value, low in (("substeps", substeps, 1), ("max_cutbacks", max_cutbacks, 0),

@@ -52,13 +52,13 @@ def solve_levels(model: Any, design: str, what: str, title: str, where: str | No
     """Solve ``design`` on ``model``, saying the plan (its levels, estimated by its fidelity's measured solve time
     and, for a volume-controlled ramp, its measured cost) and counting each level as it converges; the
     :class:`~pneumorph.models.fe.base.Solution`."""
-    from pneumorph.models.chain.plan import model_seconds, volume_ramp_note
+    from pneumorph.models.chain.plan import model_seconds, ramp_note
 
     each, levels = model_seconds(model, len(design)), len(model.pressures())
     with reporter() as lines:
         lines.plan(what, levels, each=None if each is None else each / levels, noun="levels", where=where,
                    title=title)
-        if note := volume_ramp_note(model):
+        if note := ramp_note(model):
             lines.say(f"  {note}")
         return model.solve(design, on_level=lambda k, p: lines.count(k + 1, f"{p * 1e3:7.3f} kPa converged",
                                                                       always=True))

@@ -9,7 +9,7 @@ import click
 
 from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import solve_levels
-from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
+from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 
 
 @click.command("simulate")
@@ -78,7 +78,10 @@ def simulate(
         settings["obstacle"] = _obstacles(obstacles, fidelity)
     settings = P.model_file_option(settings, model_file, {"fidelity": "fidelity", "pressure_kpa": "pressure",
                                                           "increments": "increments", "gravity": "gravity",
-                                                          "obstacle": "obstacles"})
+                                                          "obstacle": "obstacles", "volume_change": "volume_change"})
+    steps = settings.get("increments")
+    if volume_change is not None and isinstance(steps, int):  # a model file's value: the factory names its key
+        check_volume_steps(volume_change, steps, ("--volume-change", "--increments"), click.UsageError)
     fidelity = str(settings["fidelity"])
     model = make_model(len(design), settings)
     model = _with_obstacles(model, design, bool(obstacles), blocked)
@@ -86,7 +89,7 @@ def simulate(
     volume = model.ramp.volume
     load = f"{pressure:g} kPa" if volume is None else f"the cavities' volume to {1 + volume:g} V0"
     solution = solve_levels(model, design, f"design {design}", f"simulating design {design} ({fidelity} model, "
-                            f"{len(design)} units, {load}{weight})")
+                            f"{len(design)} units, {load}{weight})", where=out)
     meta = provenance(command=" ".join(sys.argv), model=model.describe(), fingerprint=model.fingerprint())
     if out:
         _write(out, solution, meta)

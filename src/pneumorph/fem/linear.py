@@ -61,10 +61,10 @@ class Pardiso:
     _local = threading.local()  # one MKL handle per thread: finding the library takes ~0.4 s
 
     def __init__(self) -> None:
-        from pypardiso import PyPardisoSolver
-
         if getattr(Pardiso._local, "solver", None) is None:
-            with _mkl_runtime():
+            with _mkl_runtime():  # the import too: pypardiso makes a solver of its own as it is imported
+                from pypardiso import PyPardisoSolver
+
                 Pardiso._local.solver = PyPardisoSolver(mtype=11)
         self._solver = Pardiso._local.solver
         self._pattern: tuple[np.ndarray, np.ndarray] | None = None

@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Self
 
 from pneumorph.errors import OutputPathError, PneumorphError, RunFolderError
+from pneumorph.io.reading import read_text_file
 
 try:
     import fcntl
@@ -136,9 +137,9 @@ class FileLock:
     @staticmethod
     def read(path: str | Path) -> dict[str, str]:
         """What the lock file ``path`` says (pid, host, started); empty if none or unreadable."""
-        try:
-            text = Path(path).read_text(encoding="utf-8", errors="replace")
-        except OSError:
+        try:  # the one bounded reader: a named pipe or a device in the lock's place is not waited on
+            text = read_text_file(path, "lock file", RunFolderError, limit=2**16, errors="replace")
+        except RunFolderError:
             return {}
         info = {}
         for line in text.splitlines():

@@ -294,9 +294,24 @@ def read_toml(path: str | Path, what: str, error: type[PneumorphError] = Setting
     ...
     pneumorph.errors.SettingsError: design config ...c.toml: not valid TOML: ...
     """
+    return parse_toml(read_text_file(path, what, error, limit=limit), f"{what} {path}", error)
+
+
+def parse_toml(text: str, where: str, error: type[PneumorphError] = SettingsError) -> dict[str, Any]:
+    """The tables of TOML ``text`` a user gave other than as a file (an upload), nested at most
+    :data:`MAX_TOML_DEPTH` deep, or one line starting with ``where`` saying why not.
+
+    Examples
+    --------
+    >>> parse_toml("[unit]\\nlength = 10.5", "the unit file")
+    {'unit': {'length': 10.5}}
+    >>> parse_toml("a = " + "[" * 40 + "]" * 40, "the unit file")
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: the unit file: nested more than 32 levels deep (MAX_TOML_DEPTH)
+    """
     # the values at the bottom count as a level of TOML's depth
-    data: dict[str, Any] = _parsed(read_text_file(path, what, error, limit=limit), f"{what} {path}", error,
-                                   "TOML", MAX_TOML_DEPTH, MAX_TOML_DEPTH - 1)
+    data: dict[str, Any] = _parsed(text, where, error, "TOML", MAX_TOML_DEPTH, MAX_TOML_DEPTH - 1)
     return data
 
 

@@ -19,7 +19,7 @@ from pneumorph.models.fe import FEModel, Full3D, RampSpec, Reduced2D
 from pneumorph.models.fe.base import CELL_TYPES
 from pneumorph.models.fe.gravity import gravity_vector
 from pneumorph.models.fe.obstacles import check_obstacles
-from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
+from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 from pneumorph.models.fe.volumetric import FORMULATIONS
 
 MODEL_KEYS = ("fidelity", "pressure_kpa", "increments", "substeps", "unit", "unit_file", "gravity",
@@ -250,6 +250,7 @@ def _ramp(s: Mapping[str, Any], defaults: StepSettings) -> RampSpec:
     if volume is not None:
         volume = checks.real(volume, "[model] volume_change", MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE,
                              error=SearchConfigError)
+        check_volume_steps(volume, increments, ("[model] volume_change", "[model] increments"), SearchConfigError)
     return RampSpec(pressure=pressure / 1e3, steps=replace(defaults, increments=increments, substeps=substeps),
                     volume=volume)
 

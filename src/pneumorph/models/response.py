@@ -20,6 +20,9 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.errors import DataFormatError
+from pneumorph.io.reading import read_json
+
 FloatArray = NDArray[np.float64]
 
 
@@ -233,8 +236,20 @@ class Response:
 
     @classmethod
     def load(cls, path: str | Path) -> Response:
-        """Read a response written by :meth:`save` (from its JSON file)."""
-        return cls.from_dict(json.loads(Path(path).with_suffix(".json").read_text(encoding="utf-8")))
+        """Read a response written by :meth:`save` (from its JSON file, through the one bounded reader).
+
+        Raises
+        ------
+        DataFormatError
+            One line naming the file: not a regular file, too large, not UTF-8, not JSON, nested
+            too deep (:func:`pneumorph.io.reading.read_json`), or not a response.
+        """
+        js = Path(path).with_suffix(".json")
+        data = read_json(js, "response", DataFormatError)
+        try:
+            return cls.from_dict(data)
+        except (AttributeError, KeyError, TypeError, ValueError) as exc:
+            raise DataFormatError(f"response {js}: not a response file ({type(exc).__name__}: {exc})") from None
 
 
 @runtime_checkable

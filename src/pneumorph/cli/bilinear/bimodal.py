@@ -14,7 +14,7 @@ from pneumorph.checks import MAX_INCREMENTS
 from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import reporter
 from pneumorph.io.files import all_or_nothing, strict_json, write_json
-from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE
+from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 
 #: the voids' relative volume change V/V0 - 1 at the end of the default volume-controlled ramp: the full-size
 #: actuator (CR 0.2, library bulk modulus) passes the pressure ramp's end (about 35 kPa) and its pressure maximum
@@ -81,6 +81,9 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
         raise click.BadParameter(f"--step {step:g} kPa must divide --pmax {pmax:g} kPa into at most {MAX_INCREMENTS} "
                                  f"equal steps, so that the ramp ends at --pmax (e.g. --step "
                                  f"{pmax / min(max(n, 1), MAX_INCREMENTS):.4g})", param_hint="'--step'")
+    if control == "volume":  # the one rule of a volume step (simulate's too), named in this command's options
+        check_volume_steps(volume_change, n, ("--volume-change", "--pmax/--step"), click.UsageError,
+                           advice=lambda least: f"give --step {pmax / least:.4g} kPa or smaller ({least} steps)")
     cr = float(crimp_ratio)
     bulk = None
     if bilinear_nu is not None:

@@ -25,6 +25,7 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from pneumorph.sensitivity.mesh import SAFETY_TWO, converge, refined, representative_size
@@ -85,14 +86,22 @@ STUDY_FILE = "mesh-study-3d.json"
 
 
 def load_study(name: str = STUDY_FILE) -> dict[str, Any] | None:
-    """The shipped mesh study (its ``mesh.json``), or None if the package has none."""
-    import json
+    """The shipped mesh study (its ``mesh.json``), or None if the package has none.
+
+    Read through the one bounded reader (:func:`pneumorph.io.reading.read_json`): a study file
+    replaced by hand is refused in one line naming it, as any JSON a user gives.
+    """
     from importlib.resources import files
 
-    path = files("pneumorph.models") / "data" / name
+    from pneumorph.errors import DataFormatError
+    from pneumorph.io.reading import read_json
+
+    path = Path(str(files("pneumorph.models") / "data" / name))
     if not path.is_file():
         return None
-    data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+    data = read_json(path, "mesh study", DataFormatError)
+    if not isinstance(data, dict):
+        raise DataFormatError(f"mesh study {path}: not a mesh study (a JSON object)")
     return data
 
 

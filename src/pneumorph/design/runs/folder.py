@@ -15,7 +15,6 @@ import io
 import json
 import os
 import re
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ from pneumorph.design.search.genetic import GenerationStats
 from pneumorph.errors import RunFolderError
 from pneumorph.io.files import atomic_write_text, read_text_file
 from pneumorph.io.lock import LOCK_NAME as LOCK_FILE
+from pneumorph.io.reading import read_toml
 
 _COMPARED = ("design", "ga", "model")
 
@@ -80,11 +80,10 @@ def check_folder(folder: Path, config: DesignConfig, fingerprint: str, overwrite
     path = folder / "config.toml"
     if not path.exists() or overwrite:
         return False
-    try:
-        old = tomllib.loads(read_text_file(path, "the output folder's config.toml", RunFolderError))  # a pipe: refused
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise RunFolderError(f"{folder} holds a config.toml that cannot be read ({exc}); choose another output "
-                             "folder or overwrite it") from None
+    try:  # the one bounded reader: a pipe, a file past its size or nested too deep is refused naming it
+        old = read_toml(path, "the output folder's config.toml", RunFolderError)
+    except RunFolderError as exc:
+        raise RunFolderError(f"{exc}; choose another output folder or overwrite it") from None
     new = config.to_dict()
     for table in _COMPARED:
         if old.get(table, {}) != new.get(table, {}):
@@ -208,9 +207,9 @@ def remove_empty(folder: Path, top: Path) -> None:
 
 def _reported_files(folder: Path) -> list[Path]:
     """The files of ``folder`` that its ``report.md`` lists (what the last run wrote)."""
-    try:
-        text = (folder / "report.md").read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+    try:  # the one bounded reader: a pipe, a device or a huge file in its place is not read
+        text = read_text_file(folder / "report.md", "the output folder's report.md", RunFolderError)
+    except RunFolderError:
         return []
     _, found, files = text.partition("\n## Files\n")
     out = []

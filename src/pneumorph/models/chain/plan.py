@@ -127,6 +127,53 @@ def volume_ramp_note(model: Any) -> str:
             "below gives the real rate)")
 
 
+#: a pressure ramp's limit point, measured on a 4-unit 2D design of the built-in unit in its Smooth-Sil 950 layer
+#: (``benchmarks/volume_ramp.py --pressure``, BENCHMARKS.md): the least :func:`softness` whose walls balloon below
+#: 45 kPa (Ecoflex 0030, 14.3, at 24.2 kPa; Dragon Skin 10 medium, 9.8, reaches 45 kPa), the lowest limit point
+#: measured (kPa), and the most a ramp that creeps to its limit point cost over the converged ramp's estimate (the
+#: softest bodies: 5 to 39 times, cut-back after cut-back until the step is too small). A softer body is no slower
+#: below its limit point (Ecoflex 00-30 to 20 kPa: 1.0 times), so the estimate stays the converged ramp's and the
+#: plan says what the limit point may cost
+LIMIT_POINT = (14.0, 24.0, 40.0)
+
+
+def limit_point_note(model: Any) -> str:
+    """What a plan says of a pressure ramp that may stop at a limit point (a soft body's walls balloon), or "".
+
+    >>> from pneumorph.models import make_model
+    >>> soft = {"fidelity": "2d", "unit": {"body_material": "ecoflex_00_30"}}
+    >>> limit_point_note(make_model(4, {"fidelity": "2d"})), limit_point_note(make_model(4, {**soft,
+    ...                                                                                "pressure_kpa": 20}))
+    ('', '')
+    >>> print(limit_point_note(make_model(4, soft)))  # doctest: +NORMALIZE_WHITESPACE
+    a body 34.5 times softer than its layer may reach a limit point (its walls balloon) past 24 kPa: the ramp then
+    creeps to it with cut-backs and stops, which took up to 40 times the estimate (measured in 2D)
+    """
+    ratio, ramp = softness(model), getattr(model, "ramp", None)
+    least, lowest, cost = LIMIT_POINT
+    if ratio is None or ratio < least or getattr(ramp, "volume", None) is not None:
+        return ""
+    try:
+        pressure_kpa = float(ramp.pressure) * 1e3  # type: ignore[union-attr]
+    except (AttributeError, TypeError, ValueError):
+        return ""
+    if pressure_kpa <= lowest:
+        return ""
+    return (f"a body {ratio:.3g} times softer than its layer may reach a limit point (its walls balloon) past "
+            f"{lowest:g} kPa: the ramp then creeps to it with cut-backs and stops, which took up to {cost:g} times "
+            "the estimate (measured in 2D)")
+
+
+def ramp_note(model: Any) -> str:
+    """What a plan says of a model's ramp beyond its estimate: :func:`volume_ramp_note` or :func:`limit_point_note`.
+
+    >>> from pneumorph.models import make_model
+    >>> ramp_note(make_model(4, {"fidelity": "2d"}))
+    ''
+    """
+    return volume_ramp_note(model) or limit_point_note(model)
+
+
 def cost_fidelity(model: Any) -> str:
     """The key of :data:`SOLVE_SECONDS` a model's build is estimated by: its fidelity, or :data:`FULL_WIDTH` for a 3D
     model over sideways units (its training designs are solved on the full width)."""
@@ -387,6 +434,7 @@ def solve_estimate(model: Any, count: int, scale: float = 1.0) -> str:
     return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
-__all__ = ["HELDOUT", "MANY_CUTBACKS", "SOLVE_SECONDS", "SOLVE_UNITS", "VOLUME_RAMP_COST", "BuildPlan", "build_plan",
-           "cached_counter", "cost_fidelity", "estimate_text", "evaluator_workers", "model_seconds", "softness",
-           "solve_estimate", "solve_seconds", "unit_text", "volume_ramp_factor", "volume_ramp_note"]
+__all__ = ["HELDOUT", "LIMIT_POINT", "MANY_CUTBACKS", "SOLVE_SECONDS", "SOLVE_UNITS", "VOLUME_RAMP_COST", "BuildPlan",
+           "build_plan", "cached_counter", "cost_fidelity", "estimate_text", "evaluator_workers", "limit_point_note",
+           "model_seconds", "ramp_note", "softness", "solve_estimate", "solve_seconds", "unit_text",
+           "volume_ramp_factor", "volume_ramp_note"]
