@@ -77,6 +77,8 @@ class WallData:
     take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    #: what the dimension's tangent keeps of the reference faces between evaluations
+    layouts: dict[str, Any] = field(default_factory=dict)
 
 
 def deformation_gradient(g: FloatArray, cells: IntArray, U: FloatArray) -> FloatArray:
@@ -204,7 +206,8 @@ class FastSystem:
         raise NotImplementedError  # pragma: no cover
 
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
-        """The follower-pressure stiffness of some walls, entries in :meth:`_entries` order."""
+        """The follower-pressure stiffness of some walls: its assembled entries (``w.take`` of the
+        :meth:`_entries` order)."""
         raise NotImplementedError  # pragma: no cover
 
     @staticmethod
@@ -390,8 +393,7 @@ class FastSystem:
             values[start : start + s.take.size] = self._solid_tangent(s, state).ravel()[s.take]
             start += s.take.size
         for w in self.walls:
-            K = self._wall_tangent(w, float(w.item.results.pressure), self._U)
-            values[start : start + w.take.size] = K.ravel()[w.take]
+            values[start : start + w.take.size] = self._wall_tangent(w, float(w.item.results.pressure), self._U)
             start += w.take.size
         remainders = []
         for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike

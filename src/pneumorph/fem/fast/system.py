@@ -149,7 +149,7 @@ class PlaneStrainSystem(FastSystem):
         # t[f, q, b] = N_1 dN_b/dX_2 - N_2 dN_b/dX_1 (with dA); M[f, a, b] = p sum_q h_a t_b
         t = w.ndA[..., 0:1] * w.g[..., 1] - w.ndA[..., 1:2] * w.g[..., 0]
         M = p * np.matmul(w.h.T[None], t)  # (f, n, n)
-        return _EPS[None, None, :, :, None] * M[:, :, None, None, :]  # (f, a, i, k, b)
+        return (_EPS[None, None, :, :, None] * M[:, :, None, None, :]).ravel()[w.take]  # of (f, a, i, k, b)
 
     @staticmethod
     def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
@@ -226,11 +226,13 @@ class SolidSystem3D(FastSystem):
             cols = act[:, :, ik[:, 1]].transpose(0, 2, 1)[:, None]
             lo, hi = np.minimum(rows, cols), np.maximum(rows, cols)
             return lo, hi, (lo >= 0) & (off | (rows <= cols))
-        # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries
+        # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries but those of the blocks i == k,
+        # which are zero (e_ikm); the face's cell is a solid's cell, whose entries hold their places in the pattern
         rows = act[:, :, :, None, None]
         cols = act[:, None, None, :, :]
         rows, cols = np.broadcast_arrays(rows, cols)
-        return rows, cols, (rows >= 0) & (rows <= cols)
+        off = np.arange(3)[:, None, None] != np.arange(3)  # (i, b, k)
+        return rows, cols, (rows >= 0) & (rows <= cols) & off
 
     def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         n = np.arange(owner.cells.shape[1])
@@ -293,16 +295,19 @@ class SolidSystem3D(FastSystem):
         return blocks
 
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
+        if "t" not in w.layouts:  # of the reference faces: kept
+            f, q, n, _ = w.g.shape
+            w.layouts["t"] = _cross(w.ndA[:, :, None, :], w.g)  # (f, q, n, 3)
+            # the entry (f, a, i, b, k) is e_ikm M[f, a, b, m]: its m and sign
+            face, a, i, b, k = np.unravel_index(w.take, (f, n, 3, n, 3))
+            w.layouts["source"] = ((face * n + a) * n + b) * 3 + (3 - i - k)
+            w.layouts["sign"] = np.where((k - i) % 3 == 1, 1.0, -1.0)
         F = deformation_gradient(w.g, w.cells, U)
         # v[f, q, b, m] = [F (N dA x dN_b/dX)]_m; M[f, a, b, m] = p sum_q h_a v_bm
-        t = _cross(w.ndA[:, :, None, :], w.g)  # (f, q, n, 3)
-        v = np.matmul(t, F.transpose(0, 1, 3, 2))  # (f, q, n, m)
+        v = np.matmul(w.layouts["t"], F.transpose(0, 1, 3, 2))  # (f, q, n, m)
         f, q, n, _ = v.shape
-        M = p * np.matmul(w.h.T[None], v.reshape(f, q, 3 * n)).reshape(f, n, n, 3)
-        K = np.zeros((f, n, 3, n, 3))  # K[a, i, b, k] = e_ikm M[a, b, m]
-        for i, k, m_, sign in ((0, 1, 2, 1), (1, 2, 0, 1), (2, 0, 1, 1), (1, 0, 2, -1), (2, 1, 0, -1), (0, 2, 1, -1)):
-            K[:, :, i, :, k] = sign * M[..., m_]
-        return K
+        M = np.matmul(w.h.T[None], v.reshape(f, q, 3 * n))  # (f, a, (b, m))
+        return M.ravel()[w.layouts["source"]] * (p * w.layouts["sign"])
 
     @staticmethod
     def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
