@@ -63,6 +63,10 @@ class SolidData:
     #: the material and its elements' pressure space when its volumetric term is integrated on a dilatation of its
     #: own (:mod:`.mixed`)
     mixed: Any = None
+    #: every cell is a box along the axes (``dN/dX = dN/dr dr/dX`` with a constant, diagonal ``dr/dX`` per cell):
+    #: the dimension may contract its tangent with the reference gradients, a constant of the element, in one
+    #: matrix product (and order the entries otherwise: part of the pattern's key)
+    boxes: bool = False
 
 
 @dataclass
@@ -162,7 +166,7 @@ class FastSystem:
                 self.walls.append(WallData(item, cells, g, h, ndA))
             elif isinstance(item, fem.SolidBody):
                 solid = SolidData(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
-                solid.layouts = self._layouts(g)
+                self._prepare(solid, region)
                 if getattr(item.umat, "mixed", False):  # P1 on quadratic cells, P0 on linear ones
                     X = np.einsum("aq,cad->cqd", region.h[:, :, 0], self.points[cells])
                     solid.mixed = (item.umat, pressure_space(X, solid.dV, linear=cells.shape[1] > 2**d))
@@ -182,8 +186,9 @@ class FastSystem:
     def _kernel_of(self, umat: Any) -> Any:
         raise NotImplementedError  # pragma: no cover
 
-    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
-        """The gradients in the layouts this dimension's products need."""
+    def _prepare(self, s: SolidData, region: Any) -> None:
+        """Set a solid's gradients in the layouts this dimension's products need (``s.layouts``, ``s.boxes``;
+        ``region``: the FElupe region they come from)."""
         raise NotImplementedError  # pragma: no cover
 
     def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
@@ -248,7 +253,7 @@ class FastSystem:
         owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
         for owner in owners:
             cells = np.ascontiguousarray(owner.cells, dtype=np.int64)
-            digest.update(f"{type(owner).__name__} {cells.shape}".encode())
+            digest.update(f"{type(owner).__name__} {cells.shape} {getattr(owner, 'boxes', False)}".encode())
             digest.update(cells.tobytes())
         return digest.hexdigest()
 

@@ -91,9 +91,10 @@ class PlaneStrainSystem(FastSystem):
             return lambda F: neo_hooke_plane_strain(F, float(umat.mu), float(umat.lmbda))
         raise TypeError(f"no fast plane-strain kernel for {type(umat).__name__}; use the FElupe backend")
 
-    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+    def _prepare(self, s: SolidData, region: Any) -> None:
+        g = s.g
         c, q, n, _ = g.shape
-        return {
+        s.layouts = {
             "g_res": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 2 * q)),  # [c, a, (q, J)]
             "gT": np.ascontiguousarray(g.transpose(0, 1, 3, 2).reshape(c * q, 2, n)),  # [(c, q), L, b]
             # d_ii' g[c, q, a, J] as [c, (a, i), (q, i', J)]
@@ -159,6 +160,17 @@ class PlaneStrainSystem(FastSystem):
         return out
 
 
+def _box_scales(region: Any) -> FloatArray | None:
+    """``dr_J/dX_J`` of every cell ``(c, 3)`` if every cell of a 3D region is a box along the axes (``dr/dX``
+    diagonal and the same at every point, to 1e-12 of its largest entry), else None."""
+    drdX, dhdr = np.asarray(region.drdX), np.asarray(region.dhdr)
+    if drdX.shape[:2] != (3, 3) or dhdr.ndim != 4 or dhdr.shape[-1] != 1:
+        return None
+    scales = np.ascontiguousarray(np.diagonal(drdX[:, :, 0], axis1=0, axis2=1))  # (c, 3)
+    box = np.eye(3)[:, :, None, None] * scales.T[:, None, None, :]
+    return scales if np.abs(drdX - box).max() <= 1e-12 * np.abs(drdX).max() else None
+
+
 def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
     """Cross products along the last axis (faster than ``numpy.cross`` on small shapes)."""
     out = np.empty(np.broadcast_shapes(a.shape, b.shape))
@@ -209,23 +221,34 @@ class SolidSystem3D(FastSystem):
                                                              volumetric=not umat.mixed)
         raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
-    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+    def _prepare(self, s: SolidData, region: Any) -> None:
+        g = s.g
         c, q, n, _ = g.shape
-        return {
+        s.layouts = {
             "G": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 3 * q)),  # [c, a, (q, J)]
             "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
         }
+        scales = _box_scales(region)
+        if scales is not None:  # g[c, q, b, L] = D[q, b, L] t[c, L]: the products by D, a constant
+            D = np.ascontiguousarray(np.transpose(region.dhdr[..., 0], (2, 0, 1)))  # (q, n, 3)
+            # W[c, J, L, q] = t_J t_L dV, DD[(J, L, q), (a, b)] = D[q, a, J] D[q, b, L]
+            s.layouts["W"] = (scales[:, :, None, None] * scales[:, None, :, None] * s.dV[:, None, None, :])[:, None]
+            s.layouts["DD"] = np.einsum("qaJ,qbL->JLqab", D, D).reshape(9 * q, n * n)
+            s.boxes = True
 
     def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         ik = np.array(_UPPER)
         if isinstance(owner, SolidData):
-            # entry (c, a, ik, b) at (row of (a, i), column of (b, k)); blocks i < k
+            # entry (c, a, ik, b) at (row of (a, i), column of (b, k)), (c, ik, a, b) of boxes; blocks i < k
             # stand for themselves and their transposes, blocks i == k hold both
             off = (ik[:, 0] != ik[:, 1])[None, None, :, None]
             rows = act[:, :, ik[:, 0]][:, :, :, None]
             cols = act[:, :, ik[:, 1]].transpose(0, 2, 1)[:, None]
             lo, hi = np.minimum(rows, cols), np.maximum(rows, cols)
-            return lo, hi, (lo >= 0) & (off | (rows <= cols))
+            valid = (lo >= 0) & (off | (rows <= cols))
+            if owner.boxes:
+                return lo.transpose(0, 2, 1, 3), hi.transpose(0, 2, 1, 3), valid.transpose(0, 2, 1, 3)
+            return lo, hi, valid
         # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries but those of the blocks i == k,
         # which are zero (e_ikm); the face's cell is a solid's cell, whose entries hold their places in the pattern
         rows = act[:, :, :, None, None]
@@ -237,7 +260,7 @@ class SolidSystem3D(FastSystem):
     def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         n = np.arange(owner.cells.shape[1])
         if isinstance(owner, SolidData):
-            return n[:, None, None], n  # entries (a, ik, b)
+            return (n[None, :, None], n) if owner.boxes else (n[:, None, None], n)  # entries (ik, a, b) or (a, ik, b)
         return n[:, None, None, None], n[:, None]  # entries (a, i, b, k)
 
     def _solid_residual(self, s: SolidData, U: FloatArray) -> tuple[FloatArray, float, Any]:
@@ -270,16 +293,22 @@ class SolidSystem3D(FastSystem):
             p, cof, detF, _ = mixed
             A += geometric_blocks(cof, detF, p, _UPPER)
         dtype = self.tangent_dtype
+        name = np.dtype(dtype).name
+        if s.boxes:
+            blocks = self._box_tangent(s, A, dtype)
+            if mixed is not None:
+                self._add_pressure_blocks(s, mixed, blocks.transpose(0, 2, 1, 3))
+            return blocks
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
         A *= s.dV.reshape(-1)  # in place: the kernel's own array, tens of MB
         Ap = A.transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
-        key = f"blocks-{np.dtype(dtype).name}"
+        key = f"blocks-{name}"
         if key not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
             s.layouts[key] = np.empty((c, n, 6, n), dtype=dtype)
-            s.layouts[f"G-{np.dtype(dtype).name}"] = s.layouts["G"].astype(dtype)
-            s.layouts[f"gt-{np.dtype(dtype).name}"] = s.layouts["gt"].astype(dtype)
+            s.layouts[f"G-{name}"] = s.layouts["G"].astype(dtype)
+            s.layouts[f"gt-{name}"] = s.layouts["gt"].astype(dtype)
         blocks = s.layouts[key]
-        G, gt = s.layouts[f"G-{np.dtype(dtype).name}"], s.layouts[f"gt-{np.dtype(dtype).name}"]
+        G, gt = s.layouts[f"G-{name}"], s.layouts[f"gt-{name}"]
         for start in range(0, c, TANGENT_CHUNK):
             sl = slice(start, min(start + TANGENT_CHUNK, c))
             m = sl.stop - sl.start
@@ -288,11 +317,31 @@ class SolidSystem3D(FastSystem):
             E = np.matmul(Ap[sl].reshape(m * q, 18, 3), gt[sl].reshape(m * q, 3, n))
             # K[c, a, (ik, b)] = sum_(q, J) g[c, q, a, J] E[c, (q, J), (ik, b)]
             blocks[sl] = np.matmul(G[sl], E.reshape(m, 3 * q, 6 * n)).reshape(m, n, 6, n)
-        if mixed is not None:  # sum_mn [M^-1 H M^-1]_mn b_m (x) b_n, blocks (i, k) of the computed pairs
-            b, term = self._pressure_vectors(s, mixed[1]), mixed[3]
-            for m_, (i, k) in enumerate(_UPPER):
-                blocks[:, :, m_, :] += np.matmul(np.matmul(b[..., i].transpose(0, 2, 1), term), b[..., k])
+        if mixed is not None:
+            self._add_pressure_blocks(s, mixed, blocks)
         return blocks
+
+    def _box_tangent(self, s: SolidData, A: FloatArray, dtype: type) -> FloatArray:
+        """The element blocks ``(c, ik, a, b)`` of boxes (:attr:`SolidData.boxes`) from the kernel's ``A``
+        ``[ik, J, L, (c, q)]``: ``sum_(J, L, q) A t_J t_L dV D[q, a, J] D[q, b, L]``, one matrix product."""
+        c, q, n, _ = s.g.shape
+        name = np.dtype(dtype).name
+        if f"box-{name}" not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
+            s.layouts[f"box-{name}"] = np.empty((c, 6, 3, 3, q), dtype=dtype)
+            s.layouts[f"blocks-{name}"] = np.empty((c, 6, n, n), dtype=dtype)
+            s.layouts[f"DD-{name}"] = s.layouts["DD"].astype(dtype)
+        weighted, blocks = s.layouts[f"box-{name}"], s.layouts[f"blocks-{name}"]
+        np.multiply(A.reshape(6, 3, 3, c, q).transpose(3, 0, 1, 2, 4), s.layouts["W"], out=weighted,
+                    casting="same_kind")
+        np.matmul(weighted.reshape(c * 6, 9 * q), s.layouts[f"DD-{name}"], out=blocks.reshape(c * 6, n * n))
+        return blocks
+
+    def _add_pressure_blocks(self, s: SolidData, mixed: Any, blocks: FloatArray) -> None:
+        """Add ``sum_mn [M^-1 H M^-1]_mn b_m (x) b_n`` of the elements' own pressure to the blocks (i, k) of the
+        computed pairs (``blocks`` as ``(c, a, ik, b)``)."""
+        b, term = self._pressure_vectors(s, mixed[1]), mixed[3]
+        for m_, (i, k) in enumerate(_UPPER):
+            blocks[:, :, m_, :] += np.matmul(np.matmul(b[..., i].transpose(0, 2, 1), term), b[..., k])
 
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
         if "t" not in w.layouts:  # of the reference faces: kept
