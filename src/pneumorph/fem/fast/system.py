@@ -252,13 +252,16 @@ class SolidSystem3D(FastSystem):
             if owner.boxes:
                 return lo.transpose(0, 2, 1, 3), hi.transpose(0, 2, 1, 3), valid.transpose(0, 2, 1, 3)
             return lo, hi, valid
-        # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries but those of the blocks i == k,
-        # which are zero (e_ikm); the face's cell is a solid's cell, whose entries hold their places in the pattern
+        # entry (f, a, i, b, k): the full face (or obstacle's node) matrix, its upper-triangle entries; of a wall not
+        # those of the blocks i == k, which are zero (e_ikm): the face's cell is a solid's cell, whose entries hold
+        # their places in the pattern
         rows = act[:, :, :, None, None]
         cols = act[:, None, None, :, :]
         rows, cols = np.broadcast_arrays(rows, cols)
-        off = np.arange(3)[:, None, None] != np.arange(3)  # (i, b, k)
-        return rows, cols, (rows >= 0) & (rows <= cols) & off
+        valid = (rows >= 0) & (rows <= cols)
+        if isinstance(owner, WallData):
+            valid &= np.arange(3)[:, None, None] != np.arange(3)  # (i, b, k)
+        return rows, cols, valid
 
     def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         n = np.arange(owner.cells.shape[1])
