@@ -127,3 +127,25 @@ def test_the_tangent_of_box_cells_and_of_distorted_cells_is_felupes(distorted: b
     assert abs(K - K_fe).max() <= 1e-12 * abs(K_fe).max()
     system.tangent_dtype = np.float32
     assert abs(system.tangent() - K_fe).max() <= 1e-6 * abs(K_fe).max()
+
+
+def test_the_3d_kernels_in_passes_give_one_passs_numbers(monkeypatch) -> None:
+    """The Ogden kernel and the eigen-decomposition of C run over slices of points (POINT_CHUNK): to the bit the
+    numbers of one pass over all points, with and without the tangent, given the decomposition or not."""
+    from pneumorph.fem.fast import kernels
+
+    rng = np.random.default_rng(11)
+    F = np.eye(3)[..., None] + 0.2 * rng.standard_normal((3, 3, 1000))
+    F = F[..., np.linalg.det(np.moveaxis(F, -1, 0)) > 0.2]
+    F[..., 0] = np.eye(3)  # equal stretches: LAPACK's points among the closed form's
+    mu, alpha, bulk = (-6.503e-6, 0.2169, 1.372e-3), (-21.32, 1.180, 4.884), 0.119
+    whole = kernels.principal_3d(F), kernels.ogden_3d(F, mu, alpha, bulk, pairs=[(0, 0), (1, 2)]), \
+        kernels.ogden_3d(F, mu, alpha, bulk, tangent=False)
+    monkeypatch.setattr(kernels, "POINT_CHUNK", 97)
+    principal = kernels.principal_3d(F)
+    passes = principal, kernels.ogden_3d(F, mu, alpha, bulk, principal=principal, pairs=[(0, 0), (1, 2)]), \
+        kernels.ogden_3d(F, mu, alpha, bulk, tangent=False)
+    for one, many in zip(whole, passes, strict=True):
+        for a, b in zip(one, many, strict=True):
+            assert (a is None and b is None) or np.array_equal(a, b)
+    assert passes[2][1] is None and passes[1][1].shape == (2, 3, 3, F.shape[-1])
