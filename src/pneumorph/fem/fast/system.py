@@ -273,9 +273,9 @@ class SolidSystem3D(FastSystem):
         c, q = s.dV.shape
         if s.boxes:  # F[c, i, (q, J)] = t_J sum_a u[c, a, i] D[q, a, J], one matrix product, then as [i, J, (c, q)]
             F = np.matmul(U[s.cells].transpose(0, 2, 1).reshape(3 * c, -1), s.layouts["Dr"]).reshape(c, 3, q, 3)
-            Fp = np.empty((3, 3, c, q))
-            np.multiply(F.transpose(1, 3, 0, 2), s.layouts["t"], out=Fp)
-            Fp = Fp.reshape(3, 3, c * q)
+            scaled = np.empty((3, 3, c, q))
+            np.multiply(F.transpose(1, 3, 0, 2), s.layouts["t"], out=scaled)
+            Fp = scaled.reshape(3, 3, c * q)
         else:  # F[c, i, (q, J)] = sum_a u[c, a, i] g[c, q, a, J], then as [i, J, (c, q)]
             F = np.matmul(U[s.cells].transpose(0, 2, 1), s.layouts["G"]).reshape(c, 3, q, 3)
             Fp = np.ascontiguousarray(F.transpose(1, 3, 0, 2)).reshape(3, 3, c * q)
@@ -293,9 +293,9 @@ class SolidSystem3D(FastSystem):
         """``r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV`` of a stress-like field ``P`` (3, 3, c q)."""
         c, q = s.dV.shape
         if s.boxes:  # r[c, i, a] = sum_(q, J) P[i, J, c, q] t_J dV D[q, a, J], one matrix product
-            PdV = np.empty((c, 3, q, 3))
-            np.multiply(P.reshape(3, 3, c, q).transpose(2, 0, 3, 1), s.layouts["tdV"], out=PdV)
-            r = np.matmul(PdV.reshape(3 * c, 3 * q), s.layouts["Dr"].T).reshape(c, 3, -1)
+            weighted = np.empty((c, 3, q, 3))
+            np.multiply(P.reshape(3, 3, c, q).transpose(2, 0, 3, 1), s.layouts["tdV"], out=weighted)
+            r = np.matmul(weighted.reshape(3 * c, 3 * q), s.layouts["Dr"].T).reshape(c, 3, -1)
             return np.ascontiguousarray(r.transpose(0, 2, 1))
         PdV = (P * s.dV.reshape(-1)).reshape(3, 3, c, q).transpose(2, 3, 1, 0).reshape(c, 3 * q, 3)
         return np.matmul(s.layouts["G"], PdV)
