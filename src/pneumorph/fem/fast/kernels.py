@@ -313,21 +313,14 @@ def ogden_3d(
     (0.0, 10.133333333333, 0.1)
     """
     if F.shape[-1] > POINT_CHUNK:
-        P_, A_, J_ = _in_chunks(lambda points: ogden_3d(
-            F[..., points], mu, alpha, bulk, tangent,
-            None if principal is None else (principal[0][:, points], principal[1][..., points]), pairs), F.shape[-1])
-        return P_, A_, J_
-    mu_ = [float(v) for v in mu]
-    alpha_ = [float(v) for v in alpha]
+        return _ogden_passes(F, mu, alpha, bulk, tangent, principal, pairs)
+    mu_, alpha_ = [float(v) for v in mu], [float(v) for v in alpha]
     terms = range(len(mu_))
     n = F.shape[-1]
     c_all, Nv = principal if principal is not None else principal_3d(F)  # Nv[a, J, p] = N_a,J
     c = [c_all[0], c_all[1], c_all[2]]
-    J = (
-        F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
-        - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
-        + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0])
-    )
+    J = (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+         + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
     lnJ = np.log(J)
     lnc = [np.log(ca) - lnJ / 1.5 for ca in c]  # ln of c_a J^(-2/3)
     lb = [[np.exp((0.5 * a) * lnc[b]) for b in range(3)] for a in alpha_]  # lb[n][b]
@@ -391,6 +384,17 @@ def ogden_3d(
             for L, R in zip(left[1:], right[1:], strict=False):
                 row += L[i, j] * R
             row[i] += S_mat[j]
+    return P, A, J
+
+
+def _ogden_passes(
+    F: FloatArray, mu: Sequence[float] | FloatArray, alpha: Sequence[float] | FloatArray, bulk: float, tangent: bool,
+    principal: tuple[FloatArray, FloatArray] | None, pairs: Sequence[tuple[int, int]] | None,
+) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+    """:func:`ogden_3d` over passes of :data:`POINT_CHUNK` points (the same numbers)."""
+    P, A, J = _in_chunks(lambda points: ogden_3d(
+        F[..., points], mu, alpha, bulk, tangent,
+        None if principal is None else (principal[0][:, points], principal[1][..., points]), pairs), F.shape[-1])
     return P, A, J
 
 
