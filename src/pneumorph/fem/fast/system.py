@@ -224,20 +224,23 @@ class SolidSystem3D(FastSystem):
     def _prepare(self, s: SolidData, region: Any) -> None:
         g = s.g
         c, q, n, _ = g.shape
-        s.layouts = {
-            "G": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 3 * q)),  # [c, a, (q, J)]
-            "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
-        }
         scales = _box_scales(region)
-        if scales is not None:  # g[c, q, b, L] = D[q, b, L] t[c, L]: the products by D, a constant
-            D = np.ascontiguousarray(np.transpose(region.dhdr[..., 0], (2, 0, 1)))  # (q, n, 3)
-            # W[c, J, L, q] = t_J t_L dV, DD[(J, L, q), (a, b)] = D[q, a, J] D[q, b, L]
-            s.layouts["W"] = (scales[:, :, None, None] * scales[:, None, :, None] * s.dV[:, None, None, :])[:, None]
-            s.layouts["DD"] = np.einsum("qaJ,qbL->JLqab", D, D).reshape(9 * q, n * n)
-            s.layouts["Dr"] = np.ascontiguousarray(D.transpose(1, 0, 2).reshape(n, 3 * q))  # [a, (q, J)]
-            s.layouts["t"] = np.ascontiguousarray(scales.T[None, :, :, None])  # [., J, c, .]
-            s.layouts["tdV"] = scales[:, None, None, :] * s.dV[:, None, :, None]  # [c, ., q, J]
-            s.boxes = True
+        if scales is None:  # every point's gradients
+            s.layouts = {
+                "G": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 3 * q)),  # [c, a, (q, J)]
+                "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
+            }
+            return
+        # g[c, q, b, L] = D[q, b, L] t[c, L]: the products by D, a constant
+        D = np.ascontiguousarray(np.transpose(region.dhdr[..., 0], (2, 0, 1)))  # (q, n, 3)
+        s.layouts = {  # W[c, J, L, q] = t_J t_L dV, DD[(J, L, q), (a, b)] = D[q, a, J] D[q, b, L]
+            "W": (scales[:, :, None, None] * scales[:, None, :, None] * s.dV[:, None, None, :])[:, None],
+            "DD": np.einsum("qaJ,qbL->JLqab", D, D).reshape(9 * q, n * n),
+            "Dr": np.ascontiguousarray(D.transpose(1, 0, 2).reshape(n, 3 * q)),  # [a, (q, J)]
+            "t": np.ascontiguousarray(scales.T[None, :, :, None]),  # [., J, c, .]
+            "tdV": scales[:, None, None, :] * s.dV[:, None, :, None],  # [c, ., q, J]
+        }
+        s.boxes = True
 
     def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         ik = np.array(_UPPER)
