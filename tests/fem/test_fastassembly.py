@@ -95,3 +95,57 @@ def test_a_design_solved_again_on_the_kept_pattern_and_ordering_gives_the_same_a
     assert second.response.metadata["newton_iterations"] == first.response.metadata["newton_iterations"]
     np.testing.assert_array_equal(second.displacements, first.displacements)
     assert np.abs(first.displacements[-1]).max() > 1.0  # it bent (mm)
+
+
+@pytest.mark.parametrize("distorted", [False, True], ids=["boxes", "distorted"])
+def test_the_tangent_of_box_cells_and_of_distorted_cells_is_felupes(distorted: bool) -> None:
+    """Box cells contract the tangent with the element's reference gradients in one matrix product (their
+    own order of entries, their own pattern key); distorted cells take every point's gradients. Both: FElupe's
+    tangent to rounding, in double and (to single precision) in single precision."""
+    import felupe as fem
+    from felupe.tools._newton import fun_items, jac_items
+
+    from pneumorph.fem import OgdenCompressible
+
+    mesh = fem.Cube(b=(2.0, 1.0, 1.5), n=(4, 3, 3)).add_midpoints_edges()
+    X = mesh.points.copy()
+    if distorted:  # a smooth map that shears and bends the cells
+        mesh.points[:, 1] += 0.15 * X[:, 0] ** 2 + 0.1 * X[:, 2]
+        mesh.points[:, 2] += 0.1 * np.sin(2.0 * X[:, 1])
+    field = fem.FieldContainer([fem.Field(fem.RegionQuadraticHexahedron(mesh), dim=3)])
+    solid = fem.SolidBody(OgdenCompressible((-6.503e-6, 0.2169, 1.372e-3), (-21.32, 1.180, 4.884), 0.119), field)
+    dof0, dof1 = fem.dof.partition(field, {"x0": fem.Boundary(field[0], fx=0.0)})
+    system = SolidSystem3D([solid], field, dof1, dof0)
+    assert system.solids[0].boxes is not distorted
+    u = np.zeros(system.ndof)
+    u[dof1] = 0.02 * np.random.default_rng(7).standard_normal(dof1.size)
+    field[0].values[:] = u.reshape(-1, 3)
+    system.residual(u)
+    K = system.tangent()
+    fun_items([solid], field)
+    K_fe = jac_items([solid], field).tocsr()[dof1][:, dof1]
+    assert abs(K - K_fe).max() <= 1e-12 * abs(K_fe).max()
+    system.tangent_dtype = np.float32
+    assert abs(system.tangent() - K_fe).max() <= 1e-6 * abs(K_fe).max()
+
+
+def test_the_3d_kernels_in_passes_give_one_passs_numbers(monkeypatch) -> None:
+    """The Ogden kernel and the eigen-decomposition of C run over slices of points (POINT_CHUNK): to the bit the
+    numbers of one pass over all points, with and without the tangent, given the decomposition or not."""
+    from pneumorph.fem.fast import kernels
+
+    rng = np.random.default_rng(11)
+    F = np.eye(3)[..., None] + 0.2 * rng.standard_normal((3, 3, 1000))
+    F = F[..., np.linalg.det(np.moveaxis(F, -1, 0)) > 0.2]
+    F[..., 0] = np.eye(3)  # equal stretches: LAPACK's points among the closed form's
+    mu, alpha, bulk = (-6.503e-6, 0.2169, 1.372e-3), (-21.32, 1.180, 4.884), 0.119
+    whole = kernels.principal_3d(F), kernels.ogden_3d(F, mu, alpha, bulk, pairs=[(0, 0), (1, 2)]), \
+        kernels.ogden_3d(F, mu, alpha, bulk, tangent=False)
+    monkeypatch.setattr(kernels, "POINT_CHUNK", 97)
+    principal = kernels.principal_3d(F)
+    passes = principal, kernels.ogden_3d(F, mu, alpha, bulk, principal=principal, pairs=[(0, 0), (1, 2)]), \
+        kernels.ogden_3d(F, mu, alpha, bulk, tangent=False)
+    for one, many in zip(whole, passes, strict=True):
+        for a, b in zip(one, many, strict=True):
+            assert (a is None and b is None) or np.array_equal(a, b)
+    assert passes[2][1] is None and passes[1][1].shape == (2, 3, 3, F.shape[-1])

@@ -63,6 +63,10 @@ class SolidData:
     #: the material and its elements' pressure space when its volumetric term is integrated on a dilatation of its
     #: own (:mod:`.mixed`)
     mixed: Any = None
+    #: every cell is a box along the axes (``dN/dX = dN/dr dr/dX`` with a constant, diagonal ``dr/dX`` per cell):
+    #: the dimension may contract its tangent with the reference gradients, a constant of the element, in one
+    #: matrix product (and order the entries otherwise: part of the pattern's key)
+    boxes: bool = False
 
 
 @dataclass
@@ -77,6 +81,8 @@ class WallData:
     take: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     scatter: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     edofs: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    #: what the dimension's tangent keeps of the reference faces between evaluations
+    layouts: dict[str, Any] = field(default_factory=dict)
 
 
 def deformation_gradient(g: FloatArray, cells: IntArray, U: FloatArray) -> FloatArray:
@@ -160,7 +166,7 @@ class FastSystem:
                 self.walls.append(WallData(item, cells, g, h, ndA))
             elif isinstance(item, fem.SolidBody):
                 solid = SolidData(cells, g, np.ascontiguousarray(region.dV.T), self._kernel_of(item.umat))
-                solid.layouts = self._layouts(g)
+                self._prepare(solid, region)
                 if getattr(item.umat, "mixed", False):  # P1 on quadratic cells, P0 on linear ones
                     X = np.einsum("aq,cad->cqd", region.h[:, :, 0], self.points[cells])
                     solid.mixed = (item.umat, pressure_space(X, solid.dV, linear=cells.shape[1] > 2**d))
@@ -180,8 +186,9 @@ class FastSystem:
     def _kernel_of(self, umat: Any) -> Any:
         raise NotImplementedError  # pragma: no cover
 
-    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
-        """The gradients in the layouts this dimension's products need."""
+    def _prepare(self, s: SolidData, region: Any) -> None:
+        """Set a solid's gradients in the layouts this dimension's products need (``s.layouts``, ``s.boxes``;
+        ``region``: the FElupe region they come from)."""
         raise NotImplementedError  # pragma: no cover
 
     def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
@@ -204,7 +211,8 @@ class FastSystem:
         raise NotImplementedError  # pragma: no cover
 
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
-        """The follower-pressure stiffness of some walls, entries in :meth:`_entries` order."""
+        """The follower-pressure stiffness of some walls: its assembled entries (``w.take`` of the
+        :meth:`_entries` order)."""
         raise NotImplementedError  # pragma: no cover
 
     @staticmethod
@@ -245,7 +253,7 @@ class FastSystem:
         owners: list[Any] = [*self.solids, *self.walls, *self.contacts]
         for owner in owners:
             cells = np.ascontiguousarray(owner.cells, dtype=np.int64)
-            digest.update(f"{type(owner).__name__} {cells.shape}".encode())
+            digest.update(f"{type(owner).__name__} {cells.shape} {getattr(owner, 'boxes', False)}".encode())
             digest.update(cells.tobytes())
         return digest.hexdigest()
 
@@ -390,8 +398,7 @@ class FastSystem:
             values[start : start + s.take.size] = self._solid_tangent(s, state).ravel()[s.take]
             start += s.take.size
         for w in self.walls:
-            K = self._wall_tangent(w, float(w.item.results.pressure), self._U)
-            values[start : start + w.take.size] = K.ravel()[w.take]
+            values[start : start + w.take.size] = self._wall_tangent(w, float(w.item.results.pressure), self._U)
             start += w.take.size
         remainders = []
         for c in self.contacts:  # (m, d, d): the entries (a, i, k, b) and (a, i, b, k) of one node alike

@@ -22,12 +22,33 @@ axis, so that NumPy's elementwise loops run over long rows rather than 2x2 block
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
+
+#: points per pass of the 3D kernels (:func:`principal_3d`, :func:`ogden_3d`): their tens of temporary rows of
+#: this many numbers stay in the processor's cache. The same numbers as one pass (every operation is per point);
+#: the 15-unit half model's tangent kernel (65,610 points) took 82 ms in passes of 4,096 against 112 ms in one.
+POINT_CHUNK = 4096
+
+
+def _in_chunks(compute: Callable[[slice], tuple[Any, ...]], n: int) -> tuple[Any, ...]:
+    """``compute(points)`` of slices of :data:`POINT_CHUNK` of ``n`` points, its arrays (points last, or None)
+    joined."""
+    joined: list[Any] = []
+    for start in range(0, n, POINT_CHUNK):
+        points = slice(start, min(start + POINT_CHUNK, n))
+        part = compute(points)
+        if not joined:
+            joined = [None if a is None else np.empty((*a.shape[:-1], n), dtype=a.dtype) for a in part]
+        for whole, a in zip(joined, part, strict=True):
+            if whole is not None:
+                whole[..., points] = a
+    return tuple(joined)
 
 
 def _power_divided_difference(cb: FloatArray, ca: FloatArray, k: float) -> FloatArray:
@@ -184,6 +205,9 @@ def principal_3d(F: FloatArray) -> tuple[FloatArray, FloatArray]:
     >>> np.round(c[:, 0], 12).tolist(), np.round(abs(N[..., 0]), 12).tolist()
     ([1.0, 1.44, 2.25], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     """
+    if F.shape[-1] > POINT_CHUNK:
+        c_, N_ = _in_chunks(lambda points: principal_3d(F[..., points]), F.shape[-1])
+        return c_, N_
     C11 = F[0, 0] * F[0, 0] + F[1, 0] * F[1, 0] + F[2, 0] * F[2, 0]
     C22 = F[0, 1] * F[0, 1] + F[1, 1] * F[1, 1] + F[2, 1] * F[2, 1]
     C33 = F[0, 2] * F[0, 2] + F[1, 2] * F[1, 2] + F[2, 2] * F[2, 2]
@@ -288,17 +312,15 @@ def ogden_3d(
     >>> float(abs(P).max()), round(float(A[0, 0, 0, 0, 0]), 12), round(float(A[0, 1, 0, 1, 0]), 12)
     (0.0, 10.133333333333, 0.1)
     """
-    mu_ = [float(v) for v in mu]
-    alpha_ = [float(v) for v in alpha]
+    if F.shape[-1] > POINT_CHUNK:
+        return _ogden_passes(F, mu, alpha, bulk, tangent, principal, pairs)
+    mu_, alpha_ = [float(v) for v in mu], [float(v) for v in alpha]
     terms = range(len(mu_))
     n = F.shape[-1]
     c_all, Nv = principal if principal is not None else principal_3d(F)  # Nv[a, J, p] = N_a,J
     c = [c_all[0], c_all[1], c_all[2]]
-    J = (
-        F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
-        - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
-        + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0])
-    )
+    J = (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+         + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
     lnJ = np.log(J)
     lnc = [np.log(ca) - lnJ / 1.5 for ca in c]  # ln of c_a J^(-2/3)
     lb = [[np.exp((0.5 * a) * lnc[b]) for b in range(3)] for a in alpha_]  # lb[n][b]
@@ -362,6 +384,17 @@ def ogden_3d(
             for L, R in zip(left[1:], right[1:], strict=False):
                 row += L[i, j] * R
             row[i] += S_mat[j]
+    return P, A, J
+
+
+def _ogden_passes(
+    F: FloatArray, mu: Sequence[float] | FloatArray, alpha: Sequence[float] | FloatArray, bulk: float, tangent: bool,
+    principal: tuple[FloatArray, FloatArray] | None, pairs: Sequence[tuple[int, int]] | None,
+) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+    """:func:`ogden_3d` over passes of :data:`POINT_CHUNK` points (the same numbers)."""
+    P, A, J = _in_chunks(lambda points: ogden_3d(
+        F[..., points], mu, alpha, bulk, tangent,
+        None if principal is None else (principal[0][:, points], principal[1][..., points]), pairs), F.shape[-1])
     return P, A, J
 
 

@@ -91,9 +91,10 @@ class PlaneStrainSystem(FastSystem):
             return lambda F: neo_hooke_plane_strain(F, float(umat.mu), float(umat.lmbda))
         raise TypeError(f"no fast plane-strain kernel for {type(umat).__name__}; use the FElupe backend")
 
-    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+    def _prepare(self, s: SolidData, region: Any) -> None:
+        g = s.g
         c, q, n, _ = g.shape
-        return {
+        s.layouts = {
             "g_res": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 2 * q)),  # [c, a, (q, J)]
             "gT": np.ascontiguousarray(g.transpose(0, 1, 3, 2).reshape(c * q, 2, n)),  # [(c, q), L, b]
             # d_ii' g[c, q, a, J] as [c, (a, i), (q, i', J)]
@@ -149,7 +150,7 @@ class PlaneStrainSystem(FastSystem):
         # t[f, q, b] = N_1 dN_b/dX_2 - N_2 dN_b/dX_1 (with dA); M[f, a, b] = p sum_q h_a t_b
         t = w.ndA[..., 0:1] * w.g[..., 1] - w.ndA[..., 1:2] * w.g[..., 0]
         M = p * np.matmul(w.h.T[None], t)  # (f, n, n)
-        return _EPS[None, None, :, :, None] * M[:, :, None, None, :]  # (f, a, i, k, b)
+        return (_EPS[None, None, :, :, None] * M[:, :, None, None, :]).ravel()[w.take]  # of (f, a, i, k, b)
 
     @staticmethod
     def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
@@ -157,6 +158,17 @@ class PlaneStrainSystem(FastSystem):
         out[..., 0] = F[..., 1, 1] * ndA[..., 0] - F[..., 1, 0] * ndA[..., 1]
         out[..., 1] = -F[..., 0, 1] * ndA[..., 0] + F[..., 0, 0] * ndA[..., 1]
         return out
+
+
+def _box_scales(region: Any) -> FloatArray | None:
+    """``dr_J/dX_J`` of every cell ``(c, 3)`` if every cell of a 3D region is a box along the axes (``dr/dX``
+    diagonal and the same at every point, to 1e-12 of its largest entry), else None."""
+    drdX, dhdr = np.asarray(region.drdX), np.asarray(region.dhdr)
+    if drdX.shape[:2] != (3, 3) or dhdr.ndim != 4 or dhdr.shape[-1] != 1:
+        return None
+    scales = np.ascontiguousarray(np.diagonal(drdX[:, :, 0], axis1=0, axis2=1))  # (c, 3)
+    box = np.eye(3)[:, :, None, None] * scales.T[:, None, None, :]
+    return scales if np.abs(drdX - box).max() <= 1e-12 * np.abs(drdX).max() else None
 
 
 def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -209,40 +221,67 @@ class SolidSystem3D(FastSystem):
                                                              volumetric=not umat.mixed)
         raise TypeError(f"no fast 3D kernel for {type(umat).__name__}; use the FElupe backend")
 
-    def _layouts(self, g: FloatArray) -> dict[str, FloatArray]:
+    def _prepare(self, s: SolidData, region: Any) -> None:
+        g = s.g
         c, q, n, _ = g.shape
-        return {
-            "G": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 3 * q)),  # [c, a, (q, J)]
-            "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
+        scales = _box_scales(region)
+        if scales is None:  # every point's gradients
+            s.layouts = {
+                "G": np.ascontiguousarray(g.transpose(0, 2, 1, 3).reshape(c, n, 3 * q)),  # [c, a, (q, J)]
+                "gt": np.ascontiguousarray(g.transpose(0, 1, 3, 2)),  # [c, q, L, b]
+            }
+            return
+        # g[c, q, b, L] = D[q, b, L] t[c, L]: the products by D, a constant
+        D = np.ascontiguousarray(np.transpose(region.dhdr[..., 0], (2, 0, 1)))  # (q, n, 3)
+        s.layouts = {  # W[c, J, L, q] = t_J t_L dV, DD[(J, L, q), (a, b)] = D[q, a, J] D[q, b, L]
+            "W": (scales[:, :, None, None] * scales[:, None, :, None] * s.dV[:, None, None, :])[:, None],
+            "DD": np.einsum("qaJ,qbL->JLqab", D, D).reshape(9 * q, n * n),
+            "Dr": np.ascontiguousarray(D.transpose(1, 0, 2).reshape(n, 3 * q)),  # [a, (q, J)]
+            "t": np.ascontiguousarray(scales.T[None, :, :, None]),  # [., J, c, .]
+            "tdV": scales[:, None, None, :] * s.dV[:, None, :, None],  # [c, ., q, J]
         }
+        s.boxes = True
 
     def _entries(self, owner: SolidData | WallData, act: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         ik = np.array(_UPPER)
         if isinstance(owner, SolidData):
-            # entry (c, a, ik, b) at (row of (a, i), column of (b, k)); blocks i < k
+            # entry (c, a, ik, b) at (row of (a, i), column of (b, k)), (c, ik, a, b) of boxes; blocks i < k
             # stand for themselves and their transposes, blocks i == k hold both
             off = (ik[:, 0] != ik[:, 1])[None, None, :, None]
             rows = act[:, :, ik[:, 0]][:, :, :, None]
             cols = act[:, :, ik[:, 1]].transpose(0, 2, 1)[:, None]
             lo, hi = np.minimum(rows, cols), np.maximum(rows, cols)
-            return lo, hi, (lo >= 0) & (off | (rows <= cols))
-        # entry (f, a, i, b, k): the full face matrix, its upper-triangle entries
+            valid = (lo >= 0) & (off | (rows <= cols))
+            if owner.boxes:
+                return lo.transpose(0, 2, 1, 3), hi.transpose(0, 2, 1, 3), valid.transpose(0, 2, 1, 3)
+            return lo, hi, valid
+        # entry (f, a, i, b, k): the full face (or obstacle's node) matrix, its upper-triangle entries; of a wall not
+        # those of the blocks i == k, which are zero (e_ikm): the face's cell is a solid's cell, whose entries hold
+        # their places in the pattern
         rows = act[:, :, :, None, None]
         cols = act[:, None, None, :, :]
         rows, cols = np.broadcast_arrays(rows, cols)
-        return rows, cols, (rows >= 0) & (rows <= cols)
+        valid = (rows >= 0) & (rows <= cols)
+        if isinstance(owner, WallData):
+            valid &= np.arange(3)[:, None, None] != np.arange(3)  # (i, b, k)
+        return rows, cols, valid
 
     def _entry_nodes(self, owner: SolidData | WallData) -> tuple[IntArray, IntArray]:
         n = np.arange(owner.cells.shape[1])
         if isinstance(owner, SolidData):
-            return n[:, None, None], n  # entries (a, ik, b)
+            return (n[None, :, None], n) if owner.boxes else (n[:, None, None], n)  # entries (ik, a, b) or (a, ik, b)
         return n[:, None, None, None], n[:, None]  # entries (a, i, b, k)
 
     def _solid_residual(self, s: SolidData, U: FloatArray) -> tuple[FloatArray, float, Any]:
         c, q = s.dV.shape
-        # F[c, i, (q, J)] = sum_a u[c, a, i] g[c, q, a, J], then as [i, J, (c, q)]
-        F = np.matmul(U[s.cells].transpose(0, 2, 1), s.layouts["G"]).reshape(c, 3, q, 3)
-        Fp = np.ascontiguousarray(F.transpose(1, 3, 0, 2)).reshape(3, 3, c * q)
+        if s.boxes:  # F[c, i, (q, J)] = t_J sum_a u[c, a, i] D[q, a, J], one matrix product, then as [i, J, (c, q)]
+            F = np.matmul(U[s.cells].transpose(0, 2, 1).reshape(3 * c, -1), s.layouts["Dr"]).reshape(c, 3, q, 3)
+            scaled = np.empty((3, 3, c, q))
+            np.multiply(F.transpose(1, 3, 0, 2), s.layouts["t"], out=scaled)
+            Fp = scaled.reshape(3, 3, c * q)
+        else:  # F[c, i, (q, J)] = sum_a u[c, a, i] g[c, q, a, J], then as [i, J, (c, q)]
+            F = np.matmul(U[s.cells].transpose(0, 2, 1), s.layouts["G"]).reshape(c, 3, q, 3)
+            Fp = np.ascontiguousarray(F.transpose(1, 3, 0, 2)).reshape(3, 3, c * q)
         Fp[0, 0] += 1.0
         Fp[1, 1] += 1.0
         Fp[2, 2] += 1.0
@@ -256,6 +295,11 @@ class SolidSystem3D(FastSystem):
     def _element_vectors(self, s: SolidData, P: FloatArray) -> FloatArray:
         """``r[c, a, i] = sum_(q, J) g[c, q, a, J] P[i, J, c, q] dV`` of a stress-like field ``P`` (3, 3, c q)."""
         c, q = s.dV.shape
+        if s.boxes:  # r[c, i, a] = sum_(q, J) P[i, J, c, q] t_J dV D[q, a, J], one matrix product
+            weighted = np.empty((c, 3, q, 3))
+            np.multiply(P.reshape(3, 3, c, q).transpose(2, 0, 3, 1), s.layouts["tdV"], out=weighted)
+            r = np.matmul(weighted.reshape(3 * c, 3 * q), s.layouts["Dr"].T).reshape(c, 3, -1)
+            return np.ascontiguousarray(r.transpose(0, 2, 1))
         PdV = (P * s.dV.reshape(-1)).reshape(3, 3, c, q).transpose(2, 3, 1, 0).reshape(c, 3 * q, 3)
         return np.matmul(s.layouts["G"], PdV)
 
@@ -268,16 +312,22 @@ class SolidSystem3D(FastSystem):
             p, cof, detF, _ = mixed
             A += geometric_blocks(cof, detF, p, _UPPER)
         dtype = self.tangent_dtype
+        name = np.dtype(dtype).name
+        if s.boxes:
+            blocks = self._box_tangent(s, A, dtype)
+            if mixed is not None:
+                self._add_pressure_blocks(s, mixed, blocks.transpose(0, 2, 1, 3))
+            return blocks
         # A[i, J, k, L, p] for the computed (i, k) pairs, as [p, J, ik, L] with dV
         A *= s.dV.reshape(-1)  # in place: the kernel's own array, tens of MB
         Ap = A.transpose(3, 1, 0, 2).astype(dtype).reshape(c, q, 3, 6, 3)
-        key = f"blocks-{np.dtype(dtype).name}"
+        key = f"blocks-{name}"
         if key not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
             s.layouts[key] = np.empty((c, n, 6, n), dtype=dtype)
-            s.layouts[f"G-{np.dtype(dtype).name}"] = s.layouts["G"].astype(dtype)
-            s.layouts[f"gt-{np.dtype(dtype).name}"] = s.layouts["gt"].astype(dtype)
+            s.layouts[f"G-{name}"] = s.layouts["G"].astype(dtype)
+            s.layouts[f"gt-{name}"] = s.layouts["gt"].astype(dtype)
         blocks = s.layouts[key]
-        G, gt = s.layouts[f"G-{np.dtype(dtype).name}"], s.layouts[f"gt-{np.dtype(dtype).name}"]
+        G, gt = s.layouts[f"G-{name}"], s.layouts[f"gt-{name}"]
         for start in range(0, c, TANGENT_CHUNK):
             sl = slice(start, min(start + TANGENT_CHUNK, c))
             m = sl.stop - sl.start
@@ -286,23 +336,46 @@ class SolidSystem3D(FastSystem):
             E = np.matmul(Ap[sl].reshape(m * q, 18, 3), gt[sl].reshape(m * q, 3, n))
             # K[c, a, (ik, b)] = sum_(q, J) g[c, q, a, J] E[c, (q, J), (ik, b)]
             blocks[sl] = np.matmul(G[sl], E.reshape(m, 3 * q, 6 * n)).reshape(m, n, 6, n)
-        if mixed is not None:  # sum_mn [M^-1 H M^-1]_mn b_m (x) b_n, blocks (i, k) of the computed pairs
-            b, term = self._pressure_vectors(s, mixed[1]), mixed[3]
-            for m_, (i, k) in enumerate(_UPPER):
-                blocks[:, :, m_, :] += np.matmul(np.matmul(b[..., i].transpose(0, 2, 1), term), b[..., k])
+        if mixed is not None:
+            self._add_pressure_blocks(s, mixed, blocks)
         return blocks
 
+    def _box_tangent(self, s: SolidData, A: FloatArray, dtype: type) -> FloatArray:
+        """The element blocks ``(c, ik, a, b)`` of boxes (:attr:`SolidData.boxes`) from the kernel's ``A``
+        ``[ik, J, L, (c, q)]``: ``sum_(J, L, q) A t_J t_L dV D[q, a, J] D[q, b, L]``, one matrix product."""
+        c, q, n, _ = s.g.shape
+        name = np.dtype(dtype).name
+        if f"box-{name}" not in s.layouts:  # kept: allocating tens of MB per tangent costs page faults
+            s.layouts[f"box-{name}"] = np.empty((c, 6, 3, 3, q), dtype=dtype)
+            s.layouts[f"blocks-{name}"] = np.empty((c, 6, n, n), dtype=dtype)
+            s.layouts[f"DD-{name}"] = s.layouts["DD"].astype(dtype)
+        weighted, blocks = s.layouts[f"box-{name}"], s.layouts[f"blocks-{name}"]
+        np.multiply(A.reshape(6, 3, 3, c, q).transpose(3, 0, 1, 2, 4), s.layouts["W"], out=weighted,
+                    casting="same_kind")
+        np.matmul(weighted.reshape(c * 6, 9 * q), s.layouts[f"DD-{name}"], out=blocks.reshape(c * 6, n * n))
+        return blocks
+
+    def _add_pressure_blocks(self, s: SolidData, mixed: Any, blocks: FloatArray) -> None:
+        """Add ``sum_mn [M^-1 H M^-1]_mn b_m (x) b_n`` of the elements' own pressure to the blocks (i, k) of the
+        computed pairs (``blocks`` as ``(c, a, ik, b)``)."""
+        b, term = self._pressure_vectors(s, mixed[1]), mixed[3]
+        for m_, (i, k) in enumerate(_UPPER):
+            blocks[:, :, m_, :] += np.matmul(np.matmul(b[..., i].transpose(0, 2, 1), term), b[..., k])
+
     def _wall_tangent(self, w: WallData, p: float, U: FloatArray) -> FloatArray:
+        if "t" not in w.layouts:  # of the reference faces: kept
+            f, q, n, _ = w.g.shape
+            w.layouts["t"] = _cross(w.ndA[:, :, None, :], w.g)  # (f, q, n, 3)
+            # the entry (f, a, i, b, k) is e_ikm M[f, a, b, m]: its m and sign
+            face, a, i, b, k = np.unravel_index(w.take, (f, n, 3, n, 3))
+            w.layouts["source"] = ((face * n + a) * n + b) * 3 + (3 - i - k)
+            w.layouts["sign"] = np.where((k - i) % 3 == 1, 1.0, -1.0)
         F = deformation_gradient(w.g, w.cells, U)
         # v[f, q, b, m] = [F (N dA x dN_b/dX)]_m; M[f, a, b, m] = p sum_q h_a v_bm
-        t = _cross(w.ndA[:, :, None, :], w.g)  # (f, q, n, 3)
-        v = np.matmul(t, F.transpose(0, 1, 3, 2))  # (f, q, n, m)
+        v = np.matmul(w.layouts["t"], F.transpose(0, 1, 3, 2))  # (f, q, n, m)
         f, q, n, _ = v.shape
-        M = p * np.matmul(w.h.T[None], v.reshape(f, q, 3 * n)).reshape(f, n, n, 3)
-        K = np.zeros((f, n, 3, n, 3))  # K[a, i, b, k] = e_ikm M[a, b, m]
-        for i, k, m_, sign in ((0, 1, 2, 1), (1, 2, 0, 1), (2, 0, 1, 1), (1, 0, 2, -1), (2, 1, 0, -1), (0, 2, 1, -1)):
-            K[:, :, i, :, k] = sign * M[..., m_]
-        return K
+        M = np.matmul(w.h.T[None], v.reshape(f, q, 3 * n))  # (f, a, (b, m))
+        return M.ravel()[w.layouts["source"]] * (p * w.layouts["sign"])
 
     @staticmethod
     def _cof_normal(F: FloatArray, ndA: FloatArray) -> FloatArray:
