@@ -342,12 +342,12 @@ class RigidContact:
         self.cells = self.points[:, None]
 
     def evaluate(self, x: FloatArray, symmetric: bool = False) -> tuple[FloatArray, FloatArray, NDArray[np.bool_],
-                                                                        FloatArray]:
+                                                                        FloatArray, NDArray[np.bool_]]:
         """At the positions ``x`` of all the body's points (p, d): the force on the obstacle at every node
         ``k phi(g) n`` (:func:`penalty_gap`) plus its friction (:mod:`.friction`), (m, d); their blocks
         ``k (phi'(g) n (x) n + phi(g) H)`` plus friction's, (m, d, d; ``symmetric``: for a symmetric tangent,
         :func:`~pneumorph.fem.fast.friction.coulomb`'s ``coupled`` off); which nodes the obstacle pushes
-        (``phi < 0``); and the anchors a commit at ``x`` keeps (m, d)."""
+        (``phi < 0``); the anchors a commit at ``x`` keeps (m, d); and which nodes slide (m,)."""
         xs = x[self.points]
         gap, n, H = self.obstacle.kinematics(xs)
         phi, slope = penalty_gap(gap, self.smoothing)
@@ -358,6 +358,7 @@ class RigidContact:
             K += self.stiffness * bound[:, None, None] * H
         active = phi < 0.0
         anchors = xs.copy()  # out of contact: where a node is
+        sliding = np.zeros(len(xs), dtype=bool)
         if self.friction > 0.0 and np.any(active):
             a = np.flatnonzero(active)
             reference = xs[a] if self.anchors is None else self.anchors[a]
@@ -367,12 +368,26 @@ class RigidContact:
             force[a] += ft
             K[a] += Kt
             anchors[a] = xs[a] - kept
-        return force, K, active, anchors
+            sliding[a] = np.any(kept != e, axis=1)  # (a return-mapped slip is shorter)
+        return force, K, active, anchors, sliding
 
     def forces(self, x: FloatArray) -> tuple[FloatArray, NDArray[np.bool_]]:
         """The force on the obstacle at every node (m, d) and which nodes it pushes (:meth:`evaluate`)."""
-        force, _, active, _ = self.evaluate(x)
+        force, _, active, _, _ = self.evaluate(x)
         return force, active
+
+    def states(self, x: FloatArray) -> NDArray[np.int8]:
+        """Every node's contact state at ``x`` (all the body's points): 0 free, 1 pressed (sticking), 2 sliding.
+
+        >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, friction=0.5)
+        >>> contact.states(np.array([[0.0, 0.0], [1.25, 0.0]])).tolist()  # pressed where it is: sticking
+        [0, 1]
+        >>> contact.commit(np.array([[0.0, 0.0], [1.25, 0.0]]))
+        >>> contact.states(np.array([[0.0, 0.0], [1.25, 3.0]])).tolist()  # 3 mm sideways: 3 N > 0.5 x 2.5 N
+        [0, 2]
+        """
+        _, _, active, _, sliding = self.evaluate(x)
+        return np.asarray(active.astype(np.int8) + sliding, dtype=np.int8)
 
     def residual(self, x: FloatArray) -> FloatArray:
         """The nodes' contributions to the residual, (m, d) (the force on the obstacle)."""

@@ -53,6 +53,10 @@ GROWTH = 2.0
 #: keeps :data:`GROWTH` (85 iterations either way).
 FRICTION_GROWTH = 1.0
 
+#: Whether a step that changed a node's contact state (free, sticking, sliding) has the tangent refreshed at once,
+#: on a body with obstacles, instead of kept while it lowers the residual.
+REFRESH_ON_CHANGE = True
+
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
 #: before a single-precision factorisation is judged too inaccurate and replaced by a
 #: double-precision one. A fresh Newton step near the solution converges quadratically;
@@ -121,10 +125,14 @@ def contact_fraction(system: Any, u: FloatArray, step: FloatArray) -> float:
     return min(c.step_fraction(x, dx) for c in contacts)
 
 
-def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray) -> bool:
-    """Whether some surface node touches an obstacle at ``u_new`` (all dofs) and not at ``u``, or the reverse."""
+def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: bool = False) -> bool:
+    """Whether some surface node touches an obstacle at ``u_new`` (all dofs) and not at ``u``, or the reverse
+    (``sliding``: or sticks at one and slides at the other,
+    :meth:`~pneumorph.fem.fast.contact.RigidContact.states`)."""
     d = system.points.shape[1]
     x, x_new = system.points + u.reshape(-1, d), system.points + u_new.reshape(-1, d)
+    if sliding:
+        return any(np.any(c.states(x) != c.states(x_new)) for c in getattr(system, "contacts", ()))
     return any(np.any(c.forces(x)[1] != c.forces(x_new)[1]) for c in getattr(system, "contacts", ()))
 
 
@@ -380,6 +388,7 @@ class FastSubstep:
     def _iterate(self, fields: Any, settings: Any, border: Any) -> tuple[int, str | None]:
         """Newton's method or chord iterations with Anderson acceleration and refresh (see the class notes)."""
         system = self.system
+        contacts = getattr(system, "contacts", ())
         reuse = float(self.reuse or 0.5)
         values = fields[0].values
         u, x = values.ravel().copy(), border.start()
@@ -409,7 +418,8 @@ class FastSubstep:
             step, u_new, x_new, r_new, jmin, fnorm_new = self._trial(u, x, step, fresh, fnorm + error, border)
             error_new = border.error(u_new)
             self._record(fnorm_new, fresh)
-            if fresh:
+            changed = REFRESH_ON_CHANGE and bool(contacts) and contacts_changed(system, u, u_new, sliding=True)
+            if fresh and not changed:  # (a step that changed the contacts says nothing of the precision)
                 poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
             if not fresh and not (fnorm_new + error_new < fnorm + error and jmin > 0.0):
                 # a kept tangent that no longer helps: take the step back, refresh
@@ -423,7 +433,7 @@ class FastSubstep:
             if poor >= STALLED_FRESH and self.precision == "single":
                 self.to_double()  # refresh at u_new, in double precision from now on
                 f, poor = None, 0
-            elif self.reuse is None or fnorm_new > reuse * fnorm:
+            elif self.reuse is None or fnorm_new > reuse * fnorm or changed:
                 self._factorised = False  # refresh at u_new (at every iteration: Newton's method)
                 f = None
             else:
