@@ -57,6 +57,11 @@ FRICTION_GROWTH = 1.0
 #: on a body with obstacles, instead of kept while it lowers the residual.
 REFRESH_ON_CHANGE = True
 
+#: The farthest a Newton step on a body with obstacles may move a node, over the farthest the ramp's predicted start
+#: of the substep moved one from the last converged state (at least the obstacles' stride:
+#: :meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`).
+MOTION = 2.0
+
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
 #: before a single-precision factorisation is judged too inaccurate and replaced by a
 #: double-precision one. A fresh Newton step near the solution converges quadratically;
@@ -111,7 +116,7 @@ def inadmissible(r: FloatArray, jmin: float) -> str | None:
     return f"the predicted start is not admissible (det F = {jmin:.3g})"
 
 
-def contact_fraction(system: Any, u: FloatArray, step: FloatArray) -> float:
+def contact_fraction(system: Any, u: FloatArray, step: FloatArray, motion: float = 0.0) -> float:
     """The fraction of a Newton ``step`` (over the active dofs) from ``u`` that carries no surface node deep into
     an obstacle it was not pressing on (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1
     without obstacles)."""
@@ -122,7 +127,7 @@ def contact_fraction(system: Any, u: FloatArray, step: FloatArray) -> float:
     du[system.dof1] = step
     d = system.points.shape[1]
     x, dx = system.points + u.reshape(-1, d), du.reshape(-1, d)
-    return min(c.step_fraction(x, dx) for c in contacts)
+    return min(c.step_fraction(x, dx, motion) for c in contacts)
 
 
 def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: bool = False) -> bool:
@@ -238,6 +243,7 @@ class FastSubstep:
         self._product: Any = None  # the whole tangent's product, where the factorised one is not all of it
         self.best = float("inf")
         self._converged: FloatArray | None = None  # the last converged state, on a body with obstacles
+        self._motion = 0.0  # the farthest a Newton step may move a node beyond the obstacles' stride (mm)
         #: set to a list to record ``(residual norm, tangent fresh)`` after every iteration
         self.trace: list[tuple[float, bool]] | None = None
 
@@ -337,7 +343,11 @@ class FastSubstep:
             return
         dof1 = self.system.dof1
         step = u[dof1] - last[dof1]
-        fraction = contact_fraction(self.system, last, step)
+        d = self.system.points.shape[1]
+        du = np.zeros_like(u)
+        du[dof1] = step
+        self._motion = MOTION * float(np.max(np.linalg.norm(du.reshape(-1, d), axis=1), initial=0.0))
+        fraction = contact_fraction(self.system, last, step, self._motion)
         if fraction < 1.0:
             u[dof1] = last[dof1] + fraction * step
             values[:] = u.reshape(values.shape)
@@ -363,7 +373,7 @@ class FastSubstep:
         contacts = getattr(system, "contacts", ())
         backtracks = BACKTRACKS if fresh and len(contacts) else 0
         growth = FRICTION_GROWTH if any(c.friction > 0.0 for c in contacts) else GROWTH
-        step = contact_fraction(system, u, step[:n]) * step
+        step = contact_fraction(system, u, step[:n], self._motion) * step
         for trial in range(backtracks + 1):
             if trial:
                 step = 0.5 * step
