@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pneumorph.models import make_model
 from pneumorph.models.fe import Reduced2D
 from pneumorph.models.fe.obstacles import blocked_obstacle
 
@@ -44,7 +45,8 @@ def test_a_finger_pressed_on_a_cylinder_in_its_way(friction: float) -> None:
 
 def test_a_blocked_finger_with_friction_cuts_back_little() -> None:
     """The wall at the first level's tip with friction 0.5: the blocked force rises to 0.7 N at 18-22.5 kPa and falls as
-    the finger curls away; 297 Newton iterations and 11 cut-backs with the former rules, 127 and 3 now."""
+    the finger curls away; 127 Newton iterations and 3 cut-backs, against 297 and 11 with the penalty at 100 times the
+    shear modulus and unbounded steps."""
     model = Reduced2D(15)
     wall = {**blocked_obstacle(model, DESIGN), "friction": 0.5}
     response = model.variant(obstacles=[wall]).solve(DESIGN).response
@@ -53,3 +55,19 @@ def test_a_blocked_finger_with_friction_cuts_back_little() -> None:
     _balanced(levels)
     forces = [level["obstacles"][0]["force_magnitude_n"] for level in levels]
     assert int(np.argmax(forces)) in (3, 4) and 0.6 < max(forces) < 0.8
+
+
+@pytest.mark.slow
+def test_a_3d_finger_pressed_on_a_rough_cylinder_in_its_way() -> None:
+    """The 3D half model against a cylinder across the width, placed as in 2D from its own free tip at 22.5 and
+    45 kPa, (163.62, 7.05) and (171.52, 8.48) mm, with friction 0.5: through the ramp with no cut-back (6 with the
+    penalty at 100 times the shear modulus, unbounded steps and a tangent kept across changes of contact state),
+    the clamp balancing the cylinder."""
+    cylinder = {"kind": "cylinder", "centre": [168.536, 7.944, 7.5], "radius": 4.0, "axis": [0.0, 0.0, 1.0],
+                "friction": 0.5}
+    response = make_model(15, {"fidelity": "3d"}).variant(obstacles=[cylinder]).solve(DESIGN).response
+    assert response.converged and response.metadata["cutbacks"] == 0
+    levels = response.metadata["contact"]["levels"]
+    _balanced(levels)
+    forces = np.array([level["obstacles"][0]["force_magnitude_n"] for level in levels])
+    assert np.all(forces[:5] == 0.0) and 0.1 < forces[-1] < 0.3  # N
