@@ -118,8 +118,8 @@ def inadmissible(r: FloatArray, jmin: float) -> str | None:
 
 def contact_fraction(system: Any, u: FloatArray, step: FloatArray, motion: float = 0.0) -> float:
     """The fraction of a Newton ``step`` (over the active dofs) from ``u`` that carries no surface node deep into
-    an obstacle it was not pressing on (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1
-    without obstacles)."""
+    an obstacle it was not pressing on, nor any node farther than the obstacles' stride or ``motion`` (mm)
+    (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1 without obstacles)."""
     contacts = getattr(system, "contacts", ())
     if not contacts:
         return 1.0
@@ -358,7 +358,8 @@ class FastSubstep:
         ``(step taken, u_new, x_new, its residual, smallest det F, relative residual)``, its load set.
 
         On a body with obstacles, the step is first shortened to carry no node deep into an obstacle it was not
-        pressing on (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
+        pressing on, nor farther than :data:`MOTION` times the substep's predicted motion or the obstacles'
+        stride (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
         (a non-finite residual, an inverted element, a residual norm above :data:`DIVERGED`, or a residual norm
         plus the border's constraint error above :data:`GROWTH` times the ``previous`` one, :data:`FRICTION_GROWTH`
         with friction) is halved, up to :data:`BACKTRACKS` times: a contact that closes or opens within the step
