@@ -10,17 +10,13 @@ a node in contact (``g < 0``) adds
     r = k g n                      to the residual,
     K = k (n (x) n + g H)          to its own d x d block of the tangent,
 
-so the obstacle pushes it with ``-k g n`` along the normal, and the force on the obstacle is the
-sum of ``k g n`` over the nodes. A node couples with itself only, so the block is already in the
-assembler's CSR pattern: a :class:`RigidContact` is one more owner of
-:class:`~pneumorph.fem.fast.assembler.FastSystem`, with one "cell" per surface node.
+so the obstacle pushes it with ``-k g n``; the force on the obstacle is the sum of ``k g n``. A node couples
+with itself only: a :class:`RigidContact` is one more owner of :class:`~pneumorph.fem.fast.assembler.FastSystem`.
 
-The penalty ``k`` (:func:`penalty_stiffness`) is :data:`PENALTY` times the body's shear modulus
-times the element size to the power ``d - 2``: a node carrying a contact pressure ``p_c`` over its
-share ``h^(d-1)`` of the surface penetrates ``g = p_c h^(d-1) / k = h p_c / (PENALTY mu)``, a
-fraction ``p_c / (PENALTY mu)`` of the element size (1 % for a contact pressure equal to the shear
-modulus). Coulomb friction (``friction`` > 0) adds a tangential penalty (:data:`TANGENTIAL` times
-``k``) with return-mapped sliding (:mod:`~pneumorph.fem.fast.friction`).
+The penalty ``k`` (:func:`penalty_stiffness`) is :data:`PENALTY` times the shear modulus times the element size to
+the power ``d - 2``: a node carrying a contact pressure ``p_c`` over its share ``h^(d-1)`` of the surface penetrates
+``g = h p_c / (PENALTY mu)``, a fraction ``p_c / (PENALTY mu)`` of an element. Coulomb friction adds a tangential
+penalty (:data:`TANGENTIAL` times ``k``) with return-mapped sliding (:mod:`~pneumorph.fem.fast.friction`).
 """
 
 from __future__ import annotations
@@ -40,8 +36,9 @@ from pneumorph.fem.fast.friction import coulomb, slip
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-#: the penalty over the shear modulus (2D) or over shear modulus x element size (3D)
-PENALTY = 100.0
+#: the penalty over the shear modulus (2D) or over shear modulus x element size (3D): 100 let in a tenth as much and
+#: moved a blocked force by 1.4 % at most, but a hard press cost twice the time (docs/grasping.md)
+PENALTY = 10.0
 
 #: the tangential penalty of friction over the normal one (FElupe's default): a sticking node creeps by
 #: ``mu f_n / k_t``, ten times its penetration at ``mu = 1``; a stiffer one (1) failed a 3D ramp whose
@@ -226,8 +223,8 @@ def penalty_stiffness(shear_modulus: float, element_size: float, dim: int, facto
 
     In N/mm per mm of depth in 2D (plane strain), N/mm in 3D.
 
-    >>> penalty_stiffness(0.03, 1.5, 2), penalty_stiffness(0.03, 1.5, 3)
-    (3.0, 4.5)
+    >>> penalty_stiffness(0.03, 1.5, 2), round(penalty_stiffness(0.03, 1.5, 3), 6)
+    (0.3, 0.45)
     """
     return float(factor * shear_modulus * element_size ** (dim - 2))
 
@@ -301,13 +298,12 @@ class RigidContact:
     reach : float
         The deepest (mm) a Newton step may carry a node into the obstacle from outside the penalty's full
         stiffness (:meth:`step_fraction`; 0: no limit).
+    stride : float
+        The farthest (mm) a Newton step may move any node of the body (:meth:`step_fraction`; 0: no limit).
 
-    Once a state is committed (:meth:`commit`), the curvature's term of the tangent ``k phi H`` takes the
-    smaller of the node's penalised gap and the converged one, as FElupe's ``curvature="converged"``: outside
-    a round obstacle the term is a negative stiffness across the normal, and a trial state deep inside (a
-    predictor or Newton step that overshoots) made the tangent of a soft finger touching a cylinder
-    indefinite, with steps of 10-150 mm. Converged states are unchanged; Newton converges linearly in that
-    term while the contact presses harder.
+    Once a state is committed (:meth:`commit`), the tangent's curvature term ``k phi H`` (a negative stiffness
+    across the normal) takes the smaller of the node's penalised gap and the converged one, as FElupe's
+    ``curvature="converged"``: an overshooting trial state made a finger's tangent indefinite (steps of 10-150 mm).
 
     Examples
     --------
@@ -327,6 +323,7 @@ class RigidContact:
     smoothing: float = 0.0
     friction: float = 0.0
     reach: float = 0.0
+    stride: float = 0.0
     #: the friction anchors of the last converged state (None: every node where it is)
     anchors: FloatArray | None = None
     #: the penalised gaps of the last converged state (None: no bound on the curvature's term)
@@ -342,12 +339,12 @@ class RigidContact:
         self.cells = self.points[:, None]
 
     def evaluate(self, x: FloatArray, symmetric: bool = False) -> tuple[FloatArray, FloatArray, NDArray[np.bool_],
-                                                                        FloatArray]:
+                                                                        FloatArray, NDArray[np.bool_]]:
         """At the positions ``x`` of all the body's points (p, d): the force on the obstacle at every node
         ``k phi(g) n`` (:func:`penalty_gap`) plus its friction (:mod:`.friction`), (m, d); their blocks
         ``k (phi'(g) n (x) n + phi(g) H)`` plus friction's, (m, d, d; ``symmetric``: for a symmetric tangent,
         :func:`~pneumorph.fem.fast.friction.coulomb`'s ``coupled`` off); which nodes the obstacle pushes
-        (``phi < 0``); and the anchors a commit at ``x`` keeps (m, d)."""
+        (``phi < 0``); the anchors a commit at ``x`` keeps (m, d); and which nodes slide (m,)."""
         xs = x[self.points]
         gap, n, H = self.obstacle.kinematics(xs)
         phi, slope = penalty_gap(gap, self.smoothing)
@@ -358,6 +355,7 @@ class RigidContact:
             K += self.stiffness * bound[:, None, None] * H
         active = phi < 0.0
         anchors = xs.copy()  # out of contact: where a node is
+        sliding = np.zeros(len(xs), dtype=bool)
         if self.friction > 0.0 and np.any(active):
             a = np.flatnonzero(active)
             reference = xs[a] if self.anchors is None else self.anchors[a]
@@ -367,12 +365,24 @@ class RigidContact:
             force[a] += ft
             K[a] += Kt
             anchors[a] = xs[a] - kept
-        return force, K, active, anchors
+            sliding[a] = np.any(kept != e, axis=1)  # (a return-mapped slip is shorter)
+        return force, K, active, anchors, sliding
 
     def forces(self, x: FloatArray) -> tuple[FloatArray, NDArray[np.bool_]]:
         """The force on the obstacle at every node (m, d) and which nodes it pushes (:meth:`evaluate`)."""
-        force, _, active, _ = self.evaluate(x)
+        force, _, active, _, _ = self.evaluate(x)
         return force, active
+
+    def states(self, x: FloatArray) -> NDArray[np.int8]:
+        """Every node's contact state at ``x`` (all the body's points): 0 free, 1 pressed (sticking), 2 sliding.
+
+        >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, friction=0.5)
+        >>> contact.commit(np.array([[0.0, 0.0], [1.25, 0.0]]))  # (0, 1): free, sticking; then 3 N > 0.5 x 2.5 N
+        >>> contact.states(np.array([[0.0, 0.0], [1.25, 3.0]])).tolist()
+        [0, 2]
+        """
+        _, _, active, _, sliding = self.evaluate(x)
+        return np.asarray(active.astype(np.int8) + sliding, dtype=np.int8)
 
     def residual(self, x: FloatArray) -> FloatArray:
         """The nodes' contributions to the residual, (m, d) (the force on the obstacle)."""
@@ -382,14 +392,15 @@ class RigidContact:
         """The nodes' d x d blocks (zero out of contact), (m, d, d) (:meth:`evaluate`)."""
         return self.evaluate(x, symmetric)[1]
 
-    def step_fraction(self, x: FloatArray, dx: FloatArray) -> float:
+    def step_fraction(self, x: FloatArray, dx: FloatArray, motion: float = 0.0) -> float:
         """The fraction of a step ``dx`` from ``x`` (all the body's points, (p, d)) that carries no node from
-        outside the penalty's full stiffness (a gap above ``-smoothing``) deeper than ``reach`` into the obstacle.
+        outside the penalty's full stiffness (a gap above ``-smoothing``) deeper than ``reach`` into the obstacle,
+        and moves no node farther than ``stride`` or ``motion`` (mm), whichever is larger.
 
-        A Newton step is computed with no contact stiffness at the nodes still outside: it can carry one a whole
-        substep's motion (mm) into the obstacle, whose penalty then throws it back far enough to invert the
-        elements next to it. Scaled to land such a node ``reach`` inside (a straight path's gap, linear
-        between its ends), the next step sees the node in contact with its full stiffness.
+        A Newton step sees no contact stiffness at the nodes still outside: it could carry one a substep's motion
+        into the obstacle, whose penalty then inverts the elements next to it. Scaled to land it ``reach`` inside
+        (a straight path's gap, linear between its ends), the next step sees it in contact. The stride bounds a
+        step along a nearly singular tangent: a finger's tip sliding on a wall, held only by its bending.
 
         >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, reach=0.1)
         >>> x = np.array([[0.0, 0.0], [0.5, 0.0]])
@@ -397,16 +408,23 @@ class RigidContact:
         0.545455
         >>> contact.step_fraction(x, np.array([[0.0, 0.0], [0.55, 0.0]]))  # 0.05 mm in: all of it
         1.0
+        >>> far = RigidContact(Plane((9.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, stride=0.5)
+        >>> far.step_fraction(x, np.array([[2.0, 0.0], [0.0, 0.0]]), motion=1.0)  # 2 mm: the substep moves 1 mm
+        0.5
         """
+        fraction = 1.0
+        if self.stride > 0.0:
+            farthest = float(np.max(np.linalg.norm(dx, axis=1), initial=0.0))
+            fraction = min(1.0, max(self.stride, motion) / farthest) if farthest > 0.0 else 1.0
         if self.reach <= 0.0:
-            return 1.0
+            return fraction
         xs = x[self.points]
         g0 = self.obstacle.kinematics(xs)[0]
         g1 = self.obstacle.kinematics(xs + dx[self.points])[0]
         deep = (g0 > -max(self.smoothing, 0.5 * self.reach)) & (g1 < -self.reach)
         if not np.any(deep):
-            return 1.0
-        return float(np.min((g0[deep] + self.reach) / (g0[deep] - g1[deep])))
+            return fraction
+        return min(fraction, float(np.min((g0[deep] + self.reach) / (g0[deep] - g1[deep]))))
 
     def _tributary(self, measures: FloatArray, share: FloatArray, touching: NDArray[np.bool_]) -> FloatArray:
         """Every point's share of the faces in contact (those whose corners all touch), or of all its faces

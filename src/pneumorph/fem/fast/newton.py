@@ -53,6 +53,15 @@ GROWTH = 2.0
 #: keeps :data:`GROWTH` (85 iterations either way).
 FRICTION_GROWTH = 1.0
 
+#: Whether a step that changed a node's contact state (free, sticking, sliding) has the tangent refreshed at once,
+#: on a body with obstacles, instead of kept while it lowers the residual.
+REFRESH_ON_CHANGE = True
+
+#: The farthest a Newton step on a body with obstacles may move a node, over the farthest the ramp's predicted start
+#: of the substep moved one from the last converged state (at least the obstacles' stride:
+#: :meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`).
+MOTION = 2.0
+
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
 #: before a single-precision factorisation is judged too inaccurate and replaced by a
 #: double-precision one. A fresh Newton step near the solution converges quadratically;
@@ -107,10 +116,10 @@ def inadmissible(r: FloatArray, jmin: float) -> str | None:
     return f"the predicted start is not admissible (det F = {jmin:.3g})"
 
 
-def contact_fraction(system: Any, u: FloatArray, step: FloatArray) -> float:
+def contact_fraction(system: Any, u: FloatArray, step: FloatArray, motion: float = 0.0) -> float:
     """The fraction of a Newton ``step`` (over the active dofs) from ``u`` that carries no surface node deep into
-    an obstacle it was not pressing on (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1
-    without obstacles)."""
+    an obstacle it was not pressing on, nor any node farther than the obstacles' stride or ``motion`` (mm)
+    (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1 without obstacles)."""
     contacts = getattr(system, "contacts", ())
     if not contacts:
         return 1.0
@@ -118,13 +127,17 @@ def contact_fraction(system: Any, u: FloatArray, step: FloatArray) -> float:
     du[system.dof1] = step
     d = system.points.shape[1]
     x, dx = system.points + u.reshape(-1, d), du.reshape(-1, d)
-    return min(c.step_fraction(x, dx) for c in contacts)
+    return min(c.step_fraction(x, dx, motion) for c in contacts)
 
 
-def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray) -> bool:
-    """Whether some surface node touches an obstacle at ``u_new`` (all dofs) and not at ``u``, or the reverse."""
+def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: bool = False) -> bool:
+    """Whether some surface node touches an obstacle at ``u_new`` (all dofs) and not at ``u``, or the reverse
+    (``sliding``: or sticks at one and slides at the other,
+    :meth:`~pneumorph.fem.fast.contact.RigidContact.states`)."""
     d = system.points.shape[1]
     x, x_new = system.points + u.reshape(-1, d), system.points + u_new.reshape(-1, d)
+    if sliding:
+        return any(np.any(c.states(x) != c.states(x_new)) for c in getattr(system, "contacts", ()))
     return any(np.any(c.forces(x)[1] != c.forces(x_new)[1]) for c in getattr(system, "contacts", ()))
 
 
@@ -230,6 +243,7 @@ class FastSubstep:
         self._product: Any = None  # the whole tangent's product, where the factorised one is not all of it
         self.best = float("inf")
         self._converged: FloatArray | None = None  # the last converged state, on a body with obstacles
+        self._motion = 0.0  # the farthest a Newton step may move a node beyond the obstacles' stride (mm)
         #: set to a list to record ``(residual norm, tangent fresh)`` after every iteration
         self.trace: list[tuple[float, bool]] | None = None
 
@@ -329,7 +343,11 @@ class FastSubstep:
             return
         dof1 = self.system.dof1
         step = u[dof1] - last[dof1]
-        fraction = contact_fraction(self.system, last, step)
+        d = self.system.points.shape[1]
+        du = np.zeros_like(u)
+        du[dof1] = step
+        self._motion = MOTION * float(np.max(np.linalg.norm(du.reshape(-1, d), axis=1), initial=0.0))
+        fraction = contact_fraction(self.system, last, step, self._motion)
         if fraction < 1.0:
             u[dof1] = last[dof1] + fraction * step
             values[:] = u.reshape(values.shape)
@@ -340,7 +358,8 @@ class FastSubstep:
         ``(step taken, u_new, x_new, its residual, smallest det F, relative residual)``, its load set.
 
         On a body with obstacles, the step is first shortened to carry no node deep into an obstacle it was not
-        pressing on (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
+        pressing on, nor farther than :data:`MOTION` times the substep's predicted motion or the obstacles'
+        stride (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
         (a non-finite residual, an inverted element, a residual norm above :data:`DIVERGED`, or a residual norm
         plus the border's constraint error above :data:`GROWTH` times the ``previous`` one, :data:`FRICTION_GROWTH`
         with friction) is halved, up to :data:`BACKTRACKS` times: a contact that closes or opens within the step
@@ -355,7 +374,7 @@ class FastSubstep:
         contacts = getattr(system, "contacts", ())
         backtracks = BACKTRACKS if fresh and len(contacts) else 0
         growth = FRICTION_GROWTH if any(c.friction > 0.0 for c in contacts) else GROWTH
-        step = contact_fraction(system, u, step[:n]) * step
+        step = contact_fraction(system, u, step[:n], self._motion) * step
         for trial in range(backtracks + 1):
             if trial:
                 step = 0.5 * step
@@ -380,6 +399,7 @@ class FastSubstep:
     def _iterate(self, fields: Any, settings: Any, border: Any) -> tuple[int, str | None]:
         """Newton's method or chord iterations with Anderson acceleration and refresh (see the class notes)."""
         system = self.system
+        contacts = getattr(system, "contacts", ())
         reuse = float(self.reuse or 0.5)
         values = fields[0].values
         u, x = values.ravel().copy(), border.start()
@@ -409,7 +429,8 @@ class FastSubstep:
             step, u_new, x_new, r_new, jmin, fnorm_new = self._trial(u, x, step, fresh, fnorm + error, border)
             error_new = border.error(u_new)
             self._record(fnorm_new, fresh)
-            if fresh:
+            changed = REFRESH_ON_CHANGE and bool(contacts) and contacts_changed(system, u, u_new, sliding=True)
+            if fresh and not changed:  # (a step that changed the contacts says nothing of the precision)
                 poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
             if not fresh and not (fnorm_new + error_new < fnorm + error and jmin > 0.0):
                 # a kept tangent that no longer helps: take the step back, refresh
@@ -423,7 +444,7 @@ class FastSubstep:
             if poor >= STALLED_FRESH and self.precision == "single":
                 self.to_double()  # refresh at u_new, in double precision from now on
                 f, poor = None, 0
-            elif self.reuse is None or fnorm_new > reuse * fnorm:
+            elif self.reuse is None or fnorm_new > reuse * fnorm or changed:
                 self._factorised = False  # refresh at u_new (at every iteration: Newton's method)
                 f = None
             else:

@@ -12,7 +12,7 @@ model's by two (their z components vanish by symmetry).
 
 The penalty is :func:`~pneumorph.fem.fast.contact.penalty_stiffness` of the body silicone's shear
 modulus and the unit's element size: a contact pressure ``p_c`` lets the surface into the obstacle
-by about ``p_c / (100 mu)`` of an element (about 1 % of an element at ``p_c = mu``).
+by about ``p_c / (10 mu)`` of an element (about 1 % of an element at ``p_c = mu / 10``).
 """
 
 from __future__ import annotations
@@ -44,6 +44,9 @@ SMOOTHING = 0.02
 #: the deepest a Newton step may carry a node into an obstacle from outside, over the element size
 #: (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`)
 REACH = 0.1
+#: the farthest a Newton step may move a node of a body with obstacles, over the element size
+#: (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`)
+STRIDE = 1.0
 #: where an obstacle may touch: the whole outer surface, or the free end face only
 TOUCHES = ("surface", "end")
 
@@ -145,7 +148,7 @@ def contact_items(obstacles: Sequence[ModelObstacle], mesh: ActuatorMesh, shear_
     smoothing = SMOOTHING * mesh.spec.element_size
     items = [RigidContact(o.obstacle, np.unique(end_faces) if o.on == "end" else nodes, k,
                           end_faces if o.on == "end" else faces, smoothing, o.friction,
-                          REACH * mesh.spec.element_size) for o in obstacles]
+                          REACH * mesh.spec.element_size, STRIDE * mesh.spec.element_size) for o in obstacles]
     for item in items:
         item.commit(mesh.points)  # friction's anchors: where the nodes start
     problem = start_inside([o.obstacle for o in obstacles], mesh.points)  # any point: an obstacle in a cavity too
@@ -291,5 +294,5 @@ def blocked_wall(tip0: FloatArray, tip1: FloatArray, end_points: FloatArray) -> 
     return {"kind": "plane", "point": farthest.tolist(), "normal": (-d).tolist(), "on": "end"}
 
 
-__all__ = ["REACH", "SMOOTHING", "TOUCHES", "ContactRecord", "ModelObstacle", "blocked_obstacle", "blocked_wall",
-           "check_obstacles", "check_reach", "contact_items", "parse_obstacle"]
+__all__ = ["REACH", "SMOOTHING", "STRIDE", "TOUCHES", "ContactRecord", "ModelObstacle", "blocked_obstacle",
+           "blocked_wall", "check_obstacles", "check_reach", "contact_items", "parse_obstacle"]
