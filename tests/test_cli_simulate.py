@@ -111,13 +111,10 @@ def test_a_ramp_stopped_by_ballooning_says_so_and_names_the_volume_control(tmp_p
     assert not out.exists()
 
 
-def test_the_plan_of_a_volume_ramp_of_a_soft_body_is_estimated_from_its_measured_cost(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
-    """A 4-unit Ecoflex 00-30 actuator in a Smooth-Sil 950 layer (34.5 times stiffer) volume-controlled to 5 V0:
-    the plan says the volume ramp, estimates it at the measured factor 601 of the built-in pressure ramp (0.147 s on a
-    quiet machine: 88 s) and that it may need many cut-backs; interrupted after its
-    first level (the solve stubbed), it writes nothing."""
-    from pneumorph.io.progress import duration_text
+def _soft_plan(tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+               *options: str) -> list[str]:
+    """The lines ``simulate -o 0110`` writes for a 4-unit 2D Ecoflex 00-30 actuator with ``options`` on a quiet
+    machine, its solve stubbed to report its first level and be interrupted; asserts exit 130 and nothing written."""
     from pneumorph.models.fe.base import FEModel
 
     def first_level_then_interrupted(self: FEModel, orientation: str, on_level: object = None) -> None:
@@ -129,9 +126,21 @@ def test_the_plan_of_a_volume_ramp_of_a_soft_body_is_estimated_from_its_measured
     settings = tmp_path / "soft.toml"
     settings.write_text('[model]\nfidelity = "2d"\n[model.unit]\nbody_material = "ecoflex_00_30"\n')
     out = tmp_path / "out"
-    code = main(["simulate", "-o", "0110", "--model-file", str(settings), "--volume-change", "4", "--out", str(out)])
+    code = main(["simulate", "-o", "0110", "--model-file", str(settings), *options, "--out", str(out)])
     lines = capsys.readouterr().err.splitlines()
     assert code == 130 and not out.exists()
+    return lines
+
+
+def test_the_plan_of_a_volume_ramp_of_a_soft_body_is_estimated_from_its_measured_cost(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """A 4-unit Ecoflex 00-30 actuator in a Smooth-Sil 950 layer (34.5 times stiffer) volume-controlled to 5 V0:
+    the plan says the volume ramp, estimates it at the measured factor 601 of the built-in pressure ramp (0.147 s on a
+    quiet machine: 88 s) and that it may need many cut-backs; interrupted after its
+    first level (the solve stubbed), it writes nothing."""
+    from pneumorph.io.progress import duration_text
+
+    lines = _soft_plan(tmp_path, capsys, monkeypatch, "--volume-change", "4")
     plan = lines[0]
     assert plan.startswith("simulating design 0110 (2d model, 4 units, the cavities' volume to 5 V0): 10 levels, "
                            "estimated ")
@@ -151,21 +160,9 @@ def test_the_plan_of_a_pressure_ramp_of_a_soft_body_says_what_its_limit_point_ma
     that creeping to the limit point took up to 40 times that; ramped to 20 kPa (measured: as fast as the built-in
     unit) nothing is added. The solve is stubbed: interrupted after its first level, it writes nothing."""
     from pneumorph.io.progress import duration_text
-    from pneumorph.models.fe.base import FEModel
 
-    def first_level_then_interrupted(self: FEModel, orientation: str, on_level: object = None) -> None:
-        on_level(0, 0.001)  # type: ignore[operator]
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(FEModel, "solve", first_level_then_interrupted)
-    monkeypatch.setattr("pneumorph.io.progress.os.getloadavg", lambda: (0.0, 0.0, 0.0))  # a quiet machine
-    settings = tmp_path / "soft.toml"
-    settings.write_text('[model]\nfidelity = "2d"\n[model.unit]\nbody_material = "ecoflex_00_30"\n')
+    lines = _soft_plan(tmp_path, capsys, monkeypatch, "--pressure", str(pressure))
     out = tmp_path / "out"
-    code = main(["simulate", "-o", "0110", "--model-file", str(settings), "--pressure", str(pressure),
-                 "--out", str(out)])
-    lines = capsys.readouterr().err.splitlines()
-    assert code == 130 and not out.exists()
     seconds = 0.55 * 4 / 15
     assert lines[0] == (f"simulating design 0110 (2d model, 4 units, {pressure:g} kPa): 10 levels, estimated "
                         f"{duration_text(seconds)} ({duration_text(seconds / 10)} each, 1 worker) -> {out}")
