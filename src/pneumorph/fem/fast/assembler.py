@@ -328,7 +328,7 @@ class FastSystem:
         indptr = np.r_[0, np.cumsum(np.bincount(rows[live], weights=per_row[live], minlength=n1))].astype(np.int64)
         total = int(indptr[-1])
         # int32 positions and indices where they fit: half the memory traffic of the gathers below
-        small = np.int32 if max(total, keys.size * d * d) < 2**31 else np.int64
+        small: type[np.signedinteger[Any]] = np.int32 if max(total, keys.size * d * d) < 2**31 else np.int64
         full = (indptr[np.maximum(rows, 0)][:, :, None] + before[:, :, None]
                 + (np.cumsum(exists, axis=2) - exists)).astype(small)
         # 3. every element entry's (pair, i, k), of the assembled ones
@@ -346,7 +346,7 @@ class FastSystem:
             pair = inverse[offsets[o] : offsets[o + 1]].reshape(-1, n, n).astype(small)
             ia, ib = self._entry_nodes(owner)
             # every entry's index (invalid ones' too: one gather of the assembled ones after)
-            index = pair[:, ia, ib] * small(d * d) + component[erows] * small(d) + component[ecols]
+            index = pair[:, ia, ib] * (d * d) + component[erows] * d + component[ecols]  # int32 stays int32
             pos = full_flat[index.reshape(-1)[owner.take]]
             used[pos] = True
             positions.append(pos)
