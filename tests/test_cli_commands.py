@@ -74,3 +74,13 @@ def test_the_group_lists_without_importing_a_command() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.splitlines()[-1] == "0 []"
     assert "Commands:" in done.stdout and "unit " in done.stdout
+
+
+@pytest.mark.parametrize("typed", ["simulat", "desing", "nothing"])
+def test_a_mistyped_command_gets_the_same_error_and_suggestion(typed: str) -> None:
+    from click.testing import CliRunner
+
+    lazy, eager = (CliRunner().invoke(group, [typed, "-o", "01"], prog_name="pneumorph") for group in (cli, _eager()))
+    assert lazy.exit_code == eager.exit_code == 2
+    assert lazy.output == eager.output
+    assert ("Did you mean" in lazy.output) == (typed != "nothing")
