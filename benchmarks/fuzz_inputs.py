@@ -156,7 +156,9 @@ def _leaves() -> dict[str, Any]:
 
     def walk(group: click.Group, path: tuple[str, ...] = ()) -> dict[str, Any]:
         out: dict[str, Any] = {}
-        for name, command in group.commands.items():
+        ctx = click.Context(group)
+        for name in group.list_commands(ctx):  # the top group imports each command here
+            command = group.get_command(ctx, name)
             if isinstance(command, click.Group):
                 out.update(walk(command, (*path, name)))
             else:

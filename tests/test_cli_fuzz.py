@@ -469,7 +469,10 @@ def _commands() -> dict[str, object]:
     found: dict[str, object] = {}
 
     def walk(group: click.Group, path: tuple[str, ...]) -> None:
-        for name, command in group.commands.items():
+        ctx = click.Context(group)
+        for name in group.list_commands(ctx):
+            command = group.get_command(ctx, name)
+            assert command is not None, name
             if isinstance(command, click.Group):
                 walk(command, (*path, name))
             else:

@@ -20,7 +20,10 @@ def _texts(command: click.Command, path: str = "pneumorph") -> Iterator[tuple[st
     for param in command.params:
         yield f"{path} {getattr(param, 'opts', [param.name])[0]}", getattr(param, "help", None) or ""
     if isinstance(command, click.Group):
-        for name, sub in command.commands.items():
+        ctx = click.Context(command)
+        for name in command.list_commands(ctx):
+            sub = command.get_command(ctx, name)
+            assert sub is not None, name
             yield from _texts(sub, f"{path} {name}")
 
 

@@ -149,3 +149,47 @@ def test_the_3d_kernels_in_passes_give_one_passs_numbers(monkeypatch) -> None:
         for a, b in zip(one, many, strict=True):
             assert (a is None and b is None) or np.array_equal(a, b)
     assert passes[2][1] is None and passes[1][1].shape == (2, 3, 3, F.shape[-1])
+
+
+def _reference_pattern(system) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The CSR pattern of every assembled element entry by a sort of all of them: indptr, indices and every
+    owner's positions."""
+    n1 = system.dof1.size
+    active = np.full(system.ndof, -1, dtype=np.int64)
+    active[system.dof1] = np.arange(n1)
+    keys = []
+    for owner in [*system.solids, *system.walls, *system.contacts]:
+        rows, cols, valid = system._entries(owner, active[owner.edofs.reshape(*owner.cells.shape, -1)])
+        take = np.flatnonzero(valid)
+        keys.append(np.ravel(rows)[take].astype(np.int64) * n1 + np.ravel(cols)[take])
+    unique = np.unique(np.concatenate(keys))
+    indptr = np.r_[0, np.cumsum(np.bincount(unique // n1, minlength=n1))]
+    return indptr, unique % n1, [np.searchsorted(unique, k) for k in keys]
+
+
+class _SomeEntriesUnassembled(SolidSystem3D):
+    """A 3D system whose solids assemble no entry of a node's own diagonal block: those of the pairs' pattern
+    that no element assembles are left out."""
+
+    def _entries(self, owner, act):
+        rows, cols, valid = super()._entries(owner, act)
+        if isinstance(owner, assembler.SolidData):
+            valid = valid & (rows != cols)
+        return rows, cols, valid
+
+
+@pytest.mark.parametrize(("model", "kind"), [(Full3D(2, UnitSpec(element_size=3.0)), SolidSystem3D),
+                                             (Reduced2D(2, UnitSpec(element_size=2.0)), PlaneStrainSystem),
+                                             (Full3D(1, UnitSpec(element_size=3.0)), _SomeEntriesUnassembled)],
+                         ids=["3d", "2d", "3d-unassembled"])
+def test_the_pattern_is_that_of_a_sort_of_every_assembled_entry(model, kind, monkeypatch) -> None:
+    monkeypatch.setattr(assembler, "PATTERN_CACHE_SIZE", 0)
+    _, body, _ = model.build("10"[: model.n_units])
+    system = kind(body.items, body.field, body.dof1, body.dof0)
+    indptr, indices, positions = _reference_pattern(system)
+    assert system.indptr.dtype == system.indices.dtype == np.int32
+    np.testing.assert_array_equal(system.indptr, indptr)
+    np.testing.assert_array_equal(system.indices, indices)
+    assert system.nnz == indices.size
+    for owner, expected in zip([*system.solids, *system.walls, *system.contacts], positions, strict=True):
+        np.testing.assert_array_equal(owner.scatter, expected)

@@ -7,6 +7,7 @@ ones users speak (kPa for pressure); the API works in mm, N, MPa.
 
 from __future__ import annotations
 
+import importlib
 import os
 import signal
 import sys
@@ -16,53 +17,89 @@ from typing import Any
 import click
 
 from pneumorph import __version__
-from pneumorph.cli.materials.group import materials
 from pneumorph.errors import PneumorphError, note_sigint, sigints
 
+#: Every command: the module that defines it (a ``click`` command of the same name) and the first sentence of its
+#: help, which ``pneumorph --help`` lists. A command's module is imported only when that command runs or shows its
+#: own help, so a command pays for its own imports only (``simulate --help`` none of ``design``'s).
+COMMANDS: dict[str, tuple[str, str]] = {
+    "bimodal": ("pneumorph.cli.bilinear.bimodal", "3D FE of the bimodal actuator: tip displacement in volume or "
+                "pressure steps, switch pressure."),
+    "calibrate": ("pneumorph.cli.calibrate", "Fit the filler law E(P) of the 2D model to the 3D model (chapter 5) "
+                  "and check it."),
+    "chain": ("pneumorph.cli.chain", "Chain tables: per-window chord turns and lengths fitted to FE solves "
+              "(documentation page chain-model, docs/chain-model.md in the source)."),
+    "composite": ("pneumorph.cli.bilinear.composite", "Bilinear paper-silicone composite: analytical transition "
+                  "strain, coupon FE, strain gauges."),
+    "correlate": ("pneumorph.cli.casting.correlate", "Align SCAN (STL, PLY, OBJ, OFF, XYZ, or a CSV of x,y traced on "
+                  "a photo) to the model's inflated shape by least squares, and report RMS and maximum distances "
+                  "on the surface, along the outline and along the centreline."),
+    "design": ("pneumorph.cli.design", "Design the actuator whose inflated shape best matches a target or tip goal."),
+    "export": ("pneumorph.cli.casting.export", "Write DESIGN's parts (the Mold Star body with its cavities, the "
+               "Smooth-Sil layer pieces, the base block) as watertight STL files, with --mould the printable casting "
+               "mould of the body, and with --inp the 3D model as a CalculiX/Abaqus deck (documentation page "
+               "manufacturing, docs/manufacturing.md in the source)."),
+    "identify": ("pneumorph.cli.casting.identify", "Fit the body silicone's bulk and shear modulus scales and the "
+                 "three mould thicknesses (side walls, Mold Star wall, Smooth-Sil layer) to scans of cast actuators, "
+                 "by least squares on the distances `correlate` measures; report each with its standard error, the "
+                 "correlations, the residuals before and after, the combinations of parameters the scans do not "
+                 "determine (held at nominal, the others still identified) and which further scan would determine "
+                 "them."),
+    "materials": ("pneumorph.cli.materials.group", "Silicone and composite materials: list, show, fit, "
+                  "characterise."),
+    "scan": ("pneumorph.cli.casting.scan", "Scans of cast actuators: a synthetic one of a design, for trying the "
+             "loop design -> cast -> scan -> identify before a real cast (documentation page identify, "
+             "docs/identify.md in the source)."),
+    "sensitivity": ("pneumorph.cli.sensitivity", "How far a design's inflated shape moves with the model's "
+                    "simplifications, mould tolerances and material data (appendices D and E; documentation page "
+                    "sensitivity, docs/sensitivity.md in the source)."),
+    "serve": ("pneumorph.cli.serve", "Open the designer's bench: type or draw a target, see the certified design at "
+              "once."),
+    "simulate": ("pneumorph.cli.simulate", "Inflate one actuator design and report its shape at every pressure "
+                 "level."),
+    "study": ("pneumorph.cli.study", "Best fitness against GA population size over several seeds (lowest, largest, "
+              "mean)."),
+    "unit": ("pneumorph.cli.unit", "The articulating unit: geometry optimisation (documentation page unit-library, "
+             "docs/unit-library.md in the source)."),
+}
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+
+class LazyGroup(click.Group):
+    """The ``pneumorph`` group: each command (:data:`COMMANDS`) imported on first use; its list from the table."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted({*COMMANDS, *self.commands})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in COMMANDS:
+            module = importlib.import_module(COMMANDS[cmd_name][0])
+            self.add_command(getattr(module, cmd_name), cmd_name)
+        return self.commands.get(cmd_name)
+
+    def resolve_command(self, ctx: click.Context, args: list[str]) -> tuple[str | None, click.Command | None,
+                                                                           list[str]]:
+        """As click's; a mistyped command's close names from the table (click's own from the loaded commands)."""
+        try:
+            return super().resolve_command(ctx, args)
+        except click.exceptions.NoSuchCommand:
+            raise click.exceptions.NoSuchCommand(args[0], possibilities=self.list_commands(ctx), ctx=ctx) from None
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The commands and their summaries as click lists them, from the table: no command imported."""
+        names = self.list_commands(ctx)
+        limit = formatter.width - 6 - max(len(name) for name in names)
+        stand_ins = [click.Command(name, help=COMMANDS[name][1]) if name in COMMANDS and name not in self.commands
+                     else self.commands[name] for name in names]
+        rows = [(name, command.get_short_help_str(limit)) for name, command in zip(names, stand_ins, strict=True)
+                if not command.hidden]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, "--version", "-V", prog_name="pneumorph")
 def cli() -> None:
     """pneumorph - generative design of soft pneumatic actuators."""
-
-
-cli.add_command(materials)
-
-from pneumorph.cli.bilinear.composite import composite  # noqa: E402
-
-cli.add_command(composite)
-
-from pneumorph.cli.calibrate import calibrate  # noqa: E402
-from pneumorph.cli.casting.correlate import correlate  # noqa: E402
-from pneumorph.cli.casting.export import export  # noqa: E402
-from pneumorph.cli.casting.identify import identify  # noqa: E402
-from pneumorph.cli.casting.scan import scan  # noqa: E402
-from pneumorph.cli.chain import chain  # noqa: E402
-from pneumorph.cli.design import design  # noqa: E402
-from pneumorph.cli.sensitivity import sensitivity  # noqa: E402
-from pneumorph.cli.serve import serve  # noqa: E402
-from pneumorph.cli.simulate import simulate  # noqa: E402
-from pneumorph.cli.study import study  # noqa: E402
-
-cli.add_command(calibrate)
-cli.add_command(chain)
-cli.add_command(correlate)
-cli.add_command(design)
-cli.add_command(export)
-cli.add_command(identify)
-cli.add_command(scan)
-cli.add_command(sensitivity)
-cli.add_command(serve)
-cli.add_command(simulate)
-cli.add_command(study)
-
-from pneumorph.cli.bilinear.bimodal import bimodal  # noqa: E402
-
-cli.add_command(bimodal)
-
-from pneumorph.cli.unit import unit  # noqa: E402
-
-cli.add_command(unit)
 
 
 class Terminated(KeyboardInterrupt):
@@ -103,9 +140,11 @@ def check_repeats(argv: list[str]) -> None:
     """
     command: click.Command = cli
     i = 0
-    while isinstance(command, click.Group) and i < len(argv) and argv[i] in command.commands:
-        command = command.commands[argv[i]]
-        i += 1
+    while isinstance(command, click.Group) and i < len(argv):
+        sub = command.get_command(click.Context(command), argv[i])  # a command's module loaded only if named
+        if sub is None:
+            break
+        command, i = sub, i + 1
     single = {name: p for p in command.params if isinstance(p, click.Option) and not p.multiple and not p.count
               for name in (*p.opts, *p.secondary_opts)}
     seen: dict[str, list[str]] = {}

@@ -326,37 +326,43 @@ class FastSystem:
         before -= before[group]  # ... of earlier pairs of the same first node
         live = rows >= 0
         indptr = np.r_[0, np.cumsum(np.bincount(rows[live], weights=per_row[live], minlength=n1))].astype(np.int64)
-        full = indptr[np.maximum(rows, 0)][:, :, None] + before[:, :, None] + (np.cumsum(exists, axis=2) - exists)
+        total = int(indptr[-1])
+        # int32 positions and indices where they fit: half the memory traffic of the gathers below
+        small: type[np.signedinteger[Any]] = np.int32 if max(total, keys.size * d * d) < 2**31 else np.int64
+        full = (indptr[np.maximum(rows, 0)][:, :, None] + before[:, :, None]
+                + (np.cumsum(exists, axis=2) - exists)).astype(small)
         # 3. every element entry's (pair, i, k), of the assembled ones
         offsets = np.cumsum([0, *(k.size for k in pair_keys)])
-        component = (self.dof1 % d).astype(np.int32)  # of each active dof
+        component = (self.dof1 % d).astype(small)  # of each active dof
         full_flat = full.reshape(-1)
         positions = []
-        used = np.zeros(int(indptr[-1]), dtype=bool)
+        used = np.zeros(total, dtype=bool)
         for o, owner in enumerate(owners):
             dofs = d * owner.cells[:, :, None] + np.arange(d)  # (c, n, d)
             owner.edofs = dofs.ravel()
             erows, ecols, valid = self._entries(owner, active[dofs])
             owner.take = np.flatnonzero(valid)
             n = owner.cells.shape[1]
-            pair = inverse[offsets[o] : offsets[o + 1]].reshape(-1, n, n).astype(np.int32)
+            pair = inverse[offsets[o] : offsets[o + 1]].reshape(-1, n, n).astype(small)
             ia, ib = self._entry_nodes(owner)
-            index = np.broadcast_to(pair[:, ia, ib] * (d * d), erows.shape).ravel()[owner.take]
-            index += component[np.ravel(erows)[owner.take]] * d
-            index += component[np.ravel(ecols)[owner.take]]
-            pos = full_flat[index]
+            # every entry's index (invalid ones' too: one gather of the assembled ones after)
+            index = pair[:, ia, ib] * (d * d) + component[erows] * d + component[ecols]  # int32 stays int32
+            pos = full_flat[index.reshape(-1)[owner.take]]
             used[pos] = True
             positions.append(pos)
-        # 4. keep the entries some element assembles; every owner's CSR positions side by side
+        # 4. the columns (a position past the end takes what does not exist); every owner's CSR positions side by
+        # side; of the entries no element assembles none kept (there are none on the actuators' meshes)
+        columns = np.empty(total + 1, dtype=np.int32)
+        columns[np.where(exists, full, total).reshape(-1)] = np.broadcast_to(cols[:, None, :], exists.shape).ravel()
+        spans = np.cumsum([0, *(pos.size for pos in positions)])
+        parts = tuple((o.edofs, o.take, int(spans[i]), int(spans[i + 1] - spans[i])) for i, o in enumerate(owners))
+        if used.all():
+            return Pattern(indptr.astype(np.int32), columns[:total], total,
+                           np.concatenate(positions).astype(np.int64), parts)
         renumber = np.cumsum(used) - 1
         kept_rows = np.repeat(np.arange(n1), np.diff(indptr))[used]
-        columns = np.empty(int(indptr[-1]), dtype=np.int32)
-        columns[full[exists]] = np.broadcast_to(cols[:, None, :], exists.shape)[exists]
-        spans = np.cumsum([0, *(pos.size for pos in positions)])
-        return Pattern(np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32), columns[used],
-                       int(used.sum()), np.take(renumber, np.concatenate(positions)),
-                       tuple((o.edofs, o.take, int(spans[i]), int(spans[i + 1] - spans[i]))
-                             for i, o in enumerate(owners)))
+        return Pattern(np.r_[0, np.cumsum(np.bincount(kept_rows, minlength=n1))].astype(np.int32),
+                       columns[:total][used], int(used.sum()), np.take(renumber, np.concatenate(positions)), parts)
 
     # -- evaluation -----------------------------------------------------------------------
     def residual(self, u: FloatArray) -> tuple[FloatArray, float]:
