@@ -2,27 +2,14 @@
 
 from __future__ import annotations
 
-import base64
 import json
-import sys
-import zlib
 from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from numpy.typing import NDArray
-
-from pneumorph import __version__
 
 _REGION_IDS = {"body": 0, "layer": 1, "filler": 2}
-
-#: VTK's number of each cell type (by FElupe's and meshio's names); these types' nodes are in VTK's order
-VTK_CELL_TYPES = {"line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12, "triangle6": 22, "quad8": 23,
-                  "tetra10": 24, "hexahedron20": 25, "quad9": 28, "hexahedron27": 29}
-#: bytes of an array compressed as one zlib block (VTK's XML format, as meshio writes it)
-_BLOCK = 32768
-_VTU_TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.int64): "Int64", np.dtype(np.int32): "Int32"}
 
 
 def region_ids(names: Any) -> dict[str, int]:
@@ -60,8 +47,7 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
     1 stiff layer, 2 filler, then the others; the PVD's comment names them). The PVD's time
     value is the pressure in kPa. A solve with obstacles (:mod:`pneumorph.models.fe.obstacles`) adds the point data
     ``contact_force``: the force each surface node exerts on the obstacles (N, as the response reports it), and
-    ``contact_pressure``: that force over the node's share of the surface (kPa). The files are VTK's XML format,
-    binary in zlib blocks, as meshio writes them; the mesh and its regions are encoded once for every file.
+    ``contact_pressure``: that force over the node's share of the surface (kPa).
 
     Parameters
     ----------
@@ -79,6 +65,8 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
     Path
         The PVD file.
     """
+    import meshio
+
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     mesh = solution.mesh
@@ -88,8 +76,6 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
     ids = region_ids(list(mesh.regions))
     for name, idx in mesh.regions.items():
         region[idx] = ids[name]
-    # the mesh and its regions, the same in every file: encoded once
-    head, tail = _vtu_frame(points, np.asarray(mesh.cells), mesh.cell_type, {"region": region})
     pressures = solution.response.pressures
     entries = []
     for k, u in enumerate(solution.displacements):
@@ -99,8 +85,10 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
         disp[:, : mesh.dim] = u
         name = f"{stem}_{k:02d}.vtu"
         data = {"displacement": disp, **_contact_forces(solution.response.metadata.get("contact"), k, len(points))}
-        point_data = "".join(_data_array(key, value) for key, value in data.items())
-        (out / name).write_text(f"{head}<PointData>\n{point_data}</PointData>\n{tail}", encoding="ascii")
+        meshio.write(
+            out / name,
+            meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data=data, cell_data={"region": [region]}),
+        )
         entries.append(f'    <DataSet timestep="{pressures[k] * 1e3:.6g}" file={quoteattr(name)}/>')
     comment = json.dumps({"regions": ids, **(meta or {})}, default=str).replace("--", "- -")
     pvd = out / f"{stem}.pvd"
@@ -113,38 +101,3 @@ def write_vtk_series(solution: Any, folder: str | Path, stem: str = "actuator",
         encoding="utf-8",
     )
     return pvd
-
-
-def _data_array(name: str, data: NDArray[Any]) -> str:
-    """One ``DataArray`` of a VTU file: binary, in zlib blocks of :data:`_BLOCK` bytes, after its header (UInt32
-    block count, block size, last block's size, every compressed block's size), each base64-encoded on its own."""
-    raw = np.ascontiguousarray(data).tobytes()
-    blocks = [zlib.compress(raw[i : i + _BLOCK]) for i in range(0, len(raw), _BLOCK)]
-    header = np.array([len(blocks), _BLOCK, len(raw) - (len(blocks) - 1) * _BLOCK, *map(len, blocks)], dtype=np.uint32)
-    components = f' NumberOfComponents="{data.shape[1]}"' if data.ndim == 2 else ""
-    return (f'<DataArray type="{_VTU_TYPES[data.dtype]}" Name="{name}"{components} format="binary">\n'
-            f"{base64.b64encode(header.tobytes()).decode()}{base64.b64encode(b''.join(blocks)).decode()}\n"
-            "</DataArray>\n")
-
-
-def _vtu_frame(points: NDArray[Any], cells: NDArray[Any], cell_type: str,
-               cell_data: dict[str, NDArray[Any]]) -> tuple[str, str]:
-    """A VTU file of an unstructured grid (VTK's XML format, as meshio writes it) up to its point data, and after it.
-
-    >>> head, tail = _vtu_frame(np.zeros((4, 3)), np.array([[0, 1, 2, 3]]), "quad", {"region": np.zeros(1, "i4")})
-    >>> head.splitlines()[4], tail.splitlines()[-1]
-    ('<Piece NumberOfPoints="4" NumberOfCells="1">', '</VTKFile>')
-    """
-    byte_order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
-    connectivity = cells.reshape(-1)
-    offsets = cells.shape[1] * np.arange(1, len(cells) + 1, dtype=connectivity.dtype)
-    head = ('<?xml version="1.0"?>\n'
-            f'<VTKFile type="UnstructuredGrid" version="0.1" byte_order="{byte_order}" '
-            'compressor="vtkZLibDataCompressor">\n'
-            f"<!--This file was written by pneumorph {__version__}-->\n"
-            f'<UnstructuredGrid>\n<Piece NumberOfPoints="{len(points)}" NumberOfCells="{len(cells)}">\n'
-            f"<Points>\n{_data_array('Points', points)}</Points>\n"
-            f"<Cells>\n{_data_array('connectivity', connectivity)}{_data_array('offsets', offsets)}"
-            f"{_data_array('types', np.full(len(cells), VTK_CELL_TYPES[cell_type], dtype=np.int64))}</Cells>\n")
-    arrays = "".join(_data_array(name, values) for name, values in cell_data.items())
-    return head, f"<CellData>\n{arrays}</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n"
