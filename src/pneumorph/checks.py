@@ -20,13 +20,19 @@ far beyond what the dissertation's actuators need (15 units, 45-85 kPa, 10 level
 ``MAX_GENERATIONS``       10 000  GA generations
 ``MAX_STARTS``              1000  multistarts of a fit, runs, seeds, held-out designs
 ``MIN_ELEMENT_FRACTION``     1/8  element size against the unit's thinnest wall
+``MIN_VOLUME_CHANGE``       1e-6  V0, a volume-controlled ramp's relative volume change
+``MAX_VOLUME_CHANGE``        100  V0, the same; no silicone survives a hundredfold inflation
+``MAX_VOLUME_STEP``            2  V0, the volume change of one step of such a ramp
 ========================  ======  =======================================================
+
+The limits and :func:`check_volume_steps` live here, below every model, so that a command's
+options can name them without importing the models (``simulate --help`` imports no FE code).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from pneumorph.errors import SettingsError
@@ -39,6 +45,23 @@ MAX_POPULATION = 10_000
 MAX_GENERATIONS = 10_000
 MAX_STARTS = 1000
 MIN_ELEMENT_FRACTION = 1.0 / 8.0
+
+#: the range of a volume-controlled ramp's relative volume change ``V / V0 - 1``: a smaller change is lost in the
+#: cavity volume's rounding and the solver's tolerance (the ramp would report an unloaded actuator ten times); a
+#: larger one is a hundredfold inflation no silicone survives
+MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE = 1e-6, 100.0
+
+#: the largest relative volume change of one step of a volume-controlled ramp (``simulate --volume-change`` over
+#: its ``--increments``, ``[model] volume_change`` over ``increments``, ``bimodal --volume-change`` over
+#: ``--pmax``/``--step``): the bimodal actuator converges at 0.67 V0 a step (the default 8 V0 in 12 steps) and 1.6 V0
+#: (two voids, 5 steps) but not at 4 V0 in one step from rest; a 4-unit 2D actuator of Ecoflex 00-30 takes 0.5 V0 in
+#: one step and stops at 1 V0 (its first iterate's pressure past the filler law's range), in a few seconds, not a
+#: long ramp
+MAX_VOLUME_STEP = 2.0
+
+#: where a batch of designs is solved (``--executor``, ``[execution] executor``;
+#: :func:`pneumorph.execution.make_evaluator`)
+EXECUTORS = ("serial", "processes", "dask")
 
 
 def _bound_text(low: float | None, high: float | None, low_open: bool, high_open: bool) -> str:
@@ -151,6 +174,42 @@ def pair(value: Any, name: str, unit: str = "", error: type[SettingsError] = Set
     if not isinstance(value, (list, tuple)) or len(value) != 2:
         raise error(f"{name} must be two numbers{f' ({unit})' if unit else ''}, got {value!r}")
     return real(value[0], name, unit=unit, error=error), real(value[1], name, unit=unit, error=error)
+
+
+def check_volume_steps(volume: float, increments: int, names: tuple[str, str] = ("volume change", "increments"),
+                       error: type[Exception] = SettingsError, advice: Callable[[int], str] | None = None) -> None:
+    """Refuse a volume-controlled ramp whose steps change the volume by more than :data:`MAX_VOLUME_STEP`.
+
+    Parameters
+    ----------
+    volume : float
+        The ramp's relative volume change ``V / V0 - 1``.
+    increments : int
+        Its equal steps.
+    names : (str, str)
+        How the caller names the two settings (``("--volume-change", "--increments")``).
+    error : exception class
+        Raised with the one-line message (the caller's kind: a settings error, a usage error).
+    advice : callable, optional
+        ``advice(least_steps)``: what to do instead, in the caller's terms (default: at least that
+        many of ``names[1]``).
+
+    Examples
+    --------
+    >>> check_volume_steps(4.0, 2)
+    >>> check_volume_steps(100.0, 1, ("--volume-change", "--increments"))  # doctest: +NORMALIZE_WHITESPACE
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: --volume-change 100 over --increments 1 is 100 V0 per step, more than the 2 V0 a
+    step can take from rest (MAX_VOLUME_STEP, pneumorph.checks): give at least 50 --increments
+    """
+    per = float(volume) / max(1, int(increments))
+    if per <= MAX_VOLUME_STEP * (1 + 1e-12):
+        return
+    least = math.ceil(float(volume) / MAX_VOLUME_STEP * (1 - 1e-12))
+    todo = advice(least) if advice is not None else f"give at least {least} {names[1]}"
+    raise error(f"{names[0]} {float(volume):g} over {names[1]} {int(increments)} is {per:g} V0 per step, more than "
+                f"the {MAX_VOLUME_STEP:g} V0 a step can take from rest (MAX_VOLUME_STEP, pneumorph.checks): {todo}")
 
 
 _SCHEMES = ("tcp", "tls", "ucx", "ws", "wss", "inproc")

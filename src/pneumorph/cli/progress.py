@@ -8,11 +8,12 @@ import math
 import os
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from pneumorph.io.progress import HEARTBEAT, Progress, duration_text
+if TYPE_CHECKING:
+    from pneumorph.io.progress import Progress
 
 
 def reporter() -> Progress:
@@ -21,6 +22,8 @@ def reporter() -> Progress:
     The heartbeat speaks after :data:`~pneumorph.io.progress.HEARTBEAT` seconds of silence, or after the seconds
     in the environment variable ``PNEUMORPH_HEARTBEAT`` (a log file may want fewer lines; the contract's test
     a shorter beat)."""
+    from pneumorph.io.progress import HEARTBEAT, Progress
+
     text = os.environ.get("PNEUMORPH_HEARTBEAT", "").strip()
     heartbeat = HEARTBEAT
     if text:
@@ -86,6 +89,8 @@ class RunLines:
                            f"executor {c.executor}) -> {self.folder}")
 
     def on_generation(self, stats: Any) -> None:
+        from pneumorph.io.progress import duration_text
+
         self.announce()
         total, done = self.config.ga.generations, stats.generation
         bar = "#" * int(20 * done / max(total, 1))

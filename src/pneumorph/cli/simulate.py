@@ -7,9 +7,9 @@ from typing import Any
 
 import click
 
+from pneumorph.checks import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import solve_levels
-from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 
 
 @click.command("simulate")

@@ -30,6 +30,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
+from pneumorph import checks
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.cluster import (
     MMAP_THRESHOLD,
@@ -42,8 +43,9 @@ from pneumorph.execution.cluster import (
 from pneumorph.execution.pool import ProcessPoolEvaluator, prepare_worker
 from pneumorph.execution.serial import THREAD_VARIABLES, Evaluator, SerialEvaluator
 
-#: The names :func:`make_evaluator` knows: in this process, a process pool, a Dask cluster.
-EXECUTORS = ("serial", "processes", "dask")
+#: The names :func:`make_evaluator` knows: in this process, a process pool, a Dask cluster (defined in
+#: :mod:`pneumorph.checks`, which the command line's options read without importing the evaluators).
+EXECUTORS = checks.EXECUTORS
 
 #: Most worker processes per core of this machine (a pool or a local Dask cluster): each solves one design at a
 #: time on one core, so more share the cores and multiply the memory.

@@ -10,11 +10,9 @@ from typing import Any
 
 import click
 
-from pneumorph.checks import MAX_INCREMENTS
+from pneumorph.checks import MAX_INCREMENTS, MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 from pneumorph.cli.options import params as P
 from pneumorph.cli.progress import reporter
-from pneumorph.io.files import all_or_nothing, strict_json, write_json
-from pneumorph.models.fe.ramp import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 
 #: the voids' relative volume change V/V0 - 1 at the end of the default volume-controlled ramp: the full-size
 #: actuator (CR 0.2, library bulk modulus) passes the pressure ramp's end (about 35 kPa) and its pressure maximum
@@ -74,6 +72,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     """
     from pneumorph.bimodal.geometry import BimodalSpec
     from pneumorph.bimodal.model import MATRIX, BimodalModel, bilinear_material, bulk_from_poisson
+    from pneumorph.io.files import strict_json
     from pneumorph.materials import get
 
     n = round(pmax / step)
@@ -175,6 +174,7 @@ def format_result(d: dict[str, Any]) -> str:
 def write_outputs(result: Any, out: Path) -> list[Path]:
     """Write ``bimodal-CR.json`` and the tip-path and outline figures into ``out``."""
     from pneumorph.bimodal import figures
+    from pneumorph.io.files import all_or_nothing, write_json
 
     tag = f"cr{result.crimp_ratio:g}".replace(".", "_")
     js = out / f"bimodal-{tag}.json"

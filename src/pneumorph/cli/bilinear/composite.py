@@ -14,7 +14,6 @@ import click
 
 from pneumorph.cli.options import params as P
 from pneumorph.errors import CrimpError
-from pneumorph.io.files import all_or_nothing, strict_json, write_json
 
 
 @click.group()
@@ -54,6 +53,8 @@ def _crimp_options(f: Any) -> Any:
 def transition(crimp_ratio: float | None, wavelength: float | None, amplitude: float, length: float,
                as_json: bool) -> None:
     """Analytical transition strain of a triangular crimp (Eqs 3.1-3.4)."""
+    from pneumorph.io.files import strict_json
+
     c = _crimp(crimp_ratio, wavelength, amplitude, length)
     data = c.to_dict()
     if as_json:
@@ -101,6 +102,7 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
            gauges: int | None, seed: int, snapshot: float | None, out: Path | None, as_json: bool) -> None:
     """Plane-strain FE tensile test of a crimped composite coupon (section 3.2.3)."""
     from pneumorph.composite.coupon import CouponSpec, simulate_coupon
+    from pneumorph.io.files import strict_json
 
     c = _crimp(crimp_ratio, wavelength, amplitude, length)
     final = strain_max if strain_max is not None else c.limit_transition_strain + 0.10
@@ -172,6 +174,7 @@ def write_outputs(result: Any, summary: dict[str, Any], out: Path, snapshot: flo
     import numpy as np
 
     from pneumorph.composite import figures
+    from pneumorph.io.files import all_or_nothing, write_json
 
     tag = f"cr{result.spec.crimp.crimp_ratio:.4g}".replace(".", "_")
     csv = out / f"coupon-{tag}.csv"

@@ -20,8 +20,8 @@ from typing import Any
 
 import click
 
+from pneumorph.checks import EXECUTORS
 from pneumorph.cli.options import params as P
-from pneumorph.execution.evaluators import EXECUTORS
 
 NAMES = ("--executor", "--workers", "--scheduler")
 

@@ -2,6 +2,10 @@
 
 A value is refused while the command line is read, before anything is computed, with the
 option's name in the message: ``--pressure must be a finite number > 0 (kPa), got nan``.
+
+A command's options are built when its module is imported, also for ``--help``: this module
+imports :mod:`pneumorph.io`'s file checks (and NumPy with them) only when a file option is
+parsed.
 """
 
 from __future__ import annotations
@@ -15,8 +19,6 @@ import click
 
 from pneumorph import checks
 from pneumorph.errors import OutputPathError, PneumorphError, SettingsError
-from pneumorph.io.files import check_writable_dir, check_writable_file
-from pneumorph.io.reading import MAX_SCAN_BYTES, MAX_TEXT_BYTES, check_input_file, check_text_file
 
 if TYPE_CHECKING:
     from pneumorph.geometry.library import UnitLibrary
@@ -118,17 +120,20 @@ class InputFile(click.ParamType):
 
     def __init__(self, text: bool = True, limit: int | None = None) -> None:
         self.text = text
-        self.limit = limit if limit is not None else (MAX_TEXT_BYTES if text else MAX_SCAN_BYTES)
+        self.limit = limit
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> str:
+        from pneumorph.io.reading import MAX_SCAN_BYTES, MAX_TEXT_BYTES, check_input_file, check_text_file
+
         name = _name(param)
         if str(value).strip() == "":
             self.fail(f"{name} must not be empty", param, ctx)
+        limit = self.limit if self.limit is not None else (MAX_TEXT_BYTES if self.text else MAX_SCAN_BYTES)
         try:
             if self.text:
-                check_text_file(value, name, limit=self.limit)
+                check_text_file(value, name, limit=limit)
             else:
-                check_input_file(value, name, limit=self.limit)
+                check_input_file(value, name, limit=limit)
         except PneumorphError as exc:
             self.fail(str(exc), param, ctx)
         return str(value)
@@ -140,6 +145,8 @@ class OutputDir(click.ParamType):
     name = "dir"
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> str:
+        from pneumorph.io.files import check_writable_dir
+
         try:
             check_writable_dir(value, _name(param))
         except OutputPathError as exc:
@@ -156,6 +163,8 @@ class OutputFile(click.ParamType):
         self.suffixes = suffixes
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> str:
+        from pneumorph.io.files import check_writable_file
+
         try:
             check_writable_file(value, _name(param))
         except OutputPathError as exc:
@@ -171,6 +180,8 @@ class CacheFile(click.ParamType):
     name = "file"
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> str:
+        from pneumorph.io.files import check_writable_dir
+
         name = _name(param)
         if str(value).strip() == "":
             self.fail(f"{name} must not be empty", param, ctx)

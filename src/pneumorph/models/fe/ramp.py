@@ -1,65 +1,19 @@
-"""The pressure ramp of a model: the final pressure and how the ramp to it is stepped."""
+"""The pressure ramp of a model: the final pressure and how the ramp to it is stepped.
+
+The volume-controlled ramp's limits (:data:`~pneumorph.checks.MIN_VOLUME_CHANGE`,
+:data:`~pneumorph.checks.MAX_VOLUME_CHANGE`, :data:`~pneumorph.checks.MAX_VOLUME_STEP`) and
+:func:`~pneumorph.checks.check_volume_steps` are :mod:`pneumorph.checks`', named here too.
+"""
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from pneumorph import checks
-from pneumorph.errors import LimitPointError, SettingsError, SimulationFailed
+from pneumorph.checks import MAX_VOLUME_CHANGE, MAX_VOLUME_STEP, MIN_VOLUME_CHANGE, check_volume_steps
+from pneumorph.errors import LimitPointError, SimulationFailed
 from pneumorph.fem import StepSettings
 from pneumorph.models.response import FloatArray
-
-#: the range of a volume-controlled ramp's relative volume change ``V / V0 - 1``: a smaller change is lost in the
-#: cavity volume's rounding and the solver's tolerance (the ramp would report an unloaded actuator ten times); a
-#: larger one is a hundredfold inflation no silicone survives
-MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE = 1e-6, 100.0
-
-#: the largest relative volume change of one step of a volume-controlled ramp (``simulate --volume-change`` over
-#: its ``--increments``, ``[model] volume_change`` over ``increments``, ``bimodal --volume-change`` over
-#: ``--pmax``/``--step``): the bimodal actuator converges at 0.67 V0 a step (the default 8 V0 in 12 steps) and 1.6 V0
-#: (two voids, 5 steps) but not at 4 V0 in one step from rest; a 4-unit 2D actuator of Ecoflex 00-30 takes 0.5 V0 in
-#: one step and stops at 1 V0 (its first iterate's pressure past the filler law's range), in a few seconds, not a
-#: long ramp
-MAX_VOLUME_STEP = 2.0
-
-
-def check_volume_steps(volume: float, increments: int, names: tuple[str, str] = ("volume change", "increments"),
-                       error: type[Exception] = SettingsError, advice: Callable[[int], str] | None = None) -> None:
-    """Refuse a volume-controlled ramp whose steps change the volume by more than :data:`MAX_VOLUME_STEP`.
-
-    Parameters
-    ----------
-    volume : float
-        The ramp's relative volume change ``V / V0 - 1``.
-    increments : int
-        Its equal steps.
-    names : (str, str)
-        How the caller names the two settings (``("--volume-change", "--increments")``).
-    error : exception class
-        Raised with the one-line message (the caller's kind: a settings error, a usage error).
-    advice : callable, optional
-        ``advice(least_steps)``: what to do instead, in the caller's terms (default: at least that
-        many of ``names[1]``).
-
-    Examples
-    --------
-    >>> check_volume_steps(4.0, 2)
-    >>> check_volume_steps(100.0, 1, ("--volume-change", "--increments"))  # doctest: +NORMALIZE_WHITESPACE
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.SettingsError: --volume-change 100 over --increments 1 is 100 V0 per step, more than the 2 V0 a
-    step can take from rest (MAX_VOLUME_STEP, pneumorph.models.fe.ramp): give at least 50 --increments
-    """
-    per = float(volume) / max(1, int(increments))
-    if per <= MAX_VOLUME_STEP * (1 + 1e-12):
-        return
-    least = math.ceil(float(volume) / MAX_VOLUME_STEP * (1 - 1e-12))
-    todo = advice(least) if advice is not None else f"give at least {least} {names[1]}"
-    raise error(f"{names[0]} {float(volume):g} over {names[1]} {int(increments)} is {per:g} V0 per step, more than "
-                f"the {MAX_VOLUME_STEP:g} V0 a step can take from rest (MAX_VOLUME_STEP, pneumorph.models.fe.ramp): "
-                f"{todo}")
 
 
 @dataclass(frozen=True)
