@@ -1,6 +1,7 @@
 """The ``pneumorph`` group loads a command's module only when that command runs: its table of commands
 (``COMMANDS``) names every command's module and summary, and ``pneumorph --help`` lists them as the commands
-themselves would, without importing one."""
+themselves would, without importing one. The ``materials`` group does the same with its table
+(``MATERIALS_COMMANDS``), and a command's own ``--help`` imports none of the numerical code."""
 
 from __future__ import annotations
 
@@ -12,24 +13,33 @@ import click
 import pytest
 
 from pneumorph.cli import COMMANDS, cli
+from pneumorph.cli.materials.group import MATERIALS_COMMANDS, materials
+
+TABLES = [(cli, COMMANDS), (materials, MATERIALS_COMMANDS)]
 
 
-def _eager() -> click.Group:
+def _command(where: str, name: str) -> click.Command:
+    module, _, attribute = where.partition(":")
+    return getattr(importlib.import_module(module), attribute or name)
+
+
+def _eager(group: click.Group = cli) -> click.Group:
     """The same group with every command imported and added, as click builds it without a table."""
-    group = click.Group("pneumorph", params=cli.params, help=cli.help,
-                        context_settings={"help_option_names": ["-h", "--help"]})
-    for name, (module, _) in COMMANDS.items():
-        group.add_command(getattr(importlib.import_module(module), name), name)
-    return group
+    table = dict(TABLES)[group]  # type: ignore[call-overload]
+    eager = click.Group(group.name, params=group.params, help=group.help, context_settings=group.context_settings)
+    for name, (where, _) in table.items():
+        eager.add_command(_command(where, name), name)
+    return eager
 
 
-@pytest.mark.parametrize("name", sorted(COMMANDS))
-def test_every_command_is_its_modules_and_its_summary_is_its_helps_first_sentence(name: str) -> None:
-    module, summary = COMMANDS[name]
-    command = getattr(importlib.import_module(module), name)
+@pytest.mark.parametrize(("group", "name"), [(group, name) for group, table in TABLES for name in sorted(table)])
+def test_every_command_is_its_modules_and_its_summary_is_its_helps_first_sentence(group: click.Group,
+                                                                                  name: str) -> None:
+    where, summary = dict(TABLES)[group][name]  # type: ignore[call-overload]
+    command = _command(where, name)
     assert isinstance(command, click.Command) and command.name == name
     assert summary == command.get_short_help_str(10_000)
-    assert cli.get_command(click.Context(cli), name) is command
+    assert group.get_command(click.Context(group), name) is command
 
 
 @pytest.mark.parametrize("width", [50, 80, 120, 200])
@@ -42,6 +52,9 @@ def test_the_list_of_commands_is_the_commands_own(width: int) -> None:
     text = help_text(cli)
     assert text == help_text(_eager())
     assert all(f"  {name}  " in text for name in COMMANDS) and "simulate     Inflate one actuator design" in text
+    listed = help_text(materials)
+    assert listed == help_text(_eager(materials))
+    assert all(f"  {name}  " in listed for name in MATERIALS_COMMANDS)
 
 
 def test_every_command_the_modules_define_is_reachable_from_the_table() -> None:
@@ -74,6 +87,18 @@ def test_the_group_lists_without_importing_a_command() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.splitlines()[-1] == "0 []"
     assert "Commands:" in done.stdout and "unit " in done.stdout
+
+
+def test_a_commands_help_imports_no_numerical_code() -> None:
+    """``pneumorph X --help`` builds X's options from :mod:`pneumorph.checks` and click alone: the models, the
+    evaluators, pneumorph.io and NumPy (half a second of imports) are imported when X runs."""
+    heavy = ("numpy", "scipy", "pneumorph.models", "pneumorph.execution", "pneumorph.io", "pneumorph.materials")
+    code = ("import sys; from pneumorph.cli import COMMANDS, main\n"
+            "for name in sorted(COMMANDS):\n"
+            "    code = main([name, '--help'])\n"
+            f"    print(name, code, [m for m in {heavy!r} if m in sys.modules], file=sys.stderr)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stderr.splitlines() == [f"{name} 0 []" for name in sorted(COMMANDS)]
 
 
 @pytest.mark.parametrize("typed", ["simulat", "desing", "nothing"])

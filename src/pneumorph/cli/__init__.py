@@ -65,15 +65,21 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 
 class LazyGroup(click.Group):
-    """The ``pneumorph`` group: each command (:data:`COMMANDS`) imported on first use; its list from the table."""
+    """A group whose commands are imported on first use, listed from a table (the ``pneumorph`` group's:
+    :data:`COMMANDS`): each name's module (``module`` or ``module:attribute``, the attribute by default the name)
+    and the first sentence of its help."""
+
+    def __init__(self, *args: Any, table: dict[str, tuple[str, str]] | None = None, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.table = table if table is not None else {}
 
     def list_commands(self, ctx: click.Context) -> list[str]:
-        return sorted({*COMMANDS, *self.commands})
+        return sorted({*self.table, *self.commands})
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
-        if cmd_name not in self.commands and cmd_name in COMMANDS:
-            module = importlib.import_module(COMMANDS[cmd_name][0])
-            self.add_command(getattr(module, cmd_name), cmd_name)
+        if cmd_name not in self.commands and cmd_name in self.table:
+            module, _, attribute = self.table[cmd_name][0].partition(":")
+            self.add_command(getattr(importlib.import_module(module), attribute or cmd_name), cmd_name)
         return self.commands.get(cmd_name)
 
     def resolve_command(self, ctx: click.Context, args: list[str]) -> tuple[str | None, click.Command | None,
@@ -88,7 +94,7 @@ class LazyGroup(click.Group):
         """The commands and their summaries as click lists them, from the table: no command imported."""
         names = self.list_commands(ctx)
         limit = formatter.width - 6 - max(len(name) for name in names)
-        stand_ins = [click.Command(name, help=COMMANDS[name][1]) if name in COMMANDS and name not in self.commands
+        stand_ins = [click.Command(name, help=self.table[name][1]) if name in self.table and name not in self.commands
                      else self.commands[name] for name in names]
         rows = [(name, command.get_short_help_str(limit)) for name, command in zip(names, stand_ins, strict=True)
                 if not command.hidden]
@@ -96,7 +102,7 @@ class LazyGroup(click.Group):
             formatter.write_dl(rows)
 
 
-@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=LazyGroup, table=COMMANDS, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, "--version", "-V", prog_name="pneumorph")
 def cli() -> None:
     """pneumorph - generative design of soft pneumatic actuators."""

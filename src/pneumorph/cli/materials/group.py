@@ -4,19 +4,21 @@ from __future__ import annotations
 
 import click
 
+from pneumorph.cli import LazyGroup
 
-@click.group()
+#: The group's commands: each one's module and attribute, and the first sentence of its help (``materials
+#: --help`` lists them without importing one; a command imports the material code it needs when it runs or
+#: shows its own help).
+MATERIALS_COMMANDS: dict[str, tuple[str, str]] = {
+    "characterise": ("pneumorph.cli.materials.characterise", "Characterise materials from test data (CSV files "
+                     "with a header row)."),
+    "fit": ("pneumorph.cli.materials.fit", "Fit hyperelastic models to test DATA (files and/or bundled data sets)."),
+    "list": ("pneumorph.cli.materials.library:list_materials", "List the materials and filler laws of the library."),
+    "show": ("pneumorph.cli.materials.library:show_material", "Show every property of material NAME with units, "
+             "convention, source and assumptions."),
+}
+
+
+@click.group(cls=LazyGroup, table=MATERIALS_COMMANDS)
 def materials() -> None:
     """Silicone and composite materials: list, show, fit, characterise."""
-
-
-from pneumorph.cli.materials.characterise import characterise  # noqa: E402
-from pneumorph.cli.materials.library import list_materials, show_material  # noqa: E402
-
-materials.add_command(list_materials)
-materials.add_command(show_material)
-materials.add_command(characterise)
-
-from pneumorph.cli.materials.fit import fit  # noqa: E402
-
-materials.add_command(fit)
