@@ -423,7 +423,7 @@ def builtin_library(name: str = "builtin") -> UnitLibrary:
     >>> builtin_library("spatial").symbols, builtin_library("spatial")["l"].layer_side
     (('a', 'l'), True)
     >>> builtin_library("modes").modes
-    ('bending', 'bimodal', 'low-bending')
+    ('bending', 'bimodal', 'low-bending', 'bimodal, paper')
     >>> builtin_library("planar")
     Traceback (most recent call last):
     ...
