@@ -123,11 +123,16 @@ def contact_fraction(system: Any, u: FloatArray, step: FloatArray, motion: float
     contacts = getattr(system, "contacts", ())
     if not contacts:
         return 1.0
-    du = np.zeros_like(u)
-    du[system.dof1] = step
-    d = system.points.shape[1]
-    x, dx = system.points + u.reshape(-1, d), du.reshape(-1, d)
+    x = system.points + u.reshape(system.points.shape)
+    dx = node_steps(system, step)
     return min(c.step_fraction(x, dx, motion) for c in contacts)
+
+
+def node_steps(system: Any, step: FloatArray) -> FloatArray:
+    """A ``step`` over the active dofs as each node's displacement increment, one row a node (0 where prescribed)."""
+    du = np.zeros(system.points.size)
+    du[system.dof1] = step
+    return du.reshape(system.points.shape)
 
 
 def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: bool = False) -> bool:
@@ -343,10 +348,7 @@ class FastSubstep:
             return
         dof1 = self.system.dof1
         step = u[dof1] - last[dof1]
-        d = self.system.points.shape[1]
-        du = np.zeros_like(u)
-        du[dof1] = step
-        self._motion = MOTION * float(np.max(np.linalg.norm(du.reshape(-1, d), axis=1), initial=0.0))
+        self._motion = MOTION * float(np.max(np.linalg.norm(node_steps(self.system, step), axis=1), initial=0.0))
         fraction = contact_fraction(self.system, last, step, self._motion)
         if fraction < 1.0:
             u[dof1] = last[dof1] + fraction * step
