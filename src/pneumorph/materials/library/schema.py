@@ -35,7 +35,9 @@ _MODEL_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "mooney-rivlin": (("c10", "c01"), ("c11",)),
     "yeoh": (("c",), ()),
 }
-_ENTRY_KEYS = {"display_name", "kind", "source", "aliases", "description", "model", "r_squared", "fit"}
+_ENTRY_KEYS = {"display_name", "kind", "source", "aliases", "description", "model", "r_squared", "fit", "matrix"}
+#: what an entry with ``matrix = "<key>"`` takes from that entry: its kind, law, density and bulk modulus
+_INHERITED = ("kind", "model", "density", "bulk_modulus")
 _FIT_KEYS = {"data", "attribution", "mode", "stretch_range", "points", "method", "caveats"}
 _ENTRY_KEYS |= set(PROPERTIES)
 
@@ -189,6 +191,39 @@ def _fit_record(where: _Where, data: dict[str, Any]) -> FitRecord:
         raise w.error(str(exc)) from None
 
 
+def _with_matrix(path: str, key: str, data: Any, entries: dict[str, Any]) -> Any:
+    """``data`` with its matrix's kind, law, density and bulk modulus under its own keys.
+
+    An entry's own table with a number (``value``, or a model's ``type``) replaces the matrix's; one
+    without (``source``, ``assumed``, ``reason``) keeps the matrix's number and says where it comes
+    from. The matrix is an entry of the same file with a law of its own (no matrix of its own).
+    """
+    if not isinstance(data, dict) or "matrix" not in data:
+        return data
+    where = _Where(path, f"materials.{key}")
+    name = where.text(data, "matrix")
+    matrix = entries.get(name) if name != key else None
+    if name == key:
+        raise where.error(f"matrix {name!r} is the entry itself; a matrix is another entry of the file")
+    if not isinstance(matrix, dict):
+        raise where.error(f"matrix {name!r} is not an entry of {path}; known: {', '.join(entries)}")
+    if "matrix" in matrix:
+        raise where.error(f"matrix {name!r} has a matrix of its own ({matrix['matrix']!r}); "
+                          "a matrix is an entry with its own law")
+    if matrix.get("kind") != "hyperelastic":
+        raise where.error(f"matrix {name!r} is not a hyperelastic entry; a matrix gives its law (model)")
+    out = {k: v for k, v in data.items() if k != "matrix"}
+    for part in _INHERITED:
+        own, theirs = data.get(part), matrix.get(part)
+        if theirs is None:
+            continue
+        if own is None:
+            out[part] = theirs
+        elif isinstance(own, dict) and isinstance(theirs, dict) and not own.keys() & {"value", "type"}:
+            out[part] = theirs | own
+    return out
+
+
 def _material(path: str, key: str, data: Any) -> Material:
     where = _Where(path, f"materials.{key}")
     if not isinstance(data, dict):
@@ -316,7 +351,7 @@ def parse_library(data: dict[str, Any], path: str) -> Library:
         raise where.error("no [materials.<name>] or [fillers.<name>] tables found")
     return Library(
         path=path,
-        materials=tuple(_material(path, k, v) for k, v in materials.items()),
+        materials=tuple(_material(path, k, _with_matrix(path, k, v, materials)) for k, v in materials.items()),
         fillers=tuple(_filler(path, k, v) for k, v in fillers.items()),
     )
 
