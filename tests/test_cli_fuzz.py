@@ -158,7 +158,8 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
                        "sphere:centre=60,20;radius=2;friction=nan", "sphere:centre=60,20;radius=2;kind=plane",
                        "cylinder:centre=60,20;radius=1e300", "plane:point=0,-30;normal=1e-320,1e-320",
                        "sphere:centre=60,20;radius=2;radius=3", "sphere:centre=60,20,5;radius=2",
-                       ";", "sphere:", "sphere:centre=1e999,20;radius=2"],
+                       ";", "sphere:", "sphere:centre=1e999,20;radius=2",
+                       "sphere:centre=60,20;radius=2;friction=1e9", "plane:point=150,0;normal=-1,0;friction=10.5"],
     },
     "study": {
         "--populations": ["", "0", "1", "20,,40", "abc", "1.5", "-20"], "--seeds": POS_COUNT + HUGE,
@@ -345,6 +346,7 @@ CONFIG_KEYS: list[tuple[str, str, str]] = [
                                '[{kind = "sphere", centre = [60, "a"], radius = 2}]',
                                '[{kind = "sphere", centre = [60, 20], radius = nan}]',
                                '[{kind = "sphere", centre = [60, 20], radius = 2, friction = -1}]',
+                               '[{kind = "sphere", centre = [60, 20], radius = 2, friction = 1e9}]',
                                '[{kind = "plane", point = [0, 0], normal = [0, 0]}]',
                                '{kind = "sphere", centre = [60, 20], radius = 2}']),
         ("model.unit", "pitch", ["nan", "0", '"ten"', "true"]),
@@ -383,6 +385,17 @@ def test_bad_unit_file(sandbox: Path, capsys: pytest.CaptureFixture[str], conten
     unit.write_bytes(content)
     for argv in (BASE["simulate"], BASE["design"], BASE["chain"]):
         _refused(sandbox, capsys, [*argv, "--unit", str(unit)])
+
+
+@pytest.mark.parametrize("friction", ["1e9", "10.5", "inf"])
+def test_a_friction_past_its_bound_in_a_model_file_is_refused(sandbox: Path, capsys: pytest.CaptureFixture[str],
+                                                              friction: str) -> None:
+    """``[[model.obstacle]]`` of ``--model-file`` has the bound of ``--obstacle`` and the config (MAX_FRICTION)."""
+    model = sandbox / "model.toml"
+    model.write_text(f"[[model.obstacle]]\nkind = 'plane'\npoint = [150, 0]\nnormal = [-1, 0]\nfriction = {friction}\n",
+                     encoding="utf-8")
+    line = _refused(sandbox, capsys, [*BASE["simulate"], "--model-file", str(model)])
+    assert "friction" in line and ("MAX_FRICTION" in line or friction == "inf"), line
 
 
 @pytest.mark.parametrize(("argv", "names", "least"), [

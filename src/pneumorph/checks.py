@@ -23,6 +23,7 @@ far beyond what the dissertation's actuators need (15 units, 45-85 kPa, 10 level
 ``MIN_VOLUME_CHANGE``       1e-6  V0, a volume-controlled ramp's relative volume change
 ``MAX_VOLUME_CHANGE``        100  V0, the same; no silicone survives a hundredfold inflation
 ``MAX_VOLUME_STEP``            2  V0, the volume change of one step of such a ramp
+``MAX_FRICTION``              10  Coulomb coefficient of an obstacle; elastomers reach 2-3
 ========================  ======  =======================================================
 
 The limits and :func:`check_volume_steps` live here, below every model, so that a command's
@@ -58,6 +59,14 @@ MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE = 1e-6, 100.0
 #: one step and stops at 1 V0 (its first iterate's pressure past the filler law's range), in a few seconds, not a
 #: long ramp
 MAX_VOLUME_STEP = 2.0
+
+#: the largest Coulomb friction coefficient of an obstacle (``friction`` of ``--obstacle`` and
+#: ``[[model.obstacle]]``): soft elastomers on clean, smooth glass or metal reach about 2-3, rarely more, at the
+#: peak of their adhesive friction (Grosch 1963, "The relation between the friction and visco-elastic properties
+#: of rubber", Proc. R. Soc. Lond. A 274, 21-39; Roberts 1992, "A guide to estimating the friction of rubber",
+#: Rubber Chem. Technol. 65, 673-686); 10 leaves a wide margin, and a larger number is a typing error, not a
+#: surface
+MAX_FRICTION = 10.0
 
 #: where a batch of designs is solved (``--executor``, ``[execution] executor``;
 #: :func:`pneumorph.execution.make_evaluator`)

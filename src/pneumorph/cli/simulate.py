@@ -39,8 +39,8 @@ from pneumorph.cli.progress import solve_levels
               help="A rigid obstacle against the outer surface, mm (repeatable): "
                    "plane:point=X,Y;normal=NX,NY (the actuator on the normal's side), cylinder:centre=X,Y;radius=R "
                    "(a circle in 2D; 3D: ;axis=AX,AY,AZ), sphere:centre=...;radius=R; on=end touches the free end "
-                   "face only, friction=MU adds Coulomb friction. Each level's force on it and the base reaction "
-                   "go to the JSON and the response.")
+                   "face only, friction=MU adds Coulomb friction (MU at most 10). Each level's force on it and the "
+                   "base reaction go to the JSON and the response.")
 @click.option("--blocked", is_flag=True,
               help="Add a wall against the free end, normal to the free tip's motion at the first level (one more "
                    "solve of that level) at its start position: the blocked force over the ramp.")

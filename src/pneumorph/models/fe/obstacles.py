@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from pneumorph import checks
 from pneumorph.errors import SettingsError
 from pneumorph.fem.fast.contact import (
     Cylinder,
@@ -76,8 +77,8 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
     Raises
     ------
     SettingsError
-        A table that is no valid obstacle (:func:`~pneumorph.fem.fast.contact.obstacle_from_dict`) or an
-        unknown ``on``.
+        A table that is no valid obstacle (:func:`~pneumorph.fem.fast.contact.obstacle_from_dict`), an
+        unknown ``on``, or a ``friction`` above :data:`~pneumorph.checks.MAX_FRICTION`.
 
     Examples
     --------
@@ -87,6 +88,11 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
     Traceback (most recent call last):
     ...
     pneumorph.errors.SettingsError: [[model.obstacle]] 1 radius must be a finite number > 0 (mm), got -1
+    >>> check_obstacles([{"kind": "plane", "point": [150, 0], "normal": [-1, 0], "friction": 20}], 2)
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SettingsError: [[model.obstacle]] 1 friction must be ... <= 10 (limit MAX_FRICTION), got 20.0
     """
     if obstacles is None:
         return ()
@@ -105,6 +111,7 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
             item = ModelObstacle(obstacle, on, float(entry.get("friction", 0.0)))
         else:
             raise SettingsError(f"{name} must be a table (kind, and its geometry), got {entry!r}")
+        checks.real(item.friction, f"{name} friction", 0.0, checks.MAX_FRICTION, limit="MAX_FRICTION")
         out.append(item)
     return tuple(out)
 
