@@ -41,7 +41,8 @@ def test_an_obstacle_out_of_reach_changes_nothing(free: object) -> None:
 
     ax = plot_shape(solution).axes[0]
     assert [type(p) for p in ax.patches if isinstance(p, Circle)] == [Circle]
-    assert any(line.get_label() == "obstacle 1: 0 N" for line in ax.lines)
+    assert any(line.get_label() == f"obstacle 1: 0 N at {solution.response.pressures[-1] * 1e3:.4g} kPa"
+               for line in ax.lines)
     # the free model's fingerprint is that of a model without the option; obstacles change it
     assert "obstacles" not in Reduced2D(3).describe()
     assert model.fingerprint() != Reduced2D(3).fingerprint()
@@ -64,6 +65,15 @@ def test_a_wall_at_the_free_tip_takes_force_only_above_its_pressure(free: object
     # a quarter of the penalty times that gap
     assert forces[k] < 1e-2 * forces[-1]
     assert np.all(np.diff(forces[k:]) > 0.0)
+    # the shape figure's legend gives the wall's force at the last level drawn, and that level's pressure
+    from pneumorph.plot.shape import plot_shape
+
+    pressures = solution.response.pressures * 1e3
+    for levels in ([k - 1, len(forces) - 1], [len(forces) - 1], [k - 1, k + 2]):
+        (legend,) = plot_shape(solution, levels=levels).legends
+        walls = [t.get_text() for t in legend.get_texts() if t.get_text().startswith("obstacle")]
+        assert walls == [f"obstacle 1: {forces[levels[-1]]:.3g} N at {pressures[levels[-1]]:.4g} kPa"]
+    assert walls != [f"obstacle 1: 0 N at {pressures[k - 1]:.4g} kPa"]  # not the first section's
 
 
 def test_the_clamp_balances_the_obstacles(tmp_path: object) -> None:
@@ -160,7 +170,7 @@ def test_3d_an_obstacle_out_of_reach_changes_nothing_and_the_clamp_balances_a_wa
     from pneumorph.plot.shape import plot_shape
 
     labels = [c.get_label() for c in plot_shape(solution).axes[0].collections]
-    assert labels[1:] == [f"obstacle 1: {levels[-1]['obstacles'][0]['force_magnitude_n']:.3g} N"]
+    assert labels[1:] == [f"obstacle 1: {levels[-1]['obstacles'][0]['force_magnitude_n']:.3g} N at 30 kPa"]
     # with friction on the wall: the end sticks to it, the clamp still balances it
     rough = model.variant(obstacles=[{**wall, "friction": 0.5}]).solve("00")
     last = _levels(rough)[-1]

@@ -35,3 +35,29 @@ def test_the_legend_is_outside_the_sections_at_a_fixed_place(solution: object, l
     (provenance,) = [t for t in fig.texts if t.get_text().startswith("pneumorph ")]
     assert not _overlap(box, provenance.get_window_extent(renderer))
     assert 0 <= box.x0 and box.x1 <= fig.bbox.x1 and 0 <= box.y0  # whole, inside the figure
+
+
+def test_a_3d_figure_names_its_obstacles_in_a_legend() -> None:
+    """The 3D figure (here of an unloaded 2-unit mesh at two levels, no solve) has the 2D figure's legend for its
+    obstacles: each named with its force at the last level drawn and that level's pressure; without obstacles, none."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from pneumorph.geometry.assembly import assemble
+    from pneumorph.geometry.unit import UnitSpec
+
+    mesh = assemble(UnitSpec(), "00", dim=3, half=True)
+    contact = {"obstacles": [{"kind": "plane", "point": [40.0, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0]},
+                             {"kind": "sphere", "centre": [20.0, 30.0, 0.0], "radius": 3.0}],
+               "levels": [{"obstacles": [{"force_magnitude_n": 0.0}, {"force_magnitude_n": 0.0}]},
+                          {"obstacles": [{"force_magnitude_n": 0.25}, {"force_magnitude_n": 0.0}]}]}
+    response = SimpleNamespace(n_levels=2, pressures=np.array([0.015, 0.03]), curl=np.zeros(2), orientation="00",
+                               metadata={"fidelity": "3d", "contact": contact})
+    solution = SimpleNamespace(response=response, mesh=mesh, displacements=np.zeros((2, *mesh.points.shape)))
+    fig = plot_shape(solution, levels=[0, 1])
+    (legend,) = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == ["obstacle 1: 0.25 N at 30 kPa", "obstacle 2: 0 N at 30 kPa"]
+    assert [ax.get_legend() for ax in fig.axes] == [None, None]
+    response.metadata = {"fidelity": "3d"}
+    assert plot_shape(solution).legends == []

@@ -81,7 +81,9 @@ def plot_shape(
     """The deformed actuator at some reported levels, coloured by material.
 
     2D models show the section with the undeformed mesh in grey; 3D models show the
-    outer surface (x along the actuator, y up, z across).
+    outer surface (x along the actuator, y up, z across). The legend, under the sections,
+    names the materials and each rigid obstacle with its force at the last level drawn
+    and that level's pressure.
 
     Parameters
     ----------
@@ -105,21 +107,20 @@ def plot_shape(
             _section(ax, solution, k, outline=True)
             ax.set_aspect("equal")
             ax.autoscale_view()
-            _obstacles(ax, resp.metadata.get("contact"), k)
+            _obstacles(ax, resp.metadata.get("contact"), k, resp.pressures[k])
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("y [mm]")
             ax.grid(alpha=0.3)
         else:
             ax = fig.add_subplot(1, len(levels), i + 1, projection="3d")
             _surface(ax, solution, k)
-            _obstacles_3d(ax, resp.metadata.get("contact"), k, solution.mesh.points)
+            _obstacles_3d(ax, resp.metadata.get("contact"), k, resp.pressures[k], solution.mesh.points)
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("z [mm]")
             ax.set_zlabel("y [mm]")
         ax.set_title(f"{resp.pressures[k] * 1e3:.4g} kPa, curl {resp.curl[k]:.1f} deg", fontsize=9)
     fig.suptitle(title or f"design {resp.orientation} ({resp.metadata.get('fidelity', '')} model)")
-    if dim == 2:
-        _legend(fig)
+    _legend(fig)
     fig.text(0.01, 0.005, f"pneumorph {__version__} | {resp.metadata.get('fingerprint', '')}", fontsize=6, color="0.4")
     if path is not None:
         save_figure(fig, path, f"design {resp.orientation}")
@@ -127,27 +128,48 @@ def plot_shape(
 
 
 def _legend(fig: Figure) -> None:
-    """The first section's legend under the sections, outside the axes, at the right (the provenance line is at the
-    left): it covers no part of the actuator and its place is fixed (matplotlib's ``loc="best"`` tests every cell's
-    polygon at each draw, about 1.3 s of a save of a 2D figure of two levels). In rows of two under one section, of
-    up to six under more."""
+    """The legend under the sections, outside the axes, at the right (the provenance line is at the left): it covers
+    no part of the actuator and its place is fixed (matplotlib's ``loc="best"`` tests every cell's polygon at each
+    draw, about 1.3 s of a save of a 2D figure of two levels). The first section's materials, with the obstacles'
+    forces of the last section (the highest level drawn). In rows of two under one section, of up to six under
+    more; none where nothing is labelled (a 3D figure without obstacles)."""
     handles, labels = fig.axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower right", ncols=min(len(handles), 4 * len(fig.axes) - 2), fontsize=7)
+    last = fig.axes[-1].get_legend_handles_labels()
+    pairs = [(h, t) for h, t in zip(handles, labels, strict=True) if not t.startswith(_OBSTACLE)]
+    pairs += [(h, t) for h, t in zip(*last, strict=True) if t.startswith(_OBSTACLE)]
+    if pairs:
+        handles, labels = (list(x) for x in zip(*pairs, strict=True))
+        fig.legend(handles, labels, loc="outside lower right", ncols=min(len(handles), 4 * len(fig.axes) - 2),
+                   fontsize=7)
 
 
-def _obstacles(ax: Any, contact: Any, k: int) -> None:
+#: how an obstacle's legend entry starts (``obstacle 1: 0.25 N at 45 kPa``)
+_OBSTACLE = "obstacle "
+
+
+def _obstacle_labels(contact: Any, k: int, pressure: float) -> list[str]:
+    """Each obstacle's legend entry at level ``k``: its force (N) and the pressure of that level.
+
+    >>> contact = {"obstacles": [{"kind": "plane"}], "levels": [{"obstacles": [{"force_magnitude_n": 0.1234}]}]}
+    >>> _obstacle_labels(contact, 0, 0.045)
+    ['obstacle 1: 0.123 N at 45 kPa']
+    """
+    level = contact["levels"][k] if k < len(contact["levels"]) else None
+    forces = [level["obstacles"][i]["force_magnitude_n"] if level else float("nan")
+              for i in range(len(contact["obstacles"]))]
+    return [f"{_OBSTACLE}{i + 1}: {force:.3g} N at {pressure * 1e3:.4g} kPa" for i, force in enumerate(forces)]
+
+
+def _obstacles(ax: Any, contact: Any, k: int, pressure: float) -> None:
     """The rigid obstacles of a 2D solve (:mod:`pneumorph.models.fe.obstacles`) on the section, each with its force
-    at level ``k`` (N); a plane as its trace across the drawn extent."""
+    at level ``k`` (N, at its ``pressure``, MPa); a plane as its trace across the drawn extent."""
     if not contact:
         return
     from matplotlib.patches import Circle
 
     x0, x1 = ax.get_xlim()
     y0, y1 = ax.get_ylim()
-    level = contact["levels"][k] if k < len(contact["levels"]) else None
-    for i, obstacle in enumerate(contact["obstacles"]):
-        force = level["obstacles"][i]["force_magnitude_n"] if level else float("nan")
-        label = f"obstacle {i + 1}: {force:.3g} N"
+    for obstacle, label in zip(contact["obstacles"], _obstacle_labels(contact, k, pressure), strict=True):
         if obstacle["kind"] == "plane":
             p, n = np.asarray(obstacle["point"][:2]), np.asarray(obstacle["normal"][:2])
             t = np.array([-n[1], n[0]]) * 2 * max(x1 - x0, y1 - y0)
@@ -160,17 +182,15 @@ def _obstacles(ax: Any, contact: Any, k: int) -> None:
     ax.set_ylim(y0, y1)
 
 
-def _obstacles_3d(ax: Any, contact: Any, k: int, points: Any) -> None:
+def _obstacles_3d(ax: Any, contact: Any, k: int, pressure: float, points: Any) -> None:
     """The rigid obstacles of a 3D solve as grey surfaces (drawn as (x, z, y), as :func:`_surface`) across the
-    actuator's extent, each labelled with its force at level ``k`` (N)."""
+    actuator's extent, each labelled with its force at level ``k`` (N, at its ``pressure``, MPa)."""
     if not contact:
         return
     lo, hi = points.min(axis=0), points.max(axis=0)
     size = float((hi - lo).max())
-    level = contact["levels"][k] if k < len(contact["levels"]) else None
     a, b = np.meshgrid(np.linspace(0.0, 2 * np.pi, 33), np.linspace(-0.5, 0.5, 9))
-    for i, obstacle in enumerate(contact["obstacles"]):
-        force = level["obstacles"][i]["force_magnitude_n"] if level else float("nan")
+    for obstacle, label in zip(contact["obstacles"], _obstacle_labels(contact, k, pressure), strict=True):
         if obstacle["kind"] == "sphere":
             c, r = np.asarray(obstacle["centre"]), obstacle["radius"]
             u, v = np.meshgrid(np.linspace(0.0, 2 * np.pi, 33), np.linspace(0.0, np.pi, 17))
@@ -189,5 +209,4 @@ def _obstacles_3d(ax: Any, contact: Any, k: int, points: Any) -> None:
                 along = np.clip(((lo + hi) / 2 - c) @ normal, -size, size)
                 xyz = (c[:, None, None] + r * (e1[:, None, None] * np.cos(a) + e2[:, None, None] * np.sin(a))
                        + normal[:, None, None] * (along + b * length))
-        ax.plot_surface(xyz[0], xyz[2], xyz[1], color="0.5", alpha=0.35, linewidth=0,
-                        label=f"obstacle {i + 1}: {force:.3g} N")
+        ax.plot_surface(xyz[0], xyz[2], xyz[1], color="0.5", alpha=0.35, linewidth=0, label=label)
