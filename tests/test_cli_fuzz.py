@@ -184,7 +184,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--bilinear-nu": ["0.5", "-1.5", *REAL],
         "--control": ["", "arc-length"], "--composite": ["", "rebar"],
         "--volume-change": [*POSITIVE, "1e3", "1e-300", "30"],  # 30 V0 in the default 12 steps: 2.5 a step
-        "--paper": ["", "crimped", "Measured"],
+        "--paper": ["", "crimped", "Measured"], "--gravity": ["", "sideways", "horizontal", "Hanging"],
         "--max-cutbacks": COUNT + HUGE, "--max-iterations": POS_COUNT + HUGE, "--out": ["a-file", "a-file/sub", ""],
     },
     "coupon": {

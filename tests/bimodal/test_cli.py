@@ -135,3 +135,39 @@ def test_the_plan_is_estimated_by_the_mesh_and_a_mesh_past_the_memory_is_refused
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and not out.exists()
     assert "--voids 100 --element-size 1: a mesh of about 863,373 nodes, 135.0 GB for the solve" in err
+
+
+@pytest.mark.parametrize(("option", "vector"), [([], None), (["--gravity", "none"], None),
+                                                (["--gravity", "hanging"], [9806.65, 0.0, 0.0])])
+def test_gravity_reaches_the_model_and_its_description(monkeypatch, capsys, option, vector) -> None:
+    """``--gravity hanging`` is the model's standard gravity along x (hanging from the clamped base), in the
+    description the JSON keeps (``metadata.model.gravity_mm_s2``); without it the description has none, as before.
+    The solve is replaced by one that records the model it was asked of."""
+    from pneumorph.bimodal.model import BimodalModel
+    from pneumorph.errors import SettingsError
+
+    seen = []
+
+    def solve(self, **kwargs):
+        seen.append((self.gravity, self.describe()))
+        raise SettingsError("solve reached")
+
+    monkeypatch.setattr(BimodalModel, "solve", solve)
+    argv = ["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "--control", "pressure"]
+    assert main([*argv, "-q", *option]) == 2
+    assert capsys.readouterr().err.strip() == "error: solve reached"
+    ((gravity, described),) = seen
+    assert (None if gravity is None else list(gravity)) == vector
+    assert described.get("gravity_mm_s2") == vector
+
+
+def test_the_summary_says_the_actuator_hangs() -> None:
+    from pneumorph.cli.bilinear.bimodal import format_result
+
+    d = {"crimp_ratio": 0.2, "completed": True, "pressures_kpa": [5.0], "tip_ux_mm": [0.1], "tip_uy_mm": [0.2],
+         "switch": {"turning_kpa": None, "peak_mm": None, "switch_kpa": None},
+         "metadata": {"dofs": 10, "wall_time_s": 1.0,
+                      "model": {"composite": "homogenised", "bulk_moduli_kpa": {"bilinear": 58.3}}}}
+    assert not format_result(d).splitlines()[0].endswith("under gravity")
+    d["metadata"]["model"]["gravity_mm_s2"] = [9806.65, 0.0, 0.0]
+    assert format_result(d).splitlines()[0].endswith(", its bulk modulus 58.3 kPa, hanging under gravity")

@@ -56,6 +56,9 @@ LEVEL_SECONDS = 1.9e-5
 @click.option("--volume-change", type=P.Real(MIN_VOLUME_CHANGE, MAX_VOLUME_CHANGE), default=DEFAULT_VOLUME_CHANGE,
               show_default=True, help="With --control volume: the voids' relative volume change V/V0 - 1 at the "
                                       "ramp's end, in --pmax/--step equal steps (--pmax then scales the solver).")
+@click.option("--gravity", type=click.Choice(["none", "hanging"]), default="none", show_default=True,
+              help="Weight of the layers, applied before the ramp and held through it: hanging from the clamped "
+                   "base as on the test bench (section 3.3.2); kept in the JSON's model description.")
 @click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the response (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
@@ -63,7 +66,7 @@ LEVEL_SECONDS = 1.9e-5
 def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size: float, end_cap: float | None,
             bilinear_nu: float | None, max_cutbacks: int | None, max_iterations: int | None, out: Path | None,
             as_json: bool, quiet: bool, control: str = "volume", volume_change: float = DEFAULT_VOLUME_CHANGE,
-            composite: str = "fibre", paper: str = "measured") -> None:
+            composite: str = "fibre", paper: str = "measured", gravity: str = "none") -> None:
     """3D FE of the bimodal actuator: tip displacement in volume or pressure steps, switch pressure.
 
     Volume control (default) follows the pressure past its maximum where a wall balloons and
@@ -98,7 +101,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
     model = BimodalModel(spec, crimp_ratio=cr, pmax=pmax / 1e3, step=step / 1e3, bilinear_bulk=bulk,
                          max_cutbacks=max_cutbacks, max_iterations=max_iterations,  # None: the model's own
                          volume=volume_change if control == "volume" else None, composite=composite,
-                         paper=paper)
+                         paper=paper, gravity=None if gravity == "none" else gravity)
 
     from pneumorph.io.progress import Progress
 
@@ -152,7 +155,8 @@ def format_result(d: dict[str, Any]) -> str:
     head = (f"bimodal actuator, CR {d['crimp_ratio']:g}: {m['dofs']} dofs, {m['wall_time_s']:.0f} s, "
             f"composite {m['model'].get('composite', 'homogenised')}"
             f"{', paper ' + m['model']['paper'] if m['model'].get('paper') else ''}, "
-            f"its bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa")
+            f"its bulk modulus {m['model']['bulk_moduli_kpa']['bilinear']:.4g} kPa"
+            f"{', hanging under gravity' if m['model'].get('gravity_mm_s2') else ''}")
     lines = [head, "pressure (kPa)   tip u_x (mm)   tip u_y (mm)"]
     for p, ux, uy in zip(d["pressures_kpa"], d["tip_ux_mm"], d["tip_uy_mm"], strict=False):
         lines.append(f"{p:10.1f}   {ux:12.3f}   {uy:12.3f}")
