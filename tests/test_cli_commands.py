@@ -93,16 +93,22 @@ def test_the_group_lists_without_importing_a_command() -> None:
     assert "Commands:" in done.stdout and "unit " in done.stdout
 
 
+MATERIALS_HELP = [f"materials {name}" for name in sorted(MATERIALS_COMMANDS)] + [
+    f"materials characterise {name}" for name in ("bilinear", "poisson", "thermal")]
+
+
 def test_a_commands_help_imports_no_numerical_code() -> None:
-    """``pneumorph X --help`` builds X's options from :mod:`pneumorph.checks` and click alone: the models, the
-    evaluators, pneumorph.io and NumPy (half a second of imports) are imported when X runs."""
+    """``pneumorph X --help`` (and ``pneumorph materials X --help``, down to ``materials characterise X``) builds X's
+    options from :mod:`pneumorph.checks` and click alone: the models, the evaluators, pneumorph.io, the material code
+    and NumPy (half a second of imports) are imported when X runs."""
     heavy = ("numpy", "scipy", "pneumorph.models", "pneumorph.execution", "pneumorph.io", "pneumorph.materials")
-    code = ("import sys; from pneumorph.cli import COMMANDS, main\n"
-            "for name in sorted(COMMANDS):\n"
-            "    code = main([name, '--help'])\n"
+    names = sorted(COMMANDS) + MATERIALS_HELP
+    code = ("import sys; from pneumorph.cli import main\n"
+            f"for name in {names!r}:\n"
+            "    code = main([*name.split(), '--help'])\n"
             f"    print(name, code, [m for m in {heavy!r} if m in sys.modules], file=sys.stderr)\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert done.stderr.splitlines() == [f"{name} 0 []" for name in sorted(COMMANDS)]
+    assert done.stderr.splitlines() == [f"{name} 0 []" for name in names]
 
 
 @pytest.mark.parametrize("typed", ["simulat", "desing", "nothing"])

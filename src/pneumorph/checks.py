@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import Any, Literal
 
 from pneumorph.errors import SettingsError
 
@@ -67,6 +67,20 @@ MAX_VOLUME_STEP = 2.0
 #: Rubber Chem. Technol. 65, 673-686); 10 leaves a wide margin, and a larger number is a typing error, not a
 #: surface
 MAX_FRICTION = 10.0
+
+# The choices of the material commands' options (``pneumorph materials fit``), defined here for the same reason as
+# the limits: a command's --help names them without importing NumPy and the material code.
+Mode = Literal["uniaxial", "equibiaxial", "planar"]
+#: The homogeneous deformation modes of the test data: uniaxial, equibiaxial, planar (pure shear).
+MODES: tuple[Mode, ...] = ("uniaxial", "equibiaxial", "planar")
+#: Names of the models a fit accepts (``N`` is a number of terms, 1-6).
+MODEL_NAMES = ("neo-hooke", "mooney-rivlin-2", "mooney-rivlin-3", "yeoh", "yeoh-N", "ogden-3", "ogden-N")
+#: The residuals of a fit: plain stress, relative to the stress, or per-mode normalised.
+WEIGHTINGS = ("absolute", "relative", "balanced")
+#: Column roles of a test file (``columns=``); ``"skip"`` ignores a column.
+COLUMN_ROLES = ("stretch", "strain", "true-strain", "stress", "skip")
+#: How much of a test curve is kept: all of it, its rows up to the largest stretch, or up to the peak stress.
+TRUNCATE = ("none", "loading", "peak-stress")
 
 #: where a batch of designs is solved (``--executor``, ``[execution] executor``;
 #: :func:`pneumorph.execution.make_evaluator`)

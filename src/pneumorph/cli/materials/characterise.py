@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
 
 from pneumorph.cli.options import params as P
 from pneumorph.errors import DataFormatError
-from pneumorph.io.files import strict_json
-from pneumorph.io.reading import check_rows, csv_rows, read_text_file
-from pneumorph.materials.characterisation import analyses as ch
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _STRAIN_SCALE = {"fraction": 1.0, "percent": 0.01}
 
@@ -33,6 +32,10 @@ def read_columns(
         Empty file, missing column, a row with too few fields or a non-numeric / non-finite
         value; the message names the file and the row (1-based, header = row 1).
     """
+    import numpy as np
+
+    from pneumorph.io.reading import check_rows, csv_rows, read_text_file
+
     p = str(path)
     text = read_text_file(path, "data file", DataFormatError, encoding="utf-8-sig")
     check_rows(text, f"data file {p}", DataFormatError)  # counted before they are split
@@ -76,6 +79,8 @@ def read_columns(
 
 
 def _emit(data: dict[str, Any], text: list[str], as_json: bool) -> None:
+    from pneumorph.io.files import strict_json
+
     click.echo(strict_json(data, indent=2) if as_json else "\n".join(text))
 
 
@@ -125,6 +130,8 @@ def poisson(data: str, strain_range: tuple[float, float], modulus: str, strain_u
     nu = -eps_y/eps_x and K = E/(3(1 - 2 nu)) are evaluated at every point with non-zero
     axial strain inside --strain-range and averaged.
     """
+    from pneumorph.materials.characterisation import analyses as ch
+
     cols = read_columns(data, ("axial_strain", "transverse_strain"), ("axial_stress",))
     scale = _STRAIN_SCALE[strain_unit]
     lo, hi = (x / 100.0 for x in strain_range)
@@ -173,6 +180,8 @@ def thermal(data: str, strain_unit: str, as_json: bool) -> None:
       temperature   degC
       strain        engineering thermal strain (any reference state)
     """
+    from pneumorph.materials.characterisation import analyses as ch
+
     cols = read_columns(data, ("temperature", "strain"))
     r = ch.thermal_expansion(cols["temperature"], cols["strain"] * _STRAIN_SCALE[strain_unit])
     out = {
@@ -217,6 +226,8 @@ def bilinear(data: str, primary_limit: float, secondary_points: int, strain_unit
     Primary modulus: line through the first --primary-limit % of strain; secondary
     modulus: line through the last --secondary-points points; transition: where they meet.
     """
+    from pneumorph.materials.characterisation import analyses as ch
+
     cols = read_columns(data, ("strain", "stress"))
     if secondary_points > cols["strain"].size:
         raise click.BadParameter(f"{secondary_points} points asked for the secondary fit, but {data} has "

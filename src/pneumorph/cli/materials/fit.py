@@ -5,14 +5,8 @@ from __future__ import annotations
 import click
 
 from pneumorph import __version__
-from pneumorph.checks import MAX_STARTS
+from pneumorph.checks import COLUMN_ROLES, MAX_STARTS, MODEL_NAMES, MODES, TRUNCATE, WEIGHTINGS
 from pneumorph.cli.options import params as P
-from pneumorph.io.files import strict_json
-from pneumorph.materials.characterisation.datasets import list_datasets, read_test_data
-from pneumorph.materials.characterisation.testdata import COLUMN_ROLES, TRUNCATE
-from pneumorph.materials.fitting.comparison import compare
-from pneumorph.materials.fitting.fit import MODEL_NAMES, WEIGHTINGS, resolve_model
-from pneumorph.materials.laws.hyperelastic import MODES
 
 
 @click.command("fit")
@@ -61,7 +55,11 @@ def fit(data: tuple[str, ...], models: tuple[str, ...], mode: str | None, column
     (e.g. treloar1944). Several files are combined, each mode taken from its file name
     (Treloar_ut.dat, .../PS/...) unless --mode is given.
     """
+    from pneumorph.io.files import strict_json
+    from pneumorph.materials.characterisation.datasets import list_datasets, read_test_data
     from pneumorph.materials.characterisation.testdata import column_roles, stress_unit_factor
+    from pneumorph.materials.fitting.comparison import compare
+    from pneumorph.materials.fitting.fit import resolve_model
 
     models = models or ("ogden-3",)
     with P.blame("--model"):

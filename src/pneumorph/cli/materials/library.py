@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from pneumorph.cli.options import params as P
 from pneumorph.errors import UnknownMaterialError
-from pneumorph.io.files import strict_json
-from pneumorph.materials.laws.filler import FillerLaw
-from pneumorph.materials.library import builtin as library
-from pneumorph.materials.library.builtin import Material, Quantity
+
+if TYPE_CHECKING:  # the library is imported when a command runs: --help imports no material code
+    from pneumorph.materials.laws.filler import FillerLaw
+    from pneumorph.materials.library.builtin import Material, Quantity
 
 _LABELS = {
     "density": "density",
@@ -24,6 +24,8 @@ _LABELS = {
 
 
 def _register(files: tuple[str, ...]) -> None:
+    from pneumorph.materials.library import builtin as library
+
     for path in files:
         with P.blame("--library"):
             library.register_toml(path)
@@ -47,6 +49,9 @@ def list_materials(as_json: bool, library_files: tuple[str, ...]) -> None:
     Shows the name to use with `show`, the kind, the initial shear modulus mu0 and the
     bulk modulus. Names are case and format tolerant ("Mold Star 15" = mold_star_15).
     """
+    from pneumorph.io.files import strict_json
+    from pneumorph.materials.library import builtin as library
+
     _register(library_files)
     materials = [library.get(n) for n in library.names()]
     fillers = [library.get_filler(n) for n in library.filler_names()]
@@ -202,6 +207,10 @@ def show_material(name: str, as_json: bool, library_files: tuple[str, ...]) -> N
     NAME may be any spelling ("Mold Star 15", mold-star-15) or the name of a filler law
     (ellis2020_eq5_2). Internal units: MPa, tonne/mm^3, 1/K, mm.
     """
+    from pneumorph.io.files import strict_json
+    from pneumorph.materials.library import builtin as library
+    from pneumorph.materials.library.builtin import Material
+
     _register(library_files)
     obj: Material | FillerLaw
     try:

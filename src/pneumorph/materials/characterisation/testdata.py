@@ -50,6 +50,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from pneumorph import checks
 from pneumorph.errors import DataFormatError
 from pneumorph.io.reading import check_rows, read_text_file
 from pneumorph.materials.characterisation.curves import MAX_STRESS_MPA, MAX_STRETCH, TestCurve, TestData
@@ -70,8 +71,8 @@ STRESS_UNITS: Mapping[str, float] = MappingProxyType(
     }
 )
 #: Column roles for ``columns=``; ``"skip"`` ignores a column.
-COLUMN_ROLES = ("stretch", "strain", "true-strain", "stress", "skip")
-TRUNCATE = ("none", "loading", "peak-stress")
+COLUMN_ROLES = checks.COLUMN_ROLES
+TRUNCATE = checks.TRUNCATE
 _SORO_MARK = "parameter;info"
 _MODE_WORDS = {
     "uniaxial": ("ut", "uc", "uni", "uniaxial", "tension", "tensile", "compression"),

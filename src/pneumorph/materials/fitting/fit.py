@@ -61,6 +61,7 @@ from typing import Any
 
 import numpy as np
 
+from pneumorph import checks
 from pneumorph.errors import FitError, UnknownModelError
 from pneumorph.materials.characterisation.testdata import TestCurve, TestData
 from pneumorph.materials.fitting.ogden import fit_ogden
@@ -77,8 +78,8 @@ from pneumorph.materials.laws.hyperelastic import (
 )
 
 #: Names accepted by :func:`fit` (``N`` is a number of terms, 1-6).
-MODEL_NAMES = ("neo-hooke", "mooney-rivlin-2", "mooney-rivlin-3", "yeoh", "yeoh-N", "ogden-3", "ogden-N")
-WEIGHTINGS = ("absolute", "relative", "balanced")
+MODEL_NAMES = checks.MODEL_NAMES
+WEIGHTINGS = checks.WEIGHTINGS
 _MAX_TERMS = 6
 
 

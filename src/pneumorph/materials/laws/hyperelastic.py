@@ -37,14 +37,16 @@ array(1.75)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar, Literal, Protocol, runtime_checkable
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-Mode = Literal["uniaxial", "equibiaxial", "planar"]
+from pneumorph import checks
+from pneumorph.checks import Mode
+
 #: The homogeneous deformation modes of the test data: uniaxial, equibiaxial, planar (pure shear).
-MODES: tuple[Mode, ...] = ("uniaxial", "equibiaxial", "planar")
+MODES: tuple[Mode, ...] = checks.MODES
 
 FloatArray = NDArray[np.float64]
 
