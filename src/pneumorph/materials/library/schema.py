@@ -202,7 +202,8 @@ def _with_matrix(path: str, key: str, data: Any, entries: dict[str, Any]) -> Any
         return data
     where = _Where(path, f"materials.{key}")
     name = where.text(data, "matrix")
-    matrix = entries.get(name) if name != key else None
+    assert name is not None  # required: text() raised otherwise
+    matrix = entries.get(name)
     if name == key:
         raise where.error(f"matrix {name!r} is the entry itself; a matrix is another entry of the file")
     if not isinstance(matrix, dict):
