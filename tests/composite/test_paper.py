@@ -148,8 +148,7 @@ def test_the_cast_composites_are_library_materials_of_the_calibrated_matrix() ->
     for name, paper in CAST_PAPER.items():
         entry = get(name)
         assert name == "paper_" + f"{paper.crimp_ratio:g}".replace(".", "_")
-        assert entry.model == ecoflex.model and entry.bulk_modulus.value == ecoflex.bulk_modulus.value
-        assert entry.density.value == ecoflex.density.value
+        assert entry.model == ecoflex.model  # by its matrix key (tests/materials/test_matrix.py)
         law = paper.law(entry.model.mu, entry.model.alpha, entry.bulk_modulus.value)
         cast = measured_composite(paper.crimp_ratio)
         assert (law.primary, law.straight, law.slope, law.blend) == (cast.primary, cast.straight, cast.slope,
