@@ -63,10 +63,13 @@ class Full3D(FEModel):
     fidelity = "3d"
     dim = 3
     backends = ("fast", "felupe")
-    # one substep per level from the quadratic extrapolation of the last three states:
-    # 36 Newton iterations for a 3-unit design at 45 kPa where two substeps from the
-    # linear one took 62 (same results within the tolerance); 37 for the 15-unit one
-    predictor_order = 2
+    # one substep per level from the cubic extrapolation of the last four states (quadratic,
+    # linear while fewer are known): 36 Newton iterations for a 3-unit design at 45 kPa where
+    # two substeps from the linear one took 62 (same results within the tolerance). On the
+    # 15-unit designs 011100110010010, 001111010001001 and 000000000000000 the cubic one took
+    # 71, 70, 131 iterations and 15, 13, 51 factorisations where the quadratic one took 72,
+    # 77, 163 and 17, 13, 60 (3 cut-backs: 2); the quartic one cut back on 001111010001001
+    predictor_order = 3
     default_steps = StepSettings(increments=10, substeps=1, max_iterations=25)
     # a tangent assembled and factorised costs several residuals: keep it while the
     # residual norm at least halves per iteration (chord steps with Anderson acceleration;
