@@ -3,7 +3,7 @@
 Runs the command in this process (as the console script does) and splits its CPU time into
 the imports of the command line, the model's set-up (mesh, FE objects, the fast system's
 pattern, up to the first Newton iteration; with the first imports of FElupe and MKL), the
-solve of every reported level (Newton iterations, factorisations, cut-backs, CPU) and the
+solve of every reported level (Newton iterations, factorisations, residual evaluations, cut-backs, CPU) and the
 writing (response, VTK series, shape figure). One thread, as a search worker runs:
 
     OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 python benchmarks/fe_phases.py -o 011100110010010
@@ -49,19 +49,29 @@ def main() -> None:
 
     print(f"imports of the command line: {since(start)}")
     from pneumorph.fem.fast.newton import FastSubstep
+    from pneumorph.fem.fast.system import SolidSystem3D
 
-    levels: list[tuple[float, float, int, int, int]] = []  # (wall, cpu, iterations, factorisations, failed) per call
+    # (wall, cpu, iterations, factorisations, failed, residuals so far) per call
+    levels: list[tuple[float, float, int, int, int, int]] = []
     starts: list[tuple[float, float]] = []  # the first substep's start
     original = FastSubstep.__call__
+    residuals = [0]  # residual evaluations of the 3D system
+    residual = SolidSystem3D.residual
+
+    def counted(self, *a, **k):
+        residuals[0] += 1
+        return residual(self, *a, **k)
 
     def traced(self, fields, settings, border=None):
         if not starts:
             starts.append(clocks())
+            residuals[0] = 0
         iterations, cause = original(self, fields, settings, border)
         wall, cpu = clocks()
-        levels.append((wall, cpu, iterations, self.factorisations, int(cause is not None)))
+        levels.append((wall, cpu, iterations, self.factorisations, int(cause is not None), residuals[0]))
         return iterations, cause
 
+    SolidSystem3D.residual = counted
     FastSubstep.__call__ = traced
     writers: dict[str, float] = {}
 
@@ -122,23 +132,26 @@ def main() -> None:
     sys.stdout.flush()
 
 
-def report(begin: tuple[float, float], calls: list[tuple[float, float, int, int, int]],
+def report(begin: tuple[float, float], calls: list[tuple[float, float, int, int, int, int]],
            levels_at: list[tuple[int, tuple[float, float]]]) -> None:
-    """The set-up (to the first substep's start) and every level's iterations, factorisations, cut-backs, CPU."""
-    print("  level  iterations  factorisations  cut-backs  CPU (s)  wall (s)")
+    """The set-up (to the first substep's start) and every level's iterations, factorisations, residual
+    evaluations, cut-backs, CPU."""
+    print("  level  iterations  factorisations  residuals  cut-backs  CPU (s)  wall (s)")
     previous_calls, previous = 0, begin
-    factorised = 0
+    factorised = evaluated = 0
     for k, (ncalls, at) in enumerate(levels_at):
         here = calls[previous_calls:ncalls]
         iterations = sum(c[2] for c in here)
         factors = here[-1][3] - factorised if here else 0
         factorised = here[-1][3] if here else factorised
+        count = here[-1][5] - evaluated if here else 0
+        evaluated = here[-1][5] if here else evaluated
         cut = sum(c[4] for c in here)
-        print(f"  {k + 1:5d}  {iterations:10d}  {factors:14d}  {cut:9d}  {at[1] - previous[1]:7.2f}  "
+        print(f"  {k + 1:5d}  {iterations:10d}  {factors:14d}  {count:9d}  {cut:9d}  {at[1] - previous[1]:7.2f}  "
               f"{at[0] - previous[0]:8.2f}")
         previous_calls, previous = ncalls, at
     total = sum(c[2] for c in calls)
-    print(f"  total  {total:10d}  {factorised:14d}  {sum(c[4] for c in calls):9d}  "
+    print(f"  total  {total:10d}  {factorised:14d}  {evaluated:9d}  {sum(c[4] for c in calls):9d}  "
           f"{previous[1] - begin[1]:7.2f}  {previous[0] - begin[0]:8.2f}  ")
 
 

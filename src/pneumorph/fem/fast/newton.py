@@ -62,6 +62,10 @@ REFRESH_ON_CHANGE = True
 #: :meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`).
 MOTION = 2.0
 
+#: A kept tangent's step that raises the residual norm (plus a constraint's error) less than this, on a body without
+#: obstacles, is kept and the tangent refreshed at its end (:func:`kept_rise`; ``docs/notes/fe-core.md``, "The ramp").
+RISE = 3.0
+
 #: Fresh tangents in a row that each lower the residual norm by less than the reuse factor
 #: before a single-precision factorisation is judged too inaccurate and replaced by a
 #: double-precision one. A fresh Newton step near the solution converges quadratically;
@@ -146,6 +150,15 @@ def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: boo
     return any(np.any(c.forces(x)[1] != c.forces(x_new)[1]) for c in getattr(system, "contacts", ()))
 
 
+def kept_rise(norm_new: float, norm: float, jmin: float) -> bool:
+    """Whether a kept tangent's step that raised the residual norm from ``norm`` to ``norm_new`` is kept (:data:`RISE`).
+
+    >>> kept_rise(2e-3, 1e-3, 0.9), kept_rise(5e-3, 1e-3, 0.9), kept_rise(2e-3, 1e-3, -0.1)
+    (True, False, False)
+    """
+    return jmin > 0.0 and norm_new < RISE * norm and norm_new <= DIVERGED
+
+
 def verdict(fnorm: float, jmin: float, u: FloatArray, values: FloatArray, tolerance: float,
             constraint: float = 0.0) -> tuple[bool, str | None]:
     """``(done, cause)`` after an iteration; on convergence (the relative residual ``fnorm`` and a constraint's
@@ -165,19 +178,17 @@ def verdict(fnorm: float, jmin: float, u: FloatArray, values: FloatArray, tolera
 class FastSubstep:
     """Solve one substep of :func:`pneumorph.fem.stepping.ramp` on the fast system.
 
-    Called as ``solve(fields, settings)``, it iterates from the values in ``fields``
-    (written back in place) and returns ``(iterations, cause of failure or None)``, like
-    the FElupe path of the ramp.
+    Called as ``solve(fields, settings)``, it iterates from the values in ``fields`` (written back in place)
+    and returns ``(iterations, cause of failure or None)``, like the FElupe path of the ramp.
 
-    With ``reuse`` it is a Newton method that keeps its factorised tangent while that
-    still converges well (a chord method with refresh): every substep starts (by
-    default) with a fresh tangent at its predicted state; an iteration whose residual norm falls by less
-    than the factor ``reuse`` has the tangent re-assembled and factorised at the state it
-    reached, and a step of a kept tangent that does not lower the residual at all is
-    taken back and redone with a fresh tangent. Near the solution a kept tangent
-    converges almost as fast as a fresh one, so where a factorisation costs many
-    residual evaluations (3D) this saves most of them; the converged states satisfy the
-    same criterion as Newton's.
+    With ``reuse`` it is a Newton method that keeps its factorised tangent while that still converges well (a
+    chord method with refresh): every substep starts (by default) with a fresh tangent at its predicted state;
+    an iteration whose residual norm falls by less than the factor ``reuse`` has the tangent re-assembled and
+    factorised at the state it reached, and a step of a kept tangent that does not lower the residual at all
+    is taken back and redone with a fresh tangent (on a body without obstacles one that raises it by less
+    than :data:`RISE` is kept, the tangent refreshed at its end). Near the solution a kept tangent converges
+    almost as fast as a fresh one, so where a factorisation costs many residual evaluations (3D) this saves
+    most of them; the converged states satisfy the same criterion as Newton's.
 
     Parameters
     ----------
@@ -434,7 +445,8 @@ class FastSubstep:
             changed = REFRESH_ON_CHANGE and bool(contacts) and contacts_changed(system, u, u_new, sliding=True)
             if fresh and not changed:  # (a step that changed the contacts says nothing of the precision)
                 poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
-            if not fresh and not (fnorm_new + error_new < fnorm + error and jmin > 0.0):
+            rose = not fresh and not (fnorm_new + error_new < fnorm + error and jmin > 0.0)
+            if rose and (bool(contacts) or not kept_rise(fnorm_new + error_new, fnorm + error, jmin)):
                 # a kept tangent that no longer helps: take the step back, refresh
                 border.set(x)
                 system.residual(u)  # the state the tangent is assembled at
@@ -446,7 +458,7 @@ class FastSubstep:
             if poor >= STALLED_FRESH and self.precision == "single":
                 self.to_double()  # refresh at u_new, in double precision from now on
                 f, poor = None, 0
-            elif self.reuse is None or fnorm_new > reuse * fnorm or changed:
+            elif self.reuse is None or fnorm_new > reuse * fnorm or changed or rose:
                 self._factorised = False  # refresh at u_new (at every iteration: Newton's method)
                 f = None
             else:

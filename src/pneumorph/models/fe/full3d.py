@@ -63,10 +63,17 @@ class Full3D(FEModel):
     fidelity = "3d"
     dim = 3
     backends = ("fast", "felupe")
-    # one substep per level from the quadratic extrapolation of the last three states:
-    # 36 Newton iterations for a 3-unit design at 45 kPa where two substeps from the
-    # linear one took 62 (same results within the tolerance); 37 for the 15-unit one
+    # one substep per level from the quadratic extrapolation of the last three states: 36
+    # Newton iterations for a 3-unit design at 45 kPa where two substeps from the linear one
+    # took 62 (same results within the tolerance); in free air the cubic one (free_predictor_order)
     predictor_order = 2
+    # without obstacles the cubic extrapolation of the last four states: the 15-unit designs
+    # 011100110010010, 001111010001001 and 000000000000000 took 71, 70, 131 Newton iterations and
+    # 15, 13, 51 factorisations where the quadratic one took 72, 77, 163 and 17, 13, 60 (3 cut-backs:
+    # 2); the quartic one cut back on 001111010001001. Against a cylinder (001111010001001, "path:22.5:5;4")
+    # the cubic one took 122 iterations and 64 factorisations against 102 and 52: a tip that slides
+    # on an obstacle does not follow a smooth path
+    free_predictor_order = 3
     default_steps = StepSettings(increments=10, substeps=1, max_iterations=25)
     # a tangent assembled and factorised costs several residuals: keep it while the
     # residual norm at least halves per iteration (chord steps with Anderson acceleration;
@@ -94,6 +101,8 @@ class Full3D(FEModel):
         super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block,
                          materials, library, formulation, obstacles, quadrature)
         self.half = bool(half)
+        if not self.obstacles:
+            self.predictor_order = self.free_predictor_order
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
                              "of the half model; use half=False")
