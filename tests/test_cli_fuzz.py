@@ -128,6 +128,7 @@ OPTIONS: dict[str, dict[str, list[str]]] = {
         "--epsilon": [*NONNEG, "1e9"], "--refine": [*POSITIVE, "1.5", "2", "0.01", "1e9"],
         "--units": POS_COUNT + HUGE, "--pop": ["1", *POS_COUNT, *HUGE], "--gen": [*COUNT, *HUGE],
         "--seed": COUNT, "--verify": POS_COUNT, "--workers": POS_COUNT, "--tolerance": [*NONNEG, "2"],
+        "--max-open": [*POS_COUNT, "5000000", "1000000000", "1000000001"],  # past the memory budget, past the cap
         "--robust-samples": POS_COUNT + HUGE, "--target": ["", "   ", "y = 1/0",
         "y = x**", "y = nan", "r = 1/0", "y = exp(1000)", "y = __import__('os')", "path:", "path:missing.csv",
         "path:binary.bin", "path:folder", "path:a-file", "path:/dev/zero", "path:pipe", "path:huge.bin",
@@ -312,6 +313,7 @@ CONFIG_KEYS: list[tuple[str, str, str]] = [
         ("design", "search", ["1", '"fast"']),
         ("design", "certify", ['"yes"', "1"]),
         ("design", "verify", ["0", "1.5", "true"]),
+        ("design", "max_open", ["0", "1.5", "true", '"9"', "2000000000"]),
         ("ga", "elitism", ["-1", "100", "1.5"]),
         ("ga", "budget", ["1", "0", "1.5"]),
         ("design", "margin", ["0", "nan", '"1"']),
@@ -448,7 +450,7 @@ def test_overflowing_stress_data_is_refused(sandbox: Path, capsys: pytest.Captur
 
 
 @pytest.mark.parametrize("extra", [["--verify", "2", "--search", "ga"], ["--margin", "2", "--search", "exhaustive"],
-                                   ["--certify", "--search", "ga"]])
+                                   ["--certify", "--search", "ga"], ["--max-open", "100", "--search", "ga"]])
 def test_options_of_another_search_are_refused_not_ignored(sandbox: Path, capsys: pytest.CaptureFixture[str],
                                                            extra: list[str]) -> None:
     line = _refused(sandbox, capsys, [*BASE["design"], *extra])

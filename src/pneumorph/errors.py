@@ -277,6 +277,12 @@ class SearchConfigError(SettingsError):
     """Design-search settings that cannot work (population below 2, no units, ...)."""
 
 
+class SearchBudgetError(SearchConfigError):
+    """The certified search's branch-and-bound past its budget of open prefixes (``[design] max_open``, or the
+    memory they would take): the chain table's bound is too loose to prune. The message names the bound and what
+    to do (a tighter table, a larger cap, or the genetic algorithm)."""
+
+
 class EvaluationError(PneumorphError, RuntimeError):
     """A model that raised something other than SimulationFailed while evaluating a design."""
 

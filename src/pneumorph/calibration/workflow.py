@@ -182,6 +182,7 @@ def run_calibration(
     on_point: Callable[[FillerPoint], None] | None = None,
     evaluator: Evaluator | None = None,
     on_reference: Callable[[ReferenceSolve], None] | None = None,
+    say: Callable[[str], None] | None = None,
 ) -> CalibrationRun:
     """Calibrate a unit's filler law against 3D, check it on held-out designs and write the folder.
 
@@ -214,6 +215,8 @@ def run_calibration(
         when the calibration asks for it.
     on_reference : callable, optional
         Progress of those solves: called with each :class:`~pneumorph.calibration.ReferenceSolve`.
+    say : callable, optional
+        Called with the line that says what is written where, before the held-out check and the files.
 
     Returns
     -------
@@ -222,8 +225,7 @@ def run_calibration(
     Raises
     ------
     SearchConfigError
-        Fewer than two different pressures, an unknown weighting, or fewer held-out
-        designs than asked for.
+        Fewer than two different pressures, an unknown weighting, or fewer held-out designs than asked for.
     OutputPathError
         If ``out`` cannot be created or written.
     CacheError
@@ -243,9 +245,8 @@ def run_calibration(
         if evaluator is not None:
             solve_references(unit, n_units, levels, runs, seed, n_validate, store, on_reference, evaluator)
         solve_3d = cached_3d_solver(store)
-        result = calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point,
-                           weighting=weighting)
-        with all_or_nothing(folder):  # stopped while writing or validating (Ctrl-C, a full disk): no partial output
+        result = calibrate(unit, n_units, levels, runs, seed, solve_3d=solve_3d, on_point=on_point, weighting=weighting)
+        with all_or_nothing(folder, say=say, what="the calibration and its check"):  # a Ctrl-C: no partial output
             written = _write(plan, result, solve_3d, folder)
     return written
 

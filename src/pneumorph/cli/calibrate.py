@@ -83,7 +83,8 @@ def calibrate(unit_file: str | None, n_units: int, pressures: list[float], runs:
                 done = None
             else:
                 done = run_calibration(unit, n_units, levels, out, runs, seed, n_validate, weighting, evaluator.cache,
-                                       on_point, evaluator=evaluator.inner, on_reference=on_reference)
+                                       on_point, evaluator=evaluator.inner, on_reference=on_reference,
+                                       say=lines)
         finally:
             evaluator.close()
             evaluator.cache.close()

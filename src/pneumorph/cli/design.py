@@ -16,8 +16,8 @@ from pneumorph.cli.progress import RunLines, reporter
 
 # the options that are [design] and [execution] settings of the same name
 _DESIGN_OPTIONS = ("amplitude", "periods", "point", "units", "search", "seed", "certify", "verify", "margin",
-                   "epsilon", "refine", "chain_table", "tolerance", "robust", "robust_samples", "executor", "workers",
-                   "scheduler", "cache")
+                   "epsilon", "max_open", "refine", "chain_table", "tolerance", "robust", "robust_samples", "executor",
+                   "workers", "scheduler", "cache")
 _TIP_GOALS = ("max-x", "min-x", "max-y", "min-y", "min-distance", "max-curl", "reach", "grip", "wrap")
 
 
@@ -67,6 +67,9 @@ def _kpa(pressure: float | None) -> float:
 @click.option("--epsilon", type=P.Real(0.0, 1e3),
               help="Certified search: certify within this much (the objective's units): designs that could beat the "
                    "winner by less are counted as ties, not verified (default 0).")
+@click.option("--max-open", type=P.Count(1, 10**9),
+              help="Certified search: open prefixes its branch-and-bound keeps at most, the best where more stay open"
+                   " (default 500,000, fewer past 4 GB; 20,000 for a table beyond its tolerance).")
 @click.option("--refine", metavar="MM", type=P.Real(0.0, 100.0, low_open=True, unit="mm"),
               help="Certified search: solve the FE-verified designs again with this element size (e.g. 1.0 or 0.75; "
                    "the default mesh is 1.5 mm), report both meshes' values, the estimated mesh error and whether "
@@ -211,7 +214,7 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any
     # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
     _check_options_apply(o.search or config.search, "certified",
                          {"--certify": o.certify, "--verify": o.verify, "--margin": o.margin, "--epsilon": o.epsilon,
-                          "--refine": o.refine, "--chain-table": o.chain_table})
+                          "--max-open": o.max_open, "--refine": o.refine, "--chain-table": o.chain_table})
     options = {"fidelity": o.fidelity, "pressure_kpa": o.pressure, "unit_file": o.unit_file, "library": o.library}
     ga = {"population": o.population, "generations": o.generations}
     nominal = None if identified is None else config.with_options(design, ga=ga, model=options)
@@ -258,11 +261,15 @@ def _check_run(config: Any, model: Any, o: Any) -> None:
     if o.robust_samples is not None and config.tolerance == 0:
         raise click.UsageError("--robust-samples sets the samples of the mould tolerance report, which --tolerance 0 "
                                "turns off; leave one of them out")
-    if config.refine and config.search == "certified":  # refused here, naming the option; the run checks again
+    if config.search == "certified":  # refused here, naming the option; the run checks again
+        from pneumorph.design.algorithms.certified import max_open
         from pneumorph.design.certified.refine import check_refine
 
-        with P.blame("--refine" if o.refine is not None else "[design] refine"):
-            check_refine(model, config.refine)
+        if config.refine:
+            with P.blame("--refine" if o.refine is not None else "[design] refine"):
+                check_refine(model, config.refine)
+        with P.blame("--max-open" if o.max_open is not None else "[design] max_open"):
+            max_open(config, model)  # the memory of the open prefixes it may keep
 
 
 def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, Any]:
@@ -312,8 +319,7 @@ def _print_result(result: Any, config: Any, model: Any) -> None:
     if result.certified is not None:
         from pneumorph.design.certified.certificate import certificate_text
 
-        for line in certificate_text(result.certified.certificate, result.objective.unit, best.design,
-                                     model.fidelity):
+        for line in certificate_text(result.certified.certificate, result.objective.unit, best.design, model.fidelity):
             click.echo(f"  {line}")
         two_d = result.opinion_2d.get(best.design)
         if two_d is not None:

@@ -99,7 +99,8 @@ def _run(name: str, common: dict[str, Any], **options: Any) -> None:
     if common["out"]:
         from pneumorph.plot.sensitivity import plot_study
 
-        with all_or_nothing(common["out"]) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+        # stopped while writing (Ctrl-C, a full disk): no partial output
+        with all_or_nothing(common["out"], say=reporter(), what="study.json and study.png") as folder:
             write_json(folder / "study.json", data)
             plot_study(result, folder / "study.png")
     if common["as_json"]:
@@ -338,7 +339,8 @@ def mesh_cmd(designs: tuple[str, ...], n_units: int, sizes: tuple[float, ...], f
     if out:
         from pneumorph.plot.mesh import plot_mesh_study
 
-        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+        # stopped while writing (Ctrl-C, a full disk): no partial output
+        with all_or_nothing(out, say=reporter(), what="mesh.json and mesh.png") as folder:
             write_json(folder / "mesh.json", data)
             plot_mesh_study(study, folder / "mesh.png", unit=objective.unit, fingerprint=model.fingerprint())
     if as_json:

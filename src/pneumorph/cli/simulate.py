@@ -9,7 +9,7 @@ import click
 
 from pneumorph.checks import MAX_VOLUME_CHANGE, MIN_VOLUME_CHANGE, check_volume_steps
 from pneumorph.cli.options import params as P
-from pneumorph.cli.progress import solve_levels
+from pneumorph.cli.progress import reporter, solve_levels
 
 
 @click.command("simulate")
@@ -157,7 +157,8 @@ def _write(out: str, solution: Any, meta: dict) -> None:
     from pneumorph.io.files import all_or_nothing, write_json
 
     resp = solution.response
-    with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+    with all_or_nothing(out, say=reporter(), what="the response, the VTK series, the shape figure and the "
+                        "provenance") as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
         resp.save(folder / "response")
         write_vtk_series(solution, folder / "vtk", meta=meta)
         from pneumorph.plot.shape import plot_shape

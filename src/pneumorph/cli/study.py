@@ -15,6 +15,7 @@ from pneumorph.cli.options.execution import (
     execution_options,
     open_evaluator,
 )
+from pneumorph.cli.progress import reporter
 
 
 @click.command("study")
@@ -101,7 +102,8 @@ def study(config_file: str | None, populations: list[int], seeds: int, generatio
         "rows": [row.as_dict() for row in result.rows], **({"cluster": cluster} if cluster else {}),
         "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint(), config=config.to_dict()),
     }
-    with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+    # stopped while writing (Ctrl-C, a full disk): no partial output
+    with all_or_nothing(out, say=reporter(), what="study.json and study.png") as folder:
         write_json(folder / "study.json", summary)
         plot_population_study(result, folder / "study.png")
     if as_json:

@@ -85,6 +85,7 @@ def optimise(variables: tuple[str, ...], strain_limit: float, pressure: float, n
             evaluator.close()
         if (line := cluster_line(evaluator)) is not None:
             lines.say(line)
+        lines.say(f"writing the candidates, the front, its figure and the chosen units to {folder}")
         write_outputs(result, out, command=" ".join(sys.argv), wall_time_s=time.perf_counter() - t0)
     _check_front(result, strain_limit, out)
     if as_json:

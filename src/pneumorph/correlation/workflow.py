@@ -67,7 +67,8 @@ def correlate_design(scan: Scan, design: str, model: Any, pressure_kpa: float, *
         from pneumorph.io import provenance, write_json
         from pneumorph.io.files import all_or_nothing
 
-        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a bad photo): no partial output
+        # stopped while writing (Ctrl-C, a bad photo): no partial output
+        with all_or_nothing(out, say=say, what="correlation.json and correlation.png") as folder:
             write_json(folder / "correlation.json",
                        {**summary, "provenance": provenance(model=model.describe(), fingerprint=model.fingerprint())})
             plot_correlation(result, shape, folder / "correlation.png", photo=photo, photo_scale=photo_scale)

@@ -12,6 +12,7 @@ A config file::
     seed = 0
     certify = false          # certified search: verify until no design can beat the winner
     verify = 2               # designs verified by FE per batch (default: one per worker)
+    max_open = 100000        # certified search: open prefixes its branch-and-bound keeps (default: what fits 4 GB)
     tolerance = 0.1          # mould tolerance of the winner's robustness report, +- mm (0: none)
     robust = "worst"         # certified search: rank designs by their worst (or mean) error under it
     robust_samples = 30      # seeded samples of the tolerance class (default 30 by the chain, 8 by FE)
@@ -47,11 +48,7 @@ from pneumorph.design.objectives.contact import clearing
 from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
 from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.search.genetic import GAConfig
-from pneumorph.errors import (
-    SearchConfigError,
-    TargetExpressionError,
-    UnknownObjectiveError,
-)
+from pneumorph.errors import SearchConfigError, TargetExpressionError, UnknownObjectiveError
 from pneumorph.execution.evaluators import EXECUTORS, check_execution
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import read_toml
@@ -109,6 +106,7 @@ class DesignConfig:
     verify: int | None = None
     margin: float = 1.0
     epsilon: float = 0.0
+    max_open: int | None = None
     refine: float = 0.0
     chain_table: str | None = None
     tolerance: float = 0.1
@@ -150,14 +148,16 @@ class DesignConfig:
         if self.search != "certified":
             given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
                                     ("chain_table", self.chain_table), ("margin", self.margin != 1.0),
-                                    ("epsilon", self.epsilon != 0.0), ("refine", self.refine != 0.0)) if v]
+                                    ("epsilon", self.epsilon != 0.0), ("max_open", self.max_open is not None),
+                                    ("refine", self.refine != 0.0)) if v]
             if given:
                 raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} "
-                                        "to the "
-                                        "certified search, not to "
-                                        f"search = {self.search!r}; leave them out or set search = \"certified\"")
+                                        f"to the certified search, not to search = {self.search!r}; leave them out "
+                                        "or set search = \"certified\"")
         if self.verify is not None:
             _integer(self.verify, "[design] verify", 1, 1024)
+        if self.max_open is not None:
+            _integer(self.max_open, "[design] max_open", 1, 10**9)
         if self.workers is not None:
             _integer(self.workers, "[execution] workers", 1, 1024)
         if self.scheduler is not None:
@@ -289,8 +289,8 @@ class DesignConfig:
 
     def as_ga(self) -> DesignConfig:
         """The same settings searched by the GA, the certified search's own dropped (``DesignConfig().as_ga()``)."""
-        return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, refine=0.0,
-                       chain_table=None)
+        return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, max_open=None,
+                       refine=0.0, chain_table=None)
 
     def searchable(self) -> tuple[DesignConfig, str | None]:
         """The settings a run can search with, and why they differ from these (None: they do not): the chain
@@ -320,8 +320,8 @@ class DesignConfig:
         design = {
             k: getattr(self, k)
             for k in ("objective", "amplitude", "periods", "point", "curve", "path", "anchored", "stage", "clear",
-                      "units", "search", "seed", "certify", "verify", "margin", "epsilon", "refine", "chain_table",
-                      "tolerance", "robust", "robust_samples")
+                      "units", "search", "seed", "certify", "verify", "margin", "epsilon", "max_open", "refine",
+                      "chain_table", "tolerance", "robust", "robust_samples")
         }
         for key in ("epsilon", "refine"):  # absent by default: the settings of earlier run folders stay the same
             if design[key] == 0.0:

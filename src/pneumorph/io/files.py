@@ -15,7 +15,7 @@ import math
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -164,12 +164,16 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
 
 
 @contextlib.contextmanager
-def all_or_nothing(folder: str | Path) -> Iterator[Path]:
+def all_or_nothing(folder: str | Path, say: Callable[[str], None] | None = None,
+                   what: str = "the results") -> Iterator[Path]:
     """Create ``folder`` for a command's outputs; if the block fails (an error, Ctrl-C), remove what it added.
 
     The files and folders that were not there before the block are removed, and the folder itself
     (with any parents this call created) if it was new: a command stopped while writing leaves no
-    partial output. A file the block replaced (:func:`atomic_path`) is its new version.
+    partial output. A file the block replaced (:func:`atomic_path`) is its new version. With ``say``
+    (a command's progress reporter, :class:`~pneumorph.io.progress.Progress`), the line
+    ``writing <what> to <folder>`` is said before anything is written: writing figures and VTK files after a
+    long solve takes seconds, which a command does not spend silent.
 
     Examples
     --------
@@ -183,8 +187,13 @@ def all_or_nothing(folder: str | Path) -> Iterator[Path]:
     ...     pass
     >>> sorted(p.name for p in d.iterdir())
     []
+    >>> with all_or_nothing(d / "run", say=print, what="the response") as out:  # doctest: +ELLIPSIS
+    ...     _ = (out / "a.json").write_text("{}")
+    writing the response to .../run
     """
     folder = Path(folder)
+    if say is not None:
+        say(f"writing {what} to {folder}")
     top = folder
     while not top.parent.exists() and top.parent != top:
         top = top.parent

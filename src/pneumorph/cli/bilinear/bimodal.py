@@ -114,7 +114,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
                                                                   always=True))
     data = result.to_dict()
     if out is not None:
-        data["files"] = [str(p) for p in write_outputs(result, Path(out))]
+        data["files"] = [str(p) for p in write_outputs(result, Path(out), say=lines)]
     if as_json:
         click.echo(strict_json(data, indent=2))
     else:
@@ -175,8 +175,9 @@ def format_result(d: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def write_outputs(result: Any, out: Path) -> list[Path]:
-    """Write ``bimodal-CR.json`` and the tip-path and outline figures into ``out``."""
+def write_outputs(result: Any, out: Path, say: Any = None) -> list[Path]:
+    """Write ``bimodal-CR.json`` and the tip-path and outline figures into ``out`` (saying so first through
+    ``say``, a reporter)."""
     from pneumorph.bimodal import figures
     from pneumorph.io.files import all_or_nothing, write_json
 
@@ -184,7 +185,8 @@ def write_outputs(result: Any, out: Path) -> list[Path]:
     js = out / f"bimodal-{tag}.json"
     tip = out / f"bimodal-{tag}-tip.png"
     shape = out / f"bimodal-{tag}-shape.png"
-    with all_or_nothing(out):  # stopped while writing (Ctrl-C, a full disk): no partial output
+    # stopped while writing (Ctrl-C, a full disk): no partial output
+    with all_or_nothing(out, say=say, what="the response (JSON) and the figures"):
         write_json(js, result.to_dict(), indent=2)
         figures.plot_tip_paths([(f"CR {result.crimp_ratio:g}", result)],
                                title=f"Bimodal actuator, CR {result.crimp_ratio:g}", path=tip)

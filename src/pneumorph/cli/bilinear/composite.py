@@ -101,6 +101,7 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
            per_flute: int, rows: int, levels: int, strain_max: float | None, bulk_modulus: float | None,
            gauges: int | None, seed: int, snapshot: float | None, out: Path | None, as_json: bool) -> None:
     """Plane-strain FE tensile test of a crimped composite coupon (section 3.2.3)."""
+    from pneumorph.cli.progress import reporter
     from pneumorph.composite.coupon import CouponSpec, simulate_coupon
     from pneumorph.io.files import strict_json
 
@@ -115,7 +116,7 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
     result = simulate_coupon(spec, strain_max=strain_max, levels=levels, snapshots=snaps)
     summary = summarise(result, gauges, seed)
     if out is not None:
-        write_outputs(result, summary, Path(out), snapshot)
+        write_outputs(result, summary, Path(out), snapshot, say=reporter())
     if as_json:
         click.echo(strict_json(summary, indent=2))
         return
@@ -169,8 +170,10 @@ def format_summary(s: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def write_outputs(result: Any, summary: dict[str, Any], out: Path, snapshot: float | None) -> list[Path]:
-    """Write ``coupon-CR.csv``, ``coupon-CR.json`` and the three figures into ``out``."""
+def write_outputs(result: Any, summary: dict[str, Any], out: Path, snapshot: float | None,
+                  say: Any = None) -> list[Path]:
+    """Write ``coupon-CR.csv``, ``coupon-CR.json`` and the three figures into ``out`` (saying so first through
+    ``say``, a reporter)."""
     import numpy as np
 
     from pneumorph.composite import figures
@@ -180,7 +183,8 @@ def write_outputs(result: Any, summary: dict[str, Any], out: Path, snapshot: flo
     csv = out / f"coupon-{tag}.csv"
     js = out / f"coupon-{tag}.json"
     paths = [csv, js]
-    with all_or_nothing(out):  # stopped while writing (Ctrl-C, a full disk): no partial output
+    # stopped while writing (Ctrl-C, a full disk): no partial output
+    with all_or_nothing(out, say=say, what="the coupon's CSV, JSON and figures"):
         np.savetxt(csv, np.column_stack([result.engineering_strain, result.surface_strain, result.force]),
                    delimiter=",", header="engineering_strain,surface_strain,force_N_per_mm", comments="", fmt="%.8g")
         write_json(js, summary, indent=2)

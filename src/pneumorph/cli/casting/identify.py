@@ -106,10 +106,12 @@ def identify(scan: str | None, design: str | None, pressure: float | None, manif
         evaluator.close()
     summary = {**result.to_dict(), "cluster": cluster_report(evaluator)}
     if out:
+        from pneumorph.cli.progress import reporter
         from pneumorph.io.files import all_or_nothing
 
         command = " ".join(["pneumorph", *sys.argv[1:]])
-        with all_or_nothing(out) as folder:  # stopped while writing (Ctrl-C, a full disk): no partial output
+        # stopped while writing (Ctrl-C, a full disk): no partial output
+        with all_or_nothing(out, say=reporter(), what="the identified parameters and identify.json") as folder:
             write_identified(result, folder, command=command)
             write_json(folder / "identify.json", {**summary, "provenance": provenance(command=command)})
     if as_json:

@@ -19,7 +19,7 @@ import numpy as np
 
 from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
 from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
-from pneumorph.design.certified.branching import MAX_NODES
+from pneumorph.design.certified.branching import open_cap
 from pneumorph.design.certified.planning import SearchPlan, plan_search
 from pneumorph.design.certified.search import CertifiedResult, certified_search, chain_candidate
 from pneumorph.design.objectives.fitness import Score
@@ -36,8 +36,33 @@ from pneumorph.sensitivity.tolerances import Tolerance
 #: designs a certified run with ``refine`` verifies (and solves on the finer mesh) at least
 REFINE_TOP = 3
 #: open prefixes the branch-and-bound keeps for a table served beyond its build's tolerance (its errors prune
-#: little: the 2D table of the built-in library, 5.95 mm, held 6 GB for 20 minutes with the default 500,000)
+#: little: the 2D table of the built-in library, 5.95 mm, held 6 GB for 20 minutes with the default 500,000),
+#: unless ``[design] max_open`` says otherwise
 LOOSE_NODES = 20_000
+
+
+def max_open(config: Any, model: Any, loose: bool = False) -> int:
+    """The open prefixes the certified search's branch-and-bound keeps at most for ``model``: ``[design] max_open``
+    if given, else :data:`~pneumorph.design.certified.branching.MAX_NODES` lowered to fit
+    :data:`~pneumorph.design.certified.branching.MAX_OPEN_MEMORY` (``2k`` children a prefix over ``k`` unit types),
+    and at most :data:`LOOSE_NODES` for a ``loose`` table.
+
+    Raises :class:`~pneumorph.errors.SearchBudgetError` where the given cap's memory passes the budget.
+
+    >>> from pneumorph.design.config import DesignConfig
+    >>> from pneumorph.models import make_model
+    >>> model = make_model(15, {"fidelity": "2d"})
+    >>> max_open(DesignConfig(), model), max_open(DesignConfig(), model, loose=True)
+    (500000, 20000)
+    >>> max_open(DesignConfig(max_open=3_000_000), model)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchBudgetError: max_open 3,000,000: ... 18.0 GB at one depth ...; give at most 666,666
+    """
+    library = getattr(model, "library", None)
+    choices = 2 * len(library.units) if library is not None else 2
+    cap = open_cap(choices, len(model.pressures()), config.max_open)
+    return cap if config.max_open is not None or not loose else min(cap, LOOSE_NODES)
 
 
 class CertifiedSearch(Search):
@@ -73,6 +98,7 @@ class CertifiedSearch(Search):
             from pneumorph.design.certified.refine import check_refine
 
             check_refine(model, config.refine, parallel=max(1, min(problem.workers, config.verify or 1024)))
+        max_open(config, model)  # a cap whose open prefixes would pass the memory budget: refused before the search
         return self, replace(problem, model=model)
 
     def setup(self, problem: Problem) -> tuple[Problem, dict[str, Any]]:
@@ -113,7 +139,7 @@ class CertifiedSearch(Search):
         cert = certified_search(problem.model, chain, problem.objective, problem.evaluator, verify=verify,
                                 certify=config.certify, hall_of_fame=config.ga.hall_of_fame,
                                 margin=config.margin, on_progress=problem.say, epsilon=config.epsilon,
-                                max_nodes=LOOSE_NODES if limits_text(chain.table) else MAX_NODES)
+                                max_nodes=max_open(config, problem.model, loose=bool(limits_text(chain.table))))
         order = cert.scores.order()[:1000]
         names = chain.table.texts(cert.scores.bits[order])
         outcome = SearchOutcome(cert.hall_of_fame, certified=cert, refinement=_refinement(problem, cert),

@@ -5,13 +5,17 @@ and kept, and the union of two answers (:mod:`pneumorph.design.certified.planegr
 
 from __future__ import annotations
 
+import contextlib
+import time
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph.design.certified.bounds import ChainScores
-from pneumorph.errors import SearchConfigError
+from pneumorph.design.certified.bounds import ChainScores, chain_errors
+from pneumorph.errors import SearchBudgetError
 from pneumorph.models.chain.windows import design_numbers
 
 FloatArray = NDArray[np.float64]
@@ -23,14 +27,118 @@ MAX_ENUMERATE = 20
 
 
 MAX_NODES = 500_000
-"""Most open prefixes the branch-and-bound keeps at one depth."""
+"""Most open prefixes the branch-and-bound keeps at one depth, by default (``[design] max_open``); beyond them it
+keeps those of lowest bound, and the certificate's floor bounds the rest."""
+
+MAX_OPEN_MEMORY = 4e9
+"""Bytes the open prefixes of one depth and their children may take (:func:`open_memory`): a sixth of a 24 GB
+machine. A cap on open prefixes whose memory would pass it is refused before the search; the default cap is
+lowered to fit it (a unit library's ``2k`` children per prefix)."""
+
+PREFIX_BYTES = 300.0
+"""Bytes of one child prefix per pressure level while a depth is pruned: its state (point, angle, partial sums)
+and the bound's temporaries. Measured on the 2D table, 22 units, 10 levels, a sine profile with the bound x64
+(every prefix open): the peak memory grew by 6.0 kB per open prefix of 2 children from 50,000 to 200,000 kept
+(BENCHMARKS.md, "The certified search's open prefixes")."""
 
 BEAM = 4096
 """Prefixes the first search keeps at every depth (a good design, whose cost sets the threshold)."""
 
 
-class BranchOverflow(SearchConfigError):
-    """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`)."""
+class BranchOverflow(SearchBudgetError):
+    """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`, ``[design] max_open``)."""
+
+
+def open_memory(nodes: int, choices: int, levels: int) -> float:
+    """Bytes the branch-and-bound takes at a depth with ``nodes`` open prefixes of ``choices`` children each, over
+    ``levels`` pressure levels (:data:`PREFIX_BYTES`).
+
+    >>> round(open_memory(MAX_NODES, 2, 10) / 1e9, 1), round(open_memory(MAX_NODES, 8, 10) / 1e9, 1)
+    (3.0, 12.0)
+    """
+    return float(nodes) * int(choices) * int(levels) * PREFIX_BYTES
+
+
+def open_cap(choices: int, levels: int, max_open: int | None = None, budget: float = MAX_OPEN_MEMORY) -> int:
+    """The open prefixes a branch-and-bound keeps at most: ``max_open`` if given (refused where its memory passes
+    ``budget``), else :data:`MAX_NODES`, lowered to what fits ``budget``.
+
+    >>> open_cap(2, 10), open_cap(8, 10)
+    (500000, 166666)
+    >>> open_cap(2, 10, max_open=2_000_000)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchBudgetError: max_open 2,000,000: ... 12.0 GB at one depth ...; give at most 666,666
+    """
+    fits = int(budget // (int(choices) * int(levels) * PREFIX_BYTES))
+    if max_open is None:
+        return max(1, min(MAX_NODES, fits))
+    if int(max_open) > fits:
+        raise SearchBudgetError(
+            f"max_open {int(max_open):,}: the open prefixes of a loose chain table could take "
+            f"{open_memory(int(max_open), choices, levels) / 1e9:.1f} GB at one depth ({choices} children each, "
+            f"{levels} levels), past the {budget / 1e9:.1f} GB budget (MAX_OPEN_MEMORY); give at most {fits:,}")
+    return int(max_open)
+
+
+class OpenWatch:
+    """How many prefixes a branch-and-bound keeps open: the most at one depth (:attr:`peak`), whether they reached
+    the search's ``cap``, and a line through ``say`` at most every ``every`` seconds while it grows (a long search's
+    progress) and when they reach the cap. A probing run's smaller cap (:data:`MAX_NODES` / 25) is the probe's own.
+
+    Examples
+    --------
+    >>> lines = []
+    >>> with watching(OpenWatch(lines.append, cap=4, every=0.0)) as watch:
+    ...     _ = narrow(np.ones(6, dtype=bool), np.arange(6.0), None, 4, 3, 9, spill=[])
+    >>> watch.peak, watch.reached, lines
+    (4, True, ['  branch-and-bound: unit 3/9, 4 open prefixes (at the cap of 4; the best kept)'])
+    """
+
+    def __init__(self, say: Callable[[str], None], cap: int = MAX_NODES, every: float = 2.0) -> None:
+        self.say, self.cap, self.every = say, int(cap), float(every)
+        self.peak, self.reached = 0, False
+        self.said_at = time.monotonic()
+
+    def __call__(self, p: int, n: int, count: int) -> None:
+        self.peak = max(self.peak, int(count))
+        full = int(count) >= self.cap
+        if (full and not self.reached) or time.monotonic() - self.said_at >= self.every:
+            self.said_at = time.monotonic()
+            state = f"at the cap of {self.cap:,}; the best kept" if full else f"cap {self.cap:,}"
+            self.say(f"  branch-and-bound: unit {p}/{n}, {count:,} open prefixes ({state})")
+        self.reached = self.reached or full
+
+
+def cap_text(chain: Any, margin: float, cap: int) -> str:
+    """What a branch-and-bound that reached its cap of open prefixes says: the chain table's bound (its worst
+    held-out centre error, times the margin) that left them open, and what lists more.
+
+    >>> from pneumorph.models.chain.model import ChainModel
+    >>> from pneumorph.models.chain.sources import find_table
+    >>> from pneumorph.models.factory import make_model
+    >>> print(cap_text(ChainModel(find_table(make_model(22, {"fidelity": "2d"})), 22), 32.0, 500_000))
+    ... # doctest: +ELLIPSIS
+      the open prefixes reached the cap of 500,000: the chain table's bound (centres within 2.94 mm, margin 32) ...
+    """
+    worst = float(np.max(chain_errors(chain, margin)["centre"]))
+    return (f"  the open prefixes reached the cap of {cap:,}: the chain table's bound (centres within {worst:.3g} mm, "
+            f"margin {margin:g}) prunes too little to list every design that can matter; the best were kept and the "
+            "certificate's floor bounds the rest. A tighter table (a smaller margin, a table within its tolerance) "
+            "or a larger max_open lists more")
+
+
+_WATCH: ContextVar[Callable[[int, int, int], None] | None] = ContextVar("open_watch", default=None)
+
+
+@contextlib.contextmanager
+def watching(watch: OpenWatch) -> Iterator[OpenWatch]:
+    """Within the block, every depth a branch-and-bound prunes (:func:`narrow`, no beam) reports to ``watch``."""
+    token = _WATCH.set(watch)
+    try:
+        yield watch
+    finally:
+        _WATCH.reset(token)
 
 
 def narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_nodes: int, p: int,
@@ -55,9 +163,12 @@ def narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_nod
         keep = np.zeros(len(bound), dtype=bool)
         keep[open_[order[:max_nodes]]] = True
     if keep.sum() > max_nodes:
-        raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}: too many "
-                             "designs come within the chain's error bound of the best to list them all - use "
-                             "--search ga")
+        raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}, past the cap "
+                             f"of {max_nodes:,}: too many designs come within the chain's error bound of the best to "
+                             "list them all; a tighter table (a smaller margin, a table within its tolerance), a "
+                             "larger max_open, or --search ga")
+    if beam is None and (watch := _WATCH.get()) is not None:
+        watch(p, n, int(keep.sum()))
     return keep
 
 
@@ -76,4 +187,5 @@ def union(a: ChainScores, b: ChainScores) -> ChainScores:
                        floor=a.floor, choices=a.choices)
 
 
-__all__ = ["BEAM", "MAX_ENUMERATE", "MAX_NODES", "BranchOverflow", "kept", "narrow", "union"]
+__all__ = ["BEAM", "MAX_ENUMERATE", "MAX_NODES", "MAX_OPEN_MEMORY", "PREFIX_BYTES", "BranchOverflow", "OpenWatch",
+           "cap_text", "kept", "narrow", "open_cap", "open_memory", "union", "watching"]

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from pneumorph.design.certified.bounds import ChainScores, chain_errors, objective_bounds, score_designs
-from pneumorph.design.certified.branching import MAX_ENUMERATE, MAX_NODES
+from pneumorph.design.certified.branching import MAX_ENUMERATE, MAX_NODES, OpenWatch, cap_text, watching
 from pneumorph.design.certified.planegrowth import best_scores, chain_scores, designs_of, enumerable, grow_designs
 from pneumorph.design.certified.prefixes import ChainGeometry, chain_geometry
 from pneumorph.design.certified.spacegrowth import space_scores
@@ -156,13 +156,7 @@ def certified_search(
         # over a library the designs' lengths differ: L is that of the first type's actuator, for the chain
         # and the FE verifications alike
         objective = replace(objective, length=chain.length)
-    if not enumerable(chain, MAX_ENUMERATE):  # a branch-and-bound: a tip goal over sideways units takes a minute
-        say(f"chain: scoring {designs_of(chain):,.0f} designs (branch-and-bound) ...")
-    scores = chain_scores(chain, objective, margin, max_nodes=max_nodes)
-    order = scores.order()
-    designs = chain.table.texts(scores.bits[order])
-    say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'} in "
-        f"{time.perf_counter() - start:.2f} s; best {designs[0]}")
+    scores, order, designs = _scored(chain, objective, margin, max_nodes, say, start)
     state = _Verification(ScoreBook(fe_model, objective, evaluator), designs, scores.optimistic[order],
                           1.0 if objective.sense == "min" else -1.0, np.zeros(len(designs), dtype=bool))
     _verify(state, fe_model, verify, certify, epsilon, max_verify, max_failures, say)
@@ -178,6 +172,25 @@ def certified_search(
         certificate["planar"] = planar
     return CertifiedResult(winner, winner_chain, hof, {d: book.candidate(d) for d in verified}, certificate, scores,
                            solves=book.solves, wall_time=time.perf_counter() - start)
+
+
+def _scored(chain: ChainModel, objective: Objective, margin: float, max_nodes: int, say: Callable[[str], None],
+            start: float) -> tuple[ChainScores, np.ndarray, list[str]]:
+    """Every design that can matter scored by the chain, their order and names, said with the most open prefixes a
+    branch-and-bound kept at one depth (and, where they reached ``max_nodes``, the table's bound that left them)."""
+    if not enumerable(chain, MAX_ENUMERATE):  # a branch-and-bound: a tip goal over sideways units takes a minute
+        say(f"chain: scoring {designs_of(chain):,.0f} designs (branch-and-bound, at most {max_nodes:,} open "
+            "prefixes) ...")
+    with watching(OpenWatch(say, cap=max_nodes)) as watch:
+        scores = chain_scores(chain, objective, margin, max_nodes=max_nodes)
+    order = scores.order()
+    designs = chain.table.texts(scores.bits[order])
+    opened = f", at most {watch.peak:,} open prefixes at a depth" if watch.peak else ""
+    say(f"chain: {len(designs):,} designs scored{'' if scores.complete else ' (branch-and-bound)'}{opened} in "
+        f"{time.perf_counter() - start:.2f} s; best {designs[0]}")
+    if watch.reached:
+        say(cap_text(chain, margin, max_nodes))
+    return scores, order, designs
 
 
 def planar_codes(fe_model: ActuatorModel, chain: ChainModel) -> np.ndarray | None:

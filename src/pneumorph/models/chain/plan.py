@@ -38,22 +38,28 @@ FULL_WIDTH = "3d full-width"
 #: held-out designs that validate a table built on first use
 HELDOUT = 20
 #: measured wall time of one FE solve of a 15-unit design (:data:`SOLVE_UNITS`) on one core, seconds, per
-#: fidelity (BENCHMARKS.md, 2 cores, 24 GB: a random 3D design 14.2-15.8 s, a 2D one 0.55 s; strongly curled
-#: designs take up to three times as long); the estimates of a build or a search scale it by the units
-#: and divide it among the workers
-SOLVE_SECONDS = {"3d": 15.0, "2d": 0.55, FULL_WIDTH: 60.0}
+#: fidelity (BENCHMARKS.md, 2 cores, 24 GB: a random 3D design 14.2-15.8 s; 2D the fit of CPU times over 5 to
+#: 30 units, :data:`SOLVE_EXPONENT`; strongly curled designs take up to three times as long); the estimates of a
+#: build or a search scale it by the units (:data:`SOLVE_EXPONENT`) and divide it among the workers
+SOLVE_SECONDS = {"3d": 15.0, "2d": 0.83, FULL_WIDTH: 60.0}
 SOLVE_UNITS = 15
+#: how a solve's time grows with the units, ``(n / SOLVE_UNITS) ** exponent``, per fidelity (1 where not
+#: measured): in 2D the unknowns grow with the units and the Newton iterations with the curl, which grows with
+#: them too; 5 to 30 units of one design pattern took 0.20 to 1.95 s of CPU, fitted by ``0.83 s (n / 15) ** 1.35``
+#: within -18 to +15 % (BENCHMARKS.md, "The 2D estimate's growth with the units")
+SOLVE_EXPONENT = {"2d": 1.35}
 
 
 def solve_seconds(fidelity: str, n_units: int) -> float | None:
     """Estimated wall time of one FE solve of ``n_units`` units on one core (s), from :data:`SOLVE_SECONDS`
-    scaled by the units; None for a model without a measured figure.
+    scaled by the units to the power :data:`SOLVE_EXPONENT`; None for a model without a measured figure.
 
-    >>> solve_seconds("3d", 15), solve_seconds("2d", 30), solve_seconds("toy", 5)
-    (15.0, 1.1, None)
+    >>> solve_seconds("3d", 15), solve_seconds("3d", 30), round(solve_seconds("2d", 30), 2), solve_seconds("toy", 5)
+    (15.0, 30.0, 2.12, None)
     """
     per = SOLVE_SECONDS.get(str(fidelity))
-    return None if per is None else per * int(n_units) / SOLVE_UNITS
+    exponent = SOLVE_EXPONENT.get(str(fidelity), 1.0)
+    return None if per is None else per * (int(n_units) / SOLVE_UNITS) ** exponent
 
 
 #: a volume-controlled ramp's CPU time over the pressure ramp's of the built-in unit (the figure :data:`SOLVE_SECONDS`
@@ -110,7 +116,7 @@ def model_seconds(model: Any, n_units: int | None = None) -> float | None:
     >>> from pneumorph.models import make_model
     >>> model_seconds(make_model(15, {"fidelity": "2d"})), round(model_seconds(make_model(4, {"fidelity": "2d",
     ...     "volume_change": 1.0})), 2)
-    (0.55, 0.51)
+    (0.83, 0.49)
     """
     seconds = solve_seconds(cost_fidelity(model), int(getattr(model, "n_units", 0) or 0) if n_units is None
                             else int(n_units))
