@@ -11,16 +11,8 @@ import scipy.sparse.linalg as spla
 from pneumorph.errors import SettingsError
 from pneumorph.fem import OgdenCompressible, StepSettings, ramp
 from pneumorph.fem.body import pressurised_body
-from pneumorph.fem.fast.contact import (
-    Cylinder,
-    Plane,
-    RigidContact,
-    Sphere,
-    obstacle_from_dict,
-    penalty_gap,
-    start_inside,
-    surface_points,
-)
+from pneumorph.fem.fast.contact import RigidContact, penalty_gap, surface_points
+from pneumorph.fem.fast.shapes import Cylinder, Plane, Sphere, obstacle_from_dict, start_inside
 from pneumorph.fem.fast.system import PlaneStrainSystem, SolidSystem3D
 
 UMAT = OgdenCompressible([0.03], [2.0], 0.3)

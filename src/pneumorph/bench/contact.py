@@ -9,7 +9,7 @@ target's. That winner is then solved by the 2D FE model with the circle as a rig
 on the object, the contact length, the clearance, the base's reaction, the nodes in contact (where they are and
 their contact pressure) and the FE centreline.
 
-The object is checked as every obstacle is (:func:`~pneumorph.fem.fast.contact.obstacle_from_dict`: a finite
+The object is checked as every obstacle is (:func:`~pneumorph.fem.fast.shapes.obstacle_from_dict`: a finite
 centre, a finite radius > 0), and by the page's own limits: its centre within :data:`PAGE` actuator lengths of the
 base in x and y, its radius at most :data:`MAX_RADIUS` of the length. One that starts inside the actuator (or in a
 cavity) is refused before the solve (:func:`~pneumorph.models.fe.obstacles.check_reach`). A query with an object
@@ -26,7 +26,7 @@ import numpy as np
 from pneumorph.bench.query import QueryError
 from pneumorph.bench.samples import centrelines
 from pneumorph.errors import SettingsError, SimulationFailed
-from pneumorph.fem.fast.contact import Cylinder, obstacle_from_dict
+from pneumorph.fem.fast.shapes import Cylinder, obstacle_from_dict
 from pneumorph.models.fe.obstacles import check_reach
 
 #: how far from the clamped base an object's centre may lie, in x and in y, over the actuator's length

@@ -37,9 +37,9 @@ from pneumorph.models.chain.sources import serve_table
 
 def chain_clearance(chain: ChainModel, design: str, level: int, obstacles: Iterable[Any]) -> float:
     """The least gap (mm) between the chain's free shape of ``design`` (its unit centres and tip) at ``level`` and
-    the ``obstacles`` (:class:`~pneumorph.fem.fast.contact.Obstacle`); negative inside one.
+    the ``obstacles`` (:class:`~pneumorph.fem.fast.shapes.Obstacle`); negative inside one.
 
-    >>> from pneumorph.fem.fast.contact import Plane
+    >>> from pneumorph.fem.fast.shapes import Plane
     >>> from pneumorph.models.chain.sources import shipped_path
     >>> from pneumorph.models.chain.table import ChainTable
     >>> chain = ChainModel(ChainTable.load(shipped_path("2d")), 5)
@@ -67,7 +67,7 @@ class ClearingScreen:
         The chain's validated worst error at that level (mm).
     goal : ContactGoal
     obstacles : tuple
-        The model's obstacles (:class:`~pneumorph.fem.fast.contact.Obstacle`).
+        The model's obstacles (:class:`~pneumorph.fem.fast.shapes.Obstacle`).
     rejected : dict
         Every design rejected so far, and why.
     """

@@ -8,9 +8,10 @@ same criterion, an order of magnitude faster:
   plane-strain and 3D hooks (:class:`PlaneStrainSystem`, :class:`SolidSystem3D`);
 - :mod:`~pneumorph.fem.fast.kernels` - constitutive kernels with the quadrature points last;
 - :mod:`~pneumorph.fem.fast.loads` - dead loads as one nodal vector;
-- :mod:`~pneumorph.fem.fast.contact` - rigid obstacles (:class:`Plane`, :class:`Cylinder`,
-  :class:`Sphere`) against a body's surface nodes, a penalty owner of the assembler
-  (:class:`RigidContact`);
+- :mod:`~pneumorph.fem.fast.shapes` - rigid obstacles' geometry (:class:`Plane`, :class:`Cylinder`,
+  :class:`Sphere`): gap, normal, curvature;
+- :mod:`~pneumorph.fem.fast.contact` - those obstacles against a body's surface nodes, a penalty owner of
+  the assembler (:class:`RigidContact`);
 - :mod:`~pneumorph.fem.fast.newton` - :class:`FastSubstep`, Newton's method on a system
   (kept factorised tangents, Anderson acceleration), a substep strategy of
   :func:`pneumorph.fem.ramp`;
@@ -18,9 +19,10 @@ same criterion, an order of magnitude faster:
   (the cavities' volume drives, the pressure is an unknown and passes its maximum).
 """
 
-from pneumorph.fem.fast.contact import Cylinder, Plane, RigidContact, Sphere
+from pneumorph.fem.fast.contact import RigidContact
 from pneumorph.fem.fast.loads import DeadLoads
 from pneumorph.fem.fast.newton import FastSubstep, pattern_solver
+from pneumorph.fem.fast.shapes import Cylinder, Plane, Sphere
 from pneumorph.fem.fast.system import FastSystem, PlaneStrainSystem, SolidSystem3D
 from pneumorph.fem.fast.volume import VolumeControl, volume_control
 

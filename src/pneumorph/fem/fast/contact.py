@@ -1,9 +1,8 @@
-"""Frictionless contact of a body's outer surface nodes with rigid obstacles, for the fast assembler.
+"""Contact of a body's outer surface nodes with rigid obstacles, for the fast assembler.
 
-An obstacle is a rigid plane (:class:`Plane`), cylinder (:class:`Cylinder`, a circle in 2D) or
-sphere (:class:`Sphere`) that does not move. Its geometry gives every point ``x`` a signed gap
-``g(x)`` (negative: the point is inside the obstacle), the outward normal ``n = dg/dx`` and the
-curvature ``H = dn/dx`` (None for a plane). A node-to-rigid-surface penalty holds the surface
+An obstacle (:mod:`~pneumorph.fem.fast.shapes`: a plane, cylinder or sphere that does not move) gives every
+point ``x`` a signed gap ``g(x)`` (negative: the point is inside the obstacle), the outward normal
+``n = dg/dx`` and the curvature ``H = dn/dx`` (None for a plane). A node-to-rigid-surface penalty holds the surface
 nodes out of it, as FElupe's ``ContactRigidPlane``/``ContactRigidCylinder`` do (their normal part):
 a node in contact (``g < 0``) adds
 
@@ -21,17 +20,14 @@ penalty (:data:`TANGENTIAL` times ``k``) with return-mapped sliding (:mod:`~pneu
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pneumorph import checks
-from pneumorph.errors import SettingsError
 from pneumorph.fem.fast.friction import coulomb, slip
+from pneumorph.fem.fast.shapes import Obstacle
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -59,163 +55,6 @@ FACES: dict[str, list[list[int]]] = {
 #: weights); a quad's corners; a quadratic quad's corners and middle nodes (half a corner's on each edge)
 SHARES: dict[int, FloatArray] = {2: np.full(2, 0.5), 3: np.array([1 / 6, 1 / 6, 2 / 3]), 4: np.full(4, 0.25),
                                  8: np.r_[np.full(4, 1 / 12), np.full(4, 1 / 6)]}
-
-
-def _vector(value: Any, name: str, dim: int) -> tuple[float, ...]:
-    """``value`` as ``dim`` finite numbers (SettingsError otherwise)."""
-    try:
-        v = np.asarray(value, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise SettingsError(f"{name} must be {dim} numbers, got {value!r}") from None
-    if v.size != dim or not np.all(np.isfinite(v)):
-        raise SettingsError(f"{name} must be {dim} finite numbers, got {value!r}")
-    return tuple(float(c) for c in v)
-
-
-def _unit(value: Any, name: str, dim: int) -> tuple[float, ...]:
-    v = np.asarray(_vector(value, name, dim))
-    norm = float(np.linalg.norm(v))
-    if norm == 0.0:
-        raise SettingsError(f"{name} must not be zero, got {value!r}")
-    return tuple(float(c) for c in v / norm)
-
-
-@dataclass(frozen=True)
-class Obstacle:
-    """A rigid obstacle (use :class:`Plane`, :class:`Cylinder` or :class:`Sphere`)."""
-
-    kind: ClassVar[str] = ""
-
-    def kinematics(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray | None]:
-        """Gaps (m,), outward unit normals (m, d) and curvatures ``dn/dx`` (m, d, d; None: flat) at points (m, d)."""
-        raise NotImplementedError  # pragma: no cover
-
-    def to_dict(self) -> dict[str, Any]:
-        """The obstacle as a TOML/JSON table (``[[model.obstacle]]``)."""
-        out: dict[str, Any] = {"kind": self.kind}
-        for key, value in vars(self).items():
-            if value != ():  # (a circle has no axis)
-                out[key] = [float(v) for v in value] if isinstance(value, tuple) else float(value)
-        return out
-
-
-@dataclass(frozen=True)
-class Plane(Obstacle):
-    """A rigid half-space: the body stays on the side ``normal`` points to, from the plane through ``point``.
-
-    >>> gap, n, H = Plane((10.0, 0.0), (-1.0, 0.0)).kinematics(np.array([[12.0, 1.0], [9.0, 5.0]]))
-    >>> gap.tolist(), n[0].tolist(), H is None
-    ([-2.0, 1.0], [-1.0, 0.0], True)
-    """
-
-    kind: ClassVar[str] = "plane"
-    point: tuple[float, ...]
-    normal: tuple[float, ...]
-
-    def kinematics(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray | None]:
-        n = np.asarray(self.normal)
-        return (x - np.asarray(self.point)) @ n, np.broadcast_to(n, x.shape), None
-
-
-def _round(dx: FloatArray, radius: float, axis: FloatArray | None) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Gap, normal and curvature of a circle, sphere (``axis`` None) or cylinder from ``dx = x - centre``."""
-    d = dx.shape[1]
-    if axis is not None:
-        dx = dx - np.outer(dx @ axis, axis)
-    dist = np.maximum(np.linalg.norm(dx, axis=1), 1e-12 * radius)
-    n = dx / dist[:, None]
-    projector = np.eye(d) if axis is None else np.eye(d) - np.outer(axis, axis)
-    H = (projector[None] - n[:, :, None] * n[:, None, :]) / dist[:, None, None]
-    return dist - radius, n, H
-
-
-@dataclass(frozen=True)
-class Cylinder(Obstacle):
-    """A rigid cylinder of ``radius`` about the line through ``centre`` along ``axis`` (a circle in 2D: no axis).
-
-    >>> gap, n, H = Cylinder((0.0, 0.0, 0.0), 2.0, (0.0, 0.0, 1.0)).kinematics(np.array([[3.0, 0.0, 7.0]]))
-    >>> gap.tolist(), n.tolist(), H[0].diagonal().round(4).tolist()
-    ([1.0], [[1.0, 0.0, 0.0]], [0.0, 0.3333, 0.0])
-    """
-
-    kind: ClassVar[str] = "cylinder"
-    centre: tuple[float, ...]
-    radius: float
-    axis: tuple[float, ...] = ()
-
-    def kinematics(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray | None]:
-        axis = np.asarray(self.axis) if len(self.axis) == 3 else None
-        return _round(x - np.asarray(self.centre), self.radius, axis)
-
-
-@dataclass(frozen=True)
-class Sphere(Obstacle):
-    """A rigid sphere (a circle in 2D) of ``radius`` about ``centre``.
-
-    >>> gap, n, H = Sphere((0.0, 0.0), 1.0).kinematics(np.array([[0.0, 0.5]]))
-    >>> gap.tolist(), n.tolist()
-    ([-0.5], [[0.0, 1.0]])
-    """
-
-    kind: ClassVar[str] = "sphere"
-    centre: tuple[float, ...]
-    radius: float
-
-    def kinematics(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray | None]:
-        return _round(x - np.asarray(self.centre), self.radius, None)
-
-
-KINDS: dict[str, type[Obstacle]] = {"plane": Plane, "cylinder": Cylinder, "sphere": Sphere}
-
-
-def obstacle_from_dict(table: Mapping[str, Any], dim: int, where: str = "obstacle") -> Obstacle:
-    """An obstacle from its table (``kind`` and its geometry, mm), checked.
-
-    Raises
-    ------
-    SettingsError
-        An unknown kind or key, a point of the wrong size or not finite, a zero normal or
-        axis, a radius <= 0, a friction < 0 (the table's ``friction`` is checked here and kept by the
-        caller: the geometry does not hold it).
-
-    Examples
-    --------
-    >>> obstacle_from_dict({"kind": "plane", "point": [150, 0], "normal": [-2, 0]}, 2)
-    Plane(point=(150.0, 0.0), normal=(-1.0, 0.0))
-    >>> obstacle_from_dict({"kind": "cylinder", "centre": [0, 0], "radius": 0}, 2)
-    Traceback (most recent call last):
-    ...
-    pneumorph.errors.SettingsError: obstacle radius must be a finite number > 0 (mm), got 0
-    """
-    if not isinstance(table, Mapping):
-        raise SettingsError(f"{where} must be a table (kind, and its geometry), got {table!r}")
-    kind = table.get("kind")
-    if kind not in KINDS:
-        raise SettingsError(f"{where} kind must be one of {', '.join(KINDS)}, got {kind!r}")
-    keys = {"plane": ["point", "normal"], "cylinder": ["centre", "radius", "axis"], "sphere": ["centre", "radius"]}
-    allowed = [*keys[kind], "kind", "friction"]
-    unknown = sorted(set(table) - set(allowed))
-    if unknown:
-        raise SettingsError(f"{where}: unknown key(s) {', '.join(unknown)} of a {kind}; known: {', '.join(allowed)}")
-    friction = table.get("friction", 0.0)
-    if not (isinstance(friction, (int, float)) and not isinstance(friction, bool) and math.isfinite(friction)
-            and friction >= 0.0):
-        raise SettingsError(f"{where} friction must be a finite number >= 0, got {friction!r}")
-    missing = [k for k in keys[kind] if k not in table and not (k == "axis" and dim == 2)]
-    if missing:
-        raise SettingsError(f"{where}: a {kind} needs {', '.join(missing)}")
-    if kind == "plane":
-        return Plane(_vector(table["point"], f"{where} point", dim),
-                     _unit(table["normal"], f"{where} normal", dim))
-    radius = checks.real(table["radius"], f"{where} radius", 0.0, low_open=True, unit="mm")
-    centre = _vector(table["centre"], f"{where} centre", dim)
-    if kind == "sphere":
-        return Sphere(centre, radius)
-    if dim == 2:
-        if "axis" in table:
-            raise SettingsError(f"{where}: a cylinder in 2D is a circle about the section's normal; give no axis")
-        return Cylinder(centre, radius)
-    return Cylinder(centre, radius, _unit(table["axis"], f"{where} axis", 3))
 
 
 def penalty_stiffness(shear_modulus: float, element_size: float, dim: int, factor: float = PENALTY) -> float:
@@ -309,6 +148,7 @@ class RigidContact:
     --------
     A node 0.25 mm inside a wall is pushed back with ``k g`` along its normal:
 
+    >>> from pneumorph.fem.fast.shapes import Plane
     >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0)
     >>> X = np.array([[0.0, 0.0], [1.25, 0.0]])
     >>> force, active = contact.forces(X)
@@ -376,6 +216,7 @@ class RigidContact:
     def states(self, x: FloatArray) -> NDArray[np.int8]:
         """Every node's contact state at ``x`` (all the body's points): 0 free, 1 pressed (sticking), 2 sliding.
 
+        >>> from pneumorph.fem.fast.shapes import Plane
         >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, friction=0.5)
         >>> contact.commit(np.array([[0.0, 0.0], [1.25, 0.0]]))  # (0, 1): free, sticking; then 3 N > 0.5 x 2.5 N
         >>> contact.states(np.array([[0.0, 0.0], [1.25, 3.0]])).tolist()
@@ -402,6 +243,7 @@ class RigidContact:
         (a straight path's gap, linear between its ends), the next step sees it in contact. The stride bounds a
         step along a nearly singular tangent: a finger's tip sliding on a wall, held only by its bending.
 
+        >>> from pneumorph.fem.fast.shapes import Plane
         >>> contact = RigidContact(Plane((1.0, 0.0), (-1.0, 0.0)), np.array([0, 1]), 10.0, reach=0.1)
         >>> x = np.array([[0.0, 0.0], [0.5, 0.0]])
         >>> round(contact.step_fraction(x, np.array([[0.0, 0.0], [1.1, 0.0]])), 6)  # 0.6 of its 1.1 mm reach 0.1 mm in
@@ -479,22 +321,37 @@ def surface_points(cells: IntArray, cell_type: str, excluded: NDArray[np.bool_] 
     return faces, np.unique(faces)
 
 
-def start_inside(obstacles: Sequence[Obstacle], x: FloatArray) -> str | None:
-    """Why an obstacle cannot start where it is (a point ``x`` (p, d) of the body inside it), or None.
-
-    >>> start_inside([Sphere((0.0, 0.0), 1.0)], np.array([[3.0, 0.0], [0.5, 0.0]]))
-    'obstacle 1 (sphere) starts inside the actuator: its point (0.5, 0) mm lies 0.5 mm inside it'
-    """
-    for i, obstacle in enumerate(obstacles):
-        gap = obstacle.kinematics(x)[0]
-        worst = int(np.argmin(gap))
-        if gap[worst] < -1e-9:  # (a wall through a surface point touches it)
-            where = ", ".join(f"{v:g}" for v in x[worst])
-            return (f"obstacle {i + 1} ({obstacle.kind}) starts inside the actuator: its point ({where}) mm lies "
-                    f"{-gap[worst]:.3g} mm inside it")
-    return None
+def contact_fraction(system: Any, u: FloatArray, step: FloatArray, motion: float = 0.0) -> float:
+    """The fraction of a Newton ``step`` (over the active dofs) from ``u`` that carries no surface node deep into
+    an obstacle it was not pressing on, nor any node farther than the obstacles' stride or ``motion`` (mm)
+    (:meth:`RigidContact.step_fraction`; 1 without obstacles)."""
+    contacts = getattr(system, "contacts", ())
+    if not contacts:
+        return 1.0
+    x = system.points + u.reshape(system.points.shape)
+    dx = node_steps(system, step)
+    return min(c.step_fraction(x, dx, motion) for c in contacts)
 
 
-__all__ = ["FACES", "KINDS", "PENALTY", "SHARES", "TANGENTIAL", "Cylinder", "Obstacle", "Plane", "RigidContact",
-           "Sphere", "face_measures", "obstacle_from_dict", "penalty_gap", "penalty_stiffness", "start_inside",
-           "surface_faces", "surface_points"]
+def node_steps(system: Any, step: FloatArray) -> FloatArray:
+    """A ``step`` over the active dofs as each node's displacement increment, one row a node (0 where prescribed)."""
+    du = np.zeros(system.points.size)
+    du[system.dof1] = step
+    return du.reshape(system.points.shape)
+
+
+def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: bool = False) -> bool:
+    """Whether some surface node touches an obstacle at ``u_new`` (all dofs) and not at ``u``, or the reverse
+    (``sliding``: or sticks at one and slides at the other,
+    :meth:`RigidContact.states`)."""
+    d = system.points.shape[1]
+    x, x_new = system.points + u.reshape(-1, d), system.points + u_new.reshape(-1, d)
+    if sliding:
+        return any(np.any(c.states(x) != c.states(x_new)) for c in getattr(system, "contacts", ()))
+    return any(np.any(c.forces(x)[1] != c.forces(x_new)[1]) for c in getattr(system, "contacts", ()))
+
+
+
+
+__all__ = ["FACES", "PENALTY", "SHARES", "TANGENTIAL", "RigidContact", "contact_fraction", "contacts_changed",
+           "face_measures", "node_steps", "penalty_gap", "penalty_stiffness", "surface_faces", "surface_points"]

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pneumorph.fem.fast.contact import contact_fraction, contacts_changed, node_steps
 from pneumorph.fem.linear import corrected, pattern_operator
 from pneumorph.fem.stepping import relative_residual
 
@@ -118,36 +119,6 @@ def inadmissible(r: FloatArray, jmin: float) -> str | None:
     if jmin > 0.0 and np.all(np.isfinite(r)):
         return None
     return f"the predicted start is not admissible (det F = {jmin:.3g})"
-
-
-def contact_fraction(system: Any, u: FloatArray, step: FloatArray, motion: float = 0.0) -> float:
-    """The fraction of a Newton ``step`` (over the active dofs) from ``u`` that carries no surface node deep into
-    an obstacle it was not pressing on, nor any node farther than the obstacles' stride or ``motion`` (mm)
-    (:meth:`~pneumorph.fem.fast.contact.RigidContact.step_fraction`; 1 without obstacles)."""
-    contacts = getattr(system, "contacts", ())
-    if not contacts:
-        return 1.0
-    x = system.points + u.reshape(system.points.shape)
-    dx = node_steps(system, step)
-    return min(c.step_fraction(x, dx, motion) for c in contacts)
-
-
-def node_steps(system: Any, step: FloatArray) -> FloatArray:
-    """A ``step`` over the active dofs as each node's displacement increment, one row a node (0 where prescribed)."""
-    du = np.zeros(system.points.size)
-    du[system.dof1] = step
-    return du.reshape(system.points.shape)
-
-
-def contacts_changed(system: Any, u: FloatArray, u_new: FloatArray, sliding: bool = False) -> bool:
-    """Whether some surface node touches an obstacle at ``u_new`` (all dofs) and not at ``u``, or the reverse
-    (``sliding``: or sticks at one and slides at the other,
-    :meth:`~pneumorph.fem.fast.contact.RigidContact.states`)."""
-    d = system.points.shape[1]
-    x, x_new = system.points + u.reshape(-1, d), system.points + u_new.reshape(-1, d)
-    if sliding:
-        return any(np.any(c.states(x) != c.states(x_new)) for c in getattr(system, "contacts", ()))
-    return any(np.any(c.forces(x)[1] != c.forces(x_new)[1]) for c in getattr(system, "contacts", ()))
 
 
 def kept_rise(norm_new: float, norm: float, jmin: float) -> bool:

@@ -1,6 +1,6 @@
 """Rigid obstacles in the FE models: ``[[model.obstacle]]`` tables, the contact items of a mesh, the forces out.
 
-An obstacle (:mod:`pneumorph.fem.fast.contact`: a plane, a cylinder - a circle in 2D - or a sphere,
+An obstacle (:mod:`pneumorph.fem.fast.shapes`: a plane, a cylinder - a circle in 2D - or a sphere,
 frictionless or with Coulomb ``friction``) touches the actuator's outer surface nodes, or with
 ``on = "end"`` the nodes of its free end face only (a load cell against the tip: :func:`blocked_wall`).
 Every reported level records, per obstacle, the force the actuator exerts on it (N), the nodes in contact and the
@@ -25,17 +25,8 @@ import numpy as np
 
 from pneumorph import checks
 from pneumorph.errors import SettingsError
-from pneumorph.fem.fast.contact import (
-    Cylinder,
-    Obstacle,
-    Plane,
-    RigidContact,
-    Sphere,
-    obstacle_from_dict,
-    penalty_stiffness,
-    start_inside,
-    surface_points,
-)
+from pneumorph.fem.fast.contact import RigidContact, penalty_stiffness, surface_points
+from pneumorph.fem.fast.shapes import Cylinder, Obstacle, Plane, Sphere, obstacle_from_dict, start_inside
 from pneumorph.geometry.assembly import ActuatorMesh
 from pneumorph.models.response import FloatArray
 
@@ -77,7 +68,7 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
     Raises
     ------
     SettingsError
-        A table that is no valid obstacle (:func:`~pneumorph.fem.fast.contact.obstacle_from_dict`), an
+        A table that is no valid obstacle (:func:`~pneumorph.fem.fast.shapes.obstacle_from_dict`), an
         unknown ``on``, or a ``friction`` above :data:`~pneumorph.checks.MAX_FRICTION`.
 
     Examples
