@@ -31,7 +31,7 @@ def test_kept_rises_and_cubic_predictor_reach_the_same_levels(monkeypatch: pytes
 
     monkeypatch.setattr(newton, "RISE", 1.0)  # every rising step taken back, as before
     old_model = Full3D(3, unit=unit)
-    old_model.predictor_order = 2
+    old_model.free_predictor_order = 2
     old = old_model.evaluate("000")
     assert abs(new.curl[-1]) > 45.0  # a real bending (58 degrees)
     np.testing.assert_allclose(new.tip, old.tip, rtol=0, atol=1e-6)

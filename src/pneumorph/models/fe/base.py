@@ -1,15 +1,13 @@
 """The finite-element actuator models' common machinery on FElupe: :class:`FEModel`.
 
-A model takes a unit (or a unit library), an orientation vector and a pressure ramp
-(:class:`RampSpec`) and returns a :class:`~pneumorph.models.response.Response`; a
-:class:`Solution` keeps the displacement fields besides. Silicones use the dissertation's
-compressible Ogden model (Eq 2.12, Tables A.4, A.5) through the hand-coded kernel
-:class:`pneumorph.fem.OgdenCompressible`; the base face is clamped and a follower pressure
-acts on the cavity walls. Optionally gravity acts on the silicones (their densities): it is
-applied in full first, then the pressure is ramped (the hanging test of appendix A.2.2).
-The fidelities are :class:`~pneumorph.models.fe.reduced2d.Reduced2D` (chapter 5) and
-:class:`~pneumorph.models.fe.full3d.Full3D` (chapter 4); :mod:`pneumorph.models.fe` is their
-public import place.
+A model takes a unit (or a unit library), an orientation vector and a pressure ramp (:class:`RampSpec`) and returns
+a :class:`~pneumorph.models.response.Response`; a :class:`Solution` keeps the displacement fields besides. Silicones
+use the dissertation's compressible Ogden model (Eq 2.12, Tables A.4, A.5) through the hand-coded kernel
+:class:`pneumorph.fem.OgdenCompressible`; the base face is clamped and a follower pressure acts on the cavity walls.
+Optionally gravity acts on the silicones (their densities): it is applied in full first, then the pressure is ramped
+(the hanging test of appendix A.2.2). The fidelities are :class:`~pneumorph.models.fe.reduced2d.Reduced2D` (chapter
+5) and :class:`~pneumorph.models.fe.full3d.Full3D` (chapter 4); :mod:`pneumorph.models.fe` is their public import
+place.
 """
 
 from __future__ import annotations
@@ -347,6 +345,10 @@ class FEModel:
         """
         return self.half and not any(u.layer_side for u in self.parse(design).units(self.library))
 
+    def predictor_order_for(self, design: str | Design) -> int:
+        """The degree of the ramp's predictor for ``design`` (:attr:`predictor_order`)."""
+        return self.predictor_order
+
     def build(self, orientation: str | Design) -> tuple[ActuatorMesh, PressurisedBody, Any]:
         """The meshed design, its pressurised body and ``set_pressure(p)`` for a load level.
 
@@ -455,7 +457,7 @@ class FEModel:
         try:
             stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
                          monitor=monitor if control is None else None, on_substep=follow, substep=substep,
-                         predictor_order=self.predictor_order,
+                         predictor_order=self.predictor_order_for(design),
                          carry=self.carry_step)
         except SimulationFailed as exc:
             reached = exc.reached if control is None else control.factor

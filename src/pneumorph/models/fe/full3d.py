@@ -12,6 +12,7 @@ from typing import Any
 
 from pneumorph.errors import SettingsError
 from pneumorph.fem import StepSettings
+from pneumorph.geometry.alphabet import Design
 from pneumorph.geometry.features import BaseBlock
 from pneumorph.geometry.library import UnitLibrary
 from pneumorph.geometry.unit import UnitSpec
@@ -67,12 +68,17 @@ class Full3D(FEModel):
     # Newton iterations for a 3-unit design at 45 kPa where two substeps from the linear one
     # took 62 (same results within the tolerance); in free air the cubic one (free_predictor_order)
     predictor_order = 2
-    # without obstacles the cubic extrapolation of the last four states: the 15-unit designs
-    # 011100110010010, 001111010001001 and 000000000000000 took 71, 70, 131 Newton iterations and
-    # 15, 13, 51 factorisations where the quadratic one took 72, 77, 163 and 17, 13, 60 (3 cut-backs:
-    # 2); the quartic one cut back on 001111010001001. Against a cylinder (001111010001001, "path:22.5:5;4")
-    # the cubic one took 122 iterations and 64 factorisations against 102 and 52: a tip that slides
-    # on an obstacle does not follow a smooth path
+    # on the half width without obstacles the cubic extrapolation of the last four states
+    # (predictor_order_for): the 15-unit designs 011100110010010, 001111010001001 and 000000000000000
+    # took 71, 70, 131 Newton iterations and 15, 13, 51 factorisations where the quadratic one took 72,
+    # 77, 163 and 17, 13, 60 (3 cut-backs: 2), and 110101101010001, 111101110010000, 101010101010101,
+    # 000111000111000 and 111000000111111 21, 32, 14, 19, 14 factorisations against 23, 34, 16, 22, 14
+    # (with RISE); the quartic one cut back on 001111010001001. On the full width it does not pay: the
+    # sideways LllAAaaaaLlLllL took 99 iterations, 23 factorisations and 1 cut-back against 97, 19 and
+    # none (66.3 s against 49.6 s CPU), aALlaaLLAaalLAa 92 and 24 against 90 and 27, the planar
+    # 111000000111111 82 and 14 against 86 and 15. Against a cylinder (001111010001001,
+    # "path:22.5:5;4") it took 122 iterations and 64 factorisations against 102 and 52: a tip that
+    # slides on an obstacle does not follow a smooth path
     free_predictor_order = 3
     default_steps = StepSettings(increments=10, substeps=1, max_iterations=25)
     # a tangent assembled and factorised costs several residuals: keep it while the
@@ -101,11 +107,22 @@ class Full3D(FEModel):
         super().__init__(n_units, unit, ramp_spec, None, backend, gravity, temperature_change, passage, base_block,
                          materials, library, formulation, obstacles, quadrature)
         self.half = bool(half)
-        if not self.obstacles:
-            self.predictor_order = self.free_predictor_order
         if self.half and self.gravity is not None and self.gravity[2] != 0.0:
             raise SettingsError(f"gravity {list(self.gravity)} mm/s^2 has a z component, which breaks the symmetry "
                              "of the half model; use half=False")
+
+    def predictor_order_for(self, design: str | Design) -> int:
+        """The cubic predictor (:attr:`free_predictor_order`) for a design on the half width without obstacles,
+        else the quadratic one (:attr:`predictor_order`; measured in the class's notes).
+
+        >>> from pneumorph.geometry.library import builtin_library
+        >>> model = Full3D(2, library=builtin_library("spatial"))
+        >>> model.predictor_order_for("aA"), model.predictor_order_for("aL")
+        (3, 2)
+        >>> Full3D(2, half=False).predictor_order_for("01")
+        2
+        """
+        return self.free_predictor_order if not self.obstacles and self.half_for(design) else self.predictor_order
 
     def describe(self) -> dict[str, Any]:
         out = {**super().describe(), "half_model": self.half}

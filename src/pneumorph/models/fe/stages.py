@@ -42,7 +42,7 @@ def weigh(model: Any, body: Any, substep: Any, follow: Any, design: str) -> int:
 
     try:
         stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, gravity_steps(model.ramp.steps),
-                     on_substep=follow, substep=substep, predictor_order=model.predictor_order,
+                     on_substep=follow, substep=substep, predictor_order=model.predictor_order_for(design),
                      carry=model.carry_step)
     except SimulationFailed as exc:
         raise SimulationFailed(reached=0.0, cause=f"under its own weight, before any pressure: {exc.cause}",
