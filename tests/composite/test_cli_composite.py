@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
+from pneumorph.composite.coupon import CouponResult, CouponSpec, simulate_coupon
 from tests.cli import run
 
 
@@ -67,3 +69,65 @@ def test_coupon_text(capsys: pytest.CaptureFixture[str]) -> None:
 def test_coupon_rejects_a_crimp_too_high_for_the_coupon(capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(capsys, "composite", "coupon", "-c", "0.3", "--thickness", "2.5")
     assert code == 2 and "thickness" in err
+
+
+@pytest.fixture(scope="module")
+def tiny_coupon() -> CouponResult:
+    """A real coupon small enough to stand in for the solve (27 nodes, about a second)."""
+    return simulate_coupon(CouponSpec.from_ratio(0.3, length=20.0, per_flute=1, rows=1), strain_max=0.9, levels=24)
+
+
+@pytest.fixture()
+def stubbed_solve(monkeypatch: pytest.MonkeyPatch, tiny_coupon: CouponResult) -> None:
+    """The coupon's solve replaced by a stub that reports each level 3 s after the last (on the reporter's clock)
+    and returns ``tiny_coupon``; a quiet machine (no load), so that the plan's estimate is the model's own."""
+    import click
+
+    import pneumorph.cli.progress as progress
+    import pneumorph.composite.coupon as coupon
+    from pneumorph.io.progress import Progress
+
+    now = [0.0]
+
+    def solve(spec: CouponSpec, strain_max: float | None = None, levels: int = 100, snapshots: tuple = (),
+              on_level: Any = None) -> CouponResult:
+        for k in range(levels):
+            now[0] += 3.0
+            on_level(k, 0.5 * (k + 1) / levels, 10.0 * k)
+        return tiny_coupon
+
+    monkeypatch.setattr(coupon, "simulate_coupon", solve)
+    monkeypatch.setattr(progress, "reporter", lambda: Progress(lambda line: click.echo(line, err=True), heartbeat=0,
+                                                               clock=lambda: now[0]))
+    monkeypatch.setattr("pneumorph.io.progress.os.getloadavg", lambda: (0.0, 0.0, 0.0))
+
+
+@pytest.mark.usefixtures("stubbed_solve")
+def test_coupon_says_its_plan_then_counts_its_levels(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """The default coupon of CR 0.25 (2,133 nodes, pulled to 2 s / lambda - 1 + 10 % = 51.4 %) is planned at
+    LEVEL_SECONDS x 2,133 = 0.16 s a level, 16 s for its 100 levels (measured: 15.5 s of CPU); then every level
+    is counted against the 100, and the files are announced."""
+    from pneumorph.composite.coupon import LEVEL_SECONDS
+
+    assert len(CouponSpec.from_ratio(0.25).mesh().points) == 2133
+    assert 100 * LEVEL_SECONDS * 2133 == pytest.approx(16.0, abs=0.01)
+    code, out, err = run(capsys, "composite", "coupon", "-c", "0.25", "--gauges", "0", "--out", str(tmp_path / "c"))
+    assert code == 0 and "transition, engineering strain" in out
+    lines = err.splitlines()
+    assert lines[0] == (f"coupon of CR 0.25 (2,133 nodes) pulled to 51.4 % strain: 100 levels, estimated 16 s "
+                        f"(0.2 s each, 1 worker) -> {tmp_path / 'c'}")
+    assert lines[1] == "  coupon: 1/100 after 3.0 s, 3.0 s each, about 5 min left; 0.5 % strain, 0 N/mm"
+    assert [line.split()[1] for line in lines[1:101]] == [f"{k}/100" for k in range(1, 101)]
+    assert lines[100] == "  coupon: 100/100 after 5 min, 3.0 s each; 50.0 % strain, 990 N/mm"
+    assert lines[101].startswith("writing the coupon's CSV, JSON and figures") and len(lines) == 102
+
+
+@pytest.mark.usefixtures("stubbed_solve")
+@pytest.mark.parametrize("more", [[], ["--json"]])
+def test_a_quiet_coupon_says_nothing_on_stderr(capsys: pytest.CaptureFixture[str], tmp_path: Path,
+                                               more: list[str]) -> None:
+    code, out, err = run(capsys, "composite", "coupon", "-c", "0.3", "--levels", "24", "--gauges", "0", "-q",
+                         "--out", str(tmp_path), *more)
+    assert code == 0 and err == ""
+    assert ("transition_engineering" if more else "transition, engineering strain") in out
+    assert len(list(tmp_path.iterdir())) == 5

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import sys
 from types import SimpleNamespace
 from typing import Any
@@ -11,6 +10,7 @@ import click
 
 from pneumorph.checks import MAX_GENERATIONS, MAX_POPULATION
 from pneumorph.cli.options import params as P
+from pneumorph.cli.options import targets as T
 from pneumorph.cli.options.execution import check_options, execution_options
 from pneumorph.cli.progress import RunLines, reporter
 
@@ -141,17 +141,6 @@ def design(config_file: str | None, **options: Any) -> None:
         sys.exit(130)
 
 
-def _target_changes(target: str) -> dict[str, Any]:
-    """The config's changes for ``--target``: a path from ``path:FILE`` (its points, read here), else the text."""
-    head, sep, rest = target.partition(":")
-    if sep and head.strip().lower() == "path":
-        from pneumorph.design.objectives.paths import read_path
-
-        route = read_path(rest.strip())
-        return {"objective": "path", "path": route.points}
-    return {"objective": target}
-
-
 def _check_inputs(o: Any) -> None:
     """The target, unit file and library checked as the options that gave them (before any setting is merged); the
     config's changes for the target kept as ``o.target_changes``."""
@@ -166,7 +155,7 @@ def _check_inputs(o: Any) -> None:
         from pneumorph.geometry.unit import UnitSpec
 
         with P.blame("--target"):  # along the built-in unit; checked again along the model's
-            o.target_changes = target = _target_changes(o.target)  # a path file read once, here
+            o.target_changes = target = T.target_changes(o.target)  # a path file read once, here
             make_objective(target["objective"], o.amplitude if o.amplitude is not None else DesignConfig.amplitude,
                            o.periods if o.periods is not None else DesignConfig.periods,
                            length=(o.units or DesignConfig.units) * UnitSpec.pitch, path=target.get("path"))
@@ -202,9 +191,10 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any
                 data["design"].pop(key, None)
             data["design"].update(target)
             config = DesignConfig.from_dict(data)
-    design.update(_stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods, o.units))
+    design.update(T.stage_changes(o.stages, bool(o.target or o.objective or o.point), o.amplitude, o.periods,
+                                  o.units))
     if o.clear is not None:
-        design["clear"] = _clear_option(o.clear, design["objective"] or config.objective)
+        design["clear"] = T.clear_option(o.clear, design["objective"] or config.objective)
     identified = None
     if o.model_file is not None:  # the identified model's settings over the config's
         from pneumorph.models.factory import read_model_file
@@ -357,80 +347,6 @@ def _print_mesh(result: Any) -> None:
                    + ("the winner holds" if ref["holds"] else f"{ref['refined_best']} is better there")
                    + (f"; could still overtake it: {', '.join(ref['could_overtake'])}"
                       if ref["could_overtake"] else ""))
-
-
-def _stage_changes(stages: tuple[str, ...], other_target: bool, amplitude: float | None, periods: float | None,
-                   units: int | None) -> dict[str, Any]:
-    """The config's changes for ``--stage`` options (none without them), each stage's target checked along the
-    built-in unit (and again along the model's)."""
-    if not stages:
-        return {}
-    if other_target:
-        raise click.UsageError("--stage gives the targets at each pressure: leave out --target, --objective and "
-                               "--point")
-    from pneumorph.design import DesignConfig
-
-    stage = tuple(_stage_option(text, amplitude, periods) for text in stages)
-    with P.blame("--stage"):
-        DesignConfig(objective="stages", stage=stage, units=units or DesignConfig.units)
-    return {"objective": "stages", "stage": stage}
-
-
-def _clear_option(text: str, objective: str) -> dict[str, Any]:
-    """``--clear KPA[:MM]`` as a ``[design.clear]`` table, checked for the contact goal ``objective``
-    (:func:`~pneumorph.design.objectives.contact.clearing`; the level of the ramp when the run starts).
-
-    >>> _clear_option("27:1.5", "grip"), _clear_option("27", "wrap")
-    ({'pressure_kpa': 27.0, 'clearance_mm': 1.5}, {'pressure_kpa': 27.0})
-    """
-    from pneumorph.design.objectives.contact import CONTACT_GOALS, clearing, contact_goal
-
-    parts = text.split(":")
-    try:
-        numbers = [float(v) for v in parts]
-    except ValueError:
-        numbers = []
-    if len(numbers) not in (1, 2) or not all(math.isfinite(v) for v in numbers):
-        raise click.BadParameter(f"{text!r} is not KPA[:MM] (e.g. 27:1, a clearance of 1 mm at 27 kPa)",
-                                 param_hint="'--clear'")
-    if objective not in CONTACT_GOALS:
-        raise click.BadParameter(f"applies to --objective {' or '.join(CONTACT_GOALS)}, not to {objective!r}",
-                                 param_hint="'--clear'")
-    table = {"pressure_kpa": numbers[0], **({"clearance_mm": numbers[1]} if len(numbers) == 2 else {})}
-    with P.blame("--clear"):
-        clearing(contact_goal(objective), table)
-    return table
-
-
-def _stage_option(text: str, amplitude: float | None, periods: float | None) -> dict[str, Any]:
-    """One ``--stage KPA:TARGET`` as a ``[[design.stage]]`` table (its values checked by the config).
-
-    >>> _stage_option("18:reach 60 40", None, None)
-    {'pressure_kpa': 18.0, 'objective': 'reach', 'point': (60.0, 40.0)}
-    >>> _stage_option("45: sin", 5.0, None)
-    {'pressure_kpa': 45.0, 'objective': 'sin', 'amplitude': 5.0}
-    """
-    kpa, sep, target = text.partition(":")
-    try:
-        pressure = float(kpa)
-    except ValueError:
-        pressure = float("nan")
-    if not sep or not target.strip() or not math.isfinite(pressure):
-        raise click.BadParameter(f"{text!r} is not KPA:TARGET (e.g. 18:sin or '45:reach 60 40')",
-                                 param_hint="'--stage'")
-    words = target.split()
-    if words[0].lower() == "reach":
-        try:
-            point = tuple(float(v) for v in words[1:])
-        except ValueError:
-            point = ()
-        if len(point) not in (2, 3):
-            raise click.BadParameter(f"{text!r}: reach needs the tip point X Y (or X Y Z) in mm, e.g. "
-                                     "'45:reach 60 40'", param_hint="'--stage'")
-        return {"pressure_kpa": pressure, "objective": "reach", "point": point}
-    stage: dict[str, Any] = {"pressure_kpa": pressure, "objective": target.strip()}
-    stage.update({k: v for k, v in (("amplitude", amplitude), ("periods", periods)) if v is not None})
-    return stage
 
 
 def _check_shape_options(objective: Any, amplitude: float | None, periods: float | None) -> None:

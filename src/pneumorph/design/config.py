@@ -39,7 +39,6 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +47,7 @@ from pneumorph.design.objectives.contact import clearing
 from pneumorph.design.objectives.targets import PRESETS, Objective, make_objective, staged_target
 from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.search.genetic import GAConfig
+from pneumorph.design.settings import address, curve_points, flag, integer, real, stage_tables, text, tip_point
 from pneumorph.errors import SearchConfigError, TargetExpressionError, UnknownObjectiveError
 from pneumorph.execution.evaluators import EXECUTORS, check_execution
 from pneumorph.geometry.unit import UnitSpec
@@ -58,15 +58,6 @@ SEARCHES = ("certified", "ga", "exhaustive")
 UNIT_SOURCES = frozenset({"unit", "unit_file", "library"})
 #: what ``robust`` ranks designs by (pneumorph.sensitivity.robust.STATISTICS)
 ROBUST = ("worst", "mean")
-
-# the settings' checks, raising the search's own error
-_integer = partial(checks.integer, error=SearchConfigError)
-_real = partial(checks.real, error=SearchConfigError)
-_flag = partial(checks.flag, error=SearchConfigError)
-_text = partial(checks.text, error=SearchConfigError)
-_pair = partial(checks.pair, error=SearchConfigError)
-_address = partial(checks.address, error=SearchConfigError)
-
 
 @dataclass(frozen=True)
 class DesignConfig:
@@ -120,28 +111,28 @@ class DesignConfig:
     model: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        _integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
-        _text(self.objective, "[design] objective")
-        _text(self.search, "[design] search", SEARCHES)
+        integer(self.units, "[design] units", 1, checks.MAX_UNITS, limit="MAX_UNITS")
+        text(self.objective, "[design] objective")
+        text(self.search, "[design] search", SEARCHES)
         if self.search == "exhaustive" and self.units > EXHAUSTIVE_MAX_UNITS:
             raise SearchConfigError(
                 f"the exhaustive search takes at most {EXHAUSTIVE_MAX_UNITS} units (2^{self.units} = "
                 f"{2 ** self.units:,} designs for {self.units}); use the certified search or the genetic algorithm")
-        _text(self.executor, "[execution] executor", EXECUTORS)
-        _integer(self.seed, "[design] seed", 0, 2**32 - 1)
-        _flag(self.certify, "[design] certify")
-        _flag(self.anchored, "[design] anchored")
-        object.__setattr__(self, "amplitude", _real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
+        text(self.executor, "[execution] executor", EXECUTORS)
+        integer(self.seed, "[design] seed", 0, 2**32 - 1)
+        flag(self.certify, "[design] certify")
+        flag(self.anchored, "[design] anchored")
+        object.__setattr__(self, "amplitude", real(self.amplitude, "[design] amplitude", 0.0, low_open=True,
                                                     unit="mm"))
-        object.__setattr__(self, "periods", _real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
-        object.__setattr__(self, "margin", _real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
-        object.__setattr__(self, "epsilon", _real(self.epsilon, "[design] epsilon", 0.0, 1e3))
-        object.__setattr__(self, "refine", _real(self.refine, "[design] refine", 0.0, 100.0, unit="mm"))
-        object.__setattr__(self, "tolerance", _real(self.tolerance, "[design] tolerance", 0.0, 1.0, unit="mm"))
+        object.__setattr__(self, "periods", real(self.periods, "[design] periods", 0.0, 1000.0, low_open=True))
+        object.__setattr__(self, "margin", real(self.margin, "[design] margin", 0.0, 1e3, low_open=True))
+        object.__setattr__(self, "epsilon", real(self.epsilon, "[design] epsilon", 0.0, 1e3))
+        object.__setattr__(self, "refine", real(self.refine, "[design] refine", 0.0, 100.0, unit="mm"))
+        object.__setattr__(self, "tolerance", real(self.tolerance, "[design] tolerance", 0.0, 1.0, unit="mm"))
         if self.robust_samples is not None:
-            _integer(self.robust_samples, "[design] robust_samples", 1, 10_000)
+            integer(self.robust_samples, "[design] robust_samples", 1, 10_000)
         if self.robust is not None:
-            _text(self.robust, "[design] robust", ROBUST)
+            text(self.robust, "[design] robust", ROBUST)
             if self.search != "certified" or self.tolerance == 0:
                 raise SearchConfigError("[design] robust ranks every design by the chain model under the mould "
                                         "tolerance: it needs search = \"certified\" and a tolerance > 0")
@@ -155,29 +146,29 @@ class DesignConfig:
                                         f"to the certified search, not to search = {self.search!r}; leave them out "
                                         "or set search = \"certified\"")
         if self.verify is not None:
-            _integer(self.verify, "[design] verify", 1, 1024)
+            integer(self.verify, "[design] verify", 1, 1024)
         if self.max_open is not None:
-            _integer(self.max_open, "[design] max_open", 1, 10**9)
+            integer(self.max_open, "[design] max_open", 1, 10**9)
         if self.workers is not None:
-            _integer(self.workers, "[execution] workers", 1, 1024)
+            integer(self.workers, "[execution] workers", 1, 1024)
         if self.scheduler is not None:
-            _address(self.scheduler, "[execution] scheduler")
+            address(self.scheduler, "[execution] scheduler")
         check_execution(self.executor, self.workers, self.scheduler,
                         ("[execution] executor", "[execution] workers", "[execution] scheduler"))
         for key in ("chain_table", "cache"):
             if getattr(self, key) is not None:
-                _text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")
+                text(getattr(self, key), f"[{'design' if key == 'chain_table' else 'execution'}] {key}")
         if not isinstance(self.model, dict):
             raise SearchConfigError(f"[model] must be a table, got {self.model!r}")
         if self.ga.seed != self.seed:
             object.__setattr__(self, "ga", replace(self.ga, seed=self.seed))
         if self.point is not None:
-            object.__setattr__(self, "point", _point(self.point, "[design] point"))
+            object.__setattr__(self, "point", tip_point(self.point, "[design] point"))
         if self.curve is not None:
-            object.__setattr__(self, "curve", _curve(self.curve, "[design] curve"))
+            object.__setattr__(self, "curve", curve_points(self.curve, "[design] curve"))
         if self.path is not None:
-            object.__setattr__(self, "path", _curve(self.path, "[design] path"))
-        object.__setattr__(self, "stage", _stages(self.objective, self.stage))
+            object.__setattr__(self, "path", curve_points(self.path, "[design] path"))
+        object.__setattr__(self, "stage", stage_tables(self.objective, self.stage))
         self._check_periods()
         unit = self.model.get("unit", {}) if isinstance(self.model.get("unit", {}), dict) else {}
         pitch = unit.get("pitch", UnitSpec.pitch)  # the inline unit's, else the built-in unit's
@@ -366,84 +357,6 @@ class DesignConfig:
         """Settings from a TOML file (a run folder's ``config.toml`` works too)."""
         data = read_toml(path, "design config", SearchConfigError)
         return cls.from_dict(data)
-
-
-#: the settings of one ``[[design.stage]]`` table, and those it must have
-STAGE_KEYS = ("pressure_kpa", "objective", "amplitude", "periods", "curve", "path", "point", "anchored", "weight")
-_STAGE_NEEDS = ("pressure_kpa", "objective")
-
-
-def _curve(points: Any, name: str) -> tuple[tuple[float, ...], ...]:
-    """A drawn curve's or a path's points as numbers (mm): all ``[x, y]`` or all ``[x, y, z]`` (in space), refusing
-    text and true/false."""
-    try:
-        if any(isinstance(v, (bool, str, bytes)) for xy in points for v in xy):
-            raise TypeError("text or true/false")
-        out = tuple(tuple(float(v) for v in xy) for xy in points)
-        if len({len(xy) for xy in out}) != 1 or len(out[0]) not in (2, 3):
-            raise ValueError("mixed or wrong point sizes")
-        return out
-    except (TypeError, ValueError, IndexError):
-        raise SearchConfigError(f"{name} must be a list of [x, y] (or all [x, y, z]) points in mm, got "
-                                f"{_short(points)}") from None
-
-
-def _short(value: Any, limit: int = 80) -> str:
-    """``repr(value)``, cut to ``limit`` characters (a long list of points in an error message)."""
-    text = repr(value)
-    return text if len(text) <= limit else text[:limit] + " ..."
-
-
-def _point(value: Any, name: str) -> tuple[float, ...]:
-    """A tip point: ``[x, y]``, or ``[x, y, z]`` off the plane of bending (mm).
-
-    >>> _point([60, 40, -10], "[design] point")
-    (60.0, 40.0, -10.0)
-    """
-    if isinstance(value, (list, tuple)) and len(value) == 3:
-        return (*_pair(value[:2], name, unit="mm"), checks.real(value[2], name, unit="mm", error=SearchConfigError))
-    return _pair(value, name, unit="mm")
-
-
-def _stages(objective: str, stages: Any) -> tuple[dict[str, Any], ...] | None:
-    """The ``[[design.stage]]`` tables checked (types and ranges; the targets when the objective is made)."""
-    staged = objective.strip().lower() == "stages"
-    if stages is None:
-        if staged:
-            raise SearchConfigError("objective = \"stages\" needs its stages: [[design.stage]] tables with "
-                                    "pressure_kpa and objective (or --stage KPA:TARGET)")
-        return None
-    if not staged:
-        raise SearchConfigError(f"[[design.stage]] only applies to objective = \"stages\", not to {objective!r}")
-    if isinstance(stages, dict) or not isinstance(stages, (list, tuple)):
-        raise SearchConfigError(f"[[design.stage]] must be a list of tables, got {stages!r}")
-    out = []
-    for i, stage in enumerate(stages, 1):
-        where = f"[[design.stage]] {i}"
-        if not isinstance(stage, dict):
-            raise SearchConfigError(f"{where} must be a table of settings, got {stage!r}")
-        for key in set(stage) - set(STAGE_KEYS):
-            raise SearchConfigError(f"unknown key {key!r} in {where}; known keys: {', '.join(STAGE_KEYS)}")
-        for key in _STAGE_NEEDS:
-            if key not in stage:
-                raise SearchConfigError(f"{where} needs {key}")
-        s = dict(stage)
-        s["pressure_kpa"] = _real(s["pressure_kpa"], f"{where} pressure_kpa", 0.0, 1000.0, low_open=True, unit="kPa")
-        _text(s["objective"], f"{where} objective")
-        if s["objective"].strip().lower() == "stages":
-            raise SearchConfigError(f"{where} objective: a stage cannot hold stages")
-        for key, low, high in (("amplitude", 0.0, 1e5), ("periods", 0.0, 1000.0), ("weight", 0.0, 1e6)):
-            if key in s:
-                s[key] = _real(s[key], f"{where} {key}", low, high, low_open=True)
-        if "anchored" in s:
-            _flag(s["anchored"], f"{where} anchored")
-        if "point" in s:
-            s["point"] = _point(s["point"], f"{where} point")
-        for key in ("curve", "path"):
-            if key in s:
-                s[key] = _curve(s[key], f"{where} {key}")
-        out.append(s)
-    return tuple(out)
 
 
 # -- a small TOML writer (tables of scalars, lists and one level of sub-tables) -----------

@@ -97,13 +97,16 @@ def transition(crimp_ratio: float | None, wavelength: float | None, amplitude: f
 @click.option("--out", type=P.OutputDir(), default=None,
               help="Folder for the curve (CSV), summary (JSON) and figures (PNG).")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress lines.")
 def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float, length: float, thickness: float,
            per_flute: int, rows: int, levels: int, strain_max: float | None, bulk_modulus: float | None,
-           gauges: int | None, seed: int, snapshot: float | None, out: Path | None, as_json: bool) -> None:
+           gauges: int | None, seed: int, snapshot: float | None, out: Path | None, as_json: bool,
+           quiet: bool) -> None:
     """Plane-strain FE tensile test of a crimped composite coupon (section 3.2.3)."""
     from pneumorph.cli.progress import reporter
     from pneumorph.composite.coupon import CouponSpec, simulate_coupon
     from pneumorph.io.files import strict_json
+    from pneumorph.io.progress import Progress
 
     c = _crimp(crimp_ratio, wavelength, amplitude, length)
     final = strain_max if strain_max is not None else c.limit_transition_strain + 0.10
@@ -113,10 +116,16 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
     spec = CouponSpec(crimp=c, thickness=thickness, per_flute=per_flute, rows=rows,
                       bulk_modulus=None if bulk_modulus is None else bulk_modulus / 1000.0)
     snaps = () if snapshot is None else (snapshot,)
-    result = simulate_coupon(spec, strain_max=strain_max, levels=levels, snapshots=snaps)
-    summary = summarise(result, gauges, seed)
-    if out is not None:
-        write_outputs(result, summary, Path(out), snapshot, say=reporter())
+    lines = Progress(lambda text: None, heartbeat=0) if quiet else reporter()
+    with lines:  # the plan, each level as it converges, and the heartbeat through the gauges and the figures
+        lines.plan("coupon", levels, each=spec.level_seconds(), noun="levels", where=None if out is None else str(out),
+                   title=f"coupon of CR {c.crimp_ratio:.4g} ({len(spec.mesh().points):,} nodes) pulled to "
+                         f"{100 * final:.1f} % strain")
+        result = simulate_coupon(spec, strain_max=strain_max, levels=levels, snapshots=snaps,
+                                 on_level=lambda k, e, f: lines.count(k + 1, f"{100 * e:.1f} % strain, {f:.4g} N/mm"))
+        summary = summarise(result, gauges, seed)
+        if out is not None:
+            write_outputs(result, summary, Path(out), snapshot, say=lines)
     if as_json:
         click.echo(strict_json(summary, indent=2))
         return
