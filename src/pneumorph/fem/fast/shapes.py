@@ -8,7 +8,6 @@ The penalty that holds a body's surface out of them is :mod:`~pneumorph.fem.fast
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -136,8 +135,8 @@ def obstacle_from_dict(table: Mapping[str, Any], dim: int, where: str = "obstacl
     ------
     SettingsError
         An unknown kind or key, a point of the wrong size or not finite, a zero normal or
-        axis, a radius <= 0, a friction < 0 (the table's ``friction`` is checked here and kept by the
-        caller: the geometry does not hold it).
+        axis, a radius <= 0, a friction < 0 or above :data:`~pneumorph.checks.MAX_FRICTION` (the table's
+        ``friction`` is checked here and kept by the caller: the geometry does not hold it).
 
     Examples
     --------
@@ -158,10 +157,7 @@ def obstacle_from_dict(table: Mapping[str, Any], dim: int, where: str = "obstacl
     unknown = sorted(set(table) - set(allowed))
     if unknown:
         raise SettingsError(f"{where}: unknown key(s) {', '.join(unknown)} of a {kind}; known: {', '.join(allowed)}")
-    friction = table.get("friction", 0.0)
-    if not (isinstance(friction, (int, float)) and not isinstance(friction, bool) and math.isfinite(friction)
-            and friction >= 0.0):
-        raise SettingsError(f"{where} friction must be a finite number >= 0, got {friction!r}")
+    checks.real(table.get("friction", 0.0), f"{where} friction", 0.0, checks.MAX_FRICTION, limit="MAX_FRICTION")
     missing = [k for k in keys[kind] if k not in table and not (k == "axis" and dim == 2)]
     if missing:
         raise SettingsError(f"{where}: a {kind} needs {', '.join(missing)}")

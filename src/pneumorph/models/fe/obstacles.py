@@ -69,7 +69,7 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
     ------
     SettingsError
         A table that is no valid obstacle (:func:`~pneumorph.fem.fast.shapes.obstacle_from_dict`), an
-        unknown ``on``, or a ``friction`` above :data:`~pneumorph.checks.MAX_FRICTION`.
+        unknown ``on``, or a ``friction`` outside 0 to :data:`~pneumorph.checks.MAX_FRICTION`.
 
     Examples
     --------
@@ -83,7 +83,7 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
     ... # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    pneumorph.errors.SettingsError: [[model.obstacle]] 1 friction must be ... <= 10 (limit MAX_FRICTION), got 20.0
+    pneumorph.errors.SettingsError: [[model.obstacle]] 1 friction must be ... <= 10 (limit MAX_FRICTION), got 20
     """
     if obstacles is None:
         return ()
@@ -92,8 +92,9 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
     out = []
     for i, entry in enumerate(obstacles):
         name = f"{where} {i + 1}"
-        if isinstance(entry, ModelObstacle):
+        if isinstance(entry, ModelObstacle):  # (a table's friction is checked with its geometry)
             item = entry
+            checks.real(item.friction, f"{name} friction", 0.0, checks.MAX_FRICTION, limit="MAX_FRICTION")
         elif isinstance(entry, Mapping):
             on = entry.get("on", "surface")
             if on not in TOUCHES:
@@ -102,7 +103,6 @@ def check_obstacles(obstacles: Sequence[Any] | None, dim: int,
             item = ModelObstacle(obstacle, on, float(entry.get("friction", 0.0)))
         else:
             raise SettingsError(f"{name} must be a table (kind, and its geometry), got {entry!r}")
-        checks.real(item.friction, f"{name} friction", 0.0, checks.MAX_FRICTION, limit="MAX_FRICTION")
         out.append(item)
     return tuple(out)
 
