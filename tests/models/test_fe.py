@@ -190,12 +190,12 @@ def test_3d_fingerprint_holds_the_result_determining_ramp_settings_only() -> Non
 
 
 def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyPatch) -> None:
-    import pneumorph.models.fe.base as febase
+    import pneumorph.models.fe.solving as fesolving
     from pneumorph.execution.outcome import solve
 
     ramp = RampSpec(pressure=0.01)  # 10 levels
     full = Reduced2D(2, ramp_spec=ramp).evaluate("01")
-    real = febase.ramp  # FEModel.solve's ramp
+    real = fesolving.ramp  # FEModel.solve's ramp
 
     def failing(*args, on_level=None, **kwargs):  # the real ramp, stopped after its third level
         def level(k, t):
@@ -205,7 +205,7 @@ def test_a_failed_ramp_keeps_the_levels_it_converged(monkeypatch: pytest.MonkeyP
 
         return real(*args, on_level=level, **kwargs)
 
-    monkeypatch.setattr(febase, "ramp", failing)
+    monkeypatch.setattr(fesolving, "ramp", failing)
     outcome = solve(Reduced2D(2, ramp_spec=ramp), "01")
     partial = outcome.response
     assert not outcome.ok and outcome.failure == "stopped by the test" and outcome.reached == pytest.approx(0.003)

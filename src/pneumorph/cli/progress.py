@@ -54,7 +54,7 @@ def plan_solves(lines: Progress, what: str, total: int, model: Any, executor: st
 def solve_levels(model: Any, design: str, what: str, title: str, where: str | None = None) -> Any:
     """Solve ``design`` on ``model``, saying the plan (its levels, estimated by its fidelity's measured solve time
     and, for a volume-controlled ramp, its measured cost) and counting each level as it converges; the
-    :class:`~pneumorph.models.fe.base.Solution`."""
+    :class:`~pneumorph.models.fe.solving.Solution`."""
     from pneumorph.models.chain.plan import model_seconds, ramp_note
 
     each, levels = model_seconds(model, len(design)), len(model.pressures())

@@ -11,7 +11,8 @@ linear grid is then made quadratic (quad8 in 2D, hex20 in 3D) so that all materi
 one set of points.
 
 The result is plain data (:class:`ActuatorMesh`): the model builders turn it into FElupe
-regions and fields.
+regions and fields. Its named point sets (cavity walls, tracked vertices, clamped points, end
+face) are found by :mod:`pneumorph.geometry.nodesets`.
 """
 
 from __future__ import annotations
@@ -26,9 +27,11 @@ from numpy.typing import NDArray
 
 from pneumorph.errors import GeometryError
 from pneumorph.geometry.alphabet import Design, library_design
-from pneumorph.geometry.features import BaseBlock, Box, check_passage
+from pneumorph.geometry.features import BaseBlock, check_passage
 from pneumorph.geometry.grid import grid_lines, section_breaks, width_breaks
 from pneumorph.geometry.library import UnitLibrary
+from pneumorph.geometry.nodesets import cavity_box as cavity_box
+from pneumorph.geometry.nodesets import cavity_points, clamped_points, end_face_points, tracked_points
 from pneumorph.geometry.unit import UnitSpec
 
 IntArray = NDArray[np.int64]
@@ -39,8 +42,6 @@ BODY, LAYER, CAVITY, SLIT, BASE, VOID = 0, 1, 2, 3, 4, 5
 #: The bottom walls of another material (:attr:`UnitSpec.bottom_material`): ``BOTTOM + i`` for
 #: the i-th of :func:`bottom_materials`, in region ``"bottom:<material>"``.
 BOTTOM = 6
-#: How near a point must lie to a cavity's wall or vertex to be on it (mm).
-_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -293,9 +294,9 @@ def assemble(spec: UnitSpec | UnitLibrary, orientation: str | Design | Iterable[
     return ActuatorMesh(
         points=points, cells=np.asarray(mesh.cells, dtype=np.int64), cell_type=mesh.cell_type,
         regions=_regions(label, dim, base, bottoms),
-        cavity_points=_cavity_points(points, ref, units, orientation, starts, dim, side),
-        tracked=_tracked(points, ref, units, orientation, starts, dim),
-        end_points=_end_points(points, ref, starts, dim), base_points=_clamped(points, ref.height, base),
+        cavity_points=cavity_points(points, ref, units, orientation, starts, dim, side),
+        tracked=tracked_points(points, ref, units, orientation, starts, dim),
+        end_points=end_face_points(points, ref, starts, dim), base_points=clamped_points(points, ref.height, base),
         orientation=orientation, spec=ref, units=units, design=design.text,
         symmetry_points=np.isclose(points[:, 2], ref.width / 2) if (dim == 3 and half) else None,
     )
@@ -405,95 +406,6 @@ def _regions(label: IntArray, dim: int, base: BaseBlock | None, bottoms: Sequenc
         regions["base"] = np.flatnonzero(label == BASE)
     return regions
 
-
-def cavity_box(unit: UnitSpec, o: str, start: float, H: float) -> Box:
-    """A unit's cavity ``(x0, x1, y0, y1, z0, z1)`` in the actuator's frame (mm): starting at ``start``, in
-    orientation ``o``, in a section of height ``H``; turned over it is mirrored (a sideways unit across the
-    width too).
-
-    >>> cavity_box(UnitSpec(), "1", 10.5, 12.0)
-    (13.5, 18.0, 4.5, 10.5, 1.5, 13.5)
-    """
-    x0, x1, y0, y1 = unit.cavity
-    z0, z1 = unit.cavity_z
-    if o == "1":
-        y0, y1 = H - y1, H - y0
-        z0, z1 = (unit.width - z1, unit.width - z0) if unit.layer_side else (z0, z1)
-    return start + x0, start + x1, y0, y1, z0, z1
-
-
-def _cavity_points(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orientation: str,
-                   starts: FloatArray, dim: int, side: float) -> BoolArray:
-    """The points on the cavity walls (in 2D inside the filler too) and on the passages' walls.
-
-    ``ref`` is the unit whose cross-section all share; a solid unit has no cavity; a
-    passage of side ``side`` joins cavity i to cavity i + 1.
-    """
-    H, W = ref.height, ref.width
-    cavity_points = np.zeros(len(points), dtype=bool)
-    for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
-        if unit.solid:
-            continue
-        x0, x1, cy0, cy1, z0, z1 = cavity_box(unit, o, float(starts[i]), H)
-        inside = (
-            (points[:, 0] > x0 - _TOL)
-            & (points[:, 0] < x1 + _TOL)
-            & (points[:, 1] > cy0 - _TOL)
-            & (points[:, 1] < cy1 + _TOL)
-        )
-        if dim == 3:
-            inside &= (points[:, 2] > z0 - _TOL) & (points[:, 2] < z1 + _TOL)
-        cavity_points |= inside
-    if side:  # the passages' walls are loaded by the pressure too
-        for i in range(len(units) - 1):
-            inside = ((points[:, 0] > float(starts[i]) + units[i].cavity[1] - _TOL)
-                      & (points[:, 0] < float(starts[i + 1]) + units[i + 1].cavity[0] + _TOL)
-                      & (np.abs(points[:, 1] - H / 2) < side / 2 + _TOL))
-            if dim == 3:
-                inside &= np.abs(points[:, 2] - W / 2) < side / 2 + _TOL
-            cavity_points |= inside
-    return cavity_points
-
-
-def _tracked(points: FloatArray, ref: UnitSpec, units: Sequence[UnitSpec], orientation: str, starts: FloatArray,
-             dim: int) -> IntArray:
-    """Per unit, the points at its cavity's four vertices (a solid unit's box too; mid-width of ``ref`` in 3D).
-
-    Raises
-    ------
-    GeometryError
-        A vertex without a mesh point (never: the grid has these lines).
-    """
-    H, W = ref.height, ref.width
-    tracked = np.zeros((len(units), 4), dtype=np.int64)
-    for i, (unit, o) in enumerate(zip(units, orientation, strict=True)):
-        x0, x1, cy0, cy1, _, _ = cavity_box(unit, o, float(starts[i]), H)
-        corners = [(x0, cy0), (x1, cy0), (x1, cy1), (x0, cy1)]
-        for k, (cx, cy) in enumerate(corners):
-            d = (points[:, 0] - cx) ** 2 + (points[:, 1] - cy) ** 2
-            if dim == 3:
-                d = d + (points[:, 2] - W / 2) ** 2
-            tracked[i, k] = int(np.argmin(d))
-            if d[tracked[i, k]] > _TOL**2:  # pragma: no cover - the grid has these lines
-                raise GeometryError(f"no mesh point at cavity vertex {k} of unit {i}")
-    return tracked
-
-
-def _clamped(points: FloatArray, height: float, base: BaseBlock | None) -> BoolArray:
-    """The clamped points: the base face x = 0, or the jaws on the base block's bottom and top faces."""
-    if base is None:
-        return np.isclose(points[:, 0], 0.0)
-    jaws = np.isclose(points[:, 1], -base.margin) | np.isclose(points[:, 1], height + base.margin)
-    return jaws & (points[:, 0] < _TOL)
-
-
-def _end_points(points: FloatArray, ref: UnitSpec, starts: FloatArray, dim: int) -> IntArray:
-    """The points of the free end face (after ``ref``'s end cap) in the section plane, ordered by height."""
-    on_end = np.isclose(points[:, 0], float(starts[-1]) + ref.end_cap)
-    if dim == 3:
-        on_end &= np.isclose(points[:, 2], ref.width / 2)
-    end_points = np.flatnonzero(on_end)
-    return end_points[np.argsort(points[end_points, 1])]
 
 __all__ = ["BASE", "BODY", "BOTTOM", "CAVITY", "LAYER", "SLIT", "VOID", "ActuatorMesh", "assemble", "bottom_materials",
            "cavity_box", "grid_lines", "unit_starts"]

@@ -9,8 +9,9 @@ Each concept has a module of its own; the names most used (``ChainModel``, ``Cha
 - :mod:`~pneumorph.models.chain.windows`, :mod:`~pneumorph.models.chain.terms`,
   :mod:`~pneumorph.models.chain.space`: a design's windows, far-field terms, chords in space;
 - :mod:`~pneumorph.models.chain.fit`, :mod:`~pneumorph.models.chain.means`,
-  :mod:`~pneumorph.models.chain.training`, :mod:`~pneumorph.models.chain.validation`: the
-  fit of a table from FE solves and its held-out check;
+  :mod:`~pneumorph.models.chain.reference`, :mod:`~pneumorph.models.chain.training`,
+  :mod:`~pneumorph.models.chain.validation`: the fit of a table from FE solves (its turns and
+  lengths, its undeformed geometry) and its held-out check;
 - :mod:`~pneumorph.models.chain.plan`, :mod:`~pneumorph.models.chain.sources`: what a build
   will cost, and where a table comes from (shipped, a user's folder, a new build).
 

@@ -24,6 +24,8 @@ from pneumorph.io.provenance import provenance
 from pneumorph.models.chain.levels import first_levels, levels_reached, ramp_source
 from pneumorph.models.chain.means import check_training, window_means
 from pneumorph.models.chain.model import ChainTable, source_description, source_key, training_model
+from pneumorph.models.chain.reference import binary_geometry, library_geometry
+from pneumorph.models.chain.reference import first_symbols as first_symbols
 from pneumorph.models.chain.terms import check_far_training, far_means, fit_text
 from pneumorph.models.chain.training import MAX_TRAINING, check_training_size, training_designs
 from pneumorph.models.chain.validation import (
@@ -34,10 +36,6 @@ from pneumorph.models.chain.validation import (
     prediction_errors,
     stop_note,
     validate_in_rounds,
-)
-from pneumorph.models.chain.windows import (
-    design_array,
-    design_strings,
 )
 from pneumorph.models.response import Response, response_elements
 
@@ -90,85 +88,9 @@ def fit_table(responses: Sequence[Response], window: int, source: dict[str, Any]
                   **({"centre_z": float(longest.reference_centres[0, 2])} if "space" in means else {}))
     if alphabet:
         assert library is not None
-        return _fit_geometry(responses, alphabet, library, mirror, ChainTable(
+        return library_geometry(responses, alphabet, library, mirror, ChainTable(
             **fitted, pitch=0.0, centre_y=(0.0, 0.0), first_offset=0.0, tip_ref=(0.0, 0.0)))
-    return ChainTable(**fitted, **_binary_geometry(responses, longest, mirror))
-
-
-def _binary_geometry(responses: Sequence[Response], longest: Response, mirror: bool) -> dict[str, Any]:
-    """The undeformed geometry of a 0/1 table: pitch, both orientations' centre heights, first centre, tip.
-
-    Raises
-    ------
-    ChainTableError
-        Training designs without both orientations at fixed heights, or unevenly spaced units.
-    """
-    xs = longest.reference_centres[:, 0]
-    pitch = float(np.mean(np.diff(xs)))
-    tip_y = float(longest.reference_tip[1])
-    heights: dict[int, list[float]] = {0: [], 1: []}
-    for r in responses:
-        for o, y in zip(r.orientation, r.reference_centres[:, 1], strict=False):
-            heights[int(o)].append(float(y))
-            if mirror:
-                heights[1 - int(o)].append(2 * tip_y - float(y))
-    if not heights[0] or not heights[1] or max(np.ptp(heights[0]), np.ptp(heights[1])) > 1e-9:
-        raise ChainTableError("the training designs do not show both unit orientations at fixed heights")
-    if not np.allclose(np.diff(xs), pitch, atol=1e-9):
-        raise ChainTableError("the training actuator's unit centres are not evenly spaced; a chain table "
-                              "needs identical units")
-    return {"pitch": pitch, "centre_y": (heights[0][0], heights[1][0]), "first_offset": float(xs[0]),
-            "tip_ref": (float(longest.reference_tip[0] - xs[-1]), tip_y)}
-
-
-def _fit_geometry(responses: Sequence[Response], alphabet: tuple[str, ...], library: UnitLibrary, mirror: bool,
-                  table: ChainTable) -> ChainTable:
-    """The undeformed geometry of a table over several unit types, checked against the training actuators."""
-    k = len(alphabet)
-    pitch = tuple(float(library[a].pitch) for a in alphabet)
-    offset = tuple(float(sum(library[a].cavity[:2]) / 2) for a in alphabet)  # the tracked cavity's middle
-    tip_y = float(responses[0].reference_tip[1])
-    heights: dict[int, list[float]] = {c: [] for c in range(2 * k)}
-    symmetric = set(library.symmetric_types)
-    for r in responses:
-        codes = design_array(r.orientation, alphabet=alphabet)[0]
-        for c, y in zip(codes, r.reference_centres[:, 1], strict=True):
-            heights[int(c)].append(float(y))
-            if mirror:
-                heights[int(c) ^ 1].append(2 * tip_y - float(y))
-            if int(c) // 2 in symmetric:  # turned over, the same body: its centre where it was
-                heights[int(c) ^ 1].append(float(y))
-    missing = [design_strings(np.array([[c]], dtype=np.uint8), alphabet)[0] for c, ys in heights.items() if not ys]
-    if missing:
-        raise ChainTableError(f"the training designs do not show the unit(s) {', '.join(missing)}; every type and "
-                              "orientation must occur")
-    if max(np.ptp(ys) for ys in heights.values()) > 1e-9:
-        raise ChainTableError("the training designs show a unit type's centre at different heights")
-    first = responses[0]
-    cap = float(first.reference_tip[0]) - float(np.sum([library[a].pitch for a in
-                                                         first_symbols(first.orientation, alphabet)]))
-    geometry = {"type_pitch": pitch, "type_offset": offset,
-                "type_centre_y": tuple(heights[c][0] for c in range(2 * k))}
-    fitted = ChainTable(**{**table.__dict__, "alphabet": alphabet, **geometry, "pitch": pitch[0],
-                           "symmetric": library.symmetric,
-                           "centre_y": (heights[0][0], heights[1][0]), "first_offset": offset[0],
-                           "tip_ref": (cap + pitch[0] - offset[0], tip_y)})
-    for r in responses:
-        centres, tip = fitted.reference(fitted.designs(r.orientation))
-        if not (np.allclose(centres[0], r.reference_centres, atol=1e-9, rtol=0)
-                and np.allclose(tip[0], r.reference_tip, atol=1e-9, rtol=0)):
-            raise ChainTableError(f"the undeformed centres of training design {r.orientation} are not where the "
-                                  "library's units put them (pitch, cavity middle); a table of another library?")
-    return fitted
-
-
-def first_symbols(design: str, alphabet: Sequence[str]) -> str:
-    """The type symbol of every unit of a design over ``alphabet`` (lower case; digits: the first type).
-
-    >>> first_symbols("aE1", ("a", "e"))
-    'aea'
-    """
-    return "".join(alphabet[int(c) // 2] for c in design_array(design, alphabet=alphabet)[0])
+    return ChainTable(**fitted, **binary_geometry(responses, longest, mirror))
 
 
 def _solver(model: Any, evaluator: Any, solved: dict[str, Response], reached: dict[str, int],

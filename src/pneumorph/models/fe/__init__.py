@@ -2,8 +2,9 @@
 
 The public import place of the FE models; each concept has a module of its own:
 
-- :mod:`pneumorph.models.fe.base`: the common machinery (:class:`FEModel`) and the solved
-  fields (:class:`Solution`); :mod:`pneumorph.models.fe.ramp`: the pressure ramp
+- :mod:`pneumorph.models.fe.base`: the common machinery (:class:`FEModel`);
+  :mod:`pneumorph.models.fe.solving`: one design's ramp solved, its levels recorded and the
+  solved fields kept (:class:`Solution`); :mod:`pneumorph.models.fe.ramp`: the pressure ramp
   (:class:`RampSpec`); :mod:`pneumorph.models.fe.volumetric`: how the silicones' volumetric
   term is integrated (the u-p-J form for a nearly incompressible one);
 - :mod:`pneumorph.models.fe.reduced2d`: :class:`Reduced2D`, the plane-strain section whose
@@ -30,9 +31,6 @@ from pneumorph.models.fe.base import (
     FEModel as FEModel,
 )
 from pneumorph.models.fe.base import (
-    Solution as Solution,
-)
-from pneumorph.models.fe.base import (
     model_library as model_library,
 )
 from pneumorph.models.fe.full3d import (
@@ -43,6 +41,9 @@ from pneumorph.models.fe.ramp import (
 )
 from pneumorph.models.fe.reduced2d import (
     Reduced2D as Reduced2D,
+)
+from pneumorph.models.fe.solving import (
+    Solution as Solution,
 )
 
 # the public place of these names is :mod:`pneumorph.models` (its reference page); here they are

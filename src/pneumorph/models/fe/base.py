@@ -1,7 +1,8 @@
 """The finite-element actuator models' common machinery on FElupe: :class:`FEModel`.
 
 A model takes a unit (or a unit library), an orientation vector and a pressure ramp (:class:`RampSpec`) and returns
-a :class:`~pneumorph.models.response.Response`; a :class:`Solution` keeps the displacement fields besides. Silicones
+a :class:`~pneumorph.models.response.Response`; a :class:`Solution` keeps the displacement fields besides (the solve
+itself: :mod:`pneumorph.models.fe.solving`). Silicones
 use the dissertation's compressible Ogden model (Eq 2.12, Tables A.4, A.5) through the hand-coded kernel
 :class:`pneumorph.fem.OgdenCompressible`; the base face is clamped and a follower pressure acts on the cavity walls.
 Optionally gravity acts on the silicones (their densities): it is applied in full first, then the pressure is ramped
@@ -13,16 +14,13 @@ place.
 from __future__ import annotations
 
 import copy
-import time
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict
 from typing import Any
 
-import numpy as np
-
-from pneumorph import __version__, checks
-from pneumorph.errors import MaterialDataError, SettingsError, SimulationFailed
-from pneumorph.fem import OgdenCompressible, RampStatistics, StepSettings, ramp
+from pneumorph import checks
+from pneumorph.errors import MaterialDataError, SettingsError
+from pneumorph.fem import OgdenCompressible, StepSettings
 from pneumorph.fem.body import QUADRATURES, PressurisedBody, check_backend, pressurised_body, quadrature_scheme
 from pneumorph.fem.fibre import CAST_PAPER
 from pneumorph.geometry.alphabet import Design, parse_design
@@ -35,11 +33,12 @@ from pneumorph.materials import get
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.library.material import Material
 from pneumorph.models.fe.gravity import gravity_vector
-from pneumorph.models.fe.obstacles import ContactRecord, check_obstacles, contact_items
-from pneumorph.models.fe.ramp import RampSpec, past_the_maximum
-from pneumorph.models.fe.stages import before_the_ramp
+from pneumorph.models.fe.obstacles import check_obstacles, contact_items
+from pneumorph.models.fe.ramp import RampSpec
+from pneumorph.models.fe.solving import Solution as Solution
+from pneumorph.models.fe.solving import end_face_angle as end_face_angle
+from pneumorph.models.fe.solving import solve_design
 from pneumorph.models.fe.volumetric import FORMULATIONS, element_volume
-from pneumorph.models.frames import record_frames
 from pneumorph.models.response import FloatArray, Response
 
 #: The cells of a model's meshes by dimension and element order (:attr:`UnitSpec.element_order`).
@@ -47,31 +46,6 @@ CELL_TYPES = {(2, 1): "quad", (2, 2): "quad8", (3, 1): "hexahedron", (3, 2): "he
 
 #: Bumped whenever a change to the model changes its results (it is part of the fingerprint).
 MODEL_REVISION = 1
-
-
-@dataclass(frozen=True)
-class Solution:
-    """A solved design with its full fields, for figures and VTK files.
-
-    Attributes
-    ----------
-    response : Response
-        What the search sees.
-    mesh : ActuatorMesh
-        The meshed actuator.
-    displacements : ndarray, shape (k, p, dim)
-        Nodal displacements at every reported level (NaN after a failure).
-    """
-
-    response: Response
-    mesh: ActuatorMesh
-    displacements: FloatArray
-
-
-def end_face_angle(x: FloatArray) -> float:
-    """Angle (rad) of the end face, from its lowest to its highest point, against +y."""
-    d = x[-1] - x[0]
-    return float(np.arctan2(-d[0], d[1]))
 
 
 def model_library(unit: UnitSpec | None, library: UnitLibrary | None) -> UnitLibrary:
@@ -393,108 +367,8 @@ class FEModel:
     def solve(self, orientation: str | Design, on_level: Any = None) -> Solution:
         """Solve the pressure ramp of one design, keeping the displacement fields.
 
-        Parameters
-        ----------
-        orientation : str or Design
-            The design, one digit per unit (``"0101..."``), or over the model's library
-            (``"aAer..."``, :mod:`pneumorph.geometry.alphabet`); the response keeps its
-            canonical text (0/1 digits for a one-type library).
-        on_level : callable, optional
-            ``on_level(k, pressure_mpa)`` after each reported level (progress).
-
-        Raises
-        ------
-        SimulationFailed
-            If the ramp cannot be completed; ``reached`` and ``pressure`` name how far it got.
-        OrientationError
-            A design of the wrong length or with symbols the library does not have.
+        :func:`~pneumorph.models.fe.solving.solve_design` on this model: see there for the
+        parameters and errors (:class:`~pneumorph.errors.SimulationFailed` when the ramp cannot
+        be completed).
         """
-        parsed = self.parse(orientation)
-        design = parsed.text
-        t0 = time.perf_counter()
-        mesh, body, set_pressure = self.build(parsed if self.mixed else design)
-        pressures = self.pressures()
-        axes = mesh.axes  # (x, y), or (x, y, z) on the full width
-        x_end0 = mesh.points[mesh.end_points][:, :axes]
-        response = self.empty_response(mesh, design)
-        angle0 = end_face_angle(x_end0[:, :2])
-        turned = {"total": 0.0, "last": angle0}  # end-face rotation, followed substep by substep
-        displacements = np.full((len(pressures), *mesh.points.shape), np.nan)
-
-        def apply(t: float) -> None:
-            set_pressure(t * self.ramp.pressure)
-
-        def follow(t: float) -> None:
-            angle = end_face_angle(x_end0[:, :2] + body.displacement[:, :2][mesh.end_points])
-            step = (angle - turned["last"] + np.pi) % (2 * np.pi) - np.pi
-            turned["total"] += step
-            turned["last"] = angle
-            for item in body.contacts:  # friction's anchors: the converged state's
-                item.commit(mesh.points + body.displacement)
-
-        def tip_of(v: FloatArray) -> FloatArray:
-            return (x_end0 + v[mesh.end_points][:, :axes]).mean(axis=0)
-
-        def record(k: int, t: float) -> None:
-            displacements[k] = body.displacement[:, : self.dim]
-            response.centres[k] = mesh.unit_centres(displacements[k], axes)
-            record_frames(response, k, mesh, displacements[k])  # the full width: each unit's and the end face's
-            response.tip[k] = tip_of(displacements[k])
-            response.curl[k] = np.degrees(turned["total"])
-            if control is not None:
-                pressures[k] = response.pressures[k] = control.factor * self.ramp.pressure
-            if contact is not None:  # the obstacles' forces, the base reaction
-                contact.record(k, pressures[k], substep.system, displacements[k])
-                response.metadata["contact"] = contact.metadata()
-            if on_level is not None:
-                on_level(k, pressures[k])
-
-        substep, monitor = body.stepper(self.backend, self.tangent_reuse, self.anderson_depth)
-        contact = ContactRecord(self.obstacles, mesh, body.contacts, mesh.symmetry_points is not None) \
-            if self.obstacles else None
-        apply, substep, control, gravity_iterations = before_the_ramp(self, body, substep, follow, design,
-                                                                      response.metadata, tip_of, apply)
-        try:
-            stats = ramp(body.items, body.field, apply, body.dof1, body.dof0, self.ramp.steps, on_level=record,
-                         monitor=monitor if control is None else None, on_substep=follow, substep=substep,
-                         predictor_order=self.predictor_order_for(design),
-                         carry=self.carry_step)
-        except SimulationFailed as exc:
-            reached = exc.reached if control is None else control.factor
-            cause = exc.cause if control is not None else past_the_maximum(exc)
-            partial = replace(response, converged=False, reached=reached * self.ramp.pressure, failure=cause)
-            raise SimulationFailed(
-                reached=exc.reached, cause=cause, design=design, pressure=self.ramp.pressure, partial=partial
-            ) from None
-        final = self._converged(response, stats, substep, gravity_iterations, int(body.displacement.size), t0)
-        return Solution(final, mesh, displacements)
-
-    def _converged(self, response: Response, stats: RampStatistics, substep: Any, gravity_iterations: int, dofs: int,
-                   t0: float) -> Response:
-        """``response`` of a completed ramp, with the solver's statistics in its metadata.
-
-        Parameters
-        ----------
-        response : Response
-            The levels as recorded.
-        stats : RampStatistics
-            The pressure ramp's statistics; ``gravity_iterations`` those of the gravity stage.
-        substep : callable
-            The ramp's Newton solver (its factorisations and precision, if it keeps them).
-        dofs : int
-            The number of unknowns; ``t0`` the solve's start (:func:`time.perf_counter`).
-        """
-        meta = dict(response.metadata)
-        meta.update(
-            newton_iterations=stats.newton_iterations + gravity_iterations,
-            factorisations=getattr(substep, "factorisations", stats.newton_iterations),
-            precision=getattr(substep, "precision", "double"),
-            substeps=stats.substeps,
-            cutbacks=stats.cutbacks,
-            wall_time_s=time.perf_counter() - t0,
-            dofs=dofs,
-            backend=self.backend,
-            quadrature=self.quadrature,
-            pneumorph=__version__,
-        )
-        return replace(response, converged=True, reached=float(response.pressures[-1]), metadata=meta)
+        return solve_design(self, orientation, on_level)

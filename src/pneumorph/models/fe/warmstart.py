@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph.models.fe.base import FEModel, Solution, end_face_angle
+from pneumorph.models.fe.base import FEModel
+from pneumorph.models.fe.solving import Solution, end_face_angle
 from pneumorph.models.frames import record_frames
 
 
