@@ -16,13 +16,17 @@ if TYPE_CHECKING:
     from pneumorph.io.progress import Progress
 
 
-def reporter() -> Progress:
-    """A reporter writing each line to standard error (``with reporter() as say:`` runs its heartbeat).
+def reporter(quiet: bool = False) -> Progress:
+    """A reporter writing each line to standard error (``with reporter() as say:`` runs its heartbeat); with
+    ``quiet`` (a command's ``-q``) one that says nothing.
 
     The heartbeat speaks after :data:`~pneumorph.io.progress.HEARTBEAT` seconds of silence, or after the seconds
     in the environment variable ``PNEUMORPH_HEARTBEAT`` (a log file may want fewer lines; the contract's test
-    a shorter beat)."""
+    a shorter beat). Standard output is the results' alone, so a command's ``--json`` keeps these lines."""
     from pneumorph.io.progress import HEARTBEAT, Progress
+
+    if quiet:
+        return Progress(lambda line: None, heartbeat=0)
 
     text = os.environ.get("PNEUMORPH_HEARTBEAT", "").strip()
     heartbeat = HEARTBEAT

@@ -103,9 +103,7 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
                          volume=volume_change if control == "volume" else None, composite=composite,
                          paper=paper, gravity=None if gravity == "none" else gravity)
 
-    from pneumorph.io.progress import Progress
-
-    lines = Progress(lambda text: None, heartbeat=0) if quiet or as_json else reporter()
+    lines = reporter(quiet)  # on standard error: with --json too, standard output holds the JSON alone
     with lines:
         lines.plan("bimodal ramp", max(1, round(pmax / step)), noun="levels", each=each,
                    title=f"bimodal ramp to {pmax:g} kPa in steps of {step:g} kPa" if control == "pressure" else

@@ -106,7 +106,6 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
     from pneumorph.cli.progress import reporter
     from pneumorph.composite.coupon import CouponSpec, simulate_coupon
     from pneumorph.io.files import strict_json
-    from pneumorph.io.progress import Progress
 
     c = _crimp(crimp_ratio, wavelength, amplitude, length)
     final = strain_max if strain_max is not None else c.limit_transition_strain + 0.10
@@ -116,7 +115,7 @@ def coupon(crimp_ratio: float | None, wavelength: float | None, amplitude: float
     spec = CouponSpec(crimp=c, thickness=thickness, per_flute=per_flute, rows=rows,
                       bulk_modulus=None if bulk_modulus is None else bulk_modulus / 1000.0)
     snaps = () if snapshot is None else (snapshot,)
-    lines = Progress(lambda text: None, heartbeat=0) if quiet else reporter()
+    lines = reporter(quiet)
     with lines:  # the plan, each level as it converges, and the heartbeat through the gauges and the figures
         lines.plan("coupon", levels, each=spec.level_seconds(), noun="levels", where=None if out is None else str(out),
                    title=f"coupon of CR {c.crimp_ratio:.4g} ({len(spec.mesh().points):,} nodes) pulled to "
