@@ -47,7 +47,8 @@ def _stub_bimodal(monkeypatch: pytest.MonkeyPatch) -> None:
 
 #: command line, its solver's stub, what its plan line starts with, the count of its last level
 COMMANDS: dict[str, tuple[list[str], Callable[[pytest.MonkeyPatch], None], str, str]] = {
-    "simulate": (["simulate", "-o", "0110", "--increments", "2", "--json"], _stub_simulate, "simulating design 0110", "2/2"),
+    "simulate": (["simulate", "-o", "0110", "--increments", "2", "--json"], _stub_simulate, "simulating design 0110",
+                 "2/2"),
     "bimodal": (["bimodal", "-c", "0.2", "--voids", "1", "--element-size", "5", "--pmax", "5", "--step", "2.5",
                  "--control", "pressure", "--json"], _stub_bimodal, "bimodal ramp to 5 kPa", "2/2"),
 }

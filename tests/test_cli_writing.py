@@ -68,3 +68,33 @@ def test_bimodal_says_what_it_writes_where_before_writing(tmp_path: Path, capsys
         assert "writing" not in err
     else:
         assert err.splitlines()[-1] == f"writing the response (JSON) and the figures to {out}"
+
+
+def test_chain_build_says_what_it_writes_where_before_writing(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """The build is a stub; the table's save is the probe: the line is said, and the table's folder not yet made."""
+    out, seen = tmp_path / "tables", []
+    target = out / "chain-2d.json"
+    monkeypatch.setattr("pneumorph.models.chain.fit.build_table",
+                        lambda *args, **kwargs: SimpleNamespace(save=_probe(capsys, out, seen)))
+    code = main(["chain", "build", "--model", "2d", "--units", "5", "--window", "1", "--out", str(target)])
+    assert code == 130 and not out.exists()  # stopped while writing: no table, no folder
+    ((err, files),) = seen
+    assert err.splitlines()[-1] == f"writing the chain table to {target}"
+    assert target.name not in files  # the table is written to a temporary file, renamed into place once whole
+
+
+@pytest.mark.parametrize("mould", [False, True])
+def test_export_says_what_it_writes_where_before_building_the_parts(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, mould: bool) -> None:
+    """The parts' builder is the probe (after the deck's writer, a stub): both lines are said before the parts'
+    booleans start, and nothing is left once stopped."""
+    out, deck, seen = tmp_path / "parts", tmp_path / "deck" / "a.inp", []
+    monkeypatch.setattr("pneumorph.export.write_calculix_deck", lambda model, design, path: path.write_text("*"))
+    monkeypatch.setattr("pneumorph.export.actuator_parts", _probe(capsys, out, seen))
+    code = main(["export", "0110", "--stl", str(out), "--inp", str(deck), *(["--mould"] if mould else [])])
+    assert code == 130 and not out.exists() and not deck.parent.exists()
+    ((err, files),) = seen
+    parts = "the parts' STL files" + (", the casting mould and its drawing" if mould else "")
+    assert err.splitlines()[-2:] == [f"writing {parts} to {out}", f"writing the CalculiX deck to {deck}"]
+    assert files == []

@@ -22,7 +22,7 @@ def test_default_design_stl_and_json(tmp_path):
     out = tmp_path / "stl"
     result = run(DEFAULT, "--stl", str(out), "--json")
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert summary["design"] == DEFAULT and summary["units"] == 15 and summary["length_mm"] == 157.5
     assert summary["volumes_mm3"]["body"] == pytest.approx(16402.5, rel=1e-12)
     assert sum(v for k, v in summary["volumes_mm3"].items() if k.startswith("layer_")) == pytest.approx(7087.5)
@@ -48,7 +48,7 @@ def test_text_output_lists_files_volumes_and_cuts(tmp_path):
 def test_mould(tmp_path):
     result = run(DEFAULT, "--stl", str(tmp_path), "--mould", "--clearance", "0.3", "--json")
     assert result.exit_code == 0, result.output
-    mould = json.loads(result.output)["mould"]
+    mould = json.loads(result.stdout)["mould"]
     assert mould["clearance_mm"] == 0.3 and mould["draft_deg"] == 0.0
     check = mould["check"]
     assert check["ok"] and all(check["watertight"].values()) and len(check["watertight"]) == 22
@@ -78,7 +78,7 @@ def test_the_design_is_read_once(tmp_path, monkeypatch):
     monkeypatch.setattr(alphabet, "parse_orientation", counted)
     result = run("0110", "--stl", str(tmp_path), "--mould", "--json")
     assert result.exit_code == 0, result.output
-    assert texts == ["0110"] and json.loads(result.output)["design"] == "0110"
+    assert texts == ["0110"] and json.loads(result.stdout)["design"] == "0110"
 
 
 def test_mould_text_and_draft(tmp_path):
@@ -114,7 +114,7 @@ def test_unit_file(tmp_path):
     unit.write_text("[unit]\npitch = 12.0\nslit_width = 1.0\nslit_depth = 4.0\n")
     result = run("0", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--json")
     assert result.exit_code == 0, result.output
-    volumes = json.loads(result.output)["volumes_mm3"]
+    volumes = json.loads(result.stdout)["volumes_mm3"]
     # 12 x 9 x 15 - slit 1 x 4 x 15 - cavity (12 - 6 - 1) x 6 x 12
     assert volumes["body"] == pytest.approx(1620 - 60 - 360, rel=1e-12)
     bad = tmp_path / "bad.toml"
@@ -133,7 +133,7 @@ def test_export_writes_the_calculix_deck_of_the_3d_model(tmp_path: Path) -> None
     deck = tmp_path / "decks" / "d.inp"
     result = CliRunner().invoke(export, ["0110", "--inp", str(deck), "--pressure", "20", "--json"])
     assert result.exit_code == 0, result.output
-    data = json.loads(result.output)
+    data = json.loads(result.stdout)
     model = make_model(4, {"fidelity": "3d", "pressure_kpa": 20})
     assert data["deck"]["fingerprint"] == model.fingerprint() and data["deck"]["levels"] == 10
     text = deck.read_text(encoding="utf-8")
@@ -148,7 +148,7 @@ def test_a_solid_unit_is_exported_as_a_solid_body(tmp_path):
     unit.write_text("[unit]\nsolid = true\n")
     result = run("0101", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--mould", "--json")
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     # 42 x 12 x 15 mm minus the four 10.5 x 3 x 15 mm layer pieces, no cavity
     assert summary["volumes_mm3"]["body"] == pytest.approx(42 * 12 * 15 - 4 * 472.5, rel=1e-12)
     body = trimesh.load_mesh(tmp_path / "out" / "body.stl")
@@ -165,7 +165,7 @@ def test_a_unit_without_a_layer_has_no_layer_pieces(tmp_path):
     unit.write_text("[unit]\nwall = 3.0\nlayer = 0.0\n")
     result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--mould", "--json")
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert sorted(summary["volumes_mm3"]) == ["base_block", "body"] and summary["layer_pieces"] == []
     # 21 x 12 x 15 mm minus two 4.5 x 6 x 12 mm cavities
     assert summary["volumes_mm3"]["body"] == pytest.approx(21 * 12 * 15 - 2 * 324.0, rel=1e-12)
@@ -191,12 +191,12 @@ def test_a_model_file_gives_the_parts_its_unit_and_the_deck_its_materials(tmp_pa
     result = run("0", "--stl", str(tmp_path / "out"), "--model-file", str(identified), "--json")
     assert result.exit_code == 0, result.output
     # the identified unit's body, as from the same unit given by --unit (12 x 9 x 15 - slit - cavity)
-    assert json.loads(result.output)["volumes_mm3"]["body"] == pytest.approx(1620 - 60 - 360, rel=1e-12)
+    assert json.loads(result.stdout)["volumes_mm3"]["body"] == pytest.approx(1620 - 60 - 360, rel=1e-12)
     result = run("0", "--inp", str(tmp_path / "d.inp"), "--pressure", "20", "--model-file", str(identified), "--json")
     assert result.exit_code == 0, result.output
     scaled = make_model(1, {"fidelity": "3d", "pressure_kpa": 20, "body_bulk_scale": 1.06,
                             "unit": {"pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}})
-    assert json.loads(result.output)["deck"]["fingerprint"] == scaled.fingerprint()
+    assert json.loads(result.stdout)["deck"]["fingerprint"] == scaled.fingerprint()
     assert scaled.fingerprint() != make_model(1, {"fidelity": "3d", "pressure_kpa": 20, "unit": {
         "pitch": 12.0, "slit_width": 1.0, "slit_depth": 4.0}}).fingerprint()
 
@@ -208,14 +208,14 @@ def test_a_sideways_unit_exports_its_parts_and_its_mould(tmp_path):
     unit.write_text("[unit]\nlayer_side = true\n")
     result = run("01", "--stl", str(tmp_path / "out"), "--unit", str(unit), "--json")
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     # per unit: 10.5 x 9 x 12 mm of body (the strip's 3 mm off the width) less the cavity 4.5 x 6 x 9
     assert summary["volumes_mm3"]["body"] == pytest.approx(2 * (10.5 * 9 * 12 - 4.5 * 6 * 9), rel=1e-12)
     assert [(p["side"], p["length_mm"]) for p in summary["layer_pieces"]] == [("right", 10.5), ("left", 10.5)]
     assert summary["volumes_mm3"]["layer_1"] == pytest.approx(10.5 * 9 * 3, rel=1e-12)
     result = run("01", "--stl", str(tmp_path / "mould"), "--unit", str(unit), "--mould", "--json")
     assert result.exit_code == 0, result.output
-    mould = json.loads(result.output)["mould"]
+    mould = json.loads(result.stdout)["mould"]
     assert mould["check"]["ok"] and mould["check"]["reassembly_error_mm3"] < 1e-6
     # the sheet: 1.5 mm under both units' footprints, 21 x 9 mm (the turned-over unit's piece is its wall)
     assert mould["cast_mm3"]["side_sheet"] == pytest.approx(21 * 9 * 1.5, rel=1e-9)
@@ -227,7 +227,7 @@ def test_a_mixed_design_over_a_library_exports_its_parts_and_deck(tmp_path):
     result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "out"), "--inp", str(tmp_path / "d.inp"),
                  "--json")
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert [p["side"] for p in summary["layer_pieces"]] == ["top", "left", "right", "bottom", "right"]
     assert summary["length_mm"] == 52.5 and summary["unit"] == "spatial"
     # 5 x (10.5 x 12 x 15 less the cavity 4.5 x 6 x 12 (a) or 4.5 x 9 x 9 (l)), less the strips
@@ -244,7 +244,7 @@ def test_a_mixed_design_over_a_library_exports_its_parts_and_deck(tmp_path):
         int(deck.split("*ELEMENT")[0].strip().splitlines()[-1].split(",")[0])
     result = run("aLlAl", "--library", "spatial", "--stl", str(tmp_path / "m"), "--mould", "--json")
     assert result.exit_code == 0, result.output
-    mould = json.loads(result.output)["mould"]  # the L unit's core on a plinth (tests/export/test_moulds.py)
+    mould = json.loads(result.stdout)["mould"]  # the L unit's core on a plinth (tests/export/test_moulds.py)
     assert mould["check"]["ok"] and (tmp_path / "m" / "mould" / "base_plate.stl").is_file()
     assert mould["cast_mm3"]["side_sheet"] + mould["cast_mm3"]["open_body"] == pytest.approx(
         summary["volumes_mm3"]["body"], rel=1e-12)

@@ -124,7 +124,8 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     cluster = cluster_report(evaluator)
     if (line := cluster_line(evaluator)) is not None:
         click.echo(line, err=True)
-    with all_or_nothing_file(target) as tmp:  # a failure or Ctrl-C while writing leaves no table and no new folder
+    # a failure or Ctrl-C while writing leaves no table and no new folder
+    with all_or_nothing_file(target, say=lines, what="the chain table") as tmp:
         try:
             table.save(tmp)
         finally:

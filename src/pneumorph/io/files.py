@@ -215,12 +215,14 @@ def all_or_nothing(folder: str | Path, say: Callable[[str], None] | None = None,
 
 
 @contextlib.contextmanager
-def all_or_nothing_file(path: str | Path) -> Iterator[Path]:
+def all_or_nothing_file(path: str | Path, say: Callable[[str], None] | None = None,
+                        what: str = "the results") -> Iterator[Path]:
     """A temporary path for ``path``'s new version (:func:`atomic_path`), in place when the block succeeds.
 
     The one-file counterpart of :func:`all_or_nothing`: if the block fails (an error, Ctrl-C),
     ``path`` is left as it was and the folders made for it are removed. Nested with
-    :func:`all_or_nothing`, the file appears only once the whole block has succeeded.
+    :func:`all_or_nothing`, the file appears only once the whole block has succeeded. With ``say``,
+    the line ``writing <what> to <path>`` is said first, as :func:`all_or_nothing` says it.
 
     Examples
     --------
@@ -234,8 +236,13 @@ def all_or_nothing_file(path: str | Path) -> Iterator[Path]:
     ...     pass
     >>> sorted(p.name for p in d.iterdir())
     []
+    >>> with all_or_nothing_file(d / "deck.inp", say=print, what="the deck") as tmp:  # doctest: +ELLIPSIS
+    ...     _ = tmp.write_text("*HEADING")
+    writing the deck to .../deck.inp
     """
     path = Path(path)
+    if say is not None:
+        say(f"writing {what} to {path}")
     with contextlib.ExitStack() as stack:
         if not path.parent.exists():
             stack.enter_context(all_or_nothing(path.parent))

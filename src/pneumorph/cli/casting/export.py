@@ -164,6 +164,7 @@ def _write(orientation: Any, unit: Any, block: Any, model: Any, stl_dir: str | N
     output); the parts, their paths and the mould."""
     from pathlib import Path
 
+    from pneumorph.cli.progress import reporter
     from pneumorph.export import actuator_parts, casting_mould, plot_mould, write_stl
     from pneumorph.io.files import all_or_nothing, all_or_nothing_file
 
@@ -172,13 +173,16 @@ def _write(orientation: Any, unit: Any, block: Any, model: Any, stl_dir: str | N
     mould = None
     with contextlib.ExitStack() as outputs:
         folder = Path(stl_dir) if stl_dir is not None else Path()
+        say = reporter()  # the parts' booleans and the mould's checks take seconds: said before they start
         if stl_dir is not None:
-            outputs.enter_context(all_or_nothing(folder))
+            what = "the parts' STL files" + (", the casting mould and its drawing" if mould_spec is not None else "")
+            outputs.enter_context(all_or_nothing(folder, say=say, what=what))
         if model is not None:
             from pneumorph.export import write_calculix_deck
 
             assert inp_file is not None
-            deck = outputs.enter_context(all_or_nothing_file(inp_file))  # in place once the STL files are written too
+            # in place once the STL files are written too
+            deck = outputs.enter_context(all_or_nothing_file(inp_file, say=say, what="the CalculiX deck"))
             write_calculix_deck(model, orientation, deck)
             summary["deck"] = {"file": str(Path(inp_file)), "pressure_kpa": round(float(model.ramp.pressure) * 1e3, 9),
                                "levels": int(model.ramp.steps.increments), "fingerprint": model.fingerprint()}
