@@ -17,6 +17,7 @@ renders them through one :class:`Progress`, which is such a ``say`` callable too
 from __future__ import annotations
 
 import math
+import multiprocessing
 import os
 import threading
 import time
@@ -45,27 +46,52 @@ def duration_text(seconds: float) -> str:
     return f"{seconds / 3600:.2g} h"
 
 
-def load_factor(workers: int = 1, load: float | None = None, cores: int | None = None) -> float:
-    """How much slower than on a quiet machine ``workers`` processes run here now: the processes
-    already running (the one-minute load average) and the new ones share the cores, never faster
-    than alone.
+def own_processes() -> int:
+    """The processes of this run that the machine's load average counts while they compute: this one and its
+    live child processes (a process pool's workers).
 
-    >>> load_factor(2, load=0.0, cores=2), load_factor(2, load=2.0, cores=2), load_factor(1, load=0.5, cores=4)
-    (1.0, 2.0, 1.0)
+    >>> own_processes() >= 1
+    True
+    """
+    return 1 + len(multiprocessing.active_children())
+
+
+def other_load(load: float | None = None, own: int | None = None) -> float:
+    """The processes of other runs that compete for the cores now: the one-minute load average ``load`` (default:
+    this machine's) less this run's own processes in it (``own``, default :func:`own_processes`), never below 0.
+
+    A run's own work is in the load average (its scoring, its workers' last solves): counted as a competitor it
+    would slow the run's estimate of itself (two busy processes of one run on 2 cores estimated each solve 1.5
+    times its time alone).
+
+    >>> other_load(1.0, own=1), other_load(3.0, own=1), other_load(0.2, own=3)
+    (0.0, 2.0, 0.0)
     """
     if load is None:
         try:
             load = os.getloadavg()[0]
         except (AttributeError, OSError):  # no load average on this system
             load = 0.0
+    return max(0.0, float(load) - (own_processes() if own is None else int(own)))
+
+
+def load_factor(workers: int = 1, load: float | None = None, cores: int | None = None) -> float:
+    """How much slower than on a quiet machine ``workers`` processes of a run compute here now: they and the
+    processes of other runs (``load``, default :func:`other_load`: the load average without this run's own) share
+    the cores, never faster than alone.
+
+    >>> load_factor(2, load=0.0, cores=2), load_factor(2, load=2.0, cores=2), load_factor(1, load=0.5, cores=4)
+    (1.0, 2.0, 1.0)
+    """
+    others = other_load() if load is None else max(0.0, float(load))
     cores = cores or os.cpu_count() or 1
-    return max(1.0, (float(load) + max(1, int(workers))) / cores)
+    return max(1.0, (others + max(1, int(workers))) / cores)
 
 
 def estimate_seconds(count: int, each: float, workers: int = 1, load: float | None = None,
                      cores: int | None = None) -> float:
     """Wall time of ``count`` items of ``each`` seconds (on one core of a quiet machine) among ``workers``
-    processes, slowed by what else runs on this machine now (:func:`load_factor`).
+    processes, slowed by what other runs on this machine compute now (``load``, :func:`load_factor`).
 
     >>> estimate_seconds(65, 0.3, workers=2, load=0.0, cores=2)
     9.9
@@ -228,4 +254,5 @@ class Progress:
             self.beat()
 
 
-__all__ = ["HEARTBEAT", "THROTTLE", "Progress", "duration_text", "estimate_seconds", "load_factor"]
+__all__ = ["HEARTBEAT", "THROTTLE", "Progress", "duration_text", "estimate_seconds", "load_factor", "other_load",
+           "own_processes"]

@@ -49,7 +49,7 @@ from pneumorph.design.search.scoring import Candidate, ScoreBook
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.evaluators import Evaluator
 from pneumorph.models.chain.model import ChainModel
-from pneumorph.models.chain.plan import solve_estimate
+from pneumorph.models.chain.plan import evaluator_workers, solve_estimate
 from pneumorph.models.response import ActuatorModel
 
 
@@ -275,7 +275,8 @@ def _verify(state: _Verification, fe_model: ActuatorModel, verify: int, certify:
                                     f"designs ({failures}); check the model (units, pressure) with pneumorph simulate")
         batch = pending[:verify]
         todo = [state.designs[i] for i in batch]
-        say(f"verifying {', '.join(todo)} by FE{solve_estimate(fe_model, len(todo))} ...")
+        workers = evaluator_workers(book.evaluator)
+        say(f"verifying {', '.join(todo)} by FE{solve_estimate(fe_model, len(todo), workers=workers)} ...")
         book.score_many(todo)
         state.done[batch] = True
         state.verified += todo

@@ -427,16 +427,43 @@ def cached_counter(evaluator: Any, model: Any) -> Callable[[list[str]], int] | N
     return count
 
 
-def solve_estimate(model: Any, count: int, scale: float = 1.0) -> str:
-    """`` (3d, about 15 s each)``: the measured solve time of the model's fidelity (a 3D model over sideways units:
-    the full width's; times ``scale``, e.g. a finer mesh's cells over the measured mesh's), slowed by what else
-    runs on this machine now (:func:`pneumorph.io.progress.load_factor`), or nothing."""
+def solve_estimate(model: Any, count: int, scale: float = 1.0, workers: int | None = None,
+                   load: float | None = None, cores: int | None = None) -> str:
+    """`` (3d, about 15 s each)``: the wall time of each of ``count`` solves of ``model``, or nothing without a
+    measured figure.
+
+    Its CPU time on one core (:func:`model_seconds`: the measured solve time of the model's fidelity, a 3D model
+    over sideways units the full width's; times ``scale``, e.g. a finer mesh's cells over the measured mesh's),
+    slowed only where the solves share the cores with other runs' processes.
+
+    Parameters
+    ----------
+    workers : int, optional
+        How many of the solves run at once (an evaluator's width); default as many as the solves and the cores
+        allow.
+    load : float, optional
+        The processes of other runs that compute now; default the machine's load average less this run's own
+        processes (:func:`pneumorph.io.progress.other_load`: a run's own scoring or workers do not slow its
+        estimate of itself).
+    cores : int, optional
+        The machine's cores (default: :func:`os.cpu_count`).
+
+    Examples
+    --------
+    >>> from pneumorph.models.fe import Full3D
+    >>> solve_estimate(Full3D(17), 2, workers=2, load=0.0, cores=2)  # a machine with nothing else on it
+    ' (3d, about 17 s each)'
+    >>> solve_estimate(Full3D(17), 2, workers=2, load=2.0, cores=2)  # two busy processes of another run
+    ' (3d, about 34 s each)'
+    """
     fidelity = cost_fidelity(model)
     seconds = model_seconds(model)
     if not seconds:
         return ""
     each = " each" if count > 1 else ""
-    seconds *= scale * load_factor(min(max(1, count), os.cpu_count() or 1))
+    cores = cores or os.cpu_count() or 1
+    at_once = min(max(1, count), cores if workers is None else max(1, int(workers)))
+    seconds *= scale * load_factor(at_once, load, cores)
     return f" ({fidelity}, about {duration_text(seconds)}{each})"
 
 
