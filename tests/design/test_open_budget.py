@@ -14,7 +14,14 @@ import pytest
 
 from pneumorph.cli import main
 from pneumorph.design.certified.bounds import chain_errors
-from pneumorph.design.certified.branching import MAX_NODES, BranchOverflow, OpenWatch, watching
+from pneumorph.design.certified.branching import (
+    MAX_NODES,
+    BranchOverflow,
+    OpenWatch,
+    cap_text,
+    more_open_advice,
+    watching,
+)
 from pneumorph.design.certified.planegrowth import chain_scores, grow_designs
 from pneumorph.design.objectives.targets import make_objective
 from pneumorph.errors import SearchBudgetError
@@ -64,6 +71,18 @@ def test_without_keeping_the_best_the_cap_is_a_budget_error_naming_what_to_do() 
     assert isinstance(caught.value, SearchBudgetError)
     text = str(caught.value)
     assert "past the cap of 1,000" in text and "a tighter table" in text and "larger max_open" in text
+
+
+def test_the_overflow_and_the_caps_note_give_the_one_advice() -> None:
+    """The error of a branch-and-bound past its cap and the note of one that kept the best at its cap word what
+    lists more alike: from one source, the note's sentence capitalised."""
+    chain = _chain(22)
+    objective = make_objective("sin", 10.0, length=chain.length)
+    with pytest.raises(BranchOverflow) as caught:
+        grow_designs(chain, objective, chain_errors(chain, 32.0), threshold=1e9, max_nodes=1_000)
+    assert str(caught.value).endswith(f"list them all; {more_open_advice('--search ga')}")
+    advice = more_open_advice()
+    assert cap_text(chain, 32.0, 1_000).endswith(f"bounds the rest. {advice[0].upper()}{advice[1:]} lists more")
 
 
 def test_the_default_main_job_keeps_far_fewer_open_prefixes_than_the_cap() -> None:

@@ -110,6 +110,19 @@ class OpenWatch:
         self.reached = self.reached or full
 
 
+def more_open_advice(*also: str) -> str:
+    """What lists more designs than a branch-and-bound's cap of open prefixes lets it: the one wording of the
+    overflow's error (:func:`narrow`) and of the cap's note (:func:`cap_text`), with ``also`` after it.
+
+    >>> more_open_advice()
+    'a tighter table (a smaller margin, a table within its tolerance) or a larger max_open'
+    >>> more_open_advice("--search ga")
+    'a tighter table (a smaller margin, a table within its tolerance), a larger max_open, or --search ga'
+    """
+    ways = ["a tighter table (a smaller margin, a table within its tolerance)", "a larger max_open", *also]
+    return f"{ways[0]} or {ways[1]}" if len(ways) == 2 else f"{', '.join(ways[:-1])}, or {ways[-1]}"
+
+
 def cap_text(chain: Any, margin: float, cap: int) -> str:
     """What a branch-and-bound that reached its cap of open prefixes says: the chain table's bound (its worst
     held-out centre error, times the margin) that left them open, and what lists more.
@@ -122,10 +135,10 @@ def cap_text(chain: Any, margin: float, cap: int) -> str:
       the open prefixes reached the cap of 500,000: the chain table's bound (centres within 2.94 mm, margin 32) ...
     """
     worst = float(np.max(chain_errors(chain, margin)["centre"]))
+    advice = more_open_advice()
     return (f"  the open prefixes reached the cap of {cap:,}: the chain table's bound (centres within {worst:.3g} mm, "
             f"margin {margin:g}) prunes too little to list every design that can matter; the best were kept and the "
-            "certificate's floor bounds the rest. A tighter table (a smaller margin, a table within its tolerance) "
-            "or a larger max_open lists more")
+            f"certificate's floor bounds the rest. {advice[0].upper()}{advice[1:]} lists more")
 
 
 _WATCH: ContextVar[Callable[[int, int, int], None] | None] = ContextVar("open_watch", default=None)
@@ -165,8 +178,7 @@ def narrow(keep: NDArray[np.bool_], bound: FloatArray, beam: int | None, max_nod
     if keep.sum() > max_nodes:
         raise BranchOverflow(f"branch-and-bound: {int(keep.sum()):,} open prefixes at unit {p} of {n}, past the cap "
                              f"of {max_nodes:,}: too many designs come within the chain's error bound of the best to "
-                             "list them all; a tighter table (a smaller margin, a table within its tolerance), a "
-                             "larger max_open, or --search ga")
+                             f"list them all; {more_open_advice('--search ga')}")
     if beam is None and (watch := _WATCH.get()) is not None:
         watch(p, n, int(keep.sum()))
     return keep
@@ -188,4 +200,4 @@ def union(a: ChainScores, b: ChainScores) -> ChainScores:
 
 
 __all__ = ["BEAM", "MAX_ENUMERATE", "MAX_NODES", "MAX_OPEN_MEMORY", "PREFIX_BYTES", "BranchOverflow", "OpenWatch",
-           "cap_text", "kept", "narrow", "open_cap", "open_memory", "union", "watching"]
+           "cap_text", "kept", "more_open_advice", "narrow", "open_cap", "open_memory", "union", "watching"]
