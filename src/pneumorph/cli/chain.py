@@ -124,8 +124,7 @@ def build(fidelity: str, unit_file: str | None, library: str | None, pressure: f
     cluster = cluster_report(evaluator)
     if (line := cluster_line(evaluator)) is not None:
         click.echo(line, err=True)
-    # a failure or Ctrl-C while writing leaves no table and no new folder
-    with all_or_nothing_file(target, say=lines, what="the chain table") as tmp:
+    with all_or_nothing_file(target, say=lines, what="the chain table") as tmp:  # stopped: no table, no new folder
         try:
             table.save(tmp)
         finally:
