@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from pneumorph.checks import MODES
 from pneumorph.materials.laws.hyperelastic import (
-    MODES,
     MooneyRivlin,
     NeoHooke,
     Ogden,

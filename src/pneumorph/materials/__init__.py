@@ -23,7 +23,6 @@ from pneumorph.materials.fitting.comparison import compare
 from pneumorph.materials.fitting.fit import FitResult, fit
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.laws.hyperelastic import (
-    MODES,
     HyperelasticModel,
     MooneyRivlin,
     NeoHooke,
@@ -38,7 +37,6 @@ from pneumorph.materials.library.builtin import get, get_filler, load_library, n
 from pneumorph.materials.library.material import Material
 
 __all__ = [
-    "MODES",
     "FillerLaw",
     "FitResult",
     "HyperelasticModel",

@@ -13,8 +13,9 @@ from typing import ClassVar
 
 import numpy as np
 
+from pneumorph.checks import MODES
 from pneumorph.errors import DataFormatError
-from pneumorph.materials.laws.hyperelastic import MODES, FloatArray
+from pneumorph.materials.laws.hyperelastic import FloatArray
 
 #: Bounds of plausible test data: beyond them a number is a unit mistake (or overflows the fit).
 MAX_STRETCH = 100.0

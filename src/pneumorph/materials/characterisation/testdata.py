@@ -54,7 +54,6 @@ from pneumorph import checks
 from pneumorph.errors import DataFormatError
 from pneumorph.io.reading import check_rows, read_text_file
 from pneumorph.materials.characterisation.curves import MAX_STRESS_MPA, MAX_STRETCH, TestCurve, TestData
-from pneumorph.materials.laws.hyperelastic import MODES
 
 #: Stress units understood by the readers and their factor to MPa.
 STRESS_UNITS: Mapping[str, float] = MappingProxyType(
@@ -70,9 +69,6 @@ STRESS_UNITS: Mapping[str, float] = MappingProxyType(
         "psi": 0.00689475729,
     }
 )
-#: Column roles for ``columns=``; ``"skip"`` ignores a column.
-COLUMN_ROLES = checks.COLUMN_ROLES
-TRUNCATE = checks.TRUNCATE
 _SORO_MARK = "parameter;info"
 _MODE_WORDS = {
     "uniaxial": ("ut", "uc", "uni", "uniaxial", "tension", "tensile", "compression"),
@@ -109,12 +105,12 @@ def column_roles(columns: str | Sequence[str], path: str | None = None) -> list[
     stress and otherwise 'skip' (roles: stretch, strain, true-strain, stress, skip)
     """
     roles = [c.strip().lower() for c in (columns.split(",") if isinstance(columns, str) else columns)]
-    bad = [r for r in roles if r not in COLUMN_ROLES]
+    bad = [r for r in roles if r not in checks.COLUMN_ROLES]
     strains = sum(r in ("stretch", "strain", "true-strain") for r in roles)
     if bad or sum(r == "stress" for r in roles) != 1 or strains != 1:
         raise DataFormatError(
             f"columns {roles} must name one of stretch/strain/true-strain, one stress and "
-            f"otherwise 'skip' (roles: {', '.join(COLUMN_ROLES)})", path=path)
+            f"otherwise 'skip' (roles: {', '.join(checks.COLUMN_ROLES)})", path=path)
     return roles
 
 
@@ -261,8 +257,8 @@ def read_curve(
     lam, p = _increasing(lam, p, rownum, src)
     if mode is None:
         mode = guess_mode(path) or "uniaxial"
-    if mode not in MODES:
-        raise DataFormatError(f"unknown loading mode {mode!r}; expected one of {', '.join(MODES)}", path=src)
+    if mode not in checks.MODES:
+        raise DataFormatError(f"unknown loading mode {mode!r}; expected one of {', '.join(checks.MODES)}", path=src)
     desc = description or metadata.get("Material") or path.stem
     return TestCurve(mode, lam, p, source=src, description=desc, metadata=metadata, notes=tuple(notes))
 
@@ -417,10 +413,10 @@ def _truncated(lam: np.ndarray, p: np.ndarray, rownum: np.ndarray, truncate: str
     Raises
     ------
     DataFormatError
-        ``truncate`` not one of :data:`TRUNCATE`.
+        ``truncate`` not one of :data:`~pneumorph.checks.TRUNCATE`.
     """
-    if truncate not in TRUNCATE:
-        raise DataFormatError(f"truncate must be one of {TRUNCATE}, got {truncate!r}", path=src)
+    if truncate not in checks.TRUNCATE:
+        raise DataFormatError(f"truncate must be one of {checks.TRUNCATE}, got {truncate!r}", path=src)
     if truncate != "none":
         end = int(np.argmax(lam if truncate == "loading" else p)) + 1
         if end < lam.size:
@@ -469,11 +465,9 @@ def _soro_metadata(body: list[tuple[int, str]], src: str) -> tuple[list[tuple[in
 
 
 __all__ = [
-    "COLUMN_ROLES",
     "MAX_STRESS_MPA",
     "MAX_STRETCH",
     "STRESS_UNITS",
-    "TRUNCATE",
     "TestCurve",
     "TestData",
     "column_roles",

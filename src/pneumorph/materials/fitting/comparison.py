@@ -9,11 +9,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from pneumorph.checks import MODES
 from pneumorph.materials.characterisation.testdata import TestCurve, TestData
 from pneumorph.materials.fitting.fit import FitResult, fit, resolve_model
-from pneumorph.materials.laws.hyperelastic import (
-    MODES,
-)
 
 
 @dataclass(frozen=True, eq=False)

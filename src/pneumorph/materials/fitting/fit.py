@@ -62,11 +62,11 @@ from typing import Any
 import numpy as np
 
 from pneumorph import checks
+from pneumorph.checks import MODES
 from pneumorph.errors import FitError, UnknownModelError
 from pneumorph.materials.characterisation.testdata import TestCurve, TestData
 from pneumorph.materials.fitting.ogden import fit_ogden
 from pneumorph.materials.laws.hyperelastic import (
-    MODES,
     FloatArray,
     HyperelasticModel,
     MooneyRivlin,

@@ -43,10 +43,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pneumorph import checks
-from pneumorph.checks import Mode
-
-#: The homogeneous deformation modes of the test data: uniaxial, equibiaxial, planar (pure shear).
-MODES: tuple[Mode, ...] = checks.MODES
 
 FloatArray = NDArray[np.float64]
 
@@ -78,7 +74,7 @@ def mode_stretches(mode: str, stretch: ArrayLike) -> tuple[FloatArray, FloatArra
         return lam, lam, lam**-2.0
     if mode == "planar":
         return lam, np.ones_like(lam), 1.0 / lam
-    raise ValueError(f"unknown loading mode {mode!r}; expected one of {', '.join(MODES)}")
+    raise ValueError(f"unknown loading mode {mode!r}; expected one of {', '.join(checks.MODES)}")
 
 
 @runtime_checkable
@@ -457,7 +453,7 @@ def drucker_stability(
     lam = np.unique(np.concatenate([lam, [1.0]]))
     h = 1e-5
     stable: dict[str, NDArray[np.bool_]] = {}
-    for mode in MODES:
+    for mode in checks.MODES:
         l1, l2, _l3 = mode_stretches(mode, lam)
         e = np.stack([np.log(l1), np.log(l2)])
 

@@ -7,10 +7,10 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from pneumorph.checks import MODES
 from pneumorph.errors import MaterialDataError, UnknownMaterialError
 from pneumorph.materials.laws.filler import FillerLaw
 from pneumorph.materials.laws.hyperelastic import (
-    MODES,
     HyperelasticModel,
     Ogden,
     StabilityReport,
@@ -141,7 +141,7 @@ class FitRecord:
     attribution : str
         The attribution line the data's licence asks for.
     mode : str
-        The loading mode fitted (one of :data:`~pneumorph.materials.laws.hyperelastic.MODES`).
+        The loading mode fitted (one of :data:`~pneumorph.checks.MODES`).
     stretch_range : (float, float)
         Smallest and largest stretch of the points fitted.
     points : int
