@@ -133,5 +133,6 @@ def test_the_verifications_estimate_of_a_model_over_sideways_units_is_the_full_w
     assert solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 15 s each)"
     assert solve_estimate(make_model(15, {"fidelity": "3d", "library": "spatial"}), 2) == (
         " (3d full-width, about 60 s each)")
-    monkeypatch.setattr("os.getloadavg", lambda: (2.0, 2.0, 2.0))  # two other processes busy: half a core each
+    # the load average of this process and two busy ones of other runs: the two verifications at half a core each
+    monkeypatch.setattr("os.getloadavg", lambda: (3.0, 3.0, 3.0))
     assert solve_estimate(make_model(15, {"fidelity": "3d"}), 2) == " (3d, about 30 s each)"
