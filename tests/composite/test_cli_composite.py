@@ -97,8 +97,11 @@ def stubbed_solve(monkeypatch: pytest.MonkeyPatch, tiny_coupon: CouponResult) ->
         return tiny_coupon
 
     monkeypatch.setattr(coupon, "simulate_coupon", solve)
-    monkeypatch.setattr(progress, "reporter", lambda: Progress(lambda line: click.echo(line, err=True), heartbeat=0,
-                                                               clock=lambda: now[0]))
+    def reporter(quiet: bool = False) -> Progress:  # the command's reporter on the stub's clock; -q: silent
+        return Progress((lambda line: None) if quiet else (lambda line: click.echo(line, err=True)), heartbeat=0,
+                        clock=lambda: now[0])
+
+    monkeypatch.setattr(progress, "reporter", reporter)
     monkeypatch.setattr("pneumorph.io.progress.os.getloadavg", lambda: (0.0, 0.0, 0.0))
 
 
