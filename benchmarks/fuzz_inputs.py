@@ -43,6 +43,10 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))  # the command tree of this checkout, as its cases run it
+sys.path.insert(0, str(ROOT / "benchmarks"))  # the baselines beside this script, also when a test loads it
+from fuzz_baselines import BASE, UNIT, spoil  # noqa: E402
+from fuzz_baselines import FILES as BASELINE_FILES  # noqa: E402
+
 TIMEOUT = 10.0  # CPU seconds of a case (interpreter start included): past it, a runaway
 WALL_LIMIT = 60.0  # a case still running after this wall time is stopped (a shared machine stretches wall times)
 MAX_RSS_MB = 300.0
@@ -71,51 +75,10 @@ from pneumorph.cli import main
 sys.exit(main(sys.argv[1:]))
 """
 
-UNIT = "[unit]\nelement_size = 3.0\n"
-RUN_TOML = ('[design]\nobjective = "sin"\nunits = 3\nsearch = "exhaustive"\n\n[model]\nfidelity = "2d"\n'
-            'pressure_kpa = 10.0\nincrements = 3\nunit_file = "unit.toml"\n\n[execution]\nexecutor = "serial"\n')
+#: the scan of correlate and identify: a bending centreline with a zigzag of 0.5 mm
 TRACE = "x,y\n" + "".join(f"{42.0 * i / 119:.4f},{6.0 + 0.002 * (42.0 * i / 119) ** 2 + (i % 2) * 0.5:.4f}\n"
                           for i in range(120))
-FILES = {
-    "unit.toml": UNIT, "run.toml": RUN_TOML, "trace.csv": TRACE,
-    "stress.csv": "stretch,stress\n1.0,0.0\n1.5,0.2\n2.0,0.35\n2.5,0.5\n",
-    "dic.csv": "axial_strain,transverse_strain\n0.1,-0.04\n0.2,-0.08\n",
-    "thermal.csv": "temperature,strain\n20,0\n30,0.002\n40,0.004\n",
-    "bilinear.csv": "strain,stress\n" + "".join(f"{0.01 * i},{0.1 * i if i < 10 else 1 + 0.01 * i}\n"
-                                                 for i in range(40)),
-}
-
-_2D = ["--model", "2d", "--pressure", "5", "--unit", "unit.toml"]
-BASE: dict[str, list[str]] = {
-    "design": ["design", "--model", "2d", "--units", "3", "--search", "exhaustive", "--pressure", "10", "--unit",
-               "unit.toml", "--executor", "serial", "--tolerance", "0", "--out", "run"],
-    "design-config": ["design", "run.toml", "--out", "run"],
-    "study": ["study", "run.toml", "--populations", "4", "--seeds", "1", "--gen", "1", "--units", "3", "--pressure",
-              "5", "--executor", "serial", "--out", "run"],
-    "simulate": ["simulate", "-o", "0110", *_2D, "--increments", "3", "--out", "run"],
-    "correlate": ["correlate", "trace.csv", "--design", "0110", *_2D, "--out", "run"],
-    "identify": ["identify", "trace.csv", "--design", "0110", *_2D, "--executor", "serial", "--out", "run"],
-    "export": ["export", "0110", "--unit", "unit.toml", "--stl", "run"],
-    "chain build": ["chain", "build", *_2D, "--units", "4", "--window", "1", "--heldout", "1", "--executor", "serial",
-                    "--out", "run/t.json"],
-    "unit optimise": ["unit", "optimise", "--units", "3", "--pop", "4", "--gen", "1", "--element-size", "3.0",
-                      "--executor", "serial", "--out", "run"],
-    "calibrate": ["calibrate", "--units", "2", "--runs", "1", "--validate", "1", "--unit", "unit.toml", "--out",
-                  "run"],
-    **{f"sensitivity {s}": ["sensitivity", s, *_2D, "--units", "2", "--executor", "serial", "--out", "run"]
-       for s in ("simplifications", "tolerances", "bulk-modulus", "calibration", "temperature", "mesh")},
-    "scan synth": ["scan", "synth", "0110", *_2D, "--out", "run/scan.csv"],
-    "bimodal": ["bimodal", "-c", "0.2", "--out", "run"],
-    "composite coupon": ["composite", "coupon", "-c", "0.2", "--out", "run"],
-    "composite transition": ["composite", "transition", "-c", "0.2"],
-    "materials fit": ["materials", "fit", "stress.csv", "--model", "yeoh"],
-    "materials characterise poisson": ["materials", "characterise", "poisson", "dic.csv"],
-    "materials characterise thermal": ["materials", "characterise", "thermal", "thermal.csv"],
-    "materials characterise bilinear": ["materials", "characterise", "bilinear", "bilinear.csv"],
-    "materials show": ["materials", "show", "mold_star_15"],
-    "materials list": ["materials", "list"],
-    "serve": ["serve", "--port", "18765", "--state", "run"],
-}
+FILES = {**BASELINE_FILES, "trace.csv": TRACE}
 #: the options that take a file by name in a text option (a library's name or its file; a path target)
 NAMED_FILES = {"design": ["--library", "--target"], "simulate": ["--library"], "chain build": ["--library"],
                "export": ["--library"], "correlate": ["--library"], "materials fit": ["stress.csv"]}
@@ -168,16 +131,6 @@ def _leaves() -> dict[str, Any]:
     return walk(cli)
 
 
-def _with(argv: list[str], option: str, value: str) -> list[str]:
-    """``argv`` with ``option``'s value (or a positional file, named by its baseline value) set to ``value``."""
-    if not option.startswith("-"):
-        return [value if a == option else a for a in argv]
-    if option in argv:
-        i = argv.index(option)
-        return [*argv[:i + 1], value, *argv[i + 2:]]
-    return [*argv, option, value]
-
-
 def all_cases() -> tuple[list[Case], list[Case]]:
     """(path cases, number cases) of every command."""
     from pneumorph.cli.options import params as P
@@ -202,14 +155,14 @@ def all_cases() -> tuple[list[Case], list[Case]]:
             for option in files:
                 for value, expect in PATHS.items():
                     given = f"path:{value}" if option == "--target" else value
-                    paths.append(Case(base, option, given, _with(argv, option, given), expect))
+                    paths.append(Case(base, option, given, spoil(argv, option, given), expect))
             if base != key:
                 continue
             for param in command.params:
                 if isinstance(param.type, (P.Real, P.Count, P.RealList)) and param.param_type_name == "option":
                     option = max(param.opts, key=len)
                     for value, expect in NUMBERS.items():
-                        numbers.append(Case(key, option, value, _with(argv, option, value), expect))
+                        numbers.append(Case(key, option, value, spoil(argv, option, value), expect))
     return paths, numbers
 
 

@@ -39,11 +39,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-TIMEOUT = 120.0
+sys.path.insert(0, str(ROOT / "benchmarks"))  # the baselines beside this script, also when a test loads it
+from fuzz_baselines import BASE as BASELINES  # noqa: E402
+from fuzz_baselines import REPEATABLE, RUN_TOML, UNIT  # noqa: E402
 
-UNIT = """[unit]
-element_size = 3.0
-"""
+TIMEOUT = 120.0
 
 # The launcher: the real command line, but a 3D solve ends the case (exit 99) instead of running.
 LAUNCHER = """
@@ -87,44 +87,16 @@ def files() -> dict[str, bytes]:
     }
 
 
-# -- baselines: command lines that run in seconds ------------------------------------------
+# -- baselines: command lines that run in seconds (benchmarks/fuzz_baselines.py), by this round's names ------
 
-BASE: dict[str, list[str]] = {
-    "design": ["design", "--model", "2d", "--units", "3", "--search", "exhaustive", "--pressure", "10",
-               "--unit", "unit.toml", "--executor", "serial", "--tolerance", "0", "--out", "OUT"],
-    "design-config": ["design", "run.toml", "--out", "OUT"],
-    "simulate": ["simulate", "-o", "0110", "--model", "2d", "--pressure", "5", "--increments", "3",
-                 "--unit", "unit.toml", "--out", "OUT"],
-    "correlate": ["correlate", "trace.csv", "--design", "0110", "--model", "2d", "--pressure", "5",
-                  "--unit", "unit.toml", "--out", "OUT"],
-    "export": ["export", "0110", "--unit", "unit.toml", "--stl", "OUT"],
-    "sensitivity": ["sensitivity", "tolerances", "--model", "2d", "--units", "2", "--pressure", "5",
-                    "--unit", "unit.toml", "--samples", "1", "--executor", "serial", "--out", "OUT"],
-    "chain": ["chain", "build", "--model", "2d", "--units", "4", "--pressure", "5", "--unit", "unit.toml",
-              "--window", "1", "--heldout", "1", "--executor", "serial", "--out", "OUT.json"],
-    "unit": ["unit", "optimise", "--units", "3", "--pop", "4", "--gen", "1", "--element-size", "3.0",
-             "--executor", "serial", "--out", "OUT"],
-    "identify": ["identify", "trace.csv", "--design", "0110", "--model", "2d", "--pressure", "5",
-                 "--unit", "unit.toml", "--executor", "serial", "--out", "OUT"],
-    "materials": ["materials", "fit", "stress.csv", "--model", "yeoh", "--plot", "OUT.png"],
-    "study": ["study", "run.toml", "--populations", "4", "--seeds", "1", "--gen", "1", "--units", "3",
-              "--pressure", "5", "--executor", "serial", "--out", "OUT"],
-}
-
-RUN_TOML = """[design]
-objective = "sin"
-units = 3
-search = "exhaustive"
-
-[model]
-fidelity = "2d"
-pressure_kpa = 10.0
-increments = 3
-unit_file = "unit.toml"
-
-[execution]
-executor = "serial"
-"""
+#: this round's commands and the baselines they start from
+COMMANDS = {"design": "design", "design-config": "design-config", "simulate": "simulate", "correlate": "correlate",
+            "export": "export", "sensitivity": "sensitivity tolerances", "chain": "chain build",
+            "unit": "unit optimise", "identify": "identify", "materials": "materials fit", "study": "study"}
+#: a baseline's output under the name a case replaces (OUT, OUT.json, OUT.png)
+_OUTPUTS = {"run": "OUT", "run.json": "OUT.json", "run.png": "OUT.png"}
+BASE: dict[str, list[str]] = {name: [_OUTPUTS.get(token, token) for token in BASELINES[path]]
+                              for name, path in COMMANDS.items()}
 
 
 def _out_option(argv: list[str]) -> str | None:
@@ -227,7 +199,7 @@ HUGE = {
 
 
 # Options that may be given more than once (each value is kept).
-MULTIPLE = {("materials", "--model")}
+MULTIPLE = {(name, option) for name, path in COMMANDS.items() for option in REPEATABLE.get(path, ())}
 
 
 def _mutations(rng: random.Random, command: str) -> tuple[str, str, list[str], dict[str, str], str] | None:

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from pneumorph.checks import MODEL_NAMES
 from pneumorph.cli import main
-from pneumorph.materials.fitting.fit import MODEL_NAMES
 
 SORO = "marechal2021_SoRo-Materials-DB/Tensile-Tests-Data"
 

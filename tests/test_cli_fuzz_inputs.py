@@ -34,7 +34,7 @@ def test_every_file_and_number_option_has_its_cases() -> None:
 def test_a_case_ends_as_its_input_deserves(option: str, value: str, code: int) -> None:
     """A named pipe is refused by name (exit 2, one line); a unit file with a byte-order mark is read and the run
     goes on to its solve (the tripwire's exit 99); nan refused."""
-    case = FUZZ.Case("simulate", option, value, FUZZ._with(FUZZ.BASE["simulate"], option, value),
+    case = FUZZ.Case("simulate", option, value, FUZZ.spoil(FUZZ.BASE["simulate"], option, value),
                      FUZZ.PATHS.get(value, "refuse"))
     outcome = FUZZ.run_case(case)
     assert outcome.verdict == "clean" and outcome.code == code, outcome

@@ -8,7 +8,8 @@ Every import is read with :mod:`ast`, at the top of a module, inside its functio
 from __future__ import annotations
 
 import ast
-from collections import defaultdict
+import re
+from collections import Counter, defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -186,12 +187,6 @@ def test_no_private_name_is_imported_from_another_module() -> None:
     assert not wrong, "\n".join(wrong)
 
 
-#: names of :mod:`pneumorph.checks` still bound again in another module (``X = checks.X``); the list may only
-#: shrink: a choice has one place to import it from
-CHECKS_ALIASES = {"pneumorph.execution.evaluators:EXECUTORS", "pneumorph.materials.fitting.fit:MODEL_NAMES",
-                  "pneumorph.materials.fitting.fit:WEIGHTINGS"}
-
-
 def test_the_names_of_checks_are_imported_from_checks() -> None:
     """A module uses a choice or limit of :mod:`pneumorph.checks` by its one name there, not through an alias of its
     own (which makes a second place to import it from)."""
@@ -201,7 +196,7 @@ def test_the_names_of_checks_are_imported_from_checks() -> None:
             value = node.value if isinstance(node, (ast.Assign, ast.AnnAssign)) else None
             if isinstance(value, ast.Attribute) and isinstance(value.value, ast.Name) and value.value.id == "checks":
                 found.add(f"{name}:{value.attr}")
-    assert found == CHECKS_ALIASES
+    assert not found, f"aliases of names of pneumorph.checks: {sorted(found)}"
 
 
 def _module_lines() -> dict[str, int]:
@@ -240,3 +235,48 @@ def test_sizes_a_reader_can_hold(measure, limit: int, exceptions: dict[str, int]
     assert not new, f"over {limit} lines: {new}"
     assert not grown, f"exceptions grown past their recorded size (now, recorded): {grown}"
     assert not stale, f"no longer over {limit} lines, take them off the list: {stale}"
+
+
+ARCHITECTURE = SRC.parent / "docs" / "architecture.md"
+#: an entry of the map's tree: its indent, then a folder (``fem/``) or modules (``scoring.py, population.py``)
+#: followed by two spaces or the line's end
+MAP_ENTRY = re.compile(r"^( *)((?:[\w./]+/|\w+\.py)(?:, \w+\.py)*)(?:\s{2,}|$)")
+
+
+def map_names() -> Counter[str]:
+    """The modules the map of docs/architecture.md ("Layout") names, by path from the repository's root.
+
+    A module is named by its entry in the tree, or inside the text of its folder's entry (``composite/ ...
+    (crimp.py, ...)``); the folders nest by indent."""
+    block = ARCHITECTURE.read_text(encoding="utf-8").split("## Layout", 1)[1].split("```", 2)[1]
+    folders: list[tuple[int, str]] = []
+    named: Counter[str] = Counter()
+    folder = None
+    for line in block.splitlines():
+        entry, text = MAP_ENTRY.match(line), line
+        if entry:
+            indent, names = len(entry.group(1)), entry.group(2).split(", ")
+            while folders and folders[-1][0] >= indent:
+                folders.pop()
+            if names[0].endswith("/"):
+                folders.append((indent, names[0].rstrip("/")))
+                folder, text = "/".join(name for _, name in folders), line[entry.end():]
+            else:
+                named.update("/".join([name for _, name in folders] + [module]) for module in names)
+                folder = None
+        if folder is not None:
+            named.update(f"{folder}/{module}" for module in re.findall(r"\b(\w+\.py)\b", text))
+    return named
+
+
+def test_the_map_names_every_module_once() -> None:
+    """docs/architecture.md's map names every module of the package once, and no module that is not there (a
+    package's ``__init__.py`` is its folder's entry)."""
+    modules_ = {f"src/{path.relative_to(SRC).as_posix()}" for path in PACKAGE.rglob("*.py")
+                if path.name != "__init__.py"}
+    named = {name: count for name, count in map_names().items()
+             if name.startswith("src/pneumorph/") and not name.endswith("/__init__.py")}
+    missing, stale = sorted(modules_ - set(named)), sorted(set(named) - modules_)
+    assert not missing, f"modules missing from the map: {missing}"
+    assert not stale, f"the map names modules that are not there: {stale}"
+    assert all(count == 1 for count in named.values()), {name: count for name, count in named.items() if count > 1}

@@ -171,3 +171,18 @@ def test_the_summary_says_the_actuator_hangs() -> None:
     assert not format_result(d).splitlines()[0].endswith("under gravity")
     d["metadata"]["model"]["gravity_mm_s2"] = [9806.65, 0.0, 0.0]
     assert format_result(d).splitlines()[0].endswith(", its bulk modulus 58.3 kPa, hanging under gravity")
+
+
+def test_the_plan_counts_its_nodes_without_meshing(monkeypatch, tmp_path, capsys) -> None:
+    """A mesh past the memory is refused from its node count alone (node_count, from the grid lines): no mesh of
+    the actuator is built before the refusal."""
+    import pneumorph.bimodal.geometry as geometry
+
+    def meshing(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the plan meshed the actuator")
+
+    monkeypatch.setattr(geometry, "mesh_actuator", meshing)
+    out = tmp_path / "long"
+    assert main(["bimodal", "-c", "0.2", "--voids", "100", "--element-size", "1", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "a mesh of about 863,373 nodes, 135.0 GB for the solve" in err and not out.exists()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from pneumorph.bimodal.geometry import ASSUMED, BimodalSpec, cell_volumes, mesh_actuator
+from pneumorph.bimodal.geometry import ASSUMED, BimodalSpec, cell_volumes, mesh_actuator, node_count
 from pneumorph.errors import GeometryError
 
 
@@ -88,3 +88,13 @@ def test_station_one_void_short_of_the_tip() -> None:
     s = BimodalSpec(voids=3, element_size=3.0)
     m = mesh_actuator(s)
     assert m.points[m.station].tolist() == [[21.0, 0.0, 7.5], [21.0, s.height, 7.5]]
+
+
+@pytest.mark.parametrize(("voids", "size", "cap"), [(1, 3.0, 4.5), (2, 2.5, 0.0), (3, 1.5, 4.5), (4, 2.0, 1.0),
+                                                    (2, 1.0, 4.5)])
+@pytest.mark.parametrize(("half", "quadratic"), [(True, True), (False, True), (True, False), (False, False)])
+def test_the_node_count_is_the_meshs(voids: int, size: float, cap: float, half: bool, quadratic: bool) -> None:
+    """node_count (the grid's nodes less those inside the voids) is the number of points mesh_actuator makes, for
+    several voids, element sizes and end caps, half and full width, 8- and 20-node cells."""
+    spec = BimodalSpec(voids=voids, element_size=size, end_cap=cap)
+    assert node_count(spec, half, quadratic) == len(mesh_actuator(spec, half=half, quadratic=quadratic).points)

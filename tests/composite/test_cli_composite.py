@@ -134,3 +134,35 @@ def test_a_quiet_coupon_says_nothing_on_stderr(capsys: pytest.CaptureFixture[str
     assert code == 0 and err == ""
     assert ("transition_engineering" if more else "transition, engineering strain") in out
     assert len(list(tmp_path.iterdir())) == 5
+
+
+def test_a_coupon_run_meshes_its_coupon_once(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+                                             tmp_path: Path) -> None:
+    """The plan's title (its nodes), its estimate (LEVEL_SECONDS per node) and the solve share one mesh: the
+    builder runs once in a coupon run (the ramp replaced by a uniform stretch to the pulled end at each level)."""
+    import pneumorph.composite.coupon as coupon
+    from pneumorph.fem.stepping import RampStatistics
+
+    builds = []
+
+    def counted(*args: Any) -> Any:
+        builds.append(args)
+        return build(*args)
+
+    def pulled_only(items: Any, fields: Any, apply: Any, dof1: Any, dof0: Any, settings: Any, on_level: Any,
+                    **kwargs: Any) -> RampStatistics:
+        u, x = fields[0].values, fields[0].region.mesh.points[:, 0]
+        for k in range(settings.increments):
+            apply((k + 1) / settings.increments)
+            u[:, 0] = u[:, 0].max() * x / x.max()  # a uniform stretch up to the pulled end
+            on_level(k, (k + 1) / settings.increments)
+        return RampStatistics()
+
+    build = coupon.coupon_mesh
+    monkeypatch.setattr(coupon, "coupon_mesh", counted)
+    monkeypatch.setattr(coupon, "ramp", pulled_only)
+    # a thickness no other test meshes, so that no mesh of these parameters was built before
+    code, _, err = run(capsys, "composite", "coupon", "-c", "0.3", "--length", "20", "--thickness", "4.75",
+                       "--per-flute", "1", "--rows", "1", "--levels", "20", "--gauges", "0", "-q")
+    assert code == 0, err
+    assert len(builds) == 1, builds

@@ -112,3 +112,21 @@ def test_a_cap_past_the_memory_budget_is_refused_before_the_search(tmp_path: Pat
     assert err[0].startswith("error: Invalid value for '--max-open': max_open 5,000,000: the open prefixes of a loose "
                              "chain table could take 30.0 GB at one depth")
     assert "past the 4.0 GB budget (MAX_OPEN_MEMORY); give at most 666,666" in err[0]
+
+
+def test_a_chain_in_space_budgets_its_prefixes_by_their_own_bytes() -> None:
+    """Over the ``spatial`` library (4 children a prefix, 10 levels) a prefix in space takes SPACE_PREFIX_BYTES
+    (310 bytes a child and level, measured; 300 in the plane): 322,580 open prefixes fit the 4 GB budget, where a
+    planar library of two types (``a`` and the rigid ``r`` of the examples) fits 333,333; a cap of 330,000 is
+    refused in space only."""
+    from pneumorph.design.algorithms.certified import max_open
+    from pneumorph.design.config import DesignConfig
+
+    space = make_model(15, {"fidelity": "3d", "library": "spatial"})
+    rigid = Path(__file__).resolve().parents[2] / "examples" / "libraries" / "units-bending-rigid.toml"
+    plane = make_model(15, {"fidelity": "3d", "library": str(rigid)})
+    assert len(space.library.units) == len(plane.library.units) == 2
+    assert len(space.pressures()) == len(plane.pressures()) == 10
+    assert max_open(DesignConfig(max_open=330_000), plane) == 330_000
+    with pytest.raises(SearchBudgetError, match=r"in space\), past the 4.0 GB budget .*give at most 322,580"):
+        max_open(DesignConfig(max_open=330_000), space)

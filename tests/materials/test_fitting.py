@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from pneumorph import __version__
+from pneumorph.checks import MODEL_NAMES
 from pneumorph.errors import FitError, UnknownModelError
 from pneumorph.materials.characterisation.datasets import load_dataset
 from pneumorph.materials.characterisation.testdata import TestCurve, TestData, read_curve
 from pneumorph.materials.fitting.comparison import compare
 from pneumorph.materials.fitting.fit import (
-    MODEL_NAMES,
     fit,
     r_squared,
     resolve_model,

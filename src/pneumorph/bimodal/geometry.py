@@ -261,6 +261,47 @@ def _label(spec: BimodalSpec, centres: FloatArray) -> IntArray:
     return np.where(void, VOID, label).astype(np.int64)
 
 
+def _lines(spec: BimodalSpec, half: bool) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The grid lines in x, y and z: a line on every interface and void wall, no gap wider than the element."""
+    P, W, h = spec.pitch, spec.width, spec.element_size
+    vx0, vx1, _, _ = spec.void
+    xb = [i * P + x for i in range(spec.voids) for x in (0.0, vx0, vx1)] + [spec.voids * P, spec.length]
+    zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
+    return grid_lines(xb, h), grid_lines([0.0, *spec.interfaces], h), grid_lines(zb, h)
+
+
+def node_count(spec: BimodalSpec, half: bool = True, quadratic: bool = True) -> int:
+    """The nodes of :func:`mesh_actuator`'s mesh, counted from its grid lines without meshing.
+
+    The grid's nodes (:func:`~pneumorph.geometry.meshsize.grid_nodes`) less those no cell keeps: inside each
+    void, the grid points strictly within it and, for 20-node cells, the edges through its inside (a half model's
+    void reaches the mid-plane z = width / 2, whose points within the void go too).
+
+    Examples
+    --------
+    >>> node_count(BimodalSpec(voids=15, element_size=2.5))  # the mesh of the plan's measured ramps
+    16291
+    >>> node_count(BimodalSpec(voids=2, element_size=3.0), half=False, quadratic=False)
+    1032
+    """
+    from pneumorph.geometry.meshsize import grid_nodes
+
+    xs, ys, zs = _lines(spec, half)
+    vx0, vx1, vy0, vy1 = spec.void
+    z1 = spec.width / 2 if half else spec.width - spec.side_wall
+
+    def inside(lines: FloatArray, lo: float, hi: float) -> int:
+        return int(np.count_nonzero((lines > lo + 1e-6) & (lines < hi - 1e-6)))
+
+    # lines strictly inside the first void (every void meshes alike), and its cells along each axis
+    mx, my, mz = inside(xs, vx0, vx1), inside(ys, vy0, vy1), inside(zs, spec.side_wall, z1)
+    ax, ay, az = mx + 1, my + 1, mz + 1
+    mz += 1 if half else 0  # the mid-plane's points within the void: no cell on its other side
+    gone = mx * my * mz + (ax * my * mz + mx * ay * mz + mx * my * az if quadratic else 0)
+    grid = grid_nodes(len(xs) - 1, len(ys) - 1, len(zs) - 1, 3, 2 if quadratic else 1)
+    return grid - spec.voids * gone
+
+
 def mesh_actuator(spec: BimodalSpec, half: bool = True, quadratic: bool = True) -> BimodalMesh:
     """Mesh the actuator as a structured hexahedral grid with a line on every interface.
 
@@ -285,14 +326,8 @@ def mesh_actuator(spec: BimodalSpec, half: bool = True, quadratic: bool = True) 
     import felupe as fem
 
     P, W = spec.pitch, spec.width
-    h = spec.element_size
     vx0, vx1, _, _ = spec.void
-    xb = [i * P + x for i in range(spec.voids) for x in (0.0, vx0, vx1)] + [spec.voids * P, spec.length]
-    xs = grid_lines(xb, h)
-    ys = grid_lines([0.0, *spec.interfaces], h)
-    zb = [0.0, spec.side_wall, W / 2] if half else [0.0, spec.side_wall, W / 2, W - spec.side_wall, W]
-    zs = grid_lines(zb, h)
-    grid = fem.Grid(xs, ys, zs)
+    grid = fem.Grid(*_lines(spec, half))
     label = _label(spec, grid.points[grid.cells].mean(axis=1))
     keep = label != VOID
     cells, label = grid.cells[keep], label[keep]

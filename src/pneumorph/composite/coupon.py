@@ -28,7 +28,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import partial
+from functools import lru_cache, partial
 from typing import Any, Literal
 
 import numpy as np
@@ -51,6 +51,24 @@ AMPLITUDE = 1.5
 #: levels to 10 % past the straight paper) took 12.1 s (CR 0.2, 1,701 nodes), 15.5 s (CR 0.25, 2,133) and 20.7 s
 #: (CR 0.3, 2,547 nodes, two cut-backs)
 LEVEL_SECONDS = 7.5e-5
+
+
+@lru_cache(maxsize=8)
+def meshed(crimp: Crimp, thickness: float, per_flute: int, rows: int) -> CouponMesh:
+    """The coupon's mesh (:func:`~pneumorph.composite.mesh.coupon_mesh`), built once per set of parameters.
+
+    A coupon command names the mesh's nodes in its plan, estimates its levels from them and solves on it: one
+    mesh, shared, so its arrays are read-only.
+
+    >>> from pneumorph.composite.crimp import Crimp
+    >>> m = meshed(Crimp.from_ratio(0.25, 1.5, 176.25), 5.0, 4, 4)
+    >>> len(m.points), m.points.flags.writeable
+    (2133, False)
+    """
+    mesh = coupon_mesh(crimp, thickness, per_flute, rows)
+    for array in (mesh.points, mesh.quads, mesh.lines, mesh.grid, mesh.kinks):
+        array.flags.writeable = False
+    return mesh
 
 
 @dataclass(frozen=True)
@@ -111,8 +129,13 @@ class CouponSpec:
         return cls(crimp=Crimp.from_ratio(crimp_ratio, amplitude, length), **kwargs)
 
     def mesh(self) -> CouponMesh:
-        """The structured mesh of this coupon."""
-        return coupon_mesh(self.crimp, self.thickness, self.per_flute, self.rows)
+        """The structured mesh of this coupon, built once for its parameters (:func:`meshed`).
+
+        >>> s = CouponSpec.from_ratio(0.25)
+        >>> s.mesh() is CouponSpec.from_ratio(0.25).mesh()
+        True
+        """
+        return meshed(self.crimp, float(self.thickness), int(self.per_flute), int(self.rows))
 
     def level_seconds(self) -> float:
         """Estimated CPU seconds of one load level of :func:`simulate_coupon` (:data:`LEVEL_SECONDS` per node).

@@ -49,7 +49,7 @@ from pneumorph.design.search.exhaustive import MAX_UNITS as EXHAUSTIVE_MAX_UNITS
 from pneumorph.design.search.genetic import GAConfig
 from pneumorph.design.settings import address, curve_points, flag, integer, real, stage_tables, text, tip_point
 from pneumorph.errors import SearchConfigError, TargetExpressionError, UnknownObjectiveError
-from pneumorph.execution.evaluators import EXECUTORS, check_execution
+from pneumorph.execution.evaluators import check_execution
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.io.files import read_toml
 
@@ -118,7 +118,7 @@ class DesignConfig:
             raise SearchConfigError(
                 f"the exhaustive search takes at most {EXHAUSTIVE_MAX_UNITS} units (2^{self.units} = "
                 f"{2 ** self.units:,} designs for {self.units}); use the certified search or the genetic algorithm")
-        text(self.executor, "[execution] executor", EXECUTORS)
+        text(self.executor, "[execution] executor", checks.EXECUTORS)
         integer(self.seed, "[design] seed", 0, 2**32 - 1)
         flag(self.certify, "[design] certify")
         flag(self.anchored, "[design] anchored")

@@ -15,7 +15,6 @@ from pneumorph.execution.cache import (
     default_cache_path,
 )
 from pneumorph.execution.evaluators import (
-    EXECUTORS,
     DaskEvaluator,
     Evaluator,
     ProcessPoolEvaluator,
@@ -25,7 +24,6 @@ from pneumorph.execution.evaluators import (
 from pneumorph.execution.outcome import Outcome, solve
 
 __all__ = [
-    "EXECUTORS",
     "CachedEvaluator",
     "DaskEvaluator",
     "EvaluationCache",

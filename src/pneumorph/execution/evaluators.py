@@ -30,7 +30,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from pneumorph import checks
+from pneumorph.checks import EXECUTORS
 from pneumorph.errors import SearchConfigError
 from pneumorph.execution.cluster import (
     MMAP_THRESHOLD,
@@ -42,10 +42,6 @@ from pneumorph.execution.cluster import (
 )
 from pneumorph.execution.pool import ProcessPoolEvaluator, prepare_worker
 from pneumorph.execution.serial import THREAD_VARIABLES, Evaluator, SerialEvaluator
-
-#: The names :func:`make_evaluator` knows: in this process, a process pool, a Dask cluster (defined in
-#: :mod:`pneumorph.checks`, which the command line's options read without importing the evaluators).
-EXECUTORS = checks.EXECUTORS
 
 #: Most worker processes per core of this machine (a pool or a local Dask cluster): each solves one design at a
 #: time on one core, so more share the cores and multiply the memory.
@@ -128,6 +124,6 @@ def make_evaluator(
     return DaskEvaluator(scheduler, workers=workers, timeout=timeout, on_message=on_message)
 
 
-__all__ = ["EXECUTORS", "MMAP_THRESHOLD", "THREAD_VARIABLES", "TRIM_THRESHOLD", "DaskEvaluator", "Evaluator",
+__all__ = ["MMAP_THRESHOLD", "THREAD_VARIABLES", "TRIM_THRESHOLD", "DaskEvaluator", "Evaluator",
            "ProcessPoolEvaluator", "SerialEvaluator", "SolverSettings", "check_execution", "make_evaluator",
            "prepare_worker", "solver_plugin", "tune_allocator"]

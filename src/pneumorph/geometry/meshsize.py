@@ -141,19 +141,23 @@ def estimate_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True,
     nx = int(units) * cells_between(xb, h) + (cells_between([0.0, spec.end_cap], h) if spec.end_cap > 0 else 0)
     ny = cells_between(yb, h)
     nz = cells_between(zb, h) if dim == 3 else 1
-    cells, elements, nodes = (nx, ny, nz), nx * ny * nz, _grid_nodes(nx, ny, nz, dim, spec.element_order)
+    cells, elements, nodes = (nx, ny, nz), nx * ny * nz, grid_nodes(nx, ny, nz, dim, spec.element_order)
     if base is not None:  # the block before the base face, with its margin's cells (the face it shares counted twice)
         m = float(base.margin)
         bx = cells_between([-float(base.length), 0.0], h)
         by = cells_between([*yb, -m, spec.height + m], h)
         bz = cells_between([*zb, -m] if half else [*zb, -m, spec.width + m], h) if dim == 3 else 1
         cells, elements = (nx + bx, by, bz), elements + bx * by * bz
-        nodes += _grid_nodes(bx, by, bz, dim, spec.element_order)
+        nodes += grid_nodes(bx, by, bz, dim, spec.element_order)
     return MeshEstimate(cells, elements, nodes, solve_memory(nodes, dim), dim)
 
 
-def _grid_nodes(nx: int, ny: int, nz: int, dim: int, order: int) -> int:
-    """Nodes of a structured grid of ``nx x ny (x nz)`` cells: corners, and mid-edge nodes if ``order`` is 2."""
+def grid_nodes(nx: int, ny: int, nz: int, dim: int, order: int) -> int:
+    """Nodes of a structured grid of ``nx x ny (x nz)`` cells: corners, and mid-edge nodes if ``order`` is 2.
+
+    >>> grid_nodes(1, 1, 1, 3, 2), grid_nodes(2, 1, 1, 2, 1)  # one hex20; two quad4
+    (20, 6)
+    """
     if dim == 3:
         nodes = (nx + 1) * (ny + 1) * (nz + 1)
         if order == 2:  # a mid-node on every edge of the grid
@@ -277,4 +281,5 @@ def check_mesh(spec: UnitSpec, units: int, dim: int, half: bool = True, memory: 
 
 
 __all__ = ["BASE_BYTES", "BYTES_3D", "BYTES_PER_NODE_2D", "MAX_NODES_2D", "MAX_NODES_3D", "MeshEstimate",
-           "available_memory", "cells_between", "check_mesh", "estimate_mesh", "solve_memory"]
+           "available_memory", "cells_between", "check_mesh", "estimate_mesh", "grid_nodes",
+           "solve_memory"]

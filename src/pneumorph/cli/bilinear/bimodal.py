@@ -129,15 +129,13 @@ def bimodal(crimp_ratio: str, pmax: float, step: float, voids: int, element_size
 
 def _level_seconds(spec: Any) -> float:
     """CPU seconds of one level of the bimodal actuator ``spec`` (:data:`LEVEL_SECONDS`), its nodes counted from
-    meshes of one and two voids (the grid repeats void by void); a solve estimated to need more memory than is
-    available (:func:`~pneumorph.geometry.meshsize.solve_memory`) is refused, naming --voids and --element-size."""
-    from dataclasses import replace
-
-    from pneumorph.bimodal.geometry import mesh_actuator
+    its grid lines without meshing (:func:`~pneumorph.bimodal.geometry.node_count`); a solve estimated to need
+    more memory than is available (:func:`~pneumorph.geometry.meshsize.solve_memory`) is refused, naming --voids
+    and --element-size."""
+    from pneumorph.bimodal.geometry import node_count
     from pneumorph.geometry.meshsize import available_memory, solve_memory
 
-    one, two = (len(mesh_actuator(replace(spec, voids=n)).points) for n in (1, 2))
-    nodes = one + (spec.voids - 1) * (two - one)
+    nodes = node_count(spec)
     need, free = solve_memory(nodes, 3), available_memory()
     if need > free:
         raise click.UsageError(f"--voids {spec.voids} --element-size {spec.element_size:g}: a mesh of about "

@@ -26,7 +26,7 @@ from pneumorph.design.objectives.fitness import Score
 from pneumorph.design.runs.comparison import compare_with_reference
 from pneumorph.design.runs.robustness import chain_robustness, winner_robustness
 from pneumorph.errors import LocalityError, MissingTableError, PneumorphError, SearchConfigError
-from pneumorph.models.chain.model import ChainModel
+from pneumorph.models.chain.model import ChainModel, in_space
 from pneumorph.models.chain.sources import limits_text, serve_table, served_as_built, table_for
 from pneumorph.models.factory import make_model
 from pneumorph.models.response import ActuatorModel
@@ -44,8 +44,9 @@ LOOSE_NODES = 20_000
 def max_open(config: Any, model: Any, loose: bool = False) -> int:
     """The open prefixes the certified search's branch-and-bound keeps at most for ``model``: ``[design] max_open``
     if given, else :data:`~pneumorph.design.certified.branching.MAX_NODES` lowered to fit
-    :data:`~pneumorph.design.certified.branching.MAX_OPEN_MEMORY` (``2k`` children a prefix over ``k`` unit types),
-    and at most :data:`LOOSE_NODES` for a ``loose`` table.
+    :data:`~pneumorph.design.certified.branching.MAX_OPEN_MEMORY` (``2k`` children a prefix over ``k`` unit types;
+    a chain in space's prefixes take more, :func:`~pneumorph.design.certified.branching.prefix_bytes`), and at most
+    :data:`LOOSE_NODES` for a ``loose`` table.
 
     Raises :class:`~pneumorph.errors.SearchBudgetError` where the given cap's memory passes the budget.
 
@@ -61,7 +62,7 @@ def max_open(config: Any, model: Any, loose: bool = False) -> int:
     """
     library = getattr(model, "library", None)
     choices = 2 * len(library.units) if library is not None else 2
-    cap = open_cap(choices, len(model.pressures()), config.max_open)
+    cap = open_cap(choices, len(model.pressures()), config.max_open, space=in_space(model))
     return cap if config.max_open is not None or not loose else min(cap, LOOSE_NODES)
 
 

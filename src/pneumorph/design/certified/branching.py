@@ -36,10 +36,17 @@ machine. A cap on open prefixes whose memory would pass it is refused before the
 lowered to fit it (a unit library's ``2k`` children per prefix)."""
 
 PREFIX_BYTES = 300.0
-"""Bytes of one child prefix per pressure level while a depth is pruned: its state (point, angle, partial sums)
-and the bound's temporaries. Measured on the 2D table, 22 units, 10 levels, a sine profile with the bound x64
-(every prefix open): the peak memory grew by 6.0 kB per open prefix of 2 children from 50,000 to 200,000 kept
-(BENCHMARKS.md, "The certified search's open prefixes")."""
+"""Bytes of one child prefix per pressure level while a depth is pruned, in the plane: its state (point, angle,
+partial sums) and the bound's temporaries. Measured on the 2D and on the 3D table, 22 units, 10 levels, a sine
+profile with the bound x64 (2D) and x256 (3D; every prefix open): the peak memory grew by 6.0 kB per open prefix of
+2 children from 50,000 to 200,000 kept, on both (BENCHMARKS.md, "The certified search's open prefixes")."""
+
+SPACE_PREFIX_BYTES = 310.0
+"""Bytes of one child prefix per pressure level while a depth is pruned, in space (a chain of the ``spatial``
+library: each prefix's point and frame, partial sums in y and z). Measured as :data:`PREFIX_BYTES` on its 3D table,
+14 units of 4 children a prefix, 10 levels, a sine with the bound x64 (every prefix open): 12.3 kB more per open
+prefix from 40,000 to 160,000 kept, 308 bytes a child and level (BENCHMARKS.md, "The certified search's open
+prefixes")."""
 
 BEAM = 4096
 """Prefixes the first search keeps at every depth (a good design, whose cost sets the threshold)."""
@@ -49,35 +56,50 @@ class BranchOverflow(SearchBudgetError):
     """The branch-and-bound keeps more open prefixes than it may (:data:`MAX_NODES`, ``[design] max_open``)."""
 
 
-def open_memory(nodes: int, choices: int, levels: int) -> float:
+def prefix_bytes(space: bool = False) -> float:
+    """Bytes of one child prefix per pressure level: :data:`SPACE_PREFIX_BYTES` for a chain in space, else
+    :data:`PREFIX_BYTES`.
+
+    >>> prefix_bytes(), prefix_bytes(space=True)
+    (300.0, 310.0)
+    """
+    return SPACE_PREFIX_BYTES if space else PREFIX_BYTES
+
+
+def open_memory(nodes: int, choices: int, levels: int, space: bool = False) -> float:
     """Bytes the branch-and-bound takes at a depth with ``nodes`` open prefixes of ``choices`` children each, over
-    ``levels`` pressure levels (:data:`PREFIX_BYTES`).
+    ``levels`` pressure levels (:func:`prefix_bytes`; ``space``: a chain in space).
 
     >>> round(open_memory(MAX_NODES, 2, 10) / 1e9, 1), round(open_memory(MAX_NODES, 8, 10) / 1e9, 1)
     (3.0, 12.0)
+    >>> round(open_memory(MAX_NODES, 4, 10, space=True) / 1e9, 1)
+    6.2
     """
-    return float(nodes) * int(choices) * int(levels) * PREFIX_BYTES
+    return float(nodes) * int(choices) * int(levels) * prefix_bytes(space)
 
 
-def open_cap(choices: int, levels: int, max_open: int | None = None, budget: float = MAX_OPEN_MEMORY) -> int:
+def open_cap(choices: int, levels: int, max_open: int | None = None, budget: float = MAX_OPEN_MEMORY,
+             space: bool = False) -> int:
     """The open prefixes a branch-and-bound keeps at most: ``max_open`` if given (refused where its memory passes
-    ``budget``), else :data:`MAX_NODES`, lowered to what fits ``budget``.
+    ``budget``), else :data:`MAX_NODES`, lowered to what fits ``budget`` (``space``: a chain in space, whose
+    prefixes take more, :func:`prefix_bytes`).
 
-    >>> open_cap(2, 10), open_cap(8, 10)
-    (500000, 166666)
+    >>> open_cap(2, 10), open_cap(8, 10), open_cap(4, 10), open_cap(4, 10, space=True)
+    (500000, 166666, 333333, 322580)
     >>> open_cap(2, 10, max_open=2_000_000)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     pneumorph.errors.SearchBudgetError: max_open 2,000,000: ... 12.0 GB at one depth ...; give at most 666,666
     """
-    fits = int(budget // (int(choices) * int(levels) * PREFIX_BYTES))
+    fits = int(budget // (int(choices) * int(levels) * prefix_bytes(space)))
     if max_open is None:
         return max(1, min(MAX_NODES, fits))
     if int(max_open) > fits:
         raise SearchBudgetError(
             f"max_open {int(max_open):,}: the open prefixes of a loose chain table could take "
-            f"{open_memory(int(max_open), choices, levels) / 1e9:.1f} GB at one depth ({choices} children each, "
-            f"{levels} levels), past the {budget / 1e9:.1f} GB budget (MAX_OPEN_MEMORY); give at most {fits:,}")
+            f"{open_memory(int(max_open), choices, levels, space) / 1e9:.1f} GB at one depth ({choices} children "
+            f"each, {levels} levels{', in space' if space else ''}), past the {budget / 1e9:.1f} GB budget "
+            f"(MAX_OPEN_MEMORY); give at most {fits:,}")
     return int(max_open)
 
 
@@ -199,5 +221,6 @@ def union(a: ChainScores, b: ChainScores) -> ChainScores:
                        floor=a.floor, choices=a.choices)
 
 
-__all__ = ["BEAM", "MAX_ENUMERATE", "MAX_NODES", "MAX_OPEN_MEMORY", "PREFIX_BYTES", "BranchOverflow", "OpenWatch",
-           "cap_text", "kept", "more_open_advice", "narrow", "open_cap", "open_memory", "union", "watching"]
+__all__ = ["BEAM", "MAX_ENUMERATE", "MAX_NODES", "MAX_OPEN_MEMORY", "PREFIX_BYTES", "SPACE_PREFIX_BYTES",
+           "BranchOverflow", "OpenWatch", "cap_text", "kept", "more_open_advice", "narrow", "open_cap", "open_memory",
+           "prefix_bytes", "union", "watching"]

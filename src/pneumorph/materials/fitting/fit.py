@@ -61,8 +61,7 @@ from typing import Any
 
 import numpy as np
 
-from pneumorph import checks
-from pneumorph.checks import MODES
+from pneumorph.checks import MODEL_NAMES, MODES, WEIGHTINGS
 from pneumorph.errors import FitError, UnknownModelError
 from pneumorph.materials.characterisation.testdata import TestCurve, TestData
 from pneumorph.materials.fitting.ogden import fit_ogden
@@ -77,9 +76,6 @@ from pneumorph.materials.laws.hyperelastic import (
     drucker_stability,
 )
 
-#: Names accepted by :func:`fit` (``N`` is a number of terms, 1-6).
-MODEL_NAMES = checks.MODEL_NAMES
-WEIGHTINGS = checks.WEIGHTINGS
 _MAX_TERMS = 6
 
 
@@ -278,7 +274,7 @@ def fit(model_name: str, data: TestData | TestCurve, *, modes: Sequence[str] | N
     Parameters
     ----------
     model_name : str
-        One of :data:`MODEL_NAMES`.
+        One of :data:`pneumorph.checks.MODEL_NAMES` (``N`` is a number of terms, 1-6).
     data : TestData or TestCurve
         The measurements; every mode present is used unless ``modes`` says otherwise.
     modes : sequence of str, optional
