@@ -118,3 +118,34 @@ def test_large_systems_start_in_double_precision(monkeypatch: pytest.MonkeyPatch
 
     monkeypatch.setattr(newton, "SINGLE_PRECISION_MAX_DOFS", 1000)
     assert _model(increments=1).evaluate("0").metadata["precision"] == "double"
+
+
+class ShortSteps:
+    """An obstacle's step limit that lets every Newton step go only ``fraction`` of its way, touched by no node
+    (the interface :func:`~pneumorph.fem.fast.contact.contact_fraction` and the contact checks read)."""
+
+    friction = 0.0
+
+    def __init__(self, fraction: float) -> None:
+        self.fraction = fraction
+
+    def step_fraction(self, x: np.ndarray, dx: np.ndarray, motion: float = 0.0) -> float:
+        return self.fraction
+
+    def states(self, x: np.ndarray) -> np.ndarray:
+        return np.zeros(len(x), dtype=np.int8)
+
+
+def test_steps_cut_short_say_nothing_of_the_precision() -> None:
+    """Fresh steps cut to a quarter by an obstacle's step limit lower the residual of a linear system by 0.75,
+    less than the reuse factor 0.7 asks: cut short, they do not judge the single-precision factorisation, which
+    stays (a well-conditioned system, condition 1e5) and converges to the exact solution."""
+    system = LinearisedScan(1e5)
+    system.points = np.zeros((len(system.f), 1))
+    system.contacts = (ShortSteps(0.25),)
+    step = FastSubstep(system, reuse=Full3D.tangent_reuse, depth=Full3D.anderson_depth)
+    fields = [SimpleNamespace(values=np.zeros(len(system.f)))]
+    iterations, cause = step(fields, SimpleNamespace(max_iterations=80, tolerance=1e-5))
+    assert cause is None and step.precision == "single"
+    assert step.factorisations == iterations  # every short step gained less than the reuse factor: refreshed
+    np.testing.assert_allclose(fields[0].values, np.linalg.solve(system.K, system.f), rtol=1e-3)

@@ -74,7 +74,10 @@ RISE = 3.0
 #: tangent grows as the elements shrink) each step removes only a fraction of the
 #: residual: the 15-unit actuator at 1.0 mm elements stalled at 1e-7 (tolerance 1e-8)
 #: with fresh single-precision tangents each gaining a factor 0.8, and converged in 5-11
-#: iterations per level in double precision.
+#: iterations per level in double precision. Steps cut short by an obstacle's step limit or
+#: the line search do not count: on a finger pressed on a cylinder they turned the ramp to
+#: double precision after its first substep in contact, where a factorisation costs 1.5-1.8
+#: times one in single precision (``BENCHMARKS.md``, "A hard press").
 STALLED_FRESH = 2
 
 #: Active unknowns above which a system that may factorise in single precision starts in
@@ -187,7 +190,7 @@ class FastSubstep:
 
     A system with more than ``single_max_dofs`` active unknowns factorises in
     double precision from the start. A single-precision factorisation (the 3D default) whose
-    fresh tangents stop converging (:data:`STALLED_FRESH` in a row each gaining less than
+    fresh tangents stop converging (:data:`STALLED_FRESH` whole steps in a row each gaining less than
     ``reuse``) is replaced by a
     double-precision one for the rest of the ramp (:attr:`precision`), from the state
     reached: a finer mesh is worse conditioned and needs it.
@@ -337,9 +340,10 @@ class FastSubstep:
             values[:] = u.reshape(values.shape)
 
     def _trial(self, u: FloatArray, x: FloatArray, step: FloatArray, fresh: bool, previous: float, border: Any
-               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float, float]:
+               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float, float, bool]:
         """The iterate of ``step`` (over the active dofs, then the border's unknowns) from ``(u, x)``:
-        ``(step taken, u_new, x_new, its residual, smallest det F, relative residual)``, its load set.
+        ``(step taken, u_new, x_new, its residual, smallest det F, relative residual, whether the step was cut
+        short)``, its load set.
 
         On a body with obstacles, the step is first shortened to carry no node deep into an obstacle it was not
         pressing on, nor farther than :data:`MOTION` times the substep's predicted motion or the obstacles'
@@ -358,7 +362,9 @@ class FastSubstep:
         contacts = getattr(system, "contacts", ())
         backtracks = BACKTRACKS if fresh and len(contacts) else 0
         growth = FRICTION_GROWTH if any(c.friction > 0.0 for c in contacts) else GROWTH
-        step = contact_fraction(system, u, step[:n], self._motion) * step
+        fraction = contact_fraction(system, u, step[:n], self._motion)
+        step = fraction * step
+        trial = 0
         for trial in range(backtracks + 1):
             if trial:
                 step = 0.5 * step
@@ -373,7 +379,7 @@ class FastSubstep:
                     fnorm + border.error(u_new) <= growth * previous
                     or (x.size and not contacts_changed(system, u, u_new))):
                 break
-        return step, u_new, x_new, r_new, jmin, fnorm
+        return step, u_new, x_new, r_new, jmin, fnorm, fraction < 1.0 or trial > 0
 
     def _record(self, fnorm: float, fresh: bool) -> None:
         self.best = min(self.best, fnorm)
@@ -410,11 +416,12 @@ class FastSubstep:
             step = _anderson(f, dU, dF)
             if not np.all(np.isfinite(step)):
                 return iteration, "the linear solve gave a non-finite increment"
-            step, u_new, x_new, r_new, jmin, fnorm_new = self._trial(u, x, step, fresh, fnorm + error, border)
+            step, u_new, x_new, r_new, jmin, fnorm_new, cut = self._trial(u, x, step, fresh, fnorm + error, border)
             error_new = border.error(u_new)
             self._record(fnorm_new, fresh)
             changed = REFRESH_ON_CHANGE and bool(contacts) and contacts_changed(system, u, u_new, sliding=True)
-            if fresh and not changed:  # (a step that changed the contacts says nothing of the precision)
+            if fresh and not changed and not cut:  # (a step that changed the contacts or was cut short says
+                # nothing of the precision: only a whole Newton step's gain measures the factorisation)
                 poor = poor + 1 if not fnorm_new < reuse * fnorm else 0
             rose = not fresh and not (fnorm_new + error_new < fnorm + error and jmin > 0.0)
             if rose and (bool(contacts) or not kept_rise(fnorm_new + error_new, fnorm + error, jmin)):

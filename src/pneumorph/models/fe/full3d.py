@@ -78,7 +78,9 @@ class Full3D(FEModel):
     # none (66.3 s against 49.6 s CPU), aALlaaLLAaalLAa 92 and 24 against 90 and 27, the planar
     # 111000000111111 82 and 14 against 86 and 15. Against a cylinder (001111010001001,
     # "path:22.5:5;4") it took 122 iterations and 64 factorisations against 102 and 52: a tip that
-    # slides on an obstacle does not follow a smooth path
+    # slides on an obstacle does not follow a smooth path. The linear one is no better there: 102 and 47
+    # on that cylinder, but 139, 71 and a cut-back against 91 and 34 on 111000000111111 grazing its
+    # cylinder ("tip;4") with friction 0.5
     free_predictor_order = 3
     default_steps = StepSettings(increments=10, substeps=1, max_iterations=25)
     # a tangent assembled and factorised costs several residuals: keep it while the
