@@ -38,6 +38,9 @@ FOUND: list[object] = [
     # run had started (config.toml left), naming an API argument; it now solves every design
     _C("design-config", "config", "gravity across", _BASE["design-config"],
        {"run.toml": _TOML.replace("[model]\n", "[model]\ngravity = [0, -9810]\n")}, "run"),
+    # a scan of 1e300 mm coordinates: refused, but with an overflow's RuntimeWarning on stderr beside the line
+    *(_C(command, "scan", "1e300", _BASE[command], {"trace.csv": "x,y\n" + "1e300,1e300\n" * 50}, "refuse")
+      for command in ("correlate", "identify")),
 ]
 
 

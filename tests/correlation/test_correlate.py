@@ -102,6 +102,25 @@ def test_scans_of_the_wrong_size_or_no_scan_at_all_are_refused(tmp_path: Path, s
         read_scan(few)
 
 
+def test_scans_near_the_range_of_a_number_are_refused_in_one_line_without_a_warning(tmp_path: Path) -> None:
+    """Coordinates of 1e300 mm overflowed when squared for the spread (a RuntimeWarning beside the refusal);
+    a scale that takes coordinates past the range of a number left infinities in the scan."""
+    import warnings
+
+    same = tmp_path / "same.csv"
+    same.write_text("x,y\n" + "1e300,1e300\n" * 50, encoding="utf-8")
+    spread = tmp_path / "spread.csv"
+    spread.write_text("x,y\n" + "".join(f"{i * 1e305:g},{(i % 7) * 1e305:g}\n" for i in range(60)),
+                      encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ScanError, match="straight line"):
+            read_scan(same)
+        with pytest.raises(ScanError, match=r"times the scale \(1e\+06 mm per unit\) pass the range"):
+            read_scan(spread, scale=1e6)
+        assert read_scan(spread).points.max() == pytest.approx(59e305)  # in range: kept as it is
+
+
 def test_a_mesh_scan_round_trips_through_stl(tmp_path: Path, shape3d) -> None:  # type: ignore[no-untyped-def]
     import trimesh
 

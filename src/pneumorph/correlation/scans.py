@@ -140,7 +140,12 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
     if not np.all(np.isfinite(points)):
         raise ScanError(f"scan {p}: some coordinates are not finite")
     check_spread(p, points)
-    return Scan(points * factor, faces, str(p))
+    with np.errstate(over="ignore"):  # said below in one line, not as a warning
+        scaled = points * factor
+    if not np.all(np.isfinite(scaled)):
+        raise ScanError(f"scan {p}: some coordinates times the scale ({factor:g} mm per unit) pass the range of a "
+                        "number; check the scan's unit or scale")
+    return Scan(scaled, faces, str(p))
 
 
 #: Least spread of a scan across its thinnest direction, relative to its widest (singular values of the centred
@@ -170,6 +175,9 @@ def check_spread(path: str | Path, points: FloatArray) -> None:
     >>> check_spread("trace.csv", np.c_[line[:, 0], np.sin(line[:, 0])])
     """
     centred = points - points.mean(axis=0)
+    size = float(np.abs(centred).max()) if centred.size else 0.0
+    if size > 0:  # the ratio is the same at any scale; coordinates near the float range would overflow squared
+        centred = centred / size
     spread = np.sqrt(np.clip(np.linalg.eigvalsh(centred.T @ centred), 0.0, None))  # ascending
     if spread[-1] > 0 and spread[0] >= MIN_SPREAD * spread[-1]:
         return
