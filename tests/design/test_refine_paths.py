@@ -117,3 +117,16 @@ def test_a_refinement_the_locality_fallback_would_drop_is_refused(solves: list[t
     assert code == 2 and "Traceback" not in err
     assert "--refine 1: the chain model does not reproduce" in err and "is not started" in err
     assert not out.exists() and solves == []
+
+
+def test_a_refinement_whose_library_units_no_longer_join_is_refused_before_any_solve(
+        solves: list[tuple[float, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The built-in library's units share grid lines at 1.5 mm (and 0.75 mm), not at 1.0 mm: refused after the
+    verification's solves, at the refinement, before the check built the refined library."""
+    out = tmp_path / "never"
+    code = main(["design", "--model", "2d", "--library", "builtin", "--refine", "1.0", "--tolerance", "0",
+                 "--executor", "serial", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert "'--refine'" in err and "cannot be joined" in err
+    assert not out.exists() and solves == []
