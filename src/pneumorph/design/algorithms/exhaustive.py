@@ -40,7 +40,8 @@ class ExhaustiveSearch(Search):
                              refinement=refinement)
 
 
-def _refinement(problem: Problem, ranking: tuple[str, ...], scores: dict[str, Any], winner: str) -> dict | None:
+def _refinement(problem: Problem, ranking: tuple[str, ...], scores: dict[str, Any],
+                winner: str) -> dict[str, Any] | None:
     """With ``[design] refine``: the best designs (one batch of the workers, at least
     :data:`~pneumorph.design.certified.refine.REFINE_TOP`) solved again on the finer mesh, as the certified search
     refines its verified ones; None without it."""
