@@ -130,3 +130,21 @@ def test_a_refinement_whose_library_units_no_longer_join_is_refused_before_any_s
     assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
     assert "'--refine'" in err and "cannot be joined" in err
     assert not out.exists() and solves == []
+
+
+def test_the_units_element_size_reaches_the_chain_tables_solves_and_a_refinement_stops_the_fall_back(
+        solves: list[tuple[float, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A unit of 1.25 mm elements has no shipped table: the table's build solves at 1.25 mm; the stand-in's units
+    interact further than any window, so the run would fall back to the GA, which a refinement stops in one line
+    (the build's solves stay in the evaluation cache for the run without it)."""
+    unit = tmp_path / "unit.toml"
+    unit.write_text("[unit]\nelement_size = 1.25\n")
+    out = tmp_path / "never"
+    code = main(["design", "--model", "2d", "--unit", str(unit), "--refine", "1.0", "--tolerance", "0",
+                 "--executor", "serial", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error: --refine 1: the chain model does not reproduce this model") and "not started" in last
+    assert solves and {h for h, _ in solves} == {1.25}
+    assert not out.exists()
