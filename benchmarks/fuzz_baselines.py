@@ -14,6 +14,12 @@ spoil the output path.
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
+#: the checkout these benchmarks live in: a case runs its ``src``, whatever the working folder or installed copy
+ROOT = Path(__file__).resolve().parents[1]
+
 #: a unit of the built-in cross-section, meshed coarsely: a 2D solve of a few units takes seconds
 UNIT = "[unit]\nelement_size = 3.0\n"
 #: the design run of ``design run.toml`` and ``study run.toml``: the exhaustive search of 3 units in 2D
@@ -97,3 +103,14 @@ def spoil(argv: list[str], option: str, value: str) -> list[str]:
         i = argv.index(given)
         return [*argv[:i + 1], value, *argv[i + 2:]]
     return [*argv, option, value]
+
+
+def case_env(folder: Path) -> dict[str, str]:
+    """The environment a case runs in: this checkout's sources first, one thread, no display, a cache and
+    ``XDG_CACHE_HOME`` of the case's own folder, no debug tracebacks."""
+    source = os.pathsep.join([str(ROOT / "src"), *filter(None, [os.environ.get("PYTHONPATH")])])
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(folder / "xdg"),
+           "PYTHONPATH": source}
+    env.pop("PNEUMORPH_DEBUG", None)
+    env.pop("PNEUMORPH_CACHE", None)
+    return env

@@ -44,7 +44,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))  # the command tree of this checkout, as its cases run it
 sys.path.insert(0, str(ROOT / "benchmarks"))  # the baselines beside this script, also when a test loads it
-from fuzz_baselines import BASE, UNIT, spoil  # noqa: E402
+from fuzz_baselines import BASE, UNIT, case_env, spoil  # noqa: E402
 from fuzz_baselines import FILES as BASELINE_FILES  # noqa: E402
 
 TIMEOUT = 10.0  # CPU seconds of a case (interpreter start included): past it, a runaway
@@ -222,11 +222,7 @@ def run_case(case: Case, python: str = sys.executable) -> Outcome:
         _prepare(folder, bulk=case.value.endswith("bulk.csv"))
         (folder / "launch.py").write_text(LAUNCHER, encoding="utf-8")
         before = _listing(folder)
-        source = os.pathsep.join([str(ROOT / "src"), *filter(None, [os.environ.get("PYTHONPATH")])])
-        env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(folder / "xdg"),
-               "PYTHONPATH": source}  # the checkout this script is in, whatever the working folder
-        env.pop("PNEUMORPH_DEBUG", None)
-        env.pop("PNEUMORPH_CACHE", None)
+        env = case_env(folder)
         t0 = time.perf_counter()
         with open(folder / "err", "wb") as err, open(os.devnull, "wb") as out:
             child = subprocess.Popen([python, "launch.py", *case.argv], cwd=folder, env=env, stdout=out, stderr=err,

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import random
 import shutil
 import struct
@@ -41,7 +40,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))  # the baselines beside this script, also when a test loads it
 from fuzz_baselines import BASE as BASELINES  # noqa: E402
-from fuzz_baselines import REPEATABLE, RUN_TOML, UNIT  # noqa: E402
+from fuzz_baselines import REPEATABLE, RUN_TOML, UNIT, case_env  # noqa: E402
 
 TIMEOUT = 120.0
 
@@ -347,10 +346,7 @@ def run_case(case: Case, python: str = sys.executable) -> Outcome:
         (folder / "proc-link").symlink_to("/proc")
         (folder / "launch.py").write_text(LAUNCHER, encoding="utf-8")
         before = _listing(folder)
-        env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg", "XDG_CACHE_HOME": str(folder / "xdg"),
-               "PYTHONHASHSEED": "0"}
-        env.pop("PNEUMORPH_DEBUG", None)
-        env.pop("PNEUMORPH_CACHE", None)
+        env = {**case_env(folder), "PYTHONHASHSEED": "0"}
         t0 = time.perf_counter()
         try:
             done = subprocess.run([python, "launch.py", *case.argv], cwd=folder, env=env, capture_output=True,

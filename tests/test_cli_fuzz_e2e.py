@@ -38,6 +38,12 @@ FOUND: list[object] = [
     # run had started (config.toml left), naming an API argument; it now solves every design
     _C("design-config", "config", "gravity across", _BASE["design-config"],
        {"run.toml": _TOML.replace("[model]\n", "[model]\ngravity = [0, -9810]\n")}, "run"),
+    # a scan of 1e300 mm coordinates: refused, but with an overflow's RuntimeWarning on stderr beside the line
+    *(_C(command, "scan", "1e300", _BASE[command], {"trace.csv": "x,y\n" + "1e300,1e300\n" * 50}, "refuse")
+      for command in ("correlate", "identify")),
+    # a scan spread over 1e305 mm: an overflow's warning and a scan that "spans inf mm"
+    _C("correlate", "scan", "1e305 spread", _BASE["correlate"],
+       {"trace.csv": "x,y\n" + "".join(f"{i * 1e305:g},{(i % 7) * 1e305:g}\n" for i in range(60))}, "refuse"),
 ]
 
 

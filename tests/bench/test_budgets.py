@@ -14,7 +14,7 @@ pytest.importorskip("fastapi")
 from fastapi.testclient import TestClient
 
 from pneumorph.bench import create_app
-from pneumorph.bench.answer import QUERY_MEMORY, QUERY_NODES
+from pneumorph.bench.answer import QUERY_MEMORY, QUERY_NODES, QUERY_PREFIX_BYTES
 from pneumorph.bench.app import SLOW_QUEUE
 
 BASE = "http://127.0.0.1:8000"
@@ -83,6 +83,19 @@ def test_the_workers_split_into_plain_and_slow_ones() -> None:
 
     pool = AnswerPool(Bench(), workers=2)
     assert pool.workers == 2 and QUERY_NODES == QUERY_MEMORY // 16_000 == 46_875
+
+
+def test_a_query_prefix_holds_the_search_s_children_and_levels() -> None:
+    """A bench query's open prefix in space (the spatial library: 2 unit types, 2 orientations each; 10 levels)
+    holds at least what the certified search measured per child and level in space."""
+    from pneumorph.design.certified.branching import prefix_bytes
+    from pneumorph.models import make_model
+
+    model = make_model(15, {"fidelity": "3d", "library": "spatial"})
+    children, levels = 2 * len(model.library.units), len(model.pressures())
+    assert (children, levels) == (4, 10)
+    assert prefix_bytes(space=True) * children * levels <= QUERY_PREFIX_BYTES < 1.5 * 12_500
+    assert QUERY_NODES * QUERY_PREFIX_BYTES <= QUERY_MEMORY
 
 
 # The peak is this process's own VmHWM, not ru_maxrss: Linux keeps ru_maxrss across exec, so a child forked from a

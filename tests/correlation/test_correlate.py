@@ -102,6 +102,34 @@ def test_scans_of_the_wrong_size_or_no_scan_at_all_are_refused(tmp_path: Path, s
         read_scan(few)
 
 
+def test_scans_past_a_kilometre_are_refused_in_one_line_without_a_warning(tmp_path: Path) -> None:
+    """Coordinates of 1e300 mm overflowed when squared for the spread (a RuntimeWarning beside the refusal);
+    spread ones of 1e305 mm reached the length check as a scan spanning "inf mm", with another warning."""
+    import warnings
+
+    from pneumorph.correlation.scans import MAX_SCAN_MM
+
+    same = tmp_path / "same.csv"
+    same.write_text("x,y\n" + "1e300,1e300\n" * 50, encoding="utf-8")
+    spread = tmp_path / "spread.csv"
+    spread.write_text("x,y\n" + "".join(f"{i * 1e305:g},{(i % 7) * 1e305:g}\n" for i in range(60)),
+                      encoding="utf-8")
+    metres = tmp_path / "metres.csv"  # 1.18 m across in metres: 1,180 mm; times 1e3 more: 1.18e6 mm, past the limit
+    metres.write_text("x,y\n" + "".join(f"{i * 0.02:g},{(i % 7) * 0.01:g}\n" for i in range(60)), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ScanError, match=r"a coordinate of 1e\+300 mm, and a scan lies within 1e\+06 mm"):
+            read_scan(same)
+        with pytest.raises(ScanError, match=r"a coordinate of 5\.9e\+306 mm"):
+            read_scan(spread)
+        with pytest.raises(ScanError, match=r"a coordinate of inf mm"):
+            read_scan(spread, scale=1e6)
+        assert read_scan(metres, unit="m").points.max() == pytest.approx(1180.0)
+        with pytest.raises(ScanError, match=r"1\.18e\+06 mm"):
+            read_scan(metres, scale=1e6)
+    assert MAX_SCAN_MM == 1e6
+
+
 def test_a_mesh_scan_round_trips_through_stl(tmp_path: Path, shape3d) -> None:  # type: ignore[no-untyped-def]
     import trimesh
 

@@ -42,13 +42,15 @@ from pneumorph.models.factory import make_model
 #: memory a query's branch-and-bound in space may hold (bytes): within the 1.5 GB a bench worker may use, with
 #: the worker's own ~0.2 GB (Python, the models and tables) and room to spare
 QUERY_MEMORY = 750 * 10**6
-#: memory one open prefix of the branch-and-bound in space costs (bytes): 12.9 kB measured (the spatial
-#: library's 15 units, 10 levels: peak resident memory 809 MB over 50,000 open prefixes, 309 MB over 10,000,
-#: BENCHMARKS.md), rounded up
-PREFIX_BYTES = 16_000
+#: memory one open prefix of a bench query in space holds, all its children and levels together (bytes; not the
+#: certified search's per child and level, :data:`~pneumorph.design.certified.branching.SPACE_PREFIX_BYTES`): the
+#: spatial library's 15 units, 4 children a prefix, 10 levels, peak resident memory 309 MB over 10,000 open
+#: prefixes and 809 MB over 50,000 (BENCHMARKS.md, "Slow queries under a budget"), 12.5 kB a prefix, as the
+#: search's 310 bytes x 4 children x 10 levels (12.4 kB); rounded up to 16 kB
+QUERY_PREFIX_BYTES = 16_000
 #: the open prefixes a query of a chain in space keeps (46,875): more stay open, the best are kept and the
 #: certificate says how much better an unlisted design could be; the default (500,000) held 6 GB
-QUERY_NODES = QUERY_MEMORY // PREFIX_BYTES
+QUERY_NODES = QUERY_MEMORY // QUERY_PREFIX_BYTES
 BUILTIN = "builtin"
 LIBRARIES = {"spatial": "spatial library: a, l (sideways)"}
 """The built-in unit libraries the bench serves, by id (their shipped 3D tables), and their names."""

@@ -210,11 +210,21 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any
     nominal = None if identified is None else config.with_options(design, ga=ga, model=options)
     config = config.with_options(design, ga=ga, model=options, model_file=identified)
     fidelity_given = "fidelity" in config.model
-    config, fallback = config.searchable()
+    config, fallback = _searchable(config, o.refine)
     if nominal is not None:  # the nominal model at the fidelity and pressure of the run's
         nominal = nominal.with_options({}, model={"fidelity": config.fidelity,
                                                   "pressure_kpa": config.model.get("pressure_kpa")})
     return config.with_options({}, model=config.model_settings()), fallback, fidelity_given, nominal
+
+
+def _searchable(config: Any, refine: float | None) -> tuple[Any, str | None]:
+    """:meth:`DesignConfig.searchable`, refusing a refinement the genetic algorithm it falls back to would drop."""
+    searched, fallback = config.searchable()
+    if fallback is not None and config.refine:
+        raise click.UsageError(f"{'--refine' if refine is not None else '[design] refine'} {config.refine:g}: "
+                               f"{fallback.split(': falling back')[0]}, and the genetic algorithm it falls back to "
+                               "does not refine its designs; leave the refinement out")
+    return searched, fallback
 
 
 def _warn_unidentified(path: str) -> None:
@@ -289,6 +299,13 @@ def _run_with(config: Any, model: Any, o: Any, fidelity_given: bool, lines: Any)
 
             raise MissingTableError(f"--no-build: {exc}; the fall-back to the genetic algorithm on the FE model "
                                     "is not started (run without --no-build to start it)") from None
+        if config.refine:  # the GA does not refine: its hundreds of solves are not started without it
+            from pneumorph.errors import SearchConfigError
+
+            raise SearchConfigError(f"{'--refine' if o.refine is not None else '[design] refine'} "
+                                    f"{config.refine:g}: {exc}; the fall-back to the genetic algorithm on the FE "
+                                    "model does not refine its designs and is not started (run without the "
+                                    "refinement to start it)") from None
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
     config = config.fallback(fidelity_given)
     model = config.make_model()

@@ -25,6 +25,9 @@ FloatArray = NDArray[np.float64]
 SCAN_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
 MESH_SUFFIXES = (".stl", ".ply", ".obj", ".off", ".xyz")
 MIN_POINTS = 10
+#: Largest coordinate of a scan, mm, after its unit or scale: a kilometre, beyond any scanner's frame; far beyond
+#: it the alignment's squares and the scan's extent pass the range of a number
+MAX_SCAN_MM = 1e6
 #: most points of a scan: the alignment (ICP from several starts, a nearest-neighbour query of every point per
 #: iteration) grows with the points, about :data:`ALIGN_SECONDS_PER_POINT` each; this many take about 30 s
 MAX_SCAN_POINTS = 500_000
@@ -139,8 +142,14 @@ def read_scan(path: str | Path, unit: str = "mm", scale: float | None = None) ->
     check_points(p, len(points))
     if not np.all(np.isfinite(points)):
         raise ScanError(f"scan {p}: some coordinates are not finite")
+    with np.errstate(over="ignore"):  # past the range of a number: inf, refused below in one line
+        scaled = points * factor
+    largest = float(np.abs(scaled).max())
+    if largest > MAX_SCAN_MM:
+        raise ScanError(f"scan {p}: a coordinate of {largest:.3g} mm, and a scan lies within {MAX_SCAN_MM:g} mm of "
+                        "its origin: check the scan's unit (--scan-unit mm, cm, m, in) or --scale")
     check_spread(p, points)
-    return Scan(points * factor, faces, str(p))
+    return Scan(scaled, faces, str(p))
 
 
 #: Least spread of a scan across its thinnest direction, relative to its widest (singular values of the centred
@@ -170,6 +179,9 @@ def check_spread(path: str | Path, points: FloatArray) -> None:
     >>> check_spread("trace.csv", np.c_[line[:, 0], np.sin(line[:, 0])])
     """
     centred = points - points.mean(axis=0)
+    size = float(np.abs(centred).max()) if centred.size else 0.0
+    if size > 0:  # the ratio is the same at any scale; coordinates near the float range would overflow squared
+        centred = centred / size
     spread = np.sqrt(np.clip(np.linalg.eigvalsh(centred.T @ centred), 0.0, None))  # ascending
     if spread[-1] > 0 and spread[0] >= MIN_SPREAD * spread[-1]:
         return

@@ -289,6 +289,8 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
     ------
     MeshLimitError
         One line: the size, its nodes and estimated memory, and what is available.
+    UnitLibraryError
+        A unit library whose units no longer join at a size (their grid lines differ).
 
     Examples
     --------
@@ -302,6 +304,8 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
     free = available_memory() if memory is None else int(memory)
     out = {}
     for h in sorted(set(float(s) for s in sizes)):
+        if getattr(model, "mixed", False):  # every unit of the library at h must still join (a UnitLibraryError)
+            refined(model, h)
         unit = replace(model.unit, element_size=h)
         try:
             estimate = check_mesh(unit, model.n_units, model.dim, getattr(model, "half", True), memory=free,

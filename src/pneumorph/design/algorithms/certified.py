@@ -21,6 +21,7 @@ from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
 from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
 from pneumorph.design.certified.branching import open_cap
 from pneumorph.design.certified.planning import SearchPlan, plan_search
+from pneumorph.design.certified.refine import REFINE_TOP, check_refine
 from pneumorph.design.certified.search import CertifiedResult, certified_search, chain_candidate
 from pneumorph.design.objectives.fitness import Score
 from pneumorph.design.runs.comparison import compare_with_reference
@@ -33,8 +34,6 @@ from pneumorph.models.response import ActuatorModel
 from pneumorph.sensitivity.robust import find_tolerance_tables, tolerance_plan_text, tolerance_tables_for
 from pneumorph.sensitivity.tolerances import Tolerance
 
-#: designs a certified run with ``refine`` verifies (and solves on the finer mesh) at least
-REFINE_TOP = 3
 #: open prefixes the branch-and-bound keeps for a table served beyond its build's tolerance (its errors prune
 #: little: the 2D table of the built-in library, 5.95 mm, held 6 GB for 20 minutes with the default 500,000),
 #: unless ``[design] max_open`` says otherwise
@@ -89,16 +88,14 @@ class CertifiedSearch(Search):
                                 "obstacles); search with --search ga or exhaustive")
         plan = plan_search(config, model, problem.table_dir, build=problem.build, workers=problem.workers)
         self.plan_, self.note = plan, plan.note
-        if plan.search == "exhaustive":
-            return ExhaustiveSearch(note=plan.note), problem
         if plan.served is not None:
             model = plan.served.model  # the FE verifications report the chain's levels
             if not problem.build and _tolerance_tables_wanted(config, model):
                 _check_tolerance_tables(config, model, problem)
-        if config.refine:
-            from pneumorph.design.certified.refine import check_refine
-
+        if config.refine:  # the exhaustive search of a short actuator refines its best designs too
             check_refine(model, config.refine, parallel=max(1, min(problem.workers, config.verify or 1024)))
+        if plan.search == "exhaustive":
+            return ExhaustiveSearch(note=plan.note), problem
         max_open(config, model)  # a cap whose open prefixes would pass the memory budget: refused before the search
         return self, replace(problem, model=model)
 
