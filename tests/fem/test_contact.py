@@ -293,3 +293,15 @@ def test_a_block_pressed_on_a_floor_has_the_contact_pressure_of_its_stress() -> 
     pressure = -r.reshape(-1, 2)[top, 1].sum() / x[top, 0].max()  # MPa: the top's reaction over the width
     assert pressure > 0.03 and sorted(report["nodes"].tolist()) == np.flatnonzero(points[:, 1] == 0.0).tolist()
     assert np.allclose(report["node_pressures"], pressure, rtol=1e-3)
+
+
+def test_penalty_of_a_gap_past_the_range_of_a_square_warns_nothing() -> None:
+    """An obstacle 1e300 mm across (a fuzzed radius) puts the nodes 1e300 mm inside or outside it: the blend's
+    square is taken only within the blend, so the refusal that follows comes without an overflow warning."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        phi, slope = penalty_gap(np.array([-1e300, -0.05, 1e300]), 0.1)
+    assert phi[[0, 2]].tolist() == [-1e300, 0.0] and slope[[0, 2]].tolist() == [1.0, 0.0]
+    assert phi[1] == pytest.approx(-(0.15**2) / 0.4, rel=1e-12) and slope[1] == pytest.approx(0.75, rel=1e-12)

@@ -85,7 +85,8 @@ def penalty_gap(gap: FloatArray, smoothing: float = 0.0) -> tuple[FloatArray, Fl
         return np.minimum(gap, 0.0), (gap < 0.0).astype(float)
     s = smoothing
     blend = np.abs(gap) < s
-    phi = np.where(gap <= -s, gap, np.where(blend, -((gap - s) ** 2) / (4 * s), 0.0))
+    d = np.where(blend, gap - s, 0.0)  # squared only in the blend (a gap past 1e154 mm would overflow)
+    phi = np.where(gap <= -s, gap, np.where(blend, -(d * d) / (4 * s), 0.0))
     slope = np.where(gap <= -s, 1.0, np.where(blend, -(gap - s) / (2 * s), 0.0))
     return phi, slope
 
