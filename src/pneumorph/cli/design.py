@@ -124,7 +124,7 @@ def design(config_file: str | None, **options: Any) -> None:
     _check_run(config, model, o)
     o.reference = nominal.make_model() if nominal is not None and config.search == "certified" else None
     if fallback:  # said once every setting has been checked
-        click.echo(fallback, err=True)
+        click.echo(f"{fallback}: falling back to the genetic algorithm", err=True)
     if o.model_file is not None:
         _warn_unidentified(o.model_file)
     result, model = _run(config, model, o, fidelity_given)
@@ -219,12 +219,16 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any
 
 def _searchable(config: Any, refine: float | None) -> tuple[Any, str | None]:
     """:meth:`DesignConfig.searchable`, refusing a refinement the genetic algorithm it falls back to would drop."""
-    searched, fallback = config.searchable()
-    if fallback is not None and config.refine:
-        raise click.UsageError(f"{'--refine' if refine is not None else '[design] refine'} {config.refine:g}: "
-                               f"{fallback.split(': falling back')[0]}, and the genetic algorithm it falls back to "
+    searched, why = config.searchable()
+    if why is not None and config.refine:
+        raise click.UsageError(f"{_refinement(refine, config)}: {why}, and the genetic algorithm it falls back to "
                                "does not refine its designs; leave the refinement out")
-    return searched, fallback
+    return searched, why
+
+
+def _refinement(option: float | None, config: Any) -> str:
+    """Where the run's refinement was asked for, with its size: ``--refine 0.75`` or ``[design] refine 0.75``."""
+    return f"{'--refine' if option is not None else '[design] refine'} {config.refine:g}"
 
 
 def _warn_unidentified(path: str) -> None:
@@ -302,10 +306,9 @@ def _run_with(config: Any, model: Any, o: Any, fidelity_given: bool, lines: Any)
         if config.refine:  # the GA does not refine: its hundreds of solves are not started without it
             from pneumorph.errors import SearchConfigError
 
-            raise SearchConfigError(f"{'--refine' if o.refine is not None else '[design] refine'} "
-                                    f"{config.refine:g}: {exc}; the fall-back to the genetic algorithm on the FE "
-                                    "model does not refine its designs and is not started (run without the "
-                                    "refinement to start it)") from None
+            raise SearchConfigError(f"{_refinement(o.refine, config)}: {exc}; the fall-back to the genetic "
+                                    "algorithm on the FE model does not refine its designs and is not started (run "
+                                    "without the refinement to start it)") from None
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
     config = config.fallback(fidelity_given)
     model = config.make_model()

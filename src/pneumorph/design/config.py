@@ -284,8 +284,9 @@ class DesignConfig:
                        refine=0.0, chain_table=None)
 
     def searchable(self) -> tuple[DesignConfig, str | None]:
-        """The settings a run can search with, and why they differ from these (None: they do not): the chain
-        model does not hold under gravity, so a certified search under gravity is the genetic algorithm's.
+        """The settings a run can search with, and why the certified search cannot run (None: it can, or was not
+        asked for): the chain model does not hold under gravity, so a certified search under gravity is the genetic
+        algorithm's.
 
         >>> DesignConfig(model={"gravity": "hanging"}).searchable()[0].search
         'ga'
@@ -293,8 +294,8 @@ class DesignConfig:
         held = "gravity" if self.model.get("gravity") not in (None, "none") else \
             "contact with [[model.obstacle]]" if self.model.get("obstacle") else None
         if self.search == "certified" and held:
-            return self.as_ga(), (f"the certified search needs a free actuator (its chain model does not hold under "
-                                  f"{held}): falling back to the genetic algorithm")
+            return self.as_ga(), ("the certified search needs a free actuator (its chain model does not hold "
+                                  f"under {held})")
         return self, None
 
     def fallback(self, fidelity_given: bool = False) -> DesignConfig:

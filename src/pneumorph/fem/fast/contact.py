@@ -87,7 +87,7 @@ def penalty_gap(gap: FloatArray, smoothing: float = 0.0) -> tuple[FloatArray, Fl
     blend = np.abs(gap) < s
     d = np.where(blend, gap - s, 0.0)  # squared only in the blend (a gap past 1e154 mm would overflow)
     phi = np.where(gap <= -s, gap, np.where(blend, -(d * d) / (4 * s), 0.0))
-    slope = np.where(gap <= -s, 1.0, np.where(blend, -(gap - s) / (2 * s), 0.0))
+    slope = np.where(gap <= -s, 1.0, np.where(blend, -d / (2 * s), 0.0))
     return phi, slope
 
 

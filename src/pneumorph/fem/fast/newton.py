@@ -364,7 +364,6 @@ class FastSubstep:
         growth = FRICTION_GROWTH if any(c.friction > 0.0 for c in contacts) else GROWTH
         fraction = contact_fraction(system, u, step[:n], self._motion)
         step = fraction * step
-        trial = 0
         for trial in range(backtracks + 1):
             if trial:
                 step = 0.5 * step
