@@ -149,3 +149,25 @@ def test_steps_cut_short_say_nothing_of_the_precision() -> None:
     assert cause is None and step.precision == "single"
     assert step.factorisations == iterations  # every short step gained less than the reuse factor: refreshed
     np.testing.assert_allclose(fields[0].values, np.linalg.solve(system.K, system.f), rtol=1e-3)
+
+
+@pytest.mark.parametrize(("reach", "taken"), [(8.0, 0.5), (14.0, 0.125)])
+def test_a_landing_step_is_kept_up_to_the_landing_growth(reach: float, taken: float) -> None:
+    """A fresh step cut to half by an obstacle's step limit (a landing: the nodes it would carry deep into an obstacle
+    end at the reach) from ``u = 0`` along ``reach K^-1 f`` lands at ``u = reach / 2 K^-1 f``, whose residual is
+    ``reach / 2 - 1`` times the start's: 3 times (within :data:`LANDING`, 3) is kept whole; 6 times is halved, to 2.5
+    times (above :data:`GROWTH`, 2), then to 0.75 times, and a quarter of the cut step is taken."""
+    from pneumorph.fem.fast.newton import GROWTH, LANDING, _FixedLoad
+    from pneumorph.fem.stepping import relative_residual
+
+    assert GROWTH < 2.5 and 3.0 <= LANDING < 6.0  # (the cases above straddle both)
+    system = LinearisedScan(10.0)
+    system.points = np.zeros((len(system.f), 1))
+    system.contacts = (ShortSteps(0.5),)
+    substep = FastSubstep(system, reuse=Full3D.tangent_reuse)
+    u = np.zeros(len(system.f))
+    previous = relative_residual(system.residual(u)[0], system.dof1, system.dof0)
+    step = reach * np.linalg.solve(system.K, system.f)
+    out = substep._trial(u, np.zeros(0), step, True, previous, _FixedLoad())
+    np.testing.assert_allclose(out[0], taken * step, rtol=1e-12)
+    assert out[6]  # cut short

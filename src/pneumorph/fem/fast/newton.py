@@ -47,6 +47,16 @@ BACKTRACKS = 5
 #: with 10, 108 and 0 with 2.
 GROWTH = 2.0
 
+#: The growth of the relative residual norm up to which a fresh tangent's step cut short by the obstacles' step limit
+#: (:func:`contact_fraction`: the nodes it would carry into an obstacle land at the reach) is kept whole instead of
+#: halved. Landed, the entering nodes touch and the next tangent holds them; halved to :data:`GROWTH`, they were carried
+#: back out, and the 15-unit 3D finger's tip crept onto a frictionless cylinder in its way over 5-6 fresh steps per
+#: level, each covering part of the distance (landings raised the residual 3.6-4.9 times): 114 Newton iterations and
+#: 58 factorisations, 107 and 51 with 3 or 5, 112 and 56 with 10. The frictionless wall took 29 factorisations
+#: against 27, the grazing cylinder 34 against 35 (``BENCHMARKS.md``, "A hard press"). With friction a fresh tangent's
+#: iterate must lower the residual norm, landed or not (:data:`FRICTION_GROWTH`): 3 cost a cylinder in the way 3 more.
+LANDING = 3.0
+
 #: :data:`GROWTH` on a body with friction on an obstacle: a fresh tangent's iterate must lower the residual norm.
 #: A node's switches between sticking and sliding, and in and out of contact, made the fresh steps of a 3-unit 3D
 #: finger on a cylinder with friction 0.5 cycle at a residual norm of 1e-2: 290 Newton iterations and 7 cut-backs
@@ -350,18 +360,20 @@ class FastSubstep:
         stride (:func:`contact_fraction`), and a fresh tangent's step whose iterate is not admissible
         (a non-finite residual, an inverted element, a residual norm above :data:`DIVERGED`, or a residual norm
         plus the border's constraint error above :data:`GROWTH` times the ``previous`` one, :data:`FRICTION_GROWTH`
-        with friction) is halved, up to :data:`BACKTRACKS` times: a contact that closes or opens within the step
-        changes the tangent the step was computed with. With a border's unknowns (a volume control) the growth
-        only counts where the step changed which nodes touch (:func:`contacts_changed`): a volume-controlled
-        substep starts from an equilibrium, at a residual norm near 0, which its first steps raise as they meet
-        the volume (halving every step in free air failed a 3-unit finger's first substep with friction).
+        with friction; without, :data:`LANDING` for the step as cut) is halved, up to :data:`BACKTRACKS` times: a
+        contact that closes or opens within the step changes the tangent the step was computed with. With a border's
+        unknowns (a volume control) the growth only counts where the step changed which nodes touch
+        (:func:`contacts_changed`): a volume-controlled substep starts from an equilibrium, at a residual norm near 0,
+        which its first steps raise as they meet the volume (halving every step in free air failed a 3-unit finger's
+        first substep with friction).
         """
         system = self.system
         dof1, dof0 = system.dof1, system.dof0
         n = len(dof1)
         contacts = getattr(system, "contacts", ())
         backtracks = BACKTRACKS if fresh and len(contacts) else 0
-        growth = FRICTION_GROWTH if any(c.friction > 0.0 for c in contacts) else GROWTH
+        frictional = any(c.friction > 0.0 for c in contacts)
+        growth, landing = (FRICTION_GROWTH, FRICTION_GROWTH) if frictional else (GROWTH, LANDING)
         fraction = contact_fraction(system, u, step[:n], self._motion)
         step = fraction * step
         for trial in range(backtracks + 1):
@@ -376,6 +388,7 @@ class FastSubstep:
                 break
             if jmin > 0.0 and fnorm <= DIVERGED and (  # (a NaN residual norm fails this too)
                     fnorm + border.error(u_new) <= growth * previous
+                    or (trial == 0 and fraction < 1.0 and fnorm + border.error(u_new) <= landing * previous)
                     or (x.size and not contacts_changed(system, u, u_new))):
                 break
         return step, u_new, x_new, r_new, jmin, fnorm, fraction < 1.0 or trial > 0
