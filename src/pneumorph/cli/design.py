@@ -61,7 +61,8 @@ def _kpa(pressure: float | None) -> float:
 @click.option("--certify", is_flag=True, default=None,
               help="Certified search: verify by FE until no design can beat the winner.")
 @click.option("--verify", type=P.Count(1, 1024),
-              help="Certified search: designs verified by FE per batch (default: one per worker).")
+              help="Certified search: designs verified by FE per batch (default: one per worker); on an actuator "
+                   "handed to the FE exhaustive search, the best designs --refine solves again.")
 @click.option("--margin", type=P.Real(0.0, 1e3, low_open=True),
               help="Certified search: factor on the chain's validated errors in the bound (default 1).")
 @click.option("--epsilon", type=P.Real(0.0, 1e3),
@@ -240,14 +241,12 @@ def _check_fallback(config: Any, o: Any, why: str) -> None:
     was given what the GA cannot honour: ``--no-build`` (stop instead of falling back) or a setting only the
     certified search reads (:meth:`DesignConfig.certified_settings`, or its option typed at its default), in one
     line naming them as given. Options and settings at their defaults, not given, are not refused."""
-    from pneumorph.design.config import CERTIFIED_ONLY
     from pneumorph.errors import MissingTableError, SearchConfigError
 
     if o.no_build:  # the fall-back is the GA on the FE model: hundreds of solves, more than any table build
         raise MissingTableError(f"--no-build: {why}; the fall-back to the genetic algorithm on the FE model is not "
                                 "started (run without --no-build to start it)")
-    away = config.certified_settings()
-    given = [key for key in CERTIFIED_ONLY if getattr(o, key) is not None or key in away]
+    given = _given_keys(config, o)
     if given:
         cannot = " and ".join(_GA_CANNOT[key] for key in given)
         raise SearchConfigError(f"{', '.join(_as_given(key, o, config) for key in given)}: {why}; the fall-back to "
@@ -258,9 +257,16 @@ def _check_fallback(config: Any, o: Any, why: str) -> None:
 def _as_given(key: str, o: Any, config: Any) -> str:
     """A setting as the run was given it, with its value: the option typed (``--refine 0.75``, ``--certify``), else
     the config file's key (``[design] refine 0.75``)."""
-    value = getattr(config, key)
-    shown = "" if isinstance(value, bool) else f" {value:g}" if isinstance(value, float) else f" {value}"
-    return (f"--{key.replace('_', '-')}" if getattr(o, key) is not None else f"[design] {key}") + shown
+    return (f"--{key.replace('_', '-')}" if getattr(o, key) is not None else f"[design] {key}") + config.value_text(key)
+
+
+def _given_keys(config: Any, o: Any) -> list[str]:
+    """The settings only the certified search reads that the run gave: away from their defaults
+    (:meth:`DesignConfig.certified_settings`) or typed as options, even at their defaults."""
+    from pneumorph.design.config import CERTIFIED_ONLY
+
+    away = config.certified_settings()
+    return [key for key in CERTIFIED_ONLY if getattr(o, key) is not None or key in away]
 
 
 def _warn_unidentified(path: str) -> None:
@@ -306,6 +312,21 @@ def _check_run(config: Any, model: Any, o: Any) -> None:
                 check_refine(model, config.refine)
         with P.blame("--max-open" if o.max_open is not None else "[design] max_open"):
             max_open(config, model)  # the memory of the open prefixes it may keep
+        _check_handover(config, model, o)
+
+
+def _check_handover(config: Any, model: Any, o: Any) -> None:
+    """Refuse, naming them as given, the certified settings that mean nothing to the FE exhaustive search a short
+    actuator is handed to (:func:`~pneumorph.design.certified.planning.check_handover`; the run checks again): its
+    plan is asked only where the run gives such a setting."""
+    from pneumorph.design.certified.planning import EXHAUSTIVE_CANNOT, check_handover, plan_search, planned_workers
+    from pneumorph.execution.cache import chain_table_dir
+
+    keys = _given_keys(config, o)
+    if any(key in EXHAUSTIVE_CANNOT for key in keys):
+        plan = plan_search(config, model, chain_table_dir(config.cache), build=not o.no_build,
+                           workers=planned_workers(config))
+        check_handover(config, plan, keys, named=lambda key: _as_given(key, o, config))
 
 
 def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, Any]:

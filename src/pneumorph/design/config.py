@@ -288,6 +288,16 @@ class DesignConfig:
         """
         return tuple(key for key, default in CERTIFIED_ONLY.items() if getattr(self, key) != default)
 
+    def value_text(self, key: str) -> str:
+        """A ``[design]`` setting's value as a message names it after its key: a space and the value (a float in
+        its shortest form), nothing for a flag.
+
+        >>> DesignConfig(refine=1.0).value_text("refine"), DesignConfig(certify=True).value_text("certify")
+        (' 1', '')
+        """
+        value = getattr(self, key)
+        return "" if isinstance(value, bool) else f" {value:g}" if isinstance(value, float) else f" {value}"
+
     def as_ga(self) -> DesignConfig:
         """The same settings searched by the GA, the certified search's own (:data:`CERTIFIED_ONLY`) set back to
         their defaults (``DesignConfig().as_ga()``)."""
