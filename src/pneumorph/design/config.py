@@ -306,7 +306,8 @@ class DesignConfig:
     def searchable(self) -> tuple[DesignConfig, str | None]:
         """The settings a run can search with, and why the certified search cannot run (None: it can, or was not
         asked for): the chain model does not hold under gravity, so a certified search under gravity is the genetic
-        algorithm's.
+        algorithm's, without the certified search's own settings (:meth:`as_ga`; ``pneumorph design`` refuses a run
+        that gives any of them, :meth:`certified_settings`).
 
         >>> DesignConfig(model={"gravity": "hanging"}).searchable()[0].search
         'ga'
