@@ -218,8 +218,8 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
 #: has no use for: it solves every design, so no chain bound is left to widen or certify within, no prefix to keep
 #: open, no batch to verify (``verify`` sets, with ``refine``, how many of its best designs the refinement solves
 #: again) and no chain to rank the designs under the tolerance
-EXHAUSTIVE_CANNOT = {"verify": "verifies no batches (it solves every design; with refine, verify sets how many "
-                               "of its best designs are refined)",
+EXHAUSTIVE_CANNOT = {"verify": "verifies no batches: it solves every design (beside a refinement, verify sets how "
+                               "many of the best are solved again)",
                      "margin": "has no chain bound to widen", "epsilon": "has no chain bound to certify within",
                      "max_open": "keeps no open prefixes", "robust": "ranks no design by the chain under the tolerance"}
 
