@@ -1,11 +1,12 @@
 """What a certified run that falls back to the genetic algorithm does with the options only the certified search reads.
 
 The genetic algorithm reads none of them (``--certify``, ``--verify``, ``--margin``, ``--epsilon``, ``--max-open``,
-``--refine``, ``--chain-table``, ``--robust``) and ``--no-build`` asks to stop instead of falling back: each given
-one is refused in one line naming it as given, exit 2, nothing written. Two paths: a model the certified search is
-known not to serve from its settings (gravity), refused before any solve; a model the chain turns out not to
-represent (a ``LocalityError`` of the plan, after a table build's solves), refused before the GA starts. Options at
-their defaults, not given, fall back as before. The FE solve is the analytical stand-in of the ``solves`` fixture.
+``--refine``, ``--chain-table``, ``--robust``), is not the ``--search certified`` typed, and ``--no-build`` asks to
+stop instead of falling back: each given one is refused in one line naming it as given, exit 2, nothing written.
+Two paths: a model the certified search is known not to serve from its settings (gravity), refused before any
+solve; a model the chain turns out not to represent (a ``LocalityError`` of the plan, after a table build's
+solves), refused before the GA starts. Options at their defaults, not given, fall back as before. The FE solve is
+the analytical stand-in of the ``solves`` fixture.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ from pneumorph.models.chain.sources import shipped_path
 GIVEN = [(["--certify"], "--certify:"), (["--verify", "2"], "--verify 2:"), (["--margin", "2"], "--margin 2:"),
          (["--margin", "1"], "--margin 1:"), (["--epsilon", "0.1"], "--epsilon 0.1:"),
          (["--max-open", "1000"], "--max-open 1000:"), (["--refine", "1.0"], "--refine 1:"),
-         (["--robust", "worst"], "--robust worst:"), (["--no-build"], "--no-build:")]
+         (["--robust", "worst"], "--robust worst:"), (["--no-build"], "--no-build:"),
+         (["--search", "certified"], "--search certified:")]
 
 
 def _hanging(tmp_path: Path, design: str = "") -> Path:

@@ -238,20 +238,24 @@ _GA_CANNOT = {"certify": "certifies no winner", "verify": "verifies no chain's b
 
 def _check_fallback(config: Any, o: Any, why: str) -> None:
     """Refuse the fall-back to the genetic algorithm of a certified run that cannot search (``why``) where the run
-    was given what the GA cannot honour: ``--no-build`` (stop instead of falling back) or a setting only the
-    certified search reads (:meth:`DesignConfig.certified_settings`, or its option typed at its default), in one
-    line naming them as given. Options and settings at their defaults, not given, are not refused."""
+    was given what the GA cannot honour: ``--no-build`` (stop instead of falling back), ``--search certified``
+    typed, or a setting only the certified search reads (:meth:`DesignConfig.certified_settings`, or its option
+    typed at its default), in one line naming them as given. Options and settings at their defaults, not given, are
+    not refused."""
     from pneumorph.errors import MissingTableError, SearchConfigError
 
     if o.no_build:  # the fall-back is the GA on the FE model: hundreds of solves, more than any table build
         raise MissingTableError(f"--no-build: {why}; the fall-back to the genetic algorithm on the FE model is not "
                                 "started (run without --no-build to start it)")
     given = _given_keys(config, o)
-    if given:
-        cannot = " and ".join(_GA_CANNOT[key] for key in given)
-        raise SearchConfigError(f"{', '.join(_as_given(key, o, config) for key in given)}: {why}; the fall-back to "
-                                f"the genetic algorithm {cannot}, and is not started (run without "
-                                f"{'it' if len(given) == 1 else 'them'} to start it)")
+    named = [_as_given(key, o, config) for key in given]
+    cannot = [_GA_CANNOT[key] for key in given]
+    if o.search == "certified":
+        named, cannot = ["--search certified", *named], ["is not the certified search", *cannot]
+    if named:
+        raise SearchConfigError(f"{', '.join(named)}: {why}; the fall-back to the genetic algorithm "
+                                f"{' and '.join(cannot)}, and is not started (run without "
+                                f"{'it' if len(named) == 1 else 'them'} to start it)")
 
 
 def _as_given(key: str, o: Any, config: Any) -> str:
