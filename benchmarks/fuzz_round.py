@@ -172,7 +172,8 @@ CONFIG_KEYS = [
 IGNORED = {
     "design": [["--objective", "max-y", "--amplitude", "5"], ["--objective", "max-y", "--periods", "2"],
                ["--workers", "2"], ["--scheduler", "tcp://x:1"],
-               ["--robust-samples", "5"], ["--point", "1", "2"], ["--verify", "2"], ["--margin", "1"]],
+               ["--robust-samples", "5"], ["--point", "1", "2"], ["--verify", "2"], ["--margin", "1"],
+               ["--no-build"]],
     "simulate": [["--library", "builtin", "--unit", "unit.toml"]],
     "sensitivity": [["--workers", "2"], ["--scheduler", "tcp://x:1"]],
     "chain": [["--workers", "3"]],

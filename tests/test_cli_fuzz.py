@@ -421,7 +421,8 @@ def test_overflowing_stress_data_is_refused(sandbox: Path, capsys: pytest.Captur
 
 
 @pytest.mark.parametrize("extra", [["--verify", "2", "--search", "ga"], ["--margin", "2", "--search", "exhaustive"],
-                                   ["--certify", "--search", "ga"], ["--max-open", "100", "--search", "ga"]])
+                                   ["--certify", "--search", "ga"], ["--max-open", "100", "--search", "ga"],
+                                   ["--no-build", "--search", "exhaustive"]])
 def test_options_of_another_search_are_refused_not_ignored(sandbox: Path, capsys: pytest.CaptureFixture[str],
                                                            extra: list[str]) -> None:
     search = extra.index("--search")

@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from pneumorph.execution import CachedEvaluator, EvaluationCache, SerialEvaluator
+from pneumorph.geometry.orientation import parse_orientation
 from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.chain.fit import build_table
 from pneumorph.models.chain.model import ChainModel, design_strings
 from pneumorph.models.fe import RampSpec, Reduced2D
+from pneumorph.models.fe.base import FEModel
+from tests.design.toy_model import ToyModel
 
 #: units of the coarse 2D actuator of :func:`coarse_2d`
 COARSE_UNITS = 6
@@ -47,3 +51,23 @@ def _keeps_every_design(every: Any, grown: Any) -> dict[str, float]:
 def keeps_every_design() -> Callable[[Any, Any], dict[str, float]]:
     """:func:`_keeps_every_design`, for tests of the branch-and-bound search."""
     return _keeps_every_design
+
+
+@pytest.fixture
+def solves(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> list[tuple[float, str]]:
+    """The (element size, design) of every FE solve of the test, each answered by an analytical stand-in
+    (:class:`tests.design.toy_model.ToyModel`, its turn grown with the element size so that two meshes differ); the
+    evaluation cache in the test's folder."""
+    seen: list[tuple[float, str]] = []
+
+    def evaluate(self: FEModel, orientation: str, on_level: object = None) -> object:
+        design = parse_orientation(orientation, self.n_units)
+        size = float(self.unit.element_size)
+        seen.append((size, design))
+        p = self.pressures()
+        toy = ToyModel(self.n_units, p_max=float(p[-1]), levels=len(p), turn=20.0 * (1.0 + 0.05 * size))
+        return toy.evaluate(design)
+
+    monkeypatch.setattr(FEModel, "evaluate", evaluate)
+    monkeypatch.setenv("PNEUMORPH_CACHE", str(tmp_path / "cache.sqlite"))
+    return seen

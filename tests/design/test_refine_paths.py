@@ -1,9 +1,9 @@
 """``design --refine`` and the unit's element size on every path of a run: the FE solves get the mesh they name.
 
-The FE solve is replaced by an analytical stand-in (:class:`tests.design.toy_model.ToyModel`, its turn grown with
-the element size so that the two meshes differ) that records the element size of every model it solves; the paths:
-the certified search with the chain, the certified search handed to the FE exhaustive search (a short actuator),
-the GA and the exhaustive search. Where a run falls back to the genetic algorithm, which does not refine, the
+The FE solve is replaced by an analytical stand-in (the ``solves`` fixture of ``tests/design/conftest.py``, its turn
+grown with the element size so that the two meshes differ) that records the element size of every model it solves;
+the paths: the certified search with the chain, the certified search handed to the FE exhaustive search (a short
+actuator), the GA and the exhaustive search. Where a run falls back to the genetic algorithm, which does not refine, the
 refinement is refused in one line, before any solve.
 """
 
@@ -15,27 +15,6 @@ from pathlib import Path
 import pytest
 
 from pneumorph.cli import main
-from pneumorph.geometry.orientation import parse_orientation
-from pneumorph.models.fe.base import FEModel
-from tests.design.toy_model import ToyModel
-
-
-@pytest.fixture
-def solves(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> list[tuple[float, str]]:
-    """The (element size, design) of every FE solve of the test, each answered by the stand-in."""
-    seen: list[tuple[float, str]] = []
-
-    def evaluate(self: FEModel, orientation: str, on_level: object = None) -> object:
-        design = parse_orientation(orientation, self.n_units)
-        size = float(self.unit.element_size)
-        seen.append((size, design))
-        p = self.pressures()
-        toy = ToyModel(self.n_units, p_max=float(p[-1]), levels=len(p), turn=20.0 * (1.0 + 0.05 * size))
-        return toy.evaluate(design)
-
-    monkeypatch.setattr(FEModel, "evaluate", evaluate)
-    monkeypatch.setenv("PNEUMORPH_CACHE", str(tmp_path / "cache.sqlite"))
-    return seen
 
 
 def _design(tmp_path: Path, capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict, str]:

@@ -1,11 +1,14 @@
 """Mesh convergence: Richardson extrapolation and the observed order (closed forms), and a real refinement."""
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
 
 from pneumorph.errors import SettingsError
+from pneumorph.geometry.library import UnitLibrary, builtin_library
+from pneumorph.geometry.unit import UnitSpec
 from pneumorph.models.fe import Full3D, Reduced2D
 from pneumorph.sensitivity.mesh import (
     SAFETY_THREE,
@@ -135,3 +138,25 @@ def test_memory_check_before_meshing() -> None:
         check_refinement(model, [1.0], parallel=2, memory=int(1.5 * peak))
     with pytest.raises(MeshLimitError, match=r"element size 0\.75 mm"):
         check_refinement(model, [1.5, 0.75], memory=int(1.01 * peak))
+
+
+@pytest.mark.parametrize(("model", "large"), [
+    (Full3D(15, library=builtin_library("spatial")), "l"),  # the sideways unit: meshed across the whole width
+    (Reduced2D(15, library=UnitLibrary(("a", "b"), (UnitSpec(), UnitSpec(pitch=31.5, name="long")))), "b")])
+def test_a_librarys_refinement_is_estimated_from_its_largest_unit_type(model: Any, large: str) -> None:
+    """An actuator of the library's largest type is a design too: its mesh, not the nominal unit's, is the cost."""
+    from dataclasses import replace
+
+    from pneumorph.geometry.limits import MeshLimitError
+    from pneumorph.geometry.meshsize import estimate_mesh
+    from pneumorph.sensitivity.mesh import check_refinement
+
+    def mesh(spec: UnitSpec) -> tuple[int, int]:
+        e = estimate_mesh(replace(spec, element_size=0.75), 15, model.dim, model.half)
+        return e.nodes, e.bytes
+
+    nominal, largest = mesh(model.unit), mesh(model.library[large])
+    assert largest[0] > 1.5 * nominal[0]
+    assert check_refinement(model, [0.75], memory=10**12) == {0.75: largest}
+    with pytest.raises(MeshLimitError, match=rf"^element size 0\.75 mm, unit type '{large}' "):
+        check_refinement(model, [0.75], memory=(nominal[1] + largest[1]) // 2)  # the nominal unit's would fit

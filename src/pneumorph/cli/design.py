@@ -61,7 +61,8 @@ def _kpa(pressure: float | None) -> float:
 @click.option("--certify", is_flag=True, default=None,
               help="Certified search: verify by FE until no design can beat the winner.")
 @click.option("--verify", type=P.Count(1, 1024),
-              help="Certified search: designs verified by FE per batch (default: one per worker).")
+              help="Certified search: designs verified by FE per batch (default: one per worker); on an actuator "
+                   "handed to the FE exhaustive search, the best designs --refine solves again.")
 @click.option("--margin", type=P.Real(0.0, 1e3, low_open=True),
               help="Certified search: factor on the chain's validated errors in the bound (default 1).")
 @click.option("--epsilon", type=P.Real(0.0, 1e3),
@@ -204,31 +205,72 @@ def _config(config_file: str | None, o: Any) -> tuple[Any, str | None, bool, Any
     # --pop/--gen also set the genetic algorithm a certified search falls back to; certified options alone
     _check_options_apply(o.search or config.search, "certified",
                          {"--certify": o.certify, "--verify": o.verify, "--margin": o.margin, "--epsilon": o.epsilon,
-                          "--max-open": o.max_open, "--refine": o.refine, "--chain-table": o.chain_table})
+                          "--max-open": o.max_open, "--refine": o.refine, "--chain-table": o.chain_table,
+                          "--no-build": o.no_build or None})
     options = {"fidelity": o.fidelity, "pressure_kpa": o.pressure, "unit_file": o.unit_file, "library": o.library}
     ga = {"population": o.population, "generations": o.generations}
     nominal = None if identified is None else config.with_options(design, ga=ga, model=options)
     config = config.with_options(design, ga=ga, model=options, model_file=identified)
     fidelity_given = "fidelity" in config.model
-    config, fallback = _searchable(config, o.refine)
+    config, fallback = _searchable(config, o)
     if nominal is not None:  # the nominal model at the fidelity and pressure of the run's
         nominal = nominal.with_options({}, model={"fidelity": config.fidelity,
                                                   "pressure_kpa": config.model.get("pressure_kpa")})
     return config.with_options({}, model=config.model_settings()), fallback, fidelity_given, nominal
 
 
-def _searchable(config: Any, refine: float | None) -> tuple[Any, str | None]:
-    """:meth:`DesignConfig.searchable`, refusing a refinement the genetic algorithm it falls back to would drop."""
+def _searchable(config: Any, o: Any) -> tuple[Any, str | None]:
+    """:meth:`DesignConfig.searchable`, refusing a fall-back to the genetic algorithm that would drop what the run
+    was given (:func:`_check_fallback`), before any solve."""
     searched, why = config.searchable()
-    if why is not None and config.refine:
-        raise click.UsageError(f"{_refinement(refine, config)}: {why}, and the genetic algorithm it falls back to "
-                               "does not refine its designs; leave the refinement out")
+    if why is not None:
+        _check_fallback(config, o, why)
     return searched, why
 
 
-def _refinement(option: float | None, config: Any) -> str:
-    """Where the run's refinement was asked for, with its size: ``--refine 0.75`` or ``[design] refine 0.75``."""
-    return f"{'--refine' if option is not None else '[design] refine'} {config.refine:g}"
+#: what the genetic algorithm a certified run falls back to does not do, per setting only the certified search reads
+#: (:data:`pneumorph.design.config.CERTIFIED_ONLY`)
+_GA_CANNOT = {"certify": "certifies no winner", "verify": "verifies no chain's best designs by FE",
+              "margin": "has no chain bound to widen", "epsilon": "has no chain bound to certify within",
+              "max_open": "keeps no open prefixes", "refine": "does not refine its designs",
+              "chain_table": "scores no design by a chain table", "robust": "ranks no design under the tolerance"}
+
+
+def _check_fallback(config: Any, o: Any, why: str) -> None:
+    """Refuse the fall-back to the genetic algorithm of a certified run that cannot search (``why``) where the run
+    was given what the GA cannot honour: ``--no-build`` (stop instead of falling back), ``--search certified``
+    typed, or a setting only the certified search reads (:meth:`DesignConfig.certified_settings`, or its option
+    typed at its default), in one line naming them as given. Options and settings at their defaults, not given, are
+    not refused."""
+    from pneumorph.errors import MissingTableError, SearchConfigError
+
+    if o.no_build:  # the fall-back is the GA on the FE model: hundreds of solves, more than any table build
+        raise MissingTableError(f"--no-build: {why}; the fall-back to the genetic algorithm on the FE model is not "
+                                "started (run without --no-build to start it)")
+    given = _given_keys(config, o)
+    named = [_as_given(key, o, config) for key in given]
+    cannot = [_GA_CANNOT[key] for key in given]
+    if o.search == "certified":
+        named, cannot = ["--search certified", *named], ["is not the certified search", *cannot]
+    if named:
+        raise SearchConfigError(f"{', '.join(named)}: {why}; the fall-back to the genetic algorithm "
+                                f"{' and '.join(cannot)}, and is not started (run without "
+                                f"{'it' if len(named) == 1 else 'them'} to start it)")
+
+
+def _as_given(key: str, o: Any, config: Any) -> str:
+    """A setting as the run was given it, with its value: the option typed (``--refine 0.75``, ``--certify``), else
+    the config file's key (``[design] refine 0.75``)."""
+    return (f"--{key.replace('_', '-')}" if getattr(o, key) is not None else f"[design] {key}") + config.value_text(key)
+
+
+def _given_keys(config: Any, o: Any) -> list[str]:
+    """The settings only the certified search reads that the run gave: away from their defaults
+    (:meth:`DesignConfig.certified_settings`) or typed as options, even at their defaults."""
+    from pneumorph.design.config import CERTIFIED_ONLY
+
+    away = config.certified_settings()
+    return [key for key in CERTIFIED_ONLY if getattr(o, key) is not None or key in away]
 
 
 def _warn_unidentified(path: str) -> None:
@@ -274,6 +316,21 @@ def _check_run(config: Any, model: Any, o: Any) -> None:
                 check_refine(model, config.refine)
         with P.blame("--max-open" if o.max_open is not None else "[design] max_open"):
             max_open(config, model)  # the memory of the open prefixes it may keep
+        _check_handover(config, model, o)
+
+
+def _check_handover(config: Any, model: Any, o: Any) -> None:
+    """Refuse, naming them as given, the certified settings that mean nothing to the FE exhaustive search a short
+    actuator is handed to (:func:`~pneumorph.design.certified.planning.check_handover`; the run checks again): its
+    plan is asked only where the run gives such a setting."""
+    from pneumorph.design.certified.planning import EXHAUSTIVE_CANNOT, check_handover, plan_search, planned_workers
+    from pneumorph.execution.cache import chain_table_dir
+
+    keys = _given_keys(config, o)
+    if any(key in EXHAUSTIVE_CANNOT for key in keys):
+        plan = plan_search(config, model, chain_table_dir(config.cache), build=not o.no_build,
+                           workers=planned_workers(config))
+        check_handover(config, plan, keys, named=lambda key: _as_given(key, o, config))
 
 
 def _run(config: Any, model: Any, o: Any, fidelity_given: bool) -> tuple[Any, Any]:
@@ -298,17 +355,7 @@ def _run_with(config: Any, model: Any, o: Any, fidelity_given: bool, lines: Any)
     except LocalityError as exc:
         if config.search != "certified":
             raise
-        if o.no_build:  # the fall-back is the GA on the FE model: hundreds of solves, more than any table build
-            from pneumorph.errors import MissingTableError
-
-            raise MissingTableError(f"--no-build: {exc}; the fall-back to the genetic algorithm on the FE model "
-                                    "is not started (run without --no-build to start it)") from None
-        if config.refine:  # the GA does not refine: its hundreds of solves are not started without it
-            from pneumorph.errors import SearchConfigError
-
-            raise SearchConfigError(f"{_refinement(o.refine, config)}: {exc}; the fall-back to the genetic "
-                                    "algorithm on the FE model does not refine its designs and is not started (run "
-                                    "without the refinement to start it)") from None
+        _check_fallback(config, o, str(exc))  # after the chain table's solves, which stay in the evaluation cache
         click.echo(f"{exc}; falling back to the genetic algorithm", err=True)
     config = config.fallback(fidelity_given)
     model = config.make_model()

@@ -58,6 +58,10 @@ SEARCHES = ("certified", "ga", "exhaustive")
 UNIT_SOURCES = frozenset({"unit", "unit_file", "library"})
 #: what ``robust`` ranks designs by (pneumorph.sensitivity.robust.STATISTICS)
 ROBUST = ("worst", "mean")
+#: the settings only the certified search reads, at their defaults: the genetic algorithm and the FE exhaustive search
+#: read none of them (:meth:`DesignConfig.as_ga` sets them back to these)
+CERTIFIED_ONLY: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "max_open": None,
+                                  "refine": 0.0, "chain_table": None, "robust": None}
 
 @dataclass(frozen=True)
 class DesignConfig:
@@ -137,10 +141,7 @@ class DesignConfig:
                 raise SearchConfigError("[design] robust ranks every design by the chain model under the mould "
                                         "tolerance: it needs search = \"certified\" and a tolerance > 0")
         if self.search != "certified":
-            given = [k for k, v in (("certify", self.certify), ("verify", self.verify),
-                                    ("chain_table", self.chain_table), ("margin", self.margin != 1.0),
-                                    ("epsilon", self.epsilon != 0.0), ("max_open", self.max_open is not None),
-                                    ("refine", self.refine != 0.0)) if v]
+            given = self.certified_settings()
             if given:
                 raise SearchConfigError(f"[design] {', '.join(given)} only appl{'y' if len(given) > 1 else 'ies'} "
                                         f"to the certified search, not to search = {self.search!r}; leave them out "
@@ -278,15 +279,35 @@ class DesignConfig:
                           **{k: v for k, v in design.items() if v is not None})
         return DesignConfig.from_dict(changed.to_dict())
 
+    def certified_settings(self) -> tuple[str, ...]:
+        """The settings only the certified search reads (:data:`CERTIFIED_ONLY`) that these settings give away from
+        their defaults, in that order.
+
+        >>> DesignConfig(refine=1.0, verify=2, margin=1.0).certified_settings()
+        ('verify', 'refine')
+        """
+        return tuple(key for key, default in CERTIFIED_ONLY.items() if getattr(self, key) != default)
+
+    def value_text(self, key: str) -> str:
+        """A ``[design]`` setting's value as a message names it after its key: a space and the value (a float in
+        its shortest form), nothing for a flag.
+
+        >>> DesignConfig(refine=1.0).value_text("refine"), DesignConfig(certify=True).value_text("certify")
+        (' 1', '')
+        """
+        value = getattr(self, key)
+        return "" if isinstance(value, bool) else f" {value:g}" if isinstance(value, float) else f" {value}"
+
     def as_ga(self) -> DesignConfig:
-        """The same settings searched by the GA, the certified search's own dropped (``DesignConfig().as_ga()``)."""
-        return replace(self, search="ga", certify=False, verify=None, margin=1.0, epsilon=0.0, max_open=None,
-                       refine=0.0, chain_table=None)
+        """The same settings searched by the GA, the certified search's own (:data:`CERTIFIED_ONLY`) set back to
+        their defaults (``DesignConfig().as_ga()``)."""
+        return replace(self, search="ga", **CERTIFIED_ONLY)
 
     def searchable(self) -> tuple[DesignConfig, str | None]:
         """The settings a run can search with, and why the certified search cannot run (None: it can, or was not
         asked for): the chain model does not hold under gravity, so a certified search under gravity is the genetic
-        algorithm's.
+        algorithm's, without the certified search's own settings (:meth:`as_ga`; ``pneumorph design`` refuses a run
+        that gives any of them, :meth:`certified_settings`).
 
         >>> DesignConfig(model={"gravity": "hanging"}).searchable()[0].search
         'ga'

@@ -278,7 +278,9 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
 
     The mesh is counted from the unit's grid, cavities included (an upper bound;
     :func:`pneumorph.geometry.meshsize.check_mesh`): 6.9 GB estimated for the 15-unit actuator
-    at 1.0 mm, which peaked at 6.0 GB. ``parallel`` solves run at once (the workers).
+    at 1.0 mm, which peaked at 6.0 GB. Over a unit library, of an actuator of its largest unit type
+    (a design may be all of it: a sideways unit meshed across the whole width, a longer pitch); with
+    the model's base block. ``parallel`` solves run at once (the workers).
 
     Returns
     -------
@@ -297,22 +299,32 @@ def check_refinement(model: Any, sizes: Iterable[float], parallel: int = 1,
     >>> from pneumorph.models.fe import Full3D
     >>> check_refinement(Full3D(15), [1.0], memory=8 * 10**9)
     {1.0: (91322, 6894416781)}
+    >>> from pneumorph.geometry.library import builtin_library
+    >>> spatial = Full3D(15, library=builtin_library("spatial"))  # its sideways unit 'l': the whole width
+    >>> check_refinement(spatial, [0.75], memory=10**12)
+    {0.75: (292933, 32055697783)}
     """
     from pneumorph.geometry.limits import MeshLimitError
     from pneumorph.geometry.meshsize import available_memory, check_mesh
 
     free = available_memory() if memory is None else int(memory)
     out = {}
+    mixed = bool(getattr(model, "mixed", False))
+    types = list(zip(model.library.symbols, model.library.units, strict=True)) if mixed else [("", model.unit)]
     for h in sorted(set(float(s) for s in sizes)):
-        if getattr(model, "mixed", False):  # every unit of the library at h must still join (a UnitLibraryError)
+        if mixed:  # every unit of the library at h must still join (a UnitLibraryError)
             refined(model, h)
-        unit = replace(model.unit, element_size=h)
-        try:
-            estimate = check_mesh(unit, model.n_units, model.dim, getattr(model, "half", True), memory=free,
-                                  parallel=parallel, advice="choose a larger element size")
-        except MeshLimitError as exc:
-            raise MeshLimitError(f"element size {h:g} mm: {exc}") from None
-        out[h] = (estimate.nodes, estimate.bytes)
+        largest = (0, 0)
+        for symbol, spec in types:
+            try:
+                estimate = check_mesh(replace(spec, element_size=h), model.n_units, model.dim,
+                                      getattr(model, "half", True), memory=free, parallel=parallel,
+                                      advice="choose a larger element size", base=getattr(model, "base_block", None))
+            except MeshLimitError as exc:
+                which = f", unit type '{symbol}' ({spec.name})" if mixed else ""
+                raise MeshLimitError(f"element size {h:g} mm{which}: {exc}") from None
+            largest = max(largest, (estimate.nodes, estimate.bytes))
+        out[h] = largest
     return out
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from pneumorph.design.algorithms.exhaustive import ExhaustiveSearch
 from pneumorph.design.algorithms.problem import Algorithm, Problem, Search, SearchOutcome
 from pneumorph.design.certified.branching import open_cap
-from pneumorph.design.certified.planning import SearchPlan, plan_search
+from pneumorph.design.certified.planning import SearchPlan, check_handover, plan_search
 from pneumorph.design.certified.refine import REFINE_TOP, check_refine
 from pneumorph.design.certified.search import CertifiedResult, certified_search, chain_candidate
 from pneumorph.design.objectives.fitness import Score
@@ -95,6 +95,7 @@ class CertifiedSearch(Search):
         if config.refine:  # the exhaustive search of a short actuator refines its best designs too
             check_refine(model, config.refine, parallel=max(1, min(problem.workers, config.verify or 1024)))
         if plan.search == "exhaustive":
+            check_handover(config, plan)  # what it has no use for, refused before any solve
             return ExhaustiveSearch(note=plan.note), problem
         max_open(config, model)  # a cap whose open prefixes would pass the memory budget: refused before the search
         return self, replace(problem, model=model)

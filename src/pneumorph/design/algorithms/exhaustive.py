@@ -42,13 +42,13 @@ class ExhaustiveSearch(Search):
 
 def _refinement(problem: Problem, ranking: tuple[str, ...], scores: dict[str, Any],
                 winner: str) -> dict[str, Any] | None:
-    """With ``[design] refine``: the best designs (one batch of the workers, at least
-    :data:`~pneumorph.design.certified.refine.REFINE_TOP`) solved again on the finer mesh, as the certified search
-    refines its verified ones; None without it."""
+    """With ``[design] refine``: the best designs (``[design] verify`` of them, else one batch of the workers, at
+    least :data:`~pneumorph.design.certified.refine.REFINE_TOP`) solved again on the finer mesh, as the certified
+    search refines its verified ones; None without it."""
     size = getattr(problem.config, "refine", 0.0)
     if not size:
         return None
     values = {d: scores[d].value for d in ranking if not scores[d].failed}
-    top = list(values)[:max(problem.workers, REFINE_TOP)]
+    top = list(values)[:max(getattr(problem.config, "verify", None) or problem.workers, REFINE_TOP)]
     return refine_verified(problem.model, problem.objective, top, {d: values[d] for d in top}, winner, size,
                            problem.evaluator, say=problem.say)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import os
 import shlex
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -211,6 +212,53 @@ def plan_search(config: Any, model: Any, table_dir: str | Path | None, build: bo
         raise MissingTableError(missing_table_message(config, model, table_dir, workers))
     return SearchPlan("certified", build=True,
                       note="certified search with a chain table built first (its plan follows)")
+
+
+#: what the FE exhaustive search a short actuator is handed to does not do, per setting of the certified search it
+#: has no use for: it solves every design, so no chain bound is left to widen or certify within, no prefix to keep
+#: open, no batch to verify (``verify`` sets, with ``refine``, how many of its best designs the refinement solves
+#: again) and no chain to rank the designs under the tolerance
+EXHAUSTIVE_CANNOT = {"verify": "verifies no batches: it solves every design (beside a refinement, verify sets how "
+                               "many of the best are solved again)",
+                     "margin": "has no chain bound to widen", "epsilon": "has no chain bound to certify within",
+                     "max_open": "keeps no open prefixes", "robust": "ranks no design by the chain under the tolerance"}
+
+
+def check_handover(config: Any, plan: SearchPlan, keys: Sequence[str] | None = None,
+                   named: Callable[[str], str] | None = None) -> None:
+    """Refuse the settings of a certified run handed to the FE exhaustive search (a short actuator) that mean nothing
+    there (:data:`EXHAUSTIVE_CANNOT`), before any solve.
+
+    ``keys`` are the run's certified settings (default
+    :meth:`~pneumorph.design.config.DesignConfig.certified_settings`); ``named`` says a key as the run was given it
+    (default ``[design] key value``). ``certify`` (every design is solved: none can beat the winner), ``refine`` and
+    ``chain_table`` (refused earlier where its window is too wide) pass, as ``verify`` does with ``refine``.
+
+    Raises
+    ------
+    SearchConfigError
+        One line naming the settings and what the exhaustive search does not do.
+
+    Examples
+    --------
+    >>> from pneumorph.design.config import DesignConfig
+    >>> plan = SearchPlan("exhaustive", note="FE exhaustive search over all 8 designs instead of the certified "
+    ...                   "search: the reason; 5 FE solves")
+    >>> check_handover(DesignConfig(units=3, margin=2.0), plan)
+    Traceback (most recent call last):
+    ...
+    pneumorph.errors.SearchConfigError: [design] margin 2: FE exhaustive search over all 8 designs instead of the
+    certified search, which has no chain bound to widen; leave it out
+    >>> check_handover(DesignConfig(units=3, verify=4, refine=1.0), plan)  # refines the best 4
+    """
+    given = config.certified_settings() if keys is None else keys
+    unused = [k for k in given if k in EXHAUSTIVE_CANNOT and not (k == "verify" and config.refine)]
+    if plan.search != "exhaustive" or not unused:
+        return
+    say = named or (lambda key: f"[design] {key}{config.value_text(key)}")
+    raise SearchConfigError(f"{', '.join(say(k) for k in unused)}: {plan.note.split(':')[0]}, which "
+                            f"{' and '.join(EXHAUSTIVE_CANNOT[k] for k in unused)}; leave "
+                            f"{'it' if len(unused) == 1 else 'them'} out")
 
 
 def missing_table_message(config: Any, model: Any, table_dir: str | Path | None, workers: int = 1) -> str:
