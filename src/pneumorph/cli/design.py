@@ -228,20 +228,13 @@ def _searchable(config: Any, o: Any) -> tuple[Any, str | None]:
     return searched, why
 
 
-#: what the genetic algorithm a certified run falls back to does not do, per setting only the certified search reads
-#: (:data:`pneumorph.design.config.CERTIFIED_ONLY`)
-_GA_CANNOT = {"certify": "certifies no winner", "verify": "verifies no chain's best designs by FE",
-              "margin": "has no chain bound to widen", "epsilon": "has no chain bound to certify within",
-              "max_open": "keeps no open prefixes", "refine": "does not refine its designs",
-              "chain_table": "scores no design by a chain table", "robust": "ranks no design under the tolerance"}
-
-
 def _check_fallback(config: Any, o: Any, why: str) -> None:
     """Refuse the fall-back to the genetic algorithm of a certified run that cannot search (``why``) where the run
     was given what the GA cannot honour: ``--no-build`` (stop instead of falling back), ``--search certified``
     typed, or a setting only the certified search reads (:meth:`DesignConfig.certified_settings`, or its option
     typed at its default), in one line naming them as given. Options and settings at their defaults, not given, are
     not refused."""
+    from pneumorph.design.config import GA_CANNOT
     from pneumorph.errors import MissingTableError, SearchConfigError
 
     if o.no_build:  # the fall-back is the GA on the FE model: hundreds of solves, more than any table build
@@ -249,7 +242,7 @@ def _check_fallback(config: Any, o: Any, why: str) -> None:
                                 "started (run without --no-build to start it)")
     given = _given_keys(config, o)
     named = [_as_given(key, o, config) for key in given]
-    cannot = [_GA_CANNOT[key] for key in given]
+    cannot = [GA_CANNOT[key] for key in given]
     if o.search == "certified":
         named, cannot = ["--search certified", *named], ["is not the certified search", *cannot]
     if named:

@@ -62,6 +62,13 @@ ROBUST = ("worst", "mean")
 #: read none of them (:meth:`DesignConfig.as_ga` sets them back to these)
 CERTIFIED_ONLY: dict[str, Any] = {"certify": False, "verify": None, "margin": 1.0, "epsilon": 0.0, "max_open": None,
                                   "refine": 0.0, "chain_table": None, "robust": None}
+#: what the genetic algorithm a certified run falls back to does not do, per setting of :data:`CERTIFIED_ONLY`
+#: (``pneumorph design`` names it when it refuses such a setting)
+GA_CANNOT = {"certify": "certifies no winner", "verify": "verifies no chain's best designs by FE",
+             "margin": "has no chain bound to widen", "epsilon": "has no chain bound to certify within",
+             "max_open": "keeps no open prefixes", "refine": "does not refine its designs",
+             "chain_table": "scores no design by a chain table", "robust": "ranks no design under the tolerance"}
+
 
 @dataclass(frozen=True)
 class DesignConfig:

@@ -373,7 +373,7 @@ class FastSubstep:
         contacts = getattr(system, "contacts", ())
         backtracks = BACKTRACKS if fresh and len(contacts) else 0
         frictional = any(c.friction > 0.0 for c in contacts)
-        growth, landing = (FRICTION_GROWTH, FRICTION_GROWTH) if frictional else (GROWTH, LANDING)
+        growth = FRICTION_GROWTH if frictional else GROWTH
         fraction = contact_fraction(system, u, step[:n], self._motion)
         step = fraction * step
         for trial in range(backtracks + 1):
@@ -386,9 +386,10 @@ class FastSubstep:
             fnorm = relative_residual(r_new, dof1, dof0)
             if not backtracks:
                 break
+            landed = trial == 0 and fraction < 1.0 and not frictional  # the step as cut, frictionless: LANDING
+            limit = max(growth, LANDING) if landed else growth
             if jmin > 0.0 and fnorm <= DIVERGED and (  # (a NaN residual norm fails this too)
-                    fnorm + border.error(u_new) <= growth * previous
-                    or (trial == 0 and fraction < 1.0 and fnorm + border.error(u_new) <= landing * previous)
+                    fnorm + border.error(u_new) <= limit * previous
                     or (x.size and not contacts_changed(system, u, u_new))):
                 break
         return step, u_new, x_new, r_new, jmin, fnorm, fraction < 1.0 or trial > 0
